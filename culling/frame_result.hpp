@@ -1,0 +1,68 @@
+#pragma once
+// What one interval (CCD) or one instant (DCD) produces: contacts in welded numbering, counters and
+// stage timings — the same for every culling method so methods compare on equal terms.
+
+#include <cstdint>
+#include <vector>
+
+namespace skelcd::culling {
+
+/// Work counters of one interval; every method fills the ones it uses and leaves the rest 0.
+struct Counters {
+  std::int64_t atomic_clusters = 0;
+  std::int64_t mega_clusters = 0;
+  std::int64_t h_minus = 0;      ///< triangles in H⁻ (radial-view methods)
+  std::int64_t h_uncertain = 0;  ///< triangles in Hᵘ (radial-view methods)
+  std::int64_t bv_tests = 0;     ///< bounding-volume overlap tests
+  std::int64_t candidate_pairs = 0;  ///< candidate triangle pairs reaching the feature stage
+  std::int64_t vf_tests = 0;     ///< vertex-face elementary tests
+  std::int64_t ee_tests = 0;     ///< edge-edge elementary tests
+  std::int64_t vf_contacts = 0;
+  std::int64_t ee_contacts = 0;
+  std::int64_t tt_tests = 0;     ///< triangle-triangle DCD tests
+  std::int64_t dcd_pairs = 0;    ///< intersecting triangle pairs found by DCD
+};
+
+/// Microseconds spent per stage in one interval.
+struct StageTimes {
+  double skin_us = 0;
+  double refit_us = 0;
+  double classify_us = 0;
+  double merge_us = 0;
+  double traverse_us = 0;
+  double elementary_us = 0;
+};
+
+/// A CCD contact in welded numbering. VF: `a` is a welded vertex, `b` a triangle. EE: `a` and `b`
+/// are edges (Topology::edges rows). Pairs are canonical: sorted by (kind, a, b).
+struct CcdContact {
+  enum class Kind : std::uint8_t { vf = 0, ee = 1 };
+  Kind kind = Kind::vf;
+  std::int32_t a = -1;
+  std::int32_t b = -1;
+  double toi_lower = 1.0;
+  double toi_upper = 1.0;
+};
+
+/// A DCD finding: triangles a < b intersect.
+struct TrianglePair {
+  std::int32_t a = -1;
+  std::int32_t b = -1;
+};
+
+struct FrameResult {
+  Counters counters;
+  StageTimes times;
+  std::vector<CcdContact> contacts;     ///< sorted by (kind, a, b)
+  std::vector<TrianglePair> dcd_pairs;  ///< sorted by (a, b)
+
+  /// Empties the vectors (keeping their capacity) and zeroes counters and times.
+  void clear() {
+    counters = {};
+    times = {};
+    contacts.clear();
+    dcd_pairs.clear();
+  }
+};
+
+}  // namespace skelcd::culling

@@ -1,0 +1,30 @@
+#!/usr/bin/env bash
+# Installs the Debian packages skelcd builds and tests with, but only those that are missing.
+# Called by `make`; safe to run again. Needs root or sudo when something is missing.
+set -euo pipefail
+
+packages=(
+  build-essential cmake ninja-build pkg-config
+  libeigen3-dev libassimp-dev assimp-testmodels liburdfdom-dev
+  libhdf5-dev hdf5-tools libgtest-dev libgmock-dev libbenchmark-dev
+  libtbb-dev libgmp-dev libcli11-dev libtomlplusplus-dev
+  libplplot-dev plplot-driver-cairo
+  nlohmann-json3-dev python3-h5py
+)
+
+missing=()
+for p in "${packages[@]}"; do
+  status=$(dpkg-query -W -f='${Status}' "$p" 2>/dev/null || true)
+  [[ "$status" == "install ok installed" ]] || missing+=("$p")
+done
+[[ ${#missing[@]} -eq 0 ]] && exit 0
+
+echo "install-deps: installing ${missing[*]}" >&2
+sudo_cmd=()
+if [[ $(id -u) -ne 0 ]]; then
+  command -v sudo >/dev/null || { echo "install-deps: need root or sudo to install: ${missing[*]}" >&2; exit 1; }
+  sudo_cmd=(sudo)
+fi
+export DEBIAN_FRONTEND=noninteractive
+"${sudo_cmd[@]}" apt-get update -qq
+"${sudo_cmd[@]}" apt-get install -y -qq --no-install-recommends "${missing[@]}"

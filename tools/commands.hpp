@@ -1,0 +1,11 @@
+#pragma once
+// The `skelcd` subcommands. Each lives in its own tools/cmd_<name>.cpp and registers itself on the
+// app with add_<name>_command; main.cpp calls them in the order `skelcd --help` lists them.
+
+#include <CLI/CLI.hpp>
+
+namespace skelcd::tools {
+
+// One line per command; keep the order of DESIGN.md's command table.
+
+}  // namespace skelcd::tools

@@ -1,0 +1,30 @@
+// skelcd: self-collision detection for skeleton-driven animation. Every error reaches the user as one
+// line on stderr and a non-zero exit status.
+
+#include <cstdio>
+#include <exception>
+#include <iostream>
+
+#include <CLI/CLI.hpp>
+
+#include "skelcd_version.hpp"
+#include "tools/commands.hpp"
+
+int main(int argc, char** argv) {
+  CLI::App app{"skelcd — finds self-collisions in skeleton-driven animation", "skelcd"};
+  app.set_version_flag("--version", skelcd::kVersion);
+  app.require_subcommand(1);
+  app.fallthrough(false);
+
+  // Commands, in the order of DESIGN.md's table (one line each):
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e);
+  } catch (const std::exception& e) {
+    std::cerr << "skelcd: " << e.what() << '\n';
+    return 1;
+  }
+  return 0;
+}
