@@ -1,0 +1,92 @@
+#pragma once
+// A rigged character: mesh + skeleton (node hierarchy with bones) + skin weights + clips.
+// Importers (assimp) and generators fill it; linear blend skinning and RigMotion read it.
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+#include <Eigen/SparseCore>
+
+#include "skinning/mesh.hpp"
+
+namespace skelcd::skinning {
+
+/// A node of the transform hierarchy (assimp's aiNode): bones are nodes, and so are the
+/// non-bone nodes between them whose animation still moves the bones below.
+struct SkeletonNode {
+  std::string name;
+  std::int32_t parent = -1;           ///< index into Skeleton::nodes; parents precede children
+  Eigen::Affine3d rest_local = Eigen::Affine3d::Identity();  ///< static local transform
+};
+
+struct Bone {
+  std::string name;
+  std::int32_t node = -1;         ///< the node that moves this bone
+  std::int32_t parent = -1;       ///< nearest ancestor that is a bone, -1 for a root bone
+  /// Object space (rest mesh) → bone space at bind time (assimp's offset matrix, with the mesh
+  /// node's transform and the unit scale folded in so that rest positions are object space).
+  Eigen::Affine3d inverse_bind = Eigen::Affine3d::Identity();
+  /// The bone segment at rest, object space: head at the bone's joint, tail at its child's joint
+  /// (or extended along the bone when it has no child).
+  Eigen::Vector3d rest_head = Eigen::Vector3d::Zero();
+  Eigen::Vector3d rest_tail = Eigen::Vector3d::Zero();
+};
+
+struct Skeleton {
+  std::vector<SkeletonNode> nodes;
+  std::vector<Bone> bones;
+  /// Applied on top of every node's global transform (the file's unit scale / axis conversion),
+  /// so that posed positions are in the same object space as Mesh::rest_positions.
+  Eigen::Affine3d root_transform = Eigen::Affine3d::Identity();
+  [[nodiscard]] std::int32_t num_bones() const { return static_cast<std::int32_t>(bones.size()); }
+};
+
+/// Keyframes of one node: each of translation, rotation, scale is optional and has its own times
+/// (seconds). Between keys: lerp (translation, scale) and slerp (rotation); before the first or
+/// after the last key the end value holds. A node with no channel keeps its rest_local transform.
+struct Channel {
+  std::int32_t node = -1;
+  std::vector<double> translation_times;
+  std::vector<Eigen::Vector3d> translations;
+  std::vector<double> rotation_times;
+  std::vector<Eigen::Quaterniond> rotations;
+  std::vector<double> scale_times;
+  std::vector<Eigen::Vector3d> scales;
+};
+
+struct Clip {
+  std::string name;
+  double duration_s = 0.0;
+  std::vector<Channel> channels;
+  /// Sorted union of every channel's key times (seconds).
+  std::vector<double> key_times;
+  /// Keys per second: (#key_times - 1) / duration_s, or 0 when it cannot be told.
+  [[nodiscard]] double keys_per_s() const {
+    return (key_times.size() > 1 && duration_s > 0)
+               ? static_cast<double>(key_times.size() - 1) / duration_s
+               : 0.0;
+  }
+};
+
+/// #V × #B skin weights, rows normalised to sum 1; a vertex with no influence is rigidly attached
+/// to the mesh node's transform (empty row) — see RigMotion.
+using SkinWeights = Eigen::SparseMatrix<double, Eigen::RowMajor>;
+
+struct Rig {
+  Mesh mesh;
+  Skeleton skeleton;
+  SkinWeights weights;
+  std::vector<Clip> clips;
+  /// Where it came from (file path or generator spec), for messages and logs.
+  std::string source;
+};
+
+/// Throws InvalidInput naming rig.source when the rig is not usable: mesh invalid, weights shape
+/// or sign wrong, node parents not preceding children (cycles), channel nodes out of range,
+/// non-finite keys or transforms.
+void validate_rig(const Rig& rig);
+
+}  // namespace skelcd::skinning
