@@ -1,0 +1,341 @@
+// The HDF5 log: round trip of every field, partial logs, refusing to clobber, bad files reported by
+// name, and the h5py example of docs/log-format.md run on a real log.
+
+#include <cstdlib>
+#include <fstream>
+#include <sstream>
+#include <string>
+
+#include <gtest/gtest.h>
+
+#include "skinning/errors.hpp"
+#include "tests/support/test_support.hpp"
+#include "tools/file_hash.hpp"
+#include "tools/log/log_reader.hpp"
+#include "tools/log/log_writer.hpp"
+
+namespace {
+
+using namespace skelcd::tools;
+using skelcd::IoError;
+using Kind = skelcd::culling::CcdContact::Kind;
+
+/// Debian's interpreter, where python3-h5py is installed (a pyenv python on PATH may lack it).
+constexpr const char* kPython = "/usr/bin/python3";
+
+LogHeader sample_header() {
+  LogHeader h;
+  h.skelcd_version = "9.8.7";
+  h.command_line = "skelcd check \"model with spaces.x\" --fps 30";
+  h.input_path = "/tmp/model with spaces.x";
+  h.input_hash = "fnv1a64:0123456789abcdef";
+  h.clip = "Walk — ünïcödé";
+  h.method = "bvh";
+  h.accuracy = "conservative";
+  h.query = "both";
+  h.fps = 29.97;
+  h.min_separation = 1.5e-4;
+  h.gamma = 0.25;
+  h.theta = 1.0471975511965976;
+  h.start_time = "2026-01-31T12:34:56Z";
+  h.first_sample = 3;
+  h.last_sample = 5;
+  h.planned_rows = 5;
+  h.num_vertices = 1234;
+  h.num_triangles = 2345;
+  h.part_names = {"Body", "Hat", ""};
+  return h;
+}
+
+/// Report with every counter and time distinct so a swapped column shows.
+FrameReport sample_report(int sample, QueryKind kind, int contacts, int pairs) {
+  FrameReport r;
+  r.row.sample = sample;
+  r.row.kind = kind;
+  r.row.t0 = sample / 30.0;
+  r.row.t1 = kind == QueryKind::ccd ? (sample + 1) / 30.0 : r.row.t0;
+  auto& c = r.row.counters;
+  const std::int64_t base = 1000 * sample + (kind == QueryKind::ccd ? 500 : 0);
+  c.atomic_clusters = base + 1;
+  c.mega_clusters = base + 2;
+  c.h_minus = base + 3;
+  c.h_uncertain = base + 4;
+  c.bv_tests = base + 5;
+  c.candidate_pairs = base + 6;
+  c.vf_tests = base + 7;
+  c.ee_tests = base + 8;
+  c.vf_contacts = base + 9;
+  c.ee_contacts = base + 10;
+  c.tt_tests = base + 11;
+  c.dcd_pairs = (std::int64_t{1} << 40) + base;  // beyond 32 bits
+  auto& t = r.row.times;
+  t.skin_us = 0.5 + sample;
+  t.refit_us = 1.25 + sample;
+  t.classify_us = 2.125 + sample;
+  t.merge_us = 3.0625 + sample;
+  t.traverse_us = 4.03125 + sample;
+  t.elementary_us = 5.015625 + sample;
+  r.row.total_us = 100.5 + sample;
+  for (int i = 0; i < contacts; ++i) {
+    r.contacts.push_back(ContactRow{
+        .frame = sample,
+        .kind = i % 2 == 0 ? Kind::vf : Kind::ee,
+        .a = FeatureId{i % 3, 10 * i, static_cast<std::int8_t>(i % 2 == 0 ? -1 : i % 3)},
+        .b = FeatureId{(i + 1) % 3, 10 * i + 1, static_cast<std::int8_t>(i % 2 == 0 ? -1 : 2)},
+        .toi_lower = 0.125 * i / (contacts + 1.0),
+        .toi_upper = 0.125 * (i + 1) / (contacts + 1.0),
+    });
+  }
+  for (int i = 0; i < pairs; ++i) {
+    r.dcd_pairs.push_back(DcdPairRow{
+        .frame = sample, .a = FeatureId{0, 7 * i, -1}, .b = FeatureId{2, 7 * i + 3, -1}});
+  }
+  return r;
+}
+
+void expect_rows_equal(const FrameRow& a, const FrameRow& b) {
+  EXPECT_EQ(a.sample, b.sample);
+  EXPECT_EQ(a.t0, b.t0);
+  EXPECT_EQ(a.t1, b.t1);
+  EXPECT_EQ(a.kind, b.kind);
+  const auto& x = a.counters;
+  const auto& y = b.counters;
+  EXPECT_EQ(x.atomic_clusters, y.atomic_clusters);
+  EXPECT_EQ(x.mega_clusters, y.mega_clusters);
+  EXPECT_EQ(x.h_minus, y.h_minus);
+  EXPECT_EQ(x.h_uncertain, y.h_uncertain);
+  EXPECT_EQ(x.bv_tests, y.bv_tests);
+  EXPECT_EQ(x.candidate_pairs, y.candidate_pairs);
+  EXPECT_EQ(x.vf_tests, y.vf_tests);
+  EXPECT_EQ(x.ee_tests, y.ee_tests);
+  EXPECT_EQ(x.vf_contacts, y.vf_contacts);
+  EXPECT_EQ(x.ee_contacts, y.ee_contacts);
+  EXPECT_EQ(x.tt_tests, y.tt_tests);
+  EXPECT_EQ(x.dcd_pairs, y.dcd_pairs);
+  EXPECT_EQ(a.times.skin_us, b.times.skin_us);
+  EXPECT_EQ(a.times.refit_us, b.times.refit_us);
+  EXPECT_EQ(a.times.classify_us, b.times.classify_us);
+  EXPECT_EQ(a.times.merge_us, b.times.merge_us);
+  EXPECT_EQ(a.times.traverse_us, b.times.traverse_us);
+  EXPECT_EQ(a.times.elementary_us, b.times.elementary_us);
+  EXPECT_EQ(a.total_us, b.total_us);
+}
+
+void expect_headers_equal(const LogHeader& a, const LogHeader& b) {
+  EXPECT_EQ(a.format_version, b.format_version);
+  EXPECT_EQ(a.skelcd_version, b.skelcd_version);
+  EXPECT_EQ(a.command_line, b.command_line);
+  EXPECT_EQ(a.input_path, b.input_path);
+  EXPECT_EQ(a.input_hash, b.input_hash);
+  EXPECT_EQ(a.clip, b.clip);
+  EXPECT_EQ(a.method, b.method);
+  EXPECT_EQ(a.accuracy, b.accuracy);
+  EXPECT_EQ(a.query, b.query);
+  EXPECT_EQ(a.fps, b.fps);
+  EXPECT_EQ(a.min_separation, b.min_separation);
+  EXPECT_EQ(a.gamma, b.gamma);
+  EXPECT_EQ(a.theta, b.theta);
+  EXPECT_EQ(a.start_time, b.start_time);
+  EXPECT_EQ(a.first_sample, b.first_sample);
+  EXPECT_EQ(a.last_sample, b.last_sample);
+  EXPECT_EQ(a.planned_rows, b.planned_rows);
+  EXPECT_EQ(a.num_vertices, b.num_vertices);
+  EXPECT_EQ(a.num_triangles, b.num_triangles);
+  EXPECT_EQ(a.part_names, b.part_names);
+}
+
+std::vector<FrameReport> sample_reports() {
+  return {sample_report(3, QueryKind::dcd, 0, 2), sample_report(3, QueryKind::ccd, 5, 0),
+          sample_report(4, QueryKind::dcd, 0, 0), sample_report(4, QueryKind::ccd, 3000, 0),
+          sample_report(5, QueryKind::dcd, 0, 1500)};
+}
+
+void write_text(const std::filesystem::path& path, const std::string& text) {
+  std::ofstream(path, std::ios::binary) << text;
+}
+
+std::string read_text(const std::filesystem::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+TEST(Log, RoundTripsEveryField) {
+  const auto path = skelcd::test::temp_dir("log-roundtrip") / "run.h5";
+  const auto header = sample_header();
+  const auto reports = sample_reports();
+  {
+    LogWriter writer(path, header);
+    for (const auto& r : reports) writer.append(r);
+    EXPECT_EQ(writer.rows_written(), 5);
+    writer.finish();
+  }
+  const auto data = read_log(path);
+  expect_headers_equal(data.header, header);
+  EXPECT_TRUE(data.header.complete);
+
+  std::vector<ContactRow> contacts;
+  std::vector<DcdPairRow> pairs;
+  ASSERT_EQ(data.frames.size(), reports.size());
+  for (std::size_t i = 0; i < reports.size(); ++i) {
+    SCOPED_TRACE(i);
+    expect_rows_equal(data.frames[i], reports[i].row);
+    contacts.insert(contacts.end(), reports[i].contacts.begin(), reports[i].contacts.end());
+    pairs.insert(pairs.end(), reports[i].dcd_pairs.begin(), reports[i].dcd_pairs.end());
+  }
+  EXPECT_EQ(data.contacts, contacts);
+  EXPECT_EQ(data.dcd_pairs, pairs);
+  EXPECT_EQ(data.contacts.size(), 3005u);
+  EXPECT_EQ(data.dcd_pairs.size(), 1502u);
+
+  const auto summary_only = read_log(path, ReadLogOptions{.findings = false});
+  EXPECT_EQ(summary_only.frames.size(), 5u);
+  EXPECT_TRUE(summary_only.contacts.empty());
+}
+
+TEST(Log, OptionalParametersStayAbsent) {
+  const auto path = skelcd::test::temp_dir("log-optional") / "run.h5";
+  auto header = sample_header();
+  header.gamma.reset();
+  header.theta.reset();
+  header.part_names.clear();
+  {
+    LogWriter writer(path, header);
+    writer.finish();
+  }
+  const auto data = read_log(path);
+  EXPECT_FALSE(data.header.gamma.has_value());
+  EXPECT_FALSE(data.header.theta.has_value());
+  EXPECT_TRUE(data.header.part_names.empty());
+  EXPECT_TRUE(data.frames.empty());
+  EXPECT_TRUE(data.header.complete);
+}
+
+TEST(Log, UnfinishedLogIsReadableAndMarkedIncomplete) {
+  const auto path = skelcd::test::temp_dir("log-unfinished") / "run.h5";
+  {
+    LogWriter writer(path, sample_header());
+    writer.append(sample_report(3, QueryKind::dcd, 0, 4));
+    writer.append(sample_report(3, QueryKind::ccd, 7, 0));
+  }  // destroyed without finish(), as a run cut short by an error
+  const auto data = read_log(path);
+  EXPECT_FALSE(data.header.complete);
+  EXPECT_EQ(data.frames.size(), 2u);
+  EXPECT_EQ(data.contacts.size(), 7u);
+  EXPECT_EQ(data.dcd_pairs.size(), 4u);
+}
+
+TEST(Log, RefusesToOverwriteAFileThatIsNotALog) {
+  const auto dir = skelcd::test::temp_dir("log-clobber");
+  const auto text = dir / "notes.txt";
+  write_text(text, "precious notes\n");
+  EXPECT_THROW_MESSAGE(LogWriter(text, sample_header()), IoError, "refusing to overwrite");
+  EXPECT_EQ(read_text(text), "precious notes\n");
+  EXPECT_FALSE(is_skelcd_log(text));
+
+  // A log and an empty file may be replaced.
+  const auto log = dir / "old.h5";
+  {
+    LogWriter writer(log, sample_header());
+    writer.append(sample_report(3, QueryKind::dcd, 0, 1));
+    writer.finish();
+  }
+  EXPECT_TRUE(is_skelcd_log(log));
+  {
+    LogWriter writer(log, sample_header());
+    writer.finish();
+  }
+  EXPECT_TRUE(read_log(log).frames.empty());
+  const auto empty = dir / "empty.h5";
+  write_text(empty, "");
+  {
+    LogWriter writer(empty, sample_header());
+    writer.finish();
+  }
+  EXPECT_TRUE(is_skelcd_log(empty));
+}
+
+TEST(Log, ReaderNamesMissingAndNonHdf5Files) {
+  const auto dir = skelcd::test::temp_dir("log-bad");
+  EXPECT_THROW_MESSAGE((void)read_log(dir / "absent.h5"), IoError, "absent.h5: no such file");
+  write_text(dir / "text.h5", "this is not HDF5\n");
+  EXPECT_THROW_MESSAGE((void)read_log(dir / "text.h5"), IoError, "text.h5: not an HDF5 file");
+}
+
+TEST(Log, ReaderReportsTruncatedAndDamagedLogsByName) {
+  const auto dir = skelcd::test::temp_dir("log-corrupt");
+  const auto good = dir / "good.h5";
+  {
+    LogWriter writer(good, sample_header());
+    for (const auto& r : sample_reports()) writer.append(r);
+    writer.finish();
+  }
+  const std::string bytes = read_text(good);
+  ASSERT_GT(bytes.size(), 4096u);
+  // Cut in half: the superblock is intact, the tables' chunks are not.
+  write_text(dir / "half.h5", bytes.substr(0, bytes.size() / 2));
+  EXPECT_THROW_MESSAGE((void)read_log(dir / "half.h5"), IoError, "half.h5");
+  // Overwrite everything after the superblock with garbage.
+  std::string garbage = bytes;
+  for (std::size_t i = 800; i < garbage.size(); ++i) garbage[i] = static_cast<char>((i * 131) & 0xff);
+  write_text(dir / "garbage.h5", garbage);
+  EXPECT_THROW_MESSAGE((void)read_log(dir / "garbage.h5"), IoError, "garbage.h5");
+}
+
+TEST(Log, ReaderRejectsForeignHdf5ByName) {
+  const auto dir = skelcd::test::temp_dir("log-foreign");
+  const auto foreign = dir / "foreign.h5";
+  const std::string script = "import h5py, numpy\n"
+                             "with h5py.File('" + foreign.string() + "', 'w') as f:\n"
+                             "    f['frames'] = numpy.arange(10)\n"
+                             "    f.attrs['format'] = 'something-else'\n";
+  write_text(dir / "make.py", script);
+  ASSERT_EQ(std::system((std::string(kPython) + " " + (dir / "make.py").string()).c_str()), 0);
+  EXPECT_THROW_MESSAGE((void)read_log(foreign), IoError, "foreign.h5: not a skelcd log");
+  EXPECT_FALSE(is_skelcd_log(foreign));
+}
+
+TEST(Log, DocumentedH5pyExampleReadsALog) {
+  // The python block of docs/log-format.md, run as it is on a log written here.
+  const std::string doc = read_text(std::filesystem::path(SKELCD_SOURCE_DIR) / "docs/log-format.md");
+  const auto begin = doc.find("```python\n");
+  ASSERT_NE(begin, std::string::npos) << "docs/log-format.md has no python example";
+  const auto code_begin = begin + 10;
+  const auto end = doc.find("```", code_begin);
+  ASSERT_NE(end, std::string::npos);
+  const std::string code = doc.substr(code_begin, end - code_begin);
+  EXPECT_LE(std::count(code.begin(), code.end(), '\n'), 6) << "the example should stay short";
+
+  const auto dir = skelcd::test::temp_dir("log-h5py");
+  {
+    LogWriter writer(dir / "run.h5", sample_header());
+    for (const auto& r : sample_reports()) writer.append(r);
+    writer.finish();
+  }
+  write_text(dir / "example.py", code);
+  const std::string command = "cd " + dir.string() + " && " + kPython + " example.py run.h5 > out.txt 2>&1";
+  ASSERT_EQ(std::system(command.c_str()), 0) << read_text(dir / "out.txt");
+  const std::string out = read_text(dir / "out.txt");
+  // The example prints the method, the row count and the first contact's frame and kind.
+  EXPECT_NE(out.find("bvh"), std::string::npos) << out;
+  EXPECT_NE(out.find("5 rows"), std::string::npos) << out;
+  EXPECT_NE(out.find("3005 contacts"), std::string::npos) << out;
+}
+
+TEST(FileHash, MatchesPublishedFnv1aVectors) {
+  const auto hash = [](std::string_view s) {
+    return fnv1a64(std::span<const unsigned char>(
+                       reinterpret_cast<const unsigned char*>(s.data()), s.size()),
+                   kFnv1a64Offset);
+  };
+  EXPECT_EQ(hash(""), 0xcbf29ce484222325ULL);
+  EXPECT_EQ(hash("a"), 0xaf63dc4c8601ec8cULL);
+  EXPECT_EQ(hash("foobar"), 0x85944171f73967e8ULL);
+  const auto dir = skelcd::test::temp_dir("file-hash");
+  write_text(dir / "foobar.txt", "foobar");
+  EXPECT_EQ(file_content_hash(dir / "foobar.txt"), "fnv1a64:85944171f73967e8");
+  EXPECT_THROW_MESSAGE((void)file_content_hash(dir / "none"), IoError, "none");
+}
+
+}  // namespace

@@ -1,0 +1,250 @@
+#include "tools/log/detail/hdf5_schema.hpp"
+
+#include <cstddef>
+#include <mutex>
+
+#include "culling/frame_result.hpp"
+#include "skinning/errors.hpp"
+#include "tools/frame_report.hpp"
+
+namespace skelcd::tools::detail {
+namespace {
+
+herr_t keep_innermost(unsigned n, const H5E_error2_t* error, void* client) {
+  // Walked upward: entry 0 is the innermost (most specific) error.
+  if (n == 0 && error != nullptr && error->desc != nullptr) {
+    *static_cast<std::string*>(client) = error->desc;
+  }
+  return 0;
+}
+
+void check(herr_t status, const char* what) {
+  if (status < 0) throw IoError(std::string("HDF5: cannot build type (") + what + ")");
+}
+
+H5Handle make_enum(std::initializer_list<std::pair<const char*, std::uint8_t>> values) {
+  H5Handle type(H5Tenum_create(H5T_NATIVE_UINT8), H5Tclose);
+  if (!type.valid()) throw IoError("HDF5: cannot create enum type");
+  for (const auto& [name, value] : values) {
+    check(H5Tenum_insert(type.get(), name, &value), name);
+  }
+  return type;
+}
+
+H5Handle kind_enum() {
+  return make_enum({{"dcd", static_cast<std::uint8_t>(QueryKind::dcd)},
+                    {"ccd", static_cast<std::uint8_t>(QueryKind::ccd)}});
+}
+
+H5Handle contact_kind_enum() {
+  return make_enum({{"vf", static_cast<std::uint8_t>(culling::CcdContact::Kind::vf)},
+                    {"ee", static_cast<std::uint8_t>(culling::CcdContact::Kind::ee)}});
+}
+
+H5Handle compound(std::size_t size) {
+  H5Handle type(H5Tcreate(H5T_COMPOUND, size), H5Tclose);
+  if (!type.valid()) throw IoError("HDF5: cannot create compound type");
+  return type;
+}
+
+void insert(const H5Handle& type, const char* name, std::size_t offset, hid_t member) {
+  check(H5Tinsert(type.get(), name, offset, member), name);
+}
+
+}  // namespace
+
+void silence_hdf5_errors() {
+  static std::once_flag once;
+  std::call_once(once, [] { H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr); });
+}
+
+std::string take_hdf5_error() {
+  std::string message;
+  H5Ewalk2(H5E_DEFAULT, H5E_WALK_UPWARD, keep_innermost, &message);
+  H5Eclear2(H5E_DEFAULT);
+  return message;
+}
+
+void clear_hdf5_error() { H5Eclear2(H5E_DEFAULT); }
+
+#define SKELCD_FIELD(type, Struct, field, member) \
+  insert(type, #field, offsetof(Struct, field), member)
+
+H5Handle frame_memory_type() {
+  auto type = compound(sizeof(FrameDisk));
+  const auto kind = kind_enum();
+  SKELCD_FIELD(type, FrameDisk, sample, H5T_NATIVE_INT32);
+  SKELCD_FIELD(type, FrameDisk, t0, H5T_NATIVE_DOUBLE);
+  SKELCD_FIELD(type, FrameDisk, t1, H5T_NATIVE_DOUBLE);
+  SKELCD_FIELD(type, FrameDisk, kind, kind.get());
+  SKELCD_FIELD(type, FrameDisk, atomic_clusters, H5T_NATIVE_INT64);
+  SKELCD_FIELD(type, FrameDisk, mega_clusters, H5T_NATIVE_INT64);
+  SKELCD_FIELD(type, FrameDisk, h_minus, H5T_NATIVE_INT64);
+  SKELCD_FIELD(type, FrameDisk, h_uncertain, H5T_NATIVE_INT64);
+  SKELCD_FIELD(type, FrameDisk, bv_tests, H5T_NATIVE_INT64);
+  SKELCD_FIELD(type, FrameDisk, candidate_pairs, H5T_NATIVE_INT64);
+  SKELCD_FIELD(type, FrameDisk, vf_tests, H5T_NATIVE_INT64);
+  SKELCD_FIELD(type, FrameDisk, ee_tests, H5T_NATIVE_INT64);
+  SKELCD_FIELD(type, FrameDisk, vf_contacts, H5T_NATIVE_INT64);
+  SKELCD_FIELD(type, FrameDisk, ee_contacts, H5T_NATIVE_INT64);
+  SKELCD_FIELD(type, FrameDisk, tt_tests, H5T_NATIVE_INT64);
+  SKELCD_FIELD(type, FrameDisk, dcd_pairs, H5T_NATIVE_INT64);
+  SKELCD_FIELD(type, FrameDisk, skin_us, H5T_NATIVE_DOUBLE);
+  SKELCD_FIELD(type, FrameDisk, refit_us, H5T_NATIVE_DOUBLE);
+  SKELCD_FIELD(type, FrameDisk, classify_us, H5T_NATIVE_DOUBLE);
+  SKELCD_FIELD(type, FrameDisk, merge_us, H5T_NATIVE_DOUBLE);
+  SKELCD_FIELD(type, FrameDisk, traverse_us, H5T_NATIVE_DOUBLE);
+  SKELCD_FIELD(type, FrameDisk, elementary_us, H5T_NATIVE_DOUBLE);
+  SKELCD_FIELD(type, FrameDisk, total_us, H5T_NATIVE_DOUBLE);
+  return type;
+}
+
+H5Handle contact_memory_type() {
+  auto type = compound(sizeof(ContactDisk));
+  const auto kind = contact_kind_enum();
+  SKELCD_FIELD(type, ContactDisk, frame, H5T_NATIVE_INT32);
+  SKELCD_FIELD(type, ContactDisk, kind, kind.get());
+  SKELCD_FIELD(type, ContactDisk, a_part, H5T_NATIVE_INT32);
+  SKELCD_FIELD(type, ContactDisk, a_index, H5T_NATIVE_INT32);
+  SKELCD_FIELD(type, ContactDisk, a_side, H5T_NATIVE_INT8);
+  SKELCD_FIELD(type, ContactDisk, b_part, H5T_NATIVE_INT32);
+  SKELCD_FIELD(type, ContactDisk, b_index, H5T_NATIVE_INT32);
+  SKELCD_FIELD(type, ContactDisk, b_side, H5T_NATIVE_INT8);
+  SKELCD_FIELD(type, ContactDisk, toi_lower, H5T_NATIVE_DOUBLE);
+  SKELCD_FIELD(type, ContactDisk, toi_upper, H5T_NATIVE_DOUBLE);
+  return type;
+}
+
+H5Handle dcd_pair_memory_type() {
+  auto type = compound(sizeof(DcdPairDisk));
+  SKELCD_FIELD(type, DcdPairDisk, frame, H5T_NATIVE_INT32);
+  SKELCD_FIELD(type, DcdPairDisk, a_part, H5T_NATIVE_INT32);
+  SKELCD_FIELD(type, DcdPairDisk, a_index, H5T_NATIVE_INT32);
+  SKELCD_FIELD(type, DcdPairDisk, b_part, H5T_NATIVE_INT32);
+  SKELCD_FIELD(type, DcdPairDisk, b_index, H5T_NATIVE_INT32);
+  return type;
+}
+
+#undef SKELCD_FIELD
+
+H5Handle packed_copy(hid_t memory_type) {
+  H5Handle type(H5Tcopy(memory_type), H5Tclose);
+  if (!type.valid()) throw IoError("HDF5: cannot copy type");
+  check(H5Tpack(type.get()), "pack");
+  return type;
+}
+
+H5Handle vlen_string_type() {
+  H5Handle type(H5Tcopy(H5T_C_S1), H5Tclose);
+  if (!type.valid()) throw IoError("HDF5: cannot copy string type");
+  check(H5Tset_size(type.get(), H5T_VARIABLE), "string size");
+  check(H5Tset_cset(type.get(), H5T_CSET_UTF8), "string charset");
+  return type;
+}
+
+namespace {
+
+H5Handle scalar_space() {
+  H5Handle space(H5Screate(H5S_SCALAR), H5Sclose);
+  if (!space.valid()) throw IoError("HDF5: cannot create a scalar dataspace");
+  return space;
+}
+
+void write_scalar(hid_t location, const char* name, hid_t file_type, hid_t memory_type,
+                  const void* value) {
+  const auto space = scalar_space();
+  H5Handle attribute(
+      H5Acreate2(location, name, file_type, space.get(), H5P_DEFAULT, H5P_DEFAULT), H5Aclose);
+  if (!attribute.valid() || H5Awrite(attribute.get(), memory_type, value) < 0) {
+    throw IoError(std::string("cannot write attribute '") + name + "' (" + take_hdf5_error() + ")");
+  }
+}
+
+/// Opens attribute `name` if present and checks that it holds one value of class `type_class`.
+std::optional<H5Handle> open_scalar(hid_t location, const char* name, bool (*accepts)(H5T_class_t)) {
+  const htri_t exists = H5Aexists(location, name);
+  if (exists < 0) {
+    throw IoError(std::string("cannot look up attribute '") + name + "' (" + take_hdf5_error() + ")");
+  }
+  if (exists == 0) return std::nullopt;
+  H5Handle attribute(H5Aopen(location, name, H5P_DEFAULT), H5Aclose);
+  if (!attribute.valid()) {
+    throw IoError(std::string("cannot open attribute '") + name + "' (" + take_hdf5_error() + ")");
+  }
+  H5Handle space(H5Aget_space(attribute.get()), H5Sclose);
+  H5Handle type(H5Aget_type(attribute.get()), H5Tclose);
+  if (!space.valid() || !type.valid() || H5Sget_simple_extent_npoints(space.get()) != 1 ||
+      !accepts(H5Tget_class(type.get()))) {
+    clear_hdf5_error();
+    throw IoError(std::string("attribute '") + name + "' has an unexpected type or shape");
+  }
+  return attribute;
+}
+
+bool is_string_class(H5T_class_t c) { return c == H5T_STRING; }
+bool is_number_class(H5T_class_t c) { return c == H5T_INTEGER || c == H5T_FLOAT; }
+
+}  // namespace
+
+void write_attribute(hid_t location, const char* name, const std::string& value) {
+  const auto type = vlen_string_type();
+  const char* text = value.c_str();
+  write_scalar(location, name, type.get(), type.get(), &text);
+}
+
+void write_attribute(hid_t location, const char* name, double value) {
+  write_scalar(location, name, H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, &value);
+}
+
+void write_attribute(hid_t location, const char* name, std::int64_t value) {
+  write_scalar(location, name, H5T_STD_I64LE, H5T_NATIVE_INT64, &value);
+}
+
+std::optional<std::string> read_string_attribute(hid_t location, const char* name) {
+  auto attribute = open_scalar(location, name, is_string_class);
+  if (!attribute) return std::nullopt;
+  H5Handle stored(H5Aget_type(attribute->get()), H5Tclose);
+  const htri_t variable = H5Tis_variable_str(stored.get());
+  if (variable > 0) {
+    const auto type = vlen_string_type();
+    char* text = nullptr;
+    if (H5Aread(attribute->get(), type.get(), &text) < 0) {
+      throw IoError(std::string("cannot read attribute '") + name + "' (" + take_hdf5_error() + ")");
+    }
+    std::string value = text != nullptr ? text : "";
+    H5free_memory(text);
+    return value;
+  }
+  // Fixed-length string: read it as stored (size bytes, maybe without a terminator).
+  const std::size_t size = H5Tget_size(stored.get());
+  std::string value(size, '\0');
+  H5Handle type(H5Tcopy(H5T_C_S1), H5Tclose);
+  H5Tset_size(type.get(), size);
+  if (size == 0 || H5Aread(attribute->get(), type.get(), value.data()) < 0) {
+    throw IoError(std::string("cannot read attribute '") + name + "' (" + take_hdf5_error() + ")");
+  }
+  value.resize(value.find('\0') == std::string::npos ? size : value.find('\0'));
+  return value;
+}
+
+std::optional<double> read_double_attribute(hid_t location, const char* name) {
+  auto attribute = open_scalar(location, name, is_number_class);
+  if (!attribute) return std::nullopt;
+  double value = 0;
+  if (H5Aread(attribute->get(), H5T_NATIVE_DOUBLE, &value) < 0) {
+    throw IoError(std::string("cannot read attribute '") + name + "' (" + take_hdf5_error() + ")");
+  }
+  return value;
+}
+
+std::optional<std::int64_t> read_int_attribute(hid_t location, const char* name) {
+  auto attribute = open_scalar(location, name, is_number_class);
+  if (!attribute) return std::nullopt;
+  std::int64_t value = 0;
+  if (H5Aread(attribute->get(), H5T_NATIVE_INT64, &value) < 0) {
+    throw IoError(std::string("cannot read attribute '") + name + "' (" + take_hdf5_error() + ")");
+  }
+  return value;
+}
+
+}  // namespace skelcd::tools::detail

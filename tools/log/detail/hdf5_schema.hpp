@@ -1,0 +1,134 @@
+#pragma once
+// Internal to tools/log/: RAII handles over the HDF5 C API and the on-disk layout of the log's
+// tables. Included only by tools/log/*.cpp — HDF5 stays out of every public header.
+
+#include <hdf5.h>
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <utility>
+
+namespace skelcd::tools::detail {
+
+/// Owns one HDF5 identifier and closes it with the matching H5?close.
+class H5Handle {
+ public:
+  using Closer = herr_t (*)(hid_t);
+  H5Handle() = default;
+  H5Handle(hid_t id, Closer closer) : id_(id), closer_(closer) {}
+  ~H5Handle() { reset(); }
+  H5Handle(H5Handle&& other) noexcept
+      : id_(std::exchange(other.id_, H5I_INVALID_HID)), closer_(other.closer_) {}
+  H5Handle& operator=(H5Handle&& other) noexcept {
+    if (this != &other) {
+      reset();
+      id_ = std::exchange(other.id_, H5I_INVALID_HID);
+      closer_ = other.closer_;
+    }
+    return *this;
+  }
+  H5Handle(const H5Handle&) = delete;
+  H5Handle& operator=(const H5Handle&) = delete;
+
+  [[nodiscard]] hid_t get() const { return id_; }
+  [[nodiscard]] bool valid() const { return id_ >= 0; }
+  /// Closes now; returns false when the close itself failed.
+  bool reset() {
+    bool ok = true;
+    if (id_ >= 0 && closer_ != nullptr) ok = closer_(id_) >= 0;
+    id_ = H5I_INVALID_HID;
+    return ok;
+  }
+
+ private:
+  hid_t id_ = H5I_INVALID_HID;
+  Closer closer_ = nullptr;
+};
+
+/// Turns HDF5's automatic error-stack printing off for this process (our messages replace it).
+void silence_hdf5_errors();
+
+/// The most specific message on HDF5's error stack ("" when empty); clears the stack.
+[[nodiscard]] std::string take_hdf5_error();
+/// Clears HDF5's error stack (after an expected failure).
+void clear_hdf5_error();
+
+/// On-disk rows, flat so that h5py and h5dump show one named column per field.
+struct FrameDisk {
+  std::int32_t sample;
+  std::uint8_t kind;  // QueryKind
+  double t0;
+  double t1;
+  std::int64_t atomic_clusters;
+  std::int64_t mega_clusters;
+  std::int64_t h_minus;
+  std::int64_t h_uncertain;
+  std::int64_t bv_tests;
+  std::int64_t candidate_pairs;
+  std::int64_t vf_tests;
+  std::int64_t ee_tests;
+  std::int64_t vf_contacts;
+  std::int64_t ee_contacts;
+  std::int64_t tt_tests;
+  std::int64_t dcd_pairs;
+  double skin_us;
+  double refit_us;
+  double classify_us;
+  double merge_us;
+  double traverse_us;
+  double elementary_us;
+  double total_us;
+};
+
+struct ContactDisk {
+  std::int32_t frame;
+  std::uint8_t kind;  // CcdContact::Kind
+  std::int32_t a_part;
+  std::int32_t a_index;
+  std::int8_t a_side;
+  std::int32_t b_part;
+  std::int32_t b_index;
+  std::int8_t b_side;
+  double toi_lower;
+  double toi_upper;
+};
+
+struct DcdPairDisk {
+  std::int32_t frame;
+  std::int32_t a_part;
+  std::int32_t a_index;
+  std::int32_t b_part;
+  std::int32_t b_index;
+};
+
+/// Compound types describing the structs above in memory (fields matched by name on read, so a
+/// reader of this version reads files that carry extra columns).
+[[nodiscard]] H5Handle frame_memory_type();
+[[nodiscard]] H5Handle contact_memory_type();
+[[nodiscard]] H5Handle dcd_pair_memory_type();
+/// The same, packed (no padding), as stored in the file.
+[[nodiscard]] H5Handle packed_copy(hid_t memory_type);
+/// Variable-length UTF-8 string type.
+[[nodiscard]] H5Handle vlen_string_type();
+
+/// Scalar attributes on `location` (a file or object). Writers replace nothing: the attribute
+/// must not exist yet. @throws IoError naming the attribute.
+void write_attribute(hid_t location, const char* name, const std::string& value);
+void write_attribute(hid_t location, const char* name, double value);
+void write_attribute(hid_t location, const char* name, std::int64_t value);
+
+/// Reads a scalar string attribute (variable or fixed length); std::nullopt when it is absent.
+/// @throws IoError naming the attribute when it exists but is not a scalar string.
+[[nodiscard]] std::optional<std::string> read_string_attribute(hid_t location, const char* name);
+/// Reads a scalar numeric attribute converted to double / int64; std::nullopt when absent.
+/// @throws IoError naming the attribute when it exists but is not a scalar number.
+[[nodiscard]] std::optional<double> read_double_attribute(hid_t location, const char* name);
+[[nodiscard]] std::optional<std::int64_t> read_int_attribute(hid_t location, const char* name);
+
+inline constexpr const char* kFramesPath = "frames";
+inline constexpr const char* kContactsPath = "contacts";
+inline constexpr const char* kDcdPairsPath = "dcd_pairs";
+inline constexpr const char* kPartsPath = "parts";
+
+}  // namespace skelcd::tools::detail

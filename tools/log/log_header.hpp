@@ -1,0 +1,43 @@
+#pragma once
+// The root attributes of a skelcd log: what was checked, how, and when (docs/log-format.md).
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace skelcd::tools {
+
+/// Value of the root attribute `format` that marks a file as a skelcd log.
+inline constexpr const char* kLogFormatName = "skelcd-log";
+/// Version of the schema written by this build; readers accept versions <= this.
+inline constexpr std::int32_t kLogFormatVersion = 1;
+
+struct LogHeader {
+  std::int32_t format_version = kLogFormatVersion;
+  std::string skelcd_version;
+  std::string command_line;
+  std::string input_path;
+  std::string input_hash;  ///< "fnv1a64:<16 hex digits>" of the input file's bytes
+  std::string clip;
+  std::string method;
+  std::string accuracy;
+  std::string query;       ///< "dcd" | "ccd" | "both"
+  double fps = 0;          ///< sampling rate of the clip (samples per second)
+  double min_separation = 0;  ///< contact distance, coordinate units
+  std::optional<double> gamma;  ///< radial-view merge parameter γ, only when the method uses it
+  std::optional<double> theta;  ///< cone angle θ (radians), only when the method uses it
+  std::string start_time;  ///< ISO 8601 UTC, e.g. 2026-01-31T12:00:00Z
+  std::int32_t first_sample = 0;  ///< samples first_sample … last_sample were asked for
+  std::int32_t last_sample = 0;
+  std::int64_t planned_rows = 0;  ///< rows /frames will hold when the run completes
+  std::int64_t num_vertices = 0;  ///< file vertices of the mesh
+  std::int64_t num_triangles = 0;
+  std::vector<std::string> part_names;  ///< stored as the /parts dataset
+  bool complete = false;  ///< set when the run finished; false in a log of a killed run
+};
+
+/// The current time as ISO 8601 UTC with seconds ("2026-01-31T12:00:00Z").
+[[nodiscard]] std::string iso8601_utc_now();
+
+}  // namespace skelcd::tools

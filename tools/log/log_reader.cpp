@@ -1,0 +1,195 @@
+#include "tools/log/log_reader.hpp"
+
+#include <string>
+
+#include "skinning/errors.hpp"
+#include "tools/log/detail/hdf5_schema.hpp"
+
+namespace skelcd::tools {
+
+using detail::H5Handle;
+
+namespace {
+
+/// Reads the whole 1-D compound dataset `name` into `rows` through `memory_type` (fields matched
+/// by name).
+template <class Row>
+void read_table(hid_t file, const char* name, const H5Handle& memory_type, std::vector<Row>& rows) {
+  const std::string where = std::string("/") + name;
+  const htri_t exists = H5Lexists(file, name, H5P_DEFAULT);
+  if (exists <= 0) throw IoError("missing table " + where);
+  H5Handle dataset(H5Dopen2(file, name, H5P_DEFAULT), H5Dclose);
+  if (!dataset.valid()) throw IoError("cannot open " + where + " (" + detail::take_hdf5_error() + ")");
+  H5Handle type(H5Dget_type(dataset.get()), H5Tclose);
+  H5Handle space(H5Dget_space(dataset.get()), H5Sclose);
+  if (!type.valid() || !space.valid() || H5Tget_class(type.get()) != H5T_COMPOUND ||
+      H5Sget_simple_extent_ndims(space.get()) != 1) {
+    detail::clear_hdf5_error();
+    throw IoError(where + " is not a one-dimensional table");
+  }
+  hsize_t count = 0;
+  H5Sget_simple_extent_dims(space.get(), &count, nullptr);
+  rows.resize(count);
+  if (count == 0) return;
+  if (H5Dread(dataset.get(), memory_type.get(), H5S_ALL, H5S_ALL, H5P_DEFAULT, rows.data()) < 0) {
+    throw IoError("cannot read " + where + " (" + detail::take_hdf5_error() + ")");
+  }
+}
+
+std::vector<std::string> read_parts(hid_t file) {
+  std::vector<std::string> names;
+  if (H5Lexists(file, detail::kPartsPath, H5P_DEFAULT) <= 0) {
+    detail::clear_hdf5_error();
+    return names;  // optional: contacts then carry part ids without names
+  }
+  H5Handle dataset(H5Dopen2(file, detail::kPartsPath, H5P_DEFAULT), H5Dclose);
+  H5Handle space(H5Dget_space(dataset.get()), H5Sclose);
+  H5Handle stored(H5Dget_type(dataset.get()), H5Tclose);
+  if (!dataset.valid() || !space.valid() || !stored.valid() ||
+      H5Tget_class(stored.get()) != H5T_STRING || H5Tis_variable_str(stored.get()) <= 0 ||
+      H5Sget_simple_extent_ndims(space.get()) != 1) {
+    detail::clear_hdf5_error();
+    throw IoError("/parts is not a list of strings");
+  }
+  hsize_t count = 0;
+  H5Sget_simple_extent_dims(space.get(), &count, nullptr);
+  if (count == 0) return names;
+  const auto type = detail::vlen_string_type();
+  std::vector<char*> pointers(count, nullptr);
+  if (H5Dread(dataset.get(), type.get(), H5S_ALL, H5S_ALL, H5P_DEFAULT, pointers.data()) < 0) {
+    throw IoError("cannot read /parts (" + detail::take_hdf5_error() + ")");
+  }
+  names.reserve(count);
+  for (const char* p : pointers) names.emplace_back(p != nullptr ? p : "");
+  H5Dvlen_reclaim(type.get(), space.get(), H5P_DEFAULT, pointers.data());
+  return names;
+}
+
+LogHeader read_header(hid_t file) {
+  using detail::read_double_attribute;
+  using detail::read_int_attribute;
+  using detail::read_string_attribute;
+  const auto format = read_string_attribute(file, "format");
+  if (!format || *format != kLogFormatName) {
+    throw IoError("not a skelcd log (no root attribute format = \"skelcd-log\")");
+  }
+  LogHeader h;
+  const auto version = read_int_attribute(file, "format_version");
+  if (!version) throw IoError("missing root attribute format_version");
+  if (*version < 1 || *version > kLogFormatVersion) {
+    throw IoError("log format version " + std::to_string(*version) +
+                  " is not supported (this build reads 1.." + std::to_string(kLogFormatVersion) + ")");
+  }
+  h.format_version = static_cast<std::int32_t>(*version);
+  const auto text = [&](const char* name) { return read_string_attribute(file, name).value_or(""); };
+  h.skelcd_version = text("skelcd_version");
+  h.command_line = text("command_line");
+  h.input_path = text("input_path");
+  h.input_hash = text("input_hash");
+  h.clip = text("clip");
+  h.method = text("method");
+  h.accuracy = text("accuracy");
+  h.query = text("query");
+  h.start_time = text("start_time");
+  h.fps = read_double_attribute(file, "fps").value_or(0.0);
+  h.min_separation = read_double_attribute(file, "min_separation").value_or(0.0);
+  h.gamma = read_double_attribute(file, "gamma");
+  h.theta = read_double_attribute(file, "theta");
+  h.first_sample = static_cast<std::int32_t>(read_int_attribute(file, "first_sample").value_or(0));
+  h.last_sample = static_cast<std::int32_t>(read_int_attribute(file, "last_sample").value_or(0));
+  h.planned_rows = read_int_attribute(file, "planned_rows").value_or(0);
+  h.num_vertices = read_int_attribute(file, "num_vertices").value_or(0);
+  h.num_triangles = read_int_attribute(file, "num_triangles").value_or(0);
+  h.complete = read_int_attribute(file, "complete").value_or(0) != 0;
+  h.part_names = read_parts(file);
+  return h;
+}
+
+FrameRow from_disk(const detail::FrameDisk& d) {
+  FrameRow row;
+  row.sample = d.sample;
+  row.t0 = d.t0;
+  row.t1 = d.t1;
+  row.kind = d.kind == static_cast<std::uint8_t>(QueryKind::ccd) ? QueryKind::ccd : QueryKind::dcd;
+  auto& c = row.counters;
+  c.atomic_clusters = d.atomic_clusters;
+  c.mega_clusters = d.mega_clusters;
+  c.h_minus = d.h_minus;
+  c.h_uncertain = d.h_uncertain;
+  c.bv_tests = d.bv_tests;
+  c.candidate_pairs = d.candidate_pairs;
+  c.vf_tests = d.vf_tests;
+  c.ee_tests = d.ee_tests;
+  c.vf_contacts = d.vf_contacts;
+  c.ee_contacts = d.ee_contacts;
+  c.tt_tests = d.tt_tests;
+  c.dcd_pairs = d.dcd_pairs;
+  auto& t = row.times;
+  t.skin_us = d.skin_us;
+  t.refit_us = d.refit_us;
+  t.classify_us = d.classify_us;
+  t.merge_us = d.merge_us;
+  t.traverse_us = d.traverse_us;
+  t.elementary_us = d.elementary_us;
+  row.total_us = d.total_us;
+  return row;
+}
+
+}  // namespace
+
+LogData read_log(const std::filesystem::path& path, const ReadLogOptions& options) {
+  detail::silence_hdf5_errors();
+  const std::string name = path.string();
+  std::error_code ec;
+  if (!std::filesystem::exists(path, ec)) throw IoError(name + ": no such file");
+  if (!std::filesystem::is_regular_file(path, ec)) throw IoError(name + ": not a regular file");
+  const htri_t is_hdf5 = H5Fis_hdf5(name.c_str());
+  if (is_hdf5 <= 0) {
+    detail::clear_hdf5_error();
+    throw IoError(name + ": not an HDF5 file");
+  }
+  H5Handle file(H5Fopen(name.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT), H5Fclose);
+  if (!file.valid()) {
+    throw IoError(name + ": cannot open HDF5 file (" + detail::take_hdf5_error() + ")");
+  }
+  LogData data;
+  try {
+    data.header = read_header(file.get());
+    std::vector<detail::FrameDisk> frames;
+    read_table(file.get(), detail::kFramesPath, detail::frame_memory_type(), frames);
+    data.frames.reserve(frames.size());
+    for (const auto& f : frames) data.frames.push_back(from_disk(f));
+    if (options.findings) {
+      std::vector<detail::ContactDisk> contacts;
+      read_table(file.get(), detail::kContactsPath, detail::contact_memory_type(), contacts);
+      data.contacts.reserve(contacts.size());
+      for (const auto& c : contacts) {
+        data.contacts.push_back(ContactRow{
+            .frame = c.frame,
+            .kind = c.kind == static_cast<std::uint8_t>(culling::CcdContact::Kind::ee)
+                        ? culling::CcdContact::Kind::ee
+                        : culling::CcdContact::Kind::vf,
+            .a = FeatureId{c.a_part, c.a_index, c.a_side},
+            .b = FeatureId{c.b_part, c.b_index, c.b_side},
+            .toi_lower = c.toi_lower,
+            .toi_upper = c.toi_upper,
+        });
+      }
+      std::vector<detail::DcdPairDisk> pairs;
+      read_table(file.get(), detail::kDcdPairsPath, detail::dcd_pair_memory_type(), pairs);
+      data.dcd_pairs.reserve(pairs.size());
+      for (const auto& p : pairs) {
+        data.dcd_pairs.push_back(DcdPairRow{
+            .frame = p.frame,
+            .a = FeatureId{p.a_part, p.a_index, -1},
+            .b = FeatureId{p.b_part, p.b_index, -1},
+        });
+      }
+    }
+  } catch (const IoError& e) {
+    throw IoError(name + ": " + e.what());
+  }
+  return data;
+}
+
+}  // namespace skelcd::tools

@@ -1,0 +1,29 @@
+#pragma once
+// Reads a skelcd log (docs/log-format.md), complete or left behind by a run that was killed.
+
+#include <filesystem>
+#include <vector>
+
+#include "tools/frame_report.hpp"
+#include "tools/log/log_header.hpp"
+
+namespace skelcd::tools {
+
+struct LogData {
+  LogHeader header;
+  std::vector<FrameRow> frames;        ///< /frames, in file order
+  std::vector<ContactRow> contacts;    ///< /contacts (empty unless ReadLogOptions::findings)
+  std::vector<DcdPairRow> dcd_pairs;   ///< /dcd_pairs (empty unless ReadLogOptions::findings)
+};
+
+struct ReadLogOptions {
+  /// Also read /contacts and /dcd_pairs (a batch summary needs only the header and /frames).
+  bool findings = true;
+};
+
+/// Reads the log at `path`.
+/// @throws IoError naming `path` and the fault when it is missing, not HDF5, not a skelcd log
+/// (no `format` attribute equal to "skelcd-log"), of a newer format version, or damaged.
+[[nodiscard]] LogData read_log(const std::filesystem::path& path, const ReadLogOptions& options = {});
+
+}  // namespace skelcd::tools

@@ -1,0 +1,304 @@
+#include "tools/log/log_writer.hpp"
+
+#include <span>
+#include <system_error>
+#include <vector>
+
+#include "skinning/errors.hpp"
+#include "tools/log/detail/hdf5_schema.hpp"
+
+namespace skelcd::tools {
+
+using detail::H5Handle;
+
+namespace {
+
+/// One extendible table: its dataset, the memory type of its rows and how many rows it holds.
+struct Table {
+  H5Handle dataset;
+  H5Handle memory_type;
+  hsize_t rows = 0;
+};
+
+/// Rows per chunk: small enough that the chunk rewritten at every flush stays cheap.
+constexpr hsize_t kFrameChunkRows = 64;
+constexpr hsize_t kPairChunkRows = 1024;
+constexpr unsigned kDeflateLevel = 4;
+
+Table create_table(hid_t file, const char* name, H5Handle memory_type, hsize_t chunk_rows,
+                   const std::string& where) {
+  const auto fail = [&](const char* what) {
+    throw IoError(where + ": cannot create /" + name + " (" + what + ": " +
+                  detail::take_hdf5_error() + ")");
+  };
+  const auto file_type = detail::packed_copy(memory_type.get());
+  const hsize_t initial = 0;
+  const hsize_t unlimited = H5S_UNLIMITED;
+  H5Handle space(H5Screate_simple(1, &initial, &unlimited), H5Sclose);
+  H5Handle properties(H5Pcreate(H5P_DATASET_CREATE), H5Pclose);
+  if (!space.valid() || !properties.valid()) fail("dataspace");
+  if (H5Pset_chunk(properties.get(), 1, &chunk_rows) < 0) fail("chunking");
+  if (H5Pset_shuffle(properties.get()) < 0 || H5Pset_deflate(properties.get(), kDeflateLevel) < 0) {
+    fail("compression");
+  }
+  Table table;
+  table.dataset = H5Handle(H5Dcreate2(file, name, file_type.get(), space.get(), H5P_DEFAULT,
+                                      properties.get(), H5P_DEFAULT),
+                           H5Dclose);
+  if (!table.dataset.valid()) fail("dataset");
+  table.memory_type = std::move(memory_type);
+  return table;
+}
+
+template <class Row>
+void append_rows(Table& table, std::span<const Row> rows, const char* name, const std::string& where) {
+  if (rows.empty()) return;
+  const auto fail = [&] {
+    throw IoError(where + ": cannot append to /" + name + " (" + detail::take_hdf5_error() + ")");
+  };
+  const hsize_t start = table.rows;
+  const hsize_t count = rows.size();
+  const hsize_t size = start + count;
+  if (H5Dset_extent(table.dataset.get(), &size) < 0) fail();
+  H5Handle file_space(H5Dget_space(table.dataset.get()), H5Sclose);
+  H5Handle memory_space(H5Screate_simple(1, &count, nullptr), H5Sclose);
+  if (!file_space.valid() || !memory_space.valid() ||
+      H5Sselect_hyperslab(file_space.get(), H5S_SELECT_SET, &start, nullptr, &count, nullptr) < 0 ||
+      H5Dwrite(table.dataset.get(), table.memory_type.get(), memory_space.get(), file_space.get(),
+               H5P_DEFAULT, rows.data()) < 0) {
+    fail();
+  }
+  table.rows = size;
+}
+
+detail::FrameDisk to_disk(const FrameRow& row) {
+  const auto& c = row.counters;
+  const auto& t = row.times;
+  return detail::FrameDisk{
+      .sample = row.sample,
+      .kind = static_cast<std::uint8_t>(row.kind),
+      .t0 = row.t0,
+      .t1 = row.t1,
+      .atomic_clusters = c.atomic_clusters,
+      .mega_clusters = c.mega_clusters,
+      .h_minus = c.h_minus,
+      .h_uncertain = c.h_uncertain,
+      .bv_tests = c.bv_tests,
+      .candidate_pairs = c.candidate_pairs,
+      .vf_tests = c.vf_tests,
+      .ee_tests = c.ee_tests,
+      .vf_contacts = c.vf_contacts,
+      .ee_contacts = c.ee_contacts,
+      .tt_tests = c.tt_tests,
+      .dcd_pairs = c.dcd_pairs,
+      .skin_us = t.skin_us,
+      .refit_us = t.refit_us,
+      .classify_us = t.classify_us,
+      .merge_us = t.merge_us,
+      .traverse_us = t.traverse_us,
+      .elementary_us = t.elementary_us,
+      .total_us = row.total_us,
+  };
+}
+
+void write_parts(hid_t file, const std::vector<std::string>& names, const std::string& where) {
+  const auto type = detail::vlen_string_type();
+  const hsize_t count = names.size();
+  H5Handle space(H5Screate_simple(1, &count, nullptr), H5Sclose);
+  H5Handle dataset(H5Dcreate2(file, detail::kPartsPath, type.get(), space.get(), H5P_DEFAULT,
+                              H5P_DEFAULT, H5P_DEFAULT),
+                   H5Dclose);
+  std::vector<const char*> pointers;
+  pointers.reserve(names.size());
+  for (const auto& name : names) pointers.push_back(name.c_str());
+  if (!space.valid() || !dataset.valid() ||
+      (count > 0 &&
+       H5Dwrite(dataset.get(), type.get(), H5S_ALL, H5S_ALL, H5P_DEFAULT, pointers.data()) < 0)) {
+    throw IoError(where + ": cannot write /parts (" + detail::take_hdf5_error() + ")");
+  }
+}
+
+void write_header(hid_t file, const LogHeader& h) {
+  using detail::write_attribute;
+  write_attribute(file, "format", std::string(kLogFormatName));
+  write_attribute(file, "format_version", static_cast<std::int64_t>(h.format_version));
+  write_attribute(file, "skelcd_version", h.skelcd_version);
+  write_attribute(file, "command_line", h.command_line);
+  write_attribute(file, "input_path", h.input_path);
+  write_attribute(file, "input_hash", h.input_hash);
+  write_attribute(file, "clip", h.clip);
+  write_attribute(file, "method", h.method);
+  write_attribute(file, "accuracy", h.accuracy);
+  write_attribute(file, "query", h.query);
+  write_attribute(file, "fps", h.fps);
+  write_attribute(file, "min_separation", h.min_separation);
+  if (h.gamma) write_attribute(file, "gamma", *h.gamma);
+  if (h.theta) write_attribute(file, "theta", *h.theta);
+  write_attribute(file, "start_time", h.start_time);
+  write_attribute(file, "first_sample", static_cast<std::int64_t>(h.first_sample));
+  write_attribute(file, "last_sample", static_cast<std::int64_t>(h.last_sample));
+  write_attribute(file, "planned_rows", h.planned_rows);
+  write_attribute(file, "num_vertices", h.num_vertices);
+  write_attribute(file, "num_triangles", h.num_triangles);
+  write_attribute(file, "complete", static_cast<std::int64_t>(0));
+}
+
+void refuse_to_clobber(const std::filesystem::path& path) {
+  std::error_code ec;
+  const auto status = std::filesystem::status(path, ec);
+  if (ec || !std::filesystem::exists(status)) return;
+  if (!std::filesystem::is_regular_file(status)) {
+    throw IoError(path.string() + ": exists and is not a regular file; refusing to overwrite it");
+  }
+  if (std::filesystem::file_size(path, ec) == 0 && !ec) return;
+  if (!is_skelcd_log(path)) {
+    throw IoError(path.string() + ": exists and is not a skelcd log; refusing to overwrite it");
+  }
+}
+
+}  // namespace
+
+struct LogWriter::Impl {
+  std::filesystem::path path;
+  std::string where;  // path as text, for messages
+  H5Handle file;
+  Table frames;
+  Table contacts;
+  Table dcd_pairs;
+  std::vector<detail::ContactDisk> contact_rows;
+  std::vector<detail::DcdPairDisk> pair_rows;
+  bool finished = false;
+
+  /// Closes every dataset, then the file; false if any close failed.
+  bool close() {
+    bool ok = frames.dataset.reset();
+    ok = contacts.dataset.reset() && ok;
+    ok = dcd_pairs.dataset.reset() && ok;
+    return file.reset() && ok;
+  }
+};
+
+LogWriter::LogWriter(const std::filesystem::path& path, const LogHeader& header)
+    : impl_(std::make_unique<Impl>()) {
+  detail::silence_hdf5_errors();
+  impl_->path = path;
+  impl_->where = path.string();
+  refuse_to_clobber(path);
+  // The default (oldest compatible) file format: a file left open by a killed process carries no
+  // "open for writing" flag, so h5dump and h5py read it as it is.
+  impl_->file = H5Handle(H5Fcreate(impl_->where.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT),
+                         H5Fclose);
+  if (!impl_->file.valid()) {
+    throw IoError(impl_->where + ": cannot create log (" + detail::take_hdf5_error() + ")");
+  }
+  // A log that cannot be set up completely is removed rather than left half-made.
+  try {
+    const hid_t file = impl_->file.get();
+    try {
+      write_header(file, header);
+    } catch (const IoError& e) {
+      throw IoError(impl_->where + ": " + e.what());
+    }
+    write_parts(file, header.part_names, impl_->where);
+    impl_->frames = create_table(file, detail::kFramesPath, detail::frame_memory_type(),
+                                 kFrameChunkRows, impl_->where);
+    impl_->contacts = create_table(file, detail::kContactsPath, detail::contact_memory_type(),
+                                   kPairChunkRows, impl_->where);
+    impl_->dcd_pairs = create_table(file, detail::kDcdPairsPath, detail::dcd_pair_memory_type(),
+                                    kPairChunkRows, impl_->where);
+    if (H5Fflush(file, H5F_SCOPE_LOCAL) < 0) {
+      throw IoError(impl_->where + ": cannot flush (" + detail::take_hdf5_error() + ")");
+    }
+  } catch (...) {
+    impl_->close();
+    std::error_code ignored;
+    std::filesystem::remove(path, ignored);
+    throw;
+  }
+}
+
+LogWriter::~LogWriter() {
+  if (impl_ && !impl_->finished) impl_->close();
+}
+
+void LogWriter::append(const FrameReport& report) {
+  if (impl_->finished) throw IoError(impl_->where + ": log already finished");
+  // Contacts and pairs first, the /frames row last: a row on disk implies its findings are too.
+  impl_->contact_rows.clear();
+  for (const auto& c : report.contacts) {
+    impl_->contact_rows.push_back(detail::ContactDisk{
+        .frame = c.frame,
+        .kind = static_cast<std::uint8_t>(c.kind),
+        .a_part = c.a.part,
+        .a_index = c.a.index,
+        .a_side = c.a.side,
+        .b_part = c.b.part,
+        .b_index = c.b.index,
+        .b_side = c.b.side,
+        .toi_lower = c.toi_lower,
+        .toi_upper = c.toi_upper,
+    });
+  }
+  impl_->pair_rows.clear();
+  for (const auto& p : report.dcd_pairs) {
+    impl_->pair_rows.push_back(detail::DcdPairDisk{
+        .frame = p.frame,
+        .a_part = p.a.part,
+        .a_index = p.a.index,
+        .b_part = p.b.part,
+        .b_index = p.b.index,
+    });
+  }
+  append_rows(impl_->contacts, std::span<const detail::ContactDisk>(impl_->contact_rows),
+              detail::kContactsPath, impl_->where);
+  append_rows(impl_->dcd_pairs, std::span<const detail::DcdPairDisk>(impl_->pair_rows),
+              detail::kDcdPairsPath, impl_->where);
+  const detail::FrameDisk row = to_disk(report.row);
+  append_rows(impl_->frames, std::span<const detail::FrameDisk>(&row, 1), detail::kFramesPath,
+              impl_->where);
+  if (H5Fflush(impl_->file.get(), H5F_SCOPE_LOCAL) < 0) {
+    throw IoError(impl_->where + ": cannot flush (" + detail::take_hdf5_error() + ")");
+  }
+}
+
+void LogWriter::finish() {
+  if (impl_->finished) return;
+  impl_->finished = true;
+  const std::int64_t one = 1;
+  H5Handle attribute(H5Aopen(impl_->file.get(), "complete", H5P_DEFAULT), H5Aclose);
+  const bool marked =
+      attribute.valid() && H5Awrite(attribute.get(), H5T_NATIVE_INT64, &one) >= 0;
+  attribute.reset();
+  const bool closed = impl_->close();
+  if (!marked || !closed) {
+    throw IoError(impl_->where + ": cannot finish log (" + detail::take_hdf5_error() + ")");
+  }
+}
+
+const std::filesystem::path& LogWriter::path() const { return impl_->path; }
+
+std::int64_t LogWriter::rows_written() const {
+  return static_cast<std::int64_t>(impl_->frames.rows);
+}
+
+bool is_skelcd_log(const std::filesystem::path& path) {
+  detail::silence_hdf5_errors();
+  const std::string name = path.string();
+  if (H5Fis_hdf5(name.c_str()) <= 0) {
+    detail::clear_hdf5_error();
+    return false;
+  }
+  H5Handle file(H5Fopen(name.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT), H5Fclose);
+  if (!file.valid()) {
+    detail::clear_hdf5_error();
+    return false;
+  }
+  try {
+    const auto format = detail::read_string_attribute(file.get(), "format");
+    return format && *format == kLogFormatName;
+  } catch (const IoError&) {
+    return false;
+  }
+}
+
+}  // namespace skelcd::tools

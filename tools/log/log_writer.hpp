@@ -1,0 +1,42 @@
+#pragma once
+// Writes a skelcd log (HDF5, docs/log-format.md) row by row as a run produces it. Every append is
+// flushed to disk, so a run that is killed leaves a readable log holding every completed frame.
+
+#include <filesystem>
+#include <memory>
+
+#include "tools/frame_report.hpp"
+#include "tools/log/log_header.hpp"
+
+namespace skelcd::tools {
+
+class LogWriter {
+ public:
+  /// Creates the log at `path` and writes the header (root attributes and /parts) and empty tables.
+  /// An existing file is replaced only if it is a skelcd log or empty.
+  /// @throws IoError naming `path` when it exists and is something else, or cannot be created.
+  LogWriter(const std::filesystem::path& path, const LogHeader& header);
+  /// Closes the file without marking it complete (as a run cut short would leave it).
+  ~LogWriter();
+  LogWriter(const LogWriter&) = delete;
+  LogWriter& operator=(const LogWriter&) = delete;
+
+  /// Appends the report's contacts, DCD pairs and its /frames row, then flushes the file.
+  /// @throws IoError naming the file when HDF5 fails.
+  void append(const FrameReport& report);
+
+  /// Sets the root attribute `complete` to 1 and closes the file. Further calls do nothing.
+  void finish();
+
+  [[nodiscard]] const std::filesystem::path& path() const;
+  [[nodiscard]] std::int64_t rows_written() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+/// True when `path` is an HDF5 file whose root attribute `format` is kLogFormatName.
+[[nodiscard]] bool is_skelcd_log(const std::filesystem::path& path);
+
+}  // namespace skelcd::tools
