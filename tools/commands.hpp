@@ -7,5 +7,6 @@
 namespace skelcd::tools {
 
 // One line per command; keep the order of DESIGN.md's command table.
+void add_inspect_command(CLI::App& app);
 
 }  // namespace skelcd::tools

@@ -1,0 +1,301 @@
+// The per-interval runner: rows in order for each --query, positions handed to the method,
+// findings converted from welded ids to the file's own numbering, non-finite samples refused.
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "skinning/errors.hpp"
+#include "tests/support/test_support.hpp"
+#include "tools/runner.hpp"
+
+namespace {
+
+using namespace skelcd;
+using namespace skelcd::tools;
+using skinning::Positions;
+
+/// Two parts: part 0 "tri" is one triangle (file vertices 0..2); part 1 "quad" is a unit square
+/// made of two triangles with its own 6 vertices (3..8), the diagonal's ends duplicated as a seam
+/// that welding merges: file vertices 6 and 7 repeat 4 and 5... see below.
+skinning::Mesh two_part_mesh() {
+  skinning::Mesh m;
+  m.rest_positions.resize(9, 3);
+  m.rest_positions << 0, 0, 1,   // 0 part 0 index 0
+      1, 0, 1,                  // 1 part 0 index 1
+      0, 1, 1,                  // 2 part 0 index 2
+      0, 0, 0,                  // 3 part 1 index 0
+      1, 0, 0,                  // 4 part 1 index 1
+      1, 1, 0,                  // 5 part 1 index 2
+      1, 1, 0,                  // 6 part 1 index 3 (= 5)
+      0, 1, 0,                  // 7 part 1 index 4
+      0, 0, 0;                  // 8 part 1 index 5 (= 3)
+  m.triangles.resize(3, 3);
+  m.triangles << 0, 1, 2, 3, 4, 5, 6, 7, 8;
+  m.face_part = {0, 1, 1};
+  m.face_index_in_part = {0, 0, 1};
+  m.vertex_part = {0, 0, 0, 1, 1, 1, 1, 1, 1};
+  m.vertex_index_in_part = {0, 1, 2, 0, 1, 2, 3, 4, 5};
+  m.part_names = {"tri", "quad"};
+  return m;
+}
+
+/// Sample i: every vertex translated by (0, 0, -0.5 i); optionally one NaN at a chosen sample.
+class ShiftMotion : public skinning::Motion {
+ public:
+  ShiftMotion(skinning::Mesh mesh, int samples) : mesh_(std::move(mesh)), samples_(samples) {}
+  const skinning::Mesh& mesh() const override { return mesh_; }
+  int num_samples() const override { return samples_; }
+  double sample_time(int i) const override { return 0.25 * i; }
+  std::string name() const override { return "shift-clip"; }
+  void positions(int i, Positions& out) const override {
+    out = mesh_.rest_positions;
+    out.col(2).array() -= 0.5 * i;
+    if (i == nan_sample) out(4, 1) = std::numeric_limits<double>::quiet_NaN();
+  }
+  int nan_sample = -1;
+
+ private:
+  skinning::Mesh mesh_;
+  int samples_;
+};
+
+/// A method that records what it was given and reports fixed findings in welded numbering.
+struct Recorded {
+  std::vector<Positions> dcd_inputs;
+  std::vector<std::pair<Positions, Positions>> ccd_inputs;
+};
+
+class FakeMethod : public culling::CullingMethod {
+ public:
+  FakeMethod(Recorded& record, std::vector<culling::CcdContact> contacts,
+             std::vector<culling::TrianglePair> pairs)
+      : record_(record), contacts_(std::move(contacts)), pairs_(std::move(pairs)) {}
+  std::string_view name() const override { return "fake"; }
+  void detect_dcd(const Positions& x, culling::FrameResult& out) override {
+    record_.dcd_inputs.push_back(x);
+    out.dcd_pairs = pairs_;
+    out.counters.tt_tests = 7;
+    out.counters.dcd_pairs = 999;  // wrong on purpose: the runner counts the findings itself
+    out.times.traverse_us = 1.5;
+  }
+  void detect_ccd(const Positions& x_t0, const Positions& x_t1, culling::FrameResult& out) override {
+    record_.ccd_inputs.emplace_back(x_t0, x_t1);
+    out.contacts = contacts_;
+    out.counters.vf_tests = 11;
+    out.times.elementary_us = 2.5;
+  }
+
+ private:
+  Recorded& record_;
+  std::vector<culling::CcdContact> contacts_;
+  std::vector<culling::TrianglePair> pairs_;
+};
+
+std::int32_t edge_between(const skinning::Topology& t, std::int32_t file_a, std::int32_t file_b) {
+  auto a = t.welded_of_vertex[static_cast<std::size_t>(file_a)];
+  auto b = t.welded_of_vertex[static_cast<std::size_t>(file_b)];
+  if (a > b) std::swap(a, b);
+  for (std::int32_t e = 0; e < t.num_edges(); ++e) {
+    if (t.edges(e, 0) == a && t.edges(e, 1) == b) return e;
+  }
+  ADD_FAILURE() << "no edge " << file_a << "-" << file_b;
+  return -1;
+}
+
+struct RunOutput {
+  std::vector<FrameReport> reports;
+  Recorded record;
+  RunPlan plan;
+};
+
+RunOutput run(QuerySet query, FrameRange frames, int samples = 4, int nan_sample = -1) {
+  ShiftMotion motion(two_part_mesh(), samples);
+  motion.nan_sample = nan_sample;
+  RunOutput out;
+  RunOptions options;
+  options.query = query;
+  options.frames = frames;
+  ClipRunner runner(motion, options,
+                    [&](const skinning::Mesh&, const skinning::Topology& t,
+                        const culling::MethodOptions&) {
+                      // VF: the quad's seam vertex (file 6 welds onto 5) against the triangle;
+                      // EE: the tri's edge 1-2 against the quad's diagonal 3-5.
+                      std::vector<culling::CcdContact> contacts{
+                          {culling::CcdContact::Kind::vf, t.welded_of_vertex[6], 0, 0.25, 0.375},
+                          {culling::CcdContact::Kind::ee, edge_between(t, 1, 2),
+                           edge_between(t, 3, 5), 0.5, 0.625}};
+                      std::vector<culling::TrianglePair> pairs{{0, 2}};
+                      return std::make_unique<FakeMethod>(out.record, contacts, pairs);
+                    });
+  out.plan = runner.plan();
+  try {
+    runner.run([&](const FrameReport& r) { out.reports.push_back(r); });
+  } catch (...) {
+    if (nan_sample < 0) throw;
+  }
+  return out;
+}
+
+TEST(FrameRange, ParsesTheFourForms) {
+  auto r = parse_frame_range("3:7");
+  EXPECT_EQ(r.first, 3);
+  EXPECT_EQ(r.last, 7);
+  r = parse_frame_range("5:");
+  EXPECT_EQ(r.first, 5);
+  EXPECT_FALSE(r.last.has_value());
+  r = parse_frame_range(":2");
+  EXPECT_EQ(r.first, 0);
+  EXPECT_EQ(r.last, 2);
+  r = parse_frame_range("4");
+  EXPECT_EQ(r.first, 4);
+  EXPECT_EQ(r.last, 4);
+  for (const char* bad : {"", "a:b", "-1:3", "3:1", "1:2:3", "1.5:3", " 1:2"}) {
+    EXPECT_THROW_MESSAGE((void)parse_frame_range(bad), InvalidInput, "--frames");
+  }
+}
+
+TEST(Runner, BothQueriesInterleaveRowsInTimeOrder) {
+  const auto out = run(QuerySet::both, FrameRange{});
+  EXPECT_EQ(out.plan.samples, 4);
+  EXPECT_EQ(out.plan.intervals, 3);
+  ASSERT_EQ(out.plan.rows, 7);
+  ASSERT_EQ(out.reports.size(), 7u);
+  const std::vector<std::pair<QueryKind, int>> expected{
+      {QueryKind::dcd, 0}, {QueryKind::ccd, 0}, {QueryKind::dcd, 1}, {QueryKind::ccd, 1},
+      {QueryKind::dcd, 2}, {QueryKind::ccd, 2}, {QueryKind::dcd, 3}};
+  for (std::size_t i = 0; i < expected.size(); ++i) {
+    const auto& row = out.reports[i].row;
+    EXPECT_EQ(row.kind, expected[i].first) << i;
+    EXPECT_EQ(row.sample, expected[i].second) << i;
+    EXPECT_EQ(row.t0, 0.25 * row.sample);
+    EXPECT_EQ(row.t1, row.kind == QueryKind::ccd ? 0.25 * (row.sample + 1) : row.t0);
+    EXPECT_GE(row.times.skin_us, 0.0);
+    EXPECT_GE(row.total_us, row.times.skin_us);
+  }
+  // Each of the 4 samples is posed once; the skinning time of sample i+1 is charged to the CCD row.
+  EXPECT_EQ(out.record.dcd_inputs.size(), 4u);
+  EXPECT_EQ(out.record.ccd_inputs.size(), 3u);
+}
+
+TEST(Runner, QuerySubsetsAndFrameRanges) {
+  auto out = run(QuerySet::dcd, parse_frame_range("1:3"));
+  EXPECT_EQ(out.plan.rows, 3);
+  ASSERT_EQ(out.reports.size(), 3u);
+  EXPECT_EQ(out.reports.front().row.sample, 1);
+  EXPECT_TRUE(out.record.ccd_inputs.empty());
+
+  out = run(QuerySet::ccd, parse_frame_range("1:3"));
+  EXPECT_EQ(out.plan.rows, 2);
+  ASSERT_EQ(out.reports.size(), 2u);
+  EXPECT_EQ(out.reports[0].row.kind, QueryKind::ccd);
+  EXPECT_EQ(out.reports[0].row.sample, 1);
+  EXPECT_EQ(out.reports[1].row.sample, 2);
+  EXPECT_TRUE(out.record.dcd_inputs.empty());
+
+  out = run(QuerySet::both, parse_frame_range("2"));
+  EXPECT_EQ(out.plan.rows, 1);
+  EXPECT_EQ(out.plan.intervals, 0);
+
+  EXPECT_THROW_MESSAGE(run(QuerySet::ccd, parse_frame_range("2")), InvalidInput, "two samples");
+  EXPECT_THROW_MESSAGE(run(QuerySet::both, parse_frame_range("2:4")), InvalidInput,
+                       "outside the 4 samples");
+}
+
+TEST(Runner, MethodSeesWeldedPositionsOfConsecutiveSamples) {
+  const auto out = run(QuerySet::ccd, FrameRange{});
+  ShiftMotion motion(two_part_mesh(), 4);
+  const auto topology = skinning::build_topology(motion.mesh());
+  ASSERT_EQ(topology.num_welded_vertices(), 7);  // 9 file vertices, two seam duplicates
+  ASSERT_EQ(out.record.ccd_inputs.size(), 3u);
+  for (int i = 0; i < 3; ++i) {
+    Positions x0, x1;
+    motion.positions(i, x0);
+    motion.positions(i + 1, x1);
+    const auto& [w0, w1] = out.record.ccd_inputs[static_cast<std::size_t>(i)];
+    ASSERT_EQ(w0.rows(), 7);
+    for (int w = 0; w < 7; ++w) {
+      const auto v = topology.representative_vertex[static_cast<std::size_t>(w)];
+      EXPECT_EQ(w0.row(w), x0.row(v)) << "sample " << i << " welded " << w;
+      EXPECT_EQ(w1.row(w), x1.row(v)) << "sample " << i + 1 << " welded " << w;
+    }
+  }
+}
+
+TEST(Runner, FindingsAreReportedInTheFilesNumbering) {
+  const auto out = run(QuerySet::both, parse_frame_range("0:1"));
+  ASSERT_EQ(out.reports.size(), 3u);
+  const auto& dcd = out.reports[0];
+  ASSERT_EQ(dcd.dcd_pairs.size(), 1u);
+  EXPECT_EQ(dcd.dcd_pairs[0].frame, 0);
+  EXPECT_EQ(dcd.dcd_pairs[0].a, (FeatureId{0, 0, -1}));  // triangle 0 = part 0 triangle 0
+  EXPECT_EQ(dcd.dcd_pairs[0].b, (FeatureId{1, 1, -1}));  // triangle 2 = part 1 triangle 1
+  EXPECT_EQ(dcd.row.counters.dcd_pairs, 1);  // counted from the findings, not the method's 999
+  EXPECT_EQ(dcd.row.counters.tt_tests, 7);
+  EXPECT_EQ(dcd.row.times.traverse_us, 1.5);
+  EXPECT_TRUE(dcd.contacts.empty());
+
+  const auto& ccd = out.reports[1];
+  ASSERT_EQ(ccd.contacts.size(), 2u);
+  const auto& vf = ccd.contacts[0];
+  EXPECT_EQ(vf.frame, 0);
+  EXPECT_EQ(vf.kind, culling::CcdContact::Kind::vf);
+  // File vertex 6 sits on file vertex 5 (part 1, index 2), the first in file order: that one names it.
+  EXPECT_EQ(vf.a, (FeatureId{1, 2, -1}));
+  EXPECT_EQ(vf.b, (FeatureId{0, 0, -1}));
+  EXPECT_EQ(vf.toi_lower, 0.25);
+  EXPECT_EQ(vf.toi_upper, 0.375);
+  const auto& ee = ccd.contacts[1];
+  EXPECT_EQ(ee.kind, culling::CcdContact::Kind::ee);
+  // Edge 1-2 belongs to triangle (0, 1, 2) only: its side 1 (corner 1 → corner 2).
+  EXPECT_EQ(ee.a, (FeatureId{0, 0, 1}));
+  // The diagonal 3-5 is shared by both quad triangles; whichever names it, its side must run
+  // between the welded ends of the diagonal.
+  const auto mesh = two_part_mesh();
+  const auto topology = skinning::build_topology(mesh);
+  ASSERT_EQ(ee.b.part, 1);
+  ASSERT_GE(ee.b.side, 0);
+  const std::int32_t f = ee.b.index == 0 ? 1 : 2;
+  const auto corner = [&](int k) {
+    return topology.welded_of_vertex[static_cast<std::size_t>(mesh.triangles(f, k % 3))];
+  };
+  std::array<std::int32_t, 2> ends{corner(ee.b.side), corner(ee.b.side + 1)};
+  std::sort(ends.begin(), ends.end());
+  std::array<std::int32_t, 2> diagonal{topology.welded_of_vertex[3], topology.welded_of_vertex[5]};
+  std::sort(diagonal.begin(), diagonal.end());
+  EXPECT_EQ(ends, diagonal);
+  EXPECT_EQ(ccd.row.counters.vf_contacts, 1);
+  EXPECT_EQ(ccd.row.counters.ee_contacts, 1);
+  EXPECT_EQ(ccd.row.counters.vf_tests, 11);
+  EXPECT_EQ(ccd.row.times.elementary_us, 2.5);
+  EXPECT_TRUE(ccd.dcd_pairs.empty());
+}
+
+TEST(Runner, NonFiniteSampleIsRefusedByNameAfterEarlierRowsWereReported) {
+  ShiftMotion motion(two_part_mesh(), 4);
+  motion.nan_sample = 2;
+  Recorded record;
+  ClipRunner runner(motion, RunOptions{},
+                    [&](const skinning::Mesh&, const skinning::Topology&,
+                        const culling::MethodOptions&) {
+                      return std::make_unique<FakeMethod>(
+                          record, std::vector<culling::CcdContact>{},
+                          std::vector<culling::TrianglePair>{});
+                    });
+  std::vector<FrameReport> reports;
+  EXPECT_THROW_MESSAGE(runner.run([&](const FrameReport& r) { reports.push_back(r); }),
+                       InvalidInput, "shift-clip: sample 2 (t = 0.5");
+  EXPECT_EQ(reports.size(), 3u);  // dcd 0, ccd 0, dcd 1
+}
+
+TEST(Runner, UnknownMethodIsRefusedBeforeAnyWork) {
+  ShiftMotion motion(two_part_mesh(), 2);
+  RunOptions options;
+  options.method = "no-such-method";
+  EXPECT_THROW_MESSAGE(ClipRunner(motion, options), InvalidInput, "no-such-method");
+}
+
+}  // namespace

@@ -1,0 +1,97 @@
+#pragma once
+// The per-interval runner: poses a Motion sample by sample, welds, and asks a culling method for
+// DCD findings at each sample and CCD contacts over each interval between consecutive samples,
+// reporting every row in the file's own numbering as soon as it completes.
+
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <optional>
+#include <string>
+#include <string_view>
+
+#include "ccd/accuracy.hpp"
+#include "culling/method.hpp"
+#include "skinning/motion.hpp"
+#include "skinning/topology.hpp"
+#include "tools/frame_report.hpp"
+
+namespace skelcd::tools {
+
+/// Samples first … last, both included (`--frames A:B`); last unset means the final sample.
+struct FrameRange {
+  std::int32_t first = 0;
+  std::optional<std::int32_t> last;
+};
+
+/// Parses `--frames`: "A:B", "A:" (to the end), ":B" (from 0) or "A" (one sample); A <= B, both >= 0.
+/// @throws InvalidInput quoting `text` when it is malformed.
+[[nodiscard]] FrameRange parse_frame_range(std::string_view text);
+
+struct RunOptions {
+  std::string clip;    ///< clip to check (empty: the model's first clip) — used by the loader
+  double fps = 0;      ///< sampling rate in samples/s (0: the clip's own key rate) — used by the loader
+  FrameRange frames;
+  std::string method = "bvh";
+  ccd::Accuracy accuracy = ccd::Accuracy::conservative;
+  QuerySet query = QuerySet::both;
+  double min_separation = 0;  ///< contact distance, model units
+};
+
+/// What a run will do, resolved against the motion's sample count.
+struct RunPlan {
+  std::int32_t first_sample = 0;
+  std::int32_t last_sample = 0;
+  std::int32_t samples = 0;    ///< last - first + 1
+  std::int32_t intervals = 0;  ///< CCD intervals checked (0 for --query dcd)
+  std::int64_t rows = 0;       ///< FrameReports the run produces
+};
+
+/// Builds the culling method for a mesh; the default calls culling::make_method(options.method…).
+using MethodFactory = std::function<std::unique_ptr<culling::CullingMethod>(
+    const skinning::Mesh&, const skinning::Topology&, const culling::MethodOptions&)>;
+
+/// Called once per completed row (a DCD sample or a CCD interval), in order.
+using FrameCallback = std::function<void(const FrameReport&)>;
+
+class ClipRunner {
+ public:
+  /// Builds the welded topology of motion.mesh() and the method; validates the options against the
+  /// motion (frame range inside [0, num_samples)).
+  /// @throws InvalidInput for a bad frame range, an unknown method or an unusable mesh.
+  ClipRunner(const skinning::Motion& motion, const RunOptions& options, MethodFactory factory = {});
+
+  [[nodiscard]] const RunPlan& plan() const { return plan_; }
+  [[nodiscard]] const skinning::Topology& topology() const { return topology_; }
+  [[nodiscard]] std::string_view method_name() const { return method_->name(); }
+
+  /// Runs every row of the plan, calling `on_frame` after each.
+  /// @throws InvalidInput naming the motion and sample when a posed position is not finite;
+  /// rows completed before it have been reported.
+  void run(const FrameCallback& on_frame);
+
+ private:
+  const skinning::Motion& motion_;
+  RunOptions options_;
+  RunPlan plan_;
+  skinning::Topology topology_;
+  std::unique_ptr<culling::CullingMethod> method_;
+};
+
+/// Maps welded ids (culling's numbering) back to the file's own numbering (part, index).
+class FeatureNumbering {
+ public:
+  FeatureNumbering(const skinning::Mesh& mesh, const skinning::Topology& topology);
+  /// Welded vertex → its representative file vertex.
+  [[nodiscard]] FeatureId vertex(std::int32_t welded_vertex) const;
+  [[nodiscard]] FeatureId triangle(std::int32_t triangle) const;
+  /// Edge (Topology::edges row) → side of the first triangle incident to it.
+  [[nodiscard]] FeatureId edge(std::int32_t edge) const;
+
+ private:
+  const skinning::Mesh& mesh_;
+  const skinning::Topology& topology_;
+  std::vector<FeatureId> edges_;
+};
+
+}  // namespace skelcd::tools
