@@ -1,0 +1,160 @@
+#pragma once
+// Discrete oriented polytopes (k-DOPs) with a fixed set of slab axes: the bounding volumes of the
+// baseline hierarchies. Dop<3> is the axis-aligned box (AABB), Dop<8> the 16-DOP.
+//
+// Conservative in floating point: the interval stored on each axis contains the *exact*
+// projection of every point the volume was built from. Coordinate axes need no rounding (min/max
+// of doubles is exact); the diagonal axes of the 16-DOP sum two coordinates, and the rounding
+// error of that sum is recovered exactly (TwoSum) and the bound moved out by one ulp when it is
+// not zero. Inflation by a distance is rounded outwards as well. See docs/culling.md.
+
+#include <algorithm>
+#include <array>
+#include <bit>
+#include <cassert>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+
+#include <Eigen/Core>
+
+namespace skelcd::culling {
+
+/// Smallest double greater than `x` (x finite, not the largest double). Inline bit arithmetic:
+/// std::nextafter is an out-of-line libm call, too slow for a per-vertex refit.
+[[nodiscard]] inline double next_up(double x) {
+  if (x == 0.0) return std::numeric_limits<double>::denorm_min();
+  auto bits = std::bit_cast<std::uint64_t>(x);
+  bits = x > 0.0 ? bits + 1 : bits - 1;
+  return std::bit_cast<double>(bits);
+}
+
+/// Largest double smaller than `x` (x finite, not the lowest double).
+[[nodiscard]] inline double next_down(double x) { return -next_up(-x); }
+
+/// The slab axes of Dop<N> (not normalised; integer components).
+/// - N = 3 (AABB): x, y, z.
+/// - N = 8 (16-DOP): x, y, z, x+y, x+z, y+z, x−y, x−z — the three coordinate axes and five of the
+///   six face diagonals, the convention of FCL's KDOP<16> (Klosowski et al. 1998 use 6/14/18/26;
+///   a 16-DOP cannot be symmetric under the cube's rotations, so some choice of five is needed).
+template <int N>
+struct DopAxes;
+
+template <>
+struct DopAxes<3> {
+  static constexpr std::array<std::array<int, 3>, 3> kAxes{{{1, 0, 0}, {0, 1, 0}, {0, 0, 1}}};
+};
+
+template <>
+struct DopAxes<8> {
+  static constexpr std::array<std::array<int, 3>, 8> kAxes{
+      {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}, {1, 1, 0}, {1, 0, 1}, {0, 1, 1}, {1, -1, 0}, {1, 0, -1}}};
+};
+
+namespace detail {
+
+/// [lo, hi] containing the exact a + b (a, b finite): TwoSum recovers the rounding error e of
+/// s = fl(a + b) exactly (s + e == a + b), so the bound moves one ulp only on the side of e.
+inline void bracket_sum(double a, double b, double& lo, double& hi) {
+  const double s = a + b;
+  const double bb = s - a;
+  const double e = (a - (s - bb)) + (b - bb);
+  lo = e < 0.0 ? next_down(s) : s;
+  hi = e > 0.0 ? next_up(s) : s;
+}
+
+}  // namespace detail
+
+/// A k-DOP: on each of N axes the closed interval [lo, hi] of projections of the bounded set.
+template <int N>
+struct Dop {
+  static constexpr int kAxes = N;
+  std::array<double, static_cast<std::size_t>(N)> lo;
+  std::array<double, static_cast<std::size_t>(N)> hi;
+
+  /// The empty volume (lo = +inf, hi = -inf on every axis): the identity of merge().
+  [[nodiscard]] static Dop empty() {
+    Dop d;
+    d.lo.fill(std::numeric_limits<double>::infinity());
+    d.hi.fill(-std::numeric_limits<double>::infinity());
+    return d;
+  }
+
+  /// The volume of one point, each projection bracketed outwards (exact on coordinate axes).
+  [[nodiscard]] static Dop of_point(double x, double y, double z);
+  [[nodiscard]] static Dop of_point(const Eigen::Vector3d& p) {
+    return of_point(p.x(), p.y(), p.z());
+  }
+
+  /// Grows this volume to contain `other`.
+  void merge(const Dop& other) {
+    for (std::size_t k = 0; k < static_cast<std::size_t>(N); ++k) {
+      lo[k] = std::min(lo[k], other.lo[k]);
+      hi[k] = std::max(hi[k], other.hi[k]);
+    }
+  }
+
+  /// True when the closed volumes share a point on every axis (touching counts).
+  [[nodiscard]] bool overlaps(const Dop& other) const {
+    for (std::size_t k = 0; k < static_cast<std::size_t>(N); ++k) {
+      if (lo[k] > other.hi[k] || other.lo[k] > hi[k]) return false;
+    }
+    return true;
+  }
+
+  /// True when `other` lies inside this volume on every axis.
+  [[nodiscard]] bool contains(const Dop& other) const {
+    for (std::size_t k = 0; k < static_cast<std::size_t>(N); ++k) {
+      if (other.lo[k] < lo[k] || other.hi[k] > hi[k]) return false;
+    }
+    return true;
+  }
+
+  /// Grows every slab by `half_width` times the axis length (so two volumes inflated by d/2
+  /// overlap whenever the sets they bound come within Euclidean distance d), rounded outwards.
+  /// @pre half_width >= 0; the volume is not empty and finite.
+  void inflate(double half_width);
+};
+
+using Aabb = Dop<3>;
+using Kdop16 = Dop<8>;
+
+template <>
+inline Dop<3> Dop<3>::of_point(double x, double y, double z) {
+  Dop<3> d;
+  d.lo = {x, y, z};
+  d.hi = {x, y, z};
+  return d;
+}
+
+template <>
+inline Dop<8> Dop<8>::of_point(double x, double y, double z) {
+  Dop<8> d;
+  d.lo[0] = d.hi[0] = x;
+  d.lo[1] = d.hi[1] = y;
+  d.lo[2] = d.hi[2] = z;
+  detail::bracket_sum(x, y, d.lo[3], d.hi[3]);
+  detail::bracket_sum(x, z, d.lo[4], d.hi[4]);
+  detail::bracket_sum(y, z, d.lo[5], d.hi[5]);
+  detail::bracket_sum(x, -y, d.lo[6], d.hi[6]);
+  detail::bracket_sum(x, -z, d.lo[7], d.hi[7]);
+  return d;
+}
+
+template <int N>
+void Dop<N>::inflate(double half_width) {
+  assert(half_width >= 0.0);
+  if (half_width == 0.0) return;
+  // Axis k has length |a_k| = sqrt(number of non-zero components) (components are 0 or ±1);
+  // the slab grows by an upper bound of half_width·|a_k|, and each end is rounded outwards.
+  for (std::size_t k = 0; k < static_cast<std::size_t>(N); ++k) {
+    const auto& axis = DopAxes<N>::kAxes[k];
+    const int nonzero = (axis[0] != 0) + (axis[1] != 0) + (axis[2] != 0);
+    double grow = half_width;
+    if (nonzero > 1) grow = next_up(half_width * next_up(std::sqrt(static_cast<double>(nonzero))));
+    lo[k] = next_down(lo[k] - grow);
+    hi[k] = next_up(hi[k] + grow);
+  }
+}
+
+}  // namespace skelcd::culling
