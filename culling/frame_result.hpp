@@ -2,6 +2,7 @@
 // What one interval (CCD) or one instant (DCD) produces: contacts in welded numbering, counters and
 // stage timings — the same for every culling method so methods compare on equal terms.
 
+#include <compare>
 #include <cstdint>
 #include <vector>
 
@@ -21,6 +22,9 @@ struct Counters {
   std::int64_t ee_contacts = 0;
   std::int64_t tt_tests = 0;     ///< triangle-triangle DCD tests
   std::int64_t dcd_pairs = 0;    ///< intersecting triangle pairs found by DCD
+  /// Feature-pair volume tests (VF: vertex vs face, EE: edge vs edge) before the elementary
+  /// tests; a cheap filter, counted apart from the hierarchy's bv_tests.
+  std::int64_t feature_bv_tests = 0;
 };
 
 /// Microseconds spent per stage in one interval.
@@ -42,12 +46,25 @@ struct CcdContact {
   std::int32_t b = -1;
   double toi_lower = 1.0;
   double toi_upper = 1.0;
+  /// Same pair (kind, a, b); the time of impact is not compared.
+  [[nodiscard]] bool same_pair(const CcdContact& other) const {
+    return kind == other.kind && a == other.a && b == other.b;
+  }
+  /// Canonical order: (kind, a, b).
+  [[nodiscard]] bool before(const CcdContact& other) const {
+    if (kind != other.kind) return kind < other.kind;
+    if (a != other.a) return a < other.a;
+    return b < other.b;
+  }
+  friend bool operator==(const CcdContact&, const CcdContact&) = default;
 };
 
-/// A DCD finding: triangles a < b intersect.
+/// A DCD finding: triangles a < b intersect. (Also a candidate triangle pair of a traversal.)
 struct TrianglePair {
   std::int32_t a = -1;
   std::int32_t b = -1;
+  friend bool operator==(const TrianglePair&, const TrianglePair&) = default;
+  friend auto operator<=>(const TrianglePair&, const TrianglePair&) = default;
 };
 
 struct FrameResult {

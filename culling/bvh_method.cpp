@@ -1,0 +1,124 @@
+// `bvh` and `kdop`: a hierarchy of AABBs or 16-DOPs over the welded triangles, built once at rest,
+// refit per interval, traversed against itself; then the shared feature and elementary stages.
+#include <string>
+
+#include "culling/bvh.hpp"
+#include "culling/candidates.hpp"
+#include "culling/detail/method_base.hpp"
+#include "culling/traversal.hpp"
+#include "culling/vertex_bounds.hpp"
+#include "skinning/errors.hpp"
+
+namespace skelcd::culling::detail {
+namespace {
+
+/// Welded rest positions: row w is the rest position of representative_vertex[w].
+skinning::Positions welded_rest_positions(
+    const skinning::Mesh& mesh,
+    const skinning::Topology& topology) {
+  skinning::Positions rest(topology.num_welded_vertices(), 3);
+  for (std::int32_t w = 0; w < topology.num_welded_vertices(); ++w) {
+    const std::int32_t v = topology.representative_vertex[static_cast<std::size_t>(w)];
+    if (v < 0 || v >= mesh.rest_positions.rows()) {
+      throw InvalidInput(
+          "culling::make_method: representative_vertex[" + std::to_string(w) + "] = " +
+          std::to_string(v) + " is not a mesh vertex");
+    }
+    rest.row(w) = mesh.rest_positions.row(v);
+  }
+  return rest;
+}
+
+template <int N>
+class BvhMethod final : public MethodBase {
+ public:
+  BvhMethod(
+      std::string_view name,
+      const skinning::Mesh& mesh,
+      const skinning::Topology& topology,
+      const MethodOptions& options)
+      : MethodBase(name, mesh, topology, options),
+        bvh_(topology_.welded_triangles(), welded_rest_positions(mesh, topology), options.bvh) {
+    // Everything an interval touches is sized here; only the candidate lists may still grow
+    // (their size depends on the motion), and they keep their capacity between intervals.
+    const auto num_faces = static_cast<std::size_t>(topology_.num_triangles());
+    bounds_.vertices.reserve(static_cast<std::size_t>(topology_.num_vertices()));
+    bounds_.edges.reserve(static_cast<std::size_t>(topology_.num_edges()));
+    bounds_.triangles.reserve(num_faces);
+    scratch_.reserve_self(bvh_);
+    pairs_.reserve(16 * num_faces);
+    features_.vf.reserve(4 * num_faces);
+    features_.ee.reserve(4 * num_faces);
+  }
+
+  void detect_dcd(const skinning::Positions& x, FrameResult& out) override {
+    check_positions(x, "detect_dcd", "x");
+    const auto t0 = Clock::now();
+    // Refit over the static volumes of the instant.
+    static_vertex_bounds<N>(x, bounds_.vertices);
+    bounds_.derive(topology_, /*with_edges=*/false);
+    bvh_.refit(bounds_.triangles);
+    const auto t1 = Clock::now();
+    // Self traversal → overlapping triangle pairs → the DCD rules.
+    pairs_.clear();
+    self_traverse<N>(bvh_, bounds_.triangles, scratch_, pairs_, out.counters.bv_tests);
+    dcd_filter_triangle_pairs(topology_, pairs_, out.counters);
+    const auto t2 = Clock::now();
+    run_dcd_tests(topology_, pairs_, x, tests_, out);
+    const auto t3 = Clock::now();
+    out.times.refit_us += micros(t0, t1);
+    out.times.traverse_us += micros(t1, t2);
+    out.times.elementary_us += micros(t2, t3);
+  }
+
+  void detect_ccd(
+      const skinning::Positions& x_t0,
+      const skinning::Positions& x_t1,
+      FrameResult& out) override {
+    check_positions(x_t0, "detect_ccd", "x_t0");
+    check_positions(x_t1, "detect_ccd", "x_t1");
+    const auto t0 = Clock::now();
+    // Refit over the swept volumes of the interval, grown by half the contact distance.
+    swept_vertex_bounds<N>(x_t0, x_t1, 0.5 * options_.min_separation, bounds_.vertices);
+    bounds_.derive(topology_);
+    bvh_.refit(bounds_.triangles);
+    const auto t1 = Clock::now();
+    // Self traversal → triangle pairs → de-duplicated feature pairs.
+    pairs_.clear();
+    features_.clear();
+    self_traverse<N>(bvh_, bounds_.triangles, scratch_, pairs_, out.counters.bv_tests);
+    ccd_candidates_from_triangle_pairs<N>(topology_, pairs_, bounds_, features_, out.counters);
+    const auto t2 = Clock::now();
+    run_ccd_tests(
+        topology_, features_, x_t0, x_t1, tests_, options_.accuracy, ccd_options_, out);
+    const auto t3 = Clock::now();
+    out.times.refit_us += micros(t0, t1);
+    out.times.traverse_us += micros(t1, t2);
+    out.times.elementary_us += micros(t2, t3);
+  }
+
+ private:
+  Bvh<N> bvh_;
+  FeatureBounds<N> bounds_;
+  TraversalScratch scratch_;
+  std::vector<TrianglePair> pairs_;
+  FeatureCandidates features_;
+};
+
+}  // namespace
+
+template <int N>
+std::unique_ptr<CullingMethod> make_bvh_method(
+    std::string_view name,
+    const skinning::Mesh& mesh,
+    const skinning::Topology& topology,
+    const MethodOptions& options) {
+  return std::make_unique<BvhMethod<N>>(name, mesh, topology, options);
+}
+
+template std::unique_ptr<CullingMethod> make_bvh_method<3>(
+    std::string_view, const skinning::Mesh&, const skinning::Topology&, const MethodOptions&);
+template std::unique_ptr<CullingMethod> make_bvh_method<8>(
+    std::string_view, const skinning::Mesh&, const skinning::Topology&, const MethodOptions&);
+
+}  // namespace skelcd::culling::detail

@@ -1,0 +1,196 @@
+#include "culling/candidates.hpp"
+
+#include <algorithm>
+
+namespace skelcd::culling {
+namespace {
+
+inline std::size_t at(std::int32_t i) { return static_cast<std::size_t>(i); }
+
+inline bool is_corner(std::int32_t v, const std::array<std::int32_t, 3>& t) {
+  return v == t[0] || v == t[1] || v == t[2];
+}
+
+inline bool share_endpoint(const std::array<std::int32_t, 2>& a, const std::array<std::int32_t, 2>& b) {
+  return a[0] == b[0] || a[0] == b[1] || a[1] == b[0] || a[1] == b[1];
+}
+
+/// VF pairs of the vertices owned by triangle `owner` against face `face`.
+template <int N>
+inline void owned_vertices_vs_face(
+    const FeatureTopology& topology,
+    std::int32_t owner,
+    std::uint8_t owned,
+    std::int32_t face,
+    const FeatureBounds<N>& bounds,
+    FeatureCandidates& out,
+    std::int64_t& feature_bv_tests) {
+  const auto& corners = topology.triangle(owner);
+  const auto& face_corners = topology.triangle(face);
+  const Dop<N>& face_bounds = bounds.triangles[at(face)];
+  for (std::size_t k = 0; k < 3; ++k) {
+    if ((owned & (1u << k)) == 0) continue;
+    const std::int32_t v = corners[k];
+    if (is_corner(v, face_corners) || topology.vertex_face_excluded(v, face)) continue;
+    ++feature_bv_tests;
+    if (bounds.vertices[at(v)].overlaps(face_bounds)) out.vf.push_back({v, face});
+  }
+}
+
+}  // namespace
+
+template <int N>
+void FeatureBounds<N>::derive(const FeatureTopology& topology, bool with_edges) {
+  const auto num_edges = with_edges ? static_cast<std::size_t>(topology.num_edges()) : 0;
+  const auto num_faces = static_cast<std::size_t>(topology.num_triangles());
+  if (with_edges) edges.resize(num_edges);
+  triangles.resize(num_faces);
+  for (std::size_t e = 0; e < num_edges; ++e) {
+    const auto& ed = topology.edge(static_cast<std::int32_t>(e));
+    Dop<N> d = vertices[at(ed[0])];
+    d.merge(vertices[at(ed[1])]);
+    edges[e] = d;
+  }
+  for (std::size_t f = 0; f < num_faces; ++f) {
+    const auto& t = topology.triangle(static_cast<std::int32_t>(f));
+    Dop<N> d = vertices[at(t[0])];
+    d.merge(vertices[at(t[1])]);
+    d.merge(vertices[at(t[2])]);
+    triangles[f] = d;
+  }
+}
+
+template <int N>
+void ccd_candidates_from_triangle_pairs(
+    const FeatureTopology& topology,
+    std::span<const TrianglePair> pairs,
+    const FeatureBounds<N>& bounds,
+    FeatureCandidates& out,
+    Counters& counters) {
+  std::int64_t feature_bv_tests = 0;
+  std::int64_t candidate_pairs = 0;
+  for (const TrianglePair& p : pairs) {
+    if (topology.owned_pairs_excluded(p.a, p.b)) continue;
+    ++candidate_pairs;
+    const std::uint8_t owned_a = topology.owned(p.a);
+    const std::uint8_t owned_b = topology.owned(p.b);
+    // VF: the vertices each triangle owns against the other triangle's face.
+    owned_vertices_vs_face<N>(topology, p.a, owned_a, p.b, bounds, out, feature_bv_tests);
+    owned_vertices_vs_face<N>(topology, p.b, owned_b, p.a, bounds, out, feature_bv_tests);
+    // EE: the edges a owns against the edges b owns.
+    if ((owned_a >> 3) == 0 || (owned_b >> 3) == 0) continue;
+    for (int i = 0; i < 3; ++i) {
+      if ((owned_a & (1u << (3 + i))) == 0) continue;
+      const std::int32_t ea = topology.face_edge(p.a, i);
+      const auto& ends_a = topology.edge(ea);
+      for (int j = 0; j < 3; ++j) {
+        if ((owned_b & (1u << (3 + j))) == 0) continue;
+        const std::int32_t eb = topology.face_edge(p.b, j);
+        if (share_endpoint(ends_a, topology.edge(eb)) || topology.edges_excluded(ea, eb)) continue;
+        ++feature_bv_tests;
+        if (bounds.edges[at(ea)].overlaps(bounds.edges[at(eb)])) {
+          out.ee.push_back({std::min(ea, eb), std::max(ea, eb)});
+        }
+      }
+    }
+  }
+  counters.feature_bv_tests += feature_bv_tests;
+  counters.candidate_pairs += candidate_pairs;
+}
+
+template <int N>
+void ccd_candidates_brute_force(
+    const FeatureTopology& topology,
+    const FeatureBounds<N>& bounds,
+    FeatureCandidates& out,
+    Counters& counters) {
+  const std::int32_t num_faces = topology.num_triangles();
+  const std::int32_t num_vertices = topology.num_vertices();
+  const std::int32_t num_edges = topology.num_edges();
+  std::int64_t tests = 0;
+  // Every vertex that lies on a triangle against every face it is not a corner of.
+  for (std::int32_t v = 0; v < num_vertices; ++v) {
+    if (topology.vertex_owner(v) < 0) continue;
+    const Dop<N>& bv = bounds.vertices[at(v)];
+    for (std::int32_t f = 0; f < num_faces; ++f) {
+      if (is_corner(v, topology.triangle(f)) || topology.vertex_face_excluded(v, f)) continue;
+      ++tests;
+      if (bv.overlaps(bounds.triangles[at(f)])) out.vf.push_back({v, f});
+    }
+  }
+  // Every pair of edges a < b without a common endpoint.
+  for (std::int32_t a = 0; a < num_edges; ++a) {
+    const Dop<N>& ba = bounds.edges[at(a)];
+    const auto& ends_a = topology.edge(a);
+    for (std::int32_t b = a + 1; b < num_edges; ++b) {
+      if (share_endpoint(ends_a, topology.edge(b)) || topology.edges_excluded(a, b)) continue;
+      ++tests;
+      if (ba.overlaps(bounds.edges[at(b)])) out.ee.push_back({a, b});
+    }
+  }
+  counters.feature_bv_tests += tests;
+  counters.candidate_pairs += static_cast<std::int64_t>(num_faces) * (num_faces - 1) / 2;
+}
+
+namespace {
+
+/// The DCD rules for one triangle pair: not part-excluded, not a duplicate face.
+inline bool dcd_keep(const FeatureTopology& topology, const TrianglePair& p) {
+  if (topology.triangles_excluded(p.a, p.b)) return false;
+  int shared = 0;
+  (void)topology.shared_corners(p.a, p.b, shared);
+  return shared < 3;
+}
+
+}  // namespace
+
+void dcd_filter_triangle_pairs(
+    const FeatureTopology& topology,
+    std::vector<TrianglePair>& pairs,
+    Counters& counters) {
+  const auto kept = std::remove_if(pairs.begin(), pairs.end(), [&](const TrianglePair& p) {
+    return !dcd_keep(topology, p);
+  });
+  pairs.erase(kept, pairs.end());
+  counters.candidate_pairs += static_cast<std::int64_t>(pairs.size());
+}
+
+template <int N>
+void dcd_candidates_brute_force(
+    const FeatureTopology& topology,
+    std::span<const Dop<N>> triangle_bounds,
+    std::vector<TrianglePair>& out,
+    Counters& counters) {
+  const std::int32_t num_faces = topology.num_triangles();
+  std::int64_t tests = 0;
+  for (std::int32_t a = 0; a < num_faces; ++a) {
+    const Dop<N>& ba = triangle_bounds[at(a)];
+    for (std::int32_t b = a + 1; b < num_faces; ++b) {
+      ++tests;
+      if (!ba.overlaps(triangle_bounds[at(b)])) continue;
+      const TrianglePair p{a, b};
+      if (dcd_keep(topology, p)) out.push_back(p);
+    }
+  }
+  counters.bv_tests += tests;
+  counters.candidate_pairs += static_cast<std::int64_t>(num_faces) * (num_faces - 1) / 2;
+}
+
+template struct FeatureBounds<3>;
+template struct FeatureBounds<8>;
+template void ccd_candidates_from_triangle_pairs<3>(
+    const FeatureTopology&, std::span<const TrianglePair>, const FeatureBounds<3>&,
+    FeatureCandidates&, Counters&);
+template void ccd_candidates_from_triangle_pairs<8>(
+    const FeatureTopology&, std::span<const TrianglePair>, const FeatureBounds<8>&,
+    FeatureCandidates&, Counters&);
+template void ccd_candidates_brute_force<3>(
+    const FeatureTopology&, const FeatureBounds<3>&, FeatureCandidates&, Counters&);
+template void ccd_candidates_brute_force<8>(
+    const FeatureTopology&, const FeatureBounds<8>&, FeatureCandidates&, Counters&);
+template void dcd_candidates_brute_force<3>(
+    const FeatureTopology&, std::span<const Dop<3>>, std::vector<TrianglePair>&, Counters&);
+template void dcd_candidates_brute_force<8>(
+    const FeatureTopology&, std::span<const Dop<8>>, std::vector<TrianglePair>&, Counters&);
+
+}  // namespace skelcd::culling

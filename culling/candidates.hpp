@@ -1,0 +1,106 @@
+#pragma once
+// The feature stage: from triangle pairs (or from nothing, by brute force) to the VF / EE feature
+// pairs (CCD) or triangle pairs (DCD) that go to the elementary tests. Every method shares these
+// rules, so methods differ only in which triangle pairs they hand over:
+// - a VF pair whose vertex is a corner of the face, an EE pair whose edges share an endpoint, and
+//   a triangle with itself are never tested; no pair is excluded by distance;
+// - part exclusions as in FeatureTopology;
+// - a feature pair is tested only when its features' volumes (of the interval) overlap.
+// CCD de-duplication (docs/culling.md has the proof): candidate triangle pair {A, B} produces
+// (vertex owned by A, face B), (vertex owned by B, face A) and (edge owned by A, edge owned by B).
+// A feature's volume lies inside its owner's, so a feature pair whose volumes overlap always has
+// its owner pair among the overlapping triangle pairs, and {owner, face} / {owner, owner} is one
+// pair only: each feature pair is produced at most once and never missed. Adjacent triangle pairs
+// are therefore *not* skipped for CCD: only their feature pairs that share a vertex are.
+
+#include <compare>
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "culling/dop.hpp"
+#include "culling/feature_topology.hpp"
+#include "culling/frame_result.hpp"
+
+namespace skelcd::culling {
+
+/// A vertex-face pair: welded vertex `vertex`, triangle `face`.
+struct VertexFacePair {
+  std::int32_t vertex = -1;
+  std::int32_t face = -1;
+  friend auto operator<=>(const VertexFacePair&, const VertexFacePair&) = default;
+};
+
+/// An edge-edge pair: edge ids a < b.
+struct EdgeEdgePair {
+  std::int32_t a = -1;
+  std::int32_t b = -1;
+  friend auto operator<=>(const EdgeEdgePair&, const EdgeEdgePair&) = default;
+};
+
+/// Feature pairs of one interval, in the order they were produced (not sorted).
+struct FeatureCandidates {
+  std::vector<VertexFacePair> vf;
+  std::vector<EdgeEdgePair> ee;
+  void clear() {
+    vf.clear();
+    ee.clear();
+  }
+};
+
+/// The per-interval volumes of every feature of a mesh: vertices (#W), edges (#E), triangles (#F).
+/// Edges and triangles are unions of their vertices' volumes (bit-for-bit inside their owners').
+template <int N>
+struct FeatureBounds {
+  std::vector<Dop<N>> vertices;
+  std::vector<Dop<N>> edges;
+  std::vector<Dop<N>> triangles;
+
+  /// Fills triangles (and edges, unless with_edges is false: DCD needs none) from `vertices`.
+  /// Allocation-free once the vectors have their sizes.
+  void derive(const FeatureTopology& topology, bool with_edges = true);
+};
+
+/// CCD feature stage of a hierarchy method: appends the feature pairs of each triangle pair in
+/// `pairs` (any order within a pair) to `out`.
+/// Counts counters.candidate_pairs (triangle pairs not wholly part-excluded) and
+/// counters.feature_bv_tests.
+template <int N>
+void ccd_candidates_from_triangle_pairs(
+    const FeatureTopology& topology,
+    std::span<const TrianglePair> pairs,
+    const FeatureBounds<N>& bounds,
+    FeatureCandidates& out,
+    Counters& counters);
+
+/// CCD brute force: appends every VF pair (vertex on some triangle × triangle) and EE pair
+/// (a < b) that passes the rules above — O(#W·#F + #E²) volume tests, no hierarchy.
+/// Counts counters.feature_bv_tests; sets counters.candidate_pairs to #F·(#F−1)/2 (every
+/// triangle pair is a candidate of brute force).
+template <int N>
+void ccd_candidates_brute_force(
+    const FeatureTopology& topology,
+    const FeatureBounds<N>& bounds,
+    FeatureCandidates& out,
+    Counters& counters);
+
+/// DCD feature stage: keeps (in place, order kept) the triangle pairs to test: drops
+/// part-excluded pairs and pairs of triangles on the same three welded vertices (duplicate
+/// faces). Pairs sharing one or two vertices stay: the exact test handles them. Counts
+/// counters.candidate_pairs (pairs kept).
+void dcd_filter_triangle_pairs(
+    const FeatureTopology& topology,
+    std::vector<TrianglePair>& pairs,
+    Counters& counters);
+
+/// DCD brute force: appends every pair a < b whose triangle volumes overlap (counted in
+/// counters.bv_tests), then filters as dcd_filter_triangle_pairs except that candidate_pairs is
+/// set to #F·(#F−1)/2.
+template <int N>
+void dcd_candidates_brute_force(
+    const FeatureTopology& topology,
+    std::span<const Dop<N>> triangle_bounds,
+    std::vector<TrianglePair>& out,
+    Counters& counters);
+
+}  // namespace skelcd::culling

@@ -1,0 +1,61 @@
+#pragma once
+// The elementary stage every method ends with: the VF / EE CCD tests of a set of feature pairs
+// and the triangle-triangle DCD tests of a set of triangle pairs, through the ccd/ kernels (or
+// substitutes: tests inject reference or counting implementations).
+
+#include <span>
+
+#include "ccd/accuracy.hpp"
+#include "ccd/ccd_types.hpp"
+#include "ccd/edge_edge.hpp"
+#include "ccd/triangle_triangle.hpp"
+#include "ccd/vertex_face.hpp"
+#include "culling/candidates.hpp"
+#include "culling/feature_topology.hpp"
+#include "culling/frame_result.hpp"
+#include "skinning/mesh.hpp"
+
+namespace skelcd::culling {
+
+/// The three elementary tests a method calls. A null member means "the ccd/ kernel".
+struct ElementaryTests {
+  using VertexFaceFn =
+      ccd::CcdResult (*)(const ccd::VertexFaceQuery&, ccd::Accuracy, const ccd::CcdOptions&);
+  using EdgeEdgeFn =
+      ccd::CcdResult (*)(const ccd::EdgeEdgeQuery&, ccd::Accuracy, const ccd::CcdOptions&);
+  using TrianglesFn = bool (*)(const ccd::TriangleTriangleQuery&, const ccd::SharedCorners&);
+  VertexFaceFn vertex_face = nullptr;
+  EdgeEdgeFn edge_edge = nullptr;
+  TrianglesFn triangles = nullptr;
+};
+
+/// `tests` with every null member replaced by the ccd/ kernel (ccd::vertex_face_ccd,
+/// ccd::edge_edge_ccd, ccd::triangles_intersect).
+[[nodiscard]] ElementaryTests with_ccd_defaults(ElementaryTests tests);
+
+/// Runs the VF and EE tests of `candidates` over the interval x_t0 → x_t1 and appends the hits to
+/// out.contacts, then sorts the appended contacts canonically (kind, a, b). Counts vf_tests,
+/// ee_tests, vf_contacts, ee_contacts.
+/// @param x_t0,x_t1 #W × 3 welded positions.  @pre `tests` has no null member.
+void run_ccd_tests(
+    const FeatureTopology& topology,
+    const FeatureCandidates& candidates,
+    const skinning::Positions& x_t0,
+    const skinning::Positions& x_t1,
+    const ElementaryTests& tests,
+    ccd::Accuracy accuracy,
+    const ccd::CcdOptions& options,
+    FrameResult& out);
+
+/// Runs the exact triangle-triangle test of each pair (with the corners the two share as mesh
+/// vertices) and appends the intersecting ones to out.dcd_pairs, sorted (a, b). Counts tt_tests
+/// and dcd_pairs.
+/// @param pairs a < b.  @param x #W × 3 welded positions.  @pre `tests` has no null member.
+void run_dcd_tests(
+    const FeatureTopology& topology,
+    std::span<const TrianglePair> pairs,
+    const skinning::Positions& x,
+    const ElementaryTests& tests,
+    FrameResult& out);
+
+}  // namespace skelcd::culling
