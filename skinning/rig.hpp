@@ -63,17 +63,27 @@ struct Clip {
   std::vector<Channel> channels;
   /// Sorted union of every channel's key times (seconds).
   std::vector<double> key_times;
-  /// Keys per second: (#key_times - 1) / duration_s, or 0 when it cannot be told.
+  /// Keys per second: (#key_times - 1) / (last key time - first key time), or 0 when it cannot
+  /// be told (fewer than two distinct key times). Measured over the keys' own span, so a clip
+  /// whose first key is at 1/24 s still reports 24 keys/s.
   [[nodiscard]] double keys_per_s() const {
-    return (key_times.size() > 1 && duration_s > 0)
-               ? static_cast<double>(key_times.size() - 1) / duration_s
-               : 0.0;
+    if (key_times.size() < 2) return 0.0;
+    const double span = key_times.back() - key_times.front();
+    return span > 0 ? static_cast<double>(key_times.size() - 1) / span : 0.0;
   }
 };
 
 /// #V × #B skin weights, rows normalised to sum 1; a vertex with no influence is rigidly attached
 /// to the mesh node's transform (empty row) — see RigMotion.
 using SkinWeights = Eigen::SparseMatrix<double, Eigen::RowMajor>;
+
+/// How the vertices of one part that carry no skin weight move: rigidly with a node (an unskinned
+/// mesh hanging from a node of the hierarchy, as in RobotExpressive.glb).
+struct PartAttachment {
+  std::int32_t node = -1;  ///< index into Skeleton::nodes; -1: the vertices stay at rest
+  /// Object space (rest mesh) → the node's space at rest, like Bone::inverse_bind.
+  Eigen::Affine3d inverse_bind = Eigen::Affine3d::Identity();
+};
 
 struct Rig {
   Mesh mesh;
@@ -82,11 +92,25 @@ struct Rig {
   std::vector<Clip> clips;
   /// Where it came from (file path or generator spec), for messages and logs.
   std::string source;
+  /// #parts or empty. A vertex whose weight row is empty follows the attachment of its part
+  /// (Mesh::vertex_part); with no attachment (empty, or node -1) it stays at its rest position.
+  std::vector<PartAttachment> part_attachments;
+
+  /// Index of the clip with this name, -1 when there is none.
+  [[nodiscard]] std::int32_t find_clip(const std::string& name) const {
+    for (std::size_t c = 0; c < clips.size(); ++c) {
+      if (clips[c].name == name) return static_cast<std::int32_t>(c);
+    }
+    return -1;
+  }
 };
 
 /// Throws InvalidInput naming rig.source when the rig is not usable: mesh invalid, weights shape
 /// or sign wrong, node parents not preceding children (cycles), channel nodes out of range,
 /// non-finite keys or transforms.
+/// Also refused: bone or attachment nodes out of range, a weight row that does not sum to 1
+/// (relative 1e-9: rows are normalised at import), key times not increasing, quaternions that are
+/// not unit (relative 1e-9), negative durations.
 void validate_rig(const Rig& rig);
 
 }  // namespace skelcd::skinning

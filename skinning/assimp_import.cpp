@@ -1,0 +1,672 @@
+#include "skinning/assimp_import.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cctype>
+#include <cmath>
+#include <cstdint>
+#include <map>
+#include <mutex>
+#include <string>
+#include <unordered_map>
+#include <unordered_set>
+#include <utility>
+#include <vector>
+
+#include <assimp/DefaultLogger.hpp>
+#include <assimp/Importer.hpp>
+#include <assimp/LogStream.hpp>
+#include <assimp/postprocess.h>
+#include <assimp/scene.h>
+
+#include "skinning/errors.hpp"
+
+namespace skelcd::skinning {
+namespace {
+
+// Weights are stored in single precision and exporters round them; a row whose sum is off by
+// less than this is not worth a line in the problem list (it is normalised all the same).
+constexpr double kWeightSumReportTolerance = 1e-4;
+// Assimp warnings repeated in the problem list, at most (the rest are counted).
+constexpr std::size_t kMaxForwardedWarnings = 8;
+// Ticks per second assimp's loaders assume when a file does not say (aiAnimation docs).
+constexpr double kDefaultTicksPerSecond = 25.0;
+
+// ---------------------------------------------------------------------------------------------
+// assimp's logger is a process-wide singleton: imports are serialised, and each one listens to
+// warnings and errors through its own stream while it runs.
+
+std::mutex& import_mutex() {
+  static std::mutex m;
+  return m;
+}
+
+class CollectingStream final : public Assimp::LogStream {
+ public:
+  void write(const char* message) override {
+    std::string line(message);
+    // DefaultLogger prefixes "Warn,  T0: " and appends a newline.
+    if (const auto colon = line.find(": "); colon != std::string::npos && colon < 16) line.erase(0, colon + 2);
+    while (!line.empty() && (line.back() == '\n' || line.back() == '\r')) line.pop_back();
+    lines.push_back(std::move(line));
+  }
+  std::vector<std::string> lines;
+};
+
+class ScopedLogCapture {
+ public:
+  ScopedLogCapture() {
+    if (Assimp::DefaultLogger::isNullLogger()) {
+      Assimp::DefaultLogger::create("", Assimp::Logger::NORMAL, 0);  // no file, no console
+    }
+    Assimp::DefaultLogger::get()->attachStream(&stream_, Assimp::Logger::Warn | Assimp::Logger::Err);
+  }
+  ~ScopedLogCapture() {
+    // Detaching hands ownership of the stream back to us (assimp does not delete it).
+    Assimp::DefaultLogger::get()->detachStream(&stream_, Assimp::Logger::Warn | Assimp::Logger::Err);
+  }
+  ScopedLogCapture(const ScopedLogCapture&) = delete;
+  ScopedLogCapture& operator=(const ScopedLogCapture&) = delete;
+  [[nodiscard]] const std::vector<std::string>& lines() const { return stream_.lines; }
+
+ private:
+  CollectingStream stream_;
+};
+
+std::string lower(std::string s) {
+  std::transform(s.begin(), s.end(), s.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  return s;
+}
+
+// ---------------------------------------------------------------------------------------------
+
+struct Context {
+  std::string file;
+  std::vector<std::string> problems;
+  [[noreturn]] void invalid(const std::string& fault) const { throw InvalidInput(file + ": " + fault); }
+};
+
+Eigen::Affine3d to_affine(const aiMatrix4x4& m, const Context& ctx, const std::string& what) {
+  Eigen::Matrix4d e;
+  for (unsigned r = 0; r < 4; ++r) {
+    for (unsigned c = 0; c < 4; ++c) e(r, c) = static_cast<double>(m[r][c]);
+  }
+  if (!e.allFinite()) ctx.invalid(what + " has a non-finite transform");
+  if (e(3, 0) != 0.0 || e(3, 1) != 0.0 || e(3, 2) != 0.0 || e(3, 3) != 1.0) {
+    ctx.invalid(what + " has a projective transform (last row is not 0 0 0 1)");
+  }
+  Eigen::Affine3d a = Eigen::Affine3d::Identity();
+  a.matrix() = e;
+  return a;
+}
+
+Eigen::Vector3d to_vector(const aiVector3D& v) {
+  return {static_cast<double>(v.x), static_cast<double>(v.y), static_cast<double>(v.z)};
+}
+
+std::string node_label(const aiNode* n) { return "node '" + std::string(n->mName.C_Str()) + "'"; }
+
+// Unit scale to metres that the file declares and assimp leaves to the caller.
+double file_unit_scale(const aiScene* scene, Context& ctx) {
+  const aiMetadata* meta = scene->mMetaData;
+  if (meta == nullptr) return 1.0;
+  aiString format;
+  if (!meta->Get("SourceAsset_Format", format) || lower(format.C_Str()).find("fbx") == std::string::npos) return 1.0;
+  double factor = 0.0;
+  float factor_f = 0.0f;
+  if (!meta->Get("UnitScaleFactor", factor)) {
+    if (!meta->Get("UnitScaleFactor", factor_f)) return 1.0;
+    factor = static_cast<double>(factor_f);
+  }
+  if (!std::isfinite(factor) || factor <= 0) {
+    ctx.problems.push_back("FBX UnitScaleFactor " + std::to_string(factor) + " is not positive; unit scale ignored");
+    return 1.0;
+  }
+  return factor / 100.0;  // FBX units are centimetres times UnitScaleFactor
+}
+
+// ---------------------------------------------------------------------------------------------
+// The node hierarchy, parents first. assimp builds a tree of pointers; a malformed file (or a
+// loader bug) could still make a node reachable twice, which would be a cycle for us.
+
+struct Hierarchy {
+  std::vector<const aiNode*> nodes;                  // pre-order
+  std::vector<Eigen::Affine3d> scene_global;          // without the unit scale
+  std::unordered_map<std::string, std::vector<std::int32_t>> by_name;
+};
+
+Hierarchy read_hierarchy(const aiScene* scene, Skeleton& skeleton, Context& ctx) {
+  Hierarchy h;
+  if (scene->mRootNode == nullptr) ctx.invalid("the scene has no root node");
+  std::unordered_set<const aiNode*> seen;
+  std::vector<std::pair<const aiNode*, std::int32_t>> stack{{scene->mRootNode, -1}};
+  while (!stack.empty()) {
+    const auto [node, parent] = stack.back();
+    stack.pop_back();
+    if (!seen.insert(node).second) ctx.invalid(node_label(node) + " is reached twice in the node hierarchy (a cycle)");
+    const auto index = static_cast<std::int32_t>(h.nodes.size());
+    h.nodes.push_back(node);
+    SkeletonNode sn;
+    sn.name = node->mName.C_Str();
+    sn.parent = parent;
+    sn.rest_local = to_affine(node->mTransformation, ctx, node_label(node));
+    h.scene_global.push_back(parent < 0 ? sn.rest_local : h.scene_global[static_cast<std::size_t>(parent)] * sn.rest_local);
+    h.by_name[sn.name].push_back(index);
+    skeleton.nodes.push_back(std::move(sn));
+    if (node->mNumChildren > 0 && node->mChildren == nullptr) ctx.invalid(node_label(node) + " lists children it does not have");
+    for (unsigned c = node->mNumChildren; c-- > 0;) {
+      if (node->mChildren[c] == nullptr) ctx.invalid(node_label(node) + " has a null child");
+      stack.emplace_back(node->mChildren[c], index);
+    }
+  }
+  return h;
+}
+
+// assimp refers to bones' and channels' nodes by name, and names need not be unique (glTF
+// allows duplicates; RobotExpressive.glb names a mesh node like the bone above it). Among
+// namesakes prefer nodes that already host a bone, then nodes without meshes, then the first.
+std::int32_t resolve_node(
+    const Hierarchy& h,
+    const std::string& name,
+    const std::vector<bool>* hosts_bone,
+    Context& ctx,
+    const std::string& what) {
+  const auto it = h.by_name.find(name);
+  if (it == h.by_name.end()) return -1;
+  const auto& candidates = it->second;
+  if (candidates.size() == 1) return candidates.front();
+  auto pick = [&](auto&& predicate) -> std::int32_t {
+    for (auto c : candidates) {
+      if (predicate(c)) return c;
+    }
+    return -1;
+  };
+  std::int32_t chosen = -1;
+  if (hosts_bone != nullptr) chosen = pick([&](std::int32_t c) { return (*hosts_bone)[static_cast<std::size_t>(c)]; });
+  if (chosen < 0) chosen = pick([&](std::int32_t c) { return h.nodes[static_cast<std::size_t>(c)]->mNumMeshes == 0; });
+  if (chosen < 0) chosen = candidates.front();
+  ctx.problems.push_back(std::to_string(candidates.size()) + " nodes are named '" + name + "'; " + what +
+                         " bound to node " + std::to_string(chosen));
+  return chosen;
+}
+
+// ---------------------------------------------------------------------------------------------
+
+struct PendingBone {
+  std::int32_t node;
+  Eigen::Affine3d inverse_bind;  // object space
+  std::string name;
+};
+
+// Two meshes bind one node with "the same" matrix when their object-space inverse binds agree up
+// to the rounding of composing them (relative to the largest entry).
+constexpr double kSameBindTolerance = 1e-12;
+
+bool same_transform(const Eigen::Affine3d& a, const Eigen::Affine3d& b) {
+  const double scale = 1.0 + std::max(a.matrix().cwiseAbs().maxCoeff(), b.matrix().cwiseAbs().maxCoeff());
+  return (a.matrix() - b.matrix()).cwiseAbs().maxCoeff() <= kSameBindTolerance * scale;
+}
+
+struct MeshBuild {
+  std::vector<Eigen::Vector3d> positions;
+  std::vector<std::array<std::int32_t, 3>> triangles;
+  std::vector<Eigen::Triplet<double>> weights;  // (vertex, pending bone, raw weight)
+  std::vector<PendingBone> bones;
+  double rest_pose_deviation = 0.0;
+};
+
+// One part: its triangles, its vertices placed in object space, and its skin.
+void add_part(
+    const aiScene* scene,
+    const aiMesh* am,
+    std::int32_t node,
+    const Hierarchy& h,
+    const Eigen::Affine3d& unit,
+    Rig& rig,
+    MeshBuild& build,
+    Context& ctx) {
+  const std::string mesh_name = am->mName.length > 0 ? am->mName.C_Str() : h.nodes[static_cast<std::size_t>(node)]->mName.C_Str();
+  const std::string label = "mesh '" + mesh_name + "'";
+  (void)scene;
+  if (am->mNumVertices > 0 && am->mVertices == nullptr) ctx.invalid(label + " has no vertex array");
+  if (am->mNumFaces > 0 && am->mFaces == nullptr) ctx.invalid(label + " has no face array");
+
+  // Faces: triangles are kept; points and lines (which Triangulate leaves alone) are dropped.
+  std::size_t points = 0, lines = 0, triangles = 0;
+  for (unsigned f = 0; f < am->mNumFaces; ++f) {
+    const aiFace& face = am->mFaces[f];
+    if (face.mNumIndices > 0 && face.mIndices == nullptr) ctx.invalid(label + ", face " + std::to_string(f) + " has no indices");
+    for (unsigned k = 0; k < face.mNumIndices; ++k) {
+      if (face.mIndices[k] >= am->mNumVertices) {
+        ctx.invalid(label + ", face " + std::to_string(f) + " has vertex index " + std::to_string(face.mIndices[k]) +
+                    " out of range [0, " + std::to_string(am->mNumVertices) + ")");
+      }
+    }
+    if (face.mNumIndices == 3) ++triangles;
+    else if (face.mNumIndices == 2) ++lines;
+    else if (face.mNumIndices == 1) ++points;
+    else ctx.invalid(label + ", face " + std::to_string(f) + " has " + std::to_string(face.mNumIndices) + " indices after triangulation");
+  }
+  if (triangles == 0) {
+    ctx.problems.push_back(label + " has no triangles (" + std::to_string(points) + " points, " + std::to_string(lines) +
+                           " lines): skipped");
+    return;
+  }
+  if (points + lines > 0) {
+    ctx.problems.push_back(label + ": dropped " + std::to_string(points) + " points and " + std::to_string(lines) + " lines");
+  }
+  if (am->mNumAnimMeshes > 0) {
+    ctx.problems.push_back(label + ": " + std::to_string(am->mNumAnimMeshes) + " morph targets ignored");
+  }
+  for (unsigned v = 0; v < am->mNumVertices; ++v) {
+    if (!to_vector(am->mVertices[v]).allFinite()) {
+      ctx.invalid(label + ", vertex " + std::to_string(v) + " has a non-finite coordinate");
+    }
+  }
+
+  const auto part = static_cast<std::int32_t>(rig.mesh.part_names.size());
+  const auto base = static_cast<std::int32_t>(build.positions.size());
+  const Eigen::Affine3d& mesh_global = h.scene_global[static_cast<std::size_t>(node)];
+
+  // Skin: which bind frame B places the mesh? assimp's offset matrices map mesh space to bone
+  // space, and a skinned vertex poses as G_bone · offset · v whatever the mesh node says. Files
+  // disagree on the frame their bind pose lives in: some store offsets relative to the mesh
+  // node (G_rest · offset ≈ mesh node transform: glTF, FBX), others relative to the scene
+  // (G_rest · offset ≈ identity: .X). Posing never depends on B (rest = B v and inverse bind =
+  // offset · B⁻¹ cancel); B only decides where the bind pose sits. Take the one under which the
+  // file's own rest hierarchy reproduces the bind pose best, and report what is left.
+  Eigen::Affine3d bind_frame = mesh_global;
+  std::vector<std::int32_t> bone_node(am->mNumBones, -1);
+  std::vector<Eigen::Affine3d> offset(am->mNumBones);
+  if (am->mNumBones > 0) {
+    if (am->mBones == nullptr) ctx.invalid(label + " lists bones it does not have");
+    std::vector<Eigen::Vector3d> skinned(am->mNumVertices, Eigen::Vector3d::Zero());
+    std::vector<double> weight_sum(am->mNumVertices, 0.0);
+    for (unsigned b = 0; b < am->mNumBones; ++b) {
+      const aiBone* bone = am->mBones[b];
+      if (bone == nullptr) ctx.invalid(label + " has a null bone " + std::to_string(b));
+      const std::string bone_name = bone->mName.C_Str();
+      bone_node[b] = resolve_node(h, bone_name, nullptr, ctx, "bone '" + bone_name + "'");
+      if (bone_node[b] < 0) ctx.invalid(label + ", bone '" + bone_name + "' names no node of the hierarchy");
+      offset[b] = to_affine(bone->mOffsetMatrix, ctx, label + ", bone '" + bone_name + "' offset matrix");
+      if (bone->mNumWeights > 0 && bone->mWeights == nullptr) ctx.invalid(label + ", bone '" + bone_name + "' has no weight array");
+      const Eigen::Affine3d at_rest = h.scene_global[static_cast<std::size_t>(bone_node[b])] * offset[b];
+      for (unsigned k = 0; k < bone->mNumWeights; ++k) {
+        const auto& vw = bone->mWeights[k];
+        const double w = static_cast<double>(vw.mWeight);
+        if (vw.mVertexId >= am->mNumVertices) {
+          ctx.invalid(label + ", bone '" + bone_name + "' weights vertex " + std::to_string(vw.mVertexId) +
+                      " out of range [0, " + std::to_string(am->mNumVertices) + ")");
+        }
+        if (!std::isfinite(w) || w < 0) {
+          ctx.invalid(label + ", bone '" + bone_name + "' has weight " + std::to_string(w) + " for vertex " +
+                      std::to_string(vw.mVertexId) + " (must be finite and >= 0)");
+        }
+        if (w == 0) continue;
+        skinned[vw.mVertexId] += w * (at_rest * to_vector(am->mVertices[vw.mVertexId]));
+        weight_sum[vw.mVertexId] += w;
+      }
+    }
+    double dev_mesh = 0.0, dev_scene = 0.0;
+    for (unsigned v = 0; v < am->mNumVertices; ++v) {
+      if (weight_sum[v] <= 0) continue;
+      const Eigen::Vector3d p = skinned[v] / weight_sum[v];
+      const Eigen::Vector3d local = to_vector(am->mVertices[v]);
+      dev_mesh = std::max(dev_mesh, (p - mesh_global * local).norm());
+      dev_scene = std::max(dev_scene, (p - local).norm());
+    }
+    if (dev_scene < dev_mesh) bind_frame = Eigen::Affine3d::Identity();
+    const double unit_scale = unit.linear()(0, 0);
+    build.rest_pose_deviation = std::max(build.rest_pose_deviation, unit_scale * std::min(dev_mesh, dev_scene));
+  }
+
+  // Vertices in object space.
+  const Eigen::Affine3d place = unit * bind_frame;
+  for (unsigned v = 0; v < am->mNumVertices; ++v) {
+    build.positions.push_back(place * to_vector(am->mVertices[v]));
+    rig.mesh.vertex_part.push_back(part);
+    rig.mesh.vertex_index_in_part.push_back(static_cast<std::int32_t>(v));
+  }
+  for (unsigned f = 0; f < am->mNumFaces; ++f) {
+    const aiFace& face = am->mFaces[f];
+    if (face.mNumIndices != 3) continue;
+    build.triangles.push_back({base + static_cast<std::int32_t>(face.mIndices[0]), base + static_cast<std::int32_t>(face.mIndices[1]),
+                               base + static_cast<std::int32_t>(face.mIndices[2])});
+    rig.mesh.face_part.push_back(part);
+    rig.mesh.face_index_in_part.push_back(static_cast<std::int32_t>(f));
+  }
+  rig.mesh.part_names.push_back(mesh_name);
+
+  // Unweighted vertices follow the mesh node rigidly.
+  PartAttachment attachment;
+  attachment.node = node;
+  attachment.inverse_bind = (unit * mesh_global).inverse();
+  rig.part_attachments.push_back(attachment);
+
+  // Bones: one per (node, bind matrix); meshes sharing a skeleton share bones.
+  const Eigen::Affine3d to_file = place.inverse();  // object space → mesh space
+  std::vector<bool> weighted(am->mNumVertices, false);
+  for (unsigned b = 0; b < am->mNumBones; ++b) {
+    const aiBone* bone = am->mBones[b];
+    const Eigen::Affine3d inverse_bind = offset[b] * to_file;
+    std::int32_t index = -1;
+    for (std::size_t k = 0; k < build.bones.size(); ++k) {
+      if (build.bones[k].node == bone_node[b] && same_transform(build.bones[k].inverse_bind, inverse_bind)) {
+        index = static_cast<std::int32_t>(k);
+        break;
+      }
+    }
+    if (index < 0) {
+      const bool node_taken = std::any_of(build.bones.begin(), build.bones.end(), [&](const PendingBone& p) { return p.node == bone_node[b]; });
+      if (node_taken) {
+        ctx.problems.push_back(label + ": bone '" + std::string(bone->mName.C_Str()) +
+                               "' has a different bind matrix than in another mesh; kept as a separate bone");
+      }
+      index = static_cast<std::int32_t>(build.bones.size());
+      build.bones.push_back({bone_node[b], inverse_bind, bone->mName.C_Str()});
+    }
+    for (unsigned k = 0; k < bone->mNumWeights; ++k) {
+      const auto& vw = bone->mWeights[k];
+      if (vw.mWeight > 0) {
+        build.weights.emplace_back(base + static_cast<int>(vw.mVertexId), index, static_cast<double>(vw.mWeight));
+        weighted[vw.mVertexId] = true;
+      }
+    }
+  }
+  if (am->mNumBones > 0) {
+    const auto unweighted = static_cast<std::size_t>(std::count(weighted.begin(), weighted.end(), false));
+    if (unweighted > 0) {
+      ctx.problems.push_back(label + ": " + std::to_string(unweighted) +
+                             " vertices have no skin weight; they follow the mesh node rigidly");
+    }
+  }
+}
+
+// Bones sorted by node (parents first), weights normalised, bone parents and rest segments.
+void finish_skin(MeshBuild& build, const Hierarchy& h, Rig& rig, Context& ctx) {
+  std::vector<std::int32_t> order(build.bones.size());
+  for (std::size_t i = 0; i < order.size(); ++i) order[i] = static_cast<std::int32_t>(i);
+  std::stable_sort(order.begin(), order.end(), [&](std::int32_t a, std::int32_t b) {
+    return build.bones[static_cast<std::size_t>(a)].node < build.bones[static_cast<std::size_t>(b)].node;
+  });
+  std::vector<std::int32_t> new_index(order.size());
+  auto& bones = rig.skeleton.bones;
+  for (std::size_t k = 0; k < order.size(); ++k) {
+    const auto& p = build.bones[static_cast<std::size_t>(order[k])];
+    new_index[static_cast<std::size_t>(order[k])] = static_cast<std::int32_t>(k);
+    Bone bone;
+    bone.name = p.name;
+    bone.node = p.node;
+    bone.inverse_bind = p.inverse_bind;
+    bones.push_back(bone);
+  }
+  // Bone hierarchy: nearest ancestor node hosting a bone.
+  const auto nn = rig.skeleton.nodes.size();
+  std::vector<std::int32_t> bone_of_node(nn, -1);
+  for (std::size_t b = 0; b < bones.size(); ++b) {
+    auto& slot = bone_of_node[static_cast<std::size_t>(bones[b].node)];
+    if (slot < 0) slot = static_cast<std::int32_t>(b);
+  }
+  for (auto& bone : bones) {
+    for (auto n = rig.skeleton.nodes[static_cast<std::size_t>(bone.node)].parent; n >= 0; n = rig.skeleton.nodes[static_cast<std::size_t>(n)].parent) {
+      if (bone_of_node[static_cast<std::size_t>(n)] >= 0) {
+        bone.parent = bone_of_node[static_cast<std::size_t>(n)];
+        break;
+      }
+    }
+  }
+
+  // Weights: #V × #B, each non-empty row scaled to sum 1.
+  const auto nv = static_cast<Eigen::Index>(build.positions.size());
+  for (auto& t : build.weights) t = Eigen::Triplet<double>(t.row(), new_index[static_cast<std::size_t>(t.col())], t.value());
+  rig.weights.resize(nv, static_cast<Eigen::Index>(bones.size()));
+  rig.weights.setFromTriplets(build.weights.begin(), build.weights.end());
+  rig.weights.makeCompressed();
+  std::size_t off = 0;
+  double lowest = 1.0, highest = 1.0;
+  for (Eigen::Index v = 0; v < rig.weights.outerSize(); ++v) {
+    double sum = 0;
+    for (SkinWeights::InnerIterator it(rig.weights, v); it; ++it) sum += it.value();
+    if (sum <= 0) continue;
+    if (std::abs(sum - 1.0) > kWeightSumReportTolerance) {
+      ++off;
+      lowest = std::min(lowest, sum);
+      highest = std::max(highest, sum);
+    }
+    for (SkinWeights::InnerIterator it(rig.weights, v); it; ++it) it.valueRef() /= sum;
+  }
+  if (off > 0) {
+    ctx.problems.push_back("skin weights of " + std::to_string(off) + " vertices did not sum to 1 (from " +
+                           std::to_string(lowest) + " to " + std::to_string(highest) + "); normalised");
+  }
+
+  // Rest segments: head at the bone's joint in the bind pose; tail at the mean of its child
+  // bones' heads, else of its node's children (e.g. Blender's "_end" nodes) placed in the bind
+  // pose, else extended along the bone's own y axis (the glTF/Blender bone direction) by half
+  // the distance to its parent's head, or by 5% of the mesh's extent for a lone root bone.
+  std::vector<Eigen::Affine3d> bind_global(bones.size());
+  for (std::size_t b = 0; b < bones.size(); ++b) {
+    bind_global[b] = bones[b].inverse_bind.inverse();
+    bones[b].rest_head = bind_global[b].translation();
+  }
+  double extent = 0.0;
+  if (nv > 0) {
+    Eigen::Vector3d lo = build.positions.front(), hi = build.positions.front();
+    for (const auto& p : build.positions) {
+      lo = lo.cwiseMin(p);
+      hi = hi.cwiseMax(p);
+    }
+    extent = (hi - lo).norm();
+  }
+  for (std::size_t b = 0; b < bones.size(); ++b) {
+    Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+    int count = 0;
+    for (const auto& child : bones) {
+      if (child.parent == static_cast<std::int32_t>(b) && child.node != bones[b].node) {
+        sum += child.rest_head;
+        ++count;
+      }
+    }
+    if (count == 0) {
+      const aiNode* node = h.nodes[static_cast<std::size_t>(bones[b].node)];
+      for (unsigned c = 0; c < node->mNumChildren; ++c) {
+        const auto it = std::find(h.nodes.begin(), h.nodes.end(), node->mChildren[c]);
+        const auto child = static_cast<std::size_t>(it - h.nodes.begin());
+        if (node->mChildren[c]->mNumMeshes > 0) continue;  // a mesh hanging off the joint
+        sum += bind_global[b] * rig.skeleton.nodes[child].rest_local.translation();
+        ++count;
+      }
+    }
+    Eigen::Vector3d tail = count > 0 ? Eigen::Vector3d(sum / count) : bones[b].rest_head;
+    if ((tail - bones[b].rest_head).norm() == 0.0) {
+      double length = 0.05 * extent;
+      if (bones[b].parent >= 0) {
+        const double to_parent = (bones[b].rest_head - bones[static_cast<std::size_t>(bones[b].parent)].rest_head).norm();
+        if (to_parent > 0) length = 0.5 * to_parent;
+      }
+      const Eigen::Vector3d axis = bind_global[b].linear().col(1);
+      const double axis_norm = axis.norm();
+      tail = bones[b].rest_head + (axis_norm > 0 ? Eigen::Vector3d(axis / axis_norm) : Eigen::Vector3d::UnitY()) * length;
+    }
+    bones[b].rest_tail = tail;
+  }
+}
+
+// ---------------------------------------------------------------------------------------------
+
+void read_clips(const aiScene* scene, const Hierarchy& h, Rig& rig, Context& ctx) {
+  std::vector<bool> hosts_bone(rig.skeleton.nodes.size(), false);
+  for (const auto& b : rig.skeleton.bones) hosts_bone[static_cast<std::size_t>(b.node)] = true;
+  std::map<std::string, int> used_names;
+  for (unsigned a = 0; a < scene->mNumAnimations; ++a) {
+    const aiAnimation* anim = scene->mAnimations[a];
+    if (anim == nullptr) ctx.invalid("animation " + std::to_string(a) + " is null");
+    Clip clip;
+    clip.name = anim->mName.C_Str();
+    if (clip.name.empty()) {
+      clip.name = "clip_" + std::to_string(a);
+      ctx.problems.push_back("animation " + std::to_string(a) + " has no name; called '" + clip.name + "'");
+    }
+    if (used_names[clip.name]++ > 0) {
+      const auto renamed = clip.name + "#" + std::to_string(a);
+      ctx.problems.push_back("animation " + std::to_string(a) + " repeats the name '" + clip.name + "'; called '" + renamed + "'");
+      clip.name = renamed;
+    }
+    const std::string label = "clip '" + clip.name + "'";
+    double ticks = anim->mTicksPerSecond;
+    if (!std::isfinite(ticks) || ticks <= 0) {
+      ticks = kDefaultTicksPerSecond;
+      ctx.problems.push_back(label + " does not give ticks per second; assumed " + std::to_string(static_cast<int>(ticks)));
+    }
+    if (!std::isfinite(anim->mDuration) || anim->mDuration < 0) ctx.invalid(label + " has duration " + std::to_string(anim->mDuration) + " ticks");
+    clip.duration_s = anim->mDuration / ticks;
+    if (anim->mNumMorphMeshChannels > 0 || anim->mNumMeshChannels > 0) {
+      ctx.problems.push_back(label + ": mesh/morph channels ignored (only node transforms are animated)");
+    }
+    std::vector<bool> animated(rig.skeleton.nodes.size(), false);
+    for (unsigned c = 0; c < anim->mNumChannels; ++c) {
+      const aiNodeAnim* na = anim->mChannels[c];
+      if (na == nullptr) ctx.invalid(label + ", channel " + std::to_string(c) + " is null");
+      const std::string node_name = na->mNodeName.C_Str();
+      const auto node = resolve_node(h, node_name, &hosts_bone, ctx, label + " channel for '" + node_name + "'");
+      if (node < 0) {
+        ctx.problems.push_back(label + ": channel for unknown node '" + node_name + "' ignored");
+        continue;
+      }
+      if (animated[static_cast<std::size_t>(node)]) {
+        ctx.problems.push_back(label + ": second channel for node '" + node_name + "' ignored");
+        continue;
+      }
+      animated[static_cast<std::size_t>(node)] = true;
+      Channel ch;
+      ch.node = node;
+      const std::string where = label + ", node '" + node_name + "'";
+      // Keys in seconds, strictly increasing: a key at the same time as the one before it is
+      // dropped (reported); a key earlier than the one before it is an error.
+      auto add_time = [&](std::vector<double>& times, double t_ticks, const char* kind, unsigned k) -> bool {
+        if (!std::isfinite(t_ticks)) ctx.invalid(where + ", " + kind + " key " + std::to_string(k) + " has a non-finite time");
+        const double t = t_ticks / ticks;
+        if (!times.empty() && t <= times.back()) {
+          if (t < times.back()) ctx.invalid(where + ", " + kind + " key " + std::to_string(k) + " is earlier than the key before it");
+          ctx.problems.push_back(where + ": " + kind + " key " + std::to_string(k) + " repeats a time; dropped");
+          return false;
+        }
+        times.push_back(t);
+        return true;
+      };
+      if ((na->mNumPositionKeys > 0 && na->mPositionKeys == nullptr) || (na->mNumRotationKeys > 0 && na->mRotationKeys == nullptr) ||
+          (na->mNumScalingKeys > 0 && na->mScalingKeys == nullptr)) {
+        ctx.invalid(where + " lists keys it does not have");
+      }
+      for (unsigned k = 0; k < na->mNumPositionKeys; ++k) {
+        const Eigen::Vector3d v = to_vector(na->mPositionKeys[k].mValue);
+        if (!v.allFinite()) ctx.invalid(where + ", translation key " + std::to_string(k) + " is not finite");
+        if (add_time(ch.translation_times, na->mPositionKeys[k].mTime, "translation", k)) ch.translations.push_back(v);
+      }
+      for (unsigned k = 0; k < na->mNumRotationKeys; ++k) {
+        const aiQuaternion& q = na->mRotationKeys[k].mValue;
+        Eigen::Quaterniond e(static_cast<double>(q.w), static_cast<double>(q.x), static_cast<double>(q.y), static_cast<double>(q.z));
+        const double norm = e.norm();
+        if (!e.coeffs().allFinite() || !(norm > 0)) ctx.invalid(where + ", rotation key " + std::to_string(k) + " is not a rotation");
+        e.coeffs() /= norm;
+        if (add_time(ch.rotation_times, na->mRotationKeys[k].mTime, "rotation", k)) ch.rotations.push_back(e);
+      }
+      for (unsigned k = 0; k < na->mNumScalingKeys; ++k) {
+        const Eigen::Vector3d v = to_vector(na->mScalingKeys[k].mValue);
+        if (!v.allFinite()) ctx.invalid(where + ", scale key " + std::to_string(k) + " is not finite");
+        if (add_time(ch.scale_times, na->mScalingKeys[k].mTime, "scale", k)) ch.scales.push_back(v);
+      }
+      for (const auto* times : {&ch.translation_times, &ch.rotation_times, &ch.scale_times}) {
+        clip.key_times.insert(clip.key_times.end(), times->begin(), times->end());
+      }
+      clip.channels.push_back(std::move(ch));
+    }
+    std::sort(clip.key_times.begin(), clip.key_times.end());
+    clip.key_times.erase(std::unique(clip.key_times.begin(), clip.key_times.end()), clip.key_times.end());
+    rig.clips.push_back(std::move(clip));
+  }
+}
+
+}  // namespace
+
+ImportedRig import_rig(const std::filesystem::path& file, const ImportOptions& options) {
+  Context ctx{file.string(), {}};
+  std::error_code ec;
+  if (!std::filesystem::exists(file, ec)) throw IoError(ctx.file + ": no such file");
+  if (std::filesystem::is_directory(file, ec)) throw IoError(ctx.file + ": is a directory, not a model file");
+  if (std::filesystem::file_size(file, ec) == 0 && !ec) throw IoError(ctx.file + ": empty file");
+
+  std::lock_guard lock(import_mutex());
+  ScopedLogCapture log;
+  Assimp::Importer importer;
+  unsigned flags = aiProcess_Triangulate | aiProcess_ValidateDataStructure;
+  if (options.join_identical_vertices) flags |= aiProcess_JoinIdenticalVertices;
+  const aiScene* scene = importer.ReadFile(ctx.file, flags);
+  if (scene == nullptr) {
+    std::string reason = importer.GetErrorString();
+    if (reason.empty()) reason = "assimp could not read it";
+    throw IoError(ctx.file + ": " + reason);
+  }
+  // assimp recovers from some broken data by dropping it with a warning; for us that is a
+  // wrong answer, not a recovery.
+  std::vector<std::string> warnings;
+  for (const auto& line : log.lines()) {
+    const auto l = lower(line);
+    if (l.find("out-of-range") != std::string::npos || l.find("out of range") != std::string::npos) {
+      throw InvalidInput(ctx.file + ": " + line);
+    }
+    if (l.find("bone weight sum") != std::string::npos) continue;  // we normalise and report it ourselves
+    if (std::find(warnings.begin(), warnings.end(), line) == warnings.end()) warnings.push_back(line);
+  }
+  if ((scene->mFlags & AI_SCENE_FLAGS_INCOMPLETE) != 0) throw InvalidInput(ctx.file + ": assimp marked the scene incomplete");
+  if (scene->mNumMeshes > 0 && scene->mMeshes == nullptr) ctx.invalid("the scene lists meshes it does not have");
+
+  ImportedRig out;
+  Rig& rig = out.rig;
+  rig.source = ctx.file;
+  out.unit_scale = options.convert_to_metres ? file_unit_scale(scene, ctx) : 1.0;
+  const Eigen::Affine3d unit(Eigen::Scaling(out.unit_scale));
+  rig.skeleton.root_transform = unit;
+
+  const Hierarchy h = read_hierarchy(scene, rig.skeleton, ctx);
+
+  // Meshes in hierarchy order; a mesh instanced by several nodes becomes several parts.
+  MeshBuild build;
+  for (std::size_t n = 0; n < h.nodes.size(); ++n) {
+    const aiNode* node = h.nodes[n];
+    if (node->mNumMeshes > 0 && node->mMeshes == nullptr) ctx.invalid(node_label(node) + " lists meshes it does not have");
+    for (unsigned k = 0; k < node->mNumMeshes; ++k) {
+      const auto mi = node->mMeshes[k];
+      if (mi >= scene->mNumMeshes || scene->mMeshes[mi] == nullptr) {
+        ctx.invalid(node_label(node) + " refers to mesh " + std::to_string(mi) + " out of range [0, " + std::to_string(scene->mNumMeshes) + ")");
+      }
+      add_part(scene, scene->mMeshes[mi], static_cast<std::int32_t>(n), h, unit, rig, build, ctx);
+    }
+  }
+  if (build.triangles.empty()) ctx.invalid("no triangles in the file");
+  if (build.positions.size() > static_cast<std::size_t>(INT32_MAX)) ctx.invalid("too many vertices");
+
+  rig.mesh.rest_positions.resize(static_cast<Eigen::Index>(build.positions.size()), 3);
+  for (std::size_t v = 0; v < build.positions.size(); ++v) rig.mesh.rest_positions.row(static_cast<Eigen::Index>(v)) = build.positions[v];
+  rig.mesh.triangles.resize(static_cast<Eigen::Index>(build.triangles.size()), 3);
+  for (std::size_t f = 0; f < build.triangles.size(); ++f) {
+    for (int k = 0; k < 3; ++k) rig.mesh.triangles(static_cast<Eigen::Index>(f), k) = build.triangles[f][static_cast<std::size_t>(k)];
+  }
+  finish_skin(build, h, rig, ctx);
+  out.rest_pose_deviation = build.rest_pose_deviation;
+  read_clips(scene, h, rig, ctx);
+
+  // assimp's own remarks, after ours.
+  for (std::size_t i = 0; i < warnings.size() && i < kMaxForwardedWarnings; ++i) ctx.problems.push_back("assimp: " + warnings[i]);
+  if (warnings.size() > kMaxForwardedWarnings) {
+    ctx.problems.push_back("assimp: " + std::to_string(warnings.size() - kMaxForwardedWarnings) + " more warnings");
+  }
+  validate_rig(rig);
+  // One line per distinct remark, in order of first appearance.
+  for (auto& p : ctx.problems) {
+    if (std::find(out.problems.begin(), out.problems.end(), p) == out.problems.end()) out.problems.push_back(std::move(p));
+  }
+  return out;
+}
+
+}  // namespace skelcd::skinning

@@ -1,0 +1,52 @@
+#pragma once
+// Importing rigged (or plain) models through assimp into a Rig: every mesh of the file becomes a
+// part of one Mesh, the node hierarchy becomes the Skeleton, skins become bones and weights,
+// animations become clips.
+
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "skinning/rig.hpp"
+
+namespace skelcd::skinning {
+
+struct ImportOptions {
+  /// Merge identical vertices within each mesh of the file (assimp's JoinIdenticalVertices:
+  /// same position, normal, UV, …). Never merges across meshes: parts stay apart.
+  bool join_identical_vertices = true;
+  /// Convert the file's unit to metres when the file declares one assimp does not apply itself
+  /// (FBX: GlobalSettings UnitScaleFactor, in centimetres). glTF is in metres by definition and
+  /// assimp applies Collada's <unit>; other formats carry no unit and are taken as they are.
+  bool convert_to_metres = true;
+};
+
+struct ImportedRig {
+  Rig rig;
+  /// What was found and handled, one sentence each (dropped points/lines, normalised weights,
+  /// unnamed clips, assimp warnings, …). Faults that make the data unusable throw instead.
+  std::vector<std::string> problems;
+  /// Scale applied to the file's coordinates (Skeleton::root_transform's scale).
+  double unit_scale = 1.0;
+  /// Largest distance (object units) between a skinned vertex at its bind position and where the
+  /// file's own node rest pose puts it; 0 when the file stores its hierarchy in the bind pose
+  /// (up to the file's float precision) or has no skin.
+  double rest_pose_deviation = 0.0;
+};
+
+/// Imports `file` with assimp (triangulated; points and lines dropped and reported).
+///
+/// Object space is the file's scene space with the unit scale applied: an unskinned mesh is
+/// placed by its node's global transform and follows that node rigidly (Rig::part_attachments);
+/// a skinned mesh is placed in its bind pose and follows its bones, with weights normalised to
+/// sum 1 (any number of influences). Bones are the nodes that skins reference, sorted parents
+/// first; nodes without a channel in a clip keep their static transform. Times are seconds.
+///
+/// @throws IoError when the file is missing, unreadable or assimp cannot parse it (the message
+///         names the file and repeats assimp's reason).
+/// @throws InvalidInput when the data are unusable: non-finite coordinates, transforms, weights
+///         or keys, indices out of range (also when assimp reports it dropped such faces),
+///         a bone naming no node, no triangle at all, a node hierarchy with a cycle.
+[[nodiscard]] ImportedRig import_rig(const std::filesystem::path& file, const ImportOptions& options = {});
+
+}  // namespace skelcd::skinning

@@ -1,0 +1,107 @@
+#include "skinning/load.hpp"
+
+#include <algorithm>
+#include <cctype>
+#include <string>
+#include <utility>
+
+#include "skinning/errors.hpp"
+#include "skinning/rig_motion.hpp"
+
+namespace skelcd::skinning {
+namespace {
+
+std::string lower(std::string s) {
+  std::transform(s.begin(), s.end(), s.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  return s;
+}
+
+std::string clip_list(const std::vector<ClipSummary>& clips) {
+  if (clips.empty()) return "it has none";
+  std::string list = "clips:";
+  for (const auto& c : clips) list += " '" + c.name + "'";
+  return list;
+}
+
+LoadedModel load_assimp_model(const std::filesystem::path& path, const LoadOptions& options) {
+  if (!options.trajectory.empty() || !options.srdf.empty() || !options.package_path.empty()) {
+    throw InvalidInput(path.string() + ": a trajectory, SRDF or package path applies to URDF robots only");
+  }
+  auto imported = import_rig(path, options.import);
+  auto model = model_from_rig(std::move(imported.rig), ModelKind::rig, std::move(imported.problems));
+  model.path = path;
+  model.unit_scale = imported.unit_scale;
+  model.rest_pose_deviation = imported.rest_pose_deviation;
+  return model;
+}
+
+}  // namespace
+
+const char* to_string(ModelKind kind) {
+  switch (kind) {
+    case ModelKind::rig:
+      return "rig";
+    case ModelKind::robot:
+      return "robot";
+    case ModelKind::frame_sequence:
+      return "frame sequence";
+  }
+  return "?";
+}
+
+ModelKind classify_model_path(const std::filesystem::path& path) {
+  const auto text = path.string();
+  if (text.find_first_of("*?[") != std::string::npos) return ModelKind::frame_sequence;
+  std::error_code ec;
+  if (std::filesystem::is_directory(path, ec)) return ModelKind::frame_sequence;
+  if (lower(path.extension().string()) == ".urdf") return ModelKind::robot;
+  return ModelKind::rig;
+}
+
+std::unique_ptr<Motion> LoadedModel::motion(const MotionRequest& request) const {
+  if (!motion_factory) throw InvalidInput(path.string() + ": this model cannot move");
+  return motion_factory(request);
+}
+
+LoadedModel model_from_rig(Rig rig, ModelKind kind, std::vector<std::string> problems) {
+  LoadedModel model;
+  model.path = rig.source;
+  model.kind = kind;
+  auto shared = std::make_shared<const Rig>(std::move(rig));
+  model.rig = shared;
+  model.mesh = std::shared_ptr<const Mesh>(shared, &shared->mesh);  // shares the rig's lifetime
+  for (const auto& c : shared->clips) model.clips.push_back({c.name, c.duration_s, c.keys_per_s()});
+  model.problems = std::move(problems);
+  model.motion_factory = [shared, clips = model.clips](const MotionRequest& request) -> std::unique_ptr<Motion> {
+    RigMotionOptions options;
+    options.rate_hz = request.rate_hz;
+    if (!request.clip.empty()) {
+      options.clip = shared->find_clip(request.clip);
+      if (options.clip < 0) {
+        throw InvalidInput(shared->source + ": no clip named '" + request.clip + "' (" + clip_list(clips) + ")");
+      }
+    } else {
+      options.clip = shared->clips.empty() ? -1 : 0;
+    }
+    return std::make_unique<RigMotion>(shared, options);
+  };
+  return model;
+}
+
+LoadedModel load_model(const std::filesystem::path& path, const LoadOptions& options) {
+  switch (classify_model_path(path)) {
+    case ModelKind::frame_sequence:
+      // Extension point (frame sequences): `return load_frame_sequence_model(path, options);`
+      // declared in skinning/frame_sequence.hpp.
+      throw InvalidInput(path.string() + ": frame sequences (a folder or glob of OBJ/PLY files) are not supported yet");
+    case ModelKind::robot:
+      // Extension point (robots): `return load_urdf_model(path, options);` declared in
+      // skinning/urdf.hpp; model_from_rig() wraps the robot's rig and trajectory clip.
+      throw InvalidInput(path.string() + ": URDF robots are not supported yet");
+    case ModelKind::rig:
+      break;
+  }
+  return load_assimp_model(path, options);
+}
+
+}  // namespace skelcd::skinning

@@ -1,0 +1,82 @@
+#include "skinning/rig_motion.hpp"
+
+#include <algorithm>
+#include <cassert>
+#include <cmath>
+#include <limits>
+#include <string>
+
+#include "skinning/errors.hpp"
+
+namespace skelcd::skinning {
+namespace {
+
+constexpr double kWholeIntervalTolerance = 1e-9;
+
+const Rig& checked(const std::shared_ptr<const Rig>& rig) {
+  if (!rig) throw InvalidInput("RigMotion: no rig");
+  return *rig;
+}
+
+}  // namespace
+
+int sample_count(double duration_s, double rate_hz) {
+  assert(duration_s >= 0 && rate_hz > 0);
+  const double intervals = duration_s * rate_hz;
+  const double nearest = std::round(intervals);
+  const double whole =
+      std::abs(intervals - nearest) <= kWholeIntervalTolerance * std::max(1.0, nearest) ? nearest : std::ceil(intervals);
+  if (whole >= static_cast<double>(std::numeric_limits<int>::max() - 1)) {
+    throw InvalidInput("sample_count: " + std::to_string(duration_s) + " s at " + std::to_string(rate_hz) +
+                       " Hz is too many samples");
+  }
+  return static_cast<int>(whole) + 1;
+}
+
+RigMotion::RigMotion(std::shared_ptr<const Rig> rig, const RigMotionOptions& options)
+    : rig_(std::move(rig)), evaluator_(checked(rig_)), skinning_(*rig_), clip_(options.clip) {
+  if (clip_ < -1 || clip_ >= static_cast<std::int32_t>(rig_->clips.size())) {
+    throw InvalidInput(rig_->source + ": clip " + std::to_string(clip_) + " out of range (the file has " +
+                       std::to_string(rig_->clips.size()) + " clips)");
+  }
+  if (!std::isfinite(options.rate_hz) || options.rate_hz < 0) {
+    throw InvalidInput(rig_->source + ": sample rate " + std::to_string(options.rate_hz) + " Hz is not positive");
+  }
+  if (clip_ >= 0) {
+    const auto& c = rig_->clips[static_cast<std::size_t>(clip_)];
+    duration_s_ = c.duration_s;
+    const double keys = c.keys_per_s();
+    rate_hz_ = options.rate_hz > 0 ? options.rate_hz : (keys > 0 ? keys : kDefaultSampleRateHz);
+    num_samples_ = sample_count(duration_s_, rate_hz_);
+  } else {
+    rate_hz_ = options.rate_hz > 0 ? options.rate_hz : kDefaultSampleRateHz;
+    num_samples_ = 1;
+  }
+}
+
+double RigMotion::sample_time(int i) const {
+  assert(i >= 0 && i < num_samples_);
+  return std::min(static_cast<double>(i) / rate_hz_, duration_s_);
+}
+
+std::string RigMotion::name() const {
+  return clip_ >= 0 ? rig_->clips[static_cast<std::size_t>(clip_)].name : std::string("bind pose");
+}
+
+void RigMotion::positions(int i, Positions& out) const {
+  assert(i >= 0 && i < num_samples_);
+  positions_at_time(sample_time(i), out);
+}
+
+void RigMotion::positions_at_time(double time_s, Positions& out) const {
+  // One pose buffer per thread, grown to the largest skeleton seen and then reused.
+  thread_local Pose pose;
+  if (clip_ >= 0) {
+    evaluator_.clip_pose(clip_, time_s, pose);
+  } else {
+    evaluator_.bind_pose(pose);
+  }
+  skinning_.apply(pose, out);
+}
+
+}  // namespace skelcd::skinning

@@ -1,0 +1,320 @@
+#include "skinning/topology.hpp"
+
+#include <algorithm>
+#include <cassert>
+#include <cstdint>
+#include <numeric>
+#include <string>
+
+#include "skinning/detail/exact_collinear.hpp"
+#include "skinning/errors.hpp"
+
+namespace skelcd::skinning {
+namespace {
+
+// Welding: sort the file vertices by position (ties by index), so that equal positions form runs
+// whose first element is the smallest file index. Welded ids are then handed out in file order of
+// those representatives: the welded numbering follows the file's.
+void weld(const Mesh& mesh, bool enabled, Topology& topo) {
+  const auto nv = static_cast<std::int32_t>(mesh.num_vertices());
+  topo.welded_of_vertex.assign(static_cast<std::size_t>(nv), -1);
+  topo.representative_vertex.clear();
+  if (!enabled) {
+    topo.representative_vertex.resize(static_cast<std::size_t>(nv));
+    std::iota(topo.representative_vertex.begin(), topo.representative_vertex.end(), 0);
+    std::iota(topo.welded_of_vertex.begin(), topo.welded_of_vertex.end(), 0);
+    return;
+  }
+  const Positions& p = mesh.rest_positions;
+  std::vector<std::int32_t> order(static_cast<std::size_t>(nv));
+  std::iota(order.begin(), order.end(), 0);
+  std::sort(order.begin(), order.end(), [&p](std::int32_t a, std::int32_t b) {
+    for (int k = 0; k < 3; ++k) {
+      if (p(a, k) < p(b, k)) return true;
+      if (p(b, k) < p(a, k)) return false;
+    }
+    return a < b;
+  });
+  // rep[v] = smallest file index with v's position (compared as values: -0.0 equals 0.0).
+  std::vector<std::int32_t> rep(static_cast<std::size_t>(nv));
+  for (std::size_t s = 0; s < order.size();) {
+    std::size_t e = s + 1;
+    while (e < order.size() && p.row(order[e]) == p.row(order[s])) ++e;
+    for (std::size_t k = s; k < e; ++k) rep[static_cast<std::size_t>(order[k])] = order[s];
+    s = e;
+  }
+  for (std::int32_t v = 0; v < nv; ++v) {
+    const auto r = static_cast<std::size_t>(rep[static_cast<std::size_t>(v)]);
+    if (r == static_cast<std::size_t>(v)) {
+      topo.welded_of_vertex[r] = static_cast<std::int32_t>(topo.representative_vertex.size());
+      topo.representative_vertex.push_back(v);
+    } else {
+      topo.welded_of_vertex[static_cast<std::size_t>(v)] = topo.welded_of_vertex[r];
+    }
+  }
+}
+
+struct HalfEdge {
+  std::uint64_t key;  // (smaller welded id << 32) | larger welded id
+  std::int32_t face;
+  std::int32_t side;
+};
+
+std::uint64_t edge_key(std::int32_t a, std::int32_t b) {
+  const auto lo = static_cast<std::uint64_t>(static_cast<std::uint32_t>(std::min(a, b)));
+  const auto hi = static_cast<std::uint64_t>(static_cast<std::uint32_t>(std::max(a, b)));
+  return (lo << 32) | hi;
+}
+
+// Unique edges: every side of every triangle is a half-edge keyed by its (sorted) welded ends;
+// sorting the keys groups the sides of one edge together, faces ascending. Sides whose two
+// corners are the same welded vertex (a collapsed triangle) are not edges.
+void build_edges(Topology& topo) {
+  const auto nf = static_cast<std::int32_t>(topo.welded_triangles.rows());
+  std::vector<HalfEdge> sides;
+  sides.reserve(static_cast<std::size_t>(nf) * 3);
+  topo.face_edges.setConstant(nf, 3, -1);
+  for (std::int32_t f = 0; f < nf; ++f) {
+    for (std::int32_t k = 0; k < 3; ++k) {
+      const auto a = topo.welded_triangles(f, k);
+      const auto b = topo.welded_triangles(f, (k + 1) % 3);
+      if (a != b) sides.push_back({edge_key(a, b), f, k});
+    }
+  }
+  std::sort(sides.begin(), sides.end(), [](const HalfEdge& x, const HalfEdge& y) {
+    return x.key != y.key ? x.key < y.key : (x.face != y.face ? x.face < y.face : x.side < y.side);
+  });
+
+  std::vector<std::uint64_t> keys;
+  keys.reserve(sides.size() / 2 + 1);
+  topo.edge_face_offsets.clear();
+  topo.edge_faces.clear();
+  topo.edge_faces.reserve(sides.size());
+  for (std::size_t s = 0; s < sides.size();) {
+    const auto e = static_cast<std::int32_t>(keys.size());
+    keys.push_back(sides[s].key);
+    topo.edge_face_offsets.push_back(static_cast<std::int32_t>(topo.edge_faces.size()));
+    std::size_t t = s;
+    for (; t < sides.size() && sides[t].key == sides[s].key; ++t) {
+      topo.face_edges(sides[t].face, sides[t].side) = e;
+      // A degenerate triangle (a, a, b) has two sides on edge (a, b): list the face once.
+      if (topo.edge_faces.size() == static_cast<std::size_t>(topo.edge_face_offsets.back()) ||
+          topo.edge_faces.back() != sides[t].face) {
+        topo.edge_faces.push_back(sides[t].face);
+      }
+    }
+    s = t;
+  }
+  topo.edge_face_offsets.push_back(static_cast<std::int32_t>(topo.edge_faces.size()));
+
+  topo.edges.resize(static_cast<Eigen::Index>(keys.size()), 2);
+  for (std::size_t e = 0; e < keys.size(); ++e) {
+    topo.edges(static_cast<Eigen::Index>(e), 0) = static_cast<std::int32_t>(keys[e] >> 32);
+    topo.edges(static_cast<Eigen::Index>(e), 1) = static_cast<std::int32_t>(keys[e] & 0xffffffffU);
+  }
+}
+
+std::int32_t edge_face_count(const Topology& topo, std::int32_t e) {
+  return topo.edge_face_offsets[static_cast<std::size_t>(e) + 1] -
+         topo.edge_face_offsets[static_cast<std::size_t>(e)];
+}
+
+void build_adjacency(Topology& topo) {
+  const auto nf = static_cast<std::int32_t>(topo.welded_triangles.rows());
+  topo.face_adjacency.setConstant(nf, 3, -1);
+  for (std::int32_t f = 0; f < nf; ++f) {
+    for (int k = 0; k < 3; ++k) {
+      const auto e = topo.face_edges(f, k);
+      if (e < 0) continue;
+      const auto begin = topo.edge_face_offsets[static_cast<std::size_t>(e)];
+      const auto end = topo.edge_face_offsets[static_cast<std::size_t>(e) + 1];
+      for (auto i = begin; i < end; ++i) {
+        const auto g = topo.edge_faces[static_cast<std::size_t>(i)];
+        if (g != f) {
+          topo.face_adjacency(f, k) = g;
+          break;
+        }
+      }
+    }
+  }
+  topo.boundary_edges.clear();
+  topo.non_manifold_edges.clear();
+  for (std::int32_t e = 0; e < topo.num_edges(); ++e) {
+    const auto n = edge_face_count(topo, e);
+    if (n == 1) topo.boundary_edges.push_back(e);
+    if (n >= 3) topo.non_manifold_edges.push_back(e);
+  }
+}
+
+// Boundary loops: walk the boundary edges vertex to vertex. Each boundary edge is oriented as its
+// face's side (a → b); at every step the walk prefers an unvisited boundary edge leaving the
+// current vertex in that orientation, so that loops around pinch vertices close where they should.
+// A walk that cannot return to its start (inconsistently oriented faces) is kept as an open chain.
+void build_boundary_loops(Topology& topo) {
+  topo.boundary_loops.clear();
+  const auto nb = topo.boundary_edges.size();
+  if (nb == 0) return;
+  const auto nw = static_cast<std::size_t>(topo.num_welded_vertices());
+  // Oriented ends of each boundary edge.
+  std::vector<std::int32_t> from(nb), to(nb);
+  for (std::size_t i = 0; i < nb; ++i) {
+    const auto e = topo.boundary_edges[i];
+    const auto f = topo.edge_faces[static_cast<std::size_t>(topo.edge_face_offsets[static_cast<std::size_t>(e)])];
+    for (int k = 0; k < 3; ++k) {
+      if (topo.face_edges(f, k) == e) {
+        from[i] = topo.welded_triangles(f, k);
+        to[i] = topo.welded_triangles(f, (k + 1) % 3);
+        break;
+      }
+    }
+  }
+  // CSR: boundary edges incident to each welded vertex.
+  std::vector<std::int32_t> offsets(nw + 1, 0);
+  for (std::size_t i = 0; i < nb; ++i) {
+    ++offsets[static_cast<std::size_t>(from[i]) + 1];
+    ++offsets[static_cast<std::size_t>(to[i]) + 1];
+  }
+  std::partial_sum(offsets.begin(), offsets.end(), offsets.begin());
+  std::vector<std::int32_t> incident(static_cast<std::size_t>(offsets.back()));
+  {
+    std::vector<std::int32_t> fill(offsets.begin(), offsets.end() - 1);
+    for (std::size_t i = 0; i < nb; ++i) {
+      incident[static_cast<std::size_t>(fill[static_cast<std::size_t>(from[i])]++)] = static_cast<std::int32_t>(i);
+      incident[static_cast<std::size_t>(fill[static_cast<std::size_t>(to[i])]++)] = static_cast<std::int32_t>(i);
+    }
+  }
+  std::vector<bool> used(nb, false);
+  for (std::size_t start = 0; start < nb; ++start) {
+    if (used[start]) continue;
+    used[start] = true;
+    std::vector<std::int32_t> loop{from[start]};
+    const auto first = from[start];
+    auto current = to[start];
+    while (current != first) {
+      std::int32_t next = -1;
+      bool next_forward = false;
+      for (auto k = offsets[static_cast<std::size_t>(current)]; k < offsets[static_cast<std::size_t>(current) + 1]; ++k) {
+        const auto i = static_cast<std::size_t>(incident[static_cast<std::size_t>(k)]);
+        if (used[i]) continue;
+        const bool forward = from[i] == current;
+        if (next < 0 || (forward && !next_forward)) {
+          next = static_cast<std::int32_t>(i);
+          next_forward = forward;
+        }
+      }
+      if (next < 0) break;  // open chain
+      loop.push_back(current);
+      used[static_cast<std::size_t>(next)] = true;
+      const auto n = static_cast<std::size_t>(next);
+      current = (from[n] == current) ? to[n] : from[n];
+    }
+    if (current != first) loop.push_back(current);  // keep the chain's last vertex
+    topo.boundary_loops.push_back(std::move(loop));
+  }
+}
+
+// Components: union-find over faces joined through shared edges; numbered by smallest face.
+std::int32_t find_root(std::vector<std::int32_t>& parent, std::int32_t x) {
+  while (parent[static_cast<std::size_t>(x)] != x) {
+    auto& px = parent[static_cast<std::size_t>(x)];
+    px = parent[static_cast<std::size_t>(px)];
+    x = px;
+  }
+  return x;
+}
+
+void build_components(const Mesh& mesh, Topology& topo) {
+  const auto nf = static_cast<std::int32_t>(topo.welded_triangles.rows());
+  std::vector<std::int32_t> parent(static_cast<std::size_t>(nf));
+  std::iota(parent.begin(), parent.end(), 0);
+  for (std::int32_t e = 0; e < topo.num_edges(); ++e) {
+    const auto begin = topo.edge_face_offsets[static_cast<std::size_t>(e)];
+    const auto end = topo.edge_face_offsets[static_cast<std::size_t>(e) + 1];
+    const auto a = find_root(parent, topo.edge_faces[static_cast<std::size_t>(begin)]);
+    for (auto i = begin + 1; i < end; ++i) {
+      const auto b = find_root(parent, topo.edge_faces[static_cast<std::size_t>(i)]);
+      if (a != b) parent[static_cast<std::size_t>(std::max(a, b))] = std::min(a, b);
+    }
+  }
+  topo.face_component.assign(static_cast<std::size_t>(nf), -1);
+  topo.components.clear();
+  for (std::int32_t f = 0; f < nf; ++f) {
+    const auto r = find_root(parent, f);
+    auto& c = topo.face_component[static_cast<std::size_t>(r)];
+    if (r == f) {
+      c = static_cast<std::int32_t>(topo.components.size());
+      Component comp;
+      comp.part = mesh.face_part.empty() ? 0 : mesh.face_part[static_cast<std::size_t>(f)];
+      comp.closed = true;
+      topo.components.push_back(std::move(comp));
+    }
+    topo.face_component[static_cast<std::size_t>(f)] = c;
+    topo.components[static_cast<std::size_t>(c)].faces.push_back(f);
+  }
+  // Open: a boundary or non-manifold edge on any of its faces, or no edge at all (only
+  // triangles collapsed to a point).
+  for (auto& comp : topo.components) {
+    comp.closed = std::any_of(comp.faces.begin(), comp.faces.end(), [&topo](std::int32_t f) {
+      return (topo.face_edges.row(f).array() >= 0).any();
+    });
+  }
+  for (const auto edges : {&topo.boundary_edges, &topo.non_manifold_edges}) {
+    for (const auto e : *edges) {
+      const auto f = topo.edge_faces[static_cast<std::size_t>(topo.edge_face_offsets[static_cast<std::size_t>(e)])];
+      topo.components[static_cast<std::size_t>(topo.face_component[static_cast<std::size_t>(f)])].closed = false;
+    }
+  }
+}
+
+void find_degenerate_triangles(const Mesh& mesh, Topology& topo) {
+  topo.degenerate_triangles.clear();
+  const auto nf = static_cast<std::int32_t>(topo.welded_triangles.rows());
+  for (std::int32_t f = 0; f < nf; ++f) {
+    const auto a = topo.welded_triangles(f, 0);
+    const auto b = topo.welded_triangles(f, 1);
+    const auto c = topo.welded_triangles(f, 2);
+    if (a == b || b == c || c == a) {
+      topo.degenerate_triangles.push_back(f);
+      continue;
+    }
+    const Eigen::Vector3d pa = mesh.rest_positions.row(mesh.triangles(f, 0)).transpose();
+    const Eigen::Vector3d pb = mesh.rest_positions.row(mesh.triangles(f, 1)).transpose();
+    const Eigen::Vector3d pc = mesh.rest_positions.row(mesh.triangles(f, 2)).transpose();
+    if (detail::exactly_collinear(pa, pb, pc)) topo.degenerate_triangles.push_back(f);
+  }
+}
+
+}  // namespace
+
+Topology build_topology(const Mesh& mesh, const WeldOptions& options) {
+  validate_mesh(mesh, "build_topology");
+  if (mesh.num_vertices() > INT32_MAX || mesh.num_triangles() > INT32_MAX / 3) {
+    throw InvalidInput("build_topology: mesh too large for 32-bit indices");
+  }
+  Topology topo;
+  weld(mesh, options.weld, topo);
+  const auto nf = mesh.num_triangles();
+  topo.welded_triangles.resize(nf, 3);
+  for (Eigen::Index f = 0; f < nf; ++f) {
+    for (int k = 0; k < 3; ++k) {
+      topo.welded_triangles(f, k) = topo.welded_of_vertex[static_cast<std::size_t>(mesh.triangles(f, k))];
+    }
+  }
+  build_edges(topo);
+  build_adjacency(topo);
+  build_boundary_loops(topo);
+  build_components(mesh, topo);
+  find_degenerate_triangles(mesh, topo);
+  return topo;
+}
+
+void gather_welded(const Topology& topology, const Positions& positions, Positions& welded) {
+  const auto nw = static_cast<Eigen::Index>(topology.representative_vertex.size());
+  assert(positions.rows() == static_cast<Eigen::Index>(topology.welded_of_vertex.size()));
+  welded.resize(nw, 3);
+  for (Eigen::Index w = 0; w < nw; ++w) {
+    welded.row(w) = positions.row(topology.representative_vertex[static_cast<std::size_t>(w)]);
+  }
+}
+
+}  // namespace skelcd::skinning
