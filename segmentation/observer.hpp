@@ -1,0 +1,82 @@
+#pragma once
+// Observer primitives (paper 002, §4.2): a cluster is watched from a point (its bone's midpoint)
+// or from a line (its bone segment; each triangle is watched from its first corner projected onto
+// the segment). A triangle is positively oriented to its observer when the observer sees its back:
+// (p − q) · n > 0 with n the outward normal and p a corner.
+
+#include <cstdint>
+#include <span>
+#include <string_view>
+
+#include <Eigen/Core>
+
+#include "segmentation/bone_segment.hpp"
+#include "skinning/mesh.hpp"
+
+namespace skelcd::segmentation {
+
+enum class ObserverKind : std::uint8_t { point = 0, line = 1 };
+
+[[nodiscard]] std::string_view to_string(ObserverKind kind);
+
+/// Orientation of a triangle to an observer at one instant. `uncertain` is the exact zero: the
+/// observer lies in the triangle's plane (or the triangle has no area).
+enum class Orientation : std::int8_t { negative = -1, uncertain = 0, positive = 1 };
+
+struct Observer {
+  ObserverKind kind = ObserverKind::point;
+  /// The cluster's bone, rest pose, object space.
+  BoneSegment segment;
+
+  /// Where a triangle whose first corner is `a` is viewed from: the midpoint for a point
+  /// observer; `a` projected onto the segment and clamped to it for a line observer (the head
+  /// when the segment has zero length).
+  [[nodiscard]] Eigen::Vector3d viewing_position(const Eigen::Vector3d& a) const {
+    return kind == ObserverKind::point ? segment.midpoint() : segment.closest_point(a);
+  }
+};
+
+/// Exact sign of (a − q) · ((b − a) × (c − a)) with q the viewing position for corner a
+/// (filtered orient3d, rational fallback: the sign is exact for the rounded q).
+[[nodiscard]] Orientation orientation(
+    const Observer& observer,
+    const Eigen::Vector3d& a,
+    const Eigen::Vector3d& b,
+    const Eigen::Vector3d& c);
+
+/// Orientation of triangle f of (V, F) to `observer`.
+[[nodiscard]] inline Orientation orientation(
+    const Observer& observer,
+    const skinning::Positions& V,
+    const skinning::Triangles& F,
+    Eigen::Index f) {
+  return orientation(observer, V.row(F(f, 0)).transpose(), V.row(F(f, 1)).transpose(),
+                     V.row(F(f, 2)).transpose());
+}
+
+struct ObserverChoice {
+  ObserverKind kind = ObserverKind::point;
+  /// Positively oriented triangles averaged over the test poses, for each candidate.
+  double mean_positive_point = 0.0;
+  double mean_positive_line = 0.0;
+  /// Number of poses averaged: the rest pose and ±θ about x, y and z (7).
+  int poses = 0;
+};
+
+/// Chooses the observer of a cluster (§4.2): the point if it keeps more triangles positively
+/// oriented on average than the line, over the rest pose and the bone rotated by ±θ about the
+/// world x, y and z axes around its head joint, else the line.
+/// @param V #W × 3 rest positions; @param F #F × 3; @param triangles the cluster's triangles.
+/// @param follow #W: the fraction of each vertex that follows the bone's rotation — the summed
+///   weight of the bone and its descendants — so that the cluster deforms as linear blend skinning
+///   would deform it (rotating triangles and observer rigidly together would change nothing).
+/// @param theta_rad rotation angle (radians).
+[[nodiscard]] ObserverChoice choose_observer(
+    const skinning::Positions& V,
+    const skinning::Triangles& F,
+    std::span<const std::int32_t> triangles,
+    const BoneSegment& bone,
+    const Eigen::VectorXd& follow,
+    double theta_rad);
+
+}  // namespace skelcd::segmentation

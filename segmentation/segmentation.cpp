@@ -1,0 +1,165 @@
+#include "segmentation/segmentation.hpp"
+
+#include <chrono>
+#include <cmath>
+#include <numbers>
+#include <string>
+
+#include "segmentation/atomic_clusters.hpp"
+#include "segmentation/face_graph.hpp"
+#include "skinning/errors.hpp"
+
+namespace skelcd::segmentation {
+
+namespace {
+
+// Per bone: which bones are in its subtree (itself and its descendants).
+std::vector<std::vector<char>> subtree_masks(const std::vector<BoneSegment>& bones) {
+  const auto nb = bones.size();
+  std::vector<std::vector<char>> mask(nb, std::vector<char>(nb, 0));
+  for (std::size_t k = 0; k < nb; ++k) {
+    // Walk up from k, marking k in every ancestor's subtree (bounded against cycles).
+    std::size_t steps = 0;
+    for (auto b = static_cast<std::int32_t>(k); b >= 0 && steps <= nb;
+         b = bones[static_cast<std::size_t>(b)].parent, ++steps) {
+      mask[static_cast<std::size_t>(b)][k] = 1;
+    }
+  }
+  return mask;
+}
+
+// The fraction of each vertex of `triangles` that follows bone j: its summed subtree weight.
+void subtree_follow(const Eigen::MatrixXd& W, const skinning::Triangles& F,
+                    std::span<const std::int32_t> triangles, const std::vector<char>& subtree,
+                    Eigen::VectorXd& follow) {
+  for (const auto f : triangles) {
+    for (int c = 0; c < 3; ++c) {
+      const auto v = F(f, c);
+      double s = 0.0;
+      for (Eigen::Index k = 0; k < W.cols(); ++k) {
+        if (subtree[static_cast<std::size_t>(k)]) s += W(v, k);
+      }
+      follow[v] = std::min(1.0, s);
+    }
+  }
+}
+
+}  // namespace
+
+Segmentation segment_mesh(const skinning::Positions& V, const skinning::Triangles& F,
+                          const std::vector<BoneSegment>& bones, const Eigen::MatrixXd& W,
+                          const SegmentationOptions& options) {
+  if (bones.empty()) throw InvalidInput("segment_mesh: the skeleton has no bones");
+  if (F.rows() == 0) throw InvalidInput("segment_mesh: the mesh has no triangles");
+  if (W.rows() != V.rows() || W.cols() != static_cast<Eigen::Index>(bones.size())) {
+    throw InvalidInput("segment_mesh: weights are " + std::to_string(W.rows()) + " x " +
+                       std::to_string(W.cols()) + ", expected " + std::to_string(V.rows()) +
+                       " x " + std::to_string(bones.size()));
+  }
+  if (!(options.theta_deg >= 0.0 && options.theta_deg <= 90.0)) {
+    throw InvalidInput("segment_mesh: theta must be in [0, 90] degrees, got " +
+                       std::to_string(options.theta_deg));
+  }
+  for (std::size_t b = 0; b < bones.size(); ++b) {
+    const auto p = bones[b].parent;
+    if (p < -1 || p >= static_cast<std::int32_t>(bones.size()) || p == static_cast<std::int32_t>(b)) {
+      throw InvalidInput("segment_mesh: bone " + std::to_string(b) + " has parent " +
+                         std::to_string(p) + " out of range");
+    }
+  }
+  for (Eigen::Index f = 0; f < F.rows(); ++f) {
+    for (int c = 0; c < 3; ++c) {
+      if (F(f, c) < 0 || F(f, c) >= V.rows()) {
+        throw InvalidInput("segment_mesh: triangle " + std::to_string(f) + " has vertex index " +
+                           std::to_string(F(f, c)) + " out of range");
+      }
+    }
+  }
+
+  const auto start = std::chrono::steady_clock::now();
+  const double theta = options.theta_deg * std::numbers::pi / 180.0;
+  const auto nb = static_cast<std::int32_t>(bones.size());
+  Segmentation out;
+  out.options = options;
+  auto& stats = out.stats;
+  stats.triangles = F.rows();
+  stats.welded_vertices = V.rows();
+  stats.vertices = V.rows();
+  stats.bones = nb;
+
+  const auto graph = face_graph(F);
+  const auto subtree = subtree_masks(bones);
+  Eigen::VectorXd follow = Eigen::VectorXd::Zero(V.rows());
+
+  // 1. Each triangle to the bone of its largest summed weight (§4.1).
+  std::vector<std::int32_t> labels = largest_weight_bones(W, F);
+
+  // 2. Observers of those per-bone clusters (§4.2), then refinement against them (§4.1).
+  if (options.refine) {
+    std::vector<std::vector<std::int32_t>> per_bone(static_cast<std::size_t>(nb));
+    for (std::int32_t f = 0; f < F.rows(); ++f) {
+      per_bone[static_cast<std::size_t>(labels[static_cast<std::size_t>(f)])].push_back(f);
+    }
+    std::vector<Observer> observers(static_cast<std::size_t>(nb));
+    for (std::int32_t b = 0; b < nb; ++b) {
+      const auto& tris = per_bone[static_cast<std::size_t>(b)];
+      observers[static_cast<std::size_t>(b)].segment = bones[static_cast<std::size_t>(b)];
+      if (tris.empty()) continue;
+      subtree_follow(W, F, tris, subtree[static_cast<std::size_t>(b)], follow);
+      observers[static_cast<std::size_t>(b)].kind =
+          choose_observer(V, F, tris, bones[static_cast<std::size_t>(b)], follow, theta).kind;
+    }
+    stats.refinement = refine_labels(V, F, graph, observers, W, labels);
+  }
+
+  // 3. Edge-connected pieces become the atomic clusters.
+  const auto split = split_connected(graph, labels);
+  out.triangle_cluster = split.triangle_cluster;
+  out.clusters.resize(split.cluster_label.size());
+  for (std::size_t c = 0; c < split.cluster_label.size(); ++c) {
+    out.clusters[c].bone = split.cluster_label[c];
+  }
+  for (std::int32_t f = 0; f < F.rows(); ++f) {
+    out.clusters[static_cast<std::size_t>(out.triangle_cluster[static_cast<std::size_t>(f)])]
+        .triangles.push_back(f);
+  }
+
+  // 4. The final observer of each atomic cluster, and the rest-pose orientation counts.
+  std::vector<char> bone_used(static_cast<std::size_t>(nb), 0);
+  for (auto& cluster : out.clusters) {
+    const auto& bone = bones[static_cast<std::size_t>(cluster.bone)];
+    bone_used[static_cast<std::size_t>(cluster.bone)] = 1;
+    subtree_follow(W, F, cluster.triangles, subtree[static_cast<std::size_t>(cluster.bone)], follow);
+    const auto choice = choose_observer(V, F, cluster.triangles, bone, follow, theta);
+    cluster.observer = Observer{choice.kind, bone};
+    cluster.mean_positive_point = choice.mean_positive_point;
+    cluster.mean_positive_line = choice.mean_positive_line;
+    (choice.kind == ObserverKind::point ? stats.point_observers : stats.line_observers)++;
+    for (const auto f : cluster.triangles) {
+      const auto o = orientation(cluster.observer, V, F, f);
+      stats.h_minus += o == Orientation::negative;
+      stats.h_uncertain += o == Orientation::uncertain;
+    }
+  }
+  stats.atomic_clusters = static_cast<std::int32_t>(out.clusters.size());
+  std::int32_t bones_with_cluster = 0;
+  for (std::int32_t b = 0; b < nb; ++b) {
+    if (bone_used[static_cast<std::size_t>(b)]) {
+      ++bones_with_cluster;
+    } else {
+      stats.bones_without_cluster.push_back(b);
+    }
+  }
+  stats.split_clusters = stats.atomic_clusters - bones_with_cluster;
+
+  // 5. The cluster graph.
+  std::vector<std::int32_t> cluster_bone;
+  for (const auto& c : out.clusters) cluster_bone.push_back(c.bone);
+  out.graph = cluster_graph(graph, out.triangle_cluster, cluster_bone, bones);
+
+  stats.decomposition_ms =
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  return out;
+}
+
+}  // namespace skelcd::segmentation
