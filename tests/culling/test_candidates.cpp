@@ -1,0 +1,473 @@
+// The feature stage: representative-triangle ownership, and the proof obligations of the CCD
+// de-duplication — the hierarchy path produces exactly brute force's feature pairs, each once,
+// and every feature pair left out is provably farther apart than the contact distance.
+#include "culling/candidates.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <numbers>
+#include <set>
+
+#include <gmpxx.h>
+#include <gtest/gtest.h>
+
+#include "culling/bvh.hpp"
+#include "culling/traversal.hpp"
+#include "culling/vertex_bounds.hpp"
+#include "skinning/errors.hpp"
+#include "tests/culling/exact_dop.hpp"
+#include "tests/culling/procedural_meshes.hpp"
+#include "tests/support/test_support.hpp"
+
+namespace skelcd::culling {
+namespace {
+
+struct Scene {
+  std::string name;
+  skinning::Mesh mesh;
+  skinning::Topology topology;
+  skinning::Positions x_t0;
+  skinning::Positions x_t1;
+};
+
+Scene make_scene(std::string name, skinning::Mesh mesh, auto&& move) {
+  Scene s;
+  s.name = std::move(name);
+  s.mesh = std::move(mesh);
+  s.topology = test::simple_topology(s.mesh);
+  s.x_t0 = test::welded(s.topology, s.mesh.rest_positions);
+  s.x_t1 = move(s.x_t0);
+  return s;
+}
+
+/// A fan of `n` triangles around one centre vertex, winding 1.6 turns as a helical ramp whose
+/// pitch reverses over the interval: the layers pass through each other. Every pair of triangles
+/// shares the centre, so a broad phase that skipped adjacent triangle pairs would find nothing.
+Scene helical_fan(int n) {
+  const double turns = 1.6;
+  auto ramp = [&](double pitch) {
+    skinning::Positions x(n + 2, 3);
+    x.row(0) << 0, 0, 0;
+    for (int i = 0; i <= n; ++i) {
+      const double theta = 2.0 * std::numbers::pi * turns * i / n;
+      x.row(1 + i) << std::cos(theta), std::sin(theta), pitch * theta;
+    }
+    return x;
+  };
+  skinning::Triangles f(n, 3);
+  for (int i = 0; i < n; ++i) f.row(i) << 0, 1 + i, 2 + i;
+  Scene s;
+  s.name = "helical fan";
+  s.mesh = test::single_part_mesh(ramp(0.05), f, "fan");
+  s.topology = test::simple_topology(s.mesh);
+  s.x_t0 = test::welded(s.topology, ramp(0.05));
+  s.x_t1 = test::welded(s.topology, ramp(-0.05));
+  return s;
+}
+
+std::vector<Scene> scenes() {
+  std::vector<Scene> out;
+  out.push_back(make_scene("twisting tube", test::tube(10, 10, 0.5, 2.0), [](const auto& x) {
+    return test::deformed(x, 1.0, 1.5);
+  }));
+  out.push_back(make_scene("sheet folding through itself", test::sheet(10, 6, 2.0, 1.0),
+                           [](const auto& x) { return test::folded(x, 1.0, 3.4); }));
+  {
+    auto a = test::uv_sphere(7, 9, 1.0);
+    auto b = test::uv_sphere(6, 8, 0.7);
+    b.rest_positions = test::translated(b.rest_positions, Eigen::Vector3d(2.0, 0.1, 0.05));
+    out.push_back(make_scene("sphere moving into another", test::combine(a, b), [](const auto& x) {
+      skinning::Positions y = x;
+      for (Eigen::Index v = 0; v < y.rows(); ++v) {
+        if (x(v, 0) > 1.05) y(v, 0) -= 1.2;  // the second sphere's vertices
+      }
+      return y;
+    }));
+  }
+  {
+    // A tube (part 0) moving sideways through a sheet (part 1) it starts beside.
+    auto t = test::tube(8, 6, 0.3, 1.2);
+    auto sh = test::sheet(6, 6, 2.0, 2.0);
+    sh.rest_positions = test::translated(sh.rest_positions, Eigen::Vector3d(-1.0, -1.0, 0.6));
+    out.push_back(make_scene("tube through a sheet", test::combine(t, sh), [](const auto& x) {
+      skinning::Positions y = x;
+      for (Eigen::Index v = 0; v < y.rows(); ++v) {
+        if (x(v, 2) != 0.6) y(v, 2) += 0.05;  // the tube rises a little
+        if (x(v, 2) == 0.6) y(v, 0) += 0.3;   // the sheet slides
+      }
+      return y;
+    }));
+  }
+  out.push_back(helical_fan(24));
+  return out;
+}
+
+template <int N>
+struct Built {
+  FeatureTopology topology;
+  FeatureBounds<N> bounds;
+};
+
+template <int N>
+Built<N> bounds_of(const Scene& s, double min_separation) {
+  Built<N> b{FeatureTopology(s.mesh, s.topology), {}};
+  swept_vertex_bounds<N>(s.x_t0, s.x_t1, 0.5 * min_separation, b.bounds.vertices);
+  b.bounds.derive(b.topology);
+  return b;
+}
+
+template <int N>
+FeatureCandidates hierarchy_candidates(
+    const Built<N>& b,
+    const skinning::Positions& build_at,
+    int leaf_size,
+    Counters& counters) {
+  Bvh<N> bvh(b.topology.welded_triangles(), build_at, BvhOptions{leaf_size});
+  bvh.refit(b.bounds.triangles);
+  TraversalScratch scratch;
+  std::vector<TrianglePair> pairs;
+  self_traverse<N>(bvh, b.bounds.triangles, scratch, pairs, counters.bv_tests);
+  FeatureCandidates out;
+  ccd_candidates_from_triangle_pairs<N>(b.topology, pairs, b.bounds, out, counters);
+  return out;
+}
+
+template <class T>
+bool has_duplicates(std::vector<T> v) {
+  std::sort(v.begin(), v.end());
+  return std::adjacent_find(v.begin(), v.end()) != v.end();
+}
+
+template <class T>
+std::vector<T> sorted(std::vector<T> v) {
+  std::sort(v.begin(), v.end());
+  return v;
+}
+
+// --- an exact, independent proof that a left-out pair cannot touch ---------------------------
+
+/// True when some axis of Dop<N> separates the convex hulls of `a` and `b` by more than
+/// `distance`·|axis| in exact rational arithmetic: then every point of one is farther than
+/// `distance` from every point of the other, at every time of the interval (linear motion keeps
+/// each feature inside the hull of its positions at t0 and t1).
+template <int N>
+bool provably_apart_exact(
+    const std::vector<Eigen::Vector3d>& a,
+    const std::vector<Eigen::Vector3d>& b,
+    double distance) {
+  const mpq_class d(distance);
+  for (std::size_t k = 0; k < static_cast<std::size_t>(N); ++k) {
+    const auto& axis = DopAxes<N>::kAxes[k];
+    const int len2 = axis[0] * axis[0] + axis[1] * axis[1] + axis[2] * axis[2];
+    auto range = [&](const std::vector<Eigen::Vector3d>& pts) {
+      mpq_class lo = test::exact_projection<N>(pts[0].x(), pts[0].y(), pts[0].z(), k);
+      mpq_class hi = lo;
+      for (const auto& p : pts) {
+        const mpq_class q = test::exact_projection<N>(p.x(), p.y(), p.z(), k);
+        if (q < lo) lo = q;
+        if (q > hi) hi = q;
+      }
+      return std::pair{lo, hi};
+    };
+    const auto [alo, ahi] = range(a);
+    const auto [blo, bhi] = range(b);
+    const mpq_class gap = std::max(mpq_class(blo - ahi), mpq_class(alo - bhi));
+    if (gap > 0 && gap * gap > d * d * len2) return true;
+  }
+  return false;
+}
+
+/// True when some axis of Dop<N> separates the convex hulls of `a` and `b` by more than
+/// `distance`·|axis|: then every point of one is farther than `distance` from every point of the
+/// other, at every time of the interval (linear motion keeps each feature inside the hull of its
+/// positions at t0 and t1). A floating-point pass with a generous error margin (projections of
+/// at most three terms with unit coefficients: error < 4u·Σ|coordinates|; the margin is 100×)
+/// settles clear cases; the rest are decided in exact rational arithmetic.
+template <int N>
+bool provably_apart(
+    const std::vector<Eigen::Vector3d>& a,
+    const std::vector<Eigen::Vector3d>& b,
+    double distance) {
+  double scale = 0.0;
+  for (const auto* pts : {&a, &b}) {
+    for (const auto& p : *pts) scale = std::max(scale, p.cwiseAbs().sum());
+  }
+  const double margin = 400.0 * std::numeric_limits<double>::epsilon() * scale;
+  for (std::size_t k = 0; k < static_cast<std::size_t>(N); ++k) {
+    const auto& ax = DopAxes<N>::kAxes[k];
+    const Eigen::Vector3d axis(ax[0], ax[1], ax[2]);
+    auto range = [&](const std::vector<Eigen::Vector3d>& pts) {
+      double lo = axis.dot(pts[0]);
+      double hi = lo;
+      for (const auto& p : pts) {
+        lo = std::min(lo, axis.dot(p));
+        hi = std::max(hi, axis.dot(p));
+      }
+      return std::pair{lo, hi};
+    };
+    const auto [alo, ahi] = range(a);
+    const auto [blo, bhi] = range(b);
+    const double gap = std::max(blo - ahi, alo - bhi);
+    if (gap > distance * axis.norm() * (1.0 + 1e-12) + margin) return true;
+  }
+  return provably_apart_exact<N>(a, b, distance);
+}
+
+template <int N>
+void check_left_out_pairs_are_apart(
+    const Scene& s,
+    const Built<N>& b,
+    const FeatureCandidates& c,
+    double min_separation) {
+  const std::set<VertexFacePair> vf(c.vf.begin(), c.vf.end());
+  const std::set<EdgeEdgePair> ee(c.ee.begin(), c.ee.end());
+  auto points = [&](std::initializer_list<std::int32_t> ids) {
+    std::vector<Eigen::Vector3d> p;
+    for (const auto v : ids) {
+      p.push_back(s.x_t0.row(v).transpose());
+      p.push_back(s.x_t1.row(v).transpose());
+    }
+    return p;
+  };
+  const FeatureTopology& t = b.topology;
+  std::int64_t left_out = 0;
+  for (std::int32_t v = 0; v < t.num_vertices(); ++v) {
+    for (std::int32_t f = 0; f < t.num_triangles(); ++f) {
+      const auto& tri = t.triangle(f);
+      if (v == tri[0] || v == tri[1] || v == tri[2] || t.vertex_face_excluded(v, f)) continue;
+      if (vf.count({v, f})) continue;
+      ++left_out;
+      ASSERT_TRUE(provably_apart<N>(points({v}), points({tri[0], tri[1], tri[2]}), min_separation))
+          << s.name << ": VF (" << v << ", " << f << ") was left out but may touch";
+    }
+  }
+  for (std::int32_t e = 0; e < t.num_edges(); ++e) {
+    for (std::int32_t g = e + 1; g < t.num_edges(); ++g) {
+      const auto& ea = t.edge(e);
+      const auto& eb = t.edge(g);
+      if (ea[0] == eb[0] || ea[0] == eb[1] || ea[1] == eb[0] || ea[1] == eb[1]) continue;
+      if (t.edges_excluded(e, g) || ee.count({e, g})) continue;
+      ++left_out;
+      ASSERT_TRUE(provably_apart<N>(points({ea[0], ea[1]}), points({eb[0], eb[1]}), min_separation))
+          << s.name << ": EE (" << e << ", " << g << ") was left out but may touch";
+    }
+  }
+  EXPECT_GT(left_out, 0) << s.name << ": nothing was culled, the check proved nothing";
+}
+
+// --- tests -------------------------------------------------------------------------------------
+
+TEST(FeatureTopology, EveryVertexAndEdgeHasExactlyOneOwner) {
+  for (const Scene& s : scenes()) {
+    const FeatureTopology t(s.mesh, s.topology);
+    std::vector<int> vertex_owners(static_cast<std::size_t>(t.num_vertices()), 0);
+    std::vector<int> edge_owners(static_cast<std::size_t>(t.num_edges()), 0);
+    for (std::int32_t f = 0; f < t.num_triangles(); ++f) {
+      for (int k = 0; k < 3; ++k) {
+        if (t.owned(f) & (1u << k)) {
+          const auto v = t.triangle(f)[static_cast<std::size_t>(k)];
+          ++vertex_owners[static_cast<std::size_t>(v)];
+          EXPECT_EQ(t.vertex_owner(v), f);
+        }
+        if (t.owned(f) & (1u << (3 + k))) {
+          const auto e = t.face_edge(f, k);
+          ++edge_owners[static_cast<std::size_t>(e)];
+          EXPECT_EQ(t.edge_owner(e), f);
+        }
+      }
+    }
+    for (const int n : vertex_owners) EXPECT_EQ(n, 1) << s.name;
+    for (const int n : edge_owners) EXPECT_EQ(n, 1) << s.name;
+  }
+}
+
+template <int N>
+void check_hierarchy_matches_brute_force(double min_separation) {
+  for (const Scene& s : scenes()) {
+    const Built<N> b = bounds_of<N>(s, min_separation);
+    Counters brute_counters;
+    FeatureCandidates brute;
+    ccd_candidates_brute_force<N>(b.topology, b.bounds, brute, brute_counters);
+    EXPECT_FALSE(brute.vf.empty()) << s.name;
+    EXPECT_FALSE(brute.ee.empty()) << s.name;
+    EXPECT_FALSE(has_duplicates(brute.vf));
+    EXPECT_FALSE(has_duplicates(brute.ee));
+    check_left_out_pairs_are_apart<N>(s, b, brute, min_separation);
+    for (const int leaf : {1, 4}) {
+      // Build at t0 and, to show the tree shape does not matter, at a different pose.
+      for (const auto* build_at : {&s.x_t0, &s.x_t1}) {
+        Counters counters;
+        const FeatureCandidates got = hierarchy_candidates<N>(b, *build_at, leaf, counters);
+        SCOPED_TRACE(s.name + ", N = " + std::to_string(N) + ", leaf " + std::to_string(leaf));
+        EXPECT_FALSE(has_duplicates(got.vf)) << "a VF pair was produced twice";
+        EXPECT_FALSE(has_duplicates(got.ee)) << "an EE pair was produced twice";
+        EXPECT_EQ(sorted(got.vf), brute.vf);
+        EXPECT_EQ(sorted(got.ee), brute.ee);
+        EXPECT_EQ(counters.feature_bv_tests <= brute_counters.feature_bv_tests, true);
+        EXPECT_GT(counters.candidate_pairs, 0);
+      }
+    }
+  }
+}
+
+TEST(CcdCandidates, AabbHierarchyProducesExactlyTheBruteForcePairsEachOnce) {
+  check_hierarchy_matches_brute_force<3>(0.0);
+}
+
+TEST(CcdCandidates, KdopHierarchyProducesExactlyTheBruteForcePairsEachOnce) {
+  check_hierarchy_matches_brute_force<8>(0.0);
+}
+
+TEST(CcdCandidates, WithAContactDistanceTooPairsWithinItAreNeverLeftOut) {
+  check_hierarchy_matches_brute_force<3>(0.03);
+  check_hierarchy_matches_brute_force<8>(0.03);
+}
+
+TEST(CcdCandidates, FanSharingOneVertexStillYieldsItsCrossings) {
+  // Every triangle pair of the fan shares the centre: skipping adjacent pairs would miss all.
+  const Scene s = helical_fan(24);
+  const Built<3> b = bounds_of<3>(s, 0.0);
+  Counters counters;
+  const auto got = hierarchy_candidates<3>(b, s.x_t0, 1, counters);
+  EXPECT_GT(got.vf.size(), 20u);
+  EXPECT_GT(got.ee.size(), 20u);
+  for (const auto& p : got.vf) EXPECT_NE(p.vertex, 0) << "the centre is a corner of every face";
+}
+
+TEST(CcdCandidates, PartExclusionsApplyPerFeatureAndRespectSharedVertices) {
+  // Two sheets in parts 0 and 1 meet along the seam x = 1 (welded across the parts); a tube in
+  // part 2 crosses the seam. Excluding (0, 1) and (2, 2): no pair of a part-0-only feature with
+  // a part-1-only one, none within part 2 — but a seam vertex (parts 0 and 1) is still tested
+  // against faces of either sheet, since (0, 0) and (1, 1) are allowed.
+  auto a = test::sheet(4, 4, 1.0, 1.0);
+  auto c = test::sheet(4, 4, 1.0, 1.0);
+  c.rest_positions = test::translated(c.rest_positions, Eigen::Vector3d(1.0, 0.0, 0.0));
+  auto cross = test::tube(6, 4, 0.2, 1.0);
+  cross.rest_positions = test::translated(cross.rest_positions, Eigen::Vector3d(1.0, 0.5, -0.5));
+  auto mesh = test::combine(test::combine(a, c), cross);
+  mesh.excluded_part_pairs = {{0, 1}, {2, 2}};
+  const Scene s = make_scene("parts", mesh, [](const auto& x) {
+    skinning::Positions y = x;
+    for (Eigen::Index v = 0; v < y.rows(); ++v) {
+      y(v, 0) += 0.3 * std::sin(5.0 * x(v, 1));
+      y(v, 2) += 0.3 * std::sin(4.0 * x(v, 0));
+    }
+    return y;
+  });
+  for (const auto* name : {"aabb", "kdop"}) {
+    SCOPED_TRACE(name);
+    const bool aabb = std::string(name) == "aabb";
+    FeatureCandidates brute, got;
+    FeatureTopology t(s.mesh, s.topology);
+    if (aabb) {
+      const Built<3> b = bounds_of<3>(s, 0.0);
+      Counters c1, c2;
+      ccd_candidates_brute_force<3>(b.topology, b.bounds, brute, c1);
+      got = hierarchy_candidates<3>(b, s.x_t0, 2, c2);
+    } else {
+      const Built<8> b = bounds_of<8>(s, 0.0);
+      Counters c1, c2;
+      ccd_candidates_brute_force<8>(b.topology, b.bounds, brute, c1);
+      got = hierarchy_candidates<8>(b, s.x_t0, 2, c2);
+    }
+    EXPECT_EQ(sorted(got.vf), brute.vf);
+    EXPECT_EQ(sorted(got.ee), brute.ee);
+    // Independent restatement of the rule on the result.
+    auto vertex_parts = [&](std::int32_t v) {
+      std::set<std::int32_t> parts;
+      for (std::int32_t f = 0; f < t.num_triangles(); ++f) {
+        const auto& tri = t.triangle(f);
+        if (v == tri[0] || v == tri[1] || v == tri[2]) parts.insert(t.face_part(f));
+      }
+      return parts;
+    };
+    auto allowed = [&](std::int32_t p, std::int32_t q) {
+      return !((std::min(p, q) == 0 && std::max(p, q) == 1) || (p == 2 && q == 2));
+    };
+    bool seam_pair_seen = false;
+    for (const auto& p : got.vf) {
+      const auto parts = vertex_parts(p.vertex);
+      const std::int32_t q = t.face_part(p.face);
+      EXPECT_TRUE(std::any_of(parts.begin(), parts.end(), [&](auto pp) { return allowed(pp, q); }))
+          << "VF (" << p.vertex << ", " << p.face << ") crosses an excluded part pair";
+      if (parts.size() == 2) seam_pair_seen = true;
+    }
+    EXPECT_TRUE(seam_pair_seen) << "the scene should exercise a vertex shared by two parts";
+    EXPECT_TRUE(t.has_exclusions());
+  }
+}
+
+TEST(DcdCandidates, HierarchyPathMatchesBruteForceAndKeepsSharedVertexPairs) {
+  for (const Scene& s : scenes()) {
+    const FeatureTopology t(s.mesh, s.topology);
+    std::vector<Dop<3>> vb;
+    static_vertex_bounds<3>(s.x_t1, vb);
+    FeatureBounds<3> bounds;
+    bounds.vertices = vb;
+    bounds.derive(t, false);
+    Counters brute_counters, counters;
+    std::vector<TrianglePair> brute, got;
+    dcd_candidates_brute_force<3>(t, bounds.triangles, brute, brute_counters);
+    Bvh<3> bvh(t.welded_triangles(), s.x_t0, BvhOptions{3});
+    bvh.refit(bounds.triangles);
+    TraversalScratch scratch;
+    self_traverse<3>(bvh, bounds.triangles, scratch, got, counters.bv_tests);
+    dcd_filter_triangle_pairs(t, got, counters);
+    EXPECT_EQ(sorted(got), brute) << s.name;
+    EXPECT_EQ(counters.candidate_pairs, static_cast<std::int64_t>(got.size()));
+    const auto nf = static_cast<std::int64_t>(t.num_triangles());
+    EXPECT_EQ(brute_counters.candidate_pairs, nf * (nf - 1) / 2);
+    // Pairs sharing one or two vertices are kept for the exact shared-corner test.
+    const auto shared = std::count_if(brute.begin(), brute.end(), [&](const TrianglePair& p) {
+      int n = 0;
+      (void)t.shared_corners(p.a, p.b, n);
+      return n > 0;
+    });
+    EXPECT_GT(shared, 0) << s.name;
+  }
+}
+
+TEST(FeatureTopology, SharedCornersMapCornersAndCountDistinctVertices) {
+  skinning::Positions x(5, 3);
+  x << 0, 0, 0, 1, 0, 0, 0, 1, 0, 1, 1, 0, 2, 2, 0;
+  skinning::Triangles f(4, 3);
+  f << 0, 1, 2,  // a
+      2, 1, 3,   // shares edge 1-2 with a
+      3, 4, 0,   // shares vertex 0 with a
+      1, 2, 0;   // same three vertices as a
+  const auto mesh = test::single_part_mesh(x, f);
+  const FeatureTopology t(mesh, test::simple_topology(mesh));
+  int n = 0;
+  EXPECT_EQ(t.shared_corners(0, 1, n), (ccd::SharedCorners{-1, 1, 0}));
+  EXPECT_EQ(n, 2);
+  EXPECT_EQ(t.shared_corners(0, 2, n), (ccd::SharedCorners{2, -1, -1}));
+  EXPECT_EQ(n, 1);
+  (void)t.shared_corners(0, 3, n);
+  EXPECT_EQ(n, 3);
+  // The duplicate face is dropped from DCD, the others kept.
+  std::vector<TrianglePair> pairs{{0, 1}, {0, 2}, {0, 3}};
+  Counters counters;
+  dcd_filter_triangle_pairs(t, pairs, counters);
+  EXPECT_EQ(pairs, (std::vector<TrianglePair>{{0, 1}, {0, 2}}));
+}
+
+TEST(FeatureTopology, RejectsATopologyThatDoesNotMatchTheMesh) {
+  const auto mesh = test::sheet(2, 2);
+  auto topo = test::simple_topology(mesh);
+  auto bad = topo;
+  bad.face_edges(3, 1) = bad.face_edges(3, 0);
+  EXPECT_THROW_MESSAGE(FeatureTopology(mesh, bad), InvalidInput, "triangle 3");
+  bad = topo;
+  bad.welded_triangles(2, 0) = 99;
+  EXPECT_THROW_MESSAGE(FeatureTopology(mesh, bad), InvalidInput, "welded triangle 2");
+  auto bad_mesh = mesh;
+  bad_mesh.excluded_part_pairs = {{0, 3}};
+  EXPECT_THROW_MESSAGE(FeatureTopology(bad_mesh, topo), InvalidInput, "excluded_part_pairs");
+  bad = topo;
+  bad.face_edges.conservativeResize(2, 3);
+  EXPECT_THROW_MESSAGE(FeatureTopology(mesh, bad), InvalidInput, "face_edges");
+}
+
+}  // namespace
+}  // namespace skelcd::culling
