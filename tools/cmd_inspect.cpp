@@ -165,13 +165,13 @@ Table summary_table(const std::vector<std::pair<std::string, LogData>>& logs) {
 Table frames_table(const LogData& log) {
   Table t;
   t.columns = {"sample",   "kind",     "t0",          "t1",          "bv_tests",
-               "candidate_pairs",      "vf_tests",    "ee_tests",    "tt_tests",
+               "candidate_pairs",      "feature_bv_tests",    "vf_tests",    "ee_tests",    "tt_tests",
                "vf_contacts",          "ee_contacts", "dcd_pairs",   "skin_ms",
                "refit_ms", "traverse_ms",             "elementary_ms", "total_ms"};
   for (const auto& r : log.frames) {
     const auto& c = r.counters;
     t.rows.push_back({r.sample, std::string(to_string(r.kind)), r.t0, r.t1, c.bv_tests,
-                      c.candidate_pairs, c.vf_tests, c.ee_tests, c.tt_tests, c.vf_contacts,
+                      c.candidate_pairs, c.feature_bv_tests, c.vf_tests, c.ee_tests, c.tt_tests, c.vf_contacts,
                       c.ee_contacts, c.dcd_pairs, r.times.skin_us / 1000.0,
                       r.times.refit_us / 1000.0, r.times.traverse_us / 1000.0,
                       r.times.elementary_us / 1000.0, r.total_us / 1000.0});

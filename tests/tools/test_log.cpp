@@ -68,6 +68,7 @@ FrameReport sample_report(int sample, QueryKind kind, int contacts, int pairs) {
   c.ee_contacts = base + 10;
   c.tt_tests = base + 11;
   c.dcd_pairs = (std::int64_t{1} << 40) + base;  // beyond 32 bits
+  c.feature_bv_tests = base + 12;
   auto& t = r.row.times;
   t.skin_us = 0.5 + sample;
   t.refit_us = 1.25 + sample;
@@ -112,6 +113,7 @@ void expect_rows_equal(const FrameRow& a, const FrameRow& b) {
   EXPECT_EQ(x.ee_contacts, y.ee_contacts);
   EXPECT_EQ(x.tt_tests, y.tt_tests);
   EXPECT_EQ(x.dcd_pairs, y.dcd_pairs);
+  EXPECT_EQ(x.feature_bv_tests, y.feature_bv_tests);
   EXPECT_EQ(a.times.skin_us, b.times.skin_us);
   EXPECT_EQ(a.times.refit_us, b.times.refit_us);
   EXPECT_EQ(a.times.classify_us, b.times.classify_us);

@@ -124,6 +124,7 @@ FrameRow from_disk(const detail::FrameDisk& d) {
   c.ee_contacts = d.ee_contacts;
   c.tt_tests = d.tt_tests;
   c.dcd_pairs = d.dcd_pairs;
+  c.feature_bv_tests = d.feature_bv_tests;
   auto& t = row.times;
   t.skin_us = d.skin_us;
   t.refit_us = d.refit_us;

@@ -91,6 +91,7 @@ detail::FrameDisk to_disk(const FrameRow& row) {
       .ee_contacts = c.ee_contacts,
       .tt_tests = c.tt_tests,
       .dcd_pairs = c.dcd_pairs,
+      .feature_bv_tests = c.feature_bv_tests,
       .skin_us = t.skin_us,
       .refit_us = t.refit_us,
       .classify_us = t.classify_us,
@@ -185,9 +186,14 @@ LogWriter::LogWriter(const std::filesystem::path& path, const LogHeader& header)
   impl_->where = path.string();
   refuse_to_clobber(path);
   // The default (oldest compatible) file format: a file left open by a killed process carries no
-  // "open for writing" flag, so h5dump and h5py read it as it is.
-  impl_->file = H5Handle(H5Fcreate(impl_->where.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT),
-                         H5Fclose);
+  // "open for writing" flag, so h5dump and h5py read it as it is. No file lock either, so that
+  // `skelcd inspect` can look at the rows flushed so far while the run goes on.
+  H5Handle access(H5Pcreate(H5P_FILE_ACCESS), H5Pclose);
+  if (!access.valid() || H5Pset_file_locking(access.get(), false, true) < 0) {
+    throw IoError(impl_->where + ": cannot set up file access (" + detail::take_hdf5_error() + ")");
+  }
+  impl_->file = H5Handle(
+      H5Fcreate(impl_->where.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, access.get()), H5Fclose);
   if (!impl_->file.valid()) {
     throw IoError(impl_->where + ": cannot create log (" + detail::take_hdf5_error() + ")");
   }

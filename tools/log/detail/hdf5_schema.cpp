@@ -89,6 +89,7 @@ H5Handle frame_memory_type() {
   SKELCD_FIELD(type, FrameDisk, ee_contacts, H5T_NATIVE_INT64);
   SKELCD_FIELD(type, FrameDisk, tt_tests, H5T_NATIVE_INT64);
   SKELCD_FIELD(type, FrameDisk, dcd_pairs, H5T_NATIVE_INT64);
+  SKELCD_FIELD(type, FrameDisk, feature_bv_tests, H5T_NATIVE_INT64);
   SKELCD_FIELD(type, FrameDisk, skin_us, H5T_NATIVE_DOUBLE);
   SKELCD_FIELD(type, FrameDisk, refit_us, H5T_NATIVE_DOUBLE);
   SKELCD_FIELD(type, FrameDisk, classify_us, H5T_NATIVE_DOUBLE);

@@ -72,6 +72,7 @@ struct FrameDisk {
   std::int64_t ee_contacts;
   std::int64_t tt_tests;
   std::int64_t dcd_pairs;
+  std::int64_t feature_bv_tests;
   double skin_us;
   double refit_us;
   double classify_us;

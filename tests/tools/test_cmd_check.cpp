@@ -1,0 +1,244 @@
+// skelcd check as a user runs it on a real character: JSON summary consistent with the log it
+// writes, bvh against the brute-force reference, bad inputs refused in one line with no log
+// left behind, and a run killed with SIGKILL half-way leaving a log that our reader, h5dump and
+// skelcd inspect all read.
+
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cstdlib>
+#include <fstream>
+#include <sstream>
+#include <thread>
+#include <tuple>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include "tests/support/test_support.hpp"
+#include "tests/tools/cli_runner.hpp"
+#include "tools/log/log_reader.hpp"
+
+namespace {
+
+using namespace skelcd::tools;
+using skelcd::test::run_skelcd;
+
+const std::string kModel =
+    skelcd::test::assimp_model("X/BCN_Epileptic.X").string();  // 5126 triangles, 100 samples
+
+std::size_t count_lines(const std::string& text) {
+  return static_cast<std::size_t>(std::count(text.begin(), text.end(), '\n'));
+}
+
+/// Sorted contact and pair keys of a log, to compare two logs' findings as sets.
+using ContactKey = std::tuple<int, int, int, int, int, int, int, int>;
+std::vector<ContactKey> contact_keys(const LogData& log) {
+  std::vector<ContactKey> keys;
+  for (const auto& c : log.contacts) {
+    keys.emplace_back(c.frame, static_cast<int>(c.kind), c.a.part, c.a.index, c.a.side, c.b.part,
+                      c.b.index, c.b.side);
+  }
+  std::sort(keys.begin(), keys.end());
+  return keys;
+}
+std::vector<std::tuple<int, int, int, int, int>> pair_keys(const LogData& log) {
+  std::vector<std::tuple<int, int, int, int, int>> keys;
+  for (const auto& p : log.dcd_pairs) {
+    keys.emplace_back(p.frame, p.a.part, p.a.index, p.b.part, p.b.index);
+  }
+  std::sort(keys.begin(), keys.end());
+  return keys;
+}
+
+TEST(CmdCheck, JsonSummaryMatchesTheLogItWrote) {
+  const auto dir = skelcd::test::temp_dir("check-json");
+  const auto log_path = (dir / "bcn.h5").string();
+  const auto r = run_skelcd({"check", kModel, "--frames", "10:13", "--json", "-o", log_path});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  for (const char* key : {"frames", "intervals", "method", "accuracy", "dcd_pairs", "ccd_vf",
+                          "ccd_ee", "frames_with_contacts", "ms_per_interval", "stages_ms"}) {
+    EXPECT_TRUE(j.contains(key)) << key;
+  }
+  EXPECT_EQ(j["frames"], 4);
+  EXPECT_EQ(j["intervals"], 3);
+  EXPECT_EQ(j["method"], "bvh");
+  EXPECT_EQ(j["accuracy"], "conservative");
+  EXPECT_EQ(j["log"], log_path);
+  EXPECT_GT(j["ms_per_interval"].get<double>(), 0.0);
+  for (const char* stage : {"skin", "refit", "traverse", "elementary"}) {
+    EXPECT_TRUE(j["stages_ms"].contains(stage)) << stage;
+  }
+
+  const auto log = read_log(log_path);
+  EXPECT_TRUE(log.header.complete);
+  EXPECT_EQ(log.header.method, "bvh");
+  EXPECT_EQ(log.header.input_path, kModel);
+  EXPECT_EQ(log.header.input_hash.rfind("fnv1a64:", 0), 0u);
+  EXPECT_EQ(log.header.first_sample, 10);
+  EXPECT_EQ(log.header.last_sample, 13);
+  EXPECT_EQ(log.header.num_triangles, 5126);
+  EXPECT_NE(log.header.command_line.find("--frames 10:13"), std::string::npos)
+      << log.header.command_line;
+  ASSERT_EQ(log.frames.size(), 7u);
+  std::int64_t dcd = 0, vf = 0, ee = 0;
+  for (const auto& row : log.frames) {
+    EXPECT_GE(row.sample, 10);
+    EXPECT_LE(row.sample, 13);
+    dcd += row.counters.dcd_pairs;
+    vf += row.counters.vf_contacts;
+    ee += row.counters.ee_contacts;
+  }
+  EXPECT_EQ(j["dcd_pairs"], dcd);
+  EXPECT_EQ(j["ccd_vf"], vf);
+  EXPECT_EQ(j["ccd_ee"], ee);
+  EXPECT_EQ(static_cast<std::int64_t>(log.dcd_pairs.size()), dcd);
+  EXPECT_EQ(static_cast<std::int64_t>(log.contacts.size()), vf + ee);
+  // Every feature id is in the file's numbering: a valid part, a non-negative index.
+  for (const auto& c : log.contacts) {
+    EXPECT_GE(c.a.part, 0);
+    EXPECT_LT(c.a.part, static_cast<int>(log.header.part_names.size()));
+    EXPECT_GE(c.b.index, 0);
+    EXPECT_LE(c.toi_lower, c.toi_upper);
+  }
+
+  // Text summary of the same run names the log.
+  const auto text = run_skelcd({"check", kModel, "--frames", "10:11", "-o", log_path});
+  ASSERT_EQ(text.exit_code, 0) << text.err;
+  EXPECT_NE(text.out.find("log       " + log_path), std::string::npos) << text.out;
+  EXPECT_NE(text.out.find("ms per interval"), std::string::npos) << text.out;
+}
+
+TEST(CmdCheck, BvhAndBruteFindTheSameContactsOnARealCharacter) {
+  // The full clip comparison is scripts/check_methods_agree.sh; one interval here keeps ctest fast.
+  const auto dir = skelcd::test::temp_dir("check-agree");
+  const auto bvh = run_skelcd({"check", kModel, "--frames", "40:41", "--method", "bvh", "--json",
+                               "-o", (dir / "bvh.h5").string()});
+  const auto brute = run_skelcd({"check", kModel, "--frames", "40:41", "--method", "brute",
+                                 "--json", "-o", (dir / "brute.h5").string()});
+  ASSERT_EQ(bvh.exit_code, 0) << bvh.err;
+  ASSERT_EQ(brute.exit_code, 0) << brute.err;
+  const auto a = nlohmann::json::parse(bvh.out);
+  const auto b = nlohmann::json::parse(brute.out);
+  EXPECT_EQ(a["dcd_pairs"], b["dcd_pairs"]);
+  EXPECT_EQ(a["ccd_vf"], b["ccd_vf"]);
+  EXPECT_EQ(a["ccd_ee"], b["ccd_ee"]);
+  const auto la = read_log(dir / "bvh.h5");
+  const auto lb = read_log(dir / "brute.h5");
+  EXPECT_EQ(contact_keys(la), contact_keys(lb));
+  EXPECT_EQ(pair_keys(la), pair_keys(lb));
+  EXPECT_EQ(lb.header.method, "brute");
+}
+
+TEST(CmdCheck, BadInputsFailWithOneLineAndLeaveNoLog) {
+  const auto dir = skelcd::test::temp_dir("check-bad");
+  const auto log = (dir / "out.h5").string();
+  const std::vector<std::pair<std::vector<std::string>, std::string>> cases{
+      {{"check", (dir / "missing.x").string(), "-o", log}, "missing.x: no such file"},
+      {{"check", kModel, "--frames", "5:2", "-o", log}, "--frames"},
+      {{"check", kModel, "--frames", "x", "-o", log}, "--frames"},
+      {{"check", kModel, "--frames", "0:100", "-o", log}, "outside the 100 samples"},
+      {{"check", kModel, "--method", "no-such-method", "-o", log}, "no-such-method"},
+      {{"check", kModel, "--accuracy", "sloppy", "-o", log}, "--accuracy"},
+      {{"check", kModel, "--query", "all", "-o", log}, "--query"},
+      {{"check", kModel, "--fps", "-3", "-o", log}, "--fps"},
+      {{"check", kModel, "--clip", "NoSuchClip", "-o", log}, "NoSuchClip"},
+  };
+  for (const auto& [args, message] : cases) {
+    const auto r = run_skelcd(args);
+    EXPECT_EQ(r.exit_code, 1) << message;
+    EXPECT_EQ(count_lines(r.err), 1u) << r.err;
+    EXPECT_NE(r.err.find(message), std::string::npos) << r.err;
+    EXPECT_TRUE(r.out.empty()) << r.out;
+    EXPECT_FALSE(std::filesystem::exists(log)) << message;
+  }
+}
+
+TEST(CmdCheck, RefusesToOverwriteAFileThatIsNotALog) {
+  const auto dir = skelcd::test::temp_dir("check-clobber");
+  const auto precious = dir / "thesis.h5";
+  std::ofstream(precious) << "chapter one\n";
+  const auto r = run_skelcd({"check", kModel, "--frames", "0:1", "-o", precious.string()});
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.err.find("refusing to overwrite"), std::string::npos) << r.err;
+  std::ifstream in(precious);
+  std::string line;
+  std::getline(in, line);
+  EXPECT_EQ(line, "chapter one");
+}
+
+TEST(CmdCheck, KilledRunLeavesALogWithEveryCompletedFrame) {
+  const auto dir = skelcd::test::temp_dir("check-kill");
+  const auto log_path = dir / "killed.h5";
+  // 300 samples per second: ~1000 samples, far more than we let it do.
+  const pid_t pid = ::fork();
+  ASSERT_GE(pid, 0);
+  if (pid == 0) {
+    std::freopen("/dev/null", "w", stdout);
+    std::freopen((dir / "stderr.txt").c_str(), "w", stderr);
+    ::execl(SKELCD_EXE, SKELCD_EXE, "check", kModel.c_str(), "--fps", "300", "-o",
+            log_path.c_str(), static_cast<char*>(nullptr));
+    ::_exit(127);
+  }
+  // Poll the log (the writer takes no file lock) until a few rows are on disk, then kill.
+  std::size_t seen = 0;
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
+  while (seen < 5 && std::chrono::steady_clock::now() < deadline) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    try {
+      seen = read_log(log_path, ReadLogOptions{.findings = false}).frames.size();
+    } catch (const std::exception&) {
+      // not created yet, or caught mid-write: poll again
+    }
+  }
+  ASSERT_EQ(::kill(pid, SIGKILL), 0);
+  int status = 0;
+  ASSERT_EQ(::waitpid(pid, &status, 0), pid);
+  ASSERT_TRUE(WIFSIGNALED(status)) << "the run ended before it was killed";
+  ASSERT_GE(seen, 5u) << "no rows appeared within 60 s";
+
+  // Our reader: every row written before the kill, the run marked incomplete, findings consistent.
+  const auto log = read_log(log_path);
+  EXPECT_FALSE(log.header.complete);
+  EXPECT_GE(log.frames.size(), seen);
+  EXPECT_LT(static_cast<std::int64_t>(log.frames.size()), log.header.planned_rows);
+  std::int64_t contacts = 0, pairs = 0;
+  for (std::size_t i = 0; i < log.frames.size(); ++i) {
+    const auto& row = log.frames[i];
+    // Rows in order: dcd 0, ccd 0, dcd 1, ccd 1, …
+    EXPECT_EQ(row.sample, static_cast<int>(i / 2)) << i;
+    EXPECT_EQ(row.kind, i % 2 == 0 ? QueryKind::dcd : QueryKind::ccd) << i;
+    contacts += row.counters.vf_contacts + row.counters.ee_contacts;
+    pairs += row.counters.dcd_pairs;
+  }
+  // Findings are written before their row: at least those of the completed rows are there, and
+  // any extra ones belong to the row being computed when the kill came.
+  const int last_sample = log.frames.back().sample;
+  std::int64_t kept_contacts = 0, kept_pairs = 0;
+  for (const auto& c : log.contacts) kept_contacts += c.frame <= last_sample ? 1 : 0;
+  for (const auto& p : log.dcd_pairs) kept_pairs += p.frame <= last_sample ? 1 : 0;
+  EXPECT_GE(kept_contacts, contacts);
+  EXPECT_GE(kept_pairs, pairs);
+
+  // h5dump reads it without our code.
+  const std::string dump = "h5dump -H " + log_path.string() + " > " + (dir / "dump.txt").string();
+  EXPECT_EQ(std::system(dump.c_str()), 0);
+  std::ifstream in(dir / "dump.txt");
+  std::stringstream text;
+  text << in.rdbuf();
+  EXPECT_NE(text.str().find("DATASET \"frames\""), std::string::npos);
+  const std::string data = "h5dump -d /frames " + log_path.string() + " > /dev/null";
+  EXPECT_EQ(std::system(data.c_str()), 0);
+
+  // skelcd inspect lists it as incomplete.
+  const auto r = run_skelcd({"inspect", log_path.string(), "--json"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(j[0]["complete"].get<std::string>().rfind("no (", 0), 0u) << j.dump();
+}
+
+}  // namespace
