@@ -1,0 +1,307 @@
+// The whole segmentation on generated rigs with known geometry and on real characters: every
+// triangle in exactly one edge-connected cluster, segments on their own bones, refinement never
+// worse, determinism, both weight sources, bad input.
+
+#include <algorithm>
+#include <cmath>
+#include <memory>
+#include <numbers>
+#include <set>
+
+#include <Eigen/Geometry>
+#include <gtest/gtest.h>
+
+#include "segmentation/atomic_clusters.hpp"
+#include "segmentation/face_graph.hpp"
+#include "segmentation/segmentation.hpp"
+#include "skinning/errors.hpp"
+#include "skinning/load.hpp"
+#include "skinning/topology.hpp"
+#include "tests/segmentation/mini_rigs.hpp"
+#include "tests/support/test_support.hpp"
+
+namespace {
+
+using namespace skelcd::segmentation;
+using skelcd::skinning::Rig;
+
+// Checks the structural invariants of a segmentation of `rig`; returns a failure message.
+::testing::AssertionResult well_formed(const Rig& rig, const Segmentation& seg) {
+  const auto nf = rig.mesh.num_triangles();
+  if (static_cast<std::int64_t>(seg.triangle_cluster.size()) != nf) {
+    return ::testing::AssertionFailure() << "triangle_cluster has " << seg.triangle_cluster.size()
+                                         << " entries for " << nf << " triangles";
+  }
+  // Exactly one cluster per triangle, and the cluster lists agree with triangle_cluster.
+  std::vector<int> seen(static_cast<std::size_t>(nf), 0);
+  for (std::size_t c = 0; c < seg.clusters.size(); ++c) {
+    const auto& cl = seg.clusters[c];
+    if (cl.triangles.empty()) return ::testing::AssertionFailure() << "cluster " << c << " empty";
+    if (cl.bone < 0 || cl.bone >= rig.skeleton.num_bones()) {
+      return ::testing::AssertionFailure() << "cluster " << c << " has bone " << cl.bone;
+    }
+    if (!std::is_sorted(cl.triangles.begin(), cl.triangles.end())) {
+      return ::testing::AssertionFailure() << "cluster " << c << " triangles not sorted";
+    }
+    for (const auto f : cl.triangles) {
+      ++seen[static_cast<std::size_t>(f)];
+      if (seg.triangle_cluster[static_cast<std::size_t>(f)] != static_cast<std::int32_t>(c)) {
+        return ::testing::AssertionFailure() << "triangle " << f << " listed in " << c;
+      }
+    }
+  }
+  for (std::int64_t f = 0; f < nf; ++f) {
+    if (seen[static_cast<std::size_t>(f)] != 1) {
+      return ::testing::AssertionFailure() << "triangle " << f << " in " << seen[static_cast<std::size_t>(f)]
+                                           << " clusters";
+    }
+  }
+  // Each cluster edge-connected (on the welded mesh).
+  const auto topo = skelcd::skinning::build_topology(rig.mesh);
+  const auto graph = face_graph(topo.welded_triangles);
+  for (std::size_t c = 0; c < seg.clusters.size(); ++c) {
+    const auto& tris = seg.clusters[c].triangles;
+    std::set<std::int32_t> reached = {tris.front()};
+    std::vector<std::int32_t> stack = {tris.front()};
+    while (!stack.empty()) {
+      const auto f = stack.back();
+      stack.pop_back();
+      for (auto k = graph.offsets[static_cast<std::size_t>(f)];
+           k < graph.offsets[static_cast<std::size_t>(f) + 1]; ++k) {
+        const auto g = graph.neighbours[static_cast<std::size_t>(k)];
+        if (seg.triangle_cluster[static_cast<std::size_t>(g)] == static_cast<std::int32_t>(c) &&
+            reached.insert(g).second) {
+          stack.push_back(g);
+        }
+      }
+    }
+    if (reached.size() != tris.size()) {
+      return ::testing::AssertionFailure() << "cluster " << c << " not edge-connected: "
+                                           << reached.size() << " of " << tris.size();
+    }
+  }
+  // Graph: ordered pairs of distinct existing clusters, each with at least one shared edge.
+  for (const auto& e : seg.graph) {
+    if (!(e.a >= 0 && e.a < e.b && e.b < static_cast<std::int32_t>(seg.clusters.size())) ||
+        e.shared_edges < 1 || !e.joint.allFinite()) {
+      return ::testing::AssertionFailure() << "bad graph edge " << e.a << "-" << e.b;
+    }
+  }
+  if (seg.stats.atomic_clusters != static_cast<std::int32_t>(seg.clusters.size()) ||
+      seg.stats.point_observers + seg.stats.line_observers != seg.stats.atomic_clusters) {
+    return ::testing::AssertionFailure() << "stats disagree with clusters";
+  }
+  return ::testing::AssertionSuccess();
+}
+
+// A capsule chain bent by `degrees` about z at the joint between bone `joint − 1` and `joint`:
+// vertices blend from 0 to the full rotation over ±`blend` around the joint (a smooth elbow), the
+// bones beyond turn rigidly.
+Rig bent_chain(int bones, int joint, double degrees, double blend) {
+  Rig rig = skelcd::test::capsule_chain(bones, 1.0, 0.25, 8, 16);
+  const Eigen::Vector3d J(joint, 0, 0);
+  const double full = degrees * std::numbers::pi / 180.0;
+  for (Eigen::Index v = 0; v < rig.mesh.rest_positions.rows(); ++v) {
+    const Eigen::Vector3d p = rig.mesh.rest_positions.row(v).transpose();
+    const double s = std::clamp((p.x() - (joint - blend)) / (2.0 * blend), 0.0, 1.0);
+    const double a = full * s * s * (3.0 - 2.0 * s);
+    rig.mesh.rest_positions.row(v) = (J + Eigen::AngleAxisd(a, Eigen::Vector3d::UnitZ()) * (p - J)).transpose();
+  }
+  const Eigen::AngleAxisd R(full, Eigen::Vector3d::UnitZ());
+  for (int b = joint; b < bones; ++b) {
+    auto& bone = rig.skeleton.bones[static_cast<std::size_t>(b)];
+    bone.rest_head = J + R * (bone.rest_head - J);
+    bone.rest_tail = J + R * (bone.rest_tail - J);
+  }
+  return rig;
+}
+
+TEST(Segmentation, CapsuleChainOneClusterPerBoneOnItsOwnSpan) {
+  const int n = 6;
+  const Rig rig = skelcd::test::capsule_chain(n);
+  for (const auto source : {WeightSource::heat, WeightSource::rig}) {
+    SegmentationOptions options;
+    options.weights = source;
+    const auto seg = segment(rig, options);
+    ASSERT_TRUE(well_formed(rig, seg));
+    ASSERT_EQ(seg.stats.atomic_clusters, n);
+    EXPECT_TRUE(seg.stats.bones_without_cluster.empty());
+    // A straight tube is seen from inside by any point of its axis: nothing non-positive.
+    EXPECT_EQ(seg.stats.h_minus, 0);
+    EXPECT_EQ(seg.stats.h_uncertain, 0);
+    for (Eigen::Index f = 0; f < rig.mesh.num_triangles(); ++f) {
+      // Heat: the span holding the centroid (the weights split evenly at the joint planes).
+      // Rig: the bone that two of the three corners are rigidly bound to.
+      double cx = 0.0;
+      int votes[16] = {};
+      for (int c = 0; c < 3; ++c) {
+        const double x = rig.mesh.rest_positions(rig.mesh.triangles(f, c), 0);
+        cx += x / 3.0;
+        ++votes[std::clamp(static_cast<int>(std::floor(x)), 0, n - 1)];
+      }
+      const int expected = source == WeightSource::heat
+                               ? std::clamp(static_cast<int>(std::floor(cx)), 0, n - 1)
+                               : static_cast<int>(std::max_element(votes, votes + n) - votes);
+      const auto& cluster = seg.clusters[static_cast<std::size_t>(seg.triangle_cluster[static_cast<std::size_t>(f)])];
+      ASSERT_EQ(cluster.bone, expected) << "triangle " << f << " at x " << cx;
+    }
+    // The graph is the chain, meeting at the joints x = 1 … n−1 (the child's head).
+    ASSERT_EQ(seg.graph.size(), static_cast<std::size_t>(n - 1));
+    for (const auto& e : seg.graph) {
+      const auto ba = seg.clusters[static_cast<std::size_t>(e.a)].bone;
+      const auto bb = seg.clusters[static_cast<std::size_t>(e.b)].bone;
+      ASSERT_EQ(std::abs(ba - bb), 1);
+      EXPECT_EQ(e.ancestor_bone, std::min(ba, bb));
+      EXPECT_TRUE(skelcd::test::expect_matrix_near(e.joint, Eigen::Vector3d(std::max(ba, bb), 0, 0), 0));
+      // Heat: the ring at the joint (16 edges). Rig: the joint ring's row of quads zigzags between
+      // the bones, each quad giving its diagonal and one side (32 edges).
+      EXPECT_EQ(e.shared_edges, source == WeightSource::heat ? 16 : 32);
+    }
+  }
+}
+
+TEST(Segmentation, RefinementNeverIncreasesNonPositiveTriangles) {
+  // A sharp elbow: the inner side of the bend faces away from the upper bone's observer.
+  for (const double degrees : {100.0, 135.0, 150.0}) {
+    const Rig rig = bent_chain(3, 1, degrees, 0.2);
+    const auto seg = segment(rig);
+    ASSERT_TRUE(well_formed(rig, seg));
+    const auto& r = seg.stats.refinement;
+    EXPECT_GT(r.non_positive_before, 0) << degrees;  // the case does exercise the refinement
+    EXPECT_LE(r.non_positive_after, r.non_positive_before) << degrees;
+    EXPECT_EQ(r.removed, r.non_positive_before);
+    EXPECT_EQ(r.removed, r.regrown_positive + r.regrown_unconstrained + r.restored);
+    // Without refinement (RVBC's plain split), the final count is not better.
+    SegmentationOptions plain;
+    plain.refine = false;
+    const auto unrefined = segment(rig, plain);
+    ASSERT_TRUE(well_formed(rig, unrefined));
+    EXPECT_LE(seg.stats.h_minus + seg.stats.h_uncertain,
+              unrefined.stats.h_minus + unrefined.stats.h_uncertain)
+        << degrees;
+  }
+}
+
+TEST(Segmentation, RefineLabelsByHand) {
+  // A sphere; label 0 watched from the centre (every triangle positive to it), label 1 from far
+  // outside on +x. Label 1 holds exactly the triangles that are not positive to its observer:
+  // all are removed, and all grow back into label 0, positively.
+  const auto sphere = skelcd::test::icosphere(2);
+  const auto graph = face_graph(sphere.F);
+  const std::vector<Observer> observers = {
+      {ObserverKind::point, {Eigen::Vector3d(-0.1, 0, 0), Eigen::Vector3d(0.1, 0, 0)}},
+      {ObserverKind::point, {Eigen::Vector3d(5, 0, 0), Eigen::Vector3d(5, 0, 0)}}};
+  std::vector<std::int32_t> labels(static_cast<std::size_t>(sphere.F.rows()));
+  for (Eigen::Index f = 0; f < sphere.F.rows(); ++f) {
+    labels[static_cast<std::size_t>(f)] =
+        orientation(observers[1], sphere.V, sphere.F, f) == Orientation::positive ? 0 : 1;
+  }
+  const Eigen::MatrixXd W = Eigen::MatrixXd::Constant(sphere.V.rows(), 2, 0.5);
+  const auto stats = refine_labels(sphere.V, sphere.F, graph, observers, W, labels);
+  EXPECT_GT(stats.removed, 0);
+  EXPECT_EQ(stats.non_positive_after, 0);
+  EXPECT_EQ(stats.regrown_positive, stats.removed);
+  for (const auto l : labels) EXPECT_EQ(l, 0);
+}
+
+TEST(Segmentation, DeterministicAndIndependentOfThreads) {
+  const Rig rig = bent_chain(4, 2, 120.0, 0.15);
+  SegmentationOptions serial;
+  serial.heat.parallel = false;
+  const auto a = segment(rig);
+  const auto b = segment(rig);
+  const auto c = segment(rig, serial);
+  EXPECT_EQ(a.triangle_cluster, b.triangle_cluster);
+  EXPECT_EQ(a.triangle_cluster, c.triangle_cluster);
+  ASSERT_EQ(a.clusters.size(), c.clusters.size());
+  for (std::size_t k = 0; k < a.clusters.size(); ++k) {
+    EXPECT_EQ(a.clusters[k].observer.kind, c.clusters[k].observer.kind);
+  }
+}
+
+TEST(Segmentation, BadInput) {
+  Rig no_bones = skelcd::test::capsule_chain(2);
+  no_bones.skeleton.bones.clear();
+  EXPECT_THROW_MESSAGE(std::ignore = segment(no_bones), skelcd::InvalidInput, "no bones");
+
+  Rig no_triangles = skelcd::test::capsule_chain(2);
+  no_triangles.mesh.triangles.resize(0, 3);
+  no_triangles.mesh.face_part.clear();
+  no_triangles.mesh.face_index_in_part.clear();
+  EXPECT_THROW_MESSAGE(std::ignore = segment(no_triangles), skelcd::InvalidInput, "no triangles");
+
+  // Rig weights asked for, but the rig has none.
+  Rig unweighted = skelcd::test::capsule_chain(2);
+  unweighted.weights.resize(0, 0);
+  SegmentationOptions rig_weights;
+  rig_weights.weights = WeightSource::rig;
+  EXPECT_THROW_MESSAGE(std::ignore = segment(unweighted, rig_weights), skelcd::InvalidInput,
+                       "weights");
+
+  SegmentationOptions bad_theta;
+  bad_theta.theta_deg = -5;
+  EXPECT_THROW_MESSAGE(std::ignore = segment(skelcd::test::capsule_chain(2), bad_theta),
+                       skelcd::InvalidInput, "theta");
+}
+
+TEST(Segmentation, FarAwayAndZeroLengthBonesAreHandled) {
+  Rig rig = skelcd::test::capsule_chain(3);
+  // Bone 3: far outside the mesh; bone 4: zero length at the middle joint.
+  for (int k = 0; k < 2; ++k) {
+    skelcd::skinning::SkeletonNode node;
+    node.name = "extra" + std::to_string(k);
+    rig.skeleton.nodes.push_back(node);
+    skelcd::skinning::Bone bone;
+    bone.name = node.name;
+    bone.node = static_cast<std::int32_t>(rig.skeleton.nodes.size()) - 1;
+    bone.rest_head = k == 0 ? Eigen::Vector3d(100, 100, 100) : Eigen::Vector3d(1.5, 0, 0);
+    bone.rest_tail = k == 0 ? Eigen::Vector3d(101, 100, 100) : Eigen::Vector3d(1.5, 0, 0);
+    rig.skeleton.bones.push_back(bone);
+  }
+  rig.weights.conservativeResize(rig.weights.rows(), 5);
+  const auto seg = segment(rig);
+  ASSERT_TRUE(well_formed(rig, seg));
+  // The far bone owns nothing and is reported.
+  EXPECT_NE(std::find(seg.stats.bones_without_cluster.begin(), seg.stats.bones_without_cluster.end(), 3),
+            seg.stats.bones_without_cluster.end());
+  EXPECT_EQ(seg.stats.heat.fallback_vertices, 0);
+}
+
+// Real characters, loaded once per suite.
+class RealCharacters : public ::testing::TestWithParam<const char*> {};
+
+std::filesystem::path character_path(const std::string& name) {
+  if (name.ends_with(".X")) return skelcd::test::assimp_model("X/" + name);
+  const auto bundled = skelcd::test::asset("characters/" + name);
+  if (std::filesystem::exists(bundled)) return bundled;
+  return std::filesystem::path(SKELCD_SHARED_DIR) / "assets/characters" / name;
+}
+
+TEST_P(RealCharacters, HeatAndRigWeightsBothPartitionTheMesh) {
+  const auto model = skelcd::skinning::load_model(character_path(GetParam()));
+  ASSERT_TRUE(model.rig);
+  const Rig& rig = *model.rig;
+  for (const auto source : {WeightSource::heat, WeightSource::rig}) {
+    SegmentationOptions options;
+    options.weights = source;
+    const auto seg = segment(rig, options);
+    ASSERT_TRUE(well_formed(rig, seg)) << GetParam();
+    EXPECT_LE(seg.stats.refinement.non_positive_after, seg.stats.refinement.non_positive_before);
+    EXPECT_GE(seg.stats.atomic_clusters, rig.skeleton.num_bones() -
+                                             static_cast<std::int32_t>(seg.stats.bones_without_cluster.size()));
+    std::cout << GetParam() << (source == WeightSource::heat ? " heat" : " rig ")
+              << ": tris " << seg.stats.triangles << " clusters " << seg.stats.atomic_clusters
+              << " (split " << seg.stats.split_clusters << ", empty bones "
+              << seg.stats.bones_without_cluster.size() << ") H- " << seg.stats.h_minus << " Hu "
+              << seg.stats.h_uncertain << " before " << seg.stats.refinement.non_positive_before
+              << " after " << seg.stats.refinement.non_positive_after << " fallback "
+              << seg.stats.heat.fallback_vertices << " clamped " << seg.stats.heat.clamped_weights
+              << " weights " << seg.stats.weights_s << " s decomposition "
+              << seg.stats.decomposition_ms << " ms\n";
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(Models, RealCharacters,
+                         ::testing::Values("CesiumMan.glb", "BCN_Epileptic.X", "Fox.glb"));
+
+}  // namespace
