@@ -6,7 +6,9 @@
 #include <utility>
 
 #include "skinning/errors.hpp"
+#include "skinning/frame_sequence.hpp"
 #include "skinning/rig_motion.hpp"
+#include "skinning/urdf.hpp"
 
 namespace skelcd::skinning {
 namespace {
@@ -93,11 +95,11 @@ LoadedModel load_model(const std::filesystem::path& path, const LoadOptions& opt
     case ModelKind::frame_sequence:
       // Extension point (frame sequences): `return load_frame_sequence_model(path, options);`
       // declared in skinning/frame_sequence.hpp.
-      throw InvalidInput(path.string() + ": frame sequences (a folder or glob of OBJ/PLY files) are not supported yet");
+      return load_frame_sequence_model(path, options);
     case ModelKind::robot:
       // Extension point (robots): `return load_urdf_model(path, options);` declared in
       // skinning/urdf.hpp; model_from_rig() wraps the robot's rig and trajectory clip.
-      throw InvalidInput(path.string() + ": URDF robots are not supported yet");
+      return load_urdf_model(path, options);
     case ModelKind::rig:
       break;
   }

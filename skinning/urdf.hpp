@@ -15,6 +15,9 @@
 
 namespace skelcd::skinning {
 
+struct LoadedModel;
+struct LoadOptions;
+
 enum class JointType { kFixed, kRevolute, kContinuous, kPrismatic };
 
 /// Name of a joint type as URDF spells it ("fixed", "revolute", "continuous", "prismatic").
@@ -110,5 +113,16 @@ struct UrdfOptions {
 [[nodiscard]] std::vector<Eigen::Affine3d> forward_kinematics(
     const Robot& robot,
     std::span<const double> positions);
+
+/// The load_model() entry point for robots (ModelKind::robot): load_urdf with
+/// LoadOptions::package_path and srdf, plus, when LoadOptions::trajectory is given, its clip
+/// (read_joint_trajectory + trajectory_clip, named after the CSV file's stem). Motions sample the
+/// clip at its key rate (the CSV rows when they are evenly spaced) unless asked otherwise.
+/// Without a trajectory the robot has no clip and its one motion is the rest pose.
+/// LoadedModel::problems lists links without geometry and the absence of a trajectory.
+/// @throws as load_urdf and read_joint_trajectory.
+[[nodiscard]] LoadedModel load_urdf_model(
+    const std::filesystem::path& urdf_file,
+    const LoadOptions& options);
 
 }  // namespace skelcd::skinning

@@ -10,6 +10,7 @@
 #include <gtest/gtest.h>
 
 #include "skinning/errors.hpp"
+#include "skinning/load.hpp"
 #include "skinning/urdf.hpp"
 #include "tests/support/test_support.hpp"
 
@@ -179,6 +180,57 @@ TEST(UrdfTrajectory, BadInputNamesFileAndLine) {
   options.check_limits = false;
   EXPECT_EQ(parse_joint_trajectory("time,panda_joint4\n0,0.5\n", "ok.csv", robot, options).positions(0, 0), 0.5);
   EXPECT_THROW_MESSAGE((void)read_joint_trajectory("/nonexistent/t.csv", robot), IoError, "/nonexistent/t.csv: cannot open");
+}
+
+// load_model on a URDF with a trajectory: the Motion (RigMotion over the trajectory clip, one-hot
+// skinning) puts every link's rest vertices where forward kinematics of that row puts them.
+TEST(UrdfTrajectory, LoadModelMotionFollowsForwardKinematics) {
+  const Robot& robot = panda();
+  const fs::path dir = test::temp_dir("trajectory_load_model");
+  write_joint_trajectory(dir / "wave.csv", robot, [&] {
+    JointTrajectory t;
+    t.joints = {robot.find_joint("panda_joint1"), robot.find_joint("panda_joint2"),
+                robot.find_joint("panda_joint6"), robot.find_joint("panda_finger_joint1")};
+    t.times = {0.0, 0.1, 0.2, 0.3};
+    t.positions.resize(4, 4);
+    t.positions << 0, 0, 0, 0, 0.4, -0.3, 1.0, 0.01, 0.8, -0.6, 2.0, 0.02, 1.2, -0.9, 3.0, 0.04;
+    return t;
+  }());
+  LoadOptions options;
+  options.trajectory = dir / "wave.csv";
+  options.srdf = test::asset("robots/example-robot-data/robots/panda_description/srdf/panda.srdf");
+  const LoadedModel model = load_model(test::asset("robots/example-robot-data/robots/panda_description/urdf/panda.urdf"), options);
+  EXPECT_EQ(model.kind, ModelKind::robot);
+  ASSERT_EQ(model.clips.size(), 1U);
+  EXPECT_EQ(model.clips[0].name, "wave");
+  EXPECT_NEAR(model.clips[0].duration_s, 0.3, 1e-15);
+  EXPECT_NEAR(model.clips[0].keys_per_s, 10.0, 1e-9);
+  EXPECT_EQ(model.mesh->excluded_part_pairs.size(), 46U);
+  ASSERT_FALSE(model.problems.empty());
+  EXPECT_NE(model.problems[0].find("panda_link8, panda_hand_tcp"), std::string::npos);
+  const auto motion = model.motion({});
+  ASSERT_EQ(motion->num_samples(), 4);
+  const JointTrajectory t = read_joint_trajectory(dir / "wave.csv", robot);
+  const auto rest = forward_kinematics(robot, std::vector<double>(robot.joints.size(), 0.0));
+  Positions p;
+  for (int i = 0; i < 4; ++i) {
+    EXPECT_NEAR(motion->sample_time(i), 0.1 * i, 1e-12);
+    motion->positions(i, p);
+    const auto world = forward_kinematics(robot, trajectory_row_positions(robot, t, i));
+    const Mesh& mesh = robot.rig.mesh;
+    ASSERT_EQ(p.rows(), mesh.num_vertices());
+    for (Eigen::Index v = 0; v < p.rows(); ++v) {
+      const std::int32_t part = mesh.vertex_part[static_cast<std::size_t>(v)];
+      const std::int32_t link = robot.find_link(mesh.part_names[static_cast<std::size_t>(part)]);
+      const Eigen::Vector3d local = rest[static_cast<std::size_t>(link)].inverse() * mesh.rest_positions.row(v).transpose();
+      const Eigen::Vector3d expected = world[static_cast<std::size_t>(link)] * local;
+      ASSERT_TRUE(expect_matrix_near(p.row(v).transpose(), expected, 1e-12)) << "sample " << i << " vertex " << v;
+    }
+  }
+  LoadOptions missing;
+  missing.trajectory = dir / "absent.csv";
+  EXPECT_THROW_MESSAGE((void)load_model(test::asset("robots/example-robot-data/robots/panda_description/urdf/panda.urdf"), missing),
+                       IoError, "absent.csv: cannot open");
 }
 
 }  // namespace

@@ -1,0 +1,532 @@
+#include "skinning/frame_sequence.hpp"
+
+#include <fnmatch.h>
+
+#include <algorithm>
+#include <bit>
+#include <cassert>
+#include <cctype>
+#include <charconv>
+#include <cmath>
+#include <cstring>
+#include <fstream>
+#include <sstream>
+
+#include "skinning/errors.hpp"
+#include "skinning/load.hpp"
+
+namespace skelcd::skinning {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+std::string lower(std::string s) {
+  std::transform(s.begin(), s.end(), s.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  return s;
+}
+
+std::string read_bytes(const fs::path& file) {
+  std::ifstream in(file, std::ios::binary);
+  if (!in) throw IoError(file.string() + ": cannot open frame file");
+  std::ostringstream bytes;
+  bytes << in.rdbuf();
+  if (in.bad()) throw IoError(file.string() + ": cannot read frame file");
+  return bytes.str();
+}
+
+// Builds the FrameMesh from polygons, checking indices and finiteness.
+FrameMesh finish(const fs::path& file, std::vector<double>&& xyz,
+                 const std::vector<std::int64_t>& corners, const std::vector<std::size_t>& face_sizes) {
+  FrameMesh m;
+  const auto nv = static_cast<Eigen::Index>(xyz.size() / 3);
+  m.positions.resize(nv, 3);
+  for (Eigen::Index v = 0; v < nv; ++v) {
+    for (int k = 0; k < 3; ++k) {
+      const double c = xyz[static_cast<std::size_t>(3 * v + k)];
+      if (!std::isfinite(c)) {
+        throw InvalidInput(file.string() + ": vertex " + std::to_string(v) + " has a non-finite coordinate");
+      }
+      m.positions(v, k) = c;
+    }
+  }
+  std::size_t triangles = 0;
+  for (std::size_t f = 0; f < face_sizes.size(); ++f) {
+    if (face_sizes[f] < 3) {
+      throw InvalidInput(file.string() + ": face " + std::to_string(f) + " has " +
+                         std::to_string(face_sizes[f]) + " corners (at least 3 needed)");
+    }
+    triangles += face_sizes[f] - 2;
+  }
+  m.triangles.resize(static_cast<Eigen::Index>(triangles), 3);
+  std::size_t at = 0;
+  Eigen::Index t = 0;
+  for (std::size_t f = 0; f < face_sizes.size(); ++f) {
+    for (std::size_t k = 0; k < face_sizes[f]; ++k) {
+      const std::int64_t i = corners[at + k];
+      if (i < 0 || i >= nv) {
+        throw InvalidInput(file.string() + ": face " + std::to_string(f) + " has vertex index " +
+                           std::to_string(i) + " out of range [0, " + std::to_string(nv) + ")");
+      }
+    }
+    // Fan (0, k, k + 1), the way a convex polygon is usually split.
+    for (std::size_t k = 1; k + 1 < face_sizes[f]; ++k, ++t) {
+      m.triangles(t, 0) = static_cast<std::int32_t>(corners[at]);
+      m.triangles(t, 1) = static_cast<std::int32_t>(corners[at + k]);
+      m.triangles(t, 2) = static_cast<std::int32_t>(corners[at + k + 1]);
+    }
+    at += face_sizes[f];
+  }
+  return m;
+}
+
+// ---------------------------------------------------------------------------------------------
+// OBJ: `v x y z [w | r g b]` and `f a b c ...` with `a`, `a/t`, `a//n`, `a/t/n`; negative indices
+// count back from the last vertex read.
+FrameMesh read_obj(const fs::path& file, const std::string& text) {
+  std::vector<double> xyz;
+  std::vector<std::int64_t> corners;
+  std::vector<std::size_t> face_sizes;
+  std::size_t line_number = 0;
+  std::size_t pos = 0;
+  while (pos < text.size()) {
+    const std::size_t end = std::min(text.find('\n', pos), text.size());
+    std::string_view line(text.data() + pos, end - pos);
+    pos = end + 1;
+    ++line_number;
+    const auto where = [&] { return file.string() + ":" + std::to_string(line_number) + ": "; };
+    std::size_t i = 0;
+    const auto skip_space = [&] {
+      while (i < line.size() && (line[i] == ' ' || line[i] == '\t' || line[i] == '\r')) ++i;
+    };
+    const auto token = [&] {
+      skip_space();
+      const std::size_t start = i;
+      while (i < line.size() && line[i] != ' ' && line[i] != '\t' && line[i] != '\r') ++i;
+      return line.substr(start, i - start);
+    };
+    const std::string_view keyword = token();
+    if (keyword == "v") {
+      for (int k = 0; k < 3; ++k) {
+        const std::string_view t = token();
+        double value = 0.0;
+        const auto [ptr, ec] = std::from_chars(t.data(), t.data() + t.size(), value);
+        if (t.empty() || ec != std::errc() || ptr != t.data() + t.size()) {
+          throw IoError(where() + "malformed vertex coordinate '" + std::string(t) + "'");
+        }
+        xyz.push_back(value);
+      }
+    } else if (keyword == "f") {
+      std::size_t n = 0;
+      const auto vertices_so_far = static_cast<std::int64_t>(xyz.size() / 3);
+      for (std::string_view t = token(); !t.empty(); t = token()) {
+        const std::string_view first = t.substr(0, t.find('/'));
+        std::int64_t index = 0;
+        const auto [ptr, ec] = std::from_chars(first.data(), first.data() + first.size(), index);
+        if (first.empty() || ec != std::errc() || ptr != first.data() + first.size() || index == 0) {
+          throw IoError(where() + "malformed face corner '" + std::string(t) + "'");
+        }
+        corners.push_back(index > 0 ? index - 1 : vertices_so_far + index);
+        ++n;
+      }
+      face_sizes.push_back(n);
+    }
+  }
+  return finish(file, std::move(xyz), corners, face_sizes);
+}
+
+// ---------------------------------------------------------------------------------------------
+// PLY.
+enum class PlyFormat { kAscii, kBinaryLittle, kBinaryBig };
+enum class PlyType { kInt8, kUint8, kInt16, kUint16, kInt32, kUint32, kFloat32, kFloat64 };
+
+struct PlyProperty {
+  std::string name;
+  PlyType type = PlyType::kFloat32;
+  bool is_list = false;
+  PlyType count_type = PlyType::kUint8;
+};
+
+struct PlyElement {
+  std::string name;
+  std::size_t count = 0;
+  std::vector<PlyProperty> properties;
+};
+
+std::size_t type_size(PlyType t) {
+  switch (t) {
+    case PlyType::kInt8:
+    case PlyType::kUint8: return 1;
+    case PlyType::kInt16:
+    case PlyType::kUint16: return 2;
+    case PlyType::kInt32:
+    case PlyType::kUint32:
+    case PlyType::kFloat32: return 4;
+    case PlyType::kFloat64: return 8;
+  }
+  return 0;
+}
+
+bool parse_type(const std::string& s, PlyType& t) {
+  static const std::pair<const char*, PlyType> kTypes[] = {
+      {"char", PlyType::kInt8},     {"int8", PlyType::kInt8},       {"uchar", PlyType::kUint8},
+      {"uint8", PlyType::kUint8},   {"short", PlyType::kInt16},     {"int16", PlyType::kInt16},
+      {"ushort", PlyType::kUint16}, {"uint16", PlyType::kUint16},   {"int", PlyType::kInt32},
+      {"int32", PlyType::kInt32},   {"uint", PlyType::kUint32},     {"uint32", PlyType::kUint32},
+      {"float", PlyType::kFloat32}, {"float32", PlyType::kFloat32}, {"double", PlyType::kFloat64},
+      {"float64", PlyType::kFloat64}};
+  for (const auto& [name, type] : kTypes) {
+    if (s == name) {
+      t = type;
+      return true;
+    }
+  }
+  return false;
+}
+
+// Reads binary or ASCII values of the body, one at a time.
+class PlyReader {
+ public:
+  PlyReader(const fs::path& file, const std::string& bytes, std::size_t offset, PlyFormat format)
+      : file_(file), bytes_(bytes), pos_(offset), format_(format) {}
+
+  double read(PlyType type) {
+    if (format_ == PlyFormat::kAscii) return read_ascii();
+    const std::size_t n = type_size(type);
+    if (pos_ + n > bytes_.size()) throw IoError(file_.string() + ": PLY body ends early (truncated file)");
+    unsigned char raw[8];
+    std::memcpy(raw, bytes_.data() + pos_, n);
+    pos_ += n;
+    const bool swap = (format_ == PlyFormat::kBinaryBig) != (std::endian::native == std::endian::big);
+    if (swap) std::reverse(raw, raw + n);
+    switch (type) {
+      case PlyType::kInt8: return static_cast<double>(static_cast<std::int8_t>(raw[0]));
+      case PlyType::kUint8: return static_cast<double>(raw[0]);
+      case PlyType::kInt16: return static_cast<double>(load<std::int16_t>(raw));
+      case PlyType::kUint16: return static_cast<double>(load<std::uint16_t>(raw));
+      case PlyType::kInt32: return static_cast<double>(load<std::int32_t>(raw));
+      case PlyType::kUint32: return static_cast<double>(load<std::uint32_t>(raw));
+      case PlyType::kFloat32: return static_cast<double>(load<float>(raw));
+      case PlyType::kFloat64: return load<double>(raw);
+    }
+    return 0.0;
+  }
+
+ private:
+  template <typename T>
+  static T load(const unsigned char* raw) {
+    T v;
+    std::memcpy(&v, raw, sizeof v);
+    return v;
+  }
+
+  double read_ascii() {
+    while (pos_ < bytes_.size() && std::isspace(static_cast<unsigned char>(bytes_[pos_]))) ++pos_;
+    const std::size_t start = pos_;
+    while (pos_ < bytes_.size() && !std::isspace(static_cast<unsigned char>(bytes_[pos_]))) ++pos_;
+    if (start == pos_) throw IoError(file_.string() + ": PLY body ends early (truncated file)");
+    double v = 0.0;
+    const auto [ptr, ec] = std::from_chars(bytes_.data() + start, bytes_.data() + pos_, v);
+    if (ec != std::errc() || ptr != bytes_.data() + pos_) {
+      throw IoError(file_.string() + ": malformed PLY value '" + bytes_.substr(start, pos_ - start) + "'");
+    }
+    return v;
+  }
+
+  const fs::path& file_;
+  const std::string& bytes_;
+  std::size_t pos_;
+  PlyFormat format_;
+};
+
+FrameMesh read_ply(const fs::path& file, const std::string& bytes) {
+  // Header: lines up to and including "end_header".
+  std::size_t pos = 0;
+  std::vector<PlyElement> elements;
+  PlyFormat format = PlyFormat::kAscii;
+  bool have_format = false;
+  bool first = true;
+  while (true) {
+    const std::size_t end = bytes.find('\n', pos);
+    if (end == std::string::npos) throw IoError(file.string() + ": PLY header has no end_header");
+    std::string line = bytes.substr(pos, end - pos);
+    pos = end + 1;
+    if (!line.empty() && line.back() == '\r') line.pop_back();
+    std::istringstream words(line);
+    std::string keyword;
+    words >> keyword;
+    if (first) {
+      if (keyword != "ply") throw IoError(file.string() + ": not a PLY file (no 'ply' magic)");
+      first = false;
+      continue;
+    }
+    if (keyword == "format") {
+      std::string f;
+      words >> f;
+      if (f == "ascii") format = PlyFormat::kAscii;
+      else if (f == "binary_little_endian") format = PlyFormat::kBinaryLittle;
+      else if (f == "binary_big_endian") format = PlyFormat::kBinaryBig;
+      else throw IoError(file.string() + ": unknown PLY format '" + f + "'");
+      have_format = true;
+    } else if (keyword == "element") {
+      PlyElement e;
+      long long count = -1;
+      words >> e.name >> count;
+      if (!words || count < 0) throw IoError(file.string() + ": malformed PLY element line '" + line + "'");
+      e.count = static_cast<std::size_t>(count);
+      elements.push_back(e);
+    } else if (keyword == "property") {
+      if (elements.empty()) throw IoError(file.string() + ": PLY property before any element");
+      PlyProperty p;
+      std::string type;
+      words >> type;
+      if (type == "list") {
+        std::string count_type;
+        std::string item_type;
+        words >> count_type >> item_type >> p.name;
+        p.is_list = true;
+        if (!parse_type(count_type, p.count_type) || !parse_type(item_type, p.type)) {
+          throw IoError(file.string() + ": unknown PLY type in '" + line + "'");
+        }
+      } else {
+        words >> p.name;
+        if (!parse_type(type, p.type)) throw IoError(file.string() + ": unknown PLY type in '" + line + "'");
+      }
+      if (p.name.empty()) throw IoError(file.string() + ": malformed PLY property line '" + line + "'");
+      elements.back().properties.push_back(p);
+    } else if (keyword == "end_header") {
+      break;
+    } else if (keyword != "comment" && keyword != "obj_info" && !keyword.empty()) {
+      throw IoError(file.string() + ": unexpected PLY header line '" + line + "'");
+    }
+  }
+  if (!have_format) throw IoError(file.string() + ": PLY header has no format line");
+
+  // Body: every element in header order; keep vertex x, y, z and the face index lists.
+  PlyReader reader(file, bytes, pos, format);
+  std::vector<double> xyz;
+  std::vector<std::int64_t> corners;
+  std::vector<std::size_t> face_sizes;
+  bool have_vertices = false;
+  for (const PlyElement& e : elements) {
+    int ix = -1, iy = -1, iz = -1, ilist = -1;
+    for (std::size_t k = 0; k < e.properties.size(); ++k) {
+      const PlyProperty& p = e.properties[k];
+      const int kk = static_cast<int>(k);
+      if (e.name == "vertex" && !p.is_list) {
+        if (p.name == "x") ix = kk;
+        if (p.name == "y") iy = kk;
+        if (p.name == "z") iz = kk;
+      }
+      if (e.name == "face" && p.is_list && (p.name == "vertex_indices" || p.name == "vertex_index")) ilist = kk;
+    }
+    if (e.name == "vertex") {
+      if (ix < 0 || iy < 0 || iz < 0) throw IoError(file.string() + ": PLY vertex element lacks x, y or z");
+      have_vertices = true;
+      xyz.reserve(3 * e.count);
+    }
+    if (e.name == "face" && ilist < 0) throw IoError(file.string() + ": PLY face element lacks vertex_indices");
+    for (std::size_t item = 0; item < e.count; ++item) {
+      double v[3] = {0, 0, 0};
+      for (std::size_t k = 0; k < e.properties.size(); ++k) {
+        const PlyProperty& p = e.properties[k];
+        const int kk = static_cast<int>(k);
+        if (p.is_list) {
+          const double n = reader.read(p.count_type);
+          if (!(n >= 0) || n != std::floor(n)) throw IoError(file.string() + ": malformed PLY list length");
+          const auto count = static_cast<std::size_t>(n);
+          for (std::size_t c = 0; c < count; ++c) {
+            const double index = reader.read(p.type);
+            if (kk == ilist) {
+              if (index != std::floor(index)) throw IoError(file.string() + ": PLY face index is not an integer");
+              corners.push_back(static_cast<std::int64_t>(index));
+            }
+          }
+          if (kk == ilist) face_sizes.push_back(count);
+        } else {
+          const double value = reader.read(p.type);
+          if (kk == ix) v[0] = value;
+          if (kk == iy) v[1] = value;
+          if (kk == iz) v[2] = value;
+        }
+      }
+      if (e.name == "vertex") xyz.insert(xyz.end(), v, v + 3);
+    }
+  }
+  if (!have_vertices) throw IoError(file.string() + ": PLY file has no vertex element");
+  return finish(file, std::move(xyz), corners, face_sizes);
+}
+
+}  // namespace
+
+FrameMesh read_frame_mesh(const fs::path& file) {
+  const std::string ext = lower(file.extension().string());
+  if (ext != ".obj" && ext != ".ply") {
+    throw IoError(file.string() + ": a frame file must be .obj or .ply");
+  }
+  const std::string bytes = read_bytes(file);
+  return ext == ".obj" ? read_obj(file, bytes) : read_ply(file, bytes);
+}
+
+bool natural_less(std::string_view a, std::string_view b) {
+  std::size_t i = 0;
+  std::size_t j = 0;
+  while (i < a.size() && j < b.size()) {
+    const bool da = std::isdigit(static_cast<unsigned char>(a[i])) != 0;
+    const bool db = std::isdigit(static_cast<unsigned char>(b[j])) != 0;
+    if (da && db) {
+      // Compare digit runs by value: skip leading zeros, then longer is larger, then lexically.
+      std::size_t ei = i;
+      std::size_t ej = j;
+      while (ei < a.size() && std::isdigit(static_cast<unsigned char>(a[ei]))) ++ei;
+      while (ej < b.size() && std::isdigit(static_cast<unsigned char>(b[ej]))) ++ej;
+      std::size_t si = i;
+      std::size_t sj = j;
+      while (si + 1 < ei && a[si] == '0') ++si;
+      while (sj + 1 < ej && b[sj] == '0') ++sj;
+      const std::string_view ra = a.substr(si, ei - si);
+      const std::string_view rb = b.substr(sj, ej - sj);
+      if (ra.size() != rb.size()) return ra.size() < rb.size();
+      if (ra != rb) return ra < rb;
+      i = ei;
+      j = ej;
+    } else {
+      if (a[i] != b[j]) return a[i] < b[j];
+      ++i;
+      ++j;
+    }
+  }
+  if (a.size() - i != b.size() - j) return a.size() - i < b.size() - j;
+  return a < b;  // equal by value ("007" vs "7"): plain order decides
+}
+
+std::vector<fs::path> list_frame_files(const fs::path& spec) {
+  std::vector<fs::path> files;
+  const std::string text = spec.string();
+  std::error_code ec;
+  if (text.find_first_of("*?[") == std::string::npos) {
+    if (!fs::is_directory(spec, ec)) throw IoError(text + ": no such folder");
+    for (const auto& entry : fs::directory_iterator(spec, ec)) {
+      const std::string ext = lower(entry.path().extension().string());
+      if (entry.is_regular_file() && (ext == ".obj" || ext == ".ply")) files.push_back(entry.path());
+    }
+    if (ec) throw IoError(text + ": cannot list folder: " + ec.message());
+  } else {
+    const fs::path dir = spec.has_parent_path() ? spec.parent_path() : fs::path(".");
+    const std::string pattern = spec.filename().string();
+    if (dir.string().find_first_of("*?[") != std::string::npos) {
+      throw InvalidInput(text + ": glob characters are allowed in the file name only");
+    }
+    if (!fs::is_directory(dir, ec)) throw IoError(text + ": no such folder " + dir.string());
+    for (const auto& entry : fs::directory_iterator(dir, ec)) {
+      if (entry.is_regular_file() && fnmatch(pattern.c_str(), entry.path().filename().c_str(), 0) == 0) {
+        files.push_back(entry.path());
+      }
+    }
+    if (ec) throw IoError(text + ": cannot list folder: " + ec.message());
+  }
+  if (files.empty()) throw InvalidInput(text + ": no OBJ or PLY frame files");
+  std::sort(files.begin(), files.end(), [](const fs::path& a, const fs::path& b) {
+    return natural_less(a.filename().string(), b.filename().string());
+  });
+  return files;
+}
+
+FrameSequenceMotion::FrameSequenceMotion(
+    std::vector<fs::path> files,
+    const FrameSequenceOptions& options,
+    std::string name)
+    : rate_hz_(options.rate_hz) {
+  if (!(std::isfinite(options.rate_hz) && options.rate_hz > 0)) {
+    throw InvalidInput("frame sequence: rate " + std::to_string(options.rate_hz) + " Hz is not positive and finite");
+  }
+  if (files.empty()) throw InvalidInput("frame sequence: no frame files");
+  auto data = std::make_shared<Data>();
+  data->name = name.empty() ? files.front().parent_path().filename().string() : std::move(name);
+  data->frames.reserve(files.size());
+  Triangles triangles;
+  for (std::size_t i = 0; i < files.size(); ++i) {
+    FrameMesh frame = read_frame_mesh(files[i]);
+    if (i == 0) {
+      triangles = std::move(frame.triangles);
+    } else {
+      // Identical topology: the same vertex count and the same triangles, index for index.
+      const std::string where = files[i].string() + ": frame " + std::to_string(i);
+      if (frame.positions.rows() != data->frames[0].rows()) {
+        throw InvalidInput(where + " has " + std::to_string(frame.positions.rows()) + " vertices, frame 0 (" +
+                           files[0].string() + ") has " + std::to_string(data->frames[0].rows()));
+      }
+      if (frame.triangles.rows() != triangles.rows()) {
+        throw InvalidInput(where + " has " + std::to_string(frame.triangles.rows()) + " triangles, frame 0 (" +
+                           files[0].string() + ") has " + std::to_string(triangles.rows()));
+      }
+      for (Eigen::Index f = 0; f < triangles.rows(); ++f) {
+        if (frame.triangles.row(f) != triangles.row(f)) {
+          throw InvalidInput(where + ": triangle " + std::to_string(f) + " differs from frame 0's (" +
+                             files[0].string() + ")");
+        }
+      }
+    }
+    data->frames.push_back(std::move(frame.positions));
+  }
+  Mesh& mesh = data->mesh;
+  mesh.rest_positions = data->frames[0];
+  mesh.triangles = std::move(triangles);
+  const auto nv = static_cast<std::size_t>(mesh.num_vertices());
+  const auto nf = static_cast<std::size_t>(mesh.num_triangles());
+  mesh.face_part.assign(nf, 0);
+  mesh.vertex_part.assign(nv, 0);
+  mesh.face_index_in_part.resize(nf);
+  mesh.vertex_index_in_part.resize(nv);
+  for (std::size_t f = 0; f < nf; ++f) mesh.face_index_in_part[f] = static_cast<std::int32_t>(f);
+  for (std::size_t v = 0; v < nv; ++v) mesh.vertex_index_in_part[v] = static_cast<std::int32_t>(v);
+  mesh.part_names = {data->name};
+  validate_mesh(mesh, files[0].string());
+  data->files = std::move(files);
+  data_ = std::move(data);
+}
+
+FrameSequenceMotion::FrameSequenceMotion(std::shared_ptr<const Data> data, double rate_hz)
+    : data_(std::move(data)), rate_hz_(rate_hz) {
+  if (!(std::isfinite(rate_hz) && rate_hz > 0)) {
+    throw InvalidInput(data_->name + ": rate " + std::to_string(rate_hz) + " Hz is not positive and finite");
+  }
+}
+
+std::unique_ptr<FrameSequenceMotion> FrameSequenceMotion::with_rate(double rate_hz) const {
+  return std::unique_ptr<FrameSequenceMotion>(new FrameSequenceMotion(data_, rate_hz));
+}
+
+void FrameSequenceMotion::positions(int i, Positions& out) const {
+  assert(i >= 0 && i < num_samples());
+  out = data_->frames[static_cast<std::size_t>(i)];
+}
+
+FrameSequenceMotion load_frame_sequence(const fs::path& spec, const FrameSequenceOptions& options) {
+  const bool is_glob = spec.string().find_first_of("*?[") != std::string::npos;
+  const std::string name = is_glob ? spec.filename().string() : fs::absolute(spec).lexically_normal().filename().string();
+  return FrameSequenceMotion(list_frame_files(spec), options, name.empty() ? spec.string() : name);
+}
+
+LoadedModel load_frame_sequence_model(const fs::path& spec, const LoadOptions& options) {
+  if (!options.trajectory.empty() || !options.srdf.empty() || !options.package_path.empty()) {
+    throw InvalidInput(spec.string() + ": a trajectory, SRDF or package path applies to URDF robots only");
+  }
+  auto motion = std::make_shared<const FrameSequenceMotion>(load_frame_sequence(spec));
+  LoadedModel model;
+  model.path = spec;
+  model.kind = ModelKind::frame_sequence;
+  model.mesh = std::shared_ptr<const Mesh>(motion, &motion->mesh());
+  const double duration = (motion->num_samples() - 1) / kDefaultFrameRateHz;
+  model.clips.push_back({motion->name(), duration, motion->num_samples() > 1 ? kDefaultFrameRateHz : 0.0});
+  model.motion_factory = [motion](const MotionRequest& request) -> std::unique_ptr<Motion> {
+    if (!request.clip.empty() && request.clip != motion->name()) {
+      throw InvalidInput(motion->frame_file(0).parent_path().string() + ": a frame sequence has one clip, '" +
+                         motion->name() + "', not '" + request.clip + "'");
+    }
+    return motion->with_rate(request.rate_hz > 0 ? request.rate_hz : kDefaultFrameRateHz);
+  };
+  return model;
+}
+
+}  // namespace skelcd::skinning

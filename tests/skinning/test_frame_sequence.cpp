@@ -1,0 +1,251 @@
+// Frame sequences: the cloth-funnel frames read bit-exactly (checked against a separate reader of
+// the binary PLY written here), vertex order as in the file (and as assimp reads it), natural
+// order, globs, refused topologies and coordinates.
+
+#include "skinning/frame_sequence.hpp"
+
+#include <cmath>
+#include <cstring>
+#include <fstream>
+
+#include <assimp/Importer.hpp>
+#include <assimp/scene.h>
+#include <gtest/gtest.h>
+
+#include "skinning/errors.hpp"
+#include "skinning/load.hpp"
+#include "tests/support/test_support.hpp"
+
+namespace skelcd::skinning {
+namespace {
+
+namespace fs = std::filesystem;
+
+fs::path funnel_frames() { return test::asset("cloth-funnel/frames"); }
+
+void write_file(const fs::path& path, const std::string& text) {
+  std::ofstream out(path, std::ios::binary);
+  out << text;
+}
+
+// A reader for exactly the cloth-funnel PLY layout (binary little endian, vertex: double x y z,
+// face: list uchar int vertex_indices), written from the header we see in the file.
+struct FunnelPly {
+  std::vector<double> xyz;
+  std::vector<std::array<std::int32_t, 3>> faces;
+};
+FunnelPly read_funnel_ply(const fs::path& file) {
+  std::ifstream in(file, std::ios::binary);
+  const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const std::string header =
+      "ply\nformat binary_little_endian 1.0\nelement vertex 9450\nproperty double x\nproperty double y\n"
+      "property double z\nelement face 18484\nproperty list uchar int vertex_indices\nend_header\n";
+  EXPECT_EQ(bytes.substr(0, header.size()), header);
+  FunnelPly ply;
+  std::size_t at = header.size();
+  ply.xyz.resize(3 * 9450);
+  std::memcpy(ply.xyz.data(), bytes.data() + at, 8 * ply.xyz.size());
+  at += 8 * ply.xyz.size();
+  for (int f = 0; f < 18484; ++f) {
+    EXPECT_EQ(static_cast<unsigned char>(bytes[at]), 3);
+    std::array<std::int32_t, 3> face{};
+    std::memcpy(face.data(), bytes.data() + at + 1, 12);
+    ply.faces.push_back(face);
+    at += 13;
+  }
+  EXPECT_EQ(at, bytes.size());
+  return ply;
+}
+
+TEST(FrameSequence, ClothFunnelIsReadBitExactly) {
+  const FrameSequenceMotion motion = load_frame_sequence(funnel_frames());
+  ASSERT_EQ(motion.num_samples(), 2);
+  EXPECT_EQ(motion.frame_file(0).filename(), "227.ply");
+  EXPECT_EQ(motion.frame_file(1).filename(), "228.ply");
+  EXPECT_EQ(motion.name(), "frames");
+  const Mesh& mesh = motion.mesh();
+  EXPECT_EQ(mesh.num_vertices(), 9450);
+  EXPECT_EQ(mesh.num_triangles(), 18484);
+  EXPECT_EQ(mesh.num_parts(), 1);
+  EXPECT_DOUBLE_EQ(motion.sample_time(1), 1.0 / 30.0);
+  for (int i = 0; i < 2; ++i) {
+    const FunnelPly ply = read_funnel_ply(motion.frame_file(i));
+    Positions p;
+    motion.positions(i, p);
+    ASSERT_EQ(p.rows(), 9450);
+    for (Eigen::Index v = 0; v < p.rows(); ++v) {
+      for (int k = 0; k < 3; ++k) {
+        ASSERT_EQ(p(v, k), ply.xyz[static_cast<std::size_t>(3 * v + k)]) << "frame " << i << " vertex " << v;
+      }
+    }
+    for (Eigen::Index f = 0; f < mesh.num_triangles(); ++f) {
+      for (int k = 0; k < 3; ++k) ASSERT_EQ(mesh.triangles(f, k), ply.faces[static_cast<std::size_t>(f)][static_cast<std::size_t>(k)]);
+    }
+  }
+  Positions rest;
+  motion.positions(0, rest);
+  EXPECT_EQ(rest, mesh.rest_positions);
+  // The two frames differ (the cloth moves).
+  Positions p1;
+  motion.positions(1, p1);
+  EXPECT_GT((p1 - rest).cwiseAbs().maxCoeff(), 0.0);
+}
+
+// assimp (float precision) reads the same vertices in the same order: each coordinate of ours
+// rounds to assimp's float.
+TEST(FrameSequence, VertexOrderAgreesWithAssimp) {
+  const FrameMesh ours = read_frame_mesh(funnel_frames() / "227.ply");
+  Assimp::Importer importer;
+  const aiScene* scene = importer.ReadFile((funnel_frames() / "227.ply").string(), 0);
+  ASSERT_NE(scene, nullptr);
+  ASSERT_EQ(scene->mNumMeshes, 1U);
+  const aiMesh* m = scene->mMeshes[0];
+  ASSERT_EQ(static_cast<Eigen::Index>(m->mNumVertices), ours.positions.rows());
+  for (unsigned v = 0; v < m->mNumVertices; ++v) {
+    const auto row = static_cast<Eigen::Index>(v);
+    ASSERT_EQ(static_cast<float>(ours.positions(row, 0)), m->mVertices[v].x) << v;
+    ASSERT_EQ(static_cast<float>(ours.positions(row, 1)), m->mVertices[v].y) << v;
+    ASSERT_EQ(static_cast<float>(ours.positions(row, 2)), m->mVertices[v].z) << v;
+  }
+  ASSERT_EQ(static_cast<Eigen::Index>(m->mNumFaces), ours.triangles.rows());
+  for (unsigned f = 0; f < m->mNumFaces; ++f) {
+    for (unsigned k = 0; k < 3; ++k) ASSERT_EQ(static_cast<unsigned>(ours.triangles(f, k)), m->mFaces[f].mIndices[k]);
+  }
+}
+
+TEST(FrameSequence, NaturalOrderAndGlobs) {
+  EXPECT_TRUE(natural_less("2.ply", "10.ply"));
+  EXPECT_FALSE(natural_less("10.ply", "2.ply"));
+  EXPECT_TRUE(natural_less("frame_9.obj", "frame_010.obj"));
+  EXPECT_TRUE(natural_less("a.ply", "b.ply"));
+  EXPECT_TRUE(natural_less("f1x2", "f1x10"));
+  EXPECT_FALSE(natural_less("same", "same"));
+
+  const fs::path dir = test::temp_dir("frames_natural");
+  const std::string tri = "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n";
+  for (const char* name : {"10.obj", "2.obj", "1.obj", "note.txt"}) write_file(dir / name, tri);
+  const auto files = list_frame_files(dir);
+  ASSERT_EQ(files.size(), 3U);
+  EXPECT_EQ(files[0].filename(), "1.obj");
+  EXPECT_EQ(files[1].filename(), "2.obj");
+  EXPECT_EQ(files[2].filename(), "10.obj");
+  const auto globbed = list_frame_files(dir / "1*.obj");
+  ASSERT_EQ(globbed.size(), 2U);
+  EXPECT_EQ(globbed[1].filename(), "10.obj");
+  EXPECT_EQ(list_frame_files(funnel_frames() / "22[78].ply").size(), 2U);
+  EXPECT_THROW_MESSAGE((void)list_frame_files(dir / "*.ply"), InvalidInput, "no OBJ or PLY frame files");
+  EXPECT_THROW_MESSAGE((void)list_frame_files(dir / "missing"), IoError, "missing: no such folder");
+}
+
+TEST(FrameSequence, ObjAndPlyVariants) {
+  const fs::path dir = test::temp_dir("frames_variants");
+  // A quad (split into a fan), negative indices, texture/normal references, a comment.
+  write_file(dir / "quad.obj", "# quad\nv 0 0 0\nv 1 0 0\nv 1 1 0\nvt 0 0\nv 0 1 0.1\nf 1/1 2/1/1 3//1 -1\nf -4 -2 -1\n");
+  const FrameMesh quad = read_frame_mesh(dir / "quad.obj");
+  ASSERT_EQ(quad.triangles.rows(), 3);
+  EXPECT_EQ(quad.triangles.row(0), Eigen::RowVector3i(0, 1, 2));
+  EXPECT_EQ(quad.triangles.row(1), Eigen::RowVector3i(0, 2, 3));
+  EXPECT_EQ(quad.triangles.row(2), Eigen::RowVector3i(0, 2, 3));
+  EXPECT_EQ(quad.positions(3, 2), 0.1);
+
+  // ASCII PLY with an extra property and an extra element.
+  write_file(dir / "a.ply",
+             "ply\nformat ascii 1.0\ncomment x\nelement vertex 3\nproperty float x\nproperty float y\n"
+             "property float z\nproperty uchar red\nelement face 1\nproperty list uchar int vertex_indices\n"
+             "element edge 1\nproperty int vertex1\nproperty int vertex2\nend_header\n"
+             "0 0 0 255\n0.1 0 0 0\n0 1e-300 0.3 1\n3 2 1 0\n0 1\n");
+  const FrameMesh a = read_frame_mesh(dir / "a.ply");
+  EXPECT_EQ(a.positions(1, 0), 0.1);  // parsed as written, double precision
+  EXPECT_EQ(a.positions(2, 1), 1e-300);
+  EXPECT_EQ(a.triangles.row(0), Eigen::RowVector3i(2, 1, 0));
+
+  // Binary big-endian PLY with float coordinates and uint indices.
+  std::string big = "ply\nformat binary_big_endian 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+                    "property float z\nelement face 1\nproperty list uchar uint vertex_indices\nend_header\n";
+  const auto put_be = [&](const void* p, std::size_t n) {
+    const auto* b = static_cast<const char*>(p);
+    for (std::size_t k = n; k-- > 0;) big.push_back(b[k]);
+  };
+  const float coords[9] = {0.0f, 0.0f, 0.0f, 0.1f, 2.0f, 0.0f, -3.5f, 0.0f, 1e-30f};
+  for (const float c : coords) put_be(&c, 4);
+  big.push_back(3);
+  for (const std::uint32_t i : {0U, 1U, 2U}) put_be(&i, 4);
+  write_file(dir / "big.ply", big);
+  const FrameMesh b = read_frame_mesh(dir / "big.ply");
+  EXPECT_EQ(b.positions(1, 0), static_cast<double>(0.1f));
+  EXPECT_EQ(b.positions(2, 0), -3.5);
+  EXPECT_EQ(b.positions(2, 2), static_cast<double>(1e-30f));
+  // Truncated: drop the last index byte.
+  write_file(dir / "cut.ply", big.substr(0, big.size() - 1));
+  EXPECT_THROW_MESSAGE((void)read_frame_mesh(dir / "cut.ply"), IoError, "cut.ply: PLY body ends early");
+}
+
+TEST(FrameSequence, MismatchedTopologyIsRefusedNamingTheFrame) {
+  const fs::path dir = test::temp_dir("frames_mismatch");
+  const std::string square = "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3\nf 1 3 4\n";
+  write_file(dir / "frame1.obj", square);
+  write_file(dir / "frame2.obj", square);
+  write_file(dir / "frame10.obj", "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 4\nf 2 3 4\n");
+  EXPECT_THROW_MESSAGE((void)load_frame_sequence(dir), InvalidInput, "frame10.obj: frame 2: triangle 0 differs");
+  write_file(dir / "frame10.obj", "v 0 0 0\nv 1 0 0\nv 1 1 0\nf 1 2 3\nf 1 3 1\n");
+  EXPECT_THROW_MESSAGE((void)load_frame_sequence(dir), InvalidInput, "frame10.obj: frame 2 has 3 vertices, frame 0");
+  write_file(dir / "frame10.obj", "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3\n");
+  EXPECT_THROW_MESSAGE((void)load_frame_sequence(dir), InvalidInput, "frame10.obj: frame 2 has 1 triangles");
+  // Same topology: fine, three samples.
+  write_file(dir / "frame10.obj", square);
+  EXPECT_EQ(load_frame_sequence(dir).num_samples(), 3);
+}
+
+TEST(FrameSequence, BadCoordinatesAndIndicesAreRefused) {
+  const fs::path dir = test::temp_dir("frames_bad");
+  write_file(dir / "nan.obj", "v 0 0 0\nv 1 nan 0\nv 0 1 0\nf 1 2 3\n");
+  EXPECT_THROW_MESSAGE((void)read_frame_mesh(dir / "nan.obj"), InvalidInput, "nan.obj: vertex 1 has a non-finite coordinate");
+  write_file(dir / "inf.ply",
+             "ply\nformat ascii 1.0\nelement vertex 3\nproperty double x\nproperty double y\nproperty double z\n"
+             "element face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n0 0 inf\n1 1 1\n3 0 1 2\n");
+  EXPECT_THROW_MESSAGE((void)read_frame_mesh(dir / "inf.ply"), InvalidInput, "inf.ply: vertex 1 has a non-finite coordinate");
+  write_file(dir / "range.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 4\n");
+  EXPECT_THROW_MESSAGE((void)read_frame_mesh(dir / "range.obj"), InvalidInput, "range.obj: face 0 has vertex index 3 out of range");
+  write_file(dir / "two.obj", "v 0 0 0\nv 1 0 0\nf 1 2\n");
+  EXPECT_THROW_MESSAGE((void)read_frame_mesh(dir / "two.obj"), InvalidInput, "two.obj: face 0 has 2 corners");
+  write_file(dir / "junk.obj", "v 0 0 zero\n");
+  EXPECT_THROW_MESSAGE((void)read_frame_mesh(dir / "junk.obj"), IoError, "junk.obj:1: malformed vertex coordinate 'zero'");
+  write_file(dir / "notply.ply", "hello\n");
+  EXPECT_THROW_MESSAGE((void)read_frame_mesh(dir / "notply.ply"), IoError, "notply.ply: not a PLY file");
+  EXPECT_THROW_MESSAGE((void)read_frame_mesh(dir / "absent.ply"), IoError, "absent.ply: cannot open");
+  // A NaN in a later frame of a sequence names that frame's file.
+  const fs::path seq = test::temp_dir("frames_nan_seq");
+  write_file(seq / "0.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
+  write_file(seq / "1.obj", "v 0 0 0\nv 1 0 0\nv 0 1 -nan\nf 1 2 3\n");
+  EXPECT_THROW_MESSAGE((void)load_frame_sequence(seq), InvalidInput, "1.obj: vertex 2 has a non-finite coordinate");
+  FrameSequenceOptions options;
+  options.rate_hz = 0.0;
+  EXPECT_THROW_MESSAGE((void)load_frame_sequence(funnel_frames(), options), InvalidInput, "not positive");
+}
+
+TEST(FrameSequence, LoadModelEntryPoint) {
+  const LoadedModel model = load_frame_sequence_model(funnel_frames(), {});
+  EXPECT_EQ(model.kind, ModelKind::frame_sequence);
+  EXPECT_EQ(model.mesh->num_triangles(), 18484);
+  EXPECT_EQ(model.rig, nullptr);
+  ASSERT_EQ(model.clips.size(), 1U);
+  EXPECT_EQ(model.clips[0].name, "frames");
+  EXPECT_DOUBLE_EQ(model.clips[0].duration_s, 1.0 / 30.0);
+  EXPECT_DOUBLE_EQ(model.clips[0].keys_per_s, 30.0);
+  const auto motion = model.motion({});
+  EXPECT_EQ(motion->num_samples(), 2);
+  EXPECT_DOUBLE_EQ(motion->sample_time(1), 1.0 / 30.0);
+  MotionRequest fast;
+  fast.rate_hz = 120.0;
+  fast.clip = "frames";
+  EXPECT_DOUBLE_EQ(model.motion(fast)->sample_time(1), 1.0 / 120.0);
+  MotionRequest wrong;
+  wrong.clip = "walk";
+  EXPECT_THROW_MESSAGE((void)model.motion(wrong), InvalidInput, "one clip, 'frames', not 'walk'");
+  LoadOptions robot_only;
+  robot_only.srdf = "x.srdf";
+  EXPECT_THROW_MESSAGE((void)load_frame_sequence_model(funnel_frames(), robot_only), InvalidInput, "URDF robots only");
+}
+
+}  // namespace
+}  // namespace skelcd::skinning
