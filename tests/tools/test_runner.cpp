@@ -298,4 +298,79 @@ TEST(Runner, UnknownMethodIsRefusedBeforeAnyWork) {
   EXPECT_THROW_MESSAGE(ClipRunner(motion, options), InvalidInput, "no-such-method");
 }
 
+/// Part 0: a large triangle in z = 0. Part 1: a small triangle that passes down through it
+/// (samples 0 → 1) and then tilts until it pierces it (sample 2). Worked out by hand:
+/// interval 0-1: each of the small triangle's 3 vertices crosses the large face at t = 1/2 inside
+/// it (3 VF), no edge comes near another (0 EE); interval 1-2: vertices 1 and 2 cross at t = 1/2
+/// at (1.75, 1) and (1.5, 2) (2 VF), vertex 0 stays at z = -1; DCD: only sample 2 intersects.
+class CrossingMotion : public skinning::Motion {
+ public:
+  CrossingMotion() {
+    mesh_.rest_positions.resize(6, 3);
+    mesh_.rest_positions << 0, 0, 0, 4, 0, 0, 0, 4, 0, 1, 1, 1, 2, 1, 1, 1, 2, 1;
+    mesh_.triangles.resize(2, 3);
+    mesh_.triangles << 0, 1, 2, 3, 4, 5;
+    mesh_.face_part = {0, 1};
+    mesh_.face_index_in_part = {0, 0};
+    mesh_.vertex_part = {0, 0, 0, 1, 1, 1};
+    mesh_.vertex_index_in_part = {0, 1, 2, 0, 1, 2};
+    mesh_.part_names = {"floor", "blade"};
+  }
+  const skinning::Mesh& mesh() const override { return mesh_; }
+  int num_samples() const override { return 3; }
+  double sample_time(int i) const override { return i / 24.0; }
+  std::string name() const override { return "crossing"; }
+  void positions(int i, Positions& out) const override {
+    out = mesh_.rest_positions;
+    if (i == 1) out.block(3, 2, 3, 1).setConstant(-1);
+    if (i == 2) out.bottomRows(3) << 1, 1, -1, 1.5, 1, 1, 2, 2, 1;
+  }
+
+ private:
+  skinning::Mesh mesh_;
+};
+
+TEST(Runner, RealMethodsFindTheHandCountedContactsInFileNumbering) {
+  const CrossingMotion motion;
+  for (const char* method : {"brute", "bvh", "kdop"}) {
+    for (const auto accuracy : {ccd::Accuracy::conservative, ccd::Accuracy::exact}) {
+      SCOPED_TRACE(std::string(method) + " " + std::string(ccd::to_string(accuracy)));
+      RunOptions options;
+      options.method = method;
+      options.accuracy = accuracy;
+      ClipRunner runner(motion, options);
+      std::vector<FrameReport> reports;
+      runner.run([&](const FrameReport& r) { reports.push_back(r); });
+      ASSERT_EQ(reports.size(), 5u);  // dcd 0, ccd 0, dcd 1, ccd 1, dcd 2
+
+      EXPECT_TRUE(reports[0].dcd_pairs.empty());
+      EXPECT_TRUE(reports[2].dcd_pairs.empty());
+      ASSERT_EQ(reports[4].dcd_pairs.size(), 1u);
+      EXPECT_EQ(reports[4].dcd_pairs[0].a, (FeatureId{0, 0, -1}));
+      EXPECT_EQ(reports[4].dcd_pairs[0].b, (FeatureId{1, 0, -1}));
+      EXPECT_EQ(reports[4].row.counters.dcd_pairs, 1);
+
+      const auto vertices_hitting_the_floor = [](const FrameReport& r) {
+        std::vector<std::int32_t> v;
+        for (const auto& c : r.contacts) {
+          EXPECT_EQ(c.kind, culling::CcdContact::Kind::vf);
+          EXPECT_EQ(c.a.part, 1);
+          EXPECT_EQ(c.b, (FeatureId{0, 0, -1}));
+          EXPECT_LE(c.toi_lower, 0.5);
+          EXPECT_GE(c.toi_upper, 0.5);
+          v.push_back(c.a.index);
+        }
+        std::sort(v.begin(), v.end());
+        return v;
+      };
+      EXPECT_EQ(vertices_hitting_the_floor(reports[1]), (std::vector<std::int32_t>{0, 1, 2}));
+      EXPECT_EQ(vertices_hitting_the_floor(reports[3]), (std::vector<std::int32_t>{1, 2}));
+      EXPECT_EQ(reports[1].row.counters.vf_contacts, 3);
+      EXPECT_EQ(reports[1].row.counters.ee_contacts, 0);
+      EXPECT_EQ(reports[3].row.counters.vf_contacts, 2);
+      EXPECT_EQ(reports[3].row.t1, 2 / 24.0);
+    }
+  }
+}
+
 }  // namespace
