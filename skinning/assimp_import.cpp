@@ -5,6 +5,7 @@
 #include <cctype>
 #include <cmath>
 #include <cstdint>
+#include <limits>
 #include <map>
 #include <mutex>
 #include <string>
@@ -27,6 +28,10 @@ namespace {
 // Weights are stored in single precision and exporters round them; a row whose sum is off by
 // less than this is not worth a line in the problem list (it is normalised all the same).
 constexpr double kWeightSumReportTolerance = 1e-4;
+// A skinned mesh is placed in the scene frame instead of its node's frame only when the scene
+// frame reproduces the file's rest pose to this fraction of the mesh's size: single-precision
+// files agree to ~1e-6, files whose rest pose is not their bind pose miss by a sizeable part of it.
+constexpr double kBindFrameEvidence = 1e-3;
 // Assimp warnings repeated in the problem list, at most (the rest are counted).
 constexpr std::size_t kMaxForwardedWarnings = 8;
 // Ticks per second assimp's loaders assume when a file does not say (aiAnimation docs).
@@ -83,6 +88,8 @@ std::string lower(std::string s) {
 struct Context {
   std::string file;
   std::vector<std::string> problems;
+  std::map<std::string, std::size_t> shared_names;  // node name → number of nodes with it
+  std::vector<std::string> clips_with_mesh_channels;
   [[noreturn]] void invalid(const std::string& fault) const { throw InvalidInput(file + ": " + fault); }
 };
 
@@ -140,6 +147,7 @@ Hierarchy read_hierarchy(const aiScene* scene, Skeleton& skeleton, Context& ctx)
   if (scene->mRootNode == nullptr) ctx.invalid("the scene has no root node");
   std::unordered_set<const aiNode*> seen;
   std::vector<std::pair<const aiNode*, std::int32_t>> stack{{scene->mRootNode, -1}};
+  // Nodes added later for bones the hierarchy lacks have no aiNode (null entries).
   while (!stack.empty()) {
     const auto [node, parent] = stack.back();
     stack.pop_back();
@@ -183,11 +191,31 @@ std::int32_t resolve_node(
   };
   std::int32_t chosen = -1;
   if (hosts_bone != nullptr) chosen = pick([&](std::int32_t c) { return (*hosts_bone)[static_cast<std::size_t>(c)]; });
-  if (chosen < 0) chosen = pick([&](std::int32_t c) { return h.nodes[static_cast<std::size_t>(c)]->mNumMeshes == 0; });
+  if (chosen < 0) {
+    chosen = pick([&](std::int32_t c) {
+      const aiNode* n = h.nodes[static_cast<std::size_t>(c)];
+      return n == nullptr || n->mNumMeshes == 0;
+    });
+  }
   if (chosen < 0) chosen = candidates.front();
-  ctx.problems.push_back(std::to_string(candidates.size()) + " nodes are named '" + name + "'; " + what +
-                         " bound to node " + std::to_string(chosen));
+  (void)what;
+  ctx.shared_names[name] = candidates.size();
   return chosen;
+}
+
+// A root node with a fixed transform, for a bone the hierarchy lacks. Its global (scene space)
+// transform is `scene_global`; it has no aiNode.
+std::int32_t add_static_node(Skeleton& skeleton, Hierarchy& h, const std::string& name, const Eigen::Affine3d& scene_global) {
+  const auto index = static_cast<std::int32_t>(skeleton.nodes.size());
+  SkeletonNode sn;
+  sn.name = name;
+  sn.parent = -1;
+  sn.rest_local = scene_global;
+  skeleton.nodes.push_back(sn);
+  h.nodes.push_back(nullptr);
+  h.scene_global.push_back(scene_global);
+  h.by_name[name].push_back(index);
+  return index;
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -220,7 +248,7 @@ void add_part(
     const aiScene* scene,
     const aiMesh* am,
     std::int32_t node,
-    const Hierarchy& h,
+    Hierarchy& h,
     const Eigen::Affine3d& unit,
     Rig& rig,
     MeshBuild& build,
@@ -273,8 +301,8 @@ void add_part(
   // disagree on the frame their bind pose lives in: some store offsets relative to the mesh
   // node (G_rest · offset ≈ mesh node transform: glTF, FBX), others relative to the scene
   // (G_rest · offset ≈ identity: .X). Posing never depends on B (rest = B v and inverse bind =
-  // offset · B⁻¹ cancel); B only decides where the bind pose sits. Take the one under which the
-  // file's own rest hierarchy reproduces the bind pose best, and report what is left.
+  // offset · B⁻¹ cancel); B only decides where the bind pose sits. Take the mesh frame unless the
+  // file's own rest hierarchy shows it is the scene frame, and report the mismatch that is left.
   Eigen::Affine3d bind_frame = mesh_global;
   std::vector<std::int32_t> bone_node(am->mNumBones, -1);
   std::vector<Eigen::Affine3d> offset(am->mNumBones);
@@ -287,10 +315,10 @@ void add_part(
       if (bone == nullptr) ctx.invalid(label + " has a null bone " + std::to_string(b));
       const std::string bone_name = bone->mName.C_Str();
       bone_node[b] = resolve_node(h, bone_name, nullptr, ctx, "bone '" + bone_name + "'");
-      if (bone_node[b] < 0) ctx.invalid(label + ", bone '" + bone_name + "' names no node of the hierarchy");
       offset[b] = to_affine(bone->mOffsetMatrix, ctx, label + ", bone '" + bone_name + "' offset matrix");
       if (bone->mNumWeights > 0 && bone->mWeights == nullptr) ctx.invalid(label + ", bone '" + bone_name + "' has no weight array");
-      const Eigen::Affine3d at_rest = h.scene_global[static_cast<std::size_t>(bone_node[b])] * offset[b];
+      const bool placed = bone_node[b] >= 0;  // a bone without a node says nothing about B
+      const Eigen::Affine3d at_rest = placed ? Eigen::Affine3d(h.scene_global[static_cast<std::size_t>(bone_node[b])] * offset[b]) : Eigen::Affine3d::Identity();
       for (unsigned k = 0; k < bone->mNumWeights; ++k) {
         const auto& vw = bone->mWeights[k];
         const double w = static_cast<double>(vw.mWeight);
@@ -302,22 +330,40 @@ void add_part(
           ctx.invalid(label + ", bone '" + bone_name + "' has weight " + std::to_string(w) + " for vertex " +
                       std::to_string(vw.mVertexId) + " (must be finite and >= 0)");
         }
-        if (w == 0) continue;
+        if (w == 0 || !placed) continue;
         skinned[vw.mVertexId] += w * (at_rest * to_vector(am->mVertices[vw.mVertexId]));
         weight_sum[vw.mVertexId] += w;
       }
     }
     double dev_mesh = 0.0, dev_scene = 0.0;
+    Eigen::Vector3d lo = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
+    Eigen::Vector3d hi = -lo;
     for (unsigned v = 0; v < am->mNumVertices; ++v) {
       if (weight_sum[v] <= 0) continue;
       const Eigen::Vector3d p = skinned[v] / weight_sum[v];
       const Eigen::Vector3d local = to_vector(am->mVertices[v]);
       dev_mesh = std::max(dev_mesh, (p - mesh_global * local).norm());
       dev_scene = std::max(dev_scene, (p - local).norm());
+      lo = lo.cwiseMin(p);
+      hi = hi.cwiseMax(p);
     }
-    if (dev_scene < dev_mesh) bind_frame = Eigen::Affine3d::Identity();
+    // assimp's documented convention (the mesh node's frame) unless the file clearly says
+    // otherwise: the scene frame reproduces the rest pose to within the file's precision and
+    // the mesh frame does not.
+    const double extent = (hi - lo).allFinite() ? (hi - lo).norm() : 0.0;
+    if (dev_scene < dev_mesh && dev_scene <= kBindFrameEvidence * extent) bind_frame = Eigen::Affine3d::Identity();
+    const double dev_chosen = bind_frame.matrix() == mesh_global.matrix() ? dev_mesh : dev_scene;
+    // A bone whose node is missing (anim_test.x binds 'joint3', which no frame defines) can only
+    // stay where the bind pose puts it: a static node of its own at the bind transform
+    // B · offset⁻¹ makes its skinning transform the identity in every pose.
+    for (unsigned b = 0; b < am->mNumBones; ++b) {
+      if (bone_node[b] >= 0) continue;
+      const std::string bone_name = am->mBones[b]->mName.C_Str();
+      bone_node[b] = add_static_node(rig.skeleton, h, bone_name, bind_frame * offset[b].inverse());
+      ctx.problems.push_back(label + ": bone '" + bone_name + "' names no node of the hierarchy; it stays in its bind pose");
+    }
     const double unit_scale = unit.linear()(0, 0);
-    build.rest_pose_deviation = std::max(build.rest_pose_deviation, unit_scale * std::min(dev_mesh, dev_scene));
+    build.rest_pose_deviation = std::max(build.rest_pose_deviation, unit_scale * dev_chosen);
   }
 
   // Vertices in object space.
@@ -469,7 +515,7 @@ void finish_skin(MeshBuild& build, const Hierarchy& h, Rig& rig, Context& ctx) {
     }
     if (count == 0) {
       const aiNode* node = h.nodes[static_cast<std::size_t>(bones[b].node)];
-      for (unsigned c = 0; c < node->mNumChildren; ++c) {
+      for (unsigned c = 0; node != nullptr && c < node->mNumChildren; ++c) {
         const auto it = std::find(h.nodes.begin(), h.nodes.end(), node->mChildren[c]);
         const auto child = static_cast<std::size_t>(it - h.nodes.begin());
         if (node->mChildren[c]->mNumMeshes > 0) continue;  // a mesh hanging off the joint
@@ -520,9 +566,7 @@ void read_clips(const aiScene* scene, const Hierarchy& h, Rig& rig, Context& ctx
     }
     if (!std::isfinite(anim->mDuration) || anim->mDuration < 0) ctx.invalid(label + " has duration " + std::to_string(anim->mDuration) + " ticks");
     clip.duration_s = anim->mDuration / ticks;
-    if (anim->mNumMorphMeshChannels > 0 || anim->mNumMeshChannels > 0) {
-      ctx.problems.push_back(label + ": mesh/morph channels ignored (only node transforms are animated)");
-    }
+    if (anim->mNumMorphMeshChannels > 0 || anim->mNumMeshChannels > 0) ctx.clips_with_mesh_channels.push_back(clip.name);
     std::vector<bool> animated(rig.skeleton.nodes.size(), false);
     for (unsigned c = 0; c < anim->mNumChannels; ++c) {
       const aiNodeAnim* na = anim->mChannels[c];
@@ -587,10 +631,31 @@ void read_clips(const aiScene* scene, const Hierarchy& h, Rig& rig, Context& ctx
   }
 }
 
+// Non-finite coordinates and weights, before any post-processing step can hide them.
+void check_raw_numbers(const aiScene* scene, const Context& ctx) {
+  for (unsigned m = 0; m < scene->mNumMeshes; ++m) {
+    const aiMesh* am = scene->mMeshes[m];
+    if (am == nullptr) continue;
+    const std::string label = am->mName.length > 0 ? "mesh '" + std::string(am->mName.C_Str()) + "'" : "mesh " + std::to_string(m);
+    for (unsigned v = 0; am->mVertices != nullptr && v < am->mNumVertices; ++v) {
+      if (!to_vector(am->mVertices[v]).allFinite()) ctx.invalid(label + ", vertex " + std::to_string(v) + " has a non-finite coordinate");
+    }
+    for (unsigned b = 0; am->mBones != nullptr && b < am->mNumBones; ++b) {
+      const aiBone* bone = am->mBones[b];
+      for (unsigned k = 0; bone != nullptr && bone->mWeights != nullptr && k < bone->mNumWeights; ++k) {
+        if (!std::isfinite(bone->mWeights[k].mWeight)) {
+          ctx.invalid(label + ", bone '" + std::string(bone->mName.C_Str()) + "' has a non-finite weight");
+        }
+      }
+    }
+  }
+}
+
 }  // namespace
 
 ImportedRig import_rig(const std::filesystem::path& file, const ImportOptions& options) {
-  Context ctx{file.string(), {}};
+  Context ctx;
+  ctx.file = file.string();
   std::error_code ec;
   if (!std::filesystem::exists(file, ec)) throw IoError(ctx.file + ": no such file");
   if (std::filesystem::is_directory(file, ec)) throw IoError(ctx.file + ": is a directory, not a model file");
@@ -599,14 +664,20 @@ ImportedRig import_rig(const std::filesystem::path& file, const ImportOptions& o
   std::lock_guard lock(import_mutex());
   ScopedLogCapture log;
   Assimp::Importer importer;
-  unsigned flags = aiProcess_Triangulate | aiProcess_ValidateDataStructure;
-  if (options.join_identical_vertices) flags |= aiProcess_JoinIdenticalVertices;
-  const aiScene* scene = importer.ReadFile(ctx.file, flags);
-  if (scene == nullptr) {
+  // Read and validate first, check the raw data, then post-process: JoinIdenticalVertices
+  // compares positions with <, so a NaN vertex would be merged into a neighbour and vanish.
+  const aiScene* scene = importer.ReadFile(ctx.file, aiProcess_ValidateDataStructure);
+  const auto fail_read = [&]() {
     std::string reason = importer.GetErrorString();
     if (reason.empty()) reason = "assimp could not read it";
     throw IoError(ctx.file + ": " + reason);
-  }
+  };
+  if (scene == nullptr) fail_read();
+  check_raw_numbers(scene, ctx);
+  unsigned flags = aiProcess_Triangulate;
+  if (options.join_identical_vertices) flags |= aiProcess_JoinIdenticalVertices;
+  scene = importer.ApplyPostProcessing(flags);
+  if (scene == nullptr) fail_read();
   // assimp recovers from some broken data by dropping it with a warning; for us that is a
   // wrong answer, not a recovery.
   std::vector<std::string> warnings;
@@ -628,12 +699,13 @@ ImportedRig import_rig(const std::filesystem::path& file, const ImportOptions& o
   const Eigen::Affine3d unit(Eigen::Scaling(out.unit_scale));
   rig.skeleton.root_transform = unit;
 
-  const Hierarchy h = read_hierarchy(scene, rig.skeleton, ctx);
+  Hierarchy h = read_hierarchy(scene, rig.skeleton, ctx);
 
   // Meshes in hierarchy order; a mesh instanced by several nodes becomes several parts.
   MeshBuild build;
   for (std::size_t n = 0; n < h.nodes.size(); ++n) {
     const aiNode* node = h.nodes[n];
+    if (node == nullptr) continue;  // a static node added for a bone the file lacks
     if (node->mNumMeshes > 0 && node->mMeshes == nullptr) ctx.invalid(node_label(node) + " lists meshes it does not have");
     for (unsigned k = 0; k < node->mNumMeshes; ++k) {
       const auto mi = node->mMeshes[k];
@@ -656,10 +728,47 @@ ImportedRig import_rig(const std::filesystem::path& file, const ImportOptions& o
   out.rest_pose_deviation = build.rest_pose_deviation;
   read_clips(scene, h, rig, ctx);
 
-  // assimp's own remarks, after ours.
-  for (std::size_t i = 0; i < warnings.size() && i < kMaxForwardedWarnings; ++i) ctx.problems.push_back("assimp: " + warnings[i]);
-  if (warnings.size() > kMaxForwardedWarnings) {
-    ctx.problems.push_back("assimp: " + std::to_string(warnings.size() - kMaxForwardedWarnings) + " more warnings");
+  if (rig.mesh.num_vertices() > 0) {
+    const double size = (rig.mesh.rest_positions.colwise().maxCoeff() - rig.mesh.rest_positions.colwise().minCoeff()).norm();
+    if (out.rest_pose_deviation > kBindFrameEvidence * size) {
+      ctx.problems.push_back("the node hierarchy's rest pose is not the skin's bind pose: skinned vertices move by up to " +
+                             std::to_string(out.rest_pose_deviation) + " (" +
+                             std::to_string(100.0 * out.rest_pose_deviation / size) + "% of the model's size) between them");
+    }
+  }
+  if (!ctx.shared_names.empty()) {
+    std::string names;
+    for (const auto& [name, count] : ctx.shared_names) names += (names.empty() ? "'" : ", '") + name + "' (" + std::to_string(count) + ")";
+    ctx.problems.push_back("node names shared by several nodes: " + names +
+                           "; bones and channels bind to the namesake that hosts a bone, else has no mesh, else comes first");
+  }
+  if (!ctx.clips_with_mesh_channels.empty()) {
+    ctx.problems.push_back(std::to_string(ctx.clips_with_mesh_channels.size()) +
+                           " clips also animate meshes or morph targets; ignored (only node transforms are animated)");
+  }
+  // assimp's own remarks, after ours: warnings that differ only in their numbers are one line.
+  std::vector<std::pair<std::string, std::size_t>> groups;  // (first instance, count)
+  std::vector<std::string> patterns;
+  for (const auto& w : warnings) {
+    std::string pattern;
+    for (char c : w) {
+      if (std::isdigit(static_cast<unsigned char>(c)) == 0) pattern += c;
+      else if (pattern.empty() || pattern.back() != '#') pattern += '#';
+    }
+    const auto it = std::find(patterns.begin(), patterns.end(), pattern);
+    if (it == patterns.end()) {
+      patterns.push_back(pattern);
+      groups.emplace_back(w, 1);
+    } else {
+      ++groups[static_cast<std::size_t>(it - patterns.begin())].second;
+    }
+  }
+  for (std::size_t i = 0; i < groups.size() && i < kMaxForwardedWarnings; ++i) {
+    const auto& [first, count] = groups[i];
+    ctx.problems.push_back("assimp: " + first + (count > 1 ? " (and " + std::to_string(count - 1) + " similar)" : ""));
+  }
+  if (groups.size() > kMaxForwardedWarnings) {
+    ctx.problems.push_back("assimp: " + std::to_string(groups.size() - kMaxForwardedWarnings) + " more kinds of warning");
   }
   validate_rig(rig);
   // One line per distinct remark, in order of first appearance.
