@@ -20,7 +20,6 @@ FaceGraph face_graph(const skinning::Triangles& F) {
 
   FaceGraph g;
   g.edge_offsets.push_back(0);
-  std::vector<std::pair<std::int32_t, std::int32_t>> pairs;
   for (std::size_t i = 0; i < sides.size();) {
     std::size_t j = i;
     while (j < sides.size() && sides[j][0] == sides[i][0] && sides[j][1] == sides[i][1]) ++j;
@@ -28,24 +27,43 @@ FaceGraph face_graph(const skinning::Triangles& F) {
       // A triangle listing the same edge twice (a folded, degenerate one) counts once.
       if (k > i && sides[k][2] == sides[k - 1][2]) continue;
       g.edge_faces.push_back(sides[k][2]);
-      for (std::size_t l = i; l < k; ++l) {
-        if (sides[l][2] == sides[k][2]) continue;
-        pairs.emplace_back(sides[k][2], sides[l][2]);
-        pairs.emplace_back(sides[l][2], sides[k][2]);
-      }
     }
     g.edge_offsets.push_back(static_cast<std::int32_t>(g.edge_faces.size()));
     i = j;
   }
-  std::sort(pairs.begin(), pairs.end());
-  pairs.erase(std::unique(pairs.begin(), pairs.end()), pairs.end());
-  g.offsets.assign(static_cast<std::size_t>(F.rows()) + 1, 0);
-  for (const auto& p : pairs) ++g.offsets[static_cast<std::size_t>(p.first) + 1];
-  for (std::size_t f = 0; f < static_cast<std::size_t>(F.rows()); ++f) {
-    g.offsets[f + 1] += g.offsets[f];
+  // Face → faces: every pair of faces on an edge, counted, placed, then sorted and deduplicated
+  // per face (lists are short: three neighbours on a manifold mesh).
+  const auto nf = static_cast<std::size_t>(F.rows());
+  std::vector<std::int32_t> degree(nf + 1, 0);
+  const auto for_each_pair = [&](auto&& visit) {
+    for (std::size_t e = 0; e + 1 < g.edge_offsets.size(); ++e) {
+      const auto begin = static_cast<std::size_t>(g.edge_offsets[e]);
+      const auto end = static_cast<std::size_t>(g.edge_offsets[e + 1]);
+      for (auto x = begin; x < end; ++x) {
+        for (auto y = begin; y < end; ++y) {
+          if (x != y) visit(g.edge_faces[x], g.edge_faces[y]);
+        }
+      }
+    }
+  };
+  for_each_pair([&](std::int32_t a, std::int32_t) { ++degree[static_cast<std::size_t>(a) + 1]; });
+  for (std::size_t f = 0; f < nf; ++f) degree[f + 1] += degree[f];
+  std::vector<std::int32_t> raw(static_cast<std::size_t>(degree[nf]));
+  std::vector<std::int32_t> fill(degree.begin(), degree.end() - 1);
+  for_each_pair([&](std::int32_t a, std::int32_t b) {
+    raw[static_cast<std::size_t>(fill[static_cast<std::size_t>(a)]++)] = b;
+  });
+  g.offsets.assign(nf + 1, 0);
+  g.neighbours.reserve(raw.size());
+  for (std::size_t f = 0; f < nf; ++f) {
+    const auto begin = raw.begin() + degree[f];
+    const auto end = raw.begin() + degree[f + 1];
+    std::sort(begin, end);
+    for (auto it = begin; it != end; ++it) {
+      if (it == begin || *it != *(it - 1)) g.neighbours.push_back(*it);
+    }
+    g.offsets[f + 1] = static_cast<std::int32_t>(g.neighbours.size());
   }
-  g.neighbours.reserve(pairs.size());
-  for (const auto& p : pairs) g.neighbours.push_back(p.second);
   return g;
 }
 

@@ -1,5 +1,9 @@
 #include "segmentation/observer.hpp"
 
+#include <algorithm>
+#include <array>
+#include <vector>
+
 #include <Eigen/Geometry>
 
 #include "segmentation/detail/orient3d.hpp"
@@ -18,9 +22,33 @@ Orientation orientation(const Observer& observer, const Eigen::Vector3d& a,
 
 ObserverChoice choose_observer(const skinning::Positions& V, const skinning::Triangles& F,
                                std::span<const std::int32_t> triangles, const BoneSegment& bone,
-                               const Eigen::VectorXd& follow, double theta_rad) {
+                               const Eigen::MatrixXd& W, std::span<const std::int32_t> subtree,
+                               double theta_rad) {
   ObserverChoice out;
   if (triangles.empty()) return out;
+
+  // The cluster's vertices, each once, and its triangles in that local numbering.
+  std::vector<std::int32_t> vertices;
+  vertices.reserve(triangles.size() * 3);
+  for (const auto f : triangles) {
+    for (int c = 0; c < 3; ++c) vertices.push_back(F(f, c));
+  }
+  std::sort(vertices.begin(), vertices.end());
+  vertices.erase(std::unique(vertices.begin(), vertices.end()), vertices.end());
+  const auto local = [&](std::int32_t v) {
+    return static_cast<std::size_t>(
+        std::lower_bound(vertices.begin(), vertices.end(), v) - vertices.begin());
+  };
+  std::vector<std::array<std::size_t, 3>> local_triangles;
+  local_triangles.reserve(triangles.size());
+  for (const auto f : triangles) local_triangles.push_back({local(F(f, 0)), local(F(f, 1)), local(F(f, 2))});
+  // How much of each vertex follows the bone: its summed weight on the bone's subtree.
+  std::vector<double> follow(vertices.size(), 0.0);
+  for (std::size_t k = 0; k < vertices.size(); ++k) {
+    double s = 0.0;
+    for (const auto b : subtree) s += W(vertices[k], b);
+    follow[k] = std::min(1.0, s);
+  }
 
   // The test poses: identity, then ±θ about x, y, z, all about the bone's head joint.
   std::vector<Eigen::Matrix3d> rotations = {Eigen::Matrix3d::Identity()};
@@ -33,22 +61,22 @@ ObserverChoice choose_observer(const skinning::Positions& V, const skinning::Tri
   const Eigen::Vector3d q1 = bone.head;
   std::int64_t positive_point = 0;
   std::int64_t positive_line = 0;
+  std::vector<Eigen::Vector3d> posed(vertices.size());
   for (std::size_t r = 0; r < rotations.size(); ++r) {
     const Eigen::Matrix3d& R = rotations[r];
-    // The bone turns rigidly about q1; a vertex turns by its blend of R and the identity
-    // (linear blend skinning with the bone's subtree weight), exactly as LBS would pose it.
-    BoneSegment posed = bone;
-    posed.tail = q1 + R * (bone.tail - q1);
-    const Observer point{ObserverKind::point, posed};
-    const Observer line{ObserverKind::line, posed};
-    const auto pose = [&](std::int32_t v) -> Eigen::Vector3d {
-      const Eigen::Vector3d x = V.row(v).transpose();
-      if (r == 0) return x;  // the rest pose, bit for bit
-      const double s = follow[v];
-      return q1 + s * (R * (x - q1)) + (1.0 - s) * (x - q1);
-    };
-    for (const auto f : triangles) {
-      const Eigen::Vector3d a = pose(F(f, 0)), b = pose(F(f, 1)), c = pose(F(f, 2));
+    BoneSegment posed_bone = bone;
+    posed_bone.tail = q1 + R * (bone.tail - q1);
+    const Observer point{ObserverKind::point, posed_bone};
+    const Observer line{ObserverKind::line, posed_bone};
+    for (std::size_t k = 0; k < vertices.size(); ++k) {
+      const Eigen::Vector3d x = V.row(vertices[k]).transpose();
+      // The rest pose bit for bit; otherwise the LBS blend of R and the identity about q1.
+      posed[k] = r == 0 ? x : Eigen::Vector3d(q1 + follow[k] * (R * (x - q1)) + (1.0 - follow[k]) * (x - q1));
+    }
+    for (const auto& t : local_triangles) {
+      const auto& a = posed[t[0]];
+      const auto& b = posed[t[1]];
+      const auto& c = posed[t[2]];
       positive_point += orientation(point, a, b, c) == Orientation::positive;
       positive_line += orientation(line, a, b, c) == Orientation::positive;
     }

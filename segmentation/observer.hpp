@@ -66,17 +66,20 @@ struct ObserverChoice {
 /// Chooses the observer of a cluster (§4.2): the point if it keeps more triangles positively
 /// oriented on average than the line, over the rest pose and the bone rotated by ±θ about the
 /// world x, y and z axes around its head joint, else the line.
+/// In a test pose the bone and its descendants turn rigidly by R about the head q1, and each
+/// vertex x of the cluster moves as linear blend skinning moves it: x' = q1 + (s R + (1 − s) I)
+/// (x − q1), with s the vertex's summed weight on the bone's subtree (rotating the triangles and
+/// the observer rigidly together would change no orientation at all).
 /// @param V #W × 3 rest positions; @param F #F × 3; @param triangles the cluster's triangles.
-/// @param follow #W: the fraction of each vertex that follows the bone's rotation — the summed
-///   weight of the bone and its descendants — so that the cluster deforms as linear blend skinning
-///   would deform it (rotating triangles and observer rigidly together would change nothing).
+/// @param W #W × #B weights; @param subtree the bone and its descendants (columns of W).
 /// @param theta_rad rotation angle (radians).
 [[nodiscard]] ObserverChoice choose_observer(
     const skinning::Positions& V,
     const skinning::Triangles& F,
     std::span<const std::int32_t> triangles,
     const BoneSegment& bone,
-    const Eigen::VectorXd& follow,
+    const Eigen::MatrixXd& W,
+    std::span<const std::int32_t> subtree,
     double theta_rad);
 
 }  // namespace skelcd::segmentation

@@ -5,6 +5,8 @@
 #include <numbers>
 #include <string>
 
+#include <tbb/parallel_for.h>
+
 #include "segmentation/atomic_clusters.hpp"
 #include "segmentation/face_graph.hpp"
 #include "skinning/errors.hpp"
@@ -13,34 +15,29 @@ namespace skelcd::segmentation {
 
 namespace {
 
-// Per bone: which bones are in its subtree (itself and its descendants).
-std::vector<std::vector<char>> subtree_masks(const std::vector<BoneSegment>& bones) {
+// Per bone: the bones of its subtree (itself and its descendants), ascending.
+std::vector<std::vector<std::int32_t>> subtrees(const std::vector<BoneSegment>& bones) {
   const auto nb = bones.size();
-  std::vector<std::vector<char>> mask(nb, std::vector<char>(nb, 0));
+  std::vector<std::vector<std::int32_t>> out(nb);
   for (std::size_t k = 0; k < nb; ++k) {
-    // Walk up from k, marking k in every ancestor's subtree (bounded against cycles).
+    // Walk up from k, adding k to every ancestor's subtree (bounded against cycles).
     std::size_t steps = 0;
     for (auto b = static_cast<std::int32_t>(k); b >= 0 && steps <= nb;
          b = bones[static_cast<std::size_t>(b)].parent, ++steps) {
-      mask[static_cast<std::size_t>(b)][k] = 1;
+      out[static_cast<std::size_t>(b)].push_back(static_cast<std::int32_t>(k));
     }
   }
-  return mask;
+  return out;
 }
 
-// The fraction of each vertex of `triangles` that follows bone j: its summed subtree weight.
-void subtree_follow(const Eigen::MatrixXd& W, const skinning::Triangles& F,
-                    std::span<const std::int32_t> triangles, const std::vector<char>& subtree,
-                    Eigen::VectorXd& follow) {
-  for (const auto f : triangles) {
-    for (int c = 0; c < 3; ++c) {
-      const auto v = F(f, c);
-      double s = 0.0;
-      for (Eigen::Index k = 0; k < W.cols(); ++k) {
-        if (subtree[static_cast<std::size_t>(k)]) s += W(v, k);
-      }
-      follow[v] = std::min(1.0, s);
-    }
+// Runs body(i) for i in [0, n), in parallel when there is enough work; each i writes only its own
+// result, so the outcome does not depend on the schedule.
+template <class Body>
+void for_each_index(std::size_t n, std::size_t work, Body&& body) {
+  if (work > 20000 && n > 1) {
+    tbb::parallel_for(std::size_t{0}, n, [&](std::size_t i) { body(i); });
+  } else {
+    for (std::size_t i = 0; i < n; ++i) body(i);
   }
 }
 
@@ -88,8 +85,7 @@ Segmentation segment_mesh(const skinning::Positions& V, const skinning::Triangle
   stats.bones = nb;
 
   const auto graph = face_graph(F);
-  const auto subtree = subtree_masks(bones);
-  Eigen::VectorXd follow = Eigen::VectorXd::Zero(V.rows());
+  const auto subtree = subtrees(bones);
 
   // 1. Each triangle to the bone of its largest summed weight (§4.1).
   std::vector<std::int32_t> labels = largest_weight_bones(W, F);
@@ -101,14 +97,12 @@ Segmentation segment_mesh(const skinning::Positions& V, const skinning::Triangle
       per_bone[static_cast<std::size_t>(labels[static_cast<std::size_t>(f)])].push_back(f);
     }
     std::vector<Observer> observers(static_cast<std::size_t>(nb));
-    for (std::int32_t b = 0; b < nb; ++b) {
-      const auto& tris = per_bone[static_cast<std::size_t>(b)];
-      observers[static_cast<std::size_t>(b)].segment = bones[static_cast<std::size_t>(b)];
-      if (tris.empty()) continue;
-      subtree_follow(W, F, tris, subtree[static_cast<std::size_t>(b)], follow);
-      observers[static_cast<std::size_t>(b)].kind =
-          choose_observer(V, F, tris, bones[static_cast<std::size_t>(b)], follow, theta).kind;
-    }
+    for_each_index(observers.size(), static_cast<std::size_t>(F.rows()), [&](std::size_t b) {
+      const auto& tris = per_bone[b];
+      observers[b].segment = bones[b];
+      if (tris.empty()) return;
+      observers[b].kind = choose_observer(V, F, tris, bones[b], W, subtree[b], theta).kind;
+    });
     stats.refinement = refine_labels(V, F, graph, observers, W, labels);
   }
 
@@ -125,16 +119,18 @@ Segmentation segment_mesh(const skinning::Positions& V, const skinning::Triangle
   }
 
   // 4. The final observer of each atomic cluster, and the rest-pose orientation counts.
-  std::vector<char> bone_used(static_cast<std::size_t>(nb), 0);
-  for (auto& cluster : out.clusters) {
-    const auto& bone = bones[static_cast<std::size_t>(cluster.bone)];
-    bone_used[static_cast<std::size_t>(cluster.bone)] = 1;
-    subtree_follow(W, F, cluster.triangles, subtree[static_cast<std::size_t>(cluster.bone)], follow);
-    const auto choice = choose_observer(V, F, cluster.triangles, bone, follow, theta);
-    cluster.observer = Observer{choice.kind, bone};
+  for_each_index(out.clusters.size(), static_cast<std::size_t>(F.rows()), [&](std::size_t c) {
+    auto& cluster = out.clusters[c];
+    const auto b = static_cast<std::size_t>(cluster.bone);
+    const auto choice = choose_observer(V, F, cluster.triangles, bones[b], W, subtree[b], theta);
+    cluster.observer = Observer{choice.kind, bones[b]};
     cluster.mean_positive_point = choice.mean_positive_point;
     cluster.mean_positive_line = choice.mean_positive_line;
-    (choice.kind == ObserverKind::point ? stats.point_observers : stats.line_observers)++;
+  });
+  std::vector<char> bone_used(static_cast<std::size_t>(nb), 0);
+  for (auto& cluster : out.clusters) {
+    bone_used[static_cast<std::size_t>(cluster.bone)] = 1;
+    (cluster.observer.kind == ObserverKind::point ? stats.point_observers : stats.line_observers)++;
     for (const auto f : cluster.triangles) {
       const auto o = orientation(cluster.observer, V, F, f);
       stats.h_minus += o == Orientation::negative;

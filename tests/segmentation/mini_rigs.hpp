@@ -2,6 +2,7 @@
 // Procedural meshes and rigs with known answers for the segmentation tests: a closed tube around a
 // chain of bones (the "capsule chain"), an icosphere, a flat grid, a cube.
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <numbers>
@@ -178,6 +179,41 @@ inline skinning::Rig capsule_chain(int bones, double bone_length = 1.0, double r
   }
   rig.weights.resize(nv, bones);
   rig.weights.setFromTriplets(w.begin(), w.end());
+  return rig;
+}
+
+/// A capsule chain bent by `degrees` about z at every joint (alternating sign when `zigzag`),
+/// each elbow smoothed over ±`blend` along the chain: a rope-like rig whose rest pose has concave
+/// sides, so refinement and observer choice have work to do. Same weights as capsule_chain.
+inline skinning::Rig bent_capsule_chain(int bones, double degrees, bool zigzag, double blend = 0.2,
+                                        int rings_per_bone = 6, int sides = 16,
+                                        double radius = 0.25) {
+  skinning::Rig rig = capsule_chain(bones, 1.0, radius, rings_per_bone, sides);
+  const double full = degrees * std::numbers::pi / 180.0;
+  const auto angle = [&](int joint) { return (zigzag && joint % 2 == 0) ? -full : full; };
+  // Forward kinematics in the straight frame: rotations about joints k = n−1 … 1, each by the
+  // part of its angle that the point follows.
+  const auto bend = [&](const Eigen::Vector3d& p, double x, bool rigid_tail) {
+    Eigen::Vector3d q = p;
+    for (int k = bones - 1; k >= 1; --k) {
+      double s = std::clamp((x - (k - blend)) / (2.0 * blend), 0.0, 1.0);
+      if (rigid_tail) s = x >= k ? 1.0 : 0.0;
+      const double a = angle(k) * s * s * (3.0 - 2.0 * s);
+      const Eigen::Vector3d J(k, 0, 0);
+      q = J + Eigen::AngleAxisd(a, Eigen::Vector3d::UnitZ()) * (q - J);
+    }
+    return q;
+  };
+  for (Eigen::Index v = 0; v < rig.mesh.rest_positions.rows(); ++v) {
+    const Eigen::Vector3d p = rig.mesh.rest_positions.row(v).transpose();
+    rig.mesh.rest_positions.row(v) = bend(p, p.x(), false).transpose();
+  }
+  for (int b = 0; b < bones; ++b) {
+    auto& bone = rig.skeleton.bones[static_cast<std::size_t>(b)];
+    bone.rest_head = bend(Eigen::Vector3d(b, 0, 0), b, true);
+    bone.rest_tail = bend(Eigen::Vector3d(b + 1, 0, 0), b + 0.5, true);
+    bone.inverse_bind = Eigen::Translation3d(-bone.rest_head);  // translation-only bind frames
+  }
   return rig;
 }
 
