@@ -84,6 +84,24 @@ void sources_of_vertex(const Eigen::Vector3d& x, const std::vector<BoneSegment>&
                        double& d_out, bool& fell_back) {
   const auto nb = bones.size();
   for (std::size_t b = 0; b < nb; ++b) dist[b] = (bones[b].closest_point(x) - x).norm();
+  // Most vertices see their nearest bone: try the nearest (and its ties) before sorting all.
+  const double d0 = *std::min_element(dist.begin(), dist.begin() + static_cast<std::ptrdiff_t>(nb));
+  out.clear();
+  for (std::size_t b = 0; b < nb; ++b) {
+    if (dist[b] <= d0 * (1.0 + tie_tolerance) &&
+        visible(x, bones[b].closest_point(x))) {
+      out.push_back(static_cast<std::int32_t>(b));
+    }
+  }
+  // When a bone at the minimum distance itself is visible, the answer is settled: it and the
+  // visible bones within the tie tolerance (what the sorted search below would also find).
+  bool nearest_visible = false;
+  for (const auto b : out) nearest_visible |= dist[static_cast<std::size_t>(b)] == d0;
+  if (nearest_visible) {
+    fell_back = false;
+    d_out = d0;
+    return;
+  }
   std::iota(order.begin(), order.end(), 0);
   std::sort(order.begin(), order.end(), [&](std::int32_t a, std::int32_t b) {
     const auto ua = static_cast<std::size_t>(a), ub = static_cast<std::size_t>(b);
@@ -101,7 +119,6 @@ void sources_of_vertex(const Eigen::Vector3d& x, const std::vector<BoneSegment>&
   }
   fell_back = !nearest;
   if (fell_back) {
-    const double d0 = dist[static_cast<std::size_t>(order[0])];
     for (const auto b : order) {
       if (dist[static_cast<std::size_t>(b)] > d0 * (1.0 + tie_tolerance)) break;
       out.push_back(b);

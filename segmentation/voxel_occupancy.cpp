@@ -74,9 +74,11 @@ VoxelOccupancy::VoxelOccupancy(const skinning::Positions& V, const skinning::Tri
     }
     Eigen::Vector3i clo, chi;
     for (int a = 0; a < 3; ++a) {
-      clo[a] = std::clamp(static_cast<int>(std::floor((tlo[a] - origin_[a]) / h_)) - 1, 0,
+      // The cells holding the triangle's box (a triangle that only touches a neighbouring cell's
+      // face need not mark it: the cells it lies in already seal the surface).
+      clo[a] = std::clamp(static_cast<int>(std::floor((tlo[a] - origin_[a]) / h_)), 0,
                           dims_[a] - 1);
-      chi[a] = std::clamp(static_cast<int>(std::floor((thi[a] - origin_[a]) / h_)) + 1, 0,
+      chi[a] = std::clamp(static_cast<int>(std::floor((thi[a] - origin_[a]) / h_)), 0,
                           dims_[a] - 1);
     }
     for (int z = clo.z(); z <= chi.z(); ++z) {

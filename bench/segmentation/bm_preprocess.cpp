@@ -40,6 +40,9 @@ void report(benchmark::State& state, const seg::Segmentation& s, std::int64_t v)
   state.counters["clusters"] = s.stats.atomic_clusters;
   state.counters["H-"] = static_cast<double>(s.stats.h_minus);
   state.counters["Hu"] = static_cast<double>(s.stats.h_uncertain);
+  state.counters["dist_s"] = s.stats.heat.distance_s;
+  state.counters["factor_s"] = s.stats.heat.factorize_s;
+  state.counters["solve_s"] = s.stats.heat.solve_s;
   state.counters["no_bone"] = static_cast<double>(s.stats.heat.fallback_vertices);
   state.counters["triangles/s"] = benchmark::Counter(
       static_cast<double>(s.stats.triangles), benchmark::Counter::kIsIterationInvariantRate);
