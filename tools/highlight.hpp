@@ -1,0 +1,38 @@
+#pragma once
+// `skelcd export --highlight LOG.h5`: which triangles of the exported mesh take part in a finding
+// of the log at the exported frame, as per-face colours for the exporter.
+
+#include <array>
+#include <cstdint>
+#include <filesystem>
+#include <vector>
+
+#include "skinning/mesh.hpp"
+#include "tools/log/log_reader.hpp"
+
+namespace skelcd::tools {
+
+/// Triangles (rows of mesh.triangles, sorted, unique) in a finding keyed to `frame`: both
+/// triangles of each DCD pair at sample `frame`; for each CCD contact of the interval
+/// [frame, frame + 1], the face and every triangle around the vertex (VF) or along the edges (EE),
+/// vertices taken welded (seam duplicates count as one).
+/// @throws InvalidInput when the log was not written for this mesh (vertex or triangle count, or a
+/// feature id outside it).
+[[nodiscard]] std::vector<std::int32_t> highlighted_triangles(
+    const LogData& log,
+    const skinning::Mesh& mesh,
+    std::int32_t frame);
+
+/// RGBA in [0, 1] of highlighted and of other triangles.
+inline constexpr std::array<float, 4> kHighlightColour{0.9f, 0.1f, 0.1f, 1.0f};
+inline constexpr std::array<float, 4> kPlainColour{0.78f, 0.78f, 0.78f, 1.0f};
+
+/// The one call `export --highlight` makes: reads `log_path` and returns #F RGBA face colours,
+/// highlighted_triangles() red and the rest grey (ExportOptions::face_colors).
+/// @throws IoError / InvalidInput naming the log.
+[[nodiscard]] std::vector<std::array<float, 4>> highlight_face_colors(
+    const std::filesystem::path& log_path,
+    const skinning::Mesh& mesh,
+    std::int32_t frame);
+
+}  // namespace skelcd::tools
