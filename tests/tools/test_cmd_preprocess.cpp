@@ -114,6 +114,26 @@ TEST(CmdPreprocess, SavedFileOpensInH5dumpAndReadsBackAsComputed) {
                        skelcd::InvalidInput, "different file");
 }
 
+TEST(CmdPreprocess, DocumentedH5pyExampleReadsASegmentation) {
+  // The python block of docs/segmentation.md, run as it stands on a file written here, with
+  // Debian's interpreter (where python3-h5py is installed).
+  const auto dir = skelcd::test::temp_dir("cmd_preprocess_h5py");
+  const auto out = dir / "seg.h5";
+  ASSERT_EQ(run_skelcd({"preprocess", character("Fox.glb").string(), "-o", out.string()}).exit_code, 0);
+  std::ifstream doc(fs::path(SKELCD_SOURCE_DIR) / "docs/segmentation.md");
+  const std::string text((std::istreambuf_iterator<char>(doc)), std::istreambuf_iterator<char>());
+  const auto begin = text.find("```python\n");
+  ASSERT_NE(begin, std::string::npos) << "docs/segmentation.md has no python example";
+  const auto end = text.find("```", begin + 10);
+  const auto script = dir / "example.py";
+  { std::ofstream(script) << text.substr(begin + 10, end - begin - 10); }
+  const auto [status, output] =
+      shell("/usr/bin/python3 '" + script.string() + "' '" + out.string() + "' 2>&1");
+  EXPECT_EQ(status, 0) << output;
+  EXPECT_NE(output.find("clusters"), std::string::npos) << output;
+  EXPECT_NE(output.find("h_minus:"), std::string::npos) << output;
+}
+
 TEST(CmdPreprocess, ClipAveragesAndCoarseDistance) {
   const auto model = skelcd::skinning::load_model(character("CesiumMan.glb"));
   ASSERT_FALSE(model.clips.empty());
