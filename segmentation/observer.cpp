@@ -84,9 +84,12 @@ ObserverChoice choose_observer(const skinning::Positions& V, const skinning::Tri
   out.poses = static_cast<int>(rotations.size());
   out.mean_positive_point = static_cast<double>(positive_point) / out.poses;
   out.mean_positive_line = static_cast<double>(positive_line) / out.poses;
-  // §4.2: "we set the observer primitive to q if |H̄⁺(q)| > |H̄⁺(q1q2)|, and to q1q2 otherwise".
-  out.kind = out.mean_positive_point > out.mean_positive_line ? ObserverKind::point
-                                                               : ObserverKind::line;
+  // §4.2: the point when it keeps more triangles positive on average, else the line. On a tie
+  // the point: "the observer points are preferred over the observer line segments" (no
+  // projection per triangle at run time); the paper's formula, read literally, gives ties to the
+  // line.
+  out.kind = out.mean_positive_point >= out.mean_positive_line ? ObserverKind::point
+                                                                : ObserverKind::line;
   return out;
 }
 

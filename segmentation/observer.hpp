@@ -63,9 +63,10 @@ struct ObserverChoice {
   int poses = 0;
 };
 
-/// Chooses the observer of a cluster (§4.2): the point if it keeps more triangles positively
-/// oriented on average than the line, over the rest pose and the bone rotated by ±θ about the
-/// world x, y and z axes around its head joint, else the line.
+/// Chooses the observer of a cluster (§4.2): the point if it keeps at least as many triangles
+/// positively oriented on average as the line (ties go to the cheaper point), over the rest pose
+/// and the bone rotated by ±θ about the world x, y and z axes around its head joint, else the
+/// line.
 /// In a test pose the bone and its descendants turn rigidly by R about the head q1, and each
 /// vertex x of the cluster moves as linear blend skinning moves it: x' = q1 + (s R + (1 − s) I)
 /// (x − q1), with s the vertex's summed weight on the bone's subtree (rotating the triangles and

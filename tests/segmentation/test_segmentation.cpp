@@ -6,6 +6,7 @@
 #include <cmath>
 #include <memory>
 #include <numbers>
+#include <numeric>
 #include <set>
 
 #include <Eigen/Geometry>
@@ -202,6 +203,37 @@ TEST(Segmentation, RefineLabelsByHand) {
   EXPECT_EQ(stats.non_positive_after, 0);
   EXPECT_EQ(stats.regrown_positive, stats.removed);
   for (const auto l : labels) EXPECT_EQ(l, 0);
+}
+
+TEST(Observer, LineWinsOnACorrugatedTubeAndTiesGoToThePoint) {
+  // One bone along x in a tube whose rings alternate between radius 0.3 and 0.1: the steep cone
+  // walls far from the middle face away from the midpoint along x, but the line sees every wall
+  // from the foot of its own corner's perpendicular (radially), hence from behind.
+  auto tube = skelcd::test::closed_tube(1.0, 0.3, 16, 12, 0.1);
+  for (Eigen::Index v = 0; v < tube.V.rows() - 2; ++v) {
+    if ((v / 12) % 2 == 1) tube.V.row(v).tail<2>() /= 3.0;
+  }
+  const BoneSegment bone{Eigen::Vector3d(0, 0, 0), Eigen::Vector3d(1, 0, 0)};
+  const Eigen::MatrixXd W = Eigen::MatrixXd::Ones(tube.V.rows(), 1);
+  std::vector<std::int32_t> all(static_cast<std::size_t>(tube.F.rows()));
+  std::iota(all.begin(), all.end(), 0);
+  const std::vector<std::int32_t> subtree = {0};
+  const auto corrugated = choose_observer(tube.V, tube.F, all, bone, W, subtree, 10.0 * std::numbers::pi / 180.0);
+  EXPECT_EQ(corrugated.poses, 7);
+  EXPECT_GT(corrugated.mean_positive_line, corrugated.mean_positive_point);
+  EXPECT_EQ(corrugated.kind, ObserverKind::line);
+  // With W = 1 on the bone's subtree the test poses are rigid motions of cluster and bone
+  // together: the counts are those of the rest pose, exactly.
+  const Observer line{ObserverKind::line, bone};
+  int rest_positive = 0;
+  for (const auto f : all) rest_positive += orientation(line, tube.V, tube.F, f) == Orientation::positive;
+  EXPECT_EQ(corrugated.mean_positive_line, rest_positive);
+  // A straight tube: both see everything; the tie goes to the point.
+  const auto straight = skelcd::test::closed_tube(1.0, 0.3, 16, 12, 0.1);
+  const auto plain = choose_observer(straight.V, straight.F, all, bone, W, subtree, 0.2);
+  EXPECT_EQ(plain.mean_positive_point, static_cast<double>(all.size()));
+  EXPECT_EQ(plain.mean_positive_line, static_cast<double>(all.size()));
+  EXPECT_EQ(plain.kind, ObserverKind::point);
 }
 
 TEST(Segmentation, DeterministicAndIndependentOfThreads) {
