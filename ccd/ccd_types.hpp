@@ -15,6 +15,11 @@ struct CcdOptions {
   /// Upper bound on subdivision steps of the conservative solver; when reached the answer is
   /// "hit" (the safe side) with the widest interval still open.
   std::int64_t max_iterations = 1'000'000;
+  /// Conservative only: the solver reports a contact once it has proven that the primitives come
+  /// within min_separation + relative_distance_tolerance * extent (+ the rounding bound), where
+  /// extent is the largest coordinate difference between the query's points at t = 0 or t = 1.
+  /// Unitless. Smaller values give fewer false positives on near misses and cost more boxes.
+  double relative_distance_tolerance = 1e-10;
 };
 
 enum class CcdStatus : std::uint8_t {
@@ -30,6 +35,36 @@ struct CcdResult {
   double toi_lower = 1.0;
   double toi_upper = 1.0;
   CcdStatus status = CcdStatus::separated;
+};
+
+/// How many queries each stage of the pipeline saw and removed (DESIGN.md: every method reports
+/// what it culled and what it tested). Filled by the overloads of vertex_face_ccd / edge_edge_ccd
+/// that take a CcdStats; the filter counters move only for the conservative accuracy.
+struct CcdStats {
+  std::int64_t queries = 0;               ///< queries answered
+  std::int64_t aabb_rejected = 0;         ///< removed by the swept-AABB filter
+  std::int64_t coplanarity_rejected = 0;  ///< removed by the deforming non-penetration filter
+  std::int64_t algebraic_rejected = 0;    ///< proven separated by the algebraic filter
+  std::int64_t algebraic_hits = 0;        ///< proven in contact by the algebraic filter
+  std::int64_t solver_runs = 0;           ///< queries the filters left to the inclusion solver
+  std::int64_t solver_rejected = 0;       ///< of those, proven separated by the solver
+  std::int64_t solver_boxes = 0;          ///< (t, u, v) boxes the solver examined (its work)
+  std::int64_t iteration_limit = 0;       ///< solver runs stopped by max_iterations (reported hit)
+  std::int64_t hits = 0;                  ///< queries answered hit == true
+
+  CcdStats& operator+=(const CcdStats& other) {
+    queries += other.queries;
+    aabb_rejected += other.aabb_rejected;
+    coplanarity_rejected += other.coplanarity_rejected;
+    algebraic_rejected += other.algebraic_rejected;
+    algebraic_hits += other.algebraic_hits;
+    solver_runs += other.solver_runs;
+    solver_rejected += other.solver_rejected;
+    solver_boxes += other.solver_boxes;
+    iteration_limit += other.iteration_limit;
+    hits += other.hits;
+    return *this;
+  }
 };
 
 }  // namespace skelcd::ccd

@@ -21,4 +21,11 @@ struct EdgeEdgeQuery {
     Accuracy accuracy = Accuracy::conservative,
     const CcdOptions& options = {});
 
+/// As above, and adds to `stats` what each stage of the pipeline removed.
+[[nodiscard]] CcdResult edge_edge_ccd(
+    const EdgeEdgeQuery& query,
+    Accuracy accuracy,
+    const CcdOptions& options,
+    CcdStats& stats);
+
 }  // namespace skelcd::ccd

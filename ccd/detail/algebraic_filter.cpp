@@ -1,0 +1,208 @@
+// The algebraic stage of conservative CCD (see algebraic_filter.hpp and docs/ccd.md).
+
+#include "ccd/detail/algebraic_filter.hpp"
+
+#include <algorithm>
+#include <cassert>
+#include <cmath>
+
+#include <Eigen/Geometry>
+
+#include "ccd/detail/float_bounds.hpp"
+
+namespace skelcd::ccd::detail {
+namespace {
+
+// Deepest halving of [0,1] (width 2^-40) and most intervals looked at before handing over.
+constexpr int kMaxDepth = 40;
+constexpr int kNodeBudget = 256;
+constexpr int kMaxQuartics = 4;
+
+// Certified sign of a Bernstein polynomial over its interval: the hull of the coefficients.
+template <std::size_t M>
+int hull_sign(const std::array<double, M>& b, double e) {
+  bool pos = true;
+  bool neg = true;
+  for (const double x : b) {
+    pos = pos && x > e;  // NaN: neither
+    neg = neg && -x > e;
+  }
+  return pos ? 1 : (neg ? -1 : 0);
+}
+
+// The two ends of the interval: b[0] and b[M-1] are the values there.
+template <std::size_t M>
+bool certain_sign_change(const std::array<double, M>& b, double e) {
+  return (b[0] > e && -b[M - 1] > e) || (-b[0] > e && b[M - 1] > e);
+}
+
+// de Casteljau at 1/2. New coefficients are convex combinations of the old (old errors carry over)
+// computed with at most n = M - 1 roundings of averages of values bounded by max|b| + e (rounding
+// lemma, k = n), plus underflow of the halvings.
+template <std::size_t M>
+double halve(const std::array<double, M>& b, double e, std::array<double, M>& left, std::array<double, M>& right) {
+  std::array<double, M> w = b;
+  double m = 0.0;
+  for (const double x : b) m = std::max(m, std::abs(x));
+  left[0] = w[0];
+  right[M - 1] = w[M - 1];
+  for (std::size_t level = 1; level < M; ++level) {
+    for (std::size_t i = 0; i + level < M; ++i) w[i] = (w[i] + w[i + 1]) * 0.5;
+    left[level] = w[0];
+    right[M - 1 - level] = w[M - 1 - level];
+  }
+  const auto n = static_cast<int>(M) - 1;
+  return add_up(add_up(e, rounding_bound(n, add_up(m, e))), n * kUnderflowUnit);
+}
+
+struct Node {
+  double lo, hi;
+  int depth;
+  std::array<double, 4> c;
+  double c_err;
+  std::array<std::array<double, 5>, kMaxQuartics> g;
+  std::array<double, kMaxQuartics> g_err;
+};
+
+// A certain root of c in [lo, hi] (certified sign change): narrow toward the first root while the
+// signs allow. Every root of c in the interval is a contact here, so the first root is the TOI.
+AlgebraicVerdict narrow(double lo, double hi, std::array<double, 4> c, double e, double toi_tolerance) {
+  for (int step = 0; step < 64 && hi - lo > toi_tolerance; ++step) {
+    std::array<double, 4> left, right;
+    const double e2 = halve(c, e, left, right);
+    const double mid = 0.5 * (lo + hi);
+    if (!(lo < mid && mid < hi)) break;
+    if (hull_sign(left, e2) != 0) {
+      // No root in the left half: the sign change is in the right half.
+      lo = mid;
+      c = right;
+    } else if (certain_sign_change(left, e2)) {
+      hi = mid;
+      c = left;
+    } else {
+      break;  // the left half may hold a root or not: keep [lo, hi]
+    }
+    e = e2;
+  }
+  return {AlgebraicOutcome::contact, lo, hi};
+}
+
+// x cross y and its permanent (absolute values, terms added).
+struct CrossPerm {
+  Eigen::Vector3d value;
+  Eigen::Vector3d permanent;
+};
+
+CrossPerm cross_perm(const Eigen::Vector3d& x, const Eigen::Vector3d& y) {
+  const Eigen::Vector3d xa = x.cwiseAbs();
+  const Eigen::Vector3d ya = y.cwiseAbs();
+  return {x.cross(y), Eigen::Vector3d(xa[1] * ya[2] + xa[2] * ya[1], xa[2] * ya[0] + xa[0] * ya[2],
+                                      xa[0] * ya[1] + xa[1] * ya[0])};
+}
+
+}  // namespace
+
+BernsteinQuartic cross_dot_quartic(const QuadrupleDifferences& q) {
+  // Blossom: b_i is the average of the C(4, i) evaluations with i of the 4 factors at t = 1.
+  // Factor pairs: A x B with (A, B) at times (mask & 1, mask & 2), C x D at (mask & 4, mask & 8).
+  const CrossPerm ab[4] = {cross_perm(q.a_t0, q.b_t0), cross_perm(q.a_t1, q.b_t0), cross_perm(q.a_t0, q.b_t1),
+                           cross_perm(q.a_t1, q.b_t1)};
+  const CrossPerm cd[4] = {cross_perm(q.c_t0, q.d_t0), cross_perm(q.c_t1, q.d_t0), cross_perm(q.c_t0, q.d_t1),
+                           cross_perm(q.c_t1, q.d_t1)};
+  static constexpr int kBits[4] = {0, 1, 1, 2};
+  std::array<double, 5> sum{};
+  std::array<double, 5> perm{};
+  for (int i = 0; i < 4; ++i) {
+    for (int j = 0; j < 4; ++j) {
+      const auto level = static_cast<std::size_t>(kBits[i] + kBits[j]);
+      const Eigen::Vector3d& x = ab[i].value;
+      const Eigen::Vector3d& y = cd[j].value;
+      const Eigen::Vector3d& px = ab[i].permanent;
+      const Eigen::Vector3d& py = cd[j].permanent;
+      sum[level] += (x[0] * y[0] + x[1] * y[1]) + x[2] * y[2];
+      perm[level] += (px[0] * py[0] + px[1] * py[1]) + px[2] * py[2];
+    }
+  }
+  static constexpr double kTerms[5] = {1.0, 4.0, 6.0, 4.0, 1.0};
+  BernsteinQuartic out;
+  double p = 0.0;
+  for (std::size_t i = 0; i < 5; ++i) {
+    out.coefficients[i] = sum[i] / kTerms[i];
+    p = std::max(p, perm[i] / kTerms[i]);
+  }
+  // Rounding count per product term: differences 1; a_y b_z 3; cross difference 4; product of two
+  // cross components 9; the dot's two sums 11; the running sum of at most 6 terms (from 0) 17;
+  // the division 18.
+  const double relative = rounding_bound(18, p);
+  // Underflow: a cross component may lose 2 units, then be multiplied by another one (at most
+  // 2 M^2, M the largest difference coordinate), plus one unit per product and the division.
+  double m = 0.0;
+  for (const auto* v : {&q.a_t0, &q.b_t0, &q.c_t0, &q.d_t0, &q.a_t1, &q.b_t1, &q.c_t1, &q.d_t1}) {
+    m = std::max(m, v->cwiseAbs().maxCoeff());
+  }
+  const double underflow = 64 * kUnderflowUnit * (1.0 + m * m);
+  out.error = add_up(relative, underflow);
+  return out;
+}
+
+AlgebraicVerdict algebraic_filter(const BernsteinCubic& c, const BernsteinQuartic* g, int count, double toi_tolerance) {
+  assert(count >= 0 && count <= kMaxQuartics);
+  // Depth first, earlier half first: the left half is processed next, the right half waits.
+  std::array<Node, kMaxDepth + 2> waiting;
+  int size = 0;
+  Node node;
+  node.lo = 0.0;
+  node.hi = 1.0;
+  node.depth = 0;
+  node.c = c.coefficients;
+  node.c_err = c.error;
+  for (int i = 0; i < count; ++i) {
+    node.g[static_cast<std::size_t>(i)] = g[i].coefficients;
+    node.g_err[static_cast<std::size_t>(i)] = g[i].error;
+  }
+  int visited = 0;
+  for (;;) {
+    // Coplanarity excluded here, or some inside condition failing throughout?
+    bool excluded = hull_sign(node.c, node.c_err) != 0;
+    bool all_positive = true;
+    for (int i = 0; i < count && !excluded; ++i) {
+      const auto ii = static_cast<std::size_t>(i);
+      const int s = hull_sign(node.g[ii], node.g_err[ii]);
+      if (s < 0) excluded = true;
+      if (s <= 0) all_positive = false;
+    }
+    if (excluded) {
+      if (size == 0) break;
+      node = waiting[static_cast<std::size_t>(--size)];
+      continue;
+    }
+    if (all_positive && certain_sign_change(node.c, node.c_err)) {
+      return narrow(node.lo, node.hi, node.c, node.c_err, toi_tolerance);
+    }
+    const double mid = 0.5 * (node.lo + node.hi);
+    if (++visited > kNodeBudget || node.depth >= kMaxDepth || !(node.lo < mid && mid < node.hi)) {
+      // Undecided; everything before node.lo was excluded.
+      return {AlgebraicOutcome::undecided, node.lo, 1.0};
+    }
+    Node& right = waiting[static_cast<std::size_t>(size++)];
+    right.lo = mid;
+    right.hi = node.hi;
+    right.depth = node.depth + 1;
+    std::array<double, 4> left_c;
+    right.c_err = halve(node.c, node.c_err, left_c, right.c);
+    node.c = left_c;
+    node.c_err = right.c_err;
+    for (int i = 0; i < count; ++i) {
+      const auto ii = static_cast<std::size_t>(i);
+      std::array<double, 5> left_g;
+      right.g_err[ii] = halve(node.g[ii], node.g_err[ii], left_g, right.g[ii]);
+      node.g[ii] = left_g;
+      node.g_err[ii] = right.g_err[ii];
+    }
+    node.hi = mid;
+    node.depth = right.depth;
+  }
+  return {AlgebraicOutcome::separated, 1.0, 1.0};
+}
+
+}  // namespace skelcd::ccd::detail

@@ -1,0 +1,57 @@
+#pragma once
+// The algebraic stage of conservative CCD (docs/ccd.md, "The algebraic filter"): the exact
+// algorithm's logic in floating point with certified Bernstein bounds.
+//
+// Contact at time t needs the coplanarity cubic c(t) = 0 and every "inside" quartic g_i(t) >= 0
+// (vertex-face: n . ((b - a) x (p - a)) and its two rotations; edge-edge: the numerators of the two
+// segment parameters and their complements). These are necessary for every configuration,
+// degenerate ones included (there the g_i vanish). [0,1] is halved depth first, earliest first:
+//  - c certified nonzero on an interval, or some g_i certified negative: no contact there;
+//  - c certified to change sign on I and every g_i certified positive: a contact in I, for sure;
+//  - neither, when the interval cannot be refined further: undecided from that interval's start
+//    (everything before it has been excluded) — the caller runs the inclusion solver from there.
+
+#include <array>
+#include <cstdint>
+
+#include <Eigen/Core>
+
+#include "ccd/polynomial_sign.hpp"
+
+namespace skelcd::ccd::detail {
+
+/// f(t) = sum_i coefficients[i] * C(4,i) t^i (1-t)^(4-i), each coefficient within `error`.
+struct BernsteinQuartic {
+  std::array<double, 5> coefficients{};
+  double error = 0.0;
+};
+
+/// Four linearly moving difference vectors at t = 0 and t = 1 (each coordinate one floating-point
+/// subtraction of two input coordinates).
+struct QuadrupleDifferences {
+  Eigen::Vector3d a_t0, b_t0, c_t0, d_t0;
+  Eigen::Vector3d a_t1, b_t1, c_t1, d_t1;
+};
+
+/// (A(t) x B(t)) . (C(t) x D(t)) in Bernstein form on [0,1], with its rounding-error bound.
+[[nodiscard]] BernsteinQuartic cross_dot_quartic(const QuadrupleDifferences& q);
+
+enum class AlgebraicOutcome : std::uint8_t { separated, contact, undecided };
+
+struct AlgebraicVerdict {
+  AlgebraicOutcome outcome = AlgebraicOutcome::undecided;
+  /// contact: the first contact lies in [t_lo, t_hi]. undecided: no contact before t_lo.
+  double t_lo = 0.0;
+  double t_hi = 1.0;
+};
+
+/// Runs the interval logic above on c and the `count` quartics g[0..count).
+/// @param toi_tolerance a certain contact's bracket is narrowed to this width when the cubic's sign
+/// allows. @note No allocation, no throw.
+[[nodiscard]] AlgebraicVerdict algebraic_filter(
+    const BernsteinCubic& c,
+    const BernsteinQuartic* g,
+    int count,
+    double toi_tolerance);
+
+}  // namespace skelcd::ccd::detail

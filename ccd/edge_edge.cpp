@@ -1,0 +1,74 @@
+// Edge-edge CCD: the three accuracies behind one call.
+
+#include "ccd/edge_edge.hpp"
+
+#include <cassert>
+
+#include "ccd/detail/fast_ccd.hpp"
+#include "ccd/detail/conservative_pipeline.hpp"
+#include "ccd/exact_ccd.hpp"
+#include "ccd/filters.hpp"
+
+namespace skelcd::ccd {
+namespace {
+
+// conservative: swept AABBs, then the pipeline of detail/conservative_pipeline.hpp.
+CcdResult conservative(const EdgeEdgeQuery& q, const CcdOptions& options, CcdStats& stats) {
+  if (swept_aabbs_disjoint(q, options.min_separation)) {
+    ++stats.aabb_rejected;
+    return {};
+  }
+  // c(t) = (b0 - a0) . ((a1 - a0) x (b1 - b0)); n = d_a x d_b.
+  const detail::DifferenceTriple t0{q.eb0_t0 - q.ea0_t0, q.ea1_t0 - q.ea0_t0, q.eb1_t0 - q.eb0_t0};
+  const detail::DifferenceTriple t1{q.eb0_t1 - q.ea0_t1, q.ea1_t1 - q.ea0_t1, q.eb1_t1 - q.eb0_t1};
+  // With w = b0 - a0: the segment parameters are u / nn and v / nn, nn = n . n, where
+  // u = (w x d_b) . n, nn - u = ((a1 - b0) x d_b) . n, v = (w x d_a) . n, nn - v = (d_a x (b1 - a0)) . n.
+  const auto quartics = [&](detail::BernsteinQuartic* g) {
+    g[0] = detail::cross_dot_quartic({t0.x, t0.z, t0.y, t0.z, t1.x, t1.z, t1.y, t1.z});
+    g[1] = detail::cross_dot_quartic({q.ea1_t0 - q.eb0_t0, t0.z, t0.y, t0.z, q.ea1_t1 - q.eb0_t1, t1.z, t1.y, t1.z});
+    g[2] = detail::cross_dot_quartic({t0.x, t0.y, t0.y, t0.z, t1.x, t1.y, t1.y, t1.z});
+    g[3] = detail::cross_dot_quartic({t0.y, q.eb1_t0 - q.ea0_t0, t0.y, t0.z, t1.y, q.eb1_t1 - q.ea0_t1, t1.y, t1.z});
+    return 4;
+  };
+  // F(t, u, v) = (a0 + u (a1 - a0)) - (b0 + v (b1 - b0)) = (a0 - b0) + u (a1 - a0) + v (b0 - b1).
+  detail::InclusionProblem problem;
+  problem.d_t0 = q.ea0_t0 - q.eb0_t0;
+  problem.e_t0 = t0.y;
+  problem.g_t0 = q.eb0_t0 - q.eb1_t0;
+  problem.d_t1 = q.ea0_t1 - q.eb0_t1;
+  problem.e_t1 = t1.y;
+  problem.g_t1 = q.eb0_t1 - q.eb1_t1;
+  problem.triangle_domain = false;
+  return detail::conservative_pipeline(t0, t1, quartics, problem, options, stats);
+}
+
+}  // namespace
+
+CcdResult edge_edge_ccd(const EdgeEdgeQuery& query, Accuracy accuracy, const CcdOptions& options) {
+  CcdStats stats;
+  return edge_edge_ccd(query, accuracy, options, stats);
+}
+
+CcdResult edge_edge_ccd(const EdgeEdgeQuery& query,
+                        Accuracy accuracy,
+                        const CcdOptions& options,
+                        CcdStats& stats) {
+  assert(options.min_separation >= 0.0);
+  CcdResult r;
+  switch (accuracy) {
+    case Accuracy::exact:
+      r = swept_aabbs_disjoint(query, 0.0) ? CcdResult{} : edge_edge_ccd_exact(to_rational(query), options);
+      break;
+    case Accuracy::conservative:
+      r = conservative(query, options, stats);
+      break;
+    case Accuracy::fast:
+      r = detail::edge_edge_ccd_fast(query);
+      break;
+  }
+  ++stats.queries;
+  if (r.hit) ++stats.hits;
+  return r;
+}
+
+}  // namespace skelcd::ccd

@@ -1,0 +1,358 @@
+// Exact VF / EE CCD on rationals. Narrative of the algorithm (docs/ccd.md, "The exact reference"):
+//  1. Contact needs coplanarity: the 4 points are coplanar at a contact time, so contact times are
+//     roots of the cubic c(t) = det(...) unless c is identically zero.
+//  2. c not identically 0: isolate the roots of c in [0,1] exactly (square-free part, Sturm
+//     sequence, bisection on rationals) and, in increasing order, decide "in contact at t*" by exact
+//     signs of polynomials at the algebraic number t*. The first that is in contact is the TOI.
+//  3. c identically 0 (coplanar throughout): the first contact is at t = 0 or happens on the
+//     boundary of a feature, so it is a point-segment contact (and the point-segment query, when
+//     collinear throughout, reduces to point-point contacts the same way).
+
+#include "ccd/exact_ccd.hpp"
+
+#include <algorithm>
+#include <cassert>
+#include <cmath>
+#include <limits>
+
+#include "ccd/detail/rational_polynomial.hpp"
+
+namespace skelcd::ccd {
+namespace {
+
+using detail::PolynomialVector;
+using detail::RationalPolynomial;
+using detail::RootPoint;
+
+PolynomialVector moving(const RationalPoint& x_t0, const RationalPoint& x_t1) {
+  return {RationalPolynomial::linear(x_t0[0], x_t1[0] - x_t0[0]),
+          RationalPolynomial::linear(x_t0[1], x_t1[1] - x_t0[1]),
+          RationalPolynomial::linear(x_t0[2], x_t1[2] - x_t0[2])};
+}
+
+RationalPoint rational(const Eigen::Vector3d& p) {
+  return {mpq_class(p.x()), mpq_class(p.y()), mpq_class(p.z())};
+}
+
+// Earliest contact found so far, bracketed by rationals.
+struct Earliest {
+  bool hit = false;
+  mpq_class lo, hi;
+
+  // The minimum of two earliest times lies in [min lo, min hi].
+  void merge(const Earliest& other) {
+    if (!other.hit) return;
+    if (!hit) {
+      *this = other;
+      return;
+    }
+    if (other.lo < lo) lo = other.lo;
+    if (other.hi < hi) hi = other.hi;
+  }
+};
+
+Earliest found_at(RootPoint& t, const mpq_class& width) {
+  t.refine(width);
+  return {true, t.lo(), t.hi()};
+}
+
+// Swept boxes: a linearly moving point stays in the box of its two positions, so disjoint boxes
+// (compared exactly) mean no contact. Just a shortcut; the algorithm below does not need it.
+bool swept_boxes_disjoint(std::initializer_list<const RationalPoint*> side_a,
+                          std::initializer_list<const RationalPoint*> side_b) {
+  for (int k = 0; k < 3; ++k) {
+    const auto axis = static_cast<std::size_t>(k);
+    const mpq_class* a_min = &(*side_a.begin())->at(axis);
+    const mpq_class* a_max = a_min;
+    for (const auto* p : side_a) {
+      if ((*p)[axis] < *a_min) a_min = &(*p)[axis];
+      if ((*p)[axis] > *a_max) a_max = &(*p)[axis];
+    }
+    const mpq_class* b_min = &(*side_b.begin())->at(axis);
+    const mpq_class* b_max = b_min;
+    for (const auto* p : side_b) {
+      if ((*p)[axis] < *b_min) b_min = &(*p)[axis];
+      if ((*p)[axis] > *b_max) b_max = &(*p)[axis];
+    }
+    if (*a_max < *b_min || *b_max < *a_min) return true;
+  }
+  return false;
+}
+
+// Polynomials deciding "point p on the closed segment [a, b]": p is on the segment iff
+// (b - a) x (p - a) = 0 (collinear, or a = b) and (p - a).(p - b) <= 0 (between a and b, or p = a
+// when a = b).
+struct OnSegment {
+  PolynomialVector collinear;
+  RationalPolynomial between;
+
+  OnSegment(const PolynomialVector& p, const PolynomialVector& a, const PolynomialVector& b)
+      : collinear(detail::cross(b - a, p - a)), between(detail::dot(p - a, p - b)) {}
+
+  bool at(RootPoint& t) const {
+    for (const auto& c : collinear) {
+      if (t.sign(c) != 0) return false;
+    }
+    return t.sign(between) <= 0;
+  }
+};
+
+// Roots in [0,1] of the common zeros of the given polynomials, first one for which `accept` holds.
+// All of them identically zero is the caller's business.
+template <typename Accept>
+Earliest first_common_root(std::initializer_list<const RationalPolynomial*> polys,
+                           const mpq_class& width,
+                           Accept&& accept) {
+  RationalPolynomial g;
+  for (const auto* p : polys) g = detail::gcd(g, *p);
+  if (g.is_zero() || g.degree() < 1) return {};
+  const RationalPolynomial f = detail::square_free(g);
+  for (const auto& root : detail::isolate_roots_in_unit_interval(f)) {
+    RootPoint t(f, root);
+    if (accept(t)) return found_at(t, width);
+  }
+  return {};
+}
+
+// Earliest t in [0,1] with p(t) = a(t).
+Earliest point_point_ccd(const PolynomialVector& p, const PolynomialVector& a, const mpq_class& width) {
+  const PolynomialVector d = p - a;
+  if (detail::is_zero(d)) return {true, 0, 0};
+  return first_common_root({&d[0], &d[1], &d[2]}, width, [](RootPoint&) { return true; });
+}
+
+// Earliest t in [0,1] with p(t) on the closed segment [a(t), b(t)].
+Earliest point_segment_ccd(const PolynomialVector& p,
+                           const PolynomialVector& a,
+                           const PolynomialVector& b,
+                           const mpq_class& width) {
+  const OnSegment on(p, a, b);
+  if (detail::is_zero(on.collinear)) {
+    // Collinear throughout: the first contact after t = 0 has p at an endpoint (docs/ccd.md).
+    RootPoint t0(mpq_class(0));
+    if (on.at(t0)) return {true, 0, 0};
+    Earliest e = point_point_ccd(p, a, width);
+    e.merge(point_point_ccd(p, b, width));
+    return e;
+  }
+  return first_common_root({&on.collinear[0], &on.collinear[1], &on.collinear[2]}, width,
+                           [&](RootPoint& t) { return t.sign(on.between) <= 0; });
+}
+
+// --- vertex-face -------------------------------------------------------------------------------
+
+struct VertexFacePolynomials {
+  PolynomialVector p, a, b, c;
+  PolynomialVector normal;          // (b - a) x (c - a)
+  RationalPolynomial coplanar;      // normal . (p - a)
+  RationalPolynomial inside_ab, inside_bc, inside_ca;  // normal . ((b - a) x (p - a)) etc.
+  OnSegment on_ab, on_bc, on_ca;
+
+  explicit VertexFacePolynomials(const RationalVertexFaceQuery& q)
+      : p(moving(q.v_t0, q.v_t1)),
+        a(moving(q.f0_t0, q.f0_t1)),
+        b(moving(q.f1_t0, q.f1_t1)),
+        c(moving(q.f2_t0, q.f2_t1)),
+        normal(detail::cross(b - a, c - a)),
+        coplanar(detail::dot(normal, p - a)),
+        inside_ab(detail::dot(normal, detail::cross(b - a, p - a))),
+        inside_bc(detail::dot(normal, detail::cross(c - b, p - b))),
+        inside_ca(detail::dot(normal, detail::cross(a - c, p - c))),
+        on_ab(p, a, b),
+        on_bc(p, b, c),
+        on_ca(p, c, a) {}
+
+  // p(t*) in the closed triangle (a, b, c)(t*).
+  bool contact(RootPoint& t) const {
+    if (t.sign(coplanar) != 0) return false;
+    const bool degenerate =
+        t.sign(normal[0]) == 0 && t.sign(normal[1]) == 0 && t.sign(normal[2]) == 0;
+    if (!degenerate) {
+      // Non-degenerate triangle, p in its plane: inside iff on the inner side of all three edges.
+      return t.sign(inside_ab) >= 0 && t.sign(inside_bc) >= 0 && t.sign(inside_ca) >= 0;
+    }
+    // Zero-area triangle: it is the union of its three edges.
+    return on_ab.at(t) || on_bc.at(t) || on_ca.at(t);
+  }
+};
+
+// --- edge-edge ---------------------------------------------------------------------------------
+
+struct EdgeEdgePolynomials {
+  PolynomialVector a0, a1, b0, b1;
+  PolynomialVector normal;        // d1 x d2, d1 = a1 - a0, d2 = b1 - b0
+  RationalPolynomial coplanar;    // normal . (b0 - a0)
+  RationalPolynomial u, v, nn;    // a0 + (u/nn) d1 = b0 + (v/nn) d2 when coplanar, non-parallel
+  OnSegment a0_on_b, a1_on_b, b0_on_a, b1_on_a;
+
+  explicit EdgeEdgePolynomials(const RationalEdgeEdgeQuery& q)
+      : a0(moving(q.ea0_t0, q.ea0_t1)),
+        a1(moving(q.ea1_t0, q.ea1_t1)),
+        b0(moving(q.eb0_t0, q.eb0_t1)),
+        b1(moving(q.eb1_t0, q.eb1_t1)),
+        normal(detail::cross(a1 - a0, b1 - b0)),
+        coplanar(detail::dot(normal, b0 - a0)),
+        u(detail::dot(detail::cross(b0 - a0, b1 - b0), normal)),
+        v(detail::dot(detail::cross(b0 - a0, a1 - a0), normal)),
+        nn(detail::dot(normal, normal)),
+        a0_on_b(a0, b0, b1),
+        a1_on_b(a1, b0, b1),
+        b0_on_a(b0, a0, a1),
+        b1_on_a(b1, a0, a1) {}
+
+  // The closed segments [a0, a1] and [b0, b1] share a point at t*.
+  bool contact(RootPoint& t) const {
+    if (t.sign(coplanar) != 0) return false;
+    const bool parallel =
+        t.sign(normal[0]) == 0 && t.sign(normal[1]) == 0 && t.sign(normal[2]) == 0;
+    if (!parallel) {
+      // Coplanar, non-parallel: the lines meet at one point; it is on both segments iff
+      // 0 <= u/nn <= 1 and 0 <= v/nn <= 1 (nn > 0).
+      return t.sign(u) >= 0 && t.sign(nn - u) >= 0 && t.sign(v) >= 0 && t.sign(nn - v) >= 0;
+    }
+    // Parallel or degenerate: two such segments meet iff an endpoint of one lies on the other.
+    return a0_on_b.at(t) || a1_on_b.at(t) || b0_on_a.at(t) || b1_on_a.at(t);
+  }
+};
+
+mpq_class positive_width(double toi_tolerance) {
+  // Refining to width 0 would never end; 2^-64 is far below anything a double time can show.
+  const double w = std::max(toi_tolerance, std::ldexp(1.0, -64));
+  return mpq_class(w);
+}
+
+CcdResult to_ccd_result(const ExactCcdResult& r) {
+  CcdResult out;
+  out.hit = r.hit;
+  if (r.hit) {
+    out.toi_lower = std::clamp(round_down(r.toi_lo), 0.0, 1.0);
+    out.toi_upper = std::clamp(round_up(r.toi_hi), 0.0, 1.0);
+    out.status = CcdStatus::contact;
+  }
+  return out;
+}
+
+}  // namespace
+
+RationalVertexFaceQuery to_rational(const VertexFaceQuery& q) {
+  return {rational(q.v_t0), rational(q.f0_t0), rational(q.f1_t0), rational(q.f2_t0),
+          rational(q.v_t1), rational(q.f0_t1), rational(q.f1_t1), rational(q.f2_t1)};
+}
+
+RationalEdgeEdgeQuery to_rational(const EdgeEdgeQuery& q) {
+  return {rational(q.ea0_t0), rational(q.ea1_t0), rational(q.eb0_t0), rational(q.eb1_t0),
+          rational(q.ea0_t1), rational(q.ea1_t1), rational(q.eb0_t1), rational(q.eb1_t1)};
+}
+
+ExactCcdResult vertex_face_ccd_rational(const RationalVertexFaceQuery& q, const mpq_class& width) {
+  assert(width > 0);
+  if (swept_boxes_disjoint({&q.v_t0, &q.v_t1},
+                           {&q.f0_t0, &q.f1_t0, &q.f2_t0, &q.f0_t1, &q.f1_t1, &q.f2_t1})) {
+    return {};
+  }
+  const VertexFacePolynomials P(q);
+  Earliest e;
+  if (!P.coplanar.is_zero()) {
+    // Contact times are roots of the coplanarity cubic: test them in increasing order.
+    const RationalPolynomial f = detail::square_free(P.coplanar);
+    for (const auto& root : detail::isolate_roots_in_unit_interval(f)) {
+      RootPoint t(f, root);
+      if (P.contact(t)) {
+        e = found_at(t, width);
+        break;
+      }
+    }
+  } else {
+    // Coplanar throughout: contact at t = 0, or the first contact is the vertex on an edge.
+    RootPoint t0(mpq_class(0));
+    if (P.contact(t0)) {
+      e = {true, 0, 0};
+    } else {
+      e = point_segment_ccd(P.p, P.a, P.b, width);
+      e.merge(point_segment_ccd(P.p, P.b, P.c, width));
+      e.merge(point_segment_ccd(P.p, P.c, P.a, width));
+    }
+  }
+  if (!e.hit) return {};
+  return {true, e.lo, e.hi};
+}
+
+ExactCcdResult edge_edge_ccd_rational(const RationalEdgeEdgeQuery& q, const mpq_class& width) {
+  assert(width > 0);
+  if (swept_boxes_disjoint({&q.ea0_t0, &q.ea1_t0, &q.ea0_t1, &q.ea1_t1},
+                           {&q.eb0_t0, &q.eb1_t0, &q.eb0_t1, &q.eb1_t1})) {
+    return {};
+  }
+  const EdgeEdgePolynomials P(q);
+  Earliest e;
+  if (!P.coplanar.is_zero()) {
+    const RationalPolynomial f = detail::square_free(P.coplanar);
+    for (const auto& root : detail::isolate_roots_in_unit_interval(f)) {
+      RootPoint t(f, root);
+      if (P.contact(t)) {
+        e = found_at(t, width);
+        break;
+      }
+    }
+  } else {
+    // Coplanar throughout: contact at t = 0, or the first contact has an endpoint of one segment
+    // on the other.
+    RootPoint t0(mpq_class(0));
+    if (P.contact(t0)) {
+      e = {true, 0, 0};
+    } else {
+      e = point_segment_ccd(P.a0, P.b0, P.b1, width);
+      e.merge(point_segment_ccd(P.a1, P.b0, P.b1, width));
+      e.merge(point_segment_ccd(P.b0, P.a0, P.a1, width));
+      e.merge(point_segment_ccd(P.b1, P.a0, P.a1, width));
+    }
+  }
+  if (!e.hit) return {};
+  return {true, e.lo, e.hi};
+}
+
+CcdResult vertex_face_ccd_exact(const RationalVertexFaceQuery& query, const CcdOptions& options) {
+  assert(options.min_separation == 0.0);
+  return to_ccd_result(vertex_face_ccd_rational(query, positive_width(options.toi_tolerance)));
+}
+
+CcdResult edge_edge_ccd_exact(const RationalEdgeEdgeQuery& query, const CcdOptions& options) {
+  assert(options.min_separation == 0.0);
+  return to_ccd_result(edge_edge_ccd_rational(query, positive_width(options.toi_tolerance)));
+}
+
+double round_down(const mpq_class& q) {
+  double d = q.get_d();  // truncates toward zero
+  if (mpq_class(d) > q) d = std::nextafter(d, -std::numeric_limits<double>::infinity());
+  return d;
+}
+
+double round_up(const mpq_class& q) {
+  double d = q.get_d();
+  if (mpq_class(d) < q) d = std::nextafter(d, std::numeric_limits<double>::infinity());
+  return d;
+}
+
+double round_to_nearest(const mpq_class& q) {
+  constexpr double kMax = std::numeric_limits<double>::max();
+  // Beyond the largest double: round-to-nearest overflows once q >= max + ulp(max)/2.
+  const mpq_class overflow_at = mpq_class(kMax) + mpq_class(std::ldexp(1.0, 970)) / 2;
+  if (q >= overflow_at) return std::numeric_limits<double>::infinity();
+  if (q <= -overflow_at) return -std::numeric_limits<double>::infinity();
+  const double lo = round_down(q);
+  const double hi = round_up(q);
+  if (lo == hi) return lo;
+  if (std::isinf(hi)) return lo;
+  if (std::isinf(lo)) return hi;
+  const mpq_class d_lo = q - mpq_class(lo);
+  const mpq_class d_hi = mpq_class(hi) - q;
+  if (d_lo < d_hi) return lo;
+  if (d_hi < d_lo) return hi;
+  // Tie: the one with an even last mantissa bit.
+  int exponent = 0;
+  const double mantissa_lo = std::frexp(lo, &exponent);
+  const auto bits = static_cast<long long>(std::ldexp(mantissa_lo, 53));
+  return (bits % 2 == 0) ? lo : hi;
+}
+
+}  // namespace skelcd::ccd

@@ -1,0 +1,76 @@
+// Vertex-face CCD: the three accuracies behind one call.
+
+#include "ccd/vertex_face.hpp"
+
+#include <cassert>
+
+#include "ccd/detail/fast_ccd.hpp"
+#include "ccd/detail/conservative_pipeline.hpp"
+#include "ccd/exact_ccd.hpp"
+#include "ccd/filters.hpp"
+
+namespace skelcd::ccd {
+namespace {
+
+// conservative: swept AABBs, then the pipeline of detail/conservative_pipeline.hpp.
+CcdResult conservative(const VertexFaceQuery& q, const CcdOptions& options, CcdStats& stats) {
+  if (swept_aabbs_disjoint(q, options.min_separation)) {
+    ++stats.aabb_rejected;
+    return {};
+  }
+  // c(t) = (p - a) . ((b - a) x (c - a)).
+  const detail::DifferenceTriple t0{q.v_t0 - q.f0_t0, q.f1_t0 - q.f0_t0, q.f2_t0 - q.f0_t0};
+  const detail::DifferenceTriple t1{q.v_t1 - q.f0_t1, q.f1_t1 - q.f0_t1, q.f2_t1 - q.f0_t1};
+  // Inside conditions n . ((b - a) x (p - a)), n . ((c - b) x (p - b)), n . ((a - c) x (p - c)),
+  // n = (b - a) x (c - a): each (A x B) . (C x D) of single differences.
+  const auto quartics = [&](detail::BernsteinQuartic* g) {
+    g[0] = detail::cross_dot_quartic({t0.y, t0.z, t0.y, t0.x, t1.y, t1.z, t1.y, t1.x});
+    g[1] = detail::cross_dot_quartic({t0.y, t0.z, q.f2_t0 - q.f1_t0, q.v_t0 - q.f1_t0, t1.y, t1.z,
+                                      q.f2_t1 - q.f1_t1, q.v_t1 - q.f1_t1});
+    g[2] = detail::cross_dot_quartic({t0.y, t0.z, q.f0_t0 - q.f2_t0, q.v_t0 - q.f2_t0, t1.y, t1.z,
+                                      q.f0_t1 - q.f2_t1, q.v_t1 - q.f2_t1});
+    return 3;
+  };
+  // F(t, u, v) = p - (a + u (b - a) + v (c - a)) = (p - a) + u (a - b) + v (a - c).
+  detail::InclusionProblem problem;
+  problem.d_t0 = t0.x;
+  problem.e_t0 = q.f0_t0 - q.f1_t0;
+  problem.g_t0 = q.f0_t0 - q.f2_t0;
+  problem.d_t1 = t1.x;
+  problem.e_t1 = q.f0_t1 - q.f1_t1;
+  problem.g_t1 = q.f0_t1 - q.f2_t1;
+  problem.triangle_domain = true;
+  return detail::conservative_pipeline(t0, t1, quartics, problem, options, stats);
+}
+
+}  // namespace
+
+CcdResult vertex_face_ccd(const VertexFaceQuery& query, Accuracy accuracy, const CcdOptions& options) {
+  CcdStats stats;
+  return vertex_face_ccd(query, accuracy, options, stats);
+}
+
+CcdResult vertex_face_ccd(const VertexFaceQuery& query,
+                          Accuracy accuracy,
+                          const CcdOptions& options,
+                          CcdStats& stats) {
+  assert(options.min_separation >= 0.0);
+  CcdResult r;
+  switch (accuracy) {
+    case Accuracy::exact:
+      // The swept-box test is exact in double and saves the rational conversion.
+      r = swept_aabbs_disjoint(query, 0.0) ? CcdResult{} : vertex_face_ccd_exact(to_rational(query), options);
+      break;
+    case Accuracy::conservative:
+      r = conservative(query, options, stats);
+      break;
+    case Accuracy::fast:
+      r = detail::vertex_face_ccd_fast(query);
+      break;
+  }
+  ++stats.queries;
+  if (r.hit) ++stats.hits;
+  return r;
+}
+
+}  // namespace skelcd::ccd
