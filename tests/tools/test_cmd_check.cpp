@@ -8,6 +8,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cstdlib>
 #include <fstream>
@@ -239,6 +240,54 @@ TEST(CmdCheck, KilledRunLeavesALogWithEveryCompletedFrame) {
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const auto j = nlohmann::json::parse(r.out);
   EXPECT_EQ(j[0]["complete"].get<std::string>().rfind("no (", 0), 0u) << j.dump();
+}
+
+TEST(CmdCheck, GeneratedFrameSequenceHasTheHandCountedContacts) {
+  // A large triangle in z = 0 and a small one that passes down through it (frames 0 → 1), then
+  // tilts until it pierces it (frame 2). By hand: interval 0-1, the small triangle's 3 vertices
+  // cross the large face at t = 1/2 (3 VF); interval 1-2, vertices 1 and 2 cross it (2 VF);
+  // no edge comes near another (0 EE); only frame 2 intersects (1 DCD pair).
+  const auto dir = skelcd::test::temp_dir("check-generated");
+  const auto frames = dir / "frames";
+  std::filesystem::create_directories(frames);
+  const std::array<std::string, 3> small{"1 1 1\nv 2 1 1\nv 1 2 1", "1 1 -1\nv 2 1 -1\nv 1 2 -1",
+                                         "1 1 -1\nv 1.5 1 1\nv 2 2 1"};
+  for (int i = 0; i < 3; ++i) {
+    std::ofstream(frames / ("frame" + std::to_string(i) + ".obj"))
+        << "v 0 0 0\nv 4 0 0\nv 0 4 0\nv " << small[static_cast<std::size_t>(i)]
+        << "\nf 1 2 3\nf 4 5 6\n";
+  }
+  for (const char* method : {"bvh", "brute", "kdop"}) {
+    SCOPED_TRACE(method);
+    const auto log_path = dir / (std::string(method) + ".h5");
+    const auto r = run_skelcd({"check", frames.string(), "--method", method, "--json", "-o",
+                               log_path.string()});
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    const auto j = nlohmann::json::parse(r.out);
+    EXPECT_EQ(j["frames"], 3);
+    EXPECT_EQ(j["intervals"], 2);
+    EXPECT_EQ(j["dcd_pairs"], 1);
+    EXPECT_EQ(j["ccd_vf"], 5);
+    EXPECT_EQ(j["ccd_ee"], 0);
+    EXPECT_EQ(j["frames_with_contacts"], 3);
+    EXPECT_EQ(j["frames_with_interpenetration"], 1);
+
+    const auto log = read_log(log_path);
+    ASSERT_EQ(log.dcd_pairs.size(), 1u);
+    EXPECT_EQ(log.dcd_pairs[0].frame, 2);
+    EXPECT_EQ(log.dcd_pairs[0].a, (FeatureId{0, 0, -1}));
+    EXPECT_EQ(log.dcd_pairs[0].b, (FeatureId{0, 1, -1}));
+    std::vector<std::pair<int, int>> hits;  // (frame, vertex of the small triangle)
+    for (const auto& c : log.contacts) {
+      EXPECT_EQ(c.kind, skelcd::culling::CcdContact::Kind::vf);
+      EXPECT_EQ(c.b, (FeatureId{0, 0, -1}));
+      EXPECT_LE(c.toi_lower, 0.5);
+      EXPECT_GE(c.toi_upper, 0.5);
+      hits.emplace_back(c.frame, c.a.index);
+    }
+    std::sort(hits.begin(), hits.end());
+    EXPECT_EQ(hits, (std::vector<std::pair<int, int>>{{0, 3}, {0, 4}, {0, 5}, {1, 4}, {1, 5}}));
+  }
 }
 
 }  // namespace
