@@ -7,8 +7,10 @@
 namespace skelcd::tools {
 
 // One line per command; keep the order of DESIGN.md's command table.
+void add_info_command(CLI::App& app);
 void add_preprocess_command(CLI::App& app);
 void add_check_command(CLI::App& app);
 void add_inspect_command(CLI::App& app);
+void add_export_command(CLI::App& app);
 
 }  // namespace skelcd::tools

@@ -17,9 +17,11 @@ int main(int argc, char** argv) {
   app.fallthrough(false);
 
   // Commands, in the order of DESIGN.md's table (one line each):
+  skelcd::tools::add_info_command(app);
   skelcd::tools::add_preprocess_command(app);
   skelcd::tools::add_check_command(app);
   skelcd::tools::add_inspect_command(app);
+  skelcd::tools::add_export_command(app);
 
   try {
     app.parse(argc, argv);

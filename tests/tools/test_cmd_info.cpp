@@ -1,0 +1,118 @@
+// skelcd info, as a user runs it: JSON and human output on real models, and bad input.
+
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include "tests/support/test_support.hpp"
+#include "tests/tools/cli_runner.hpp"
+
+namespace {
+
+using skelcd::test::asset;
+using skelcd::test::assimp_model;
+using skelcd::test::run_skelcd;
+
+nlohmann::json info_json(const std::string& model) {
+  const auto r = run_skelcd({"info", model, "--json"});
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_TRUE(r.err.empty()) << r.err;
+  return nlohmann::json::parse(r.out);  // throws (fails the test) unless stdout is one JSON document
+}
+
+TEST(CmdInfo, BcnEpilepticAsAssimpInfoReportsIt) {
+  const auto j = info_json(assimp_model("X/BCN_Epileptic.X").string());
+  EXPECT_EQ(j["triangles"], 5126);
+  EXPECT_EQ(j["bones"], 54);
+  ASSERT_EQ(j["clips"].size(), 1u);
+  EXPECT_EQ(j["clips"][0]["name"], "Epileptisch");
+  EXPECT_NEAR(j["clips"][0]["duration_s"].get<double>(), 3.3, 1e-12);
+  EXPECT_NEAR(j["clips"][0]["keys_per_s"].get<double>(), 30.0, 1e-9);
+  ASSERT_EQ(j["parts"].size(), 3u);
+  EXPECT_EQ(j["parts"][0]["name"], "Torso");
+  EXPECT_EQ(j["parts"][0]["triangles"], 1966);
+  for (const auto& p : j["parts"]) EXPECT_TRUE(p.contains("closed"));
+  EXPECT_TRUE(j["problems"].is_array());
+  for (const char* key : {"vertices", "welded_vertices", "edges", "boundary_loops", "non_manifold_edges", "degenerate_triangles"}) {
+    EXPECT_TRUE(j.contains(key)) << key;
+  }
+}
+
+TEST(CmdInfo, ClosedCharacterAndOpenParts) {
+  const auto cesium = info_json(asset("characters/CesiumMan.glb").string());
+  EXPECT_EQ(cesium["triangles"], 4672);
+  EXPECT_EQ(cesium["bones"], 19);
+  ASSERT_EQ(cesium["parts"].size(), 1u);
+  EXPECT_TRUE(cesium["parts"][0]["closed"].get<bool>());
+  EXPECT_EQ(cesium["boundary_loops"], 0);
+  const auto robot = info_json(asset("characters/RobotExpressive.glb").string());
+  EXPECT_EQ(robot["clips"].size(), 14u);
+  EXPECT_EQ(robot["degenerate_triangles"], 3);
+  bool open = false;
+  for (const auto& p : robot["parts"]) open |= !p["closed"].get<bool>();
+  EXPECT_TRUE(open);
+  bool reported = false;
+  for (const auto& p : robot["problems"]) reported |= p.get<std::string>().find("degenerate triangles") != std::string::npos;
+  EXPECT_TRUE(reported);
+}
+
+TEST(CmdInfo, AHandWrittenCubeHasEighteenEdgesAndIsClosed) {
+  const auto dir = skelcd::test::temp_dir("cmd_info_cube");
+  const auto file = dir / "cube.obj";
+  std::ofstream(file) << "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nv 0 0 1\nv 1 0 1\nv 0 1 1\nv 1 1 1\n"
+                         "f 1 3 4 2\nf 5 6 8 7\nf 1 2 6 5\nf 3 7 8 4\nf 1 5 7 3\nf 2 4 8 6\n";
+  const auto j = info_json(file.string());
+  EXPECT_EQ(j["triangles"], 12);
+  EXPECT_EQ(j["edges"], 18);
+  EXPECT_EQ(j["welded_vertices"], 8);
+  EXPECT_EQ(j["bones"], 0);
+  EXPECT_EQ(j["clips"].size(), 0u);
+  ASSERT_EQ(j["parts"].size(), 1u);
+  EXPECT_TRUE(j["parts"][0]["closed"].get<bool>());
+}
+
+TEST(CmdInfo, HumanSummary) {
+  const auto r = run_skelcd({"info", assimp_model("X/BCN_Epileptic.X").string()});
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find("5126 triangles"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("54 bones"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("Epileptisch  3.300 s"), std::string::npos) << r.out;
+}
+
+TEST(CmdInfo, Help) {
+  const auto r = run_skelcd({"info", "--help"});
+  EXPECT_EQ(r.exit_code, 0);
+  EXPECT_NE(r.out.find("--json"), std::string::npos);
+}
+
+// Bad input: exit 1, exactly one line on stderr naming the file, nothing on stdout.
+void expect_refused(const std::string& model, const std::string& fault) {
+  const auto r = run_skelcd({"info", model, "--json"});
+  EXPECT_EQ(r.exit_code, 1) << model;
+  EXPECT_TRUE(r.out.empty()) << r.out;
+  ASSERT_FALSE(r.err.empty());
+  EXPECT_EQ(r.err.find('\n'), r.err.size() - 1) << "not one line: " << r.err;
+  EXPECT_NE(r.err.find(model), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find(fault), std::string::npos) << r.err;
+}
+
+TEST(CmdInfo, BadInputIsOneLineAndNonZeroExit) {
+  const auto dir = skelcd::test::temp_dir("cmd_info_bad");
+  expect_refused((dir / "missing.glb").string(), "no such file");
+  expect_refused(assimp_model("glTF2/IndexOutOfRange/IndexOutOfRange.gltf").string(), "out-of-range");
+  expect_refused(assimp_model("glTF2/BoxWithInfinites-glTF-Binary/BoxWithInfinites.glb").string(), "non-finite");
+  expect_refused(assimp_model("glTF2/RecursiveNodes/RecursiveNodes.gltf").string(), "recursive");
+  expect_refused(assimp_model("glTF2/MissingBin/BoxTextured.gltf").string(), "BoxTextured0.bin");
+  expect_refused(assimp_model("glTF2/SchemaFailures/sceneWrongType.gltf").string(), "scene");
+  const auto nan = dir / "nan.obj";
+  std::ofstream(nan) << "v 0 0 0\nv 1 nan 0\nv 0 1 0\nf 1 2 3\n";
+  expect_refused(nan.string(), "non-finite");
+  const auto empty = dir / "empty.glb";
+  std::ofstream{empty};
+  expect_refused(empty.string(), "empty file");
+}
+
+}  // namespace

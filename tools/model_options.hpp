@@ -1,0 +1,15 @@
+#pragma once
+// The options every command that reads a MODEL shares (how to load it), so that `info`,
+// `export` and the others accept the same spellings.
+
+#include <CLI/CLI.hpp>
+
+#include "skinning/load.hpp"
+
+namespace skelcd::tools {
+
+/// Adds --trajectory, --srdf and --package-path (robots) to `command`, filling `options`.
+/// `options` must outlive the parse.
+void add_model_options(CLI::App& command, skinning::LoadOptions& options);
+
+}  // namespace skelcd::tools
