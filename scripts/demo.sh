@@ -1,6 +1,18 @@
 #!/usr/bin/env bash
-# make demo: the main job on a bundled model.
+# make demo: the main job on a bundled model. For now: what the model holds (`skelcd info`) and
+# one posed frame of its clip written for a viewer (`skelcd export`), under the build folder.
 set -euo pipefail
 build=${1:-build}
 exe="$build/tools/skelcd"
-"$exe" --help
+root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+model="$root/assets/characters/CesiumMan.glb"
+out_dir="$build/demo"
+mkdir -p "$out_dir"
+
+echo "== skelcd info $model"
+"$exe" info "$model"
+echo
+echo "== skelcd export $model --frame 12 -o $out_dir/CesiumMan_frame12.glb"
+"$exe" export "$model" --frame 12 -o "$out_dir/CesiumMan_frame12.glb"
+echo
+echo "demo: the posed mesh (frame 12 of the walk) is in $(cd "$out_dir" && pwd)/CesiumMan_frame12.glb"
