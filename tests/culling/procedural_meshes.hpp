@@ -260,4 +260,18 @@ inline Positions deformed(const Positions& x, double s, double amp) {
   return y;
 }
 
+/// A tube along z squashed flat and through itself: y scaled by (1 − 1.2·s) (the walls meet at
+/// s = 1/1.2 and cross after), with a slight twist about z so they do not meet all at once.
+inline Positions squashed(const Positions& x, double s) {
+  Positions y = x;
+  for (Eigen::Index v = 0; v < x.rows(); ++v) {
+    const double a = 0.15 * s * x(v, 2);
+    const double px = x(v, 0);
+    const double py = x(v, 1) * (1.0 - 1.2 * s);
+    y(v, 0) = std::cos(a) * px - std::sin(a) * py;
+    y(v, 1) = std::sin(a) * px + std::cos(a) * py;
+  }
+  return y;
+}
+
 }  // namespace skelcd::test
