@@ -35,6 +35,8 @@ struct ImportedRig {
 };
 
 /// Imports `file` with assimp (triangulated; points and lines dropped and reported).
+/// Mesh::vertex_index_in_part and face_index_in_part number vertices and faces as assimp hands
+/// them over: faces as in the file, vertices after JoinIdenticalVertices when that is on.
 ///
 /// Object space is the file's scene space with the unit scale applied: an unskinned mesh is
 /// placed by its node's global transform and follows that node rigidly (Rig::part_attachments);

@@ -52,12 +52,13 @@ const char* to_string(ModelKind kind) {
 }
 
 ModelKind classify_model_path(const std::filesystem::path& path) {
-  const auto text = path.string();
-  if (text.find_first_of("*?[") != std::string::npos) return ModelKind::frame_sequence;
   std::error_code ec;
+  const bool is_urdf = lower(path.extension().string()) == ".urdf";
+  // An existing file is a file, even when its name has glob characters ("walk[2].glb").
+  if (std::filesystem::is_regular_file(path, ec)) return is_urdf ? ModelKind::robot : ModelKind::rig;
   if (std::filesystem::is_directory(path, ec)) return ModelKind::frame_sequence;
-  if (lower(path.extension().string()) == ".urdf") return ModelKind::robot;
-  return ModelKind::rig;
+  if (path.string().find_first_of("*?[") != std::string::npos) return ModelKind::frame_sequence;
+  return is_urdf ? ModelKind::robot : ModelKind::rig;
 }
 
 std::unique_ptr<Motion> LoadedModel::motion(const MotionRequest& request) const {
@@ -92,14 +93,11 @@ LoadedModel model_from_rig(Rig rig, ModelKind kind, std::vector<std::string> pro
 
 LoadedModel load_model(const std::filesystem::path& path, const LoadOptions& options) {
   switch (classify_model_path(path)) {
+    // One loader per kind; each returns a complete LoadedModel (model_from_rig() wraps a Rig).
     case ModelKind::frame_sequence:
-      // Extension point (frame sequences): `return load_frame_sequence_model(path, options);`
-      // declared in skinning/frame_sequence.hpp.
-      return load_frame_sequence_model(path, options);
+      return load_frame_sequence_model(path, options);  // skinning/frame_sequence.hpp
     case ModelKind::robot:
-      // Extension point (robots): `return load_urdf_model(path, options);` declared in
-      // skinning/urdf.hpp; model_from_rig() wraps the robot's rig and trajectory clip.
-      return load_urdf_model(path, options);
+      return load_urdf_model(path, options);  // skinning/urdf.hpp (+ urdf_model.cpp)
     case ModelKind::rig:
       break;
   }

@@ -24,8 +24,9 @@ enum class ModelKind {
 
 [[nodiscard]] const char* to_string(ModelKind kind);
 
-/// A directory or a path with glob characters (* ? [) is a frame sequence, a `.urdf` file a
-/// robot, anything else a model file. Decided on the path alone (a glob need not exist).
+/// An existing regular file is a robot when it ends in `.urdf`, a model file otherwise; a
+/// directory, or a path that does not exist and has glob characters (* ? [), is a frame
+/// sequence; any other path is classified by its extension (and fails to load later).
 [[nodiscard]] ModelKind classify_model_path(const std::filesystem::path& path);
 
 struct LoadOptions {
