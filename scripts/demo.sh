@@ -15,4 +15,7 @@ echo
 echo "== skelcd export $model --frame 12 -o $out_dir/CesiumMan_frame12.glb"
 "$exe" export "$model" --frame 12 -o "$out_dir/CesiumMan_frame12.glb"
 echo
+echo "== skelcd check $model -o $out_dir/CesiumMan_check.h5"
+"$exe" check "$model" -o "$out_dir/CesiumMan_check.h5"
+echo
 echo "demo: the posed mesh (frame 12 of the walk) is in $(cd "$out_dir" && pwd)/CesiumMan_frame12.glb"
