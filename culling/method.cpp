@@ -3,6 +3,7 @@
 #include <cmath>
 
 #include "culling/detail/method_base.hpp"
+#include "culling/method_extension.hpp"
 #include "skinning/errors.hpp"
 
 namespace skelcd::culling {
@@ -54,8 +55,11 @@ std::unique_ptr<CullingMethod> make_method(
   if (name == "brute") return detail::make_brute_method(mesh, topology, options);
   if (name == "bvh") return detail::make_bvh_method<3>(name, mesh, topology, options);
   if (name == "kdop") return detail::make_bvh_method<8>(name, mesh, topology, options);
+  if (options.extension) {
+    if (auto m = options.extension->make_method(name, mesh, topology, options)) return m;
+  }
   std::string known;
-  for (const auto& n : method_names()) known += (known.empty() ? "" : ", ") + n;
+  for (const auto& n : method_names(options)) known += (known.empty() ? "" : ", ") + n;
   throw InvalidInput("unknown method '" + std::string(name) + "' (known: " + known + ")");
 }
 

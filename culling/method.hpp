@@ -17,6 +17,8 @@
 
 namespace skelcd::culling {
 
+class MethodExtension;
+
 struct MethodOptions {
   ccd::Accuracy accuracy = ccd::Accuracy::conservative;
   /// Contact distance (coordinate units); 0 = touching counts. CCD bounds are inflated by half of
@@ -26,6 +28,8 @@ struct MethodOptions {
   BvhOptions bvh{};
   /// The elementary tests to call; null members mean the ccd/ kernels.
   ElementaryTests elementary{};
+  /// Methods built above culling/ (culling/method_extension.hpp): make_method builds its names too.
+  std::shared_ptr<const MethodExtension> extension{};
 };
 
 class CullingMethod {

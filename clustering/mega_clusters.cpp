@@ -1,0 +1,291 @@
+#include "clustering/mega_clusters.hpp"
+
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <random>
+#include <string>
+
+#include "skinning/errors.hpp"
+
+namespace skelcd::clustering {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+constexpr std::int64_t kNoLimit = std::numeric_limits<std::int64_t>::max();
+
+std::size_t at(std::int32_t i) { return static_cast<std::size_t>(i); }
+
+double micros(Clock::time_point from, Clock::time_point to) {
+  return std::chrono::duration<double, std::micro>(to - from).count();
+}
+
+Eigen::Vector3d apply(const skinning::BoneTransform& T, const Eigen::Vector3d& p) {
+  return T.leftCols<3>() * p + T.col(3);
+}
+
+/// A draw in [0, n) from a 64-bit generator (modulo: the bias is below n / 2⁶⁴). Unlike
+/// std::uniform_int_distribution its values are the same with every standard library, so a seed
+/// means the same clusters everywhere.
+std::size_t draw(std::mt19937_64& rng, std::size_t n) {
+  return static_cast<std::size_t>(rng() % static_cast<std::uint64_t>(n));
+}
+
+}  // namespace
+
+std::int64_t merge_limit(std::int64_t size, double gamma) {
+  if (size <= 0) return 1;  // D of an empty cluster is taken as 0: it always joins
+  if (!(gamma > 0.0)) return 0;
+  const auto n_size = static_cast<double>(size);
+  if (gamma > 1.0) return size + 1;
+  // The smallest n with n / size >= gamma, evaluated exactly as D is (double division).
+  auto n = static_cast<std::int64_t>(std::ceil(gamma * n_size));
+  while (n > 0 && static_cast<double>(n - 1) / n_size >= gamma) --n;
+  while (static_cast<double>(n) / n_size < gamma) ++n;
+  return n;
+}
+
+void pose_observers(
+    const ClusterSet& clusters,
+    std::span<const skinning::BoneTransform> t0,
+    std::span<const skinning::BoneTransform> t1,
+    IntervalObservers& out) {
+  const std::int32_t num_atomic = clusters.num_atomic();
+  const auto check = [&](std::int32_t bone) {
+    if (bone < 0 || at(bone) >= t0.size() || at(bone) >= t1.size()) {
+      throw InvalidInput(
+          "clustering: bone " + std::to_string(bone) + " has no transform (" +
+          std::to_string(t0.size()) + " and " + std::to_string(t1.size()) + " given)");
+    }
+  };
+  out.atomic.resize(at(num_atomic));
+  for (std::int32_t a = 0; a < num_atomic; ++a) {
+    const std::int32_t b = clusters.bone(a);
+    check(b);
+    const auto& rest = clusters.observer(a);
+    auto& o = out.atomic[at(a)];
+    o.kind = rest.kind;
+    if (rest.kind == segmentation::ObserverKind::point) {
+      const Eigen::Vector3d mid = rest.segment.midpoint();
+      o.point = {apply(t0[at(b)], mid), apply(t1[at(b)], mid)};
+    } else {
+      o.segment = {apply(t0[at(b)], rest.segment.head), apply(t0[at(b)], rest.segment.tail),
+                   apply(t1[at(b)], rest.segment.head), apply(t1[at(b)], rest.segment.tail)};
+    }
+  }
+  const auto joints = clusters.joints();
+  out.joints.resize(joints.size());
+  for (std::size_t j = 0; j < joints.size(); ++j) {
+    check(joints[j].bone);
+    out.joints[j] = {apply(t0[at(joints[j].bone)], joints[j].rest),
+                     apply(t1[at(joints[j].bone)], joints[j].rest)};
+  }
+}
+
+MegaClusterBuilder::MegaClusterBuilder(const ClusterSet& clusters, const MegaClusterOptions& options)
+    : clusters_(clusters), options_(options) {
+  const auto num_atomic = at(clusters.num_atomic());
+  previous_offsets_.assign(num_atomic + 1, 0);
+  stamp_.assign(at(clusters.num_triangles()), 0);
+  unplaced_.reserve(num_atomic);
+  unplaced_slot_.assign(num_atomic, -1);
+  queue_.reserve(num_atomic + 2 * clusters.joints().size());
+  tried_by_.assign(num_atomic, 0);
+}
+
+bool MegaClusterBuilder::evaluate(
+    std::int32_t a,
+    const MovingObserver& observer,
+    std::int64_t limit,
+    IntervalClasses& out) {
+  const auto start = Clock::now();
+  if (++evaluation_ == 0) {  // the stamps wrapped around: clear them once
+    std::fill(stamp_.begin(), stamp_.end(), 0u);
+    evaluation_ = 1;
+  }
+  const auto& F = *triangles_;
+  const auto& x0 = *x_t0_;
+  const auto& x1 = *x_t1_;
+  std::int64_t non_positive = 0;
+  std::int64_t classified = 0;
+  bool below = true;
+  const auto classify_one = [&](std::int32_t f) {
+    const Eigen::Index i = f;
+    const MovingTriangle t{x0.row(F(i, 0)).transpose(), x0.row(F(i, 1)).transpose(),
+                           x0.row(F(i, 2)).transpose(), x1.row(F(i, 0)).transpose(),
+                           x1.row(F(i, 1)).transpose(), x1.row(F(i, 2)).transpose()};
+    const OrientationClass c = observer.kind == segmentation::ObserverKind::point
+                                   ? classify(t, observer.point)
+                                   : classify(t, observer.segment);
+    out.triangle_class[at(f)] = c;
+    stamp_[at(f)] = evaluation_;
+    ++classified;
+    if (c != OrientationClass::positive) ++non_positive;
+    return non_positive < limit;
+  };
+  // Last interval's non-positive triangles first: they decide most failing merges early.
+  const auto p_begin = previous_offsets_[at(a)];
+  const auto p_end = previous_offsets_[at(a) + 1];
+  for (auto i = p_begin; i < p_end && below; ++i) below = classify_one(previous_[at(i)]);
+  if (below) {
+    for (const std::int32_t f : clusters_.triangles(a)) {
+      if (stamp_[at(f)] == evaluation_) continue;
+      if (!classify_one(f)) {
+        below = false;
+        break;
+      }
+    }
+  }
+  out.classifications += classified;
+  out.classify_us += micros(start, Clock::now());
+  return below;
+}
+
+void MegaClusterBuilder::remember_non_positive(IntervalClasses& out) {
+  const std::int32_t num_atomic = clusters_.num_atomic();
+  next_offsets_.assign(at(num_atomic) + 1, 0);
+  next_.clear();
+  for (std::int32_t a = 0; a < num_atomic; ++a) {
+    for (const std::int32_t f : clusters_.triangles(a)) {
+      const OrientationClass c = out.triangle_class[at(f)];
+      if (c == OrientationClass::positive) continue;
+      next_.push_back(f);
+      (c == OrientationClass::negative ? out.h_minus : out.h_uncertain) += 1;
+    }
+    next_offsets_[at(a) + 1] = static_cast<std::int32_t>(next_.size());
+  }
+  std::swap(previous_offsets_, next_offsets_);
+  std::swap(previous_, next_);
+}
+
+void MegaClusterBuilder::build(
+    const skinning::Triangles& triangles,
+    const skinning::Positions& x_t0,
+    const skinning::Positions& x_t1,
+    const IntervalObservers& observers,
+    IntervalClasses& out) {
+  const auto start = Clock::now();
+  triangles_ = &triangles;
+  x_t0_ = &x_t0;
+  x_t1_ = &x_t1;
+  const std::int32_t num_atomic = clusters_.num_atomic();
+  out.triangle_class.resize(at(clusters_.num_triangles()));
+  out.atomic_mega.assign(at(num_atomic), -1);
+  out.mega_observer.clear();
+  out.mega_offsets.assign(1, 0);
+  out.mega_members.clear();
+  out.h_minus = 0;
+  out.h_uncertain = 0;
+  out.classifications = 0;
+  out.merge_attempts = 0;
+  out.classify_us = 0.0;
+  out.merge_us = 0.0;
+
+  const auto open_mega = [&](std::int32_t a, const MovingObserver& observer) {
+    out.atomic_mega[at(a)] = out.num_mega();
+    out.mega_members.push_back(a);
+    out.mega_observer.push_back(observer);
+  };
+  const auto close_mega = [&] {
+    out.mega_offsets.push_back(static_cast<std::int32_t>(out.mega_members.size()));
+  };
+
+  if (!options_.merge) {
+    // rvbc: the atomic clusters as they are, each against its own observer.
+    for (std::int32_t a = 0; a < num_atomic; ++a) {
+      (void)evaluate(a, observers.atomic[at(a)], kNoLimit, out);
+      open_mega(a, observers.atomic[at(a)]);
+      close_mega();
+    }
+    remember_non_positive(out);
+    out.merge_us = 0.0;
+    return;
+  }
+
+  // dynamic (§5). Unplaced clusters in a swap-remove list (O(1) removal, deterministic order).
+  unplaced_.clear();
+  for (std::int32_t a = 0; a < num_atomic; ++a) {
+    unplaced_slot_[at(a)] = a;
+    unplaced_.push_back(a);
+  }
+  const auto place = [&](std::int32_t a) {
+    const auto slot = at(unplaced_slot_[at(a)]);
+    const std::int32_t last = unplaced_.back();
+    unplaced_[slot] = last;
+    unplaced_slot_[at(last)] = static_cast<std::int32_t>(slot);
+    unplaced_.pop_back();
+    unplaced_slot_[at(a)] = -1;
+  };
+  const auto placed = [&](std::int32_t a) { return unplaced_slot_[at(a)] < 0; };
+  const auto limit = [&](std::int32_t a) {
+    return merge_limit(static_cast<std::int64_t>(clusters_.triangles(a).size()), options_.gamma);
+  };
+  // tried_by_[a] == mega stamp: a was rejected by the mega cluster being grown (stamps are unique
+  // over the builder's life: they never need clearing).
+  std::mt19937_64 rng(options_.seed);
+
+  while (!unplaced_.empty()) {
+    // A random seed atomic cluster becomes a mega cluster.
+    const std::int32_t seed = unplaced_[draw(rng, unplaced_.size())];
+    place(seed);
+    if (++mega_stamp_ == 0) {  // wrapped around: clear the stamps once
+      std::fill(tried_by_.begin(), tried_by_.end(), 0u);
+      mega_stamp_ = 1;
+    }
+    const std::uint32_t stamp = mega_stamp_;
+
+    // The second atomic cluster decides the observer: the joint its bone shares with the seed's.
+    // Both must stay below γ against that joint (the seed's triangles are re-classified too:
+    // they are no longer seen from their own primitive).
+    MovingObserver joint;
+    std::int32_t second = -1;
+    for (const ClusterNeighbour& nb : clusters_.neighbours(seed)) {
+      if (placed(nb.cluster)) continue;
+      joint.kind = segmentation::ObserverKind::point;
+      joint.point = observers.joints[at(nb.edge)];
+      ++out.merge_attempts;
+      if (evaluate(nb.cluster, joint, limit(nb.cluster), out) &&
+          evaluate(seed, joint, limit(seed), out)) {
+        second = nb.cluster;
+        break;
+      }
+    }
+    if (second < 0) {
+      // Nothing joins: the seed keeps its own observer (point or line).
+      (void)evaluate(seed, observers.atomic[at(seed)], kNoLimit, out);
+      open_mega(seed, observers.atomic[at(seed)]);
+      close_mega();
+      continue;
+    }
+    open_mega(seed, joint);
+    place(second);
+    out.atomic_mega[at(second)] = out.num_mega() - 1;
+    out.mega_members.push_back(second);
+
+    // Grow breadth-first over neighbours, the observer fixed at the joint.
+    queue_.clear();
+    const auto push_neighbours = [&](std::int32_t a) {
+      for (const ClusterNeighbour& nb : clusters_.neighbours(a)) {
+        if (!placed(nb.cluster) && tried_by_[at(nb.cluster)] != stamp) queue_.push_back(nb.cluster);
+      }
+    };
+    push_neighbours(seed);
+    push_neighbours(second);
+    for (std::size_t head = 0; head < queue_.size(); ++head) {
+      const std::int32_t c = queue_[head];
+      if (placed(c) || tried_by_[at(c)] == stamp) continue;
+      tried_by_[at(c)] = stamp;
+      ++out.merge_attempts;
+      if (!evaluate(c, joint, limit(c), out)) continue;
+      place(c);
+      out.atomic_mega[at(c)] = out.num_mega() - 1;
+      out.mega_members.push_back(c);
+      push_neighbours(c);
+    }
+    close_mega();
+  }
+  remember_non_positive(out);
+  out.merge_us = std::max(0.0, micros(start, Clock::now()) - out.classify_us);
+}
+
+}  // namespace skelcd::clustering

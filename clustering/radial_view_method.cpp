@@ -1,0 +1,456 @@
+#include "clustering/radial_view_method.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <utility>
+
+#include "culling/cluster_checks.hpp"
+#include "culling/relative_aabb.hpp"
+#include "culling/vertex_bounds.hpp"
+#include "skinning/errors.hpp"
+
+namespace skelcd::clustering {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+using culling::MaskedPairs;
+
+std::size_t at(std::int32_t i) { return static_cast<std::size_t>(i); }
+
+double micros(Clock::time_point from, Clock::time_point to) {
+  return std::chrono::duration<double, std::micro>(to - from).count();
+}
+
+bool same_positions(const skinning::Positions& a, const skinning::Positions& b) {
+  return a.rows() == b.rows() && std::equal(a.data(), a.data() + a.size(), b.data());
+}
+
+culling::MethodOptions without_extension(culling::MethodOptions options) {
+  options.extension = nullptr;
+  return options;
+}
+
+}  // namespace
+
+RadialViewMethod::RadialViewMethod(
+    std::string name,
+    const skinning::Mesh& mesh,
+    const skinning::Topology& topology,
+    std::shared_ptr<const segmentation::Segmentation> segmentation,
+    std::shared_ptr<const BonePoses> poses,
+    std::int32_t num_bones,
+    const culling::MethodOptions& method_options,
+    const RadialViewOptions& options)
+    : name_(std::move(name)),
+      segmentation_(std::move(segmentation)),
+      poses_(std::move(poses)),
+      topology_(mesh, topology),
+      clusters_(mesh, topology, *segmentation_, num_bones, method_options.bvh),
+      method_options_(without_extension(method_options)),
+      options_(options),
+      tests_(culling::with_ccd_defaults(method_options.elementary)),
+      // The bvh method checks the method options (min_separation, accuracy) as every method does.
+      bvh_(culling::make_method("bvh", mesh, topology, method_options_)),
+      builder_(clusters_, options.clusters),
+      edge_face_offsets_(topology.edge_face_offsets),
+      edge_faces_(topology.edge_faces) {
+  if (!poses_) throw InvalidInput("clustering::" + name_ + ": no bone poses");
+  ccd_options_.min_separation = method_options.min_separation;
+  const auto num_faces = at(topology_.num_triangles());
+  const auto num_atomic = at(clusters_.num_atomic());
+  const auto num_components = at(clusters_.num_components());
+  // Everything an interval touches is sized here; only candidate lists may still grow.
+  bounds_.vertices.reserve(at(topology_.num_vertices()));
+  bounds_.edges.reserve(at(topology_.num_edges()));
+  bounds_.triangles.reserve(num_faces);
+  cluster_bounds_.resize(num_atomic);
+  triangle_mask_.assign(num_faces, culling::kMaskOther);
+  node_masks_.resize(num_atomic);
+  std::size_t deepest = 0;
+  for (std::int32_t a = 0; a < clusters_.num_atomic(); ++a) {
+    node_masks_[at(a)].resize(clusters_.local_bvh(a).nodes().size());
+    deepest = std::max(deepest, static_cast<std::size_t>(clusters_.local_bvh(a).depth()));
+  }
+  scratch_.reserve(std::max(
+      4 * deepest + 4,
+      4 * static_cast<std::size_t>(clusters_.global_bvh().depth()) + 4));
+  vertex_label_.resize(at(topology_.num_vertices()));
+  edge_label_.resize(at(topology_.num_edges()));
+  status_.assign(num_components, Status::unknown);
+  culled_.assign(num_components, 0);
+  escalate_.assign(num_components, 0);
+  carry_clean_.assign(num_components, 0);
+  dcd_clean_.assign(num_components, 0);
+  pairs_.reserve(16 * num_faces);
+  features_.vf.reserve(4 * num_faces);
+  features_.ee.reserve(4 * num_faces);
+}
+
+void RadialViewMethod::check_positions(
+    const skinning::Positions& x,
+    const char* call,
+    const char* which) const {
+  if (x.rows() != topology_.num_vertices()) {
+    throw InvalidInput(
+        "clustering::" + name_ + "::" + call + ": " + which + " has " + std::to_string(x.rows()) +
+        " rows, expected one per welded vertex (" + std::to_string(topology_.num_vertices()) +
+        ")");
+  }
+}
+
+void RadialViewMethod::record_dcd(
+    const skinning::Positions& x,
+    const culling::FrameResult& result) {
+  dcd_x_ = x;
+  std::fill(dcd_clean_.begin(), dcd_clean_.end(), 1);
+  for (const auto& p : result.dcd_pairs) {
+    const std::int32_t k = clusters_.component_of_triangle(p.a);
+    if (k == clusters_.component_of_triangle(p.b)) dcd_clean_[at(k)] = 0;
+  }
+  has_dcd_ = true;
+}
+
+void RadialViewMethod::detect_dcd(const skinning::Positions& x, culling::FrameResult& out) {
+  check_positions(x, "detect_dcd", "x");
+  bvh_->detect_dcd(x, out);
+  record_dcd(x, out);
+}
+
+// --- preconditions at the interval's start ------------------------------------------------------
+
+void RadialViewMethod::start_status(const skinning::Positions& x_t0, culling::FrameResult& out) {
+  const std::int32_t num_components = clusters_.num_components();
+  std::fill(status_.begin(), status_.end(), Status::unknown);
+  const bool culling_possible = method_options_.min_separation == 0.0;
+  if (!culling_possible) return;  // nothing is skipped: the start state does not matter
+  if (!options_.guard) {
+    for (std::int32_t k = 0; k < num_components; ++k) {
+      if (clusters_.component_ok(k)) status_[at(k)] = Status::clean;
+    }
+    return;
+  }
+  // Known from the previous interval (its end is this start) or from a DCD at these positions.
+  const bool carried = has_carry_ && same_positions(x_t0, carry_x_);
+  const bool dcd_known = has_dcd_ && same_positions(x_t0, dcd_x_);
+  bool any_unknown = false;
+  for (std::int32_t k = 0; k < num_components; ++k) {
+    if (!clusters_.component_ok(k)) continue;
+    if (carried && carry_clean_[at(k)] != 0) {
+      status_[at(k)] = Status::clean;
+    } else if (dcd_known) {
+      status_[at(k)] = dcd_clean_[at(k)] != 0 ? Status::clean : Status::dirty;
+    } else {
+      any_unknown = true;
+    }
+  }
+  if (!any_unknown) return;
+
+  // A DCD pass over the unknown components: every pair of their triangles within one component
+  // whose static boxes overlap, through the cluster hierarchies, then the exact triangle test.
+  const auto start = Clock::now();
+  const auto unknown = [&](std::int32_t k) { return status_[at(k)] == Status::unknown; };
+  culling::static_vertex_bounds<3>(x_t0, static_bounds_.vertices);
+  static_bounds_.derive(topology_, /*with_edges=*/false);
+  const std::int32_t num_atomic = clusters_.num_atomic();
+  for (std::int32_t a = 0; a < num_atomic; ++a) {
+    auto& local = clusters_.local_bvh(a);
+    const std::int32_t k = clusters_.component_of_atomic(a);
+    if (local.empty() || k < 0 || !clusters_.component_ok(k) || !unknown(k)) {
+      cluster_bounds_[at(a)] = culling::Aabb::empty();
+      continue;
+    }
+    local.refit(static_bounds_.triangles);
+    cluster_bounds_[at(a)] = local.node_bounds()[0];
+  }
+  auto& global = clusters_.global_bvh();
+  global.refit(cluster_bounds_);
+  std::int64_t bv_tests = 0;
+  cluster_pairs_.clear();
+  culling::self_traverse<3>(global, cluster_bounds_, scratch_, cluster_pairs_, bv_tests);
+  dcd_pairs_.clear();
+  const std::span<const culling::Aabb> tri_bounds(static_bounds_.triangles);
+  for (std::int32_t a = 0; a < num_atomic; ++a) {
+    if (cluster_bounds_[at(a)].lo[0] > cluster_bounds_[at(a)].hi[0]) continue;  // empty
+    culling::self_traverse<3>(clusters_.local_bvh(a), tri_bounds, scratch_, dcd_pairs_, bv_tests);
+  }
+  for (const auto& cp : cluster_pairs_) {
+    if (clusters_.component_of_atomic(cp.a) != clusters_.component_of_atomic(cp.b)) continue;
+    const std::size_t first = dcd_pairs_.size();
+    culling::pair_traverse<3>(clusters_.local_bvh(cp.a), tri_bounds, clusters_.local_bvh(cp.b),
+                              tri_bounds, scratch_, dcd_pairs_, bv_tests);
+    for (std::size_t i = first; i < dcd_pairs_.size(); ++i) {
+      if (dcd_pairs_[i].b < dcd_pairs_[i].a) std::swap(dcd_pairs_[i].a, dcd_pairs_[i].b);
+    }
+  }
+  const auto traversed = Clock::now();
+  culling::Counters ignored;
+  culling::dcd_filter_triangle_pairs(topology_, dcd_pairs_, ignored);
+  dcd_result_.clear();
+  culling::run_dcd_tests(topology_, dcd_pairs_, x_t0, tests_, dcd_result_);
+  for (std::int32_t k = 0; k < num_components; ++k) {
+    if (unknown(k)) {
+      status_[at(k)] = Status::clean;
+      ++stats_.components_dcd;
+    }
+  }
+  for (const auto& p : dcd_result_.dcd_pairs) {
+    const std::int32_t k = clusters_.component_of_triangle(p.a);
+    if (k == clusters_.component_of_triangle(p.b) && clusters_.component_ok(k)) {
+      status_[at(k)] = Status::dirty;
+    }
+  }
+  out.counters.bv_tests += bv_tests;
+  out.counters.tt_tests += dcd_result_.counters.tt_tests;
+  const auto end = Clock::now();
+  out.times.traverse_us += micros(start, traversed);
+  out.times.elementary_us += micros(traversed, end);
+}
+
+// --- class masks: which pairs of a mega cluster may be skipped -----------------------------------
+
+void RadialViewMethod::compute_masks() {
+  // A triangle's label: (mega cluster, sign) when the argument applies to it and it is H⁺ or H⁻;
+  // −1 otherwise. A feature (vertex, edge) is pure when all its triangles carry the same label.
+  // A triangle may be skipped against another of the same label only if every feature it owns
+  // (representative triangles, culling/feature_topology.hpp) is pure with that label: then every
+  // feature pair the triangle pair produces joins two pure features of one sign, which is what
+  // the argument rules out (docs/radial-view.md, "Why features, not triangles").
+  const auto label = [&](std::int32_t f) -> std::int64_t {
+    const std::int32_t k = clusters_.component_of_triangle(f);
+    if (culled_[at(k)] == 0) return -1;
+    const OrientationClass c = classes_.triangle_class[at(f)];
+    if (c == OrientationClass::uncertain) return -1;
+    const std::int32_t mega = classes_.atomic_mega[at(clusters_.atomic_of(f))];
+    return 2 * static_cast<std::int64_t>(mega) + (c == OrientationClass::negative ? 1 : 0);
+  };
+  const std::int32_t num_vertices = topology_.num_vertices();
+  for (std::int32_t w = 0; w < num_vertices; ++w) {
+    std::int64_t l = -2;
+    for (const std::int32_t f : clusters_.vertex_triangles(w)) {
+      const std::int64_t lf = label(f);
+      l = (l == -2 || l == lf) ? lf : -1;
+      if (l == -1) break;
+    }
+    vertex_label_[at(w)] = l < 0 ? -1 : l;
+  }
+  const std::int32_t num_edges = topology_.num_edges();
+  for (std::int32_t e = 0; e < num_edges; ++e) {
+    std::int64_t l = -2;
+    for (auto i = edge_face_offsets_[at(e)]; i < edge_face_offsets_[at(e) + 1]; ++i) {
+      const std::int64_t lf = label(edge_faces_[at(i)]);
+      l = (l == -2 || l == lf) ? lf : -1;
+      if (l == -1) break;
+    }
+    edge_label_[at(e)] = l < 0 ? -1 : l;
+  }
+  const std::int32_t num_faces = topology_.num_triangles();
+  for (std::int32_t f = 0; f < num_faces; ++f) {
+    const std::int64_t l = label(f);
+    std::uint8_t mask = culling::kMaskOther;
+    if (l >= 0) {
+      const std::uint8_t owned = topology_.owned(f);
+      const auto& corners = topology_.triangle(f);
+      bool pure = true;
+      for (int k = 0; k < 3 && pure; ++k) {
+        if ((owned & (1u << k)) != 0 && vertex_label_[at(corners[at(k)])] != l) pure = false;
+        if ((owned & (1u << (3 + k))) != 0 && edge_label_[at(topology_.face_edge(f, k))] != l) {
+          pure = false;
+        }
+      }
+      if (pure) mask = (l & 1) != 0 ? culling::kMaskNegative : culling::kMaskPositive;
+    }
+    triangle_mask_[at(f)] = mask;
+  }
+  for (std::int32_t a = 0; a < clusters_.num_atomic(); ++a) {
+    culling::node_class_masks<3>(clusters_.local_bvh(a), triangle_mask_, node_masks_[at(a)]);
+  }
+}
+
+// --- intra- and inter-cluster checks (§6) ---------------------------------------------------------
+
+void RadialViewMethod::traverse(MaskedPairs which, culling::FrameResult& out) {
+  const std::span<const culling::Aabb> tri_bounds(bounds_.triangles);
+  std::int64_t& bv_tests = out.counters.bv_tests;
+  const bool retest = which == MaskedPairs::skipped;
+  const auto wanted = [&](std::int32_t a) {
+    return !retest || escalate_[at(clusters_.component_of_atomic(a))] != 0;
+  };
+  // Intra-cluster: each atomic cluster against itself, with the masks of its mega cluster.
+  for (std::int32_t a = 0; a < clusters_.num_atomic(); ++a) {
+    if (!wanted(a)) continue;
+    culling::masked_self_traverse<3>(clusters_.local_bvh(a), tri_bounds, node_masks_[at(a)],
+                                     triangle_mask_, which, scratch_, pairs_, bv_tests);
+  }
+  // Atomic cluster pairs whose swept volumes meet (the global hierarchy's self traversal): within
+  // one mega cluster with masks (intra-cluster check across atomic clusters), across mega
+  // clusters without (inter-cluster check).
+  for (const auto& cp : cluster_pairs_) {
+    const bool same_mega = classes_.atomic_mega[at(cp.a)] == classes_.atomic_mega[at(cp.b)];
+    if (same_mega) {
+      if (!wanted(cp.a)) continue;
+      culling::masked_pair_traverse<3>(clusters_.local_bvh(cp.a), node_masks_[at(cp.a)],
+                                       clusters_.local_bvh(cp.b), node_masks_[at(cp.b)],
+                                       tri_bounds, triangle_mask_, which, scratch_, pairs_,
+                                       bv_tests);
+    } else if (!retest) {
+      culling::pair_traverse<3>(clusters_.local_bvh(cp.a), tri_bounds, clusters_.local_bvh(cp.b),
+                                tri_bounds, scratch_, pairs_, bv_tests);
+    }
+  }
+}
+
+void RadialViewMethod::detect_ccd(
+    const skinning::Positions& x_t0,
+    const skinning::Positions& x_t1,
+    culling::FrameResult& out) {
+  check_positions(x_t0, "detect_ccd", "x_t0");
+  check_positions(x_t1, "detect_ccd", "x_t1");
+  if (!poses_->ready()) {
+    throw InvalidInput(
+        "clustering::" + name_ +
+        "::detect_ccd: no bone poses selected for the interval (BonePoses::select_samples)");
+  }
+  stats_ = RadialViewStats{};
+  const std::int32_t num_components = clusters_.num_components();
+  stats_.components = num_components;
+
+  // 1. Which components the radial-view argument may be applied to in this interval.
+  start_status(x_t0, out);
+  const bool culling_possible = method_options_.min_separation == 0.0;
+  for (std::int32_t k = 0; k < num_components; ++k) {
+    culled_[at(k)] = culling_possible && clusters_.component_ok(k) &&
+                     status_[at(k)] == Status::clean;
+    stats_.components_culled += culled_[at(k)];
+    stats_.components_open += clusters_.component_ok(k) ? 0 : 1;
+    stats_.components_dirty += status_[at(k)] == Status::dirty ? 1 : 0;
+  }
+
+  // 2. Swept volumes of the interval, local hierarchies, then the global one over their roots.
+  const auto t_refit = Clock::now();
+  const double half_width = 0.5 * method_options_.min_separation;
+  culling::swept_vertex_bounds<3>(x_t0, x_t1, half_width, bounds_.vertices);
+  bounds_.derive(topology_);
+  for (std::int32_t a = 0; a < clusters_.num_atomic(); ++a) {
+    auto& local = clusters_.local_bvh(a);
+    if (local.empty()) {
+      cluster_bounds_[at(a)] = culling::Aabb::empty();
+      continue;
+    }
+    local.refit(bounds_.triangles);
+    cluster_bounds_[at(a)] = local.node_bounds()[0];
+  }
+  clusters_.global_bvh().refit(cluster_bounds_);
+  const auto t_classify = Clock::now();
+
+  // 3. RV update: observers ride their bones; classes and mega clusters (§3.1, §5).
+  pose_observers(clusters_, poses_->t0(), poses_->t1(), observers_);
+  builder_.build(topology_.welded_triangles(), x_t0, x_t1, observers_, classes_);
+  const auto t_masks = Clock::now();
+  compute_masks();
+  const auto t_traverse = Clock::now();
+
+  // 4. Intra- and inter-cluster checks, relative AABBs, feature pairs.
+  pairs_.clear();
+  cluster_pairs_.clear();
+  culling::self_traverse<3>(clusters_.global_bvh(), cluster_bounds_, scratch_, cluster_pairs_,
+                            out.counters.bv_tests);
+  traverse(MaskedPairs::tested, out);
+  if (options_.relative_aabb) {
+    stats_.relative_aabb_culled +=
+        culling::relative_aabb_filter(topology_, x_t0, x_t1, half_width, pairs_);
+  }
+  features_.clear();
+  culling::ccd_candidates_from_triangle_pairs<3>(topology_, pairs_, bounds_, features_,
+                                                 out.counters);
+  const auto t_elementary = Clock::now();
+
+  // 5. Elementary tests.
+  culling::run_ccd_tests(topology_, features_, x_t0, x_t1, tests_, method_options_.accuracy,
+                         ccd_options_, out);
+  const auto t_escalate = Clock::now();
+
+  // 6. The argument guarantees the first contact of a component, not the ones after it: where a
+  //    component that had pairs skipped has a self-contact, test the skipped pairs too.
+  const auto component_of_contact = [&](const culling::CcdContact& c) -> std::int32_t {
+    std::int32_t ka = -1;
+    std::int32_t kb = -1;
+    if (c.kind == culling::CcdContact::Kind::vf) {
+      ka = clusters_.component_of_vertex(c.a);
+      kb = clusters_.component_of_triangle(c.b);
+    } else {
+      ka = clusters_.component_of_vertex(topology_.edge(c.a)[0]);
+      kb = clusters_.component_of_vertex(topology_.edge(c.b)[0]);
+    }
+    return ka == kb ? ka : -1;
+  };
+  double escalate_traverse_us = 0.0;
+  double escalate_elementary_us = 0.0;
+  if (options_.guard) {
+    std::fill(escalate_.begin(), escalate_.end(), 0);
+    bool any = false;
+    for (const auto& c : out.contacts) {
+      const std::int32_t k = component_of_contact(c);
+      if (k >= 0 && culled_[at(k)] != 0 && escalate_[at(k)] == 0) {
+        escalate_[at(k)] = 1;
+        ++stats_.components_escalated;
+        any = true;
+      }
+    }
+    if (any) {
+      const auto e0 = Clock::now();
+      pairs_.clear();
+      traverse(MaskedPairs::skipped, out);
+      stats_.skipped_pairs_retested += static_cast<std::int64_t>(pairs_.size());
+      if (options_.relative_aabb) {
+        stats_.relative_aabb_culled +=
+            culling::relative_aabb_filter(topology_, x_t0, x_t1, half_width, pairs_);
+      }
+      features_.clear();
+      culling::ccd_candidates_from_triangle_pairs<3>(topology_, pairs_, bounds_, features_,
+                                                     out.counters);
+      const auto e1 = Clock::now();
+      const std::size_t before = out.contacts.size();
+      culling::run_ccd_tests(topology_, features_, x_t0, x_t1, tests_, method_options_.accuracy,
+                             ccd_options_, out);
+      stats_.escalation_contacts += static_cast<std::int64_t>(out.contacts.size() - before);
+      // Both runs are sorted; one canonical order for the whole interval (in place).
+      std::inplace_merge(
+          out.contacts.begin(), out.contacts.begin() + static_cast<std::ptrdiff_t>(before),
+          out.contacts.end(),
+          [](const culling::CcdContact& a, const culling::CcdContact& b) { return a.before(b); });
+      const auto e2 = Clock::now();
+      escalate_traverse_us = micros(e0, e1);
+      escalate_elementary_us = micros(e1, e2);
+    }
+  }
+  const auto t_end = Clock::now();
+
+  // 7. What the next interval may assume at its start (these positions' end): components that
+  //    were free of self-intersection here and had no self-contact stay free of it.
+  if (options_.guard && culling_possible) {
+    for (std::int32_t k = 0; k < num_components; ++k) {
+      carry_clean_[at(k)] = status_[at(k)] == Status::clean ? 1 : 0;
+    }
+    for (const auto& c : out.contacts) {
+      const std::int32_t k = component_of_contact(c);
+      if (k >= 0) carry_clean_[at(k)] = 0;
+    }
+    carry_x_ = x_t1;
+    has_carry_ = true;
+  }
+
+  // Counters and stage times (paper Table 3: RV-update = classify + merge).
+  out.counters.atomic_clusters += clusters_.num_atomic();
+  out.counters.mega_clusters += classes_.num_mega();
+  out.counters.h_minus += classes_.h_minus;
+  out.counters.h_uncertain += classes_.h_uncertain;
+  out.times.refit_us += micros(t_refit, t_classify);
+  out.times.classify_us += classes_.classify_us + micros(t_masks, t_traverse);
+  out.times.merge_us += classes_.merge_us;
+  out.times.traverse_us += micros(t_traverse, t_elementary) + escalate_traverse_us;
+  out.times.elementary_us += micros(t_elementary, t_escalate) + escalate_elementary_us;
+  (void)t_end;
+}
+
+}  // namespace skelcd::clustering

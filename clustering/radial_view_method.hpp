@@ -1,0 +1,147 @@
+#pragma once
+// `rvbc` and `dynamic`: radial-view culling at run time (paper 002, §3, §5, §6), behind the
+// culling::CullingMethod interface. Per interval: classify every triangle against its (mega)
+// cluster's observer, skip the pairs of one mega cluster whose features are all positive (or all
+// negative), traverse the rest through the atomic clusters' local hierarchies and the global one,
+// filter with relative AABBs, then the shared feature stage and elementary tests of culling/.
+//
+// The radial-view argument has preconditions; this method checks them instead of assuming them
+// (docs/radial-view.md): the argument is applied only to closed, consistently oriented components
+// that are free of self-intersection at the interval's start (proven by a DCD pass, or carried
+// over from the previous interval), and when such a component has any self-contact in the
+// interval, the pairs it skipped are tested too (the argument guarantees only the first contact).
+// Contacts therefore equal those of `bvh` exactly. DCD queries are answered by the `bvh` method:
+// orientation at one instant says nothing about interpenetration.
+
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "clustering/bone_poses.hpp"
+#include "clustering/cluster_set.hpp"
+#include "clustering/mega_clusters.hpp"
+#include "culling/candidates.hpp"
+#include "culling/cluster_checks.hpp"
+#include "culling/elementary.hpp"
+#include "culling/feature_topology.hpp"
+#include "culling/method.hpp"
+#include "culling/traversal.hpp"
+#include "segmentation/segmentation.hpp"
+
+namespace skelcd::clustering {
+
+struct RadialViewOptions {
+  /// Mega clusters (`dynamic`) or fixed atomic clusters (`rvbc`), γ, seed.
+  MegaClusterOptions clusters{};
+  /// Relative AABB filter on non-adjacent candidate pairs (§6).
+  bool relative_aabb = true;
+  /// Check the preconditions and re-test skipped pairs where a component has a self-contact.
+  /// Off only to show what the bare theory misses (tests/clustering): then contacts may be lost.
+  bool guard = true;
+};
+
+/// What the last detect_ccd did beyond the counters of FrameResult.
+struct RadialViewStats {
+  std::int32_t components = 0;         ///< components of the mesh
+  std::int32_t components_culled = 0;  ///< components where pairs were skipped
+  std::int32_t components_open = 0;    ///< not closed / not consistently oriented / mixed parts
+  std::int32_t components_dcd = 0;     ///< components proven at the start by a DCD pass here
+  std::int32_t components_dirty = 0;   ///< self-intersecting at the start: nothing skipped there
+  std::int32_t components_escalated = 0;  ///< had a self-contact: skipped pairs re-tested
+  std::int64_t relative_aabb_culled = 0;  ///< candidate pairs removed by the relative AABB filter
+  std::int64_t skipped_pairs_retested = 0;  ///< overlapping skipped pairs tested on escalation
+  std::int64_t escalation_contacts = 0;     ///< contacts found only by the escalation pass
+};
+
+class RadialViewMethod final : public culling::CullingMethod {
+ public:
+  /// @param name "rvbc" or "dynamic" (the name reported; `options.clusters.merge` decides).
+  /// @param segmentation of `mesh` (same triangle order); @param poses selected before each query.
+  /// @param num_bones bones of the rig (transform count the observers need).
+  /// @throws InvalidInput as culling::make_method for bad method options, and when the
+  ///   segmentation does not fit the mesh.
+  RadialViewMethod(
+      std::string name,
+      const skinning::Mesh& mesh,
+      const skinning::Topology& topology,
+      std::shared_ptr<const segmentation::Segmentation> segmentation,
+      std::shared_ptr<const BonePoses> poses,
+      std::int32_t num_bones,
+      const culling::MethodOptions& method_options,
+      const RadialViewOptions& options);
+
+  [[nodiscard]] std::string_view name() const override { return name_; }
+
+  /// The `bvh` method's DCD (recorded: a following detect_ccd from the same positions knows which
+  /// components are free of self-intersection without a pass of its own).
+  void detect_dcd(const skinning::Positions& x, culling::FrameResult& out) override;
+
+  /// @throws InvalidInput for positions with the wrong row count, or when no bone poses have been
+  ///   selected (BonePoses::select_samples / set).
+  void detect_ccd(
+      const skinning::Positions& x_t0,
+      const skinning::Positions& x_t1,
+      culling::FrameResult& out) override;
+
+  [[nodiscard]] const ClusterSet& clusters() const { return clusters_; }
+  /// The classes and mega clusters of the last detect_ccd.
+  [[nodiscard]] const IntervalClasses& last_classes() const { return classes_; }
+  [[nodiscard]] const RadialViewStats& last_stats() const { return stats_; }
+  [[nodiscard]] const RadialViewOptions& options() const { return options_; }
+
+ private:
+  enum class Status : std::uint8_t { unknown, clean, dirty };
+
+  void check_positions(const skinning::Positions& x, const char* call, const char* which) const;
+  void start_status(const skinning::Positions& x_t0, culling::FrameResult& out);
+  void compute_masks();
+  void traverse(culling::MaskedPairs which, culling::FrameResult& out);
+  void record_dcd(const skinning::Positions& x, const culling::FrameResult& result);
+
+  std::string name_;
+  std::shared_ptr<const segmentation::Segmentation> segmentation_;
+  std::shared_ptr<const BonePoses> poses_;
+  culling::FeatureTopology topology_;
+  ClusterSet clusters_;
+  culling::MethodOptions method_options_;
+  RadialViewOptions options_;
+  culling::ElementaryTests tests_;
+  ccd::CcdOptions ccd_options_;
+  std::unique_ptr<culling::CullingMethod> bvh_;  // DCD
+  MegaClusterBuilder builder_;
+  std::vector<std::int32_t> edge_face_offsets_, edge_faces_;
+
+  // Per interval.
+  IntervalObservers observers_;
+  IntervalClasses classes_;
+  RadialViewStats stats_;
+  culling::FeatureBounds<3> bounds_;
+  std::vector<culling::Aabb> cluster_bounds_;
+  std::vector<std::uint8_t> triangle_mask_;
+  std::vector<std::vector<std::uint8_t>> node_masks_;
+  std::vector<std::int64_t> vertex_label_, edge_label_;
+  std::vector<Status> status_;          // per component, at the interval's start
+  std::vector<std::uint8_t> culled_;    // per component: pairs were skipped this interval
+  std::vector<std::uint8_t> escalate_;  // per component
+  std::vector<culling::TrianglePair> cluster_pairs_, pairs_;
+  culling::FeatureCandidates features_;
+  culling::TraversalScratch scratch_;
+
+  // The start-of-interval knowledge carried between queries: components free of
+  // self-intersection at positions carry_x_ (the last interval's end), and the DCD findings at
+  // dcd_x_ (the last detect_dcd).
+  bool has_carry_ = false;
+  skinning::Positions carry_x_;
+  std::vector<std::uint8_t> carry_clean_;
+  bool has_dcd_ = false;
+  skinning::Positions dcd_x_;
+  std::vector<std::uint8_t> dcd_clean_;
+  // Precondition DCD scratch.
+  culling::FeatureBounds<3> static_bounds_;
+  std::vector<culling::TrianglePair> dcd_pairs_;
+  culling::FrameResult dcd_result_;
+};
+
+}  // namespace skelcd::clustering

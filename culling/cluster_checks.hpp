@@ -1,0 +1,74 @@
+#pragma once
+// The traversals the radial-view methods drive (paper 002, §6). Inside a mega cluster a pair of
+// triangles whose features are all positively oriented to the mega cluster's observer (or all
+// negatively) needs no test (docs/radial-view.md); every other pair does. Each triangle carries a
+// *class mask* — one bit: positive, negative or other — and each hierarchy node the union of its
+// triangles' bits, so a node pair whose two masks are the same single sign is skipped without
+// descending. Pairs from different mega clusters are traversed without masks (traversal.hpp).
+
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "culling/bvh.hpp"
+#include "culling/frame_result.hpp"
+#include "culling/traversal.hpp"
+
+namespace skelcd::culling {
+
+/// Class-mask bits.
+inline constexpr std::uint8_t kMaskPositive = 1;  ///< all the triangle's features H⁺
+inline constexpr std::uint8_t kMaskNegative = 2;  ///< all the triangle's features H⁻
+inline constexpr std::uint8_t kMaskOther = 4;     ///< anything else: tested against everything
+
+/// True when a pair of triangles with masks a and b (single bits) needs no test.
+[[nodiscard]] inline bool mask_pair_skipped(std::uint8_t a, std::uint8_t b) {
+  return a == b && a != kMaskOther;
+}
+
+/// Which pairs a masked traversal reports.
+enum class MaskedPairs : std::uint8_t {
+  tested,   ///< pairs that need a test (not mask_pair_skipped)
+  skipped,  ///< exactly the pairs a `tested` traversal leaves out (for re-checking them)
+};
+
+/// Node masks of `bvh`: out[n] = OR of triangle_mask over node n's triangles.
+/// @param triangle_mask indexed by triangle id.  @param out resized to #nodes.
+template <int N>
+void node_class_masks(
+    const Bvh<N>& bvh,
+    std::span<const std::uint8_t> triangle_mask,
+    std::vector<std::uint8_t>& out);
+
+/// Self traversal of one hierarchy with masks: appends every pair a < b of its triangles whose
+/// volumes overlap and that `which` selects, each once. Counts node-pair and triangle-pair
+/// volume tests in bv_tests.
+/// @param node_mask node_class_masks(bvh, triangle_mask).
+/// @note Allocation-free once `scratch` is reserved (reserve_self) and `out` has the capacity.
+template <int N>
+void masked_self_traverse(
+    const Bvh<N>& bvh,
+    std::span<const Dop<N>> triangle_bounds,
+    std::span<const std::uint8_t> node_mask,
+    std::span<const std::uint8_t> triangle_mask,
+    MaskedPairs which,
+    TraversalScratch& scratch,
+    std::vector<TrianglePair>& out,
+    std::int64_t& bv_tests);
+
+/// Pair traversal of two hierarchies (two atomic clusters of one mega cluster) with masks:
+/// appends every (triangle of a, triangle of b) whose volumes overlap and that `which` selects.
+template <int N>
+void masked_pair_traverse(
+    const Bvh<N>& a,
+    std::span<const std::uint8_t> node_mask_a,
+    const Bvh<N>& b,
+    std::span<const std::uint8_t> node_mask_b,
+    std::span<const Dop<N>> triangle_bounds,
+    std::span<const std::uint8_t> triangle_mask,
+    MaskedPairs which,
+    TraversalScratch& scratch,
+    std::vector<TrianglePair>& out,
+    std::int64_t& bv_tests);
+
+}  // namespace skelcd::culling

@@ -1,0 +1,83 @@
+#include "culling/relative_aabb.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cassert>
+
+#include "culling/dop.hpp"
+
+namespace skelcd::culling {
+namespace {
+
+inline bool shares_vertex(const std::array<std::int32_t, 3>& a, const std::array<std::int32_t, 3>& b) {
+  for (const std::int32_t v : a) {
+    if (v == b[0] || v == b[1] || v == b[2]) return true;
+  }
+  return false;
+}
+
+/// The swept box of one triangle in the relative motion: its corners at t = 0 (exact) and at
+/// t = 1 minus the common displacement `w`, each rounded result bracketed by its neighbours
+/// (round-to-nearest is within one ulp of the exact difference).
+Aabb relative_box(
+    const std::array<std::int32_t, 3>& t,
+    const skinning::Positions& x_t0,
+    const skinning::Positions& x_t1,
+    const Eigen::Vector3d& w) {
+  Aabb box = Aabb::empty();
+  for (const std::int32_t v : t) {
+    const auto i = static_cast<Eigen::Index>(v);
+    for (std::size_t k = 0; k < 3; ++k) {
+      const auto c = static_cast<Eigen::Index>(k);
+      const double p0 = x_t0(i, c);
+      const double p1 = x_t1(i, c) - w[c];
+      box.lo[k] = std::min({box.lo[k], p0, next_down(p1)});
+      box.hi[k] = std::max({box.hi[k], p0, next_up(p1)});
+    }
+  }
+  return box;
+}
+
+}  // namespace
+
+bool relative_boxes_overlap(
+    const FeatureTopology& topology,
+    const TrianglePair& pair,
+    const skinning::Positions& x_t0,
+    const skinning::Positions& x_t1,
+    double half_width) {
+  assert(half_width >= 0.0);
+  const auto& ta = topology.triangle(pair.a);
+  const auto& tb = topology.triangle(pair.b);
+  // The mean displacement of the six corners over the interval (velocity × Δt, Δt = 1).
+  Eigen::Vector3d w = Eigen::Vector3d::Zero();
+  for (const auto* t : {&ta, &tb}) {
+    for (const std::int32_t v : *t) {
+      const auto i = static_cast<Eigen::Index>(v);
+      w += (x_t1.row(i) - x_t0.row(i)).transpose();
+    }
+  }
+  w /= 6.0;
+  Aabb a = relative_box(ta, x_t0, x_t1, w);
+  Aabb b = relative_box(tb, x_t0, x_t1, w);
+  a.inflate(half_width);
+  b.inflate(half_width);
+  return a.overlaps(b);
+}
+
+std::int64_t relative_aabb_filter(
+    const FeatureTopology& topology,
+    const skinning::Positions& x_t0,
+    const skinning::Positions& x_t1,
+    double half_width,
+    std::vector<TrianglePair>& pairs) {
+  const auto kept = std::remove_if(pairs.begin(), pairs.end(), [&](const TrianglePair& p) {
+    if (shares_vertex(topology.triangle(p.a), topology.triangle(p.b))) return false;
+    return !relative_boxes_overlap(topology, p, x_t0, x_t1, half_width);
+  });
+  const auto removed = static_cast<std::int64_t>(pairs.end() - kept);
+  pairs.erase(kept, pairs.end());
+  return removed;
+}
+
+}  // namespace skelcd::culling

@@ -1,0 +1,39 @@
+#pragma once
+// The relative axis-aligned bounding box filter (paper 002, §6): two triangles that move together
+// do not meet, however large their swept boxes. Subtracting one common velocity from all six
+// vertices changes no distance between points of the two triangles at any instant, so if the swept
+// boxes of the *relative* motion are apart, the triangles are apart over the whole interval. The
+// common velocity is the mean of the six (any vector would be sound; the mean makes the boxes
+// small). Rounding is outward: each relative end position is bracketed by the doubles around it.
+
+#include <cstdint>
+#include <vector>
+
+#include "culling/feature_topology.hpp"
+#include "culling/frame_result.hpp"
+#include "skinning/mesh.hpp"
+
+namespace skelcd::culling {
+
+/// True when the swept AABBs of triangles a and b, in the motion relative to the mean velocity of
+/// their six corners and grown by `half_width` each, overlap. False proves that no point of a comes
+/// within 2·half_width of a point of b at any t in [0,1].
+/// @param x_t0,x_t1 #W × 3 welded positions.  @pre half_width >= 0.
+[[nodiscard]] bool relative_boxes_overlap(
+    const FeatureTopology& topology,
+    const TrianglePair& pair,
+    const skinning::Positions& x_t0,
+    const skinning::Positions& x_t1,
+    double half_width);
+
+/// Removes, in place (order kept), the pairs without a shared vertex whose relative boxes are
+/// apart; pairs sharing a vertex stay (their boxes always meet). Returns the number removed.
+/// Allocation-free.
+std::int64_t relative_aabb_filter(
+    const FeatureTopology& topology,
+    const skinning::Positions& x_t0,
+    const skinning::Positions& x_t1,
+    double half_width,
+    std::vector<TrianglePair>& pairs);
+
+}  // namespace skelcd::culling
