@@ -79,12 +79,17 @@ FeatureTopology::FeatureTopology(const skinning::Mesh& mesh, const skinning::Top
     }
     for (Eigen::Index k = 0; k < 3; ++k) {
       const std::int32_t e = topology.face_edges(r, k);
+      // Side k joins corner k and corner (k+1) % 3; a collapsed side (both corners the same
+      // welded vertex) is no edge and has id -1.
+      const std::int32_t u = triangles_[f][static_cast<std::size_t>(k)];
+      const std::int32_t w = triangles_[f][static_cast<std::size_t>((k + 1) % 3)];
+      if (e == -1 && u == w) {
+        face_edges_[f][static_cast<std::size_t>(k)] = -1;
+        continue;
+      }
       if (e < 0 || static_cast<std::size_t>(e) >= num_edges) {
         throw InvalidInput(at("face_edges of triangle", r) + " has edge id out of range");
       }
-      // Side k joins corner k and corner (k+1) % 3.
-      const std::int32_t u = triangles_[f][static_cast<std::size_t>(k)];
-      const std::int32_t w = triangles_[f][static_cast<std::size_t>((k + 1) % 3)];
       const auto& ed = edges_[static_cast<std::size_t>(e)];
       if (!((ed[0] == u && ed[1] == w) || (ed[0] == w && ed[1] == u))) {
         throw InvalidInput(
@@ -115,6 +120,7 @@ FeatureTopology::FeatureTopology(const skinning::Mesh& mesh, const skinning::Top
         vo = static_cast<std::int32_t>(f);
         owned_[f] = static_cast<std::uint8_t>(owned_[f] | (1u << k));
       }
+      if (face_edges_[f][k] < 0) continue;  // a collapsed side
       auto& eo = edge_owner_[static_cast<std::size_t>(face_edges_[f][k])];
       if (eo < 0) {
         eo = static_cast<std::int32_t>(f);
@@ -155,6 +161,7 @@ FeatureTopology::FeatureTopology(const skinning::Mesh& mesh, const skinning::Top
     pairs.clear();
     for (std::size_t f = 0; f < num_faces; ++f) {
       for (std::size_t k = 0; k < 3; ++k) {
+        if (face_edges_[f][k] < 0) continue;
         pairs.emplace_back(face_edges_[f][k], face_part(static_cast<std::int32_t>(f)));
       }
     }

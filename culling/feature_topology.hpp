@@ -24,8 +24,8 @@ class FeatureTopology {
   /// @param topology welded_triangles (#F × 3), edges (#E × 2), face_edges (#F × 3) and
   ///        representative_vertex (#W) are used.
   /// @throws InvalidInput naming "culling" and the offending index when the two disagree: sizes,
-  ///         ids out of range, a face_edges entry that is not the side it claims, a part id of an
-  ///         excluded pair outside [0, num_parts).
+  ///         ids out of range, a face_edges entry that is not the side it claims (-1 is accepted
+  ///         for a collapsed side only), a part id of an excluded pair outside [0, num_parts).
   FeatureTopology(const skinning::Mesh& mesh, const skinning::Topology& topology);
 
   [[nodiscard]] std::int32_t num_vertices() const { return num_vertices_; }
@@ -42,7 +42,8 @@ class FeatureTopology {
   [[nodiscard]] const std::array<std::int32_t, 2>& edge(std::int32_t e) const {
     return edges_[static_cast<std::size_t>(e)];
   }
-  /// Edge id of side k (corner k → corner (k+1) % 3) of triangle f.
+  /// Edge id of side k (corner k → corner (k+1) % 3) of triangle f; -1 for a collapsed side
+  /// (both corners the same welded vertex), which is no edge.
   [[nodiscard]] std::int32_t face_edge(std::int32_t f, int k) const {
     return face_edges_[static_cast<std::size_t>(f)][static_cast<std::size_t>(k)];
   }

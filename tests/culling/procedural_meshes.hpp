@@ -24,7 +24,7 @@ using skinning::Triangles;
 
 /// Welds vertices with bit-identical positions and builds the parts of a Topology the culling
 /// module reads: welded_of_vertex, representative_vertex, welded_triangles, edges (sorted, unique,
-/// smaller id first), face_edges, edge_face_offsets / edge_faces.
+/// smaller id first), face_edges (-1 for a collapsed side), edge_face_offsets / edge_faces.
 inline Topology simple_topology(const Mesh& mesh) {
   Topology t;
   const auto nv = static_cast<std::size_t>(mesh.rest_positions.rows());
@@ -51,7 +51,7 @@ inline Topology simple_topology(const Mesh& mesh) {
     for (Eigen::Index k = 0; k < 3; ++k) {
       const std::int32_t a = t.welded_triangles(f, k);
       const std::int32_t b = t.welded_triangles(f, (k + 1) % 3);
-      edge_ids.emplace(std::minmax(a, b), 0);
+      if (a != b) edge_ids.emplace(std::minmax(a, b), 0);  // a collapsed side is no edge
     }
   }
   t.edges.resize(static_cast<Eigen::Index>(edge_ids.size()), 2);
@@ -68,9 +68,16 @@ inline Topology simple_topology(const Mesh& mesh) {
     for (Eigen::Index k = 0; k < 3; ++k) {
       const std::int32_t a = t.welded_triangles(f, k);
       const std::int32_t b = t.welded_triangles(f, (k + 1) % 3);
+      if (a == b) {
+        t.face_edges(f, k) = -1;
+        continue;
+      }
       const std::int32_t e = edge_ids.at(std::minmax(a, b));
       t.face_edges(f, k) = e;
-      faces_of_edge[static_cast<std::size_t>(e)].push_back(static_cast<std::int32_t>(f));
+      auto& faces = faces_of_edge[static_cast<std::size_t>(e)];
+      if (faces.empty() || faces.back() != static_cast<std::int32_t>(f)) {
+        faces.push_back(static_cast<std::int32_t>(f));
+      }
     }
   }
   t.edge_face_offsets.push_back(0);

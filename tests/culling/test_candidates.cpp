@@ -100,6 +100,16 @@ std::vector<Scene> scenes() {
     }));
   }
   out.push_back(helical_fan(24));
+  {
+    // Two vertices of a sheet at the same position: welding collapses the triangles that hold
+    // both into segments (sides with id -1), which must not break ownership or the stages.
+    auto m = test::sheet(8, 4, 2.0, 1.0);
+    m.rest_positions.row(12) = m.rest_positions.row(11);
+    m.rest_positions.row(30) = m.rest_positions.row(21);
+    out.push_back(make_scene("sheet with collapsed triangles", m, [](const auto& x) {
+      return test::folded(x, 1.0, 3.4);
+    }));
+  }
   return out;
 }
 
@@ -277,8 +287,18 @@ TEST(FeatureTopology, EveryVertexAndEdgeHasExactlyOneOwner) {
         }
       }
     }
-    for (const int n : vertex_owners) EXPECT_EQ(n, 1) << s.name;
+    for (std::int32_t v = 0; v < t.num_vertices(); ++v) {
+      EXPECT_EQ(vertex_owners[static_cast<std::size_t>(v)], t.vertex_owner(v) < 0 ? 0 : 1)
+          << s.name;
+    }
     for (const int n : edge_owners) EXPECT_EQ(n, 1) << s.name;
+    if (s.name == "sheet with collapsed triangles") {
+      int collapsed_sides = 0;
+      for (std::int32_t f = 0; f < t.num_triangles(); ++f) {
+        for (int k = 0; k < 3; ++k) collapsed_sides += t.face_edge(f, k) < 0;
+      }
+      EXPECT_GT(collapsed_sides, 0);
+    }
   }
 }
 
