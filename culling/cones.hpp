@@ -1,0 +1,130 @@
+#pragma once
+// Cones of directions for the cone culling methods (normal-cone, dual-cone, enhanced-dual-cone):
+// the surface normal cone (SNC) of every hierarchy node — of the static normals for DCD, of the
+// continuous normal n(t) over an interval for CCD — and the binormal cone (BNC) of a set of
+// vectors. A cone here is only ever used to prove "every bounded vector has a positive dot product
+// with the axis", so a cone whose half-angle may reach π/2 is stored as `full` (useless), and every
+// stored half-angle is an upper bound with its rounding errors accounted for (docs/dual-cone.md,
+// "Cones").
+
+#include <array>
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+
+#include "culling/bvh.hpp"
+#include "culling/feature_topology.hpp"
+#include "skinning/mesh.hpp"
+
+namespace skelcd::culling {
+
+/// A cone (axis, θ) with θ < π/2 that contains (as exact real vectors) every vector it bounds:
+/// angle(x, axis) ≤ θ. `cos_angle` is a lower bound of cos θ (> 0), `sin_angle` an upper bound of
+/// sin θ, both with rounding accounted for; `axis` is a unit vector to within 3 ulp.
+struct DirectionCone {
+  enum class Kind : std::uint8_t {
+    empty,    ///< bounds no vector (e.g. the BNC of a node without boundary edges)
+    bounded,  ///< bounds its vectors within θ < π/2
+    full,     ///< may bound vectors at π/2 or more from any axis: proves nothing
+  };
+  Kind kind = Kind::empty;
+  Eigen::Vector3d axis = Eigen::Vector3d::UnitZ();
+  double cos_angle = 1.0;
+  double sin_angle = 0.0;
+
+  [[nodiscard]] static DirectionCone empty_cone() { return {}; }
+  [[nodiscard]] static DirectionCone full_cone() {
+    DirectionCone c;
+    c.kind = Kind::full;
+    c.cos_angle = -1.0;
+    c.sin_angle = 1.0;
+    return c;
+  }
+  [[nodiscard]] bool is_empty() const { return kind == Kind::empty; }
+  [[nodiscard]] bool is_full() const { return kind == Kind::full; }
+  /// True when every bounded vector x has x · axis > 0 (the surface normal test, §3.3). Holds
+  /// for every bounded cone (θ < π/2 by construction).
+  [[nodiscard]] bool in_open_half_space() const { return kind == Kind::bounded; }
+  /// The half-angle in radians (an upper bound; π/2 for full, 0 for empty). For reports.
+  [[nodiscard]] double angle() const;
+  /// True when the exact vector `x` (non-zero) lies inside: x · axis ≥ |x| cos θ, evaluated with
+  /// a tolerance of a few ulp in the cone's favour. For tests and assertions.
+  [[nodiscard]] bool contains(const Eigen::Vector3d& x) const;
+};
+
+/// The cone of one vector: the exact vector lies within Euclidean distance `error` of `v`.
+/// Full when that ball may reach 30° from v (a nearly degenerate normal): the culling tests then
+/// fail at every node holding it, which is the safe side.
+[[nodiscard]] DirectionCone cone_of_vector(const Eigen::Vector3d& v, double error);
+
+/// The smallest cone around the given unit `axis` that contains cones a and b (either may be
+/// empty), conservative: cos(θ_a + ∠(axis, a.axis)) bounded from below, etc. Full when that
+/// half-angle may reach π/2.
+[[nodiscard]] DirectionCone enclose_around(
+    const Eigen::Vector3d& axis,
+    const DirectionCone& a,
+    const DirectionCone& b);
+
+/// A cone containing a and b with a near-optimal axis (the minimal enclosing cone of two cones:
+/// half-angle (α + θ_a + θ_b)/2), then made conservative by enclose_around.
+[[nodiscard]] DirectionCone merge(const DirectionCone& a, const DirectionCone& b);
+
+/// Unit vector along v (v / |v|), or zero when |v| is zero or not finite.
+[[nodiscard]] Eigen::Vector3d unit_or_zero(const Eigen::Vector3d& v);
+
+/// Normal n = (b − a) × (c − a) of a triangle computed in floating point from the corner
+/// positions, and a bound on the Euclidean distance to the exact normal (docs/dual-cone.md).
+struct BoundedNormal {
+  Eigen::Vector3d n;
+  double error = 0.0;
+};
+[[nodiscard]] BoundedNormal triangle_normal(
+    const Eigen::Vector3d& a,
+    const Eigen::Vector3d& b,
+    const Eigen::Vector3d& c);
+
+/// The Bernstein control vectors of the continuous normal n(t) of a triangle whose corners move
+/// linearly over [0,1]: n(t) = B0 (1−t)² + B1 2t(1−t) + B2 t², each with its error bound. Since
+/// the Bernstein basis is non-negative, n(t) lies in the conic hull of B0, B1, B2 — inside any
+/// cone with θ < π/2 that contains them.
+[[nodiscard]] std::array<BoundedNormal, 3> continuous_normal_control_vectors(
+    const Eigen::Vector3d& a_t0,
+    const Eigen::Vector3d& b_t0,
+    const Eigen::Vector3d& c_t0,
+    const Eigen::Vector3d& a_t1,
+    const Eigen::Vector3d& b_t1,
+    const Eigen::Vector3d& c_t1);
+
+/// Surface normal cones of every node of a hierarchy over the welded triangles, refit bottom-up
+/// per instant (static normals, DCD) or per interval (continuous normals, CCD). A node's cone
+/// contains the (continuous) normal of each of its triangles; a parent's axis is its triangles'
+/// mean normal, or the optimal merge axis of its children when that gives a smaller cone.
+class NormalConeTree {
+ public:
+  /// Static normals at positions x (#W × 3). Allocation-free after the first call.
+  void refit(const AabbBvh& bvh, const FeatureTopology& topology, const skinning::Positions& x);
+  /// Continuous normals over x_t0 → x_t1 (#W × 3 each). Allocation-free after the first call.
+  void refit(
+      const AabbBvh& bvh,
+      const FeatureTopology& topology,
+      const skinning::Positions& x_t0,
+      const skinning::Positions& x_t1);
+
+  /// One cone per node of the hierarchy (node ids of AabbBvh::nodes()).
+  [[nodiscard]] std::span<const DirectionCone> node_cones() const { return node_cones_; }
+  /// One cone per triangle id.
+  [[nodiscard]] std::span<const DirectionCone> triangle_cones() const { return triangle_cones_; }
+
+ private:
+  void refit_nodes(const AabbBvh& bvh);
+
+  std::vector<DirectionCone> triangle_cones_;
+  std::vector<Eigen::Vector3d> triangle_sums_;  // raw normal (sum of control vectors) per triangle
+  std::vector<DirectionCone> node_cones_;
+  std::vector<Eigen::Vector3d> node_sums_;
+};
+
+}  // namespace skelcd::culling

@@ -1,0 +1,48 @@
+#pragma once
+// What the cone culling methods (`normal-cone`, `dual-cone`, `enhanced-dual-cone`) report beside
+// the shared Counters: how many hierarchy nodes their cone tests examined, culled, and why the
+// others failed. Read it through `dynamic_cast<const ConeStatistics*>(&method)`.
+
+#include <array>
+#include <cstdint>
+
+#include "culling/contour.hpp"
+
+namespace skelcd::culling {
+
+/// Cone-test statistics of the last detect_dcd / detect_ccd call.
+struct ConeCullingStats {
+  std::int64_t nodes_tested = 0;        ///< node self-tests evaluated with the cone criteria
+  std::int64_t nodes_culled = 0;        ///< ... that proved the node free of self-collision
+  std::int64_t failed_normal_cone = 0;  ///< condition 1: SNC not within a half-space
+  std::int64_t failed_topology = 0;     ///< the node's contour is not one simple loop
+  std::int64_t failed_dual_cone = 0;    ///< condition 2: a chain's BNC (or FASTCD's BNC test)
+  std::int64_t failed_contour = 0;      ///< condition 3: projected contour edges may meet
+  /// Algorithm 3's ten results, as failures counted over the failing nodes whose condition 1
+  /// held: [0..3] the four sub-surface tests R_ll, R_lr, R_rl, R_rr; [4..9] the pair tests
+  /// (ll,lr), (ll,rl), (ll,rr), (lr,rl), (lr,rr), (rl,rr). Only the first failure of a node is
+  /// recorded (the test stops there).
+  std::array<std::int64_t, 10> ten_results_failed{};
+  std::int64_t subtree_pairs = 0;  ///< node-pair traversals started (Collide of Algorithm 3)
+  ContourTestCounters contour;
+  /// True when cone culling was off for this call (min_separation > 0: the cone theorems are
+  /// about intersection, not distance — the method then equals `bvh`).
+  bool culling_disabled = false;
+};
+
+/// Implemented by the cone methods beside CullingMethod.
+class ConeStatistics {
+ public:
+  virtual ~ConeStatistics() = default;
+  [[nodiscard]] virtual const ConeCullingStats& cone_stats() const = 0;
+  /// Static contour statistics of the method's hierarchy (nodes per ContourStatus).
+  [[nodiscard]] virtual const NodeContours& contours() const = 0;
+};
+
+/// Index into ConeCullingStats::ten_results_failed of the pair test (p, q), p < q < 4.
+[[nodiscard]] constexpr int ten_result_pair_index(int p, int q) {
+  // (0,1)→4 (0,2)→5 (0,3)→6 (1,2)→7 (1,3)→8 (2,3)→9
+  return p == 0 ? 3 + q : (p == 1 ? 5 + q : 9);
+}
+
+}  // namespace skelcd::culling

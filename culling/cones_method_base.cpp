@@ -1,0 +1,220 @@
+#include "culling/cones_method_base.hpp"
+
+#include <algorithm>
+#include <cassert>
+#include <string>
+
+#include "culling/vertex_bounds.hpp"
+#include "skinning/errors.hpp"
+
+namespace skelcd::culling::detail {
+namespace {
+
+inline std::size_t sz(std::int32_t i) { return static_cast<std::size_t>(i); }
+
+/// Welded rest positions (row w = rest position of representative_vertex[w]): the hierarchy is
+/// split at rest, like the `bvh` method's.
+skinning::Positions welded_rest(const skinning::Mesh& mesh, const skinning::Topology& topology) {
+  skinning::Positions rest(topology.num_welded_vertices(), 3);
+  for (std::int32_t w = 0; w < topology.num_welded_vertices(); ++w) {
+    const std::int32_t v = topology.representative_vertex[sz(w)];
+    if (v < 0 || v >= mesh.rest_positions.rows()) {
+      throw InvalidInput(
+          "culling::make_method: representative_vertex[" + std::to_string(w) + "] = " +
+          std::to_string(v) + " is not a mesh vertex");
+    }
+    rest.row(w) = mesh.rest_positions.row(v);
+  }
+  return rest;
+}
+
+}  // namespace
+
+ConeMethodBase::ConeMethodBase(
+    std::string_view name,
+    const skinning::Mesh& mesh,
+    const skinning::Topology& topology,
+    const MethodOptions& options,
+    Descent descent,
+    bool needs_contours)
+    : MethodBase(name, mesh, topology, options),
+      bvh_(topology_.welded_triangles(), welded_rest(mesh, topology), options.bvh),
+      descent_(descent),
+      // The cone theorems say "no intersection", not "no pair within a distance": with a contact
+      // distance the method culls nothing and equals `bvh` (docs/dual-cone.md).
+      cull_enabled_(options.min_separation == 0.0) {
+  if (needs_contours) contours_ = NodeContours(bvh_, topology_);
+  const auto num_faces = static_cast<std::size_t>(topology_.num_triangles());
+  bounds_.vertices.reserve(static_cast<std::size_t>(topology_.num_vertices()));
+  bounds_.edges.reserve(static_cast<std::size_t>(topology_.num_edges()));
+  bounds_.triangles.reserve(num_faces);
+  const auto depth = static_cast<std::size_t>(bvh_.depth());
+  self_stack_.reserve(4 * depth + 8);
+  pair_stack_.reserve(2 * depth + 8);
+  pairs_.reserve(16 * num_faces);
+  features_.vf.reserve(4 * num_faces);
+  features_.ee.reserve(4 * num_faces);
+}
+
+void ConeMethodBase::detect_dcd(const skinning::Positions& x, FrameResult& out) {
+  check_positions(x, "detect_dcd", "x");
+  stats_ = {};
+  stats_.culling_disabled = !cull_enabled_;
+  const auto t0 = Clock::now();
+  // Refit: static volumes, the hierarchy, the normal cones of the instant.
+  static_vertex_bounds<3>(x, bounds_.vertices);
+  bounds_.derive(topology_, /*with_edges=*/false);
+  bvh_.refit(bounds_.triangles);
+  const Interval interval{&x, &x, false};
+  if (cull_enabled_) {
+    cones_.refit(bvh_, topology_, x);
+    refit_extra(interval);
+  }
+  const auto t1 = Clock::now();
+  // Cone-culled self traversal → triangle pairs → the DCD rules.
+  pairs_.clear();
+  traverse(interval, out.counters.bv_tests);
+  dcd_filter_triangle_pairs(topology_, pairs_, out.counters);
+  const auto t2 = Clock::now();
+  run_dcd_tests(topology_, pairs_, x, tests_, out);
+  const auto t3 = Clock::now();
+  out.times.refit_us += micros(t0, t1);
+  out.times.traverse_us += micros(t1, t2);
+  out.times.elementary_us += micros(t2, t3);
+}
+
+void ConeMethodBase::detect_ccd(
+    const skinning::Positions& x_t0,
+    const skinning::Positions& x_t1,
+    FrameResult& out) {
+  check_positions(x_t0, "detect_ccd", "x_t0");
+  check_positions(x_t1, "detect_ccd", "x_t1");
+  stats_ = {};
+  stats_.culling_disabled = !cull_enabled_;
+  const auto t0 = Clock::now();
+  // Refit: swept volumes, the hierarchy, the continuous normal cones of the interval.
+  swept_vertex_bounds<3>(x_t0, x_t1, 0.5 * options_.min_separation, bounds_.vertices);
+  bounds_.derive(topology_);
+  bvh_.refit(bounds_.triangles);
+  const Interval interval{&x_t0, &x_t1, true};
+  if (cull_enabled_) {
+    cones_.refit(bvh_, topology_, x_t0, x_t1);
+    refit_extra(interval);
+  }
+  const auto t1 = Clock::now();
+  // Cone-culled self traversal → triangle pairs → de-duplicated feature pairs. A culled node's
+  // triangle pairs produce only feature pairs inside a surface proven free of contact.
+  pairs_.clear();
+  features_.clear();
+  traverse(interval, out.counters.bv_tests);
+  ccd_candidates_from_triangle_pairs<3>(topology_, pairs_, bounds_, features_, out.counters);
+  const auto t2 = Clock::now();
+  run_ccd_tests(topology_, features_, x_t0, x_t1, tests_, options_.accuracy, ccd_options_, out);
+  const auto t3 = Clock::now();
+  out.times.refit_us += micros(t0, t1);
+  out.times.traverse_us += micros(t1, t2);
+  out.times.elementary_us += micros(t2, t3);
+}
+
+void ConeMethodBase::traverse(const Interval& interval, std::int64_t& bv_tests) {
+  if (bvh_.empty()) return;
+  const auto nodes = bvh_.nodes();
+  self_stack_.clear();
+  self_stack_.push_back(0);
+  while (!self_stack_.empty()) {
+    const std::int32_t n = self_stack_.back();
+    self_stack_.pop_back();
+    const BvhNode& node = nodes[sz(n)];
+    if (node.is_leaf()) {
+      leaf_self(n, bv_tests);
+      continue;
+    }
+    const std::int32_t l = n + 1;
+    const std::int32_t r = node.right;
+    const bool leaf_children = nodes[sz(l)].is_leaf() && nodes[sz(r)].is_leaf();
+    // SelfCollide(N): the method's cone test first; a culled node's whole subtree is done.
+    if (cull_enabled_ && node_culled(n, interval)) {
+      ++stats_.nodes_culled;
+      continue;
+    }
+    if (descent_ == Descent::grandchildren && !leaf_children) {
+      // Algorithm 3: the sub-surfaces' self-tests and the six pairs between them (every one of
+      // the ten: skipping those whose test passed is not sound, docs/dual-cone.md).
+      std::array<std::int32_t, 4> parts{};
+      const int k = sub_surfaces(bvh_, n, parts);
+      for (int p = k; p-- > 0;) self_stack_.push_back(parts[static_cast<std::size_t>(p)]);
+      for (int p = 0; p < k; ++p) {
+        for (int q = p + 1; q < k; ++q) {
+          collide(parts[static_cast<std::size_t>(p)], parts[static_cast<std::size_t>(q)], bv_tests);
+        }
+      }
+    } else {
+      self_stack_.push_back(r);
+      self_stack_.push_back(l);
+      collide(l, r, bv_tests);
+    }
+  }
+}
+
+void ConeMethodBase::collide(std::int32_t a, std::int32_t b, std::int64_t& bv_tests) {
+  ++stats_.subtree_pairs;
+  const auto nodes = bvh_.nodes();
+  const auto volumes = bvh_.node_bounds();
+  const auto order = bvh_.triangle_order();
+  const auto& tri = bounds_.triangles;
+  const bool single = bvh_.leaf_size() == 1;
+  pair_stack_.clear();
+  pair_stack_.emplace_back(a, b);
+  while (!pair_stack_.empty()) {
+    const auto [x, y] = pair_stack_.back();
+    pair_stack_.pop_back();
+    ++bv_tests;
+    if (!volumes[sz(x)].overlaps(volumes[sz(y)])) continue;
+    const BvhNode& nx = nodes[sz(x)];
+    const BvhNode& ny = nodes[sz(y)];
+    if (nx.is_leaf() && ny.is_leaf()) {
+      if (single) {  // one-triangle leaves: the node test was the triangle test
+        const std::int32_t ta = order[sz(nx.begin)];
+        const std::int32_t tb = order[sz(ny.begin)];
+        pairs_.push_back({std::min(ta, tb), std::max(ta, tb)});
+        continue;
+      }
+      for (std::int32_t i = nx.begin; i < nx.end; ++i) {
+        const std::int32_t ta = order[sz(i)];
+        for (std::int32_t j = ny.begin; j < ny.end; ++j) {
+          const std::int32_t tb = order[sz(j)];
+          ++bv_tests;
+          if (tri[sz(ta)].overlaps(tri[sz(tb)])) {
+            pairs_.push_back({std::min(ta, tb), std::max(ta, tb)});
+          }
+        }
+      }
+      continue;
+    }
+    // Split the node with more triangles (a leaf never).
+    assert(pair_stack_.size() + 2 <= pair_stack_.capacity());
+    if (ny.is_leaf() || (!nx.is_leaf() && nx.size() >= ny.size())) {
+      pair_stack_.emplace_back(nx.right, y);
+      pair_stack_.emplace_back(x + 1, y);
+    } else {
+      pair_stack_.emplace_back(x, ny.right);
+      pair_stack_.emplace_back(x, y + 1);
+    }
+  }
+}
+
+void ConeMethodBase::leaf_self(std::int32_t leaf, std::int64_t& bv_tests) {
+  const BvhNode& node = bvh_.nodes()[sz(leaf)];
+  const auto order = bvh_.triangle_order();
+  const auto& tri = bounds_.triangles;
+  for (std::int32_t i = node.begin; i < node.end; ++i) {
+    const std::int32_t ta = order[sz(i)];
+    for (std::int32_t j = i + 1; j < node.end; ++j) {
+      const std::int32_t tb = order[sz(j)];
+      ++bv_tests;
+      if (tri[sz(ta)].overlaps(tri[sz(tb)])) pairs_.push_back({std::min(ta, tb), std::max(ta, tb)});
+    }
+  }
+}
+
+}  // namespace skelcd::culling::detail

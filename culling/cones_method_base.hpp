@@ -1,0 +1,86 @@
+#pragma once
+// The engine shared by the cone culling methods (`normal-cone`, `dual-cone`,
+// `enhanced-dual-cone`): the culling module's AABB hierarchy over the welded triangles with a
+// surface normal cone per node, refit per instant or interval; a self traversal that asks the
+// method's node test before descending (into the children — the standard scheme — or into the
+// four grandchildren and their six pairs — Algorithm 3's scheme); node-pair descents (Collide);
+// then the shared feature and elementary stages of culling/candidates.hpp and
+// culling/elementary.hpp. Internal to culling/.
+
+#include <cstdint>
+#include <span>
+#include <string_view>
+#include <vector>
+
+#include "culling/candidates.hpp"
+#include "culling/cones.hpp"
+#include "culling/cones_method.hpp"
+#include "culling/contour.hpp"
+#include "culling/detail/method_base.hpp"
+
+namespace skelcd::culling::detail {
+
+class ConeMethodBase : public MethodBase, public ConeStatistics {
+ public:
+  void detect_dcd(const skinning::Positions& x, FrameResult& out) override;
+  void detect_ccd(
+      const skinning::Positions& x_t0,
+      const skinning::Positions& x_t1,
+      FrameResult& out) override;
+
+  [[nodiscard]] const ConeCullingStats& cone_stats() const override { return stats_; }
+  [[nodiscard]] const NodeContours& contours() const override { return contours_; }
+
+ protected:
+  /// Where a self-test descends when its node is not culled.
+  enum class Descent : std::uint8_t {
+    children,      ///< SelfCollide(L), SelfCollide(R), Collide(L, R)
+    grandchildren, ///< the 4 sub-surfaces' self-tests and their 6 pairs (Algorithm 3)
+  };
+
+  /// The instant (x_t1 == x_t0, continuous false) or interval the node tests see.
+  struct Interval {
+    const skinning::Positions* x_t0 = nullptr;
+    const skinning::Positions* x_t1 = nullptr;
+    bool continuous = false;
+  };
+
+  /// @param needs_contours build the per-node contours (normal-cone, enhanced-dual-cone).
+  ConeMethodBase(
+      std::string_view name,
+      const skinning::Mesh& mesh,
+      const skinning::Topology& topology,
+      const MethodOptions& options,
+      Descent descent,
+      bool needs_contours);
+
+  /// Per-interval refit beyond the normal cones (FASTCD's binormal cones). Default: nothing.
+  virtual void refit_extra(const Interval& /*interval*/) {}
+  /// The method's test of internal node `node`: true when its surface is proven free of
+  /// self-collision over the instant / interval. Counts its failures in stats_.
+  [[nodiscard]] virtual bool node_culled(std::int32_t node, const Interval& interval) = 0;
+
+  AabbBvh bvh_;
+  NormalConeTree cones_;
+  NodeContours contours_;
+  ContourTester contour_tester_;
+  ConeCullingStats stats_;
+
+ private:
+  void traverse(const Interval& interval, std::int64_t& bv_tests);
+  /// Collide(a, b) of Algorithm 3: every triangle pair (one under a, one under b) whose volumes
+  /// overlap, as (min, max); the node with more triangles is split first.
+  void collide(std::int32_t a, std::int32_t b, std::int64_t& bv_tests);
+  /// The triangle pairs inside one leaf (leaf_size > 1).
+  void leaf_self(std::int32_t leaf, std::int64_t& bv_tests);
+
+  Descent descent_;
+  bool cull_enabled_;
+  FeatureBounds<3> bounds_;
+  std::vector<std::int32_t> self_stack_;
+  std::vector<std::pair<std::int32_t, std::int32_t>> pair_stack_;
+  std::vector<TrianglePair> pairs_;
+  FeatureCandidates features_;
+};
+
+}  // namespace skelcd::culling::detail

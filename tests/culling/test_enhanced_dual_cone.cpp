@@ -1,0 +1,238 @@
+// The cone methods against the references: `enhanced-dual-cone` and `normal-cone` find exactly
+// what `bvh` (and `brute`, on small cases) finds, DCD and CCD, on every open scene and on the
+// cloth-funnel frames; `dual-cone` (FASTCD) demonstrably misses on the pipe and the wrapped sheet.
+#include <algorithm>
+#include <set>
+#include <string>
+#include <tuple>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "ccd/edge_edge.hpp"
+#include "ccd/vertex_face.hpp"
+#include "culling/cones_method.hpp"
+#include "culling/method.hpp"
+#include "skinning/errors.hpp"
+#include "tests/culling/test_dual_cone_scenes.hpp"
+#include "tests/support/test_support.hpp"
+
+namespace skelcd::culling {
+namespace {
+
+using test::OpenScene;
+using Key = std::tuple<int, std::int32_t, std::int32_t>;
+
+FrameResult run_dcd(const std::string& name, const OpenScene& s, std::size_t frame,
+                    const MethodOptions& options = {}) {
+  auto m = make_method(name, s.mesh, s.topo, options);
+  FrameResult out;
+  m->detect_dcd(s.frames[frame], out);
+  return out;
+}
+
+FrameResult run_ccd(const std::string& name, const OpenScene& s, std::size_t from,
+                    const MethodOptions& options = {}) {
+  auto m = make_method(name, s.mesh, s.topo, options);
+  FrameResult out;
+  m->detect_ccd(s.frames[from], s.frames[from + 1], out);
+  return out;
+}
+
+std::set<Key> keys(const FrameResult& r) {
+  std::set<Key> k;
+  for (const auto& c : r.contacts) k.emplace(static_cast<int>(c.kind), c.a, c.b);
+  return k;
+}
+
+/// True when the exact elementary test says contact `k` does not happen over the interval.
+bool exactly_refuted(const OpenScene& s, std::size_t from, const Key& k) {
+  const auto& x0 = s.frames[from];
+  const auto& x1 = s.frames[from + 1];
+  auto p = [](const skinning::Positions& x, std::int32_t w) -> Eigen::Vector3d {
+    return x.row(w).transpose();
+  };
+  const auto [kind, a, b] = k;
+  if (kind == 0) {
+    const auto f = s.topo.welded_triangles.row(b);
+    const ccd::VertexFaceQuery q{p(x0, a), p(x0, f(0)), p(x0, f(1)), p(x0, f(2)),
+                                 p(x1, a), p(x1, f(0)), p(x1, f(1)), p(x1, f(2))};
+    return !ccd::vertex_face_ccd(q, ccd::Accuracy::exact).hit;
+  }
+  const auto ea = s.topo.edges.row(a);
+  const auto eb = s.topo.edges.row(b);
+  const ccd::EdgeEdgeQuery q{p(x0, ea(0)), p(x0, ea(1)), p(x0, eb(0)), p(x0, eb(1)),
+                             p(x1, ea(0)), p(x1, ea(1)), p(x1, eb(0)), p(x1, eb(1))};
+  return !ccd::edge_edge_ccd(q, ccd::Accuracy::exact).hit;
+}
+
+/// CCD of a culling method against the reference's contacts (conservative elementary tests):
+/// nothing the method reports is missing from the reference, and whatever the reference reports
+/// beyond it is a false positive of the conservative test, refuted in exact arithmetic.
+::testing::AssertionResult same_ccd_contacts(const OpenScene& s, std::size_t from,
+                                             const FrameResult& method, const FrameResult& reference) {
+  const auto got = keys(method);
+  const auto want = keys(reference);
+  for (const Key& k : got) {
+    if (!want.count(k)) {
+      return ::testing::AssertionFailure()
+             << "contact (" << std::get<0>(k) << ", " << std::get<1>(k) << ", " << std::get<2>(k)
+             << ") is not in the reference";
+    }
+  }
+  for (const Key& k : want) {
+    if (!got.count(k) && !exactly_refuted(s, from, k)) {
+      return ::testing::AssertionFailure()
+             << "missed contact (" << std::get<0>(k) << ", " << std::get<1>(k) << ", "
+             << std::get<2>(k) << ") of " << want.size();
+    }
+  }
+  return ::testing::AssertionSuccess();
+}
+
+const ConeCullingStats& stats_of(const CullingMethod& m) {
+  return dynamic_cast<const ConeStatistics&>(m).cone_stats();
+}
+
+std::vector<OpenScene> small_open_scenes() {
+  std::vector<OpenScene> out;
+  out.push_back(test::pipe_scene(12, 72, {0.5, 0.7, 0.9}));
+  out.push_back(test::wrap_sheet_scene(8, 90, {0.30, 0.36}));
+  out.push_back(test::crumpled_tube_scene(12, 56, {0.55, 0.6}));
+  out.push_back(test::skirt_body_scene(9, 14, 16, 10, {0.3, 0.5}));
+  return out;
+}
+
+const std::vector<std::string> kExactMethods = {"enhanced-dual-cone", "normal-cone"};
+
+TEST(ConeMethods, FactoryBuildsThemByName) {
+  const auto s = test::wrap_sheet_scene(3, 12, {0.3});
+  for (const std::string name : {"enhanced-dual-cone", "normal-cone", "dual-cone"}) {
+    const auto m = make_method(name, s.mesh, s.topo);
+    EXPECT_EQ(m->name(), name);
+    EXPECT_NE(dynamic_cast<const ConeStatistics*>(m.get()), nullptr);
+  }
+}
+
+TEST(ConeMethods, EveryOpenSceneCollidesAndMatchesBruteForce) {
+  for (const OpenScene& s : small_open_scenes()) {
+    SCOPED_TRACE(s.name);
+    for (std::size_t f = 0; f < s.frames.size(); ++f) {
+      const FrameResult brute = run_dcd("brute", s, f);
+      EXPECT_FALSE(brute.dcd_pairs.empty()) << "scene must self-intersect at frame " << f;
+      for (const auto& name : kExactMethods) {
+        EXPECT_EQ(run_dcd(name, s, f).dcd_pairs, brute.dcd_pairs) << name << " frame " << f;
+      }
+    }
+    for (std::size_t f = 0; f + 1 < s.frames.size(); ++f) {
+      const FrameResult brute = run_ccd("brute", s, f);
+      EXPECT_FALSE(brute.contacts.empty());
+      for (const auto& name : kExactMethods) {
+        EXPECT_TRUE(same_ccd_contacts(s, f, run_ccd(name, s, f), brute)) << name << " interval " << f;
+      }
+    }
+  }
+}
+
+TEST(ConeMethods, EnhancedCullsWhatItCanAndReportsWhy) {
+  const auto s = test::wrap_sheet_scene(8, 90, {0.30, 0.36});
+  auto m = make_method("enhanced-dual-cone", s.mesh, s.topo);
+  FrameResult out;
+  m->detect_dcd(s.frames[0], out);
+  const ConeCullingStats& st = stats_of(*m);
+  EXPECT_GT(st.nodes_culled, 0);
+  EXPECT_EQ(st.nodes_tested, st.nodes_culled + st.failed_normal_cone + st.failed_topology +
+                                 st.failed_dual_cone + st.failed_contour);
+  // Nodes holding both crossing layers have two loops whose projections cross or nest.
+  EXPECT_GT(st.failed_contour, 0);
+  EXPECT_GT(st.contour.chain_tests, 0);
+  EXPECT_GT(st.contour.nesting_tests, 0);
+  // Fewer candidate pairs than the plain hierarchy, the same answer.
+  const FrameResult bvh = run_dcd("bvh", s, 0);
+  EXPECT_LT(out.counters.candidate_pairs, bvh.counters.candidate_pairs);
+  EXPECT_EQ(out.dcd_pairs, bvh.dcd_pairs);
+}
+
+TEST(ConeMethods, FlatSheetIsCulledAtTheRoot) {
+  const auto mesh = test::sheet(16, 16);
+  const auto topo = skinning::build_topology(mesh);
+  const skinning::Positions x = test::welded(topo, mesh.rest_positions);
+  for (const std::string name : {"enhanced-dual-cone", "normal-cone"}) {
+    auto m = make_method(name, mesh, topo);
+    FrameResult out;
+    m->detect_dcd(x, out);
+    EXPECT_EQ(stats_of(*m).nodes_tested, 1) << name;
+    EXPECT_EQ(stats_of(*m).nodes_culled, 1) << name;
+    EXPECT_EQ(out.counters.tt_tests, 0) << name;
+    FrameResult ccd;
+    m->detect_ccd(x, test::translated(x, Eigen::Vector3d(0.01, 0.02, 0.03)), ccd);
+    EXPECT_EQ(stats_of(*m).nodes_culled, 1) << name;
+    EXPECT_EQ(ccd.counters.vf_tests + ccd.counters.ee_tests, 0) << name;
+  }
+  // FASTCD's root BNC holds the binormals of the whole boundary, pointing every way in the
+  // plane: it fails at the root and culls lower down.
+  auto m = make_method("dual-cone", mesh, topo);
+  FrameResult out;
+  m->detect_dcd(x, out);
+  EXPECT_EQ(stats_of(*m).failed_dual_cone, stats_of(*m).nodes_tested - stats_of(*m).nodes_culled);
+  EXPECT_GT(stats_of(*m).failed_dual_cone, 0);
+  EXPECT_GT(stats_of(*m).nodes_culled, 0);
+  EXPECT_TRUE(out.dcd_pairs.empty());
+}
+
+TEST(ConeMethods, ContactDistanceTurnsCullingOffAndMatchesBvh) {
+  const auto s = test::wrap_sheet_scene(6, 60, {0.30, 0.36});
+  const MethodOptions opts{.min_separation = 1e-3};
+  const FrameResult bvh = run_ccd("bvh", s, 0, opts);
+  for (const auto& name : kExactMethods) {
+    auto m = make_method(name, s.mesh, s.topo, opts);
+    FrameResult out;
+    m->detect_ccd(s.frames[0], s.frames[1], out);
+    EXPECT_TRUE(stats_of(*m).culling_disabled);
+    EXPECT_EQ(keys(out), keys(bvh)) << name;
+  }
+}
+
+TEST(DualCone, MissesCollisionsInsideThePipeAndTheWrappedSheetWhereEnhancedDoesNot) {
+  // Paper 000 Fig. 1/3/4: nodes away from the original boundary, holding two layers with
+  // similar normals, pass FASTCD's test and are culled although the layers intersect.
+  for (const OpenScene& s : {test::pipe_scene(16, 96, {0.6, 0.9}), test::wrap_sheet_scene(10, 120, {0.30, 0.36})}) {
+    SCOPED_TRACE(s.name);
+    const FrameResult bvh = run_dcd("bvh", s, 0);
+    const FrameResult dual = run_dcd("dual-cone", s, 0);
+    const FrameResult enhanced = run_dcd("enhanced-dual-cone", s, 0);
+    ASSERT_FALSE(bvh.dcd_pairs.empty());
+    EXPECT_EQ(enhanced.dcd_pairs, bvh.dcd_pairs);
+    // dual-cone: a strict subset (it only culls; its elementary tests are the same).
+    EXPECT_LT(dual.dcd_pairs.size(), bvh.dcd_pairs.size());
+    EXPECT_TRUE(std::includes(bvh.dcd_pairs.begin(), bvh.dcd_pairs.end(), dual.dcd_pairs.begin(),
+                              dual.dcd_pairs.end()));
+    // CCD likewise.
+    const FrameResult bvh_ccd = run_ccd("bvh", s, 0);
+    const FrameResult dual_ccd = run_ccd("dual-cone", s, 0);
+    EXPECT_TRUE(same_ccd_contacts(s, 0, run_ccd("enhanced-dual-cone", s, 0), bvh_ccd));
+    EXPECT_LT(dual_ccd.contacts.size(), bvh_ccd.contacts.size());
+    const auto d = keys(dual_ccd);
+    const auto b = keys(bvh_ccd);
+    EXPECT_TRUE(std::includes(b.begin(), b.end(), d.begin(), d.end()));
+  }
+}
+
+TEST(ConeMethods, ClothFunnelMatchesBvh) {
+  const OpenScene s = test::cloth_funnel_scene(test::asset("cloth-funnel/frames"));
+  ASSERT_EQ(s.mesh.num_triangles(), 18484);
+  for (std::size_t f = 0; f < 2; ++f) {
+    const FrameResult bvh = run_dcd("bvh", s, f);
+    for (const auto& name : kExactMethods) {
+      EXPECT_EQ(run_dcd(name, s, f).dcd_pairs, bvh.dcd_pairs) << name << " frame " << f;
+    }
+  }
+  const FrameResult bvh = run_ccd("bvh", s, 0);
+  EXPECT_FALSE(bvh.contacts.empty());
+  for (const auto& name : kExactMethods) {
+    EXPECT_TRUE(same_ccd_contacts(s, 0, run_ccd(name, s, 0), bvh)) << name;
+  }
+}
+
+}  // namespace
+}  // namespace skelcd::culling
