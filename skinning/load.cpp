@@ -7,6 +7,7 @@
 
 #include "skinning/errors.hpp"
 #include "skinning/frame_sequence.hpp"
+#include "skinning/generators.hpp"
 #include "skinning/rig_motion.hpp"
 #include "skinning/urdf.hpp"
 
@@ -92,6 +93,8 @@ LoadedModel model_from_rig(Rig rig, ModelKind kind, std::vector<std::string> pro
 }
 
 LoadedModel load_model(const std::filesystem::path& path, const LoadOptions& options) {
+  // `gen:NAME?…` names a generated rig (skinning/generators.hpp), not a file.
+  if (is_generator_spec(path.string())) return load_generated_model(path.string(), options);
   switch (classify_model_path(path)) {
     // One loader per kind; each returns a complete LoadedModel (model_from_rig() wraps a Rig).
     case ModelKind::frame_sequence:
