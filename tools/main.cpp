@@ -22,6 +22,7 @@ int main(int argc, char** argv) {
   skelcd::tools::add_check_command(app);
   skelcd::tools::add_inspect_command(app);
   skelcd::tools::add_export_command(app);
+  skelcd::tools::add_generate_command(app);
 
   try {
     app.parse(argc, argv);
