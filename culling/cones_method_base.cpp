@@ -36,9 +36,13 @@ ConeMethodBase::ConeMethodBase(
     const skinning::Topology& topology,
     const MethodOptions& options,
     Descent descent,
-    bool needs_contours)
+    bool needs_contours,
+    const std::vector<std::int32_t>* subset)
     : MethodBase(name, mesh, topology, options),
-      bvh_(topology_.welded_triangles(), welded_rest(mesh, topology), options.bvh),
+      bvh_(subset == nullptr
+               ? AabbBvh(topology_.welded_triangles(), welded_rest(mesh, topology), options.bvh)
+               : AabbBvh(topology_.welded_triangles(), welded_rest(mesh, topology), *subset,
+                         options.bvh)),
       descent_(descent),
       // The cone theorems say "no intersection", not "no pair within a distance": with a contact
       // distance the method culls nothing and equals `bvh` (docs/dual-cone.md).

@@ -46,13 +46,16 @@ class ConeMethodBase : public MethodBase, public ConeStatistics {
   };
 
   /// @param needs_contours build the per-node contours (normal-cone, enhanced-dual-cone).
+  /// @param subset when not null, the triangle ids the method covers (its hierarchy is built over
+  ///        them only: pairs with a triangle outside are never reported) — for routing.
   ConeMethodBase(
       std::string_view name,
       const skinning::Mesh& mesh,
       const skinning::Topology& topology,
       const MethodOptions& options,
       Descent descent,
-      bool needs_contours);
+      bool needs_contours,
+      const std::vector<std::int32_t>* subset);
 
   /// Per-interval refit beyond the normal cones (FASTCD's binormal cones). Default: nothing.
   virtual void refit_extra(const Interval& /*interval*/) {}

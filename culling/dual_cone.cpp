@@ -14,15 +14,18 @@ class DualConeMethod final : public detail::ConeMethodBase {
   DualConeMethod(
       const skinning::Mesh& mesh,
       const skinning::Topology& topology,
-      const MethodOptions& options)
+      const MethodOptions& options,
+      const std::vector<std::int32_t>* subset)
       : ConeMethodBase("dual-cone", mesh, topology, options, Descent::children,
-                       /*needs_contours=*/false) {
+                       /*needs_contours=*/false, subset) {
     // Which sides of each triangle are boundary edges of the mesh (one incident face).
     const auto nf = static_cast<std::size_t>(topology_.num_triangles());
     boundary_sides_.assign(nf, 0);
     for (std::int32_t f = 0; f < topology_.num_triangles(); ++f) {
       for (int k = 0; k < 3; ++k) {
-        const auto e = static_cast<std::size_t>(topology_.face_edge(f, k));
+        const std::int32_t side = topology_.face_edge(f, k);
+        if (side < 0) continue;  // a collapsed side of a degenerate triangle
+        const auto e = static_cast<std::size_t>(side);
         if (e + 1 < topology.edge_face_offsets.size() &&
             topology.edge_face_offsets[e + 1] - topology.edge_face_offsets[e] == 1) {
           boundary_sides_[static_cast<std::size_t>(f)] |= static_cast<std::uint8_t>(1u << k);
@@ -108,7 +111,15 @@ std::unique_ptr<CullingMethod> make_dual_cone_method(
     const skinning::Mesh& mesh,
     const skinning::Topology& topology,
     const MethodOptions& options) {
-  return std::make_unique<DualConeMethod>(mesh, topology, options);
+  return std::make_unique<DualConeMethod>(mesh, topology, options, nullptr);
+}
+
+std::unique_ptr<CullingMethod> make_dual_cone_method(
+    const skinning::Mesh& mesh,
+    const skinning::Topology& topology,
+    const MethodOptions& options,
+    const std::vector<std::int32_t>& triangles) {
+  return std::make_unique<DualConeMethod>(mesh, topology, options, &triangles);
 }
 
 }  // namespace skelcd::culling

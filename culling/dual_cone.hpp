@@ -7,7 +7,9 @@
 // cones bound the Bernstein control vectors of n(t) and of n(t) × e(t).
 // May miss collisions by design: never use it where a miss matters.
 
+#include <cstdint>
 #include <memory>
+#include <vector>
 
 #include "culling/method.hpp"
 
@@ -19,5 +21,14 @@ namespace skelcd::culling {
     const skinning::Mesh& mesh,
     const skinning::Topology& topology,
     const MethodOptions& options = {});
+
+/// The same method over the triangles listed in `triangles` only (welded triangle ids): pairs
+/// with a triangle outside the list are never reported. Used by routing for the open parts.
+/// @throws InvalidInput as make_method, or for a triangle id out of range.
+[[nodiscard]] std::unique_ptr<CullingMethod> make_dual_cone_method(
+    const skinning::Mesh& mesh,
+    const skinning::Topology& topology,
+    const MethodOptions& options,
+    const std::vector<std::int32_t>& triangles);
 
 }  // namespace skelcd::culling

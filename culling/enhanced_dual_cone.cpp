@@ -11,10 +11,11 @@ class EnhancedDualConeMethod final : public detail::ConeMethodBase {
   EnhancedDualConeMethod(
       const skinning::Mesh& mesh,
       const skinning::Topology& topology,
-      const MethodOptions& options)
+      const MethodOptions& options,
+      const std::vector<std::int32_t>* subset)
       : ConeMethodBase(
             "enhanced-dual-cone", mesh, topology, options, Descent::grandchildren,
-            /*needs_contours=*/true) {}
+            /*needs_contours=*/true, subset) {}
 
  private:
   // EnhancedDualConeTest (Algorithms 1 and 4) of node n.
@@ -63,7 +64,15 @@ std::unique_ptr<CullingMethod> make_enhanced_dual_cone_method(
     const skinning::Mesh& mesh,
     const skinning::Topology& topology,
     const MethodOptions& options) {
-  return std::make_unique<EnhancedDualConeMethod>(mesh, topology, options);
+  return std::make_unique<EnhancedDualConeMethod>(mesh, topology, options, nullptr);
+}
+
+std::unique_ptr<CullingMethod> make_enhanced_dual_cone_method(
+    const skinning::Mesh& mesh,
+    const skinning::Topology& topology,
+    const MethodOptions& options,
+    const std::vector<std::int32_t>& triangles) {
+  return std::make_unique<EnhancedDualConeMethod>(mesh, topology, options, &triangles);
 }
 
 }  // namespace skelcd::culling

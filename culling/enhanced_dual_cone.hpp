@@ -9,7 +9,9 @@
 // (Bernstein control vectors of n(t)) and the continuous contour test.
 // docs/dual-cone.md says where and why this differs from the paper's text.
 
+#include <cstdint>
 #include <memory>
+#include <vector>
 
 #include "culling/method.hpp"
 
@@ -21,5 +23,14 @@ namespace skelcd::culling {
     const skinning::Mesh& mesh,
     const skinning::Topology& topology,
     const MethodOptions& options = {});
+
+/// The same method over the triangles listed in `triangles` only (welded triangle ids): pairs
+/// with a triangle outside the list are never reported. Used by routing for the open parts.
+/// @throws InvalidInput as make_method, or for a triangle id out of range.
+[[nodiscard]] std::unique_ptr<CullingMethod> make_enhanced_dual_cone_method(
+    const skinning::Mesh& mesh,
+    const skinning::Topology& topology,
+    const MethodOptions& options,
+    const std::vector<std::int32_t>& triangles);
 
 }  // namespace skelcd::culling

@@ -11,10 +11,11 @@ class NormalConeMethod final : public detail::ConeMethodBase {
   NormalConeMethod(
       const skinning::Mesh& mesh,
       const skinning::Topology& topology,
-      const MethodOptions& options)
+      const MethodOptions& options,
+      const std::vector<std::int32_t>* subset)
       : ConeMethodBase(
             "normal-cone", mesh, topology, options, Descent::children,
-            /*needs_contours=*/true) {}
+            /*needs_contours=*/true, subset) {}
 
  private:
   bool node_culled(std::int32_t n, const Interval& interval) override {
@@ -51,7 +52,15 @@ std::unique_ptr<CullingMethod> make_normal_cone_method(
     const skinning::Mesh& mesh,
     const skinning::Topology& topology,
     const MethodOptions& options) {
-  return std::make_unique<NormalConeMethod>(mesh, topology, options);
+  return std::make_unique<NormalConeMethod>(mesh, topology, options, nullptr);
+}
+
+std::unique_ptr<CullingMethod> make_normal_cone_method(
+    const skinning::Mesh& mesh,
+    const skinning::Topology& topology,
+    const MethodOptions& options,
+    const std::vector<std::int32_t>& triangles) {
+  return std::make_unique<NormalConeMethod>(mesh, topology, options, &triangles);
 }
 
 }  // namespace skelcd::culling

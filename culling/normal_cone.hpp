@@ -6,7 +6,9 @@
 // simple polygon (every pair of contour edges tested, after 2D box culling); otherwise the standard
 // descent follows: both children's self-tests and the pair of children.
 
+#include <cstdint>
 #include <memory>
+#include <vector>
 
 #include "culling/method.hpp"
 
@@ -18,5 +20,14 @@ namespace skelcd::culling {
     const skinning::Mesh& mesh,
     const skinning::Topology& topology,
     const MethodOptions& options = {});
+
+/// The same method over the triangles listed in `triangles` only (welded triangle ids): pairs
+/// with a triangle outside the list are never reported. Used by routing for the open parts.
+/// @throws InvalidInput as make_method, or for a triangle id out of range.
+[[nodiscard]] std::unique_ptr<CullingMethod> make_normal_cone_method(
+    const skinning::Mesh& mesh,
+    const skinning::Topology& topology,
+    const MethodOptions& options,
+    const std::vector<std::int32_t>& triangles);
 
 }  // namespace skelcd::culling

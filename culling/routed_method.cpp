@@ -1,0 +1,375 @@
+// `auto`: per-component routing. Open components → a cone method over their triangles; closed
+// components → `dynamic` (through the options' extension) or the `bvh` fallback; the pairs
+// between the two groups → a BVH pair traversal; one feature and elementary stage for what this
+// class traverses itself, and the groups' contacts merged, de-duplicated and sorted.
+#include "culling/routed_method.hpp"
+
+#include <algorithm>
+#include <numeric>
+
+#include "culling/bvh.hpp"
+#include "culling/candidates.hpp"
+#include "culling/detail/method_base.hpp"
+#include "culling/dual_cone.hpp"
+#include "culling/enhanced_dual_cone.hpp"
+#include "culling/method_extension.hpp"
+#include "culling/normal_cone.hpp"
+#include "culling/traversal.hpp"
+#include "culling/vertex_bounds.hpp"
+#include "skinning/errors.hpp"
+
+namespace skelcd::culling {
+namespace {
+
+inline std::size_t sz(std::int32_t i) { return static_cast<std::size_t>(i); }
+
+bool is_cone_method(std::string_view name) {
+  return name == "enhanced-dual-cone" || name == "normal-cone" || name == "dual-cone";
+}
+
+bool extension_builds(const MethodOptions& options, std::string_view name) {
+  if (!options.extension) return false;
+  const auto names = options.extension->method_names();
+  return std::find(names.begin(), names.end(), name) != names.end();
+}
+
+/// The method of the closed group: as asked, else `dynamic` if available, else the fallback.
+std::string closed_method_name(const MethodOptions& options, const RoutingOptions& routing) {
+  if (!routing.closed_method.empty()) return routing.closed_method;
+  if (extension_builds(options, "dynamic")) return "dynamic";
+  return std::string(kClosedFallbackMethod);
+}
+
+void check_group_method(const MethodOptions& options, const std::string& name, bool open) {
+  if (is_cone_method(name) || name == "bvh") return;
+  if (!open && extension_builds(options, name)) return;
+  throw InvalidInput(
+      "culling::make_method(auto): '" + name + "' cannot take the " +
+      (open ? "open" : "closed") +
+      " components (use enhanced-dual-cone, normal-cone, dual-cone or bvh" +
+      (open ? ")" : ", or a method of the options' extension)"));
+}
+
+/// Edge-connected components and whether each is closed (every edge has exactly two triangles):
+/// Topology::components when filled, else computed from the edge → face incidence.
+std::vector<skinning::Component> components_of(const skinning::Topology& topology) {
+  if (!topology.components.empty()) return topology.components;
+  const auto nf = static_cast<std::size_t>(topology.welded_triangles.rows());
+  std::vector<std::int32_t> root(nf);
+  std::iota(root.begin(), root.end(), 0);
+  auto find = [&root](std::int32_t f) {
+    while (root[sz(f)] != f) f = root[sz(f)] = root[sz(root[sz(f)])];
+    return f;
+  };
+  const std::size_t ne = topology.edge_face_offsets.empty() ? 0 : topology.edge_face_offsets.size() - 1;
+  std::vector<std::uint8_t> open_face(nf, 0);
+  for (std::size_t e = 0; e < ne; ++e) {
+    const auto b = topology.edge_face_offsets[e];
+    const auto c = topology.edge_face_offsets[e + 1];
+    for (auto k = b + 1; k < c; ++k) {
+      const std::int32_t r0 = find(topology.edge_faces[sz(b)]);
+      const std::int32_t r1 = find(topology.edge_faces[sz(k)]);
+      if (r0 != r1) root[sz(r1)] = r0;
+    }
+    if (c - b != 2) {
+      for (auto k = b; k < c; ++k) open_face[sz(topology.edge_faces[sz(k)])] = 1;
+    }
+  }
+  std::vector<skinning::Component> out;
+  std::vector<std::int32_t> index(nf, -1);
+  for (std::size_t f = 0; f < nf; ++f) {
+    const auto r = sz(find(static_cast<std::int32_t>(f)));
+    if (index[r] < 0) {
+      index[r] = static_cast<std::int32_t>(out.size());
+      out.emplace_back();
+      out.back().closed = true;
+    }
+    auto& c = out[sz(index[r])];
+    c.faces.push_back(static_cast<std::int32_t>(f));
+    if (open_face[f] != 0) c.closed = false;
+  }
+  return out;
+}
+
+void add(Counters& a, const Counters& b) {
+  a.atomic_clusters += b.atomic_clusters;
+  a.mega_clusters += b.mega_clusters;
+  a.h_minus += b.h_minus;
+  a.h_uncertain += b.h_uncertain;
+  a.bv_tests += b.bv_tests;
+  a.candidate_pairs += b.candidate_pairs;
+  a.vf_tests += b.vf_tests;
+  a.ee_tests += b.ee_tests;
+  a.vf_contacts += b.vf_contacts;
+  a.ee_contacts += b.ee_contacts;
+  a.tt_tests += b.tt_tests;
+  a.dcd_pairs += b.dcd_pairs;
+  a.feature_bv_tests += b.feature_bv_tests;
+}
+
+void add(StageTimes& a, const StageTimes& b) {
+  a.skin_us += b.skin_us;
+  a.refit_us += b.refit_us;
+  a.classify_us += b.classify_us;
+  a.merge_us += b.merge_us;
+  a.traverse_us += b.traverse_us;
+  a.elementary_us += b.elementary_us;
+}
+
+/// A copy of `mesh` whose parts are split into (part, open) and (part, closed), with every pair
+/// that involves an open triangle excluded on top of the mesh's own exclusions: what a whole-mesh
+/// method (an extension's `dynamic`) is given so that it tests only closed-closed pairs.
+skinning::Mesh closed_only_mesh(const skinning::Mesh& mesh, const std::vector<std::uint8_t>& open_face) {
+  skinning::Mesh m = mesh;
+  const std::int32_t parts = std::max<std::int32_t>(1, mesh.num_parts());
+  auto refined = [](std::int32_t p, bool open) { return 2 * p + (open ? 1 : 0); };
+  m.part_names.clear();
+  for (std::int32_t p = 0; p < parts; ++p) {
+    const std::string base = p < mesh.num_parts() ? mesh.part_names[sz(p)] : "mesh";
+    m.part_names.push_back(base + "/closed");
+    m.part_names.push_back(base + "/open");
+  }
+  const auto nf = static_cast<std::size_t>(mesh.num_triangles());
+  m.face_part.resize(nf);
+  for (std::size_t f = 0; f < nf; ++f) {
+    const std::int32_t p = mesh.face_part.empty() ? 0 : mesh.face_part[f];
+    m.face_part[f] = refined(p, open_face[f] != 0);
+  }
+  m.vertex_part.assign(static_cast<std::size_t>(mesh.num_vertices()), 0);
+  for (std::size_t f = 0; f < nf; ++f) {
+    for (Eigen::Index k = 0; k < 3; ++k) {
+      m.vertex_part[sz(mesh.triangles(static_cast<Eigen::Index>(f), k))] = m.face_part[f];
+    }
+  }
+  m.excluded_part_pairs.clear();
+  for (const auto& [a, b] : mesh.excluded_part_pairs) {
+    for (const bool oa : {false, true}) {
+      for (const bool ob : {false, true}) {
+        const std::int32_t x = refined(a, oa);
+        const std::int32_t y = refined(b, ob);
+        m.excluded_part_pairs.emplace_back(std::min(x, y), std::max(x, y));
+      }
+    }
+  }
+  for (std::int32_t p = 0; p < parts; ++p) {
+    for (std::int32_t q = 0; q < 2 * parts; ++q) {
+      const std::int32_t o = refined(p, true);
+      m.excluded_part_pairs.emplace_back(std::min(o, q), std::max(o, q));
+    }
+  }
+  return m;
+}
+
+class AutoMethod final : public detail::MethodBase, public RoutedMethod {
+ public:
+  AutoMethod(
+      const skinning::Mesh& mesh,
+      const skinning::Topology& topology,
+      const MethodOptions& options,
+      const RoutingOptions& routing)
+      : MethodBase("auto", mesh, topology, options) {
+    // The plan, with each component's part taken from the mesh.
+    routes_ = route_components(topology, options, routing);
+    const auto components = components_of(topology);
+    const auto nf = static_cast<std::size_t>(topology_.num_triangles());
+    std::vector<std::uint8_t> open_face(nf, 0);
+    for (std::size_t c = 0; c < components.size(); ++c) {
+      auto& r = routes_[c];
+      if (r.part < 0 && !components[c].faces.empty()) r.part = topology_.face_part(components[c].faces[0]);
+      for (const std::int32_t f : components[c].faces) {
+        (components[c].closed ? closed_triangles_ : open_triangles_).push_back(f);
+        open_face[sz(f)] = components[c].closed ? 0 : 1;
+      }
+    }
+    std::sort(open_triangles_.begin(), open_triangles_.end());
+    std::sort(closed_triangles_.begin(), closed_triangles_.end());
+
+    // Welded rest positions for the groups' hierarchies.
+    skinning::Positions rest(topology.num_welded_vertices(), 3);
+    for (std::int32_t w = 0; w < topology.num_welded_vertices(); ++w) {
+      rest.row(w) = mesh.rest_positions.row(topology.representative_vertex[sz(w)]);
+    }
+    const std::string open_name = routing.open_method;
+    const std::string closed_name = closed_method_name(options, routing);
+    if (!open_triangles_.empty()) {
+      open_bvh_ = AabbBvh(topology_.welded_triangles(), rest, open_triangles_, options.bvh);
+      open_method_ = make_group_method(open_name, mesh, topology, options, open_triangles_);
+    }
+    if (!closed_triangles_.empty()) {
+      closed_bvh_ = AabbBvh(topology_.welded_triangles(), rest, closed_triangles_, options.bvh);
+      if (extension_builds(options, closed_name) && !is_cone_method(closed_name)) {
+        // A whole-mesh method (an extension's `dynamic`): the open triangles are excluded.
+        closed_method_ = make_method(closed_name, closed_only_mesh(mesh, open_face), topology, options);
+      } else {
+        closed_method_ = make_group_method(closed_name, mesh, topology, options, closed_triangles_);
+      }
+    }
+    const auto num_faces = nf;
+    bounds_.vertices.reserve(static_cast<std::size_t>(topology_.num_vertices()));
+    bounds_.edges.reserve(static_cast<std::size_t>(topology_.num_edges()));
+    bounds_.triangles.reserve(num_faces);
+    scratch_.reserve(static_cast<std::size_t>(4 * std::max(open_bvh_.depth(), closed_bvh_.depth()) + 8));
+    pairs_.reserve(num_faces);
+  }
+
+  [[nodiscard]] std::span<const ComponentRoute> routes() const override { return routes_; }
+
+  void detect_dcd(const skinning::Positions& x, FrameResult& out) override {
+    check_positions(x, "detect_dcd", "x");
+    run_groups([&](CullingMethod& m, FrameResult& r) { m.detect_dcd(x, r); }, out);
+    const auto t0 = Clock::now();
+    static_vertex_bounds<3>(x, bounds_.vertices);
+    bounds_.derive(topology_, /*with_edges=*/false);
+    refit_groups();
+    const auto t1 = Clock::now();
+    pairs_.clear();
+    traverse_own(out.counters.bv_tests);
+    for (auto& p : pairs_) {
+      if (p.a > p.b) std::swap(p.a, p.b);
+    }
+    dcd_filter_triangle_pairs(topology_, pairs_, out.counters);
+    const auto t2 = Clock::now();
+    run_dcd_tests(topology_, pairs_, x, tests_, out);
+    const auto t3 = Clock::now();
+    // Merge: sorted, each pair once.
+    std::sort(out.dcd_pairs.begin(), out.dcd_pairs.end());
+    out.dcd_pairs.erase(std::unique(out.dcd_pairs.begin(), out.dcd_pairs.end()), out.dcd_pairs.end());
+    out.counters.dcd_pairs = static_cast<std::int64_t>(out.dcd_pairs.size());
+    out.times.refit_us += micros(t0, t1);
+    out.times.traverse_us += micros(t1, t2);
+    out.times.elementary_us += micros(t2, t3);
+  }
+
+  void detect_ccd(
+      const skinning::Positions& x_t0,
+      const skinning::Positions& x_t1,
+      FrameResult& out) override {
+    check_positions(x_t0, "detect_ccd", "x_t0");
+    check_positions(x_t1, "detect_ccd", "x_t1");
+    run_groups([&](CullingMethod& m, FrameResult& r) { m.detect_ccd(x_t0, x_t1, r); }, out);
+    const auto t0 = Clock::now();
+    swept_vertex_bounds<3>(x_t0, x_t1, 0.5 * options_.min_separation, bounds_.vertices);
+    bounds_.derive(topology_);
+    refit_groups();
+    const auto t1 = Clock::now();
+    pairs_.clear();
+    features_.clear();
+    traverse_own(out.counters.bv_tests);
+    ccd_candidates_from_triangle_pairs<3>(topology_, pairs_, bounds_, features_, out.counters);
+    const auto t2 = Clock::now();
+    run_ccd_tests(topology_, features_, x_t0, x_t1, tests_, options_.accuracy, ccd_options_, out);
+    const auto t3 = Clock::now();
+    // Merge: canonical order, each pair once (a vertex shared by an open and a closed component
+    // can reach one feature pair from two groups), earliest time of impact kept.
+    auto& c = out.contacts;
+    std::sort(c.begin(), c.end(), [](const CcdContact& a, const CcdContact& b) {
+      return a.before(b) || (a.same_pair(b) && a.toi_lower < b.toi_lower);
+    });
+    c.erase(std::unique(c.begin(), c.end(),
+                        [](const CcdContact& a, const CcdContact& b) { return a.same_pair(b); }),
+            c.end());
+    out.counters.vf_contacts = std::count_if(
+        c.begin(), c.end(), [](const CcdContact& x) { return x.kind == CcdContact::Kind::vf; });
+    out.counters.ee_contacts = static_cast<std::int64_t>(c.size()) - out.counters.vf_contacts;
+    out.times.refit_us += micros(t0, t1);
+    out.times.traverse_us += micros(t1, t2);
+    out.times.elementary_us += micros(t2, t3);
+  }
+
+ private:
+  static std::unique_ptr<CullingMethod> make_group_method(
+      const std::string& name,
+      const skinning::Mesh& mesh,
+      const skinning::Topology& topology,
+      const MethodOptions& options,
+      const std::vector<std::int32_t>& triangles) {
+    if (name == "enhanced-dual-cone") return make_enhanced_dual_cone_method(mesh, topology, options, triangles);
+    if (name == "normal-cone") return make_normal_cone_method(mesh, topology, options, triangles);
+    if (name == "dual-cone") return make_dual_cone_method(mesh, topology, options, triangles);
+    return nullptr;  // `bvh`: traversed here (traverse_own)
+  }
+
+  template <class Call>
+  void run_groups(Call call, FrameResult& out) {
+    for (CullingMethod* m : {open_method_.get(), closed_method_.get()}) {
+      if (m == nullptr) continue;
+      sub_.clear();
+      call(*m, sub_);
+      add(out.counters, sub_.counters);
+      add(out.times, sub_.times);
+      out.contacts.insert(out.contacts.end(), sub_.contacts.begin(), sub_.contacts.end());
+      out.dcd_pairs.insert(out.dcd_pairs.end(), sub_.dcd_pairs.begin(), sub_.dcd_pairs.end());
+    }
+  }
+
+  void refit_groups() {
+    if (!open_bvh_.empty()) open_bvh_.refit(bounds_.triangles);
+    if (!closed_bvh_.empty()) closed_bvh_.refit(bounds_.triangles);
+  }
+
+  /// The `bvh` groups' self pairs and the pairs between the groups.
+  void traverse_own(std::int64_t& bv_tests) {
+    const std::span<const Aabb> tri(bounds_.triangles);
+    if (!open_bvh_.empty() && open_method_ == nullptr) {
+      self_traverse<3>(open_bvh_, tri, scratch_, pairs_, bv_tests);
+    }
+    if (!closed_bvh_.empty() && closed_method_ == nullptr) {
+      self_traverse<3>(closed_bvh_, tri, scratch_, pairs_, bv_tests);
+    }
+    if (!open_bvh_.empty() && !closed_bvh_.empty()) {
+      pair_traverse<3>(open_bvh_, tri, closed_bvh_, tri, scratch_, pairs_, bv_tests);
+    }
+  }
+
+  std::vector<ComponentRoute> routes_;
+  std::vector<std::int32_t> open_triangles_;
+  std::vector<std::int32_t> closed_triangles_;
+  AabbBvh open_bvh_;
+  AabbBvh closed_bvh_;
+  std::unique_ptr<CullingMethod> open_method_;
+  std::unique_ptr<CullingMethod> closed_method_;
+  FeatureBounds<3> bounds_;
+  TraversalScratch scratch_;
+  std::vector<TrianglePair> pairs_;
+  FeatureCandidates features_;
+  FrameResult sub_;
+};
+
+}  // namespace
+
+std::vector<ComponentRoute> route_components(
+    const skinning::Topology& topology,
+    const MethodOptions& options,
+    const RoutingOptions& routing) {
+  const std::string closed_name = closed_method_name(options, routing);
+  check_group_method(options, routing.open_method, /*open=*/true);
+  check_group_method(options, closed_name, /*open=*/false);
+  const auto components = components_of(topology);
+  std::vector<ComponentRoute> routes;
+  routes.reserve(components.size());
+  for (std::size_t c = 0; c < components.size(); ++c) {
+    ComponentRoute r;
+    r.component = static_cast<std::int32_t>(c);
+    r.part = components[c].part;
+    r.closed = components[c].closed;
+    r.num_triangles = static_cast<std::int32_t>(components[c].faces.size());
+    r.method = r.closed ? closed_name : routing.open_method;
+    routes.push_back(std::move(r));
+  }
+  return routes;
+}
+
+std::unique_ptr<CullingMethod> make_routed_method(
+    const skinning::Mesh& mesh,
+    const skinning::Topology& topology,
+    const MethodOptions& options,
+    const RoutingOptions& routing) {
+  return std::make_unique<AutoMethod>(mesh, topology, options, routing);
+}
+
+std::span<const ComponentRoute> routes_of(const CullingMethod& method) {
+  if (const auto* r = dynamic_cast<const RoutedMethod*>(&method)) return r->routes();
+  return {};
+}
+
+}  // namespace skelcd::culling

@@ -1,0 +1,71 @@
+#pragma once
+// `auto`: each connected component of a mesh goes to the culling method that fits it (DESIGN.md
+// "Routing"). Components with an open boundary go to `enhanced-dual-cone` (radial-view culling
+// needs a closed surface); closed components go to `dynamic` when MethodOptions::extension builds
+// it, else to kClosedFallbackMethod (`bvh`) — the one named fallback while `dynamic` is not
+// available. Pairs of triangles in different groups go through a BVH pair traversal between the
+// groups' hierarchies. Everything ends in the shared feature and elementary stages over the whole
+// mesh, so contacts are reported in the mesh's own welded numbering, canonical and sorted, as by
+// any other method. To force one method for a whole object, call make_method with its name
+// instead of "auto".
+
+#include <cstdint>
+#include <memory>
+#include <span>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "culling/method.hpp"
+
+namespace skelcd::culling {
+
+/// What closed components use when no extension in the options builds `dynamic`.
+inline constexpr std::string_view kClosedFallbackMethod = "bvh";
+
+struct RoutingOptions {
+  /// Method for components with an open boundary: `enhanced-dual-cone` (default),
+  /// `normal-cone`, `dual-cone` or `bvh`.
+  std::string open_method = "enhanced-dual-cone";
+  /// Method for closed components: empty picks `dynamic` when MethodOptions::extension builds
+  /// it, else kClosedFallbackMethod. Otherwise any name above, or a name of the extension.
+  std::string closed_method;
+};
+
+/// Where one connected component (Topology::components) goes.
+struct ComponentRoute {
+  std::int32_t component = -1;    ///< index into Topology::components
+  std::int32_t part = -1;         ///< Mesh part of its first triangle
+  bool closed = false;            ///< no boundary and no non-manifold edge
+  std::int32_t num_triangles = 0;
+  std::string method;             ///< the method testing its pairs within its group
+};
+
+/// The plan of make_routed_method: one route per component, in component order. Uses
+/// Topology::components, or finds the edge-connected components itself when that is empty.
+/// @throws InvalidInput naming the method when a group's method is unknown or unusable here.
+[[nodiscard]] std::vector<ComponentRoute> route_components(
+    const skinning::Topology& topology,
+    const MethodOptions& options = {},
+    const RoutingOptions& routing = {});
+
+/// Implemented by the `auto` method beside CullingMethod: routes() says which method each
+/// component used (for the log). Reach it with routes_of().
+class RoutedMethod {
+ public:
+  virtual ~RoutedMethod() = default;
+  [[nodiscard]] virtual std::span<const ComponentRoute> routes() const = 0;
+};
+
+/// Builds the `auto` method (what make_method("auto", …) returns, with default RoutingOptions).
+/// @throws InvalidInput as make_method and route_components.
+[[nodiscard]] std::unique_ptr<CullingMethod> make_routed_method(
+    const skinning::Mesh& mesh,
+    const skinning::Topology& topology,
+    const MethodOptions& options = {},
+    const RoutingOptions& routing = {});
+
+/// The routes of `method` when it is a routed method, else empty.
+[[nodiscard]] std::span<const ComponentRoute> routes_of(const CullingMethod& method);
+
+}  // namespace skelcd::culling

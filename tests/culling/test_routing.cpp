@@ -1,0 +1,177 @@
+// `auto`: open components go to enhanced-dual-cone, closed ones to `dynamic` (through an
+// extension) or the `bvh` fallback, pairs across groups through a BVH pair traversal — and the
+// answer is exactly `bvh`'s.
+#include <set>
+#include <string>
+#include <tuple>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "culling/method.hpp"
+#include "culling/method_extension.hpp"
+#include "culling/routed_method.hpp"
+#include "skinning/errors.hpp"
+#include "tests/culling/test_dual_cone_scenes.hpp"
+#include "tests/support/test_support.hpp"
+
+namespace skelcd::culling {
+namespace {
+
+using test::OpenScene;
+
+std::set<std::tuple<int, std::int32_t, std::int32_t>> keys(const FrameResult& r) {
+  std::set<std::tuple<int, std::int32_t, std::int32_t>> k;
+  for (const auto& c : r.contacts) k.emplace(static_cast<int>(c.kind), c.a, c.b);
+  return k;
+}
+
+FrameResult dcd(CullingMethod& m, const skinning::Positions& x) {
+  FrameResult out;
+  m.detect_dcd(x, out);
+  return out;
+}
+
+FrameResult ccd(CullingMethod& m, const skinning::Positions& x0, const skinning::Positions& x1) {
+  FrameResult out;
+  m.detect_ccd(x0, x1, out);
+  return out;
+}
+
+/// Stands in for clustering's extension: builds "dynamic" as a `bvh` over the mesh it is given
+/// (with that mesh's part exclusions), and counts how often it was asked.
+class FakeDynamic final : public MethodExtension {
+ public:
+  [[nodiscard]] std::vector<std::string> method_names() const override { return {"dynamic"}; }
+  [[nodiscard]] std::unique_ptr<CullingMethod> make_method(
+      std::string_view name,
+      const skinning::Mesh& mesh,
+      const skinning::Topology& topology,
+      const MethodOptions& options) const override {
+    if (name != "dynamic") return nullptr;
+    ++built;
+    MethodOptions plain = options;
+    plain.extension = nullptr;
+    return culling::make_method("bvh", mesh, topology, plain);
+  }
+  mutable int built = 0;
+};
+
+TEST(Routing, SkirtGoesToEnhancedDualConeAndTheBodyToTheFallback) {
+  const OpenScene s = test::skirt_body_scene(9, 14, 16, 10, {0.3, 0.5});
+  const auto routes = route_components(s.topo);
+  ASSERT_EQ(routes.size(), 2u);
+  for (const auto& r : routes) {
+    EXPECT_EQ(r.method, r.closed ? std::string(kClosedFallbackMethod) : "enhanced-dual-cone");
+  }
+  EXPECT_TRUE(routes[0].closed);   // the body comes first
+  EXPECT_FALSE(routes[1].closed);  // the skirt
+  EXPECT_EQ(routes[0].num_triangles + routes[1].num_triangles, s.mesh.num_triangles());
+  auto m = make_method("auto", s.mesh, s.topo);
+  EXPECT_EQ(m->name(), "auto");
+  const auto used = routes_of(*m);
+  ASSERT_EQ(used.size(), 2u);
+  EXPECT_EQ(used[1].method, "enhanced-dual-cone");
+  EXPECT_EQ(used[1].part, 1);  // the skirt's part
+  // A forced method has no routes.
+  EXPECT_TRUE(routes_of(*make_method("bvh", s.mesh, s.topo)).empty());
+}
+
+TEST(Routing, AutoFindsExactlyWhatBvhAndBruteFind) {
+  const OpenScene s = test::skirt_body_scene(9, 14, 16, 10, {0.3, 0.5});
+  auto a = make_method("auto", s.mesh, s.topo);
+  auto b = make_method("bvh", s.mesh, s.topo);
+  auto r = make_method("brute", s.mesh, s.topo);
+  for (const auto& x : s.frames) {
+    const FrameResult want = dcd(*r, x);
+    EXPECT_FALSE(want.dcd_pairs.empty());
+    EXPECT_EQ(dcd(*a, x).dcd_pairs, want.dcd_pairs);
+    EXPECT_EQ(dcd(*b, x).dcd_pairs, want.dcd_pairs);
+  }
+  const FrameResult got = ccd(*a, s.frames[0], s.frames[1]);
+  const FrameResult want = ccd(*b, s.frames[0], s.frames[1]);
+  EXPECT_FALSE(want.contacts.empty());
+  EXPECT_EQ(keys(got), keys(want));
+  EXPECT_EQ(got.counters.vf_contacts + got.counters.ee_contacts,
+            static_cast<std::int64_t>(got.contacts.size()));
+  // Skirt against body: some contacts join the two groups (found by the pair traversal).
+  std::int32_t body_faces = 0;
+  for (const auto& c : s.topo.components) body_faces += c.closed ? static_cast<std::int32_t>(c.faces.size()) : 0;
+  bool across = false;
+  for (const auto& p : dcd(*a, s.frames[1]).dcd_pairs) across |= (p.a < body_faces) != (p.b < body_faces);
+  EXPECT_TRUE(across);
+}
+
+TEST(Routing, ClothFunnelRoutesThreeClothPartsAndTheFunnelAndMatchesBvh) {
+  const OpenScene s = test::cloth_funnel_scene(test::asset("cloth-funnel/frames"));
+  auto a = make_method("auto", s.mesh, s.topo);
+  const auto routes = routes_of(*a);
+  ASSERT_EQ(routes.size(), 4u);
+  int open = 0;
+  for (const auto& r : routes) {
+    open += r.closed ? 0 : 1;
+    EXPECT_EQ(r.method, r.closed ? "bvh" : "enhanced-dual-cone");
+  }
+  EXPECT_EQ(open, 3);
+  auto b = make_method("bvh", s.mesh, s.topo);
+  EXPECT_EQ(dcd(*a, s.frames[1]).dcd_pairs, dcd(*b, s.frames[1]).dcd_pairs);
+  EXPECT_EQ(keys(ccd(*a, s.frames[0], s.frames[1])), keys(ccd(*b, s.frames[0], s.frames[1])));
+}
+
+TEST(Routing, ClosedPartsGoToDynamicWhenTheExtensionBuildsIt) {
+  const OpenScene s = test::skirt_body_scene(9, 14, 16, 10, {0.3, 0.5});
+  auto ext = std::make_shared<FakeDynamic>();
+  MethodOptions options;
+  options.extension = ext;
+  auto a = make_method("auto", s.mesh, s.topo, options);
+  EXPECT_EQ(ext->built, 1);
+  const auto routes = routes_of(*a);
+  EXPECT_EQ(routes[0].method, "dynamic");
+  EXPECT_EQ(routes[1].method, "enhanced-dual-cone");
+  // The whole-mesh `dynamic` is told to skip every pair with an open triangle: the merged
+  // answer is still bvh's, each contact once.
+  auto b = make_method("bvh", s.mesh, s.topo);
+  EXPECT_EQ(dcd(*a, s.frames[1]).dcd_pairs, dcd(*b, s.frames[1]).dcd_pairs);
+  const FrameResult got = ccd(*a, s.frames[0], s.frames[1]);
+  EXPECT_EQ(keys(got), keys(ccd(*b, s.frames[0], s.frames[1])));
+  EXPECT_EQ(keys(got).size(), got.contacts.size());
+}
+
+TEST(Routing, OptionsChooseOtherGroupMethodsAndRejectUnknownOnes) {
+  const OpenScene s = test::skirt_body_scene(9, 14, 16, 10, {0.3, 0.5});
+  auto b = make_method("bvh", s.mesh, s.topo);
+  const auto want = keys(ccd(*b, s.frames[0], s.frames[1]));
+  for (const auto& [open, closed] : std::vector<std::pair<std::string, std::string>>{
+           {"normal-cone", "bvh"}, {"bvh", "enhanced-dual-cone"}, {"enhanced-dual-cone", "normal-cone"}}) {
+    auto m = make_routed_method(s.mesh, s.topo, {}, {.open_method = open, .closed_method = closed});
+    EXPECT_EQ(keys(ccd(*m, s.frames[0], s.frames[1])), want) << open << " / " << closed;
+    EXPECT_EQ(routes_of(*m)[0].method, closed);
+  }
+  EXPECT_THROW_MESSAGE((void)make_routed_method(s.mesh, s.topo, {}, {.open_method = "octree", .closed_method = ""}),
+                       InvalidInput, "'octree' cannot take the open components");
+  EXPECT_THROW_MESSAGE((void)make_routed_method(s.mesh, s.topo, {}, {.open_method = "enhanced-dual-cone", .closed_method = "dynamic"}),
+                       InvalidInput, "'dynamic' cannot take the closed components");
+}
+
+TEST(Routing, ComponentsAreFoundWhenTheTopologyHasNone) {
+  // The culling tests' own topology builder fills no components.
+  auto sphere = test::uv_sphere(8, 10);
+  auto sheet = test::sheet(6, 6, 3.0, 3.0);
+  sheet.rest_positions = test::translated(sheet.rest_positions, Eigen::Vector3d(-1.5, -1.5, 0.2));
+  const auto mesh = test::combine(sphere, sheet);
+  const auto topo = test::simple_topology(mesh);
+  ASSERT_TRUE(topo.components.empty());
+  const auto routes = route_components(topo);
+  ASSERT_EQ(routes.size(), 2u);
+  EXPECT_TRUE(routes[0].closed);
+  EXPECT_FALSE(routes[1].closed);
+  EXPECT_EQ(routes[0].num_triangles, sphere.num_triangles());
+  auto a = make_method("auto", mesh, topo);
+  auto b = make_method("brute", mesh, topo);
+  const skinning::Positions x = test::welded(topo, mesh.rest_positions);
+  EXPECT_FALSE(dcd(*b, x).dcd_pairs.empty());  // the sheet cuts through the sphere
+  EXPECT_EQ(dcd(*a, x).dcd_pairs, dcd(*b, x).dcd_pairs);
+}
+
+}  // namespace
+}  // namespace skelcd::culling
