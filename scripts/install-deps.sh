@@ -10,6 +10,7 @@ packages=(
   libtbb-dev libgmp-dev libcli11-dev libtomlplusplus-dev
   libplplot-dev plplot-driver-cairo
   nlohmann-json3-dev python3-h5py
+  libtinyxml-dev libconsole-bridge-dev  # used directly by skinning/urdf*.cpp (SRDF, urdfdom messages)
 )
 
 missing=()
