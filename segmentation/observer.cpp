@@ -6,7 +6,7 @@
 
 #include <Eigen/Geometry>
 
-#include "segmentation/detail/orient3d.hpp"
+#include "ccd/orientation.hpp"
 
 namespace skelcd::segmentation {
 
@@ -16,7 +16,8 @@ std::string_view to_string(ObserverKind kind) {
 
 Orientation orientation(const Observer& observer, const Eigen::Vector3d& a,
                         const Eigen::Vector3d& b, const Eigen::Vector3d& c) {
-  const int s = detail::orient3d_sign(a, b, c, observer.viewing_position(a));
+  // ccd::orient3d(a, b, c, q) is the sign of (q − a) · n: the opposite of ours.
+  const int s = -ccd::orient3d(a, b, c, observer.viewing_position(a));
   return s > 0 ? Orientation::positive : (s < 0 ? Orientation::negative : Orientation::uncertain);
 }
 

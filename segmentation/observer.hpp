@@ -37,7 +37,7 @@ struct Observer {
 };
 
 /// Exact sign of (a − q) · ((b − a) × (c − a)) with q the viewing position for corner a
-/// (filtered orient3d, rational fallback: the sign is exact for the rounded q).
+/// (ccd::orient3d: filtered, rational fallback; exact for the rounded q).
 [[nodiscard]] Orientation orientation(
     const Observer& observer,
     const Eigen::Vector3d& a,
