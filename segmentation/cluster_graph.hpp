@@ -31,12 +31,14 @@ struct ClusterAdjacency {
   Eigen::Vector3d joint = Eigen::Vector3d::Zero();
 };
 
-/// The joint between bones j and k and their nearest common ancestor (see ClusterAdjacency).
-/// @param bones rest segments with parents (parents may come in any order but form a forest).
+/// Where two bones meet: their nearest common ancestor and the joint (see ClusterAdjacency).
 struct BoneJoint {
   std::int32_t ancestor_bone = -1;
   Eigen::Vector3d joint = Eigen::Vector3d::Zero();
 };
+
+/// The joint between bones j and k and their nearest common ancestor (see ClusterAdjacency).
+/// @param bones rest segments with parents (parents may come in any order but form a forest).
 [[nodiscard]] BoneJoint bone_joint(
     const std::vector<BoneSegment>& bones,
     std::int32_t j,

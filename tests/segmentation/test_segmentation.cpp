@@ -16,6 +16,7 @@
 #include "segmentation/face_graph.hpp"
 #include "segmentation/segmentation.hpp"
 #include "skinning/errors.hpp"
+#include "skinning/generators.hpp"
 #include "skinning/load.hpp"
 #include "skinning/topology.hpp"
 #include "tests/segmentation/mini_rigs.hpp"
@@ -335,5 +336,90 @@ TEST_P(RealCharacters, HeatAndRigWeightsBothPartitionTheMesh) {
 
 INSTANTIATE_TEST_SUITE_P(Models, RealCharacters,
                          ::testing::Values("CesiumMan.glb", "BCN_Epileptic.X", "Fox.glb"));
+
+}  // namespace
+
+namespace {
+
+TEST(ClusterGraph, BoneJointsByHand) {
+  using skelcd::segmentation::bone_joint;
+  using skelcd::segmentation::BoneSegment;
+  // 0 root (0,0,0)→(0,1,0); 1 and 2 children of 0 at (0,1,0) going ±x; 3 child of 1;
+  // 4 a second root far away.
+  const std::vector<BoneSegment> bones = {
+      {Eigen::Vector3d(0, 0, 0), Eigen::Vector3d(0, 1, 0), -1},
+      {Eigen::Vector3d(0, 1, 0), Eigen::Vector3d(1, 1, 0), 0},
+      {Eigen::Vector3d(0, 1, 0), Eigen::Vector3d(-1, 1, 0), 0},
+      {Eigen::Vector3d(1, 1, 0), Eigen::Vector3d(2, 1, 0), 1},
+      {Eigen::Vector3d(5, 5, 5), Eigen::Vector3d(6, 5, 5), -1}};
+  auto j = bone_joint(bones, 2, 2);  // pieces of one bone: its midpoint
+  EXPECT_EQ(j.ancestor_bone, 2);
+  EXPECT_EQ(j.joint, Eigen::Vector3d(-0.5, 1, 0));
+  j = bone_joint(bones, 0, 1);  // parent and child: the child's head
+  EXPECT_EQ(j.ancestor_bone, 0);
+  EXPECT_EQ(j.joint, Eigen::Vector3d(0, 1, 0));
+  j = bone_joint(bones, 3, 0);  // grandchild: the head of the child of 0 on the way (bone 1)
+  EXPECT_EQ(j.ancestor_bone, 0);
+  EXPECT_EQ(j.joint, Eigen::Vector3d(0, 1, 0));
+  j = bone_joint(bones, 1, 2);  // siblings: their shared head
+  EXPECT_EQ(j.ancestor_bone, 0);
+  EXPECT_EQ(j.joint, Eigen::Vector3d(0, 1, 0));
+  j = bone_joint(bones, 3, 2);  // cousins through 0: heads of 1 and 2
+  EXPECT_EQ(j.ancestor_bone, 0);
+  EXPECT_EQ(j.joint, Eigen::Vector3d(0, 1, 0));
+  j = bone_joint(bones, 3, 4);  // different trees: the roots' heads' midpoint
+  EXPECT_EQ(j.ancestor_bone, -1);
+  EXPECT_EQ(j.joint, Eigen::Vector3d(2.5, 2.5, 2.5));
+}
+
+}  // namespace
+
+namespace {
+
+// The limb a bone belongs to: "<model>_limb<k>_…" → k; −1 for a bone outside the limbs.
+int limb_of(const std::string& bone_name) {
+  const auto at = bone_name.find("_limb");
+  if (at == std::string::npos) return -1;
+  return std::stoi(bone_name.substr(at + 5));
+}
+
+class GeneratedLimbs : public ::testing::TestWithParam<const char*> {};
+
+TEST_P(GeneratedLimbs, EachLimbsTrianglesLandOnThatLimbsBones) {
+  // The generator's own weights bind each limb's vertices to that limb's chain; the heat
+  // weights, computed from geometry alone, must give (almost) every limb triangle to a bone of
+  // the same limb, and every triangle must end in exactly one connected cluster.
+  const auto generated = skelcd::skinning::generate({GetParam(), 6000, 2});
+  const Rig& rig = generated.rig;
+  const auto seg = segment(rig);
+  ASSERT_TRUE(well_formed(rig, seg));
+  const auto topo = skelcd::skinning::build_topology(rig.mesh);
+  const auto file_bones = largest_weight_bones(
+      [&] {
+        Eigen::MatrixXd W = Eigen::MatrixXd::Zero(topo.num_welded_vertices(), rig.skeleton.num_bones());
+        for (Eigen::Index v = 0; v < rig.weights.outerSize(); ++v) {
+          for (skelcd::skinning::SkinWeights::InnerIterator it(rig.weights, v); it; ++it) {
+            W(topo.welded_of_vertex[static_cast<std::size_t>(v)], it.col()) = it.value();
+          }
+        }
+        return W;
+      }(),
+      topo.welded_triangles);
+  int limb_triangles = 0, agree = 0;
+  for (std::size_t f = 0; f < file_bones.size(); ++f) {
+    const int expected = limb_of(rig.skeleton.bones[static_cast<std::size_t>(file_bones[f])].name);
+    if (expected < 0) continue;
+    ++limb_triangles;
+    const auto bone = seg.clusters[static_cast<std::size_t>(seg.triangle_cluster[f])].bone;
+    agree += limb_of(rig.skeleton.bones[static_cast<std::size_t>(bone)].name) == expected;
+  }
+  ASSERT_GT(limb_triangles, 0) << "no bone named _limb: the test would check nothing";
+  EXPECT_GE(agree, 0.97 * limb_triangles) << agree << " of " << limb_triangles;
+  std::cout << GetParam() << ": " << agree << " of " << limb_triangles << " limb triangles on their limb, "
+            << seg.stats.atomic_clusters << " clusters, H- " << seg.stats.h_minus << " Hu "
+            << seg.stats.h_uncertain << "\n";
+}
+
+INSTANTIATE_TEST_SUITE_P(Generators, GeneratedLimbs, ::testing::Values("octopus", "hand"));
 
 }  // namespace
