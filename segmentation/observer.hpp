@@ -37,7 +37,8 @@ struct Observer {
 };
 
 /// Exact sign of (a − q) · ((b − a) × (c − a)) with q the viewing position for corner a
-/// (ccd::orient3d: filtered, rational fallback; exact for the rounded q).
+/// (a static floating-point filter, then ccd::orient3d — filtered, rational fallback — when it
+/// cannot decide; exact for the rounded q).
 [[nodiscard]] Orientation orientation(
     const Observer& observer,
     const Eigen::Vector3d& a,
