@@ -16,12 +16,14 @@ struct ConeCullingStats {
   std::int64_t nodes_culled = 0;        ///< ... that proved the node free of self-collision
   std::int64_t failed_normal_cone = 0;  ///< condition 1: SNC not within a half-space
   std::int64_t failed_topology = 0;     ///< the node's contour is not one simple loop
-  std::int64_t failed_dual_cone = 0;    ///< condition 2: a chain's BNC (or FASTCD's BNC test)
+  /// Condition 2: FASTCD's BNC test failed; for enhanced-dual-cone, a chain failed the dual-cone
+  /// test (and was cut into monotone runs) and condition 3 then failed as well.
+  std::int64_t failed_dual_cone = 0;
   std::int64_t failed_contour = 0;      ///< condition 3: projected contour edges may meet
-  /// Algorithm 3's ten results, as failures counted over the failing nodes whose condition 1
-  /// held: [0..3] the four sub-surface tests R_ll, R_lr, R_rl, R_rr; [4..9] the pair tests
-  /// (ll,lr), (ll,rl), (ll,rr), (lr,rl), (lr,rr), (rl,rr). Only the first failure of a node is
-  /// recorded (the test stops there).
+  /// Algorithm 3's ten results, as failures counted over the nodes whose condition 1 held:
+  /// [0..3] the sub-surface tests R_ll, R_lr, R_rl, R_rr (a chain failed the dual-cone test);
+  /// [4..9] the pair tests (ll,lr), (ll,rl), (ll,rr), (lr,rl), (lr,rr), (rl,rr) (only the first
+  /// failing pair of a node: the test stops there).
   std::array<std::int64_t, 10> ten_results_failed{};
   std::int64_t subtree_pairs = 0;  ///< node-pair traversals started (Collide of Algorithm 3)
   ContourTestCounters contour;

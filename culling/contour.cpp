@@ -596,66 +596,83 @@ ContourVerdict ContourTester::run(
   // projected e along the witness direction.
   chain_of_.resize(m);
   const std::size_t num_chains = chains.empty() ? 0 : chains.size() - 1;
+  std::int32_t next_id = 0;
+  auto angle2 = [&frame](const Eigen::Vector3d& e) {
+    return std::atan2(frame.g2.dot(e), frame.g1.dot(e));
+  };
+  auto wrap = [](double a) {
+    constexpr double kPi = std::numbers::pi;
+    while (a > kPi) a -= 2.0 * kPi;
+    while (a < -kPi) a += 2.0 * kPi;
+    return a;
+  };
+  auto edge0 = [&](std::size_t k) -> Eigen::Vector3d { return x.at0(edges[k].to) - x.at0(edges[k].from); };
+  auto edge1 = [&](std::size_t k) -> Eigen::Vector3d { return x.at1(edges[k].to) - x.at1(edges[k].from); };
   for (std::size_t c = 0; c < num_chains; ++c) {
     const auto begin = static_cast<std::size_t>(chains[c]);
     const auto end = static_cast<std::size_t>(chains[c + 1]);
-    for (std::size_t k = begin; k < end; ++k) {
-      chain_of_[k] = mode == ContourMode::chains ? static_cast<std::int32_t>(c)
-                                                 : static_cast<std::int32_t>(k);
+    if (mode != ContourMode::chains) {
+      for (std::size_t k = begin; k < end; ++k) chain_of_[k] = next_id++;
+      continue;
     }
-    if (mode != ContourMode::chains || end - begin < 2) continue;
-    ++counters.chain_tests;
-    auto angle2 = [&frame](const Eigen::Vector3d& e) {
-      return std::atan2(frame.g2.dot(e), frame.g1.dot(e));
-    };
-    auto wrap = [](double a) {
-      constexpr double kPi = std::numbers::pi;
-      while (a > kPi) a -= 2.0 * kPi;
-      while (a < -kPi) a += 2.0 * kPi;
-      return a;
-    };
-    // The chain's direction angles, unwrapped along the chain (and, for CCD, from its first
-    // edge at t0 to the same edge at t1, then along the chain again).
-    double lo = 0.0;
-    double hi = 0.0;
-    double first = 0.0;
-    double prev = 0.0;
-    for (int pass = 0; pass < (kContinuous ? 2 : 1); ++pass) {
-      for (std::size_t k = begin; k < end; ++k) {
-        const Eigen::Vector3d e = pass == 0 ? Eigen::Vector3d(x.at0(edges[k].to) - x.at0(edges[k].from))
-                                            : Eigen::Vector3d(x.at1(edges[k].to) - x.at1(edges[k].from));
-        const double a = angle2(e);
-        double unwrapped;
-        if (pass == 0 && k == begin) {
-          unwrapped = first = lo = hi = a;
-        } else {
-          unwrapped = k == begin ? first + wrap(a - first) : prev + wrap(a - prev);
-        }
-        prev = unwrapped;
-        lo = std::min(lo, unwrapped);
-        hi = std::max(hi, unwrapped);
+    if (end - begin >= 2) ++counters.chain_tests;
+    // Cut the chain greedily into runs whose projected edge directions (at t0 and t1 for CCD)
+    // span less than π: each such run has a binormal cone of half-angle < π/2 in the projection
+    // plane, which is proven edge by edge below (det_V(w, e) > 0 for the witness direction w,
+    // w = cos φ e_i + sin φ e_j, φ mid-range) and makes the run strictly monotone, hence simple.
+    // A chain that needs no cut passes the dual-cone test of Algorithm 2 as is; one that needs
+    // cuts (or whose proof fails, leaving one-edge runs) is counted, and its runs are then
+    // tested against each other like any two chains.
+    bool cut = false;
+    std::size_t run = begin;
+    while (run < end) {
+      double prev = angle2(edge0(run));
+      double lo = prev;
+      double hi = prev;
+      if (kContinuous) {
+        const double a1 = prev + wrap(angle2(edge1(run)) - prev);
+        lo = std::min(lo, a1);
+        hi = std::max(hi, a1);
       }
-    }
-    bool monotone = hi - lo < std::numbers::pi;
-    if (monotone) {
-      const double mid = 0.5 * (lo + hi);
-      Eigen::Vector3d w = Eigen::Vector3d::Zero();
-      w(frame.i) = std::cos(mid);
-      w(frame.j) = std::sin(mid);
-      for (std::size_t k = begin; k < end && monotone; ++k) {
-        const Eigen::Vector3d e0 = x.at0(edges[k].to) - x.at0(edges[k].from);
-        monotone = sign_of(det_v(v, w, e0)) == ProvenSign::positive;
-        if (kContinuous && monotone) {
+      std::size_t k = run + 1;
+      for (; k < end; ++k) {
+        const double a0 = prev + wrap(angle2(edge0(k)) - prev);
+        double nlo = std::min(lo, a0);
+        double nhi = std::max(hi, a0);
+        if (kContinuous) {
+          const double a1 = a0 + wrap(angle2(edge1(k)) - angle2(edge0(k)));
+          nlo = std::min(nlo, a1);
+          nhi = std::max(nhi, a1);
+        }
+        if (nhi - nlo >= std::numbers::pi * (1.0 - 1e-9)) break;
+        lo = nlo;
+        hi = nhi;
+        prev = a0;
+      }
+      bool monotone = k - run >= 2;
+      if (monotone) {
+        const double mid = 0.5 * (lo + hi);
+        Eigen::Vector3d w = Eigen::Vector3d::Zero();
+        w(frame.i) = std::cos(mid);
+        w(frame.j) = std::sin(mid);
+        for (std::size_t q = run; q < k && monotone; ++q) {
+          monotone = sign_of(det_v(v, w, edge0(q))) == ProvenSign::positive;
           // det_V(w, e(t)) is linear in t: positive at both ends means positive throughout.
-          const Eigen::Vector3d e1 = x.at1(edges[k].to) - x.at1(edges[k].from);
-          monotone = sign_of(det_v(v, w, e1)) == ProvenSign::positive;
+          if (kContinuous && monotone) monotone = sign_of(det_v(v, w, edge1(q))) == ProvenSign::positive;
         }
       }
+      if (monotone) {
+        for (std::size_t q = run; q < k; ++q) chain_of_[q] = next_id;
+        ++next_id;
+      } else {
+        for (std::size_t q = run; q < k; ++q) chain_of_[q] = next_id++;
+      }
+      cut = cut || k < end || !monotone;
+      run = k;
     }
-    if (!monotone) {
-      verdict.failed_chain = true;
-      verdict.part_a = static_cast<std::int8_t>(edges[begin].part);
-      return verdict;
+    if (cut && end - begin >= 2) {
+      ++counters.chain_cuts;
+      verdict.cut_parts = static_cast<std::uint8_t>(verdict.cut_parts | (1u << edges[begin].part));
     }
   }
 

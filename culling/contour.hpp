@@ -132,6 +132,7 @@ enum class ContourMode : std::uint8_t {
 /// What the contour test did, for the stats of a method.
 struct ContourTestCounters {
   std::int64_t chain_tests = 0;        ///< dual-cone (monotone chain) tests of condition 2
+  std::int64_t chain_cuts = 0;         ///< chains that failed it and were cut into monotone runs
   std::int64_t projected_edges = 0;    ///< contour edges projected
   std::int64_t edge_box_tests = 0;     ///< 2D box tests of projected edge pairs
   std::int64_t edge_pair_tests = 0;    ///< exact/conservative projected segment tests
@@ -143,7 +144,10 @@ struct ContourTestCounters {
 /// Algorithm 3), with the sub-surfaces involved.
 struct ContourVerdict {
   bool simple = false;
-  bool failed_chain = false;    ///< a chain was not proven monotone (condition 2)
+  /// Chains mode: bit p set when a chain of sub-surface p failed the dual-cone test (its BNC in
+  /// the projection plane spans π or more) and was cut into monotone runs. Not a failure by
+  /// itself: the runs are then tested against each other by condition 3.
+  std::uint8_t cut_parts = 0;
   bool failed_pinch = false;    ///< fans at a pinch vertex may overlap in projection
   bool failed_nesting = false;  ///< loops may nest so that two sheets cover one point
   std::int8_t part_a = -1;    ///< sub-surface of the failing chain / first failing edge

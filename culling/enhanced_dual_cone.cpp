@@ -12,10 +12,11 @@ class EnhancedDualConeMethod final : public detail::ConeMethodBase {
       const skinning::Mesh& mesh,
       const skinning::Topology& topology,
       const MethodOptions& options,
-      const std::vector<std::int32_t>* subset)
+      const EnhancedDualConeOptions& variant)
       : ConeMethodBase(
-            "enhanced-dual-cone", mesh, topology, options, Descent::grandchildren,
-            /*needs_contours=*/true, subset) {}
+            "enhanced-dual-cone", mesh, topology, options,
+            variant.grandchildren_descent ? Descent::grandchildren : Descent::children,
+            /*needs_contours=*/true, variant.triangles.empty() ? nullptr : &variant.triangles) {}
 
  private:
   // EnhancedDualConeTest (Algorithms 1 and 4) of node n.
@@ -29,7 +30,7 @@ class EnhancedDualConeMethod final : public detail::ConeMethodBase {
       ++stats_.failed_normal_cone;
       return false;
     }
-    // The degree argument behind conditions 2 and 3 needs one simple loop of contour.
+    // The degree argument behind conditions 2 and 3 needs the contour to be closed loops.
     if (status != ContourStatus::loops) {
       ++stats_.failed_topology;
       return false;
@@ -42,17 +43,18 @@ class EnhancedDualConeMethod final : public detail::ConeMethodBase {
                   stats_.contour)
             : contour_tester_.test(
                   contours_, n, snc.axis, *interval.x_t0, ContourMode::chains, stats_.contour);
+    // The ten-result record (Algorithm 3): the sub-surfaces whose chains failed the dual-cone
+    // test, and the first pair of sub-surfaces whose contours may meet.
+    for (int p = 0; p < 4; ++p) {
+      if ((verdict.cut_parts & (1u << p)) != 0) ++stats_.ten_results_failed[static_cast<std::size_t>(p)];
+    }
     if (verdict.simple) return true;
-    if (verdict.failed_chain) {
-      ++stats_.failed_dual_cone;
-      if (verdict.part_a >= 0) ++stats_.ten_results_failed[static_cast<std::size_t>(verdict.part_a)];
-    } else {
-      ++stats_.failed_contour;
+    ++(verdict.cut_parts != 0 ? stats_.failed_dual_cone : stats_.failed_contour);
+    if (verdict.part_a >= 0 && verdict.part_b >= 0) {
       const int p = std::min(verdict.part_a, verdict.part_b);
       const int q = std::max(verdict.part_a, verdict.part_b);
       // Two chains of one sub-surface meeting fail that sub-surface's own test.
-      const int index = p == q ? p : ten_result_pair_index(p, q);
-      if (p >= 0) ++stats_.ten_results_failed[static_cast<std::size_t>(index)];
+      ++stats_.ten_results_failed[static_cast<std::size_t>(p == q ? p : ten_result_pair_index(p, q))];
     }
     return false;
   }
@@ -64,15 +66,15 @@ std::unique_ptr<CullingMethod> make_enhanced_dual_cone_method(
     const skinning::Mesh& mesh,
     const skinning::Topology& topology,
     const MethodOptions& options) {
-  return std::make_unique<EnhancedDualConeMethod>(mesh, topology, options, nullptr);
+  return std::make_unique<EnhancedDualConeMethod>(mesh, topology, options, EnhancedDualConeOptions{});
 }
 
 std::unique_ptr<CullingMethod> make_enhanced_dual_cone_method(
     const skinning::Mesh& mesh,
     const skinning::Topology& topology,
     const MethodOptions& options,
-    const std::vector<std::int32_t>& triangles) {
-  return std::make_unique<EnhancedDualConeMethod>(mesh, topology, options, &triangles);
+    const EnhancedDualConeOptions& variant) {
+  return std::make_unique<EnhancedDualConeMethod>(mesh, topology, options, variant);
 }
 
 }  // namespace skelcd::culling

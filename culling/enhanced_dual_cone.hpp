@@ -24,13 +24,23 @@ namespace skelcd::culling {
     const skinning::Topology& topology,
     const MethodOptions& options = {});
 
-/// The same method over the triangles listed in `triangles` only (welded triangle ids): pairs
-/// with a triangle outside the list are never reported. Used by routing for the open parts.
+/// Variants of the method (for routing, benchmarks and the traversal-scheme comparison).
+struct EnhancedDualConeOptions {
+  /// Algorithm 3's scheme: a node that is not culled descends straight to its sub-surfaces'
+  /// self-tests and their six pairs. false: the simple top-down scheme (both children's
+  /// self-tests and their pair), which tests the children with the cone criteria too.
+  bool grandchildren_descent = true;
+  /// When not empty, the only triangles covered (welded triangle ids): pairs with a triangle
+  /// outside the list are never reported. Routing uses it for the open components.
+  std::vector<std::int32_t> triangles;
+};
+
+/// The method with explicit variant options.
 /// @throws InvalidInput as make_method, or for a triangle id out of range.
 [[nodiscard]] std::unique_ptr<CullingMethod> make_enhanced_dual_cone_method(
     const skinning::Mesh& mesh,
     const skinning::Topology& topology,
     const MethodOptions& options,
-    const std::vector<std::int32_t>& triangles);
+    const EnhancedDualConeOptions& variant);
 
 }  // namespace skelcd::culling

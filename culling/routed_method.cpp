@@ -283,7 +283,9 @@ class AutoMethod final : public detail::MethodBase, public RoutedMethod {
       const skinning::Topology& topology,
       const MethodOptions& options,
       const std::vector<std::int32_t>& triangles) {
-    if (name == "enhanced-dual-cone") return make_enhanced_dual_cone_method(mesh, topology, options, triangles);
+    if (name == "enhanced-dual-cone") {
+      return make_enhanced_dual_cone_method(mesh, topology, options, {.grandchildren_descent = true, .triangles = triangles});
+    }
     if (name == "normal-cone") return make_normal_cone_method(mesh, topology, options, triangles);
     if (name == "dual-cone") return make_dual_cone_method(mesh, topology, options, triangles);
     return nullptr;  // `bvh`: traversed here (traverse_own)

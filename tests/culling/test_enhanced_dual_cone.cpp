@@ -12,6 +12,7 @@
 #include "ccd/edge_edge.hpp"
 #include "ccd/vertex_face.hpp"
 #include "culling/cones_method.hpp"
+#include "culling/enhanced_dual_cone.hpp"
 #include "culling/method.hpp"
 #include "skinning/errors.hpp"
 #include "tests/culling/test_dual_cone_scenes.hpp"
@@ -178,6 +179,54 @@ TEST(ConeMethods, FlatSheetIsCulledAtTheRoot) {
   EXPECT_GT(stats_of(*m).failed_dual_cone, 0);
   EXPECT_GT(stats_of(*m).nodes_culled, 0);
   EXPECT_TRUE(out.dcd_pairs.empty());
+}
+
+TEST(ConeMethods, ChainsThatTurnBackAreCutIntoMonotoneRunsAndTheFlatSheetIsStillCulled) {
+  // A flat U-shaped sheet (a slot cut into one side): along the slot the boundary turns back on
+  // itself, so the chains there span more than π and fail the dual-cone test; cut into monotone
+  // runs and tested against each other they prove the contour simple all the same.
+  const auto full = test::sheet(12, 12);
+  std::vector<Eigen::Index> kept;
+  for (Eigen::Index t = 0; t < full.triangles.rows(); ++t) {
+    const Eigen::Vector3d c = (full.rest_positions.row(full.triangles(t, 0)) + full.rest_positions.row(full.triangles(t, 1)) +
+                               full.rest_positions.row(full.triangles(t, 2))).transpose() / 3.0;
+    if (c.x() > 0.4 && c.x() < 0.6 && c.y() > 0.25) continue;  // the slot
+    kept.push_back(t);
+  }
+  skinning::Triangles f(static_cast<Eigen::Index>(kept.size()), 3);
+  for (std::size_t k = 0; k < kept.size(); ++k) f.row(static_cast<Eigen::Index>(k)) = full.triangles.row(kept[k]);
+  const auto mesh = test::single_part_mesh(full.rest_positions, f);
+  const auto topo = skinning::build_topology(mesh);
+  const skinning::Positions x = test::welded(topo, mesh.rest_positions);
+  auto m = make_method("enhanced-dual-cone", mesh, topo);
+  FrameResult out;
+  m->detect_dcd(x, out);
+  EXPECT_EQ(stats_of(*m).nodes_culled, 1);
+  EXPECT_EQ(stats_of(*m).nodes_tested, 1);
+  EXPECT_GT(stats_of(*m).contour.chain_cuts, 0);
+  EXPECT_GT(stats_of(*m).ten_results_failed[0] + stats_of(*m).ten_results_failed[1] +
+                stats_of(*m).ten_results_failed[2] + stats_of(*m).ten_results_failed[3], 0);
+  FrameResult c;
+  m->detect_ccd(x, test::translated(x, Eigen::Vector3d(0.0, 0.01, 0.02)), c);
+  EXPECT_EQ(stats_of(*m).nodes_culled, 1);
+}
+
+TEST(ConeMethods, BothTraversalSchemesFindWhatBvhFinds) {
+  // Algorithm 3 (straight to the sub-surfaces) and the simple top-down scheme.
+  for (const OpenScene& s : {test::pipe_scene(12, 72, {0.5, 0.7}), test::crumpled_tube_scene(12, 56, {0.55, 0.6})}) {
+    const FrameResult bvh = run_dcd("bvh", s, 0);
+    const FrameResult bvh_ccd = run_ccd("bvh", s, 0);
+    for (const bool grand : {true, false}) {
+      auto m = make_enhanced_dual_cone_method(s.mesh, s.topo, {}, {.grandchildren_descent = grand, .triangles = {}});
+      FrameResult d;
+      m->detect_dcd(s.frames[0], d);
+      EXPECT_EQ(d.dcd_pairs, bvh.dcd_pairs) << s.name << " " << grand;
+      FrameResult c;
+      m->detect_ccd(s.frames[0], s.frames[1], c);
+      EXPECT_TRUE(same_ccd_contacts(s, 0, c, bvh_ccd)) << s.name << " " << grand;
+      EXPECT_GT(stats_of(*m).nodes_culled, 0);
+    }
+  }
 }
 
 TEST(ConeMethods, ContactDistanceTurnsCullingOffAndMatchesBvh) {
