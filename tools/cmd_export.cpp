@@ -14,6 +14,7 @@
 #include "skinning/rig_motion.hpp"
 #include "tools/commands.hpp"
 #include "tools/export_mesh.hpp"
+#include "tools/highlight.hpp"
 #include "tools/model_options.hpp"
 
 namespace skelcd::tools {
@@ -31,6 +32,7 @@ struct ExportArgs {
   double rate = 0.0;
   std::string output;
   std::string format;
+  std::string highlight;
   skinning::LoadOptions load;
 };
 
@@ -76,6 +78,7 @@ void run_export(const ExportArgs& args) {
   }
   // Later: --highlight LOG.h5 (colliding triangles of this frame) and --segmentation SEG.h5
   // (clusters) fill options.face_colors, one RGBA per triangle.
+  if (!args.highlight.empty()) options.face_colors = highlight_face_colors(args.highlight, motion->mesh(), args.frame.value_or(0), motion->sample_time(args.frame.value_or(0)));
   const auto result = export_mesh(motion->mesh(), positions, args.output, options);
   // Standard output may be carrying the mesh: the summary goes to stderr then.
   auto& report = is_stdout(args.output) ? std::cerr : std::cout;
@@ -98,6 +101,7 @@ void add_export_command(CLI::App& app) {
   cmd->add_option("-o,--output", args->output, "OUT.obj, OUT.ply or OUT.glb; '-' or /dev/stdout for standard output")
       ->required();
   cmd->add_option("--format", args->format, "obj, ply or glb (default: from OUT's extension; obj on standard output)");
+  cmd->add_option("--highlight", args->highlight, "colour the triangles the log LOG.h5 found colliding at --frame")->excludes(time);
   add_model_options(*cmd, args->load);
   cmd->callback([args] { run_export(*args); });
 }

@@ -1,6 +1,7 @@
 #include "tools/highlight.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <map>
 #include <string>
 
@@ -9,6 +10,9 @@
 
 namespace skelcd::tools {
 namespace {
+
+/// Relative difference under which two sample times (i / rate, in doubles) are the same.
+constexpr double kSampleTimeTolerance = 1e-9;
 
 /// (part, index within part) → row, for vertices or triangles.
 std::map<std::pair<std::int32_t, std::int32_t>, std::int32_t> index_map(
@@ -100,13 +104,29 @@ std::vector<std::int32_t> highlighted_triangles(
 std::vector<std::array<float, 4>> highlight_face_colors(
     const std::filesystem::path& log_path,
     const skinning::Mesh& mesh,
-    std::int32_t frame) {
+    std::int32_t frame,
+    double frame_time_s) {
   const auto log = read_log(log_path);
+  const std::string where = log_path.string() + ": ";
+  // The log must have checked this very pose: a row for the sample, at the same time.
+  const auto row = std::find_if(log.frames.begin(), log.frames.end(),
+                                [&](const FrameRow& r) { return r.sample == frame; });
+  if (row == log.frames.end()) {
+    throw InvalidInput(where + "no row for frame " + std::to_string(frame) + " (the log covers samples " +
+                       std::to_string(log.header.first_sample) + " to " +
+                       std::to_string(log.header.last_sample) + ")");
+  }
+  if (std::abs(row->t0 - frame_time_s) > kSampleTimeTolerance * std::max(1.0, std::abs(frame_time_s))) {
+    throw InvalidInput(where + "frame " + std::to_string(frame) + " is at t = " +
+                       std::to_string(row->t0) + " s in the log (" + std::to_string(log.header.fps) +
+                       " samples/s) but at t = " + std::to_string(frame_time_s) +
+                       " s here: pose it at the log's rate");
+  }
   std::vector<std::int32_t> hits;
   try {
     hits = highlighted_triangles(log, mesh, frame);
   } catch (const InvalidInput& e) {
-    throw InvalidInput(log_path.string() + ": " + e.what());
+    throw InvalidInput(where + e.what());
   }
   std::vector<std::array<float, 4>> colours(static_cast<std::size_t>(mesh.num_triangles()),
                                             kPlainColour);

@@ -29,10 +29,15 @@ inline constexpr std::array<float, 4> kPlainColour{0.78f, 0.78f, 0.78f, 1.0f};
 
 /// The one call `export --highlight` makes: reads `log_path` and returns #F RGBA face colours,
 /// highlighted_triangles() red and the rest grey (ExportOptions::face_colors).
-/// @throws IoError / InvalidInput naming the log.
+/// @param frame_time_s time of `frame` in the exported motion (seconds): must equal the time the
+///   log recorded for that sample, so that a log checked at another rate is not shown on the
+///   wrong pose.
+/// @throws IoError / InvalidInput naming the log: unreadable, another mesh, no row for `frame`,
+///   or a different sample time.
 [[nodiscard]] std::vector<std::array<float, 4>> highlight_face_colors(
     const std::filesystem::path& log_path,
     const skinning::Mesh& mesh,
-    std::int32_t frame);
+    std::int32_t frame,
+    double frame_time_s);
 
 }  // namespace skelcd::tools

@@ -1,10 +1,15 @@
 // export --highlight: which triangles are coloured for a frame of a log, worked out by hand on a
 // mesh with a welded seam.
 
+#include <cstring>
+#include <fstream>
+#include <sstream>
+
 #include <gtest/gtest.h>
 
 #include "skinning/errors.hpp"
 #include "tests/support/test_support.hpp"
+#include "tests/tools/cli_runner.hpp"
 #include "tools/highlight.hpp"
 #include "tools/log/log_writer.hpp"
 
@@ -78,17 +83,85 @@ TEST(Highlight, FaceColoursFromALogFile) {
     LogWriter writer(path, header);
     FrameReport report;
     report.row.sample = 3;
+    report.row.t0 = report.row.t1 = 0.125;
     report.dcd_pairs = seam_log().dcd_pairs;
     writer.append(report);
     writer.finish();
   }
-  const auto colours = highlight_face_colors(path, mesh, 3);
+  const auto colours = highlight_face_colors(path, mesh, 3, 0.125);
   ASSERT_EQ(colours.size(), 3u);
   EXPECT_EQ(colours[0], kHighlightColour);
   EXPECT_EQ(colours[1], kPlainColour);
   EXPECT_EQ(colours[2], kHighlightColour);
-  EXPECT_THROW_MESSAGE((void)highlight_face_colors(path.parent_path() / "none.h5", mesh, 3),
+  EXPECT_THROW_MESSAGE((void)highlight_face_colors(path.parent_path() / "none.h5", mesh, 3, 0.125),
                        IoError, "none.h5");
+  // A frame the log does not cover, and the right frame at another rate's time.
+  EXPECT_THROW_MESSAGE((void)highlight_face_colors(path, mesh, 4, 0.125), InvalidInput,
+                       "no row for frame 4");
+  EXPECT_THROW_MESSAGE((void)highlight_face_colors(path, mesh, 3, 0.1), InvalidInput,
+                       "pose it at the log's rate");
+}
+
+TEST(Highlight, ExportColoursTheCollidingTrianglesOfAFrame) {
+  // Frames: a large triangle in z = 0 (0), a small one piercing it at frame 2 (1), and a third
+  // far away that nothing touches (2). check, then export frame 2 with --highlight to PLY.
+  const auto dir = test::temp_dir("highlight-export");
+  std::filesystem::create_directories(dir / "frames");
+  const char* small[3] = {"1 1 1\nv 2 1 1\nv 1 2 1", "1 1 -1\nv 2 1 -1\nv 1 2 -1",
+                          "1 1 -1\nv 1.5 1 1\nv 2 2 1"};
+  for (int i = 0; i < 3; ++i) {
+    std::string name = "f";  // (appending avoids GCC 12's -Wrestrict false positive on "lit" + str)
+    name += std::to_string(i);
+    name += ".obj";
+    std::ofstream(dir / "frames" / name)
+        << "v 0 0 0\nv 4 0 0\nv 0 4 0\nv " << small[i]
+        << "\nv 10 10 10\nv 11 10 10\nv 10 11 10\nf 1 2 3\nf 4 5 6\nf 7 8 9\n";
+  }
+  const auto log = (dir / "run.h5").string();
+  const auto check = test::run_skelcd({"check", (dir / "frames").string(), "-o", log});
+  ASSERT_EQ(check.exit_code, 0) << check.err;
+  const auto ply = dir / "frame2.ply";
+  const auto r = test::run_skelcd({"export", (dir / "frames").string(), "--frame", "2",
+                                   "--highlight", log, "-o", ply.string()});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+
+  // Binary PLY, one vertex per triangle corner (9), then 3 faces of 1 + 3 × 4 bytes. The header
+  // declares uchar colours, but Debian's assimp 5.2 binary PLY exporter writes each vertex colour
+  // as four floats: read the vertex records by the size the bytes imply (16: uchar, 28: float).
+  std::ifstream in(ply, std::ios::binary);
+  std::stringstream bytes;
+  bytes << in.rdbuf();
+  const std::string text = bytes.str();
+  const auto end = text.find("end_header\n");
+  ASSERT_NE(end, std::string::npos);
+  const std::string header = text.substr(0, end);
+  ASSERT_NE(header.find("element vertex 9"), std::string::npos) << header;
+  ASSERT_NE(header.find("element face 3"), std::string::npos) << header;
+  const std::size_t body = text.size() - (end + 11) - 3 * 13;
+  ASSERT_EQ(body % 9, 0u);
+  const std::size_t record = body / 9;
+  ASSERT_TRUE(record == 16 || record == 28) << record;
+  const char* vertices = text.data() + end + 11;
+  std::vector<float> red;
+  for (std::size_t v = 0; v < 9; ++v) {
+    const char* colour = vertices + record * v + 12;
+    if (record == 16) {
+      red.push_back(static_cast<float>(static_cast<unsigned char>(colour[0])) / 255.0f);
+    } else {
+      float value = 0;
+      std::memcpy(&value, colour, sizeof value);
+      red.push_back(value);
+    }
+  }
+  for (std::size_t v = 0; v < 6; ++v) EXPECT_NEAR(red[v], kHighlightColour[0], 0.01) << v;
+  for (std::size_t v = 6; v < 9; ++v) EXPECT_NEAR(red[v], kPlainColour[0], 0.01) << v;
+
+  // A frame the log did not check is refused, nothing written.
+  const auto bad = test::run_skelcd({"export", (dir / "frames").string(), "--frame", "2", "--fps",
+                                     "60", "--highlight", log, "-o", (dir / "x.ply").string()});
+  EXPECT_EQ(bad.exit_code, 1);
+  EXPECT_NE(bad.err.find("log's rate"), std::string::npos) << bad.err;
+  EXPECT_FALSE(std::filesystem::exists(dir / "x.ply"));
 }
 
 }  // namespace
