@@ -143,10 +143,8 @@ Earliest point_segment_ccd(const PolynomialVector& p,
 
 struct VertexFacePolynomials {
   PolynomialVector p, a, b, c;
-  PolynomialVector normal;          // (b - a) x (c - a)
-  RationalPolynomial coplanar;      // normal . (p - a)
-  RationalPolynomial inside_ab, inside_bc, inside_ca;  // normal . ((b - a) x (p - a)) etc.
-  OnSegment on_ab, on_bc, on_ca;
+  PolynomialVector normal;      // (b - a) x (c - a)
+  RationalPolynomial coplanar;  // normal . (p - a)
 
   explicit VertexFacePolynomials(const RationalVertexFaceQuery& q)
       : p(moving(q.v_t0, q.v_t1)),
@@ -154,25 +152,22 @@ struct VertexFacePolynomials {
         b(moving(q.f1_t0, q.f1_t1)),
         c(moving(q.f2_t0, q.f2_t1)),
         normal(detail::cross(b - a, c - a)),
-        coplanar(detail::dot(normal, p - a)),
-        inside_ab(detail::dot(normal, detail::cross(b - a, p - a))),
-        inside_bc(detail::dot(normal, detail::cross(c - b, p - b))),
-        inside_ca(detail::dot(normal, detail::cross(a - c, p - c))),
-        on_ab(p, a, b),
-        on_bc(p, b, c),
-        on_ca(p, c, a) {}
+        coplanar(detail::dot(normal, p - a)) {}
 
-  // p(t*) in the closed triangle (a, b, c)(t*).
+  // p(t*) in the closed triangle (a, b, c)(t*). The inside polynomials are built when needed.
   bool contact(RootPoint& t) const {
     if (t.sign(coplanar) != 0) return false;
     const bool degenerate =
         t.sign(normal[0]) == 0 && t.sign(normal[1]) == 0 && t.sign(normal[2]) == 0;
     if (!degenerate) {
-      // Non-degenerate triangle, p in its plane: inside iff on the inner side of all three edges.
-      return t.sign(inside_ab) >= 0 && t.sign(inside_bc) >= 0 && t.sign(inside_ca) >= 0;
+      // Non-degenerate triangle, p in its plane: inside iff on the inner side of all three edges,
+      // n . ((b - a) x (p - a)) >= 0 and its two rotations.
+      return t.sign(detail::dot(normal, detail::cross(b - a, p - a))) >= 0 &&
+             t.sign(detail::dot(normal, detail::cross(c - b, p - b))) >= 0 &&
+             t.sign(detail::dot(normal, detail::cross(a - c, p - c))) >= 0;
     }
     // Zero-area triangle: it is the union of its three edges.
-    return on_ab.at(t) || on_bc.at(t) || on_ca.at(t);
+    return OnSegment(p, a, b).at(t) || OnSegment(p, b, c).at(t) || OnSegment(p, c, a).at(t);
   }
 };
 
@@ -180,10 +175,8 @@ struct VertexFacePolynomials {
 
 struct EdgeEdgePolynomials {
   PolynomialVector a0, a1, b0, b1;
-  PolynomialVector normal;        // d1 x d2, d1 = a1 - a0, d2 = b1 - b0
-  RationalPolynomial coplanar;    // normal . (b0 - a0)
-  RationalPolynomial u, v, nn;    // a0 + (u/nn) d1 = b0 + (v/nn) d2 when coplanar, non-parallel
-  OnSegment a0_on_b, a1_on_b, b0_on_a, b1_on_a;
+  PolynomialVector normal;      // d1 x d2, d1 = a1 - a0, d2 = b1 - b0
+  RationalPolynomial coplanar;  // normal . (b0 - a0)
 
   explicit EdgeEdgePolynomials(const RationalEdgeEdgeQuery& q)
       : a0(moving(q.ea0_t0, q.ea0_t1)),
@@ -191,14 +184,7 @@ struct EdgeEdgePolynomials {
         b0(moving(q.eb0_t0, q.eb0_t1)),
         b1(moving(q.eb1_t0, q.eb1_t1)),
         normal(detail::cross(a1 - a0, b1 - b0)),
-        coplanar(detail::dot(normal, b0 - a0)),
-        u(detail::dot(detail::cross(b0 - a0, b1 - b0), normal)),
-        v(detail::dot(detail::cross(b0 - a0, a1 - a0), normal)),
-        nn(detail::dot(normal, normal)),
-        a0_on_b(a0, b0, b1),
-        a1_on_b(a1, b0, b1),
-        b0_on_a(b0, a0, a1),
-        b1_on_a(b1, a0, a1) {}
+        coplanar(detail::dot(normal, b0 - a0)) {}
 
   // The closed segments [a0, a1] and [b0, b1] share a point at t*.
   bool contact(RootPoint& t) const {
@@ -206,14 +192,35 @@ struct EdgeEdgePolynomials {
     const bool parallel =
         t.sign(normal[0]) == 0 && t.sign(normal[1]) == 0 && t.sign(normal[2]) == 0;
     if (!parallel) {
-      // Coplanar, non-parallel: the lines meet at one point; it is on both segments iff
-      // 0 <= u/nn <= 1 and 0 <= v/nn <= 1 (nn > 0).
-      return t.sign(u) >= 0 && t.sign(nn - u) >= 0 && t.sign(v) >= 0 && t.sign(nn - v) >= 0;
+      // Coplanar, non-parallel: the lines meet at a0 + (u/nn) d1 = b0 + (v/nn) d2 with
+      // u = (w x d2) . n, v = (w x d1) . n, nn = n . n > 0, w = b0 - a0; on both segments iff
+      // 0 <= u <= nn and 0 <= v <= nn.
+      const PolynomialVector w = b0 - a0;
+      const RationalPolynomial nn = detail::dot(normal, normal);
+      const RationalPolynomial u = detail::dot(detail::cross(w, b1 - b0), normal);
+      if (t.sign(u) < 0 || t.sign(nn - u) < 0) return false;
+      const RationalPolynomial v = detail::dot(detail::cross(w, a1 - a0), normal);
+      return t.sign(v) >= 0 && t.sign(nn - v) >= 0;
     }
     // Parallel or degenerate: two such segments meet iff an endpoint of one lies on the other.
-    return a0_on_b.at(t) || a1_on_b.at(t) || b0_on_a.at(t) || b1_on_a.at(t);
+    return OnSegment(a0, b0, b1).at(t) || OnSegment(a1, b0, b1).at(t) || OnSegment(b0, a0, a1).at(t) ||
+           OnSegment(b1, a0, a1).at(t);
   }
 };
+
+// The contact times of a query whose coplanarity polynomial is not identically zero are roots of
+// it in [0,1]: visit them in increasing order. A Bernstein hull of one strict sign proves there
+// are none (a cheap exact shortcut).
+template <typename Polynomials>
+Earliest first_contact_at_coplanarity_roots(const Polynomials& P, const mpq_class& width) {
+  if (detail::bernstein_sign(P.coplanar, 0, 1) != 0) return {};
+  const RationalPolynomial f = detail::square_free(P.coplanar);
+  for (const auto& root : detail::isolate_roots_in_unit_interval(f)) {
+    RootPoint t(f, root);
+    if (P.contact(t)) return found_at(t, width);
+  }
+  return {};
+}
 
 mpq_class positive_width(double toi_tolerance) {
   // Refining to width 0 would never end; 2^-64 is far below anything a double time can show.
@@ -254,14 +261,7 @@ ExactCcdResult vertex_face_ccd_rational(const RationalVertexFaceQuery& q, const 
   Earliest e;
   if (!P.coplanar.is_zero()) {
     // Contact times are roots of the coplanarity cubic: test them in increasing order.
-    const RationalPolynomial f = detail::square_free(P.coplanar);
-    for (const auto& root : detail::isolate_roots_in_unit_interval(f)) {
-      RootPoint t(f, root);
-      if (P.contact(t)) {
-        e = found_at(t, width);
-        break;
-      }
-    }
+    e = first_contact_at_coplanarity_roots(P, width);
   } else {
     // Coplanar throughout: contact at t = 0, or the first contact is the vertex on an edge.
     RootPoint t0(mpq_class(0));
@@ -286,14 +286,7 @@ ExactCcdResult edge_edge_ccd_rational(const RationalEdgeEdgeQuery& q, const mpq_
   const EdgeEdgePolynomials P(q);
   Earliest e;
   if (!P.coplanar.is_zero()) {
-    const RationalPolynomial f = detail::square_free(P.coplanar);
-    for (const auto& root : detail::isolate_roots_in_unit_interval(f)) {
-      RootPoint t(f, root);
-      if (P.contact(t)) {
-        e = found_at(t, width);
-        break;
-      }
-    }
+    e = first_contact_at_coplanarity_roots(P, width);
   } else {
     // Coplanar throughout: contact at t = 0, or the first contact has an endpoint of one segment
     // on the other.

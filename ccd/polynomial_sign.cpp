@@ -172,6 +172,10 @@ BernsteinCubic bernstein_from_values(const std::array<double, 4>& v, double valu
 }
 
 PolynomialSign cubic_sign(const BernsteinCubic& f, int max_subdivisions) {
+  for (const double b : f.coefficients) {
+    if (!std::isfinite(b)) return PolynomialSign::uncertain;
+  }
+  if (!std::isfinite(f.error)) return PolynomialSign::uncertain;
   return subdivided_sign(f.coefficients, f.error, max_subdivisions);
 }
 

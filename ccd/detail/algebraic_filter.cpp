@@ -147,6 +147,10 @@ BernsteinQuartic cross_dot_quartic(const QuadrupleDifferences& q) {
 
 AlgebraicVerdict algebraic_filter(const BernsteinCubic& c, const BernsteinQuartic* g, int count, double toi_tolerance) {
   assert(count >= 0 && count <= kMaxQuartics);
+  // Overflowed bounds (coordinates near the double range) prove nothing: leave it to the solver.
+  bool finite = std::isfinite(c.error);
+  for (int i = 0; i < count; ++i) finite = finite && std::isfinite(g[i].error);
+  if (!finite) return {AlgebraicOutcome::undecided, 0.0, 1.0};
   // Depth first, earlier half first: the left half is processed next, the right half waits.
   std::array<Node, kMaxDepth + 2> waiting;
   int size = 0;

@@ -216,21 +216,27 @@ InclusionResult solve_inclusion(const InclusionProblem& p, const CcdOptions& opt
       w.row(7) = e;                        // along e (collinear cases)
       w.row(8) = g;
       w.row(9) = f.rowwise().sum();        // toward the values themselves (near misses)
-      Eigen::Matrix<double, kMaxDirections, 1> threshold;
+      // Scale each direction to max-norm about 1 (any scale is sound): w . F then cannot overflow
+      // and its products underflow by at most one unit each.
       for (int j = 0; j < kMaxDirections; ++j) {
         const double m = w.row(j).cwiseAbs().maxCoeff();
         if (m > 0.0 && m < inf) {
-          w.row(j) /= m;
-          // |w . F| > s |w|_2 + err_w implies |F| > s; |w|_2 rounded up (sqrt is correctly rounded).
-          const Vector3d aw = w.row(j).cwiseAbs().transpose();
-          const double norm = std::sqrt(aw.squaredNorm() * kRoundUp) * kRoundUp;
-          threshold[j] =
-              (((aw[0] * dir_err[0] + aw[1] * dir_err[1]) + aw[2] * dir_err[2]) + s * norm) * kRoundUp * kRoundUp;
+          w.row(j) *= 1.0 / m;
         } else {
-          w.row(j).setZero();
-          threshold[j] = inf;  // unusable direction: never excludes
+          w.row(j).setZero();  // unusable: its threshold below is 0 and "x > 0" at every vertex
+        }                      // cannot hold for w = 0
+      }
+      // |w . F| > s |w|_2 + err_w implies |F| > s, err_w = sum_k |w_k| dir_err_k + 4 units of
+      // underflow; |w|_2 rounded up (sqrt is correctly rounded), and only needed when s > 0.
+      const Eigen::Matrix<double, kMaxDirections, 3> aw = w.cwiseAbs();
+      Eigen::Matrix<double, kMaxDirections, 1> threshold =
+          ((aw.col(0) * dir_err[0] + aw.col(1) * dir_err[1]) + aw.col(2) * dir_err[2]).array() + 4 * kUnderflowUnit;
+      if (s > 0.0) {
+        for (int j = 0; j < kMaxDirections; ++j) {
+          threshold[j] += s * (std::sqrt(aw.row(j).squaredNorm() * kRoundUp) * kRoundUp);
         }
       }
+      threshold *= kRoundUp * kRoundUp;
       const Eigen::Matrix<double, kMaxDirections, 2 * kMaxVertices> projected = w.lazyProduct(f);
       const auto wlo = projected.rowwise().minCoeff();
       const auto whi = projected.rowwise().maxCoeff();

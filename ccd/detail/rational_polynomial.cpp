@@ -118,36 +118,6 @@ void isolate(const RationalPolynomial& f,
   isolate(f, seq, mid, hi, out);
 }
 
-// Sign of g on the closed [lo, hi] when its Bernstein coefficients there all have one strict sign;
-// 0 when they do not (g may or may not vanish in [lo, hi]).
-int bernstein_sign(const RationalPolynomial& g, const mpq_class& lo, const mpq_class& hi) {
-  if (g.is_zero()) return 0;
-  const int n = g.degree();
-  // Taylor shift: coefficients of g(lo + x), by repeated synthetic division.
-  std::vector<mpq_class> q = g.coefficients();
-  for (int i = 0; i < n; ++i) {
-    for (int j = n - 1; j >= i; --j) q[static_cast<std::size_t>(j)] += lo * q[static_cast<std::size_t>(j) + 1];
-  }
-  // Scale x = w s so the interval becomes s in [0,1].
-  const mpq_class w = hi - lo;
-  mpq_class wk = 1;
-  for (int k = 0; k <= n; ++k) {
-    q[static_cast<std::size_t>(k)] *= wk;
-    wk *= w;
-  }
-  // Power basis on [0,1] -> Bernstein basis: b_i = sum_{k<=i} C(i,k)/C(n,k) q_k.
-  int sign = 0;
-  for (int i = 0; i <= n; ++i) {
-    mpq_class b = 0;
-    for (int k = 0; k <= i; ++k) b += bernstein_weight(n, i, k) * q[static_cast<std::size_t>(k)];
-    const int s = sign_of(b);
-    if (s == 0) return 0;
-    if (sign != 0 && s != sign) return 0;
-    sign = s;
-  }
-  return sign;
-}
-
 }  // namespace
 
 RationalPolynomial::RationalPolynomial(std::vector<mpq_class> coefficients) : c_(std::move(coefficients)) {
@@ -255,6 +225,36 @@ void divide(const RationalPolynomial& a,
   }
 }
 }  // namespace
+
+// Sign of g on the closed [lo, hi] when its Bernstein coefficients there all have one strict sign;
+// 0 when they do not (g may or may not vanish in [lo, hi]).
+int bernstein_sign(const RationalPolynomial& g, const mpq_class& lo, const mpq_class& hi) {
+  if (g.is_zero()) return 0;
+  const int n = g.degree();
+  // Taylor shift: coefficients of g(lo + x), by repeated synthetic division.
+  std::vector<mpq_class> q = g.coefficients();
+  for (int i = 0; i < n; ++i) {
+    for (int j = n - 1; j >= i; --j) q[static_cast<std::size_t>(j)] += lo * q[static_cast<std::size_t>(j) + 1];
+  }
+  // Scale x = w s so the interval becomes s in [0,1].
+  const mpq_class w = hi - lo;
+  mpq_class wk = 1;
+  for (int k = 0; k <= n; ++k) {
+    q[static_cast<std::size_t>(k)] *= wk;
+    wk *= w;
+  }
+  // Power basis on [0,1] -> Bernstein basis: b_i = sum_{k<=i} C(i,k)/C(n,k) q_k.
+  int sign = 0;
+  for (int i = 0; i <= n; ++i) {
+    mpq_class b = 0;
+    for (int k = 0; k <= i; ++k) b += bernstein_weight(n, i, k) * q[static_cast<std::size_t>(k)];
+    const int s = sign_of(b);
+    if (s == 0) return 0;
+    if (sign != 0 && s != sign) return 0;
+    sign = s;
+  }
+  return sign;
+}
 
 RationalPolynomial remainder(const RationalPolynomial& a, const RationalPolynomial& b) {
   std::vector<mpq_class> q, r;

@@ -70,6 +70,10 @@ struct RealRoot {
 /// @pre f is square-free and not zero.
 [[nodiscard]] std::vector<RealRoot> isolate_roots_in_unit_interval(const RationalPolynomial& f);
 
+/// +1 / -1 when the Bernstein coefficients of f on [lo, hi] all have that strict sign (so f has
+/// that sign on all of [lo, hi]); 0 otherwise (f may or may not vanish there).
+[[nodiscard]] int bernstein_sign(const RationalPolynomial& f, const mpq_class& lo, const mpq_class& hi);
+
 /// Exact sign queries at one point t* of [0,1]: a rational, or an isolated root of a square-free
 /// polynomial. Isolating intervals are refined in place as needed.
 class RootPoint {

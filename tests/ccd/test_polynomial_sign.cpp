@@ -1,0 +1,225 @@
+// Sign of a cubic on [0,1] and the moving-orientation cubic: every certain answer is checked with
+// exact rationals, and every stated error bound is checked against the exact coefficients, on
+// inputs chosen to hurt (cancellation after a 1e6 translation, 1e-6 / 1e6 scales, roots near and
+// at the interval ends, underflow).
+
+#include "ccd/polynomial_sign.hpp"
+
+#include <random>
+
+#include <Eigen/Geometry>
+#include <gmpxx.h>
+#include <gtest/gtest.h>
+
+#include "ccd/detail/rational_polynomial.hpp"
+#include "ccd/filters.hpp"
+
+namespace skelcd::ccd {
+namespace {
+
+using detail::RationalPolynomial;
+using V = Eigen::Vector3d;
+
+// Exact sign of f on [0,1]: +1 / -1 when f has no root there, 0 otherwise.
+int exact_sign_on_unit(const RationalPolynomial& f) {
+  if (f.is_zero()) return 0;
+  if (!detail::isolate_roots_in_unit_interval(detail::square_free(f)).empty()) return 0;
+  return f.sign_at(mpq_class(1, 2));
+}
+
+RationalPolynomial power(const std::array<double, 4>& c) {
+  return RationalPolynomial({mpq_class(c[0]), mpq_class(c[1]), mpq_class(c[2]), mpq_class(c[3])});
+}
+
+// Exact Bernstein coefficients of an exact cubic.
+std::array<mpq_class, 4> bernstein(const RationalPolynomial& f) {
+  std::array<mpq_class, 4> c{0, 0, 0, 0};
+  for (std::size_t i = 0; i < f.coefficients().size(); ++i) c[i] = f.coefficients()[i];
+  return {c[0], c[0] + c[1] / 3, c[0] + (2 * c[1] + c[2]) / 3, c[0] + c[1] + c[2] + c[3]};
+}
+
+::testing::AssertionResult within(const std::array<double, 4>& b, double error, const std::array<mpq_class, 4>& exact) {
+  for (std::size_t i = 0; i < 4; ++i) {
+    const mpq_class diff = abs(mpq_class(b[i]) - exact[i]);
+    if (diff > mpq_class(error)) {
+      return ::testing::AssertionFailure() << "coefficient " << i << " off by " << diff.get_d() << " > bound " << error;
+    }
+  }
+  return ::testing::AssertionSuccess();
+}
+
+TEST(CubicSign, CertainAnswersAreRight) {
+  std::mt19937_64 rng(3);
+  std::uniform_real_distribution<double> u(-1, 1);
+  int certain = 0;
+  int clearly_signed = 0;
+  int clearly_signed_certain = 0;
+  for (int n = 0; n < 20000; ++n) {
+    std::array<double, 4> c{u(rng), u(rng), u(rng), u(rng)};
+    if (n % 4 == 1) c[0] = -(c[1] + c[2] + c[3]);          // root exactly at t = 1 (up to rounding)
+    if (n % 4 == 2) c[0] = std::ldexp(c[0], -50);          // root right next to t = 0
+    if (n % 4 == 3) c[0] = -(c[1] / 2 + c[2] / 4 + c[3] / 8);  // root at t = 1/2 (up to rounding)
+    const double scale = std::ldexp(1.0, static_cast<int>(n % 61) - 30);
+    for (auto& x : c) x *= scale;
+    const PowerCubic f{c, 0.0};
+    const PolynomialSign s = cubic_sign(f);
+    const int truth = exact_sign_on_unit(power(c));
+    if (s != PolynomialSign::uncertain) {
+      ++certain;
+      ASSERT_EQ(static_cast<int>(s), truth) << "case " << n;
+    }
+    if (n % 4 == 0 && truth != 0) {
+      // Away from roots the classifier should usually decide.
+      const auto bc = bernstein(power(c));
+      const mpq_class m = std::min({abs(bc[0]), abs(bc[3])});
+      if (m > mpq_class(std::abs(c[0]) + std::abs(c[3])) / 8) {
+        ++clearly_signed;
+        clearly_signed_certain += s != PolynomialSign::uncertain ? 1 : 0;
+      }
+    }
+  }
+  EXPECT_GT(certain, 3000);
+  EXPECT_GT(clearly_signed_certain, clearly_signed * 9 / 10);
+}
+
+TEST(CubicSign, ExactlyZeroOrNonFiniteIsUncertain) {
+  EXPECT_EQ(cubic_sign(PowerCubic{{0, 0, 0, 0}, 0}), PolynomialSign::uncertain);
+  EXPECT_EQ(cubic_sign(PowerCubic{{1, std::numeric_limits<double>::quiet_NaN(), 0, 0}, 0}), PolynomialSign::uncertain);
+  EXPECT_EQ(cubic_sign(BernsteinCubic{{1, 1, 1, std::numeric_limits<double>::infinity()}, 0}), PolynomialSign::uncertain);
+  EXPECT_EQ(cubic_sign(PowerCubic{{1, 0, 0, 0}, 0}), PolynomialSign::positive);
+  EXPECT_EQ(cubic_sign(PowerCubic{{-1, 0, 0, 0}, 0.2}), PolynomialSign::negative);  // bound x4: 0.8
+  EXPECT_EQ(cubic_sign(PowerCubic{{-1, 0, 0, 0}, 1.0}), PolynomialSign::uncertain);
+}
+
+TEST(CubicSign, SubdivisionDecidesWhatTheHullCannot) {
+  // f(t) = (t - 1/2)^2 + 1/100 > 0, but its Bernstein coefficients are not all positive.
+  const PowerCubic f{{0.26, -1.0, 1.0, 0.0}, 0.0};
+  EXPECT_EQ(cubic_sign(f, 0), PolynomialSign::uncertain);
+  EXPECT_EQ(cubic_sign(f, 4), PolynomialSign::positive);
+}
+
+TEST(CubicSign, ConversionsCarryTheirErrorBounds) {
+  std::mt19937_64 rng(11);
+  std::uniform_real_distribution<double> u(-1, 1);
+  for (int n = 0; n < 5000; ++n) {
+    const double scale = std::ldexp(1.0, static_cast<int>(n % 41) - 20);
+    const std::array<double, 4> c{u(rng) * scale, u(rng) * scale, u(rng) * scale, u(rng) * scale};
+    const auto exact = power(c);
+    // power -> Bernstein
+    const BernsteinCubic b = to_bernstein(PowerCubic{c, 0.0});
+    ASSERT_TRUE(within(b.coefficients, b.error, bernstein(exact))) << n;
+    // Bernstein -> power, against the exact power form of the rounded Bernstein coefficients.
+    const PowerCubic back = to_power(BernsteinCubic{b.coefficients, 0.0});
+    const auto& bb = b.coefficients;
+    const mpq_class b0(bb[0]), b1(bb[1]), b2(bb[2]), b3(bb[3]);
+    const std::array<mpq_class, 4> exact_power{b0, 3 * (b1 - b0), 3 * (b0 - 2 * b1 + b2), b3 - 3 * b2 + 3 * b1 - b0};
+    ASSERT_TRUE(within(back.coefficients, back.error, exact_power)) << n;
+    // Values at 0, 1/3, 2/3, 1 (rounded, with their error) -> Bernstein.
+    std::array<double, 4> values;
+    double value_error = 0;
+    for (int i = 0; i < 4; ++i) {
+      const mpq_class t(i, 3);
+      const mpq_class v = exact(t);
+      values[static_cast<std::size_t>(i)] = v.get_d();
+      value_error = std::max(value_error, mpq_class(abs(mpq_class(values[static_cast<std::size_t>(i)]) - v)).get_d() * 2);
+    }
+    const BernsteinCubic from_values = bernstein_from_values(values, value_error);
+    ASSERT_TRUE(within(from_values.coefficients, from_values.error, bernstein(exact))) << n;
+  }
+}
+
+// Exact Bernstein coefficients of (a(t) - q(t)) . ((b(t) - a(t)) x (c(t) - a(t))).
+std::array<mpq_class, 4> exact_orientation(const MovingOrientationQuery& q) {
+  using detail::PolynomialVector;
+  const auto moving = [](const V& p0, const V& p1) {
+    PolynomialVector r;
+    for (int k = 0; k < 3; ++k) {
+      r[static_cast<std::size_t>(k)] = RationalPolynomial::linear(mpq_class(p0[k]), mpq_class(p1[k]) - mpq_class(p0[k]));
+    }
+    return r;
+  };
+  const auto a = moving(q.a_t0, q.a_t1), b = moving(q.b_t0, q.b_t1), c = moving(q.c_t0, q.c_t1),
+             o = moving(q.q_t0, q.q_t1);
+  return bernstein(detail::dot(a - o, detail::cross(b - a, c - a)));
+}
+
+TEST(MovingOrientationCubic, CoefficientsWithinTheStatedBound) {
+  std::mt19937_64 rng(5);
+  std::uniform_real_distribution<double> u(-1, 1);
+  const auto point = [&] {
+    const double x = u(rng), y = u(rng), z = u(rng);
+    return V(x, y, z);
+  };
+  int positive = 0, negative = 0;
+  for (int n = 0; n < 4000; ++n) {
+    MovingOrientationQuery q{point(), point(), point(), point(), point(), point(), point(), point()};
+    if (n % 3 == 1) {
+      // The observer in the triangle's plane at both ends (coplanar up to rounding).
+      q.q_t0 = q.a_t0 + 0.3 * (q.b_t0 - q.a_t0) + 0.2 * (q.c_t0 - q.a_t0);
+      q.q_t1 = q.a_t1 + 0.6 * (q.b_t1 - q.a_t1) + 0.1 * (q.c_t1 - q.a_t1);
+    }
+    const double scale = (n % 5 == 0) ? 1e-6 : (n % 5 == 1) ? 1e6 : 1.0;
+    const V shift = (n % 7 == 0) ? V(1e6, -1e6, 1e6) : V::Zero();
+    for (V* p : {&q.a_t0, &q.b_t0, &q.c_t0, &q.q_t0, &q.a_t1, &q.b_t1, &q.c_t1, &q.q_t1}) *p = *p * scale + shift;
+    const BernsteinCubic f = moving_orientation_cubic(q);
+    ASSERT_TRUE(within(f.coefficients, f.error, exact_orientation(q))) << n;
+    const PolynomialSign s = cubic_sign(f);
+    if (s != PolynomialSign::uncertain) {
+      const auto& e = exact_orientation(q);
+      RationalPolynomial exact_power({e[0], 3 * (e[1] - e[0]), 3 * (e[0] - 2 * e[1] + e[2]), e[3] - 3 * e[2] + 3 * e[1] - e[0]});
+      ASSERT_EQ(static_cast<int>(s), exact_sign_on_unit(exact_power)) << n;
+      (s == PolynomialSign::positive ? positive : negative) += 1;
+    }
+    // |n(t)| <= the bound at a few exact times.
+    const double bound = moving_normal_bound(q);
+    for (const double t : {0.0, 0.25, 0.5, 1.0}) {
+      const V b = (1 - t) * q.b_t0 + t * q.b_t1, a = (1 - t) * q.a_t0 + t * q.a_t1, c = (1 - t) * q.c_t0 + t * q.c_t1;
+      ASSERT_LE((b - a).cross(c - a).norm(), bound * (1 + 1e-12)) << n;
+    }
+  }
+  EXPECT_GT(positive, 250);
+  EXPECT_GT(negative, 250);
+}
+
+TEST(MovingOrientationCubic, SignMeansFrontOrBack) {
+  // Observer above the xy triangle (normal +z): f = (a - q) . n < 0 ("in front").
+  const V a(0, 0, 0), b(1, 0, 0), c(0, 1, 0), q(0.2, 0.2, 1);
+  EXPECT_EQ(cubic_sign(moving_orientation_cubic({a, b, c, q, a, b, c, q})), PolynomialSign::negative);
+  EXPECT_EQ(cubic_sign(moving_orientation_cubic({a, b, c, -q, a, b, c, -q})), PolynomialSign::positive);
+  // Passing through the plane: uncertain.
+  EXPECT_EQ(cubic_sign(moving_orientation_cubic({a, b, c, q, a, b, c, -q})), PolynomialSign::uncertain);
+}
+
+TEST(Filters, SweptAabbs) {
+  const VertexFaceQuery q{V(0, 0, 2), V(0, 0, 0), V(1, 0, 0), V(0, 1, 0),
+                          V(0, 0, 1), V(0, 0, 0), V(1, 0, 0), V(0, 1, 0)};
+  EXPECT_TRUE(swept_aabbs_disjoint(q));
+  EXPECT_TRUE(swept_aabbs_disjoint(q, 0.999));
+  EXPECT_FALSE(swept_aabbs_disjoint(q, 1.0));  // exactly min_separation apart counts as touching
+  const EdgeEdgeQuery e{V(0, 0, 0), V(1, 0, 0), V(2, 0, 0), V(3, 0, 0),
+                        V(0, 0, 0), V(1, 0, 0), V(1, 0, 0), V(2, 0, 0)};
+  EXPECT_FALSE(swept_aabbs_disjoint(e));
+}
+
+TEST(Filters, CoplanarityFilter) {
+  // Gliding 1/2 above the face: never coplanar.
+  const VertexFaceQuery glide{V(0.2, 0.2, 0.5), V(0, 0, 0), V(1, 0, 0), V(0, 1, 0),
+                              V(0.3, 0.2, 0.5), V(0, 0, 0), V(1, 0, 0), V(0, 1, 0)};
+  EXPECT_TRUE(coplanarity_filter_rejects(glide));
+  EXPECT_TRUE(coplanarity_filter_rejects(glide, 0.4));
+  EXPECT_FALSE(coplanarity_filter_rejects(glide, 0.6));
+  // Crossing the plane: not rejected.
+  const VertexFaceQuery cross{V(2, 2, 0.5), V(0, 0, 0), V(1, 0, 0), V(0, 1, 0),
+                              V(2, 2, -0.5), V(0, 0, 0), V(1, 0, 0), V(0, 1, 0)};
+  EXPECT_FALSE(coplanarity_filter_rejects(cross));
+  // Skew edges that stay apart vertically; then crossing.
+  const EdgeEdgeQuery ee{V(0, 0, 1), V(1, 0, 1), V(0.5, -1, 0), V(0.5, 1, 0),
+                         V(0, 0, 0.5), V(1, 0, 0.5), V(0.5, -1, 0), V(0.5, 1, 0)};
+  EXPECT_TRUE(coplanarity_filter_rejects(ee));
+  EdgeEdgeQuery through = ee;
+  through.ea0_t1.z() = through.ea1_t1.z() = -0.5;
+  EXPECT_FALSE(coplanarity_filter_rejects(through));
+}
+
+}  // namespace
+}  // namespace skelcd::ccd

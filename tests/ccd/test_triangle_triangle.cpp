@@ -1,0 +1,230 @@
+// triangles_intersect against an independent brute-force rational reference: A n B is the set of
+// points sum alpha_i a_i = sum beta_j b_j with alpha, beta >= 0 summing to 1 — a polytope whose
+// vertices are the basic feasible solutions of that linear system. Enumerating every basic solution
+// exactly (GMP) gives every extreme point of A n B; the triangles meet beyond their shared part
+// iff one of those points is outside it.
+
+#include "ccd/triangle_triangle.hpp"
+
+#include <random>
+#include <vector>
+
+#include <gmpxx.h>
+#include <gtest/gtest.h>
+
+#include "ccd/orientation.hpp"
+
+namespace skelcd::ccd {
+namespace {
+
+using V = Eigen::Vector3d;
+using Q3 = std::array<mpq_class, 3>;
+
+Q3 rational(const V& p) { return {mpq_class(p.x()), mpq_class(p.y()), mpq_class(p.z())}; }
+
+// Solves M_S x = r exactly for the columns S (5 equations). Returns false when the columns are
+// dependent or the system is inconsistent.
+bool solve(const std::array<std::array<mpq_class, 6>, 5>& m, const std::array<mpq_class, 5>& r,
+           const std::vector<int>& cols, std::vector<mpq_class>& x) {
+  const std::size_t n = cols.size();
+  std::vector<std::vector<mpq_class>> a(5, std::vector<mpq_class>(n + 1));
+  for (std::size_t i = 0; i < 5; ++i) {
+    for (std::size_t j = 0; j < n; ++j) a[i][j] = m[i][static_cast<std::size_t>(cols[j])];
+    a[i][n] = r[i];
+  }
+  std::size_t row = 0;
+  for (std::size_t col = 0; col < n; ++col) {
+    std::size_t pivot = row;
+    while (pivot < 5 && a[pivot][col] == 0) ++pivot;
+    if (pivot == 5) return false;  // dependent columns
+    std::swap(a[row], a[pivot]);
+    for (std::size_t i = 0; i < 5; ++i) {
+      if (i == row || a[i][col] == 0) continue;
+      const mpq_class f = a[i][col] / a[row][col];
+      for (std::size_t j = col; j <= n; ++j) a[i][j] -= f * a[row][j];
+    }
+    ++row;
+  }
+  for (std::size_t i = row; i < 5; ++i) {
+    if (a[i][n] != 0) return false;  // inconsistent
+  }
+  x.assign(n, 0);
+  for (std::size_t i = 0; i < n; ++i) x[i] = a[i][n] / a[i][i];
+  return true;
+}
+
+bool on_segment(const Q3& p, const Q3& a, const Q3& b) {
+  // p = a + s (b - a), 0 <= s <= 1, or p = a when a = b.
+  Q3 d, e;
+  for (std::size_t k = 0; k < 3; ++k) {
+    d[k] = b[k] - a[k];
+    e[k] = p[k] - a[k];
+  }
+  const mpq_class cx = d[1] * e[2] - d[2] * e[1], cy = d[2] * e[0] - d[0] * e[2], cz = d[0] * e[1] - d[1] * e[0];
+  if (cx != 0 || cy != 0 || cz != 0) return false;
+  mpq_class dot_pa_pb = 0;
+  for (std::size_t k = 0; k < 3; ++k) dot_pa_pb += (p[k] - a[k]) * (p[k] - b[k]);
+  return dot_pa_pb <= 0;
+}
+
+bool brute_intersect(const TriangleTriangleQuery& q, const SharedCorners& shared) {
+  const Q3 a[3] = {rational(q.a0), rational(q.a1), rational(q.a2)};
+  const Q3 b[3] = {rational(q.b0), rational(q.b1), rational(q.b2)};
+  std::array<std::array<mpq_class, 6>, 5> m;
+  for (std::size_t j = 0; j < 3; ++j) {
+    m[0][j] = 1;
+    m[0][j + 3] = 0;
+    m[1][j] = 0;
+    m[1][j + 3] = 1;
+    for (std::size_t k = 0; k < 3; ++k) {
+      m[2 + k][j] = a[j][k];
+      m[2 + k][j + 3] = -b[j][k];
+    }
+  }
+  const std::array<mpq_class, 5> r{1, 1, 0, 0, 0};
+  std::vector<Q3> shared_points;
+  for (std::size_t i = 0; i < 3; ++i) {
+    if (shared[i] >= 0) shared_points.push_back(a[i]);
+  }
+  std::vector<mpq_class> x;
+  for (int mask = 1; mask < 64; ++mask) {
+    std::vector<int> cols;
+    for (int j = 0; j < 6; ++j) {
+      if (mask & (1 << j)) cols.push_back(j);
+    }
+    if (cols.size() > 5 || !solve(m, r, cols, x)) continue;
+    bool feasible = true;
+    for (const auto& xi : x) feasible = feasible && xi >= 0;
+    if (!feasible) continue;
+    // A vertex of A n B.
+    Q3 p{0, 0, 0};
+    for (std::size_t j = 0; j < cols.size(); ++j) {
+      if (cols[j] >= 3) continue;
+      for (std::size_t k = 0; k < 3; ++k) p[k] += x[j] * a[static_cast<std::size_t>(cols[j])][k];
+    }
+    if (shared_points.empty()) return true;
+    const bool in_shared = shared_points.size() == 1 ? p == shared_points[0]
+                           : shared_points.size() == 2 ? on_segment(p, shared_points[0], shared_points[1])
+                                                       : true;  // three shared corners: the same triangle
+    if (!in_shared) return true;
+  }
+  return false;
+}
+
+TriangleTriangleQuery tri(V a0, V a1, V a2, V b0, V b1, V b2) { return {a0, a1, a2, b0, b1, b2}; }
+
+TEST(TriangleTriangle, HandPickedCases) {
+  const V o(0, 0, 0), x(1, 0, 0), y(0, 1, 0);
+  // Piercing, touching at a point, apart, coplanar overlapping, coplanar apart, coplanar touching edges.
+  EXPECT_TRUE(triangles_intersect(tri(o, x, y, V(0.2, 0.2, -1), V(0.2, 0.2, 1), V(2, 2, 0))));
+  EXPECT_TRUE(triangles_intersect(tri(o, x, y, V(0.2, 0.2, 0), V(0.2, 0.3, 1), V(0.3, 0.2, 1))));
+  EXPECT_FALSE(triangles_intersect(tri(o, x, y, V(0.2, 0.2, 1e-12), V(0.2, 0.3, 1), V(0.3, 0.2, 1))));
+  EXPECT_TRUE(triangles_intersect(tri(o, x, y, V(0.2, 0.2, 0), V(2, 0.2, 0), V(0.2, 2, 0))));
+  EXPECT_FALSE(triangles_intersect(tri(o, x, y, V(2, 2, 0), V(3, 2, 0), V(2, 3, 0))));
+  EXPECT_TRUE(triangles_intersect(tri(o, x, y, V(1, 0, 0), V(2, 0, 0), V(1, 1, 0))));
+  EXPECT_FALSE(triangles_intersect(tri(o, x, y, V(1 + 1e-15, 0, 0), V(2, 0, 0), V(1, 1, 0))));
+  // Degenerate: a segment triangle through the face; a point triangle on an edge.
+  EXPECT_TRUE(triangles_intersect(tri(o, x, y, V(0.3, 0.3, -1), V(0.3, 0.3, 1), V(0.3, 0.3, 0.5))));
+  EXPECT_TRUE(triangles_intersect(tri(o, x, y, V(0.5, 0, 0), V(0.5, 0, 0), V(0.5, 0, 0))));
+  EXPECT_FALSE(triangles_intersect(tri(o, x, y, V(0.5, -1e-300, 0), V(0.5, -1e-300, 0), V(0.5, -1e-300, 0))));
+}
+
+TEST(TriangleTriangle, SharedVertexAndEdge) {
+  const V o(0, 0, 0), x(1, 0, 0), y(0, 1, 0);
+  // A fan around o: neighbours share o and meet nowhere else.
+  EXPECT_FALSE(triangles_intersect(tri(o, x, y, o, V(-1, 0, 0), V(0, -1, 0.5)), {0, -1, -1}));
+  // Shared vertex, and the other triangle folds back through this one.
+  EXPECT_TRUE(triangles_intersect(tri(o, x, y, o, V(0.5, 0.5, 1), V(0.5, 0.5, -1)), {0, -1, -1}));
+  // Shared vertex, coplanar, overlapping wedge.
+  EXPECT_TRUE(triangles_intersect(tri(o, x, y, o, V(1, 1, 0), V(2, 0.5, 0)), {0, -1, -1}));
+  // Shared vertex, coplanar, only the vertex in common.
+  EXPECT_FALSE(triangles_intersect(tri(o, x, y, o, V(-1, 0, 0), V(-1, -1, 0)), {0, -1, -1}));
+  // Without the shared flag the common vertex counts.
+  EXPECT_TRUE(triangles_intersect(tri(o, x, y, o, V(-1, 0, 0), V(-1, -1, 0))));
+  // Shared edge o-x: bent (not coplanar), flat on the other side, folded onto the same side.
+  EXPECT_FALSE(triangles_intersect(tri(o, x, y, x, o, V(0.5, -1, 1)), {1, 0, -1}));
+  EXPECT_FALSE(triangles_intersect(tri(o, x, y, x, o, V(0.5, -1, 0)), {1, 0, -1}));
+  EXPECT_TRUE(triangles_intersect(tri(o, x, y, x, o, V(0.5, 0.25, 0)), {1, 0, -1}));
+  // The same triangle.
+  EXPECT_FALSE(triangles_intersect(tri(o, x, y, y, o, x), {1, 2, 0}));
+  // A degenerate neighbour: shared vertex o, the other two corners collinear with o along x.
+  EXPECT_TRUE(triangles_intersect(tri(o, x, y, o, V(0.5, 0, 0), V(2, 0, 0)), {0, -1, -1}));
+  EXPECT_FALSE(triangles_intersect(tri(o, x, y, o, V(-0.5, 0, 0), V(-2, 0, 0)), {0, -1, -1}));
+}
+
+// Random triangles on a small grid (exact degeneracies everywhere), sometimes sharing corners.
+TEST(TriangleTriangle, AgreesWithBruteForceOnGridTriangles) {
+  std::mt19937_64 rng(42);
+  std::uniform_int_distribution<int> coord(-1, 2);
+  const auto grid_point = [&] {
+    const double x = 0.5 * coord(rng);
+    const double y = 0.5 * coord(rng);
+    const double z = 0.5 * coord(rng);
+    return V(x, y, z);
+  };
+  int hits = 0;
+  int shared_cases = 0;
+  for (int n = 0; n < 1500; ++n) {
+    TriangleTriangleQuery q{grid_point(), grid_point(), grid_point(), grid_point(), grid_point(), grid_point()};
+    SharedCorners shared = kNoSharedCorners;
+    const int share = std::uniform_int_distribution<int>(0, 3)(rng);  // 0: none, 1: vertex, 2: edge
+    if (share == 1 || share == 2) {
+      V* a[3] = {&q.a0, &q.a1, &q.a2};
+      V* b[3] = {&q.b0, &q.b1, &q.b2};
+      int perm[3] = {0, 1, 2};
+      std::shuffle(perm, perm + 3, rng);
+      for (int s = 0; s < share; ++s) {
+        const int i = s;
+        const int j = perm[s];
+        *b[j] = *a[i];
+        shared[static_cast<std::size_t>(i)] = static_cast<std::int8_t>(j);
+      }
+      ++shared_cases;
+    }
+    const bool expected = brute_intersect(q, shared);
+    ASSERT_EQ(triangles_intersect(q, shared), expected) << "case " << n;
+    hits += expected ? 1 : 0;
+  }
+  EXPECT_GT(hits, 200);
+  EXPECT_LT(hits, 1300);
+  EXPECT_GT(shared_cases, 500);
+}
+
+// Nearly degenerate doubles: contacts built exactly on a grid, then nudged by one ulp, so that the
+// floating-point filter cannot decide and the exact fallback must.
+TEST(TriangleTriangle, AgreesWithBruteForceNextToDegeneracies) {
+  std::mt19937_64 rng(7);
+  std::uniform_int_distribution<int> coord(-2, 2);
+  std::uniform_int_distribution<int> pick(0, 17);
+  int hits = 0;
+  for (int n = 0; n < 600; ++n) {
+    std::array<V, 6> p;
+    for (auto& v : p) {
+      const double x = 0.25 * coord(rng) + 0.1;
+      const double y = 0.25 * coord(rng) + 0.3;
+      const double z = 0.25 * coord(rng) + 0.7;
+      v = V(x, y, z);
+    }
+    const int k = pick(rng);
+    double& c = p[static_cast<std::size_t>(k / 3)][k % 3];
+    c = std::nextafter(c, (n % 2) ? 10.0 : -10.0);
+    const TriangleTriangleQuery q{p[0], p[1], p[2], p[3], p[4], p[5]};
+    const bool expected = brute_intersect(q, kNoSharedCorners);
+    ASSERT_EQ(triangles_intersect(q), expected) << "case " << n;
+    hits += expected ? 1 : 0;
+  }
+  EXPECT_GT(hits, 50);
+}
+
+TEST(Orientation, ExactOnNearlyCoplanarPoints) {
+  const V a(0.1, 0.2, 0.3), b(1e8 + 0.1, 0.2, 0.3), c(0.1, 1e8 + 0.2, 0.3);
+  EXPECT_EQ(orient3d(a, b, c, V(5, 7, 0.3)), 0);
+  EXPECT_EQ(orient3d(a, b, c, V(5, 7, std::nextafter(0.3, 1.0))), 1);
+  EXPECT_EQ(orient3d(a, b, c, V(5, 7, std::nextafter(0.3, 0.0))), -1);
+  // Scaled to the underflow range: the filter hands over to the exact path.
+  const double s = 1e-300;
+  EXPECT_EQ(orient3d(a * s, b * s, c * s, V(5, 7, 0.4) * s), 1);
+}
+
+}  // namespace
+}  // namespace skelcd::ccd
