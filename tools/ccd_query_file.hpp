@@ -1,0 +1,45 @@
+#pragma once
+// Reading CCD query files (format: docs/ccd-queries.md). One query per line: `vf` or `ee`, 24
+// coordinates (decimal or exact rational p/q), an optional expected result 0/1; `#` comments and
+// blank lines ignored.
+
+#include <array>
+#include <filesystem>
+#include <iosfwd>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <gmpxx.h>
+
+namespace skelcd::tools {
+
+struct CcdQueryRecord {
+  bool vertex_face = true;
+  /// The 8 points x, y, z in file order (vf: vertex, corners 0..2; ee: a0, a1, b0, b1; t = 0 then
+  /// t = 1), each coordinate the double nearest to the written number.
+  std::array<double, 24> coordinates{};
+  /// The written numbers exactly (0.1 is 1/10); filled only when asked for.
+  std::array<mpq_class, 24> exact;
+  std::optional<bool> expected;
+  int line = 0;  ///< 1-based line number in the file
+};
+
+/// Parses every query of `in`. Throws InvalidInput "<name>:<line>: <fault>" on the first malformed
+/// line (wrong keyword, wrong count, a number that is not one, a value beyond the double range, an
+/// expected result other than 0 or 1).
+/// @param keep_exact also fill CcdQueryRecord::exact (slower).
+[[nodiscard]] std::vector<CcdQueryRecord> parse_ccd_queries(
+    std::istream& in,
+    const std::string& name,
+    bool keep_exact);
+
+/// Reads `path` ("-" for standard input). Throws IoError if it cannot be opened, InvalidInput as
+/// parse_ccd_queries.
+[[nodiscard]] std::vector<CcdQueryRecord> read_ccd_queries(const std::string& path, bool keep_exact);
+
+/// One number token: the double nearest to it, and (when `exact` is not null) its exact value.
+/// Returns false with `fault` set when the token is not a finite number of the format.
+[[nodiscard]] bool parse_ccd_number(std::string_view token, double& value, mpq_class* exact, std::string& fault);
+
+}  // namespace skelcd::tools
