@@ -15,11 +15,11 @@
 #include "segmentation/segmentation.hpp"
 #include "skelcd_version.hpp"
 #include "skinning/errors.hpp"
+#include "skinning/generators.hpp"
 #include "skinning/load.hpp"
 #include "skinning/rig_motion.hpp"
 #include "tools/cli_util.hpp"
 #include "tools/commands.hpp"
-#include "tools/file_hash.hpp"
 #include "tools/segmentation_file.hpp"
 
 namespace skelcd::tools {
@@ -201,7 +201,7 @@ void run_preprocess(const PreprocessArguments& args) {
   // Everything that can be refused is checked before anything is computed or written.
   const auto options = to_options(args);
   const std::filesystem::path model_path(args.model);
-  require_exists(model_path);
+  if (!skinning::is_generator_spec(args.model)) require_exists(model_path);
   const auto model = skinning::load_model(model_path);
   if (!model.rig) {
     throw InvalidInput(args.model + ": preprocess needs a rigged model (a mesh with a skeleton); "
@@ -217,7 +217,7 @@ void run_preprocess(const PreprocessArguments& args) {
       throw InvalidInput(args.model + ": --clip: clip statistics need a skinned rig's clip");
     }
   }
-  const auto input_hash = file_content_hash(model_path);
+  const auto input_hash = model_identity(args.model);
 
   const auto s = seg::segment(rig, options);
   std::optional<seg::ClipOrientationStats> clip;
@@ -247,7 +247,9 @@ void add_preprocess_command(CLI::App& app) {
   auto* cmd = app.add_subcommand(
       "preprocess",
       "Segmentation: bone weights, atomic clusters and observers; Table 1 statistics; saved to HDF5");
-  cmd->add_option("model", args->model, "rigged model file (glTF, FBX, Collada, .X, …)")->required();
+  cmd->add_option("model", args->model,
+                  "rigged model file (glTF, FBX, Collada, .X, …) or generator spec (gen:rope?…)")
+      ->required();
   cmd->add_option("--weights", args->weights, "heat (bone heat diffusion) or rig (the file's own)")
       ->capture_default_str();
   cmd->add_option("--distance", args->distance,

@@ -10,6 +10,7 @@
 #include <utility>
 
 #include "skinning/errors.hpp"
+#include "skinning/generators.hpp"
 #include "tools/file_hash.hpp"
 
 namespace skelcd::tools {
@@ -568,22 +569,28 @@ SegmentationFile read_segmentation(const std::filesystem::path& path) {
   return out;
 }
 
-SegmentationFile read_segmentation(const std::filesystem::path& path,
-                                   const std::filesystem::path& model) {
+std::string model_identity(const std::string& model) {
+  if (skinning::is_generator_spec(model)) {
+    return skinning::to_string(skinning::parse_generator_spec(model));
+  }
+  return file_content_hash(model);
+}
+
+SegmentationFile read_segmentation(const std::filesystem::path& path, const std::string& model) {
   auto out = read_segmentation(path);
-  const auto hash = file_content_hash(model);
-  if (out.record.input_hash != hash) {
+  const auto identity = model_identity(model);
+  if (out.record.input_hash != identity) {
     throw InvalidInput(path.string() + ": made from a different file (" + out.record.input_hash +
-                       " of " + out.record.input_path + "), not from " + model.string() + " (" +
-                       hash + ")");
+                       " of " + out.record.input_path + "), not from " + model + " (" + identity +
+                       ")");
   }
   return out;
 }
 
-bool segmentation_matches(const std::filesystem::path& path, const std::filesystem::path& model) {
+bool segmentation_matches(const std::filesystem::path& path, const std::string& model) {
   try {
     return is_segmentation_file(path) &&
-           read_segmentation(path).record.input_hash == file_content_hash(model);
+           read_segmentation(path).record.input_hash == model_identity(model);
   } catch (const std::exception&) {
     return false;
   }

@@ -26,7 +26,7 @@ struct SegmentationRecord {
   std::int64_t format_version = kSegmentationFormatVersion;
   std::string skelcd_version;
   std::string input_path;  ///< the model as given on the command line
-  std::string input_hash;  ///< file_content_hash of the model ("fnv1a64:…")
+  std::string input_hash;  ///< model_identity of the model ("fnv1a64:…" or "gen:…")
   std::vector<std::string> bone_names;           ///< #B
   std::vector<segmentation::BoneSegment> bones;  ///< #B rest segments with parents
   /// |H⁻| / |Hᵘ| over a clip, when one was classified.
@@ -37,6 +37,12 @@ struct SegmentationFile {
   segmentation::Segmentation segmentation;
   SegmentationRecord record;
 };
+
+/// What identifies the input a segmentation was made from: the content hash of a model file
+/// (file_content_hash, "fnv1a64:…"), or the canonical spec of a generated rig ("gen:rope?…":
+/// generators are deterministic).
+/// @throws IoError when a file cannot be read; InvalidInput for a bad generator spec.
+[[nodiscard]] std::string model_identity(const std::string& model);
 
 /// Writes `segmentation` to `path`: first to a temporary file beside it, renamed over `path` only
 /// when complete (a failed or interrupted write leaves nothing half-written).
@@ -53,17 +59,17 @@ void write_segmentation(
 ///   version, or inconsistent (a cluster or triangle index out of range).
 [[nodiscard]] SegmentationFile read_segmentation(const std::filesystem::path& path);
 
-/// Reads `path` and checks that it was made from `model`: same content hash.
+/// Reads `path` and checks that it was made from `model`: same model_identity.
 /// @throws InvalidInput naming both files when the hashes differ (the model changed since);
 ///   IoError as above.
 [[nodiscard]] SegmentationFile read_segmentation(
     const std::filesystem::path& path,
-    const std::filesystem::path& model);
+    const std::string& model);
 
-/// True when `path` is a readable skelcd segmentation made from `model` (same content hash):
+/// True when `path` is a readable skelcd segmentation made from `model` (same model_identity):
 /// the test `check` and `bench` use to reuse a saved segmentation or compute a new one.
 [[nodiscard]] bool segmentation_matches(
     const std::filesystem::path& path,
-    const std::filesystem::path& model);
+    const std::string& model);
 
 }  // namespace skelcd::tools

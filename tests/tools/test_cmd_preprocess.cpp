@@ -81,7 +81,7 @@ TEST(CmdPreprocess, SavedFileOpensInH5dumpAndReadsBackAsComputed) {
 
   // Equal to the segmentation computed here with the same options (the computation is
   // deterministic), and the input hash ties it to the model.
-  const auto file = skelcd::tools::read_segmentation(out, kBcn);
+  const auto file = skelcd::tools::read_segmentation(out, kBcn.string());
   const auto model = skelcd::skinning::load_model(kBcn);
   skelcd::segmentation::SegmentationOptions options;
   options.weights = skelcd::segmentation::WeightSource::rig;
@@ -105,12 +105,12 @@ TEST(CmdPreprocess, SavedFileOpensInH5dumpAndReadsBackAsComputed) {
   EXPECT_EQ(file.segmentation.stats.h_minus, expected.stats.h_minus);
   EXPECT_EQ(file.segmentation.options.weights, skelcd::segmentation::WeightSource::rig);
   EXPECT_EQ(file.record.bone_names.size(), 54u);
-  EXPECT_TRUE(skelcd::tools::segmentation_matches(out, kBcn));
+  EXPECT_TRUE(skelcd::tools::segmentation_matches(out, kBcn.string()));
 
   // A different model: the hash check refuses it, and matches() says no.
   const auto fox = character("Fox.glb");
-  EXPECT_FALSE(skelcd::tools::segmentation_matches(out, fox));
-  EXPECT_THROW_MESSAGE(std::ignore = skelcd::tools::read_segmentation(out, fox),
+  EXPECT_FALSE(skelcd::tools::segmentation_matches(out, fox.string()));
+  EXPECT_THROW_MESSAGE(std::ignore = skelcd::tools::read_segmentation(out, fox.string()),
                        skelcd::InvalidInput, "different file");
 }
 
@@ -132,6 +132,19 @@ TEST(CmdPreprocess, DocumentedH5pyExampleReadsASegmentation) {
   EXPECT_EQ(status, 0) << output;
   EXPECT_NE(output.find("clusters"), std::string::npos) << output;
   EXPECT_NE(output.find("h_minus:"), std::string::npos) << output;
+}
+
+TEST(CmdPreprocess, GeneratedRigsAreIdentifiedByTheirSpec) {
+  const auto dir = skelcd::test::temp_dir("cmd_preprocess_gen");
+  const auto out = dir / "octopus.h5";
+  const std::string spec = "gen:octopus?triangles=4000";
+  const auto r = run_skelcd({"preprocess", spec, "-o", out.string(), "--json"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto file = skelcd::tools::read_segmentation(out, spec);
+  EXPECT_EQ(file.record.input_hash.rfind("gen:octopus?", 0), 0u) << file.record.input_hash;
+  EXPECT_TRUE(skelcd::tools::segmentation_matches(out, spec));
+  EXPECT_FALSE(skelcd::tools::segmentation_matches(out, "gen:octopus?triangles=5000"));
+  EXPECT_FALSE(skelcd::tools::segmentation_matches(out, kBcn.string()));
 }
 
 TEST(CmdPreprocess, ClipAveragesAndCoarseDistance) {
