@@ -3,9 +3,10 @@
 // and on the real characters. Counters: triangles, weights_s, decomposition_ms, atomic clusters,
 // |H⁻|, |Hᵘ| (rest pose), vertices that saw no bone.
 //
-//   build-seg/bench/segmentation/bm_segmentation_preprocess --benchmark_counters_tabular=true
+//   SKELCD_THREADS=1 build/bench/segmentation/bm_segmentation_preprocess --benchmark_counters_tabular=true
 
 #include <algorithm>
+#include <cstdlib>
 #include <filesystem>
 #include <map>
 #include <memory>
@@ -13,6 +14,7 @@
 #include <utility>
 
 #include <benchmark/benchmark.h>
+#include <tbb/global_control.h>
 
 #include "segmentation/segmentation.hpp"
 #include "skinning/load.hpp"
@@ -110,6 +112,15 @@ BENCHMARK(BM_RealCharacter)
 }  // namespace
 
 int main(int argc, char** argv) {
+  // SKELCD_THREADS=1 runs single-threaded, so that the CPU column is all the work done (the
+  // parallel parts — distances, per-bone solves, observer choice — otherwise run on worker
+  // threads that the CPU column does not count).
+  std::unique_ptr<tbb::global_control> threads;
+  if (const char* n = std::getenv("SKELCD_THREADS")) {
+    threads = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism,
+                                                    static_cast<std::size_t>(std::max(1, std::atoi(n))));
+    benchmark::AddCustomContext("threads", n);
+  }
 #ifdef NDEBUG
   benchmark::AddCustomContext("asserts", "off (NDEBUG)");
 #else
