@@ -11,9 +11,7 @@ namespace {
 class BruteMethod final : public MethodBase {
  public:
   BruteMethod(
-      const skinning::Mesh& mesh,
-      const skinning::Topology& topology,
-      const MethodOptions& options)
+      const skinning::Mesh& mesh, const skinning::Topology& topology, const MethodOptions& options)
       : MethodBase("brute", mesh, topology, options) {
     const auto num_faces = static_cast<std::size_t>(topology_.num_triangles());
     bounds_.vertices.reserve(static_cast<std::size_t>(topology_.num_vertices()));
@@ -41,9 +39,7 @@ class BruteMethod final : public MethodBase {
   }
 
   void detect_ccd(
-      const skinning::Positions& x_t0,
-      const skinning::Positions& x_t1,
-      FrameResult& out) override {
+      const skinning::Positions& x_t0, const skinning::Positions& x_t1, FrameResult& out) override {
     check_positions(x_t0, "detect_ccd", "x_t0");
     check_positions(x_t1, "detect_ccd", "x_t1");
     const auto t0 = Clock::now();
@@ -53,8 +49,7 @@ class BruteMethod final : public MethodBase {
     features_.clear();
     ccd_candidates_brute_force<3>(topology_, bounds_, features_, out.counters);
     const auto t2 = Clock::now();
-    run_ccd_tests(
-        topology_, features_, x_t0, x_t1, tests_, options_.accuracy, ccd_options_, out);
+    run_ccd_tests(topology_, features_, x_t0, x_t1, tests_, options_.accuracy, ccd_options_, out);
     const auto t3 = Clock::now();
     out.times.refit_us += micros(t0, t1);
     out.times.traverse_us += micros(t1, t2);
@@ -70,9 +65,7 @@ class BruteMethod final : public MethodBase {
 }  // namespace
 
 std::unique_ptr<CullingMethod> make_brute_method(
-    const skinning::Mesh& mesh,
-    const skinning::Topology& topology,
-    const MethodOptions& options) {
+    const skinning::Mesh& mesh, const skinning::Topology& topology, const MethodOptions& options) {
   return std::make_unique<BruteMethod>(mesh, topology, options);
 }
 

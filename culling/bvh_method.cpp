@@ -14,15 +14,14 @@ namespace {
 
 /// Welded rest positions: row w is the rest position of representative_vertex[w].
 skinning::Positions welded_rest_positions(
-    const skinning::Mesh& mesh,
-    const skinning::Topology& topology) {
+    const skinning::Mesh& mesh, const skinning::Topology& topology) {
   skinning::Positions rest(topology.num_welded_vertices(), 3);
   for (std::int32_t w = 0; w < topology.num_welded_vertices(); ++w) {
     const std::int32_t v = topology.representative_vertex[static_cast<std::size_t>(w)];
     if (v < 0 || v >= mesh.rest_positions.rows()) {
       throw InvalidInput(
-          "culling::make_method: representative_vertex[" + std::to_string(w) + "] = " +
-          std::to_string(v) + " is not a mesh vertex");
+          "culling::make_method: representative_vertex[" + std::to_string(w) +
+          "] = " + std::to_string(v) + " is not a mesh vertex");
     }
     rest.row(w) = mesh.rest_positions.row(v);
   }
@@ -72,9 +71,7 @@ class BvhMethod final : public MethodBase {
   }
 
   void detect_ccd(
-      const skinning::Positions& x_t0,
-      const skinning::Positions& x_t1,
-      FrameResult& out) override {
+      const skinning::Positions& x_t0, const skinning::Positions& x_t1, FrameResult& out) override {
     check_positions(x_t0, "detect_ccd", "x_t0");
     check_positions(x_t1, "detect_ccd", "x_t1");
     const auto t0 = Clock::now();
@@ -89,8 +86,7 @@ class BvhMethod final : public MethodBase {
     self_traverse<N>(bvh_, bounds_.triangles, scratch_, pairs_, out.counters.bv_tests);
     ccd_candidates_from_triangle_pairs<N>(topology_, pairs_, bounds_, features_, out.counters);
     const auto t2 = Clock::now();
-    run_ccd_tests(
-        topology_, features_, x_t0, x_t1, tests_, options_.accuracy, ccd_options_, out);
+    run_ccd_tests(topology_, features_, x_t0, x_t1, tests_, options_.accuracy, ccd_options_, out);
     const auto t3 = Clock::now();
     out.times.refit_us += micros(t0, t1);
     out.times.traverse_us += micros(t1, t2);

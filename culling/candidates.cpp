@@ -11,7 +11,8 @@ inline bool is_corner(std::int32_t v, const std::array<std::int32_t, 3>& t) {
   return v == t[0] || v == t[1] || v == t[2];
 }
 
-inline bool share_endpoint(const std::array<std::int32_t, 2>& a, const std::array<std::int32_t, 2>& b) {
+inline bool share_endpoint(
+    const std::array<std::int32_t, 2>& a, const std::array<std::int32_t, 2>& b) {
   return a[0] == b[0] || a[0] == b[1] || a[1] == b[0] || a[1] == b[1];
 }
 
@@ -145,12 +146,9 @@ inline bool dcd_keep(const FeatureTopology& topology, const TrianglePair& p) {
 }  // namespace
 
 void dcd_filter_triangle_pairs(
-    const FeatureTopology& topology,
-    std::vector<TrianglePair>& pairs,
-    Counters& counters) {
-  const auto kept = std::remove_if(pairs.begin(), pairs.end(), [&](const TrianglePair& p) {
-    return !dcd_keep(topology, p);
-  });
+    const FeatureTopology& topology, std::vector<TrianglePair>& pairs, Counters& counters) {
+  const auto kept = std::remove_if(
+      pairs.begin(), pairs.end(), [&](const TrianglePair& p) { return !dcd_keep(topology, p); });
   pairs.erase(kept, pairs.end());
   counters.candidate_pairs += static_cast<std::int64_t>(pairs.size());
 }
@@ -179,11 +177,17 @@ void dcd_candidates_brute_force(
 template struct FeatureBounds<3>;
 template struct FeatureBounds<8>;
 template void ccd_candidates_from_triangle_pairs<3>(
-    const FeatureTopology&, std::span<const TrianglePair>, const FeatureBounds<3>&,
-    FeatureCandidates&, Counters&);
+    const FeatureTopology&,
+    std::span<const TrianglePair>,
+    const FeatureBounds<3>&,
+    FeatureCandidates&,
+    Counters&);
 template void ccd_candidates_from_triangle_pairs<8>(
-    const FeatureTopology&, std::span<const TrianglePair>, const FeatureBounds<8>&,
-    FeatureCandidates&, Counters&);
+    const FeatureTopology&,
+    std::span<const TrianglePair>,
+    const FeatureBounds<8>&,
+    FeatureCandidates&,
+    Counters&);
 template void ccd_candidates_brute_force<3>(
     const FeatureTopology&, const FeatureBounds<3>&, FeatureCandidates&, Counters&);
 template void ccd_candidates_brute_force<8>(

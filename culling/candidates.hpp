@@ -89,9 +89,7 @@ void ccd_candidates_brute_force(
 /// faces). Pairs sharing one or two vertices stay: the exact test handles them. Counts
 /// counters.candidate_pairs (pairs kept).
 void dcd_filter_triangle_pairs(
-    const FeatureTopology& topology,
-    std::vector<TrianglePair>& pairs,
-    Counters& counters);
+    const FeatureTopology& topology, std::vector<TrianglePair>& pairs, Counters& counters);
 
 /// DCD brute force: appends every pair a < b whose triangle volumes overlap (counted in
 /// counters.bv_tests), then filters as dcd_filter_triangle_pairs except that candidate_pairs is

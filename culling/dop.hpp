@@ -8,6 +8,7 @@
 // error of that sum is recovered exactly (TwoSum) and the bound moved out by one ulp when it is
 // not zero. Inflation by a distance is rounded outwards as well. See docs/culling.md.
 
+#include <Eigen/Core>
 #include <algorithm>
 #include <array>
 #include <bit>
@@ -15,8 +16,6 @@
 #include <cmath>
 #include <cstdint>
 #include <limits>
-
-#include <Eigen/Core>
 
 namespace skelcd::culling {
 

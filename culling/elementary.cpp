@@ -27,22 +27,33 @@ void run_ccd_tests(
   for (const VertexFacePair& p : candidates.vf) {
     const auto& f = topology.triangle(p.face);
     const ccd::VertexFaceQuery q{
-        row(x_t0, p.vertex), row(x_t0, f[0]), row(x_t0, f[1]), row(x_t0, f[2]),
-        row(x_t1, p.vertex), row(x_t1, f[0]), row(x_t1, f[1]), row(x_t1, f[2])};
+        row(x_t0, p.vertex),
+        row(x_t0, f[0]),
+        row(x_t0, f[1]),
+        row(x_t0, f[2]),
+        row(x_t1, p.vertex),
+        row(x_t1, f[0]),
+        row(x_t1, f[1]),
+        row(x_t1, f[2])};
     const ccd::CcdResult r = tests.vertex_face(q, accuracy, options);
     ++c.vf_tests;
     if (r.hit) {
       ++c.vf_contacts;
-      out.contacts.push_back(
-          {CcdContact::Kind::vf, p.vertex, p.face, r.toi_lower, r.toi_upper});
+      out.contacts.push_back({CcdContact::Kind::vf, p.vertex, p.face, r.toi_lower, r.toi_upper});
     }
   }
   for (const EdgeEdgePair& p : candidates.ee) {
     const auto& ea = topology.edge(p.a);
     const auto& eb = topology.edge(p.b);
     const ccd::EdgeEdgeQuery q{
-        row(x_t0, ea[0]), row(x_t0, ea[1]), row(x_t0, eb[0]), row(x_t0, eb[1]),
-        row(x_t1, ea[0]), row(x_t1, ea[1]), row(x_t1, eb[0]), row(x_t1, eb[1])};
+        row(x_t0, ea[0]),
+        row(x_t0, ea[1]),
+        row(x_t0, eb[0]),
+        row(x_t0, eb[1]),
+        row(x_t1, ea[0]),
+        row(x_t1, ea[1]),
+        row(x_t1, eb[0]),
+        row(x_t1, eb[1])};
     const ccd::CcdResult r = tests.edge_edge(q, accuracy, options);
     ++c.ee_tests;
     if (r.hit) {
@@ -52,7 +63,8 @@ void run_ccd_tests(
   }
   // std::sort works in place: no allocation.
   std::sort(
-      out.contacts.begin() + static_cast<std::ptrdiff_t>(first), out.contacts.end(),
+      out.contacts.begin() + static_cast<std::ptrdiff_t>(first),
+      out.contacts.end(),
       [](const CcdContact& a, const CcdContact& b) { return a.before(b); });
 }
 

@@ -34,8 +34,7 @@ void build_csr(
 }  // namespace
 
 FeatureTopology::FeatureTopology(const skinning::Mesh& mesh, const skinning::Topology& topology)
-    : welded_triangles_(topology.welded_triangles),
-      num_vertices_(topology.num_welded_vertices()) {
+    : welded_triangles_(topology.welded_triangles), num_vertices_(topology.num_welded_vertices()) {
   const auto num_faces = static_cast<std::size_t>(topology.welded_triangles.rows());
   const auto num_edges = static_cast<std::size_t>(topology.edges.rows());
   const auto num_vertices = static_cast<std::size_t>(num_vertices_);
@@ -141,8 +140,8 @@ FeatureTopology::FeatureTopology(const skinning::Mesh& mesh, const skinning::Top
     if (p < 0 || q < 0 || static_cast<std::size_t>(p) >= num_parts_ ||
         static_cast<std::size_t>(q) >= num_parts_) {
       throw InvalidInput(
-          at("excluded_part_pairs entry", static_cast<std::int64_t>(i)) + " names a part outside [0, " +
-          std::to_string(num_parts_) + ")");
+          at("excluded_part_pairs entry", static_cast<std::int64_t>(i)) +
+          " names a part outside [0, " + std::to_string(num_parts_) + ")");
     }
     excluded_[static_cast<std::size_t>(p) * num_parts_ + static_cast<std::size_t>(q)] = 1;
     excluded_[static_cast<std::size_t>(q) * num_parts_ + static_cast<std::size_t>(p)] = 1;
@@ -199,8 +198,7 @@ bool FeatureTopology::all_excluded(std::span<const std::int32_t> parts, std::int
 }
 
 bool FeatureTopology::all_excluded(
-    std::span<const std::int32_t> parts_a,
-    std::span<const std::int32_t> parts_b) const {
+    std::span<const std::int32_t> parts_a, std::span<const std::int32_t> parts_b) const {
   for (const std::int32_t p : parts_a) {
     for (const std::int32_t q : parts_b) {
       if (!part_pair_excluded(p, q)) return false;
@@ -210,9 +208,7 @@ bool FeatureTopology::all_excluded(
 }
 
 ccd::SharedCorners FeatureTopology::shared_corners(
-    std::int32_t a,
-    std::int32_t b,
-    int& count) const {
+    std::int32_t a, std::int32_t b, int& count) const {
   const auto& ta = triangle(a);
   const auto& tb = triangle(b);
   ccd::SharedCorners shared = ccd::kNoSharedCorners;

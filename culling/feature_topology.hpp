@@ -90,10 +90,7 @@ class FeatureTopology {
   /// Which corners triangle a shares with triangle b: result[i] = j when corner i of a is corner
   /// j of b (the first such j), -1 otherwise. `count` receives the number of distinct shared
   /// welded vertices.
-  [[nodiscard]] ccd::SharedCorners shared_corners(
-      std::int32_t a,
-      std::int32_t b,
-      int& count) const;
+  [[nodiscard]] ccd::SharedCorners shared_corners(std::int32_t a, std::int32_t b, int& count) const;
 
   [[nodiscard]] std::int32_t face_part(std::int32_t f) const {
     return face_part_.empty() ? 0 : face_part_[static_cast<std::size_t>(f)];
@@ -107,8 +104,7 @@ class FeatureTopology {
   [[nodiscard]] std::span<const std::int32_t> edge_parts(std::int32_t e) const;
   [[nodiscard]] bool all_excluded(std::span<const std::int32_t> parts, std::int32_t q) const;
   [[nodiscard]] bool all_excluded(
-      std::span<const std::int32_t> parts_a,
-      std::span<const std::int32_t> parts_b) const;
+      std::span<const std::int32_t> parts_a, std::span<const std::int32_t> parts_b) const;
 
   skinning::Triangles welded_triangles_;
   std::int32_t num_vertices_ = 0;

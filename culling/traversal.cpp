@@ -106,8 +106,18 @@ void self_traverse(
     if (e.a == e.b) {
       // A node against itself: pairs inside each child, then pairs across the two children.
       if (na.is_leaf()) {
-        leaf_pairs<N>(na, order, triangle_bounds, na, order, triangle_bounds, true, true, single,
-                      out, bv_tests);
+        leaf_pairs<N>(
+            na,
+            order,
+            triangle_bounds,
+            na,
+            order,
+            triangle_bounds,
+            true,
+            true,
+            single,
+            out,
+            bv_tests);
       } else {
         push(stack, e.a + 1, na.right);
         push(stack, na.right, na.right);
@@ -119,8 +129,18 @@ void self_traverse(
     if (!bounds[to_size(e.a)].overlaps(bounds[to_size(e.b)])) continue;
     const BvhNode& nb = nodes[to_size(e.b)];
     if (na.is_leaf() && nb.is_leaf()) {
-      leaf_pairs<N>(na, order, triangle_bounds, nb, order, triangle_bounds, false, true, single,
-                    out, bv_tests);
+      leaf_pairs<N>(
+          na,
+          order,
+          triangle_bounds,
+          nb,
+          order,
+          triangle_bounds,
+          false,
+          true,
+          single,
+          out,
+          bv_tests);
     } else {
       split_pair(stack, e.a, na, e.b, nb);
     }
@@ -152,8 +172,18 @@ void pair_traverse(
     const BvhNode& na = nodes_a[to_size(e.a)];
     const BvhNode& nb = nodes_b[to_size(e.b)];
     if (na.is_leaf() && nb.is_leaf()) {
-      leaf_pairs<N>(na, a.triangle_order(), triangle_bounds_a, nb, b.triangle_order(),
-                    triangle_bounds_b, false, false, single, out, bv_tests);
+      leaf_pairs<N>(
+          na,
+          a.triangle_order(),
+          triangle_bounds_a,
+          nb,
+          b.triangle_order(),
+          triangle_bounds_b,
+          false,
+          false,
+          single,
+          out,
+          bv_tests);
       continue;
     }
     split_pair(stack, e.a, na, e.b, nb);
@@ -161,16 +191,32 @@ void pair_traverse(
 }
 
 template void self_traverse<3>(
-    const Bvh<3>&, std::span<const Dop<3>>, TraversalScratch&, std::vector<TrianglePair>&,
+    const Bvh<3>&,
+    std::span<const Dop<3>>,
+    TraversalScratch&,
+    std::vector<TrianglePair>&,
     std::int64_t&);
 template void self_traverse<8>(
-    const Bvh<8>&, std::span<const Dop<8>>, TraversalScratch&, std::vector<TrianglePair>&,
+    const Bvh<8>&,
+    std::span<const Dop<8>>,
+    TraversalScratch&,
+    std::vector<TrianglePair>&,
     std::int64_t&);
 template void pair_traverse<3>(
-    const Bvh<3>&, std::span<const Dop<3>>, const Bvh<3>&, std::span<const Dop<3>>,
-    TraversalScratch&, std::vector<TrianglePair>&, std::int64_t&);
+    const Bvh<3>&,
+    std::span<const Dop<3>>,
+    const Bvh<3>&,
+    std::span<const Dop<3>>,
+    TraversalScratch&,
+    std::vector<TrianglePair>&,
+    std::int64_t&);
 template void pair_traverse<8>(
-    const Bvh<8>&, std::span<const Dop<8>>, const Bvh<8>&, std::span<const Dop<8>>,
-    TraversalScratch&, std::vector<TrianglePair>&, std::int64_t&);
+    const Bvh<8>&,
+    std::span<const Dop<8>>,
+    const Bvh<8>&,
+    std::span<const Dop<8>>,
+    TraversalScratch&,
+    std::vector<TrianglePair>&,
+    std::int64_t&);
 
 }  // namespace skelcd::culling

@@ -11,14 +11,14 @@
 // mesh). Motion: test::deformed — a twist about the tube's axis growing along it plus a
 // travelling lateral wave — sampled at 30 Hz (s advances by 1/30 per interval).
 
+#include <benchmark/benchmark.h>
+
 #include <cmath>
 #include <map>
 #include <memory>
 #include <string>
 #include <tuple>
 #include <vector>
-
-#include <benchmark/benchmark.h>
 
 #include "culling/method.hpp"
 #include "tests/culling/procedural_meshes.hpp"
@@ -70,7 +70,8 @@ void report(benchmark::State& state, const culling::FrameResult& sum, std::int64
   state.counters["feat_bv"] = avg(static_cast<double>(c.feature_bv_tests));
   state.counters["vf+ee"] = avg(static_cast<double>(c.vf_tests + c.ee_tests));
   state.counters["tt"] = avg(static_cast<double>(c.tt_tests));
-  state.counters["contacts"] = avg(static_cast<double>(c.vf_contacts + c.ee_contacts + c.dcd_pairs));
+  state.counters["contacts"] =
+      avg(static_cast<double>(c.vf_contacts + c.ee_contacts + c.dcd_pairs));
   state.counters["refit_ms"] = avg(sum.times.refit_us) / 1e3;
   state.counters["trav_ms"] = avg(sum.times.traverse_us) / 1e3;
   state.counters["elem_ms"] = avg(sum.times.elementary_us) / 1e3;
@@ -152,8 +153,7 @@ int register_all() {
     const auto& sizes = std::string(name) == "brute" ? kBruteSizes : kSizes;
     for (const auto* kind : {"ccd", "dcd"}) {
       auto* b = benchmark::RegisterBenchmark(
-          (std::string("BM_") + kind + "/" + name).c_str(),
-          [name, kind](benchmark::State& s) {
+          (std::string("BM_") + kind + "/" + name).c_str(), [name, kind](benchmark::State& s) {
             std::string(kind) == "ccd" ? bm_ccd(s, name) : bm_dcd(s, name);
           });
       for (const auto n : sizes) b->Args({n, 1});

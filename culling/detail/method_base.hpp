@@ -38,9 +38,7 @@ class MethodBase : public CullingMethod {
 };
 
 [[nodiscard]] std::unique_ptr<CullingMethod> make_brute_method(
-    const skinning::Mesh& mesh,
-    const skinning::Topology& topology,
-    const MethodOptions& options);
+    const skinning::Mesh& mesh, const skinning::Topology& topology, const MethodOptions& options);
 
 /// `bvh` (N = 3) and `kdop` (N = 8).
 template <int N>

@@ -8,13 +8,12 @@
 //   `new`) inside the measured window is counted — in Release too.
 // - Under AddressSanitizer, malloc hooks count every malloc (Eigen allocates with malloc).
 #define EIGEN_RUNTIME_NO_MALLOC
-#include <Eigen/Core>
+#include <gtest/gtest.h>
 
+#include <Eigen/Core>
 #include <atomic>
 #include <cstdlib>
 #include <new>
-
-#include <gtest/gtest.h>
 
 #include "culling/method.hpp"
 #include "tests/culling/procedural_meshes.hpp"
@@ -48,7 +47,8 @@ void malloc_hook(const volatile void*, std::size_t) {
   if (g_counting.load(std::memory_order_relaxed)) g_allocations.fetch_add(1);
 }
 void free_hook(const volatile void*) {}
-[[maybe_unused]] const int kHooksInstalled = __sanitizer_install_malloc_and_free_hooks(malloc_hook, free_hook);
+[[maybe_unused]] const int kHooksInstalled =
+    __sanitizer_install_malloc_and_free_hooks(malloc_hook, free_hook);
 #endif
 
 }  // namespace
@@ -105,13 +105,19 @@ class AllocationWindow {
 // the contact paths run too (the guard is about culling's own code).
 ccd::CcdResult fake_vf(const ccd::VertexFaceQuery& q, ccd::Accuracy, const ccd::CcdOptions&) {
   const bool hit = q.v_t1.z() > q.f0_t1.z();
-  return {hit, hit ? 0.25 : 1.0, hit ? 0.5 : 1.0, hit ? ccd::CcdStatus::contact
-                                                    : ccd::CcdStatus::separated};
+  return {
+      hit,
+      hit ? 0.25 : 1.0,
+      hit ? 0.5 : 1.0,
+      hit ? ccd::CcdStatus::contact : ccd::CcdStatus::separated};
 }
 ccd::CcdResult fake_ee(const ccd::EdgeEdgeQuery& q, ccd::Accuracy, const ccd::CcdOptions&) {
   const bool hit = q.ea0_t1.x() < q.eb0_t1.x();
-  return {hit, hit ? 0.25 : 1.0, hit ? 0.5 : 1.0, hit ? ccd::CcdStatus::contact
-                                                    : ccd::CcdStatus::separated};
+  return {
+      hit,
+      hit ? 0.25 : 1.0,
+      hit ? 0.5 : 1.0,
+      hit ? ccd::CcdStatus::contact : ccd::CcdStatus::separated};
 }
 bool fake_tt(const ccd::TriangleTriangleQuery& q, const ccd::SharedCorners&) {
   return q.a0.y() < q.b0.y();
@@ -173,11 +179,13 @@ void expect_no_allocation_after_warm_up(const std::string& name, const MethodOpt
 
 TEST(Allocation, MethodsAllocateNothingPerIntervalAfterWarmUp) {
   const MethodOptions options{.elementary = {&fake_vf, &fake_ee, &fake_tt}};
-  for (const char* name : {"bvh", "kdop", "brute"}) expect_no_allocation_after_warm_up(name, options);
+  for (const char* name : {"bvh", "kdop", "brute"})
+    expect_no_allocation_after_warm_up(name, options);
   MethodOptions leafy = options;
   leafy.bvh.leaf_size = 4;
   expect_no_allocation_after_warm_up("bvh", leafy);
-  expect_no_allocation_after_warm_up("kdop", {.min_separation = 1e-3, .elementary = options.elementary});
+  expect_no_allocation_after_warm_up(
+      "kdop", {.min_separation = 1e-3, .elementary = options.elementary});
 }
 
 TEST(Allocation, WithTheCcdKernelsToo) {

@@ -1,14 +1,13 @@
 // Bvh<N>: build structure (a permutation, nested ranges, balanced) and refit invariants (every
 // leaf contains its triangles' vertices at both ends of the interval, exactly; every parent
 // contains its children).
-#include "culling/bvh.hpp"
+#include <gtest/gtest.h>
 
 #include <algorithm>
 #include <cmath>
 #include <numeric>
 
-#include <gtest/gtest.h>
-
+#include "culling/bvh.hpp"
 #include "culling/candidates.hpp"
 #include "culling/vertex_bounds.hpp"
 #include "skinning/errors.hpp"
@@ -67,8 +66,9 @@ void check_structure(const Bvh<N>& bvh, std::int32_t num_triangles, int leaf_siz
   }
   EXPECT_EQ(leaves_total, num_triangles);
   // A median split is balanced: depth <= ceil(log2(#F / leaf_size)) + 1.
-  EXPECT_LE(bvh.depth(), static_cast<int>(std::ceil(std::log2(
-                             static_cast<double>(num_triangles) / leaf_size))) + 1);
+  EXPECT_LE(
+      bvh.depth(),
+      static_cast<int>(std::ceil(std::log2(static_cast<double>(num_triangles) / leaf_size))) + 1);
 }
 
 template <int N>
@@ -142,8 +142,8 @@ TEST(Bvh, BuildIsDeterministic) {
   const Bvh<8> a(s.topology.welded_triangles, s.x_t0, BvhOptions{1});
   const Bvh<8> b(s.topology.welded_triangles, s.x_t0, BvhOptions{1});
   ASSERT_EQ(a.nodes().size(), b.nodes().size());
-  EXPECT_TRUE(std::equal(a.triangle_order().begin(), a.triangle_order().end(),
-                         b.triangle_order().begin()));
+  EXPECT_TRUE(
+      std::equal(a.triangle_order().begin(), a.triangle_order().end(), b.triangle_order().begin()));
 }
 
 TEST(Bvh, EmptyAndSingleTriangle) {

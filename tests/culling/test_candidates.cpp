@@ -1,7 +1,8 @@
 // The feature stage: representative-triangle ownership, and the proof obligations of the CCD
 // de-duplication — the hierarchy path produces exactly brute force's feature pairs, each once,
 // and every feature pair left out is provably farther apart than the contact distance.
-#include "culling/candidates.hpp"
+#include <gmpxx.h>
+#include <gtest/gtest.h>
 
 #include <algorithm>
 #include <cmath>
@@ -9,10 +10,8 @@
 #include <numbers>
 #include <set>
 
-#include <gmpxx.h>
-#include <gtest/gtest.h>
-
 #include "culling/bvh.hpp"
+#include "culling/candidates.hpp"
 #include "culling/traversal.hpp"
 #include "culling/vertex_bounds.hpp"
 #include "skinning/errors.hpp"
@@ -71,8 +70,10 @@ std::vector<Scene> scenes() {
   out.push_back(make_scene("twisting tube", test::tube(10, 10, 0.5, 2.0), [](const auto& x) {
     return test::deformed(x, 1.0, 1.5);
   }));
-  out.push_back(make_scene("sheet folding through itself", test::sheet(10, 6, 2.0, 1.0),
-                           [](const auto& x) { return test::folded(x, 1.0, 3.4); }));
+  out.push_back(
+      make_scene("sheet folding through itself", test::sheet(10, 6, 2.0, 1.0), [](const auto& x) {
+        return test::folded(x, 1.0, 3.4);
+      }));
   {
     auto a = test::uv_sphere(7, 9, 1.0);
     auto b = test::uv_sphere(6, 8, 0.7);
@@ -129,10 +130,7 @@ Built<N> bounds_of(const Scene& s, double min_separation) {
 
 template <int N>
 FeatureCandidates hierarchy_candidates(
-    const Built<N>& b,
-    const skinning::Positions& build_at,
-    int leaf_size,
-    Counters& counters) {
+    const Built<N>& b, const skinning::Positions& build_at, int leaf_size, Counters& counters) {
   Bvh<N> bvh(b.topology.welded_triangles(), build_at, BvhOptions{leaf_size});
   bvh.refit(b.bounds.triangles);
   TraversalScratch scratch;
@@ -163,9 +161,7 @@ std::vector<T> sorted(std::vector<T> v) {
 /// each feature inside the hull of its positions at t0 and t1).
 template <int N>
 bool provably_apart_exact(
-    const std::vector<Eigen::Vector3d>& a,
-    const std::vector<Eigen::Vector3d>& b,
-    double distance) {
+    const std::vector<Eigen::Vector3d>& a, const std::vector<Eigen::Vector3d>& b, double distance) {
   const mpq_class d(distance);
   for (std::size_t k = 0; k < static_cast<std::size_t>(N); ++k) {
     const auto& axis = DopAxes<N>::kAxes[k];
@@ -196,9 +192,7 @@ bool provably_apart_exact(
 /// settles clear cases; the rest are decided in exact rational arithmetic.
 template <int N>
 bool provably_apart(
-    const std::vector<Eigen::Vector3d>& a,
-    const std::vector<Eigen::Vector3d>& b,
-    double distance) {
+    const std::vector<Eigen::Vector3d>& a, const std::vector<Eigen::Vector3d>& b, double distance) {
   double scale = 0.0;
   for (const auto* pts : {&a, &b}) {
     for (const auto& p : *pts) scale = std::max(scale, p.cwiseAbs().sum());
@@ -226,10 +220,7 @@ bool provably_apart(
 
 template <int N>
 void check_left_out_pairs_are_apart(
-    const Scene& s,
-    const Built<N>& b,
-    const FeatureCandidates& c,
-    double min_separation) {
+    const Scene& s, const Built<N>& b, const FeatureCandidates& c, double min_separation) {
   const std::set<VertexFacePair> vf(c.vf.begin(), c.vf.end());
   const std::set<EdgeEdgePair> ee(c.ee.begin(), c.ee.end());
   auto points = [&](std::initializer_list<std::int32_t> ids) {

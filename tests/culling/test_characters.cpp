@@ -1,9 +1,9 @@
 // brute, bvh and kdop on real rigged characters (assets/characters, see assets/SOURCES.md): the
 // bind pose against posed frames of their clips (large motions) and consecutive samples.
+#include <gtest/gtest.h>
+
 #include <algorithm>
 #include <string>
-
-#include <gtest/gtest.h>
 
 #include "culling/method.hpp"
 #include "skinning/load.hpp"
@@ -57,8 +57,8 @@ TEST_P(Characters, BruteBvhAndKdopAgree) {
     auto bvh = make_method("bvh", mesh, topo, options);
     auto kdop = make_method("kdop", mesh, topo, options);
     for (std::size_t i = 0; i + 1 < x.size(); ++i) {
-      const std::string what = c.file + " " + std::string(ccd::to_string(acc)) + " interval " +
-                               std::to_string(i);
+      const std::string what =
+          c.file + " " + std::string(ccd::to_string(acc)) + " interval " + std::to_string(i);
       FrameResult rb, rv, rk;
       brute->detect_ccd(x[i], x[i + 1], rb);
       bvh->detect_ccd(x[i], x[i + 1], rv);

@@ -1,12 +1,11 @@
 // Dop<N> (AABB, 16-DOP): outward rounding proven against exact rationals, inflation, overlap.
-#include "culling/dop.hpp"
+#include <gtest/gtest.h>
 
 #include <cmath>
 #include <limits>
 #include <random>
 
-#include <gtest/gtest.h>
-
+#include "culling/dop.hpp"
 #include "tests/culling/exact_dop.hpp"
 
 namespace skelcd::culling {
@@ -14,8 +13,20 @@ namespace {
 
 TEST(NextUpDown, MatchNextafterAcrossSignsAndMagnitudes) {
   const double inf = std::numeric_limits<double>::infinity();
-  const double values[] = {0.0, -0.0, 1.0, -1.0, 1e-310, -1e-310, 3.5e300, -3.5e300,
-                           std::numeric_limits<double>::denorm_min(), 0.1, -0.1, 1e6, -1e-6};
+  const double values[] = {
+      0.0,
+      -0.0,
+      1.0,
+      -1.0,
+      1e-310,
+      -1e-310,
+      3.5e300,
+      -3.5e300,
+      std::numeric_limits<double>::denorm_min(),
+      0.1,
+      -0.1,
+      1e6,
+      -1e-6};
   for (const double v : values) {
     EXPECT_EQ(next_up(v), std::nextafter(v, inf)) << v;
     EXPECT_EQ(next_down(v), std::nextafter(v, -inf)) << v;

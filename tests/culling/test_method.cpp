@@ -1,13 +1,12 @@
 // The methods behind make_method: hand-made cases with a known number of contacts, and `brute`,
 // `bvh`, `kdop` agreeing on generated meshes with known collisions (DCD pairs and CCD VF/EE).
-#include "culling/method.hpp"
+#include <gtest/gtest.h>
 
 #include <algorithm>
 #include <cmath>
 #include <numbers>
 
-#include <gtest/gtest.h>
-
+#include "culling/method.hpp"
 #include "skinning/errors.hpp"
 #include "tests/culling/procedural_meshes.hpp"
 #include "tests/support/test_support.hpp"
@@ -54,27 +53,36 @@ TEST(Method, NamesAndFactory) {
   const auto mesh = test::sheet(2, 2);
   const auto topo = test::simple_topology(mesh);
   for (const auto& name : names) EXPECT_EQ(make_method(name, mesh, topo)->name(), name);
-  EXPECT_THROW_MESSAGE((void)make_method("octree", mesh, topo), InvalidInput,
-                       "unknown method 'octree' (known: brute, bvh, kdop");
+  EXPECT_THROW_MESSAGE(
+      (void)make_method("octree", mesh, topo),
+      InvalidInput,
+      "unknown method 'octree' (known: brute, bvh, kdop");
 }
 
 TEST(Method, RejectsBadOptionsAndPositions) {
   const auto mesh = test::sheet(2, 2);
   const auto topo = test::simple_topology(mesh);
-  EXPECT_THROW_MESSAGE((void)make_method("bvh", mesh, topo, {.min_separation = -1.0}),
-                       InvalidInput, "min_separation");
-  EXPECT_THROW_MESSAGE((void)make_method("bvh", mesh, topo, {.min_separation = std::nan("")}),
-                       InvalidInput, "min_separation");
+  EXPECT_THROW_MESSAGE(
+      (void)make_method("bvh", mesh, topo, {.min_separation = -1.0}),
+      InvalidInput,
+      "min_separation");
+  EXPECT_THROW_MESSAGE(
+      (void)make_method("bvh", mesh, topo, {.min_separation = std::nan("")}),
+      InvalidInput,
+      "min_separation");
   EXPECT_THROW_MESSAGE(
       (void)make_method("kdop", mesh, topo, {.accuracy = Accuracy::exact, .min_separation = 0.1}),
-      InvalidInput, "exact");
-  EXPECT_THROW_MESSAGE((void)make_method("bvh", mesh, topo, {.bvh = {.leaf_size = 0}}),
-                       InvalidInput, "leaf_size");
+      InvalidInput,
+      "exact");
+  EXPECT_THROW_MESSAGE(
+      (void)make_method("bvh", mesh, topo, {.bvh = {.leaf_size = 0}}), InvalidInput, "leaf_size");
   auto m = make_method("kdop", mesh, topo);
   FrameResult out;
   const skinning::Positions few(3, 3);
-  EXPECT_THROW_MESSAGE(m->detect_dcd(few, out), InvalidInput,
-                       "culling::kdop::detect_dcd: x has 3 rows, expected one per welded vertex (9)");
+  EXPECT_THROW_MESSAGE(
+      m->detect_dcd(few, out),
+      InvalidInput,
+      "culling::kdop::detect_dcd: x has 3 rows, expected one per welded vertex (9)");
   const skinning::Positions x = test::welded(topo, mesh.rest_positions);
   EXPECT_THROW_MESSAGE(m->detect_ccd(x, few, out), InvalidInput, "x_t1 has 3 rows");
 }
@@ -208,8 +216,8 @@ TEST(Method, ExcludedPartPairIsNeverReported) {
 /// common point); flat, sharing only the vertex, they do not intersect.
 TEST(Method, DcdReportsTrianglesSharingAVertexOnlyWhenTheyCrossBeyondIt) {
   skinning::Positions x(5, 3);
-  x << 0, 0, 0,  // shared
-      2, -1, 0, 2, 1, 0,  // triangle 0 in z = 0
+  x << 0, 0, 0,                 // shared
+      2, -1, 0, 2, 1, 0,        // triangle 0 in z = 0
       1.5, 0, -1, 1.5, 0.2, 1;  // triangle 1 stands across triangle 0
   skinning::Triangles f(2, 3);
   f << 0, 1, 2, 0, 3, 4;
@@ -233,7 +241,7 @@ struct Scene {
   skinning::Mesh mesh;
   skinning::Topology topo;
   std::vector<skinning::Positions> samples;  // DCD at each, CCD between consecutive ones
-  bool exact_too = true;  // also run the (slow, GMP) exact accuracy
+  bool exact_too = true;                     // also run the (slow, GMP) exact accuracy
 };
 
 std::vector<Scene> scenes() {
@@ -334,8 +342,8 @@ TEST(Methods, AgreeOnGeneratedMeshesWithKnownCollisions) {
       auto bvh = make_method("bvh", s.mesh, s.topo, options);
       auto kdop = make_method("kdop", s.mesh, s.topo, options);
       for (std::size_t i = 0; i < s.samples.size(); ++i) {
-        const std::string what = s.name + " " + std::string(ccd::to_string(acc)) + " sample " +
-                                 std::to_string(i);
+        const std::string what =
+            s.name + " " + std::string(ccd::to_string(acc)) + " sample " + std::to_string(i);
         FrameResult rb, rv, rk;
         brute->detect_dcd(s.samples[i], rb);
         bvh->detect_dcd(s.samples[i], rv);
@@ -365,8 +373,9 @@ TEST(Methods, AgreeOnGeneratedMeshesWithKnownCollisions) {
         // The culling worked: fewer volume tests than brute force's (on meshes large enough
         // for a hierarchy to matter).
         if (s.topo.welded_triangles.rows() >= 150) {
-          EXPECT_LT(cv.counters.bv_tests + cv.counters.feature_bv_tests,
-                    cb.counters.feature_bv_tests) << what;
+          EXPECT_LT(
+              cv.counters.bv_tests + cv.counters.feature_bv_tests, cb.counters.feature_bv_tests)
+              << what;
         }
       }
     }
@@ -382,8 +391,8 @@ TEST(Methods, ExactContactsAreContainedInConservativeOnes) {
     if (!s.exact_too) continue;
     for (const auto& name : kBaselines) {
       for (std::size_t i = 0; i + 1 < s.samples.size(); ++i) {
-        const auto exact = run_ccd(name, s.mesh, s.topo, s.samples[i], s.samples[i + 1],
-                                   {.accuracy = Accuracy::exact});
+        const auto exact = run_ccd(
+            name, s.mesh, s.topo, s.samples[i], s.samples[i + 1], {.accuracy = Accuracy::exact});
         const auto cons = run_ccd(name, s.mesh, s.topo, s.samples[i], s.samples[i + 1]);
         EXPECT_TRUE(is_subset(exact.contacts, cons.contacts)) << s.name << " " << name;
       }
@@ -395,10 +404,13 @@ TEST(Methods, ContactsAreCanonicallySortedAndCountersConsistent) {
   const Scene s = scenes()[0];
   for (const auto& name : kBaselines) {
     const auto r = run_ccd(name, s.mesh, s.topo, s.samples[1], s.samples[2]);
-    EXPECT_TRUE(std::is_sorted(r.contacts.begin(), r.contacts.end(),
-                               [](const CcdContact& a, const CcdContact& b) { return a.before(b); }));
-    EXPECT_EQ(static_cast<std::int64_t>(r.contacts.size()),
-              r.counters.vf_contacts + r.counters.ee_contacts);
+    EXPECT_TRUE(std::is_sorted(
+        r.contacts.begin(), r.contacts.end(), [](const CcdContact& a, const CcdContact& b) {
+          return a.before(b);
+        }));
+    EXPECT_EQ(
+        static_cast<std::int64_t>(r.contacts.size()),
+        r.counters.vf_contacts + r.counters.ee_contacts);
     EXPECT_GE(r.times.refit_us, 0.0);
     EXPECT_GT(r.times.traverse_us + r.times.elementary_us, 0.0);
     const auto d = run_dcd(name, s.mesh, s.topo, s.samples[2]);

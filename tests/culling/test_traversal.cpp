@@ -1,13 +1,12 @@
 // Self and pair traversal report exactly the triangle pairs whose volumes overlap (compared with
 // an all-pairs test), each once, with far fewer volume tests than all pairs.
-#include "culling/traversal.hpp"
+#include <gtest/gtest.h>
 
 #include <algorithm>
 #include <numeric>
 
-#include <gtest/gtest.h>
-
 #include "culling/candidates.hpp"
+#include "culling/traversal.hpp"
 #include "culling/vertex_bounds.hpp"
 #include "tests/culling/procedural_meshes.hpp"
 
@@ -33,8 +32,8 @@ std::vector<Case> cases() {
     auto m = test::sheet(20, 12, 2.0, 1.0);
     auto t = test::simple_topology(m);
     auto x = test::welded(t, m.rest_positions);
-    out.push_back({"sheet folding through itself", m, test::folded(x, 1.0, 3.0),
-                   test::folded(x, 1.0, 3.3)});
+    out.push_back(
+        {"sheet folding through itself", m, test::folded(x, 1.0, 3.0), test::folded(x, 1.0, 3.3)});
   }
   {
     auto a = test::uv_sphere(12, 16, 1.0);
@@ -43,8 +42,11 @@ std::vector<Case> cases() {
     auto m = test::combine(a, b);
     auto t = test::simple_topology(m);
     auto x = test::welded(t, m.rest_positions);
-    out.push_back({"two interpenetrating spheres", m, x,
-                   test::translated(x, Eigen::Vector3d(-0.05, 0.02, 0.01))});
+    out.push_back(
+        {"two interpenetrating spheres",
+         m,
+         x,
+         test::translated(x, Eigen::Vector3d(-0.05, 0.02, 0.01))});
   }
   return out;
 }
@@ -64,8 +66,9 @@ std::vector<TrianglePair> all_overlapping_pairs(std::span<const Dop<N>> bounds) 
 
 template <int N>
 void check_self(const Case& c, int leaf_size) {
-  SCOPED_TRACE(std::string(c.name) + ", N = " + std::to_string(N) + ", leaf_size = " +
-               std::to_string(leaf_size));
+  SCOPED_TRACE(
+      std::string(c.name) + ", N = " + std::to_string(N) +
+      ", leaf_size = " + std::to_string(leaf_size));
   const skinning::Topology topo = test::simple_topology(c.mesh);
   const FeatureTopology ft(c.mesh, topo);
   Bvh<N> bvh(ft.welded_triangles(), c.x_t0, BvhOptions{leaf_size});
