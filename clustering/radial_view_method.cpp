@@ -1,10 +1,12 @@
 #include "clustering/radial_view_method.hpp"
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <utility>
 
+#include "ccd/orientation.hpp"
 #include "culling/cluster_checks.hpp"
 #include "culling/relative_aabb.hpp"
 #include "culling/vertex_bounds.hpp"
@@ -24,6 +26,53 @@ double micros(Clock::time_point from, Clock::time_point to) {
 
 bool same_positions(const skinning::Positions& a, const skinning::Positions& b) {
   return a.rows() == b.rows() && std::equal(a.data(), a.data() + a.size(), b.data());
+}
+
+/// True when triangles a and b, which share one vertex or one edge (shared: corner i of a is
+/// corner shared[i] of b, else −1), are proven to meet nowhere beyond it by exact orientations:
+/// - an edge: b's third corner off a's plane (b minus the edge lies strictly on one side);
+/// - a vertex: b's other two corners strictly on one side of a's plane, or a's of b's plane.
+/// False means "not proven": the full test decides.
+bool apart_beyond_shared(
+    const std::array<Eigen::Vector3d, 3>& a,
+    const std::array<Eigen::Vector3d, 3>& b,
+    const ccd::SharedCorners& shared) {
+  std::array<bool, 3> b_shared{false, false, false};
+  int count = 0;
+  for (const auto j : shared) {
+    if (j >= 0 && !b_shared[static_cast<std::size_t>(j)]) {
+      b_shared[static_cast<std::size_t>(j)] = true;
+      ++count;
+    }
+  }
+  const auto side = [](const std::array<Eigen::Vector3d, 3>& t, const Eigen::Vector3d& p) {
+    return ccd::orient3d(t[0], t[1], t[2], p);
+  };
+  if (count == 2) {
+    for (std::size_t j = 0; j < 3; ++j) {
+      if (!b_shared[j]) return side(a, b[j]) != 0;
+    }
+    return false;
+  }
+  if (count != 1) return false;
+  // The two corners of b that are not shared, and the two of a.
+  std::array<std::size_t, 2> bo{}, ao{};
+  std::size_t nb = 0, na = 0;
+  for (std::size_t j = 0; j < 3; ++j) {
+    if (!b_shared[j] && nb < 2) bo[nb++] = j;
+  }
+  for (std::size_t i = 0; i < 3; ++i) {
+    if (shared[i] < 0 && na < 2) ao[na++] = i;
+  }
+  if (nb == 2) {
+    const int s0 = side(a, b[bo[0]]);
+    if (s0 != 0 && s0 == side(a, b[bo[1]])) return true;
+  }
+  if (na == 2) {
+    const int s0 = side(b, a[ao[0]]);
+    if (s0 != 0 && s0 == side(b, a[ao[1]])) return true;
+  }
+  return false;
 }
 
 culling::MethodOptions without_extension(culling::MethodOptions options) {
@@ -81,6 +130,7 @@ RadialViewMethod::RadialViewMethod(
   culled_.assign(num_components, 0);
   escalate_.assign(num_components, 0);
   carry_clean_.assign(num_components, 0);
+  carry_contact_.assign(num_components, 0);
   dcd_clean_.assign(num_components, 0);
   pairs_.reserve(16 * num_faces);
   features_.vf.reserve(4 * num_faces);
@@ -140,6 +190,12 @@ void RadialViewMethod::start_status(const skinning::Positions& x_t0, culling::Fr
       status_[at(k)] = Status::clean;
     } else if (dcd_known) {
       status_[at(k)] = dcd_clean_[at(k)] != 0 ? Status::clean : Status::dirty;
+    } else if (carried && carry_contact_[at(k)] != 0) {
+      // A self-contact in the previous interval: most likely still intersecting. Taking it as
+      // dirty without a DCD pass is safe (nothing is skipped there); the first interval without
+      // a self-contact runs the pass and may find it clean again.
+      status_[at(k)] = Status::dirty;
+      ++stats_.components_assumed_dirty;
     } else {
       any_unknown = true;
     }
@@ -184,24 +240,39 @@ void RadialViewMethod::start_status(const skinning::Positions& x_t0, culling::Fr
     }
   }
   const auto traversed = Clock::now();
-  culling::Counters ignored;
-  culling::dcd_filter_triangle_pairs(topology_, dcd_pairs_, ignored);
-  dcd_result_.clear();
-  culling::run_dcd_tests(topology_, dcd_pairs_, x_t0, tests_, dcd_result_);
+  // The exact triangle test, pair by pair: pairs without a shared vertex first (an intersecting one
+  // settles its component at once), then adjacent pairs, most of which an exact orientation
+  // proves apart beyond the shared vertex or edge without the full test.
   for (std::int32_t k = 0; k < num_components; ++k) {
     if (unknown(k)) {
       status_[at(k)] = Status::clean;
       ++stats_.components_dcd;
     }
   }
-  for (const auto& p : dcd_result_.dcd_pairs) {
-    const std::int32_t k = clusters_.component_of_triangle(p.a);
-    if (k == clusters_.component_of_triangle(p.b) && clusters_.component_ok(k)) {
-      status_[at(k)] = Status::dirty;
+  std::int64_t tt_tests = 0;
+  for (const bool adjacent : {false, true}) {
+    for (const auto& p : dcd_pairs_) {
+      const std::int32_t k = clusters_.component_of_triangle(p.a);
+      if (status_[at(k)] == Status::dirty || topology_.triangles_excluded(p.a, p.b)) continue;
+      int shared_count = 0;
+      const ccd::SharedCorners shared = topology_.shared_corners(p.a, p.b, shared_count);
+      if ((shared_count > 0) != adjacent || shared_count >= 3) continue;  // 3: duplicate face
+      const auto& ta = topology_.triangle(p.a);
+      const auto& tb = topology_.triangle(p.b);
+      const auto row = [&](std::int32_t v) -> Eigen::Vector3d {
+        return x_t0.row(static_cast<Eigen::Index>(v)).transpose();
+      };
+      const std::array<Eigen::Vector3d, 3> a{row(ta[0]), row(ta[1]), row(ta[2])};
+      const std::array<Eigen::Vector3d, 3> b{row(tb[0]), row(tb[1]), row(tb[2])};
+      if (adjacent && apart_beyond_shared(a, b, shared)) continue;
+      ++tt_tests;
+      if (tests_.triangles({a[0], a[1], a[2], b[0], b[1], b[2]}, shared)) {
+        status_[at(k)] = Status::dirty;
+      }
     }
   }
   out.counters.bv_tests += bv_tests;
-  out.counters.tt_tests += dcd_result_.counters.tt_tests;
+  out.counters.tt_tests += tt_tests;
   const auto end = Clock::now();
   out.times.traverse_us += micros(start, traversed);
   out.times.elementary_us += micros(traversed, end);
@@ -431,10 +502,13 @@ void RadialViewMethod::detect_ccd(
   if (options_.guard && culling_possible) {
     for (std::int32_t k = 0; k < num_components; ++k) {
       carry_clean_[at(k)] = status_[at(k)] == Status::clean ? 1 : 0;
+      carry_contact_[at(k)] = 0;
     }
     for (const auto& c : out.contacts) {
       const std::int32_t k = component_of_contact(c);
-      if (k >= 0) carry_clean_[at(k)] = 0;
+      if (k < 0) continue;
+      carry_clean_[at(k)] = 0;
+      carry_contact_[at(k)] = 1;
     }
     carry_x_ = x_t1;
     has_carry_ = true;

@@ -49,6 +49,8 @@ struct RadialViewStats {
   std::int32_t components_open = 0;    ///< not closed / not consistently oriented / mixed parts
   std::int32_t components_dcd = 0;     ///< components proven at the start by a DCD pass here
   std::int32_t components_dirty = 0;   ///< self-intersecting at the start: nothing skipped there
+  /// Of those, assumed so without a DCD pass: they had a self-contact in the previous interval.
+  std::int32_t components_assumed_dirty = 0;
   std::int32_t components_escalated = 0;  ///< had a self-contact: skipped pairs re-tested
   std::int64_t relative_aabb_culled = 0;  ///< candidate pairs removed by the relative AABB filter
   std::int64_t skipped_pairs_retested = 0;  ///< overlapping skipped pairs tested on escalation
@@ -135,13 +137,13 @@ class RadialViewMethod final : public culling::CullingMethod {
   bool has_carry_ = false;
   skinning::Positions carry_x_;
   std::vector<std::uint8_t> carry_clean_;
+  std::vector<std::uint8_t> carry_contact_;  // had a self-contact: assumed still intersecting
   bool has_dcd_ = false;
   skinning::Positions dcd_x_;
   std::vector<std::uint8_t> dcd_clean_;
   // Precondition DCD scratch.
   culling::FeatureBounds<3> static_bounds_;
   std::vector<culling::TrianglePair> dcd_pairs_;
-  culling::FrameResult dcd_result_;
 };
 
 }  // namespace skelcd::clustering

@@ -1,0 +1,130 @@
+#pragma once
+// A rig, its clip, its segmentation and the methods to compare (`brute`, `bvh`, `rvbc`,
+// `dynamic`), run interval by interval the way the runner does, with the bone poses selected
+// before every query. Shared by the tests and the benchmark of clustering/.
+
+#include <algorithm>
+#include <chrono>
+#include <cstdint>
+#include <map>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "clustering/bone_poses.hpp"
+#include "clustering/radial_view_extension.hpp"
+#include "clustering/radial_view_method.hpp"
+#include "culling/method.hpp"
+#include "segmentation/segmentation.hpp"
+#include "skinning/rig_motion.hpp"
+#include "skinning/topology.hpp"
+
+namespace skelcd::test {
+
+/// A loaded rig with its motion, welded topology and segmentation.
+struct RadialViewScene {
+  std::shared_ptr<const skinning::Rig> rig;
+  std::unique_ptr<skinning::RigMotion> motion;
+  skinning::Topology topology;
+  std::shared_ptr<const segmentation::Segmentation> segmentation;
+  std::shared_ptr<clustering::BonePoses> poses;
+
+  /// @param clip index into rig->clips (−1: bind pose); @param weights rig (fast) or heat.
+  RadialViewScene(
+      std::shared_ptr<const skinning::Rig> rig_in,
+      std::int32_t clip = 0,
+      segmentation::WeightSource weights = segmentation::WeightSource::rig,
+      double rate_hz = 0.0)
+      : rig(std::move(rig_in)) {
+    motion = std::make_unique<skinning::RigMotion>(
+        rig, skinning::RigMotionOptions{.clip = clip, .rate_hz = rate_hz});
+    topology = skinning::build_topology(rig->mesh);
+    segmentation::SegmentationOptions options;
+    options.weights = weights;
+    segmentation = std::make_shared<const segmentation::Segmentation>(
+        segmentation::segment(*rig, options));
+    poses = std::make_shared<clustering::BonePoses>(clustering::pose_at_sample(*motion));
+  }
+
+  [[nodiscard]] culling::MethodOptions options(
+      const clustering::RadialViewParameters& parameters = {},
+      culling::MethodOptions base = {}) const {
+    base.extension = std::make_shared<clustering::RadialViewExtension>(
+        segmentation, poses, rig->skeleton.num_bones(), parameters);
+    return base;
+  }
+
+  [[nodiscard]] std::unique_ptr<culling::CullingMethod> method(
+      const std::string& name,
+      const clustering::RadialViewParameters& parameters = {},
+      culling::MethodOptions base = {}) const {
+    return culling::make_method(name, rig->mesh, topology, options(parameters, base));
+  }
+
+  /// Welded positions of sample i.
+  void welded(std::int32_t i, skinning::Positions& out) const {
+    skinning::Positions posed;
+    motion->positions(i, posed);
+    skinning::gather_welded(topology, posed, out);
+  }
+};
+
+/// A contact without its time of impact (what the methods must agree on).
+struct ContactKey {
+  std::int32_t interval;
+  culling::CcdContact::Kind kind;
+  std::int32_t a;
+  std::int32_t b;
+  friend auto operator<=>(const ContactKey&, const ContactKey&) = default;
+};
+
+struct ClipRun {
+  std::vector<ContactKey> contacts;
+  std::vector<culling::FrameResult> frames;  ///< one per interval
+  std::vector<double> ccd_ms;                ///< wall time of each detect_ccd call
+  /// Radial-view methods only: their stats per interval.
+  std::vector<clustering::RadialViewStats> stats;
+};
+
+/// DCD queries made by run_clip besides the CCD ones (not recorded).
+enum class DcdQueries : std::uint8_t {
+  none,   ///< CCD only (`check --query ccd`)
+  first,  ///< a DCD at the first sample, then CCD only
+  every,  ///< a DCD at every interval's start sample (`check --query both`)
+};
+
+/// Runs `method` over intervals [first, last) of the scene's motion.
+inline ClipRun run_clip(
+    RadialViewScene& scene,
+    culling::CullingMethod& method,
+    std::int32_t first,
+    std::int32_t last,
+    DcdQueries dcd = DcdQueries::none) {
+  ClipRun run;
+  skinning::Positions x0, x1;
+  scene.welded(first, x1);
+  for (std::int32_t i = first; i < last; ++i) {
+    std::swap(x0, x1);
+    scene.welded(i + 1, x1);
+    culling::FrameResult out;
+    if (dcd == DcdQueries::every || (dcd == DcdQueries::first && i == first)) {
+      scene.poses->select_samples(i, i);
+      method.detect_dcd(x0, out);
+      out.clear();
+    }
+    scene.poses->select_samples(i, i + 1);
+    const auto start = std::chrono::steady_clock::now();
+    method.detect_ccd(x0, x1, out);
+    run.ccd_ms.push_back(
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count());
+    for (const auto& c : out.contacts) run.contacts.push_back({i, c.kind, c.a, c.b});
+    if (const auto* rv = dynamic_cast<const clustering::RadialViewMethod*>(&method)) {
+      run.stats.push_back(rv->last_stats());
+    }
+    run.frames.push_back(std::move(out));
+  }
+  std::sort(run.contacts.begin(), run.contacts.end());
+  return run;
+}
+
+}  // namespace skelcd::test
