@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 
 #include "segmentation/heat_weights.hpp"
+#include "segmentation/voxel_occupancy.hpp"
 #include "skinning/errors.hpp"
 #include "tests/segmentation/mini_rigs.hpp"
 #include "tests/support/test_support.hpp"
@@ -202,6 +203,63 @@ TEST(HeatWeights, BadInputIsRefused) {
   HeatWeightsOptions bad;
   bad.grid_resolution = 0;
   EXPECT_THROW(HeatWeightsSolver(tube.V, tube.F, chain_bones(2), bad), skelcd::InvalidInput);
+}
+
+}  // namespace
+
+namespace {
+
+TEST(HeatWeights, OneShotOnARigGivesFileVertexRows) {
+  auto rig = skelcd::test::capsule_chain(3);
+  HeatWeightsSolver solver(rig.mesh.rest_positions, rig.mesh.triangles, bone_segments(rig.skeleton));
+  const auto welded = solver.solve_all().weights;
+  // A seam: the first ring's vertices duplicated, and the odd triangles using the copies.
+  const auto nv = rig.mesh.num_vertices();
+  const int sides = 16;
+  rig.mesh.rest_positions.conservativeResize(nv + sides, 3);
+  for (int k = 0; k < sides; ++k) {
+    rig.mesh.rest_positions.row(nv + k) = rig.mesh.rest_positions.row(k);
+    rig.mesh.vertex_part.push_back(0);
+    rig.mesh.vertex_index_in_part.push_back(static_cast<std::int32_t>(nv + k));
+  }
+  for (Eigen::Index f = 1; f < rig.mesh.num_triangles(); f += 2) {
+    for (int c = 0; c < 3; ++c) {
+      if (rig.mesh.triangles(f, c) < sides) rig.mesh.triangles(f, c) += static_cast<std::int32_t>(nv);
+    }
+  }
+  rig.weights.conservativeResize(nv + sides, 3);
+  for (int k = 0; k < sides; ++k) rig.weights.insert(nv + k, 0) = 1.0;
+  const auto result = heat_weights(rig);
+  ASSERT_EQ(result.weights.rows(), nv + sides);
+  ASSERT_EQ(result.weights.cols(), 3);
+  expect_partition_of_unity(result.weights);
+  EXPECT_EQ(result.stats.vertices, nv + sides);
+  // Welding undoes the seam: the same numbers as on the seamless mesh, copies included.
+  EXPECT_TRUE(skelcd::test::expect_matrix_near(result.weights.topRows(nv), welded, 0));
+  EXPECT_TRUE(skelcd::test::expect_matrix_near(result.weights.bottomRows(sides), welded.topRows(sides), 0));
+  skelcd::skinning::Rig no_bones = rig;
+  no_bones.skeleton.bones.clear();
+  EXPECT_THROW_MESSAGE(std::ignore = heat_weights(no_bones), skelcd::InvalidInput, "capsule_chain");
+}
+
+TEST(VoxelOccupancy, SphereInsideSurfaceOutside) {
+  const auto sphere = skelcd::test::icosphere(3, 1.0);
+  const VoxelOccupancy field(sphere.V, sphere.F, 20);
+  EXPECT_EQ(field.at(Eigen::Vector3d::Zero()), Cell::inside);
+  EXPECT_EQ(field.at(Eigen::Vector3d(0.5, 0.2, -0.1)), Cell::inside);
+  EXPECT_EQ(field.at(Eigen::Vector3d(1.0, 0, 0)), Cell::surface);  // a vertex of the sphere
+  EXPECT_EQ(field.at(Eigen::Vector3d(1.05, 1.05, 0)), Cell::outside);
+  EXPECT_EQ(field.at(Eigen::Vector3d(9, 9, 9)), Cell::outside);   // beyond the grid
+  EXPECT_NEAR(field.cell_size(), 2.0 / 20, 1e-12);
+  EXPECT_GT(field.count(Cell::inside), 0);
+  // Segments: centre to centre-ish stays inside; centre to far away leaves the body.
+  EXPECT_TRUE(field.segment_inside(Eigen::Vector3d(-0.5, 0, 0), Eigen::Vector3d(0.5, 0, 0)));
+  EXPECT_FALSE(field.segment_inside(Eigen::Vector3d(0, 0, 0), Eigen::Vector3d(3, 0, 0)));
+  // Smoothing keeps a sphere a sphere (Taubin barely shrinks it) and moves nothing in no triangle.
+  const auto smoothed = taubin_smooth(sphere.V, sphere.F, 10);
+  const Eigen::VectorXd radii = smoothed.rowwise().norm();
+  EXPECT_GT(radii.minCoeff(), 0.97);
+  EXPECT_LT(radii.maxCoeff(), 1.03);
 }
 
 }  // namespace
