@@ -198,6 +198,19 @@ InclusionResult solve_inclusion(const InclusionProblem& p, const CcdOptions& opt
       if (lo[k] > exclude[k] || -hi[k] > exclude[k]) excluded = true;
       if (!(hi[k] <= accept[k] && -lo[k] <= accept[k])) within = false;
     }
+    // Does some direction keep one t-face of the slab clear of zero (while the slab is not)? Then
+    // the zeros sit at the other times, and splitting t is what makes progress (below).
+    const auto face_clears = [&](const auto& face_lo, const auto& face_hi, const auto& bound) {
+      return ((face_lo.array() > bound.array()) || ((-face_hi).array() > bound.array())).any();
+    };
+    bool face_clear = false;
+    if (!excluded && !within) {
+      const Vector3d lo0 = f.leftCols<kMaxVertices>().rowwise().minCoeff();
+      const Vector3d hi0 = f.leftCols<kMaxVertices>().rowwise().maxCoeff();
+      const Vector3d lo1 = f.rightCols<kMaxVertices>().rowwise().minCoeff();
+      const Vector3d hi1 = f.rightCols<kMaxVertices>().rowwise().maxCoeff();
+      face_clear = face_clears(lo0, hi0, exclude) || face_clears(lo1, hi1, exclude);
+    }
     if (!excluded && !within) {
       // Directions from the geometry at the middle time (any direction is sound), scaled to
       // max-norm 1 so that nothing overflows.
@@ -243,6 +256,13 @@ InclusionResult solve_inclusion(const InclusionProblem& p, const CcdOptions& opt
       for (int j = 0; j < kMaxDirections; ++j) {
         if (wlo[j] > threshold[j] || -whi[j] > threshold[j]) excluded = true;
       }
+      if (!excluded && !face_clear) {
+        const auto p0 = projected.leftCols<kMaxVertices>();
+        const auto p1 = projected.rightCols<kMaxVertices>();
+        const Eigen::Matrix<double, kMaxDirections, 1> lo0 = p0.rowwise().minCoeff(), hi0 = p0.rowwise().maxCoeff();
+        const Eigen::Matrix<double, kMaxDirections, 1> lo1 = p1.rowwise().minCoeff(), hi1 = p1.rowwise().maxCoeff();
+        face_clear = face_clears(lo0, hi0, threshold) || face_clears(lo1, hi1, threshold);
+      }
     }
     if (excluded) continue;
 
@@ -254,17 +274,25 @@ InclusionResult solve_inclusion(const InclusionProblem& p, const CcdOptions& opt
       // Proven near-contact: narrow the time interval only.
       if (b.t1 - b.t0 > options.toi_tolerance && split_t) dim = 0;
     } else {
-      // Split where F varies most (that is what keeps the box from being decided).
+      // Split where F varies most (that is what keeps the box from being decided) — except that
+      // when a t-face is clear, time is split first, down to the scale of the acceptance test:
+      // otherwise a contact set that is a whole segment of (u, v) at one time (zero-area
+      // triangles, parallel edges) multiplies boxes that all start at the same time.
       const double var_t =
           (f.rightCols<kMaxVertices>() - f.leftCols<kMaxVertices>()).cwiseAbs().maxCoeff();
+      // Once F varies by less than the acceptance scale over the time range, splitting time cannot
+      // help a box become acceptable, and it would move the rest of it behind every other box that
+      // starts at the same time: split u or v instead.
+      const bool t_matters = var_t > accept.maxCoeff();
+      if (face_clear && split_t && t_matters) dim = 0;
       const double var[3] = {var_t, (b.u1 - b.u0) * e_rate, (b.v1 - b.v0) * g_rate};
-      const bool can[3] = {split_t, split_u, split_v};
+      const bool can[3] = {split_t && (t_matters || !(split_u || split_v)), split_u, split_v};
       double best_var = -1.0;
-      for (int dd = 0; dd < 3; ++dd) {
-        if (can[dd] && var[dd] > best_var) {
-          best_var = var[dd];
-          dim = dd;
-        }
+      for (int dd = 0; dd < 3 && dim < 0; ++dd) {
+        if (can[dd] && var[dd] > best_var) best_var = var[dd];
+      }
+      for (int dd = 0; dd < 3 && dim < 0; ++dd) {
+        if (can[dd] && var[dd] == best_var) dim = dd;
       }
     }
     if (dim >= 0 && heap.full()) dim = -1;  // out of room: report this box (see kHeapCapacity)
