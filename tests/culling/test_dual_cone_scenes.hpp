@@ -8,12 +8,15 @@
 #include <cmath>
 #include <cstdint>
 #include <filesystem>
+#include <memory>
 #include <numbers>
 #include <string>
 #include <utility>
 #include <vector>
 
 #include "skinning/frame_sequence.hpp"
+#include "skinning/generators.hpp"
+#include "skinning/rig_motion.hpp"
 #include "skinning/mesh.hpp"
 #include "skinning/topology.hpp"
 #include "tests/culling/procedural_meshes.hpp"
@@ -199,6 +202,24 @@ inline OpenScene cloth_funnel_scene(const std::filesystem::path& dir) {
   s.topo = skinning::build_topology(s.mesh);
   s.frames.push_back(welded(s.topo, f227.positions));
   s.frames.push_back(welded(s.topo, f228.positions));
+  return s;
+}
+
+/// A generated rig of the skinning generators (`pipe`, `cloth`: open boundaries), posed by its
+/// clip at its last two samples (the known answer says both intersect).
+inline OpenScene generated_scene(const std::string& name, std::int64_t triangles, int frames) {
+  skinning::GeneratedRig g = skinning::generate({name, triangles, frames});
+  const auto rig = std::make_shared<const skinning::Rig>(std::move(g.rig));
+  const skinning::RigMotion motion(rig, {.clip = 0, .rate_hz = skinning::kGeneratorFrameRateHz});
+  OpenScene s;
+  s.name = "gen:" + name;
+  s.mesh = rig->mesh;
+  s.topo = skinning::build_topology(s.mesh);
+  skinning::Positions x;
+  for (int i = motion.num_samples() - 2; i < motion.num_samples(); ++i) {
+    motion.positions(i, x);
+    s.frames.push_back(welded(s.topo, x));
+  }
   return s;
 }
 

@@ -97,7 +97,7 @@ const ConeCullingStats& stats_of(const CullingMethod& m) {
 
 std::vector<OpenScene> small_open_scenes() {
   std::vector<OpenScene> out;
-  out.push_back(test::pipe_scene(12, 72, {0.5, 0.7, 0.9}));
+  out.push_back(test::pipe_scene(12, 72, {0.5, 0.7}));
   out.push_back(test::wrap_sheet_scene(8, 90, {0.30, 0.36}));
   out.push_back(test::crumpled_tube_scene(12, 56, {0.55, 0.6}));
   out.push_back(test::skirt_body_scene(9, 14, 16, 10, {0.3, 0.5}));
@@ -270,14 +270,18 @@ TEST(DualCone, MissesCollisionsInsideThePipeAndTheWrappedSheetWhereEnhancedDoesN
 TEST(ConeMethods, ClothFunnelMatchesBvh) {
   const OpenScene s = test::cloth_funnel_scene(test::asset("cloth-funnel/frames"));
   ASSERT_EQ(s.mesh.num_triangles(), 18484);
-  for (std::size_t f = 0; f < 2; ++f) {
-    const FrameResult bvh = run_dcd("bvh", s, f);
-    for (const auto& name : kExactMethods) {
-      EXPECT_EQ(run_dcd(name, s, f).dcd_pairs, bvh.dcd_pairs) << name << " frame " << f;
-    }
+  const FrameResult bvh_dcd = run_dcd("bvh", s, 1);
+  EXPECT_FALSE(bvh_dcd.dcd_pairs.empty());
+  for (const auto& name : kExactMethods) {
+    EXPECT_EQ(run_dcd(name, s, 1).dcd_pairs, bvh_dcd.dcd_pairs) << name;
   }
+  // FASTCD misses intersecting pairs in this real cloth too.
+  const FrameResult dual = run_dcd("dual-cone", s, 1);
+  EXPECT_LT(dual.dcd_pairs.size(), bvh_dcd.dcd_pairs.size());
+  // The step's ground truth (SOURCES.md): 27 VF and 107 EE contacts.
   const FrameResult bvh = run_ccd("bvh", s, 0);
-  EXPECT_FALSE(bvh.contacts.empty());
+  EXPECT_EQ(bvh.counters.vf_contacts, 27);
+  EXPECT_EQ(bvh.counters.ee_contacts, 107);
   for (const auto& name : kExactMethods) {
     EXPECT_TRUE(same_ccd_contacts(s, 0, run_ccd(name, s, 0), bvh)) << name;
   }
