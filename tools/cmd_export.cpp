@@ -15,6 +15,7 @@
 #include "tools/commands.hpp"
 #include "tools/export_mesh.hpp"
 #include "tools/highlight.hpp"
+#include "tools/segmentation_colors.hpp"
 #include "tools/model_options.hpp"
 
 namespace skelcd::tools {
@@ -33,6 +34,7 @@ struct ExportArgs {
   std::string output;
   std::string format;
   std::string highlight;
+  std::string segmentation;
   skinning::LoadOptions load;
 };
 
@@ -76,8 +78,9 @@ void run_export(const ExportArgs& args) {
     options.format = parse_mesh_format(args.format);
     if (!options.format) throw InvalidInput("--format " + args.format + ": expected obj, ply or glb");
   }
-  // Later: --highlight LOG.h5 (colliding triangles of this frame) and --segmentation SEG.h5
-  // (clusters) fill options.face_colors, one RGBA per triangle.
+  // --highlight LOG.h5 (colliding triangles of this frame) or --segmentation SEG.h5 (one colour
+  // per atomic cluster) fill options.face_colors, one RGBA per triangle.
+  if (!args.segmentation.empty()) options.face_colors = segmentation_face_colors(args.segmentation, motion->mesh());
   if (!args.highlight.empty()) options.face_colors = highlight_face_colors(args.highlight, motion->mesh(), args.frame.value_or(0), motion->sample_time(args.frame.value_or(0)));
   const auto result = export_mesh(motion->mesh(), positions, args.output, options);
   // Standard output may be carrying the mesh: the summary goes to stderr then.
@@ -102,6 +105,8 @@ void add_export_command(CLI::App& app) {
       ->required();
   cmd->add_option("--format", args->format, "obj, ply or glb (default: from OUT's extension; obj on standard output)");
   cmd->add_option("--highlight", args->highlight, "colour the triangles the log LOG.h5 found colliding at --frame")->excludes(time);
+  cmd->add_option("--segmentation", args->segmentation, "colour each atomic cluster of the segmentation SEG.h5 (from skelcd preprocess)")
+      ->excludes("--highlight");
   add_model_options(*cmd, args->load);
   cmd->callback([args] { run_export(*args); });
 }
