@@ -21,9 +21,10 @@ inline constexpr std::uint8_t kMaskPositive = 1;  ///< all the triangle's featur
 inline constexpr std::uint8_t kMaskNegative = 2;  ///< all the triangle's features H⁻
 inline constexpr std::uint8_t kMaskOther = 4;     ///< anything else: tested against everything
 
-/// True when a pair of triangles with masks a and b (single bits) needs no test.
+/// True when no pair between two sets of triangles with class masks a and b needs a test: both
+/// sets are of one and the same sign. (For single triangles: both positive or both negative.)
 [[nodiscard]] inline bool mask_pair_skipped(std::uint8_t a, std::uint8_t b) {
-  return a == b && a != kMaskOther;
+  return a == b && (a == kMaskPositive || a == kMaskNegative);
 }
 
 /// Which pairs a masked traversal reports.
