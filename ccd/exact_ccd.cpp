@@ -228,6 +228,25 @@ mpq_class positive_width(double toi_tolerance) {
   return mpq_class(w);
 }
 
+// Contact and contact times do not change under a translation and a uniform positive scaling of
+// all points. Moving the first point to the origin and multiplying by the common denominator makes
+// every coordinate an integer: the polynomial arithmetic then runs on integers (no gcds) and on
+// smaller numbers (a query far from the origin loses its offset).
+template <std::size_t N>
+void normalize(const std::array<RationalPoint*, N>& points) {
+  const RationalPoint origin = *points[0];
+  mpz_class denominator = 1;
+  for (RationalPoint* p : points) {
+    for (std::size_t k = 0; k < 3; ++k) {
+      (*p)[k] -= origin[k];
+      mpz_lcm(denominator.get_mpz_t(), denominator.get_mpz_t(), (*p)[k].get_den_mpz_t());
+    }
+  }
+  for (RationalPoint* p : points) {
+    for (std::size_t k = 0; k < 3; ++k) (*p)[k] *= denominator;
+  }
+}
+
 CcdResult to_ccd_result(const ExactCcdResult& r) {
   CcdResult out;
   out.hit = r.hit;
@@ -251,12 +270,14 @@ RationalEdgeEdgeQuery to_rational(const EdgeEdgeQuery& q) {
           rational(q.ea0_t1), rational(q.ea1_t1), rational(q.eb0_t1), rational(q.eb1_t1)};
 }
 
-ExactCcdResult vertex_face_ccd_rational(const RationalVertexFaceQuery& q, const mpq_class& width) {
+ExactCcdResult vertex_face_ccd_rational(const RationalVertexFaceQuery& query, const mpq_class& width) {
   assert(width > 0);
-  if (swept_boxes_disjoint({&q.v_t0, &q.v_t1},
-                           {&q.f0_t0, &q.f1_t0, &q.f2_t0, &q.f0_t1, &q.f1_t1, &q.f2_t1})) {
+  if (swept_boxes_disjoint({&query.v_t0, &query.v_t1},
+                           {&query.f0_t0, &query.f1_t0, &query.f2_t0, &query.f0_t1, &query.f1_t1, &query.f2_t1})) {
     return {};
   }
+  RationalVertexFaceQuery q = query;
+  normalize(std::array{&q.v_t0, &q.f0_t0, &q.f1_t0, &q.f2_t0, &q.v_t1, &q.f0_t1, &q.f1_t1, &q.f2_t1});
   const VertexFacePolynomials P(q);
   Earliest e;
   if (!P.coplanar.is_zero()) {
@@ -277,12 +298,14 @@ ExactCcdResult vertex_face_ccd_rational(const RationalVertexFaceQuery& q, const 
   return {true, e.lo, e.hi};
 }
 
-ExactCcdResult edge_edge_ccd_rational(const RationalEdgeEdgeQuery& q, const mpq_class& width) {
+ExactCcdResult edge_edge_ccd_rational(const RationalEdgeEdgeQuery& query, const mpq_class& width) {
   assert(width > 0);
-  if (swept_boxes_disjoint({&q.ea0_t0, &q.ea1_t0, &q.ea0_t1, &q.ea1_t1},
-                           {&q.eb0_t0, &q.eb1_t0, &q.eb0_t1, &q.eb1_t1})) {
+  if (swept_boxes_disjoint({&query.ea0_t0, &query.ea1_t0, &query.ea0_t1, &query.ea1_t1},
+                           {&query.eb0_t0, &query.eb1_t0, &query.eb0_t1, &query.eb1_t1})) {
     return {};
   }
+  RationalEdgeEdgeQuery q = query;
+  normalize(std::array{&q.ea0_t0, &q.ea1_t0, &q.eb0_t0, &q.eb1_t0, &q.ea0_t1, &q.ea1_t1, &q.eb0_t1, &q.eb1_t1});
   const EdgeEdgePolynomials P(q);
   Earliest e;
   if (!P.coplanar.is_zero()) {

@@ -4,10 +4,10 @@
 // blank lines ignored.
 
 #include <array>
-#include <filesystem>
 #include <iosfwd>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include <gmpxx.h>
