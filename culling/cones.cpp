@@ -172,12 +172,15 @@ void NormalConeTree::refit(
   const auto nf = static_cast<std::size_t>(topology.num_triangles());
   triangle_cones_.resize(nf);
   triangle_sums_.resize(nf);
+  triangle_normals_.resize(nf);
+  vectors_per_triangle_ = 1;
   for (std::int32_t f = 0; f < topology.num_triangles(); ++f) {
     const auto& t = topology.triangle(f);
     const BoundedNormal n = triangle_normal(
         x.row(t[0]).transpose(), x.row(t[1]).transpose(), x.row(t[2]).transpose());
     triangle_cones_[static_cast<std::size_t>(f)] = cone_of_vector(n.n, n.error);
     triangle_sums_[static_cast<std::size_t>(f)] = n.n;
+    triangle_normals_[static_cast<std::size_t>(f)][0] = n;
   }
   refit_nodes(bvh);
 }
@@ -190,6 +193,8 @@ void NormalConeTree::refit(
   const auto nf = static_cast<std::size_t>(topology.num_triangles());
   triangle_cones_.resize(nf);
   triangle_sums_.resize(nf);
+  triangle_normals_.resize(nf);
+  vectors_per_triangle_ = 3;
   for (std::int32_t f = 0; f < topology.num_triangles(); ++f) {
     const auto& t = topology.triangle(f);
     const auto b = continuous_normal_control_vectors(
@@ -212,8 +217,35 @@ void NormalConeTree::refit(
     }
     triangle_cones_[static_cast<std::size_t>(f)] = cone;
     triangle_sums_[static_cast<std::size_t>(f)] = b[0].n + b[1].n + b[2].n;
+    triangle_normals_[static_cast<std::size_t>(f)] = b;
   }
   refit_nodes(bvh);
+}
+
+Eigen::Vector3d NormalConeTree::mean_normal(std::int32_t node) const {
+  return unit_or_zero(node_sums_[static_cast<std::size_t>(node)]);
+}
+
+bool NormalConeTree::normals_in_half_space(
+    const AabbBvh& bvh,
+    std::int32_t node,
+    const Eigen::Vector3d& v) const {
+  if (!std::isfinite(v.squaredNorm()) || v.isZero(0.0)) return false;
+  const BvhNode& n = bvh.nodes()[static_cast<std::size_t>(node)];
+  const auto order = bvh.triangle_order();
+  const double vn = v.norm() * (1.0 + 4.0 * kU);
+  for (std::int32_t s = n.begin; s < n.end; ++s) {
+    const auto& normals = triangle_normals_[static_cast<std::size_t>(order[static_cast<std::size_t>(s)])];
+    for (int k = 0; k < vectors_per_triangle_; ++k) {
+      // The exact normal is within `error` of the computed one: n·v ≥ ñ·v − error·|v|; the dot
+      // product itself is within 3u·Σ|ñ_i v_i| (4u with the bound's own rounding).
+      const BoundedNormal& b = normals[static_cast<std::size_t>(k)];
+      const double d = b.n.dot(v);
+      const double m = std::abs(b.n.x() * v.x()) + std::abs(b.n.y() * v.y()) + std::abs(b.n.z() * v.z());
+      if (!(d > b.error * vn + 4.0 * kU * m)) return false;
+    }
+  }
+  return true;
 }
 
 void NormalConeTree::refit_nodes(const AabbBvh& bvh) {

@@ -113,6 +113,17 @@ class NormalConeTree {
       const skinning::Positions& x_t0,
       const skinning::Positions& x_t1);
 
+  /// The node's mean normal direction (unit; zero when its normals cancel): the sum of its
+  /// triangles' normals (of their control vectors for CCD), i.e. area-weighted.
+  [[nodiscard]] Eigen::Vector3d mean_normal(std::int32_t node) const;
+  /// True when every normal of the node's triangles (every Bernstein control vector for CCD) is
+  /// proven to have a positive dot product with `v`: the surface normal test done triangle by
+  /// triangle, for a node whose hierarchical cone is too loose. Stops at the first failure.
+  [[nodiscard]] bool normals_in_half_space(
+      const AabbBvh& bvh,
+      std::int32_t node,
+      const Eigen::Vector3d& v) const;
+
   /// One cone per node of the hierarchy (node ids of AabbBvh::nodes()).
   [[nodiscard]] std::span<const DirectionCone> node_cones() const { return node_cones_; }
   /// One cone per triangle id.
@@ -122,6 +133,8 @@ class NormalConeTree {
   void refit_nodes(const AabbBvh& bvh);
 
   std::vector<DirectionCone> triangle_cones_;
+  std::vector<std::array<BoundedNormal, 3>> triangle_normals_;  // [0] only for static normals
+  int vectors_per_triangle_ = 1;
   std::vector<Eigen::Vector3d> triangle_sums_;  // raw normal (sum of control vectors) per triangle
   std::vector<DirectionCone> node_cones_;
   std::vector<Eigen::Vector3d> node_sums_;

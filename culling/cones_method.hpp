@@ -15,6 +15,9 @@ struct ConeCullingStats {
   std::int64_t nodes_tested = 0;        ///< node self-tests evaluated with the cone criteria
   std::int64_t nodes_culled = 0;        ///< ... that proved the node free of self-collision
   std::int64_t failed_normal_cone = 0;  ///< condition 1: SNC not within a half-space
+  /// Condition 1 proven triangle by triangle (around the mean normal) after the node's
+  /// hierarchical cone failed — counted among the nodes that passed condition 1.
+  std::int64_t normal_direct_passes = 0;
   std::int64_t failed_topology = 0;     ///< the node's contour is not one simple loop
   /// Condition 2: FASTCD's BNC test failed; for enhanced-dual-cone, a chain failed the dual-cone
   /// test (and was cut into monotone runs) and condition 3 then failed as well.

@@ -120,6 +120,20 @@ void ConeMethodBase::detect_ccd(
   out.times.elementary_us += micros(t2, t3);
 }
 
+bool ConeMethodBase::normal_test(std::int32_t n, Eigen::Vector3d& axis) {
+  const DirectionCone& snc = cones_.node_cones()[static_cast<std::size_t>(n)];
+  if (snc.in_open_half_space()) {
+    axis = snc.axis;
+    return true;
+  }
+  // Cones merged level by level grow looser than the normals they bound; a node that fails by
+  // its cone may still pass triangle by triangle (early exit on the first normal that fails).
+  axis = cones_.mean_normal(n);
+  if (!cones_.normals_in_half_space(bvh_, n, axis)) return false;
+  ++stats_.normal_direct_passes;
+  return true;
+}
+
 void ConeMethodBase::traverse(const Interval& interval, std::int64_t& bv_tests) {
   if (bvh_.empty()) return;
   const auto nodes = bvh_.nodes();

@@ -57,6 +57,11 @@ class ConeMethodBase : public MethodBase, public ConeStatistics {
       bool needs_contours,
       const std::vector<std::int32_t>* subset);
 
+  /// The surface normal test (condition 1) of node n: its cone lies in a half-space, or — when
+  /// the hierarchical cone is too loose — every normal of its triangles is proven to point into
+  /// the half-space of its mean normal. Sets `axis` to the proven direction.
+  [[nodiscard]] bool normal_test(std::int32_t n, Eigen::Vector3d& axis);
+
   /// Per-interval refit beyond the normal cones (FASTCD's binormal cones). Default: nothing.
   virtual void refit_extra(const Interval& /*interval*/) {}
   /// The method's test of internal node `node`: true when its surface is proven free of

@@ -25,8 +25,8 @@ class EnhancedDualConeMethod final : public detail::ConeMethodBase {
     if (status == ContourStatus::not_tested) return false;  // children are leaves: standard tests
     ++stats_.nodes_tested;
     // Condition 1: θ_n < π/2 — every (continuous) normal of the node has n · A_n > 0.
-    const DirectionCone& snc = cones_.node_cones()[static_cast<std::size_t>(n)];
-    if (!snc.in_open_half_space()) {
+    Eigen::Vector3d axis;
+    if (!normal_test(n, axis)) {
       ++stats_.failed_normal_cone;
       return false;
     }
@@ -39,10 +39,10 @@ class EnhancedDualConeMethod final : public detail::ConeMethodBase {
     const ContourVerdict verdict =
         interval.continuous
             ? contour_tester_.test(
-                  contours_, n, snc.axis, *interval.x_t0, *interval.x_t1, ContourMode::chains,
+                  contours_, n, axis, *interval.x_t0, *interval.x_t1, ContourMode::chains,
                   stats_.contour)
             : contour_tester_.test(
-                  contours_, n, snc.axis, *interval.x_t0, ContourMode::chains, stats_.contour);
+                  contours_, n, axis, *interval.x_t0, ContourMode::chains, stats_.contour);
     // The ten-result record (Algorithm 3): the sub-surfaces whose chains failed the dual-cone
     // test, and the first pair of sub-surfaces whose contours may meet.
     for (int p = 0; p < 4; ++p) {

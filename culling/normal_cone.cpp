@@ -23,8 +23,8 @@ class NormalConeMethod final : public detail::ConeMethodBase {
     if (status == ContourStatus::not_tested) return false;  // two leaves: one pair test is cheaper
     ++stats_.nodes_tested;
     // Surface normal test (continuous normal cone for CCD).
-    const DirectionCone& snc = cones_.node_cones()[static_cast<std::size_t>(n)];
-    if (!snc.in_open_half_space()) {
+    Eigen::Vector3d axis;
+    if (!normal_test(n, axis)) {
       ++stats_.failed_normal_cone;
       return false;
     }
@@ -36,10 +36,10 @@ class NormalConeMethod final : public detail::ConeMethodBase {
     const ContourVerdict verdict =
         interval.continuous
             ? contour_tester_.test(
-                  contours_, n, snc.axis, *interval.x_t0, *interval.x_t1, ContourMode::every_edge,
+                  contours_, n, axis, *interval.x_t0, *interval.x_t1, ContourMode::every_edge,
                   stats_.contour)
             : contour_tester_.test(
-                  contours_, n, snc.axis, *interval.x_t0, ContourMode::every_edge, stats_.contour);
+                  contours_, n, axis, *interval.x_t0, ContourMode::every_edge, stats_.contour);
     if (verdict.simple) return true;
     ++stats_.failed_contour;
     return false;

@@ -284,7 +284,9 @@ class AutoMethod final : public detail::MethodBase, public RoutedMethod {
       const MethodOptions& options,
       const std::vector<std::int32_t>& triangles) {
     if (name == "enhanced-dual-cone") {
-      return make_enhanced_dual_cone_method(mesh, topology, options, {.grandchildren_descent = true, .triangles = triangles});
+      // The simple top-down scheme: measured faster than Algorithm 3's descent on most scenes of
+      // bench/culling/bm_cones (docs/benchmarks.md, "## dual-cone"); same contacts.
+      return make_enhanced_dual_cone_method(mesh, topology, options, {.grandchildren_descent = false, .triangles = triangles});
     }
     if (name == "normal-cone") return make_normal_cone_method(mesh, topology, options, triangles);
     if (name == "dual-cone") return make_dual_cone_method(mesh, topology, options, triangles);

@@ -198,6 +198,45 @@ TEST(Cones, FlippingTriangleMakesItsContinuousConeFull) {
   EXPECT_TRUE(tree.node_cones()[0].in_open_half_space());
 }
 
+TEST(Cones, DirectTestAroundTheMeanNormalProvesWhatTheCheckAllowsAndNothingElse) {
+  // A strip folded by 150° along its middle: normals 75° either side of the mean normal. The
+  // direct test around the mean normal passes; folded by 180° + a little (normals more than 90°
+  // from any common axis) it must fail, and a triangle seen exactly edge-on fails too.
+  const auto mesh = test::sheet(8, 2, 2.0, 0.5);
+  const auto topo = test::simple_topology(mesh);
+  const FeatureTopology features(mesh, topo);
+  const skinning::Positions x = test::welded(topo, mesh.rest_positions);
+  const AabbBvh bvh(features.welded_triangles(), x);
+  NormalConeTree tree;
+  const skinning::Positions bent = test::folded(x, 1.0, 150.0 * std::numbers::pi / 180.0);
+  tree.refit(bvh, features, bent);
+  const Vec mean = tree.mean_normal(0);
+  EXPECT_NEAR(mean.norm(), 1.0, 1e-12);
+  EXPECT_TRUE(tree.normals_in_half_space(bvh, 0, mean));
+  EXPECT_FALSE(tree.normals_in_half_space(bvh, 0, Vec(0, 0, 1)));  // the far half faces down
+  tree.refit(bvh, features, bent, bent);                          // CCD: the same, constant
+  EXPECT_TRUE(tree.normals_in_half_space(bvh, 0, tree.mean_normal(0)));
+  // Folded by 181°: the two halves' normals are 179° apart — still a half-space, barely; the
+  // opposite direction never is.
+  tree.refit(bvh, features, test::folded(x, 1.0, 181.0 * std::numbers::pi / 180.0));
+  EXPECT_TRUE(tree.normals_in_half_space(bvh, 0, tree.mean_normal(0)));
+  EXPECT_FALSE(tree.normals_in_half_space(bvh, 0, -tree.mean_normal(0)));
+  // A closed sphere: its normals cancel, no direction passes.
+  const auto sphere = test::uv_sphere(6, 8);
+  const auto st = test::simple_topology(sphere);
+  const FeatureTopology sf(sphere, st);
+  const skinning::Positions sx = test::welded(st, sphere.rest_positions);
+  const AabbBvh sb(sf.welded_triangles(), sx);
+  NormalConeTree stree;
+  stree.refit(sb, sf, sx);
+  for (const Vec& v : {Vec(0, 0, 1), Vec(1, 0, 0), Vec(0.3, -0.2, 0.9), stree.mean_normal(0)}) {
+    EXPECT_FALSE(stree.normals_in_half_space(sb, 0, v));
+  }
+  tree.refit(bvh, features, x);
+  EXPECT_FALSE(tree.normals_in_half_space(bvh, 0, Vec(1, 0, 0)));  // every normal ⟂ V
+  EXPECT_TRUE(tree.normals_in_half_space(bvh, 0, Vec(1e-12, 0, 1)));
+}
+
 // --- predicates vs exact rationals ---------------------------------------------------------------
 
 mpq_class q(double d) { return mpq_class(d); }
