@@ -23,12 +23,15 @@ CcdResult conservative(const VertexFaceQuery& q, const CcdOptions& options, CcdS
   const detail::DifferenceTriple t1{q.v_t1 - q.f0_t1, q.f1_t1 - q.f0_t1, q.f2_t1 - q.f0_t1};
   // Inside conditions n . ((b - a) x (p - a)), n . ((c - b) x (p - b)), n . ((a - c) x (p - c)),
   // n = (b - a) x (c - a): each (A x B) . (C x D) of single differences.
-  const auto quartics = [&](detail::BernsteinQuartic* g) {
+  const auto quartics = [&](detail::BernsteinQuartic* g, double* lengths) {
+    const Eigen::Vector3d bc_t0 = q.f2_t0 - q.f1_t0, bc_t1 = q.f2_t1 - q.f1_t1;
+    const Eigen::Vector3d ca_t0 = q.f0_t0 - q.f2_t0, ca_t1 = q.f0_t1 - q.f2_t1;
     g[0] = detail::cross_dot_quartic({t0.y, t0.z, t0.y, t0.x, t1.y, t1.z, t1.y, t1.x});
-    g[1] = detail::cross_dot_quartic({t0.y, t0.z, q.f2_t0 - q.f1_t0, q.v_t0 - q.f1_t0, t1.y, t1.z,
-                                      q.f2_t1 - q.f1_t1, q.v_t1 - q.f1_t1});
-    g[2] = detail::cross_dot_quartic({t0.y, t0.z, q.f0_t0 - q.f2_t0, q.v_t0 - q.f2_t0, t1.y, t1.z,
-                                      q.f0_t1 - q.f2_t1, q.v_t1 - q.f2_t1});
+    g[1] = detail::cross_dot_quartic({t0.y, t0.z, bc_t0, q.v_t0 - q.f1_t0, t1.y, t1.z, bc_t1, q.v_t1 - q.f1_t1});
+    g[2] = detail::cross_dot_quartic({t0.y, t0.z, ca_t0, q.v_t0 - q.f2_t0, t1.y, t1.z, ca_t1, q.v_t1 - q.f2_t1});
+    lengths[0] = detail::norm_bound(t0.y, t1.y);
+    lengths[1] = detail::norm_bound(bc_t0, bc_t1);
+    lengths[2] = detail::norm_bound(ca_t0, ca_t1);
     return 3;
   };
   // F(t, u, v) = p - (a + u (b - a) + v (c - a)) = (p - a) + u (a - b) + v (a - c).

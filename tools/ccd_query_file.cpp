@@ -5,6 +5,8 @@
 #include <cstdint>
 #include <fstream>
 #include <iostream>
+#include <limits>
+#include <numeric>
 #include <sstream>
 
 #include "ccd/exact_ccd.hpp"
@@ -15,6 +17,44 @@ namespace {
 
 bool is_digit(char c) { return c >= '0' && c <= '9'; }
 
+// Half an ulp of |v|: the most round-to-nearest can move a number to v.
+double half_ulp(double v) {
+  const double a = std::abs(v);
+  return (std::nextafter(a, std::numeric_limits<double>::infinity()) - a) * 0.5;
+}
+
+bool is_power_of_two(std::uint64_t x) { return x != 0 && (x & (x - 1)) == 0; }
+
+// Is digits * 10^shift exactly the double v? Decided without big numbers when the digits fit in
+// 64 bits; otherwise "no" (the safe answer: it only adds a rounding margin).
+bool decimal_is_exact(std::string_view digits, long shift, double v) {
+  while (!digits.empty() && digits.front() == '0') digits.remove_prefix(1);
+  if (digits.empty()) return true;  // zero
+  if (digits.size() > 19) return false;
+  std::uint64_t d = 0;
+  std::from_chars(digits.data(), digits.data() + digits.size(), d);
+  while (shift < 0 && d % 10 == 0) {
+    d /= 10;
+    ++shift;
+  }
+  if (shift >= 0) {
+    // d * 10^shift = d * 5^shift * 2^shift: exact if d * 5^shift < 2^53.
+    for (long i = 0; i < shift; ++i) {
+      if (d > (std::uint64_t{1} << 53) / 5) return false;
+      d *= 5;
+    }
+    return d < (std::uint64_t{1} << 53) && std::ldexp(static_cast<double>(d), static_cast<int>(shift)) == std::abs(v);
+  }
+  // d / 10^k = (d / 5^k) / 2^k: exact if 5^k divides d and the quotient has at most 53 bits.
+  const long k = -shift;
+  if (k > 27) return false;
+  std::uint64_t five = 1;
+  for (long i = 0; i < k; ++i) five *= 5;
+  if (d % five != 0) return false;
+  const std::uint64_t m = d / five;
+  return m < (std::uint64_t{1} << 53) && std::ldexp(static_cast<double>(m), static_cast<int>(shift)) == std::abs(v);
+}
+
 bool all_digits(std::string_view s) {
   if (s.empty()) return false;
   for (const char c : s) {
@@ -24,7 +64,7 @@ bool all_digits(std::string_view s) {
 }
 
 // p/q with p = [+-]digits, q = digits (not zero).
-bool parse_rational(std::string_view token, double& value, mpq_class* exact, std::string& fault) {
+bool parse_rational(std::string_view token, double& value, mpq_class* exact, double& rounding, std::string& fault) {
   const auto slash = token.find('/');
   std::string_view num = token.substr(0, slash);
   const std::string_view den = token.substr(slash + 1);
@@ -52,22 +92,28 @@ bool parse_rational(std::string_view token, double& value, mpq_class* exact, std
     r.canonicalize();
     if (negative) r = -r;
   }
+  bool exact_double = false;
   if (small) {
     value = static_cast<double>(p) / static_cast<double>(q);
     if (negative) value = -value;
+    // p/q is a double iff, in lowest terms, q is a power of two and p has at most 53 bits.
+    const std::uint64_t g = std::gcd(p, q);
+    exact_double = is_power_of_two(q / g) && p / g < (std::uint64_t{1} << 53);
   } else {
     value = ccd::round_to_nearest(r);
+    exact_double = std::isfinite(value) && mpq_class(value) == r;
   }
   if (!std::isfinite(value)) {
     fault = "beyond the range of a double";
     return false;
   }
+  rounding = exact_double ? 0.0 : half_ulp(value);
   if (exact != nullptr) *exact = r;
   return true;
 }
 
 // [+-] digits [. digits] [(e|E) [+-] digits], with at least one mantissa digit.
-bool parse_decimal(std::string_view token, double& value, mpq_class* exact, std::string& fault) {
+bool parse_decimal(std::string_view token, double& value, mpq_class* exact, double& rounding, std::string& fault) {
   fault = "not a number (expected a decimal or p/q with integer p and q)";
   std::size_t i = 0;
   bool negative = false;
@@ -116,6 +162,7 @@ bool parse_decimal(std::string_view token, double& value, mpq_class* exact, std:
     return false;
   }
   if (negative) value = -value;
+  rounding = decimal_is_exact(digits, exponent - static_cast<long>(frac_digits), value) ? 0.0 : half_ulp(value);
   if (exact != nullptr) {
     // digits * 10^(exponent - frac_digits), exactly.
     const auto first = digits.find_first_not_of('0');
@@ -149,9 +196,10 @@ std::string quote(std::string_view s) {
 
 }  // namespace
 
-bool parse_ccd_number(std::string_view token, double& value, mpq_class* exact, std::string& fault) {
-  if (token.find('/') != std::string_view::npos) return parse_rational(token, value, exact, fault);
-  return parse_decimal(token, value, exact, fault);
+bool parse_ccd_number(std::string_view token, double& value, mpq_class* exact, double& rounding, std::string& fault) {
+  rounding = 0.0;
+  if (token.find('/') != std::string_view::npos) return parse_rational(token, value, exact, rounding, fault);
+  return parse_decimal(token, value, exact, rounding, fault);
 }
 
 std::vector<CcdQueryRecord> parse_ccd_queries(std::istream& in, const std::string& name, bool keep_exact) {
@@ -190,9 +238,11 @@ std::vector<CcdQueryRecord> parse_ccd_queries(std::istream& in, const std::strin
     }
     std::string fault;
     for (std::size_t k = 0; k < 24; ++k) {
-      if (!parse_ccd_number(tokens[k + 1], r.coordinates[k], keep_exact ? &r.exact[k] : nullptr, fault)) {
+      double rounding = 0.0;
+      if (!parse_ccd_number(tokens[k + 1], r.coordinates[k], keep_exact ? &r.exact[k] : nullptr, rounding, fault)) {
         fail("coordinate " + std::to_string(k + 1) + " " + quote(tokens[k + 1]) + ": " + fault);
       }
+      r.rounding = std::max(r.rounding, rounding);
     }
     if (tokens.size() == 26) {
       if (tokens[25] == "0") {

@@ -23,6 +23,9 @@ struct CcdQueryRecord {
   std::array<mpq_class, 24> exact;
   std::optional<bool> expected;
   int line = 0;  ///< 1-based line number in the file
+  /// Largest |double - written number| over the 24 coordinates, bounded from above (0 when every
+  /// coordinate is exactly a double, e.g. p/q with q a power of two, or 0.5).
+  double rounding = 0.0;
 };
 
 /// Parses every query of `in`. Throws InvalidInput "<name>:<line>: <fault>" on the first malformed
@@ -39,7 +42,14 @@ struct CcdQueryRecord {
 [[nodiscard]] std::vector<CcdQueryRecord> read_ccd_queries(const std::string& path, bool keep_exact);
 
 /// One number token: the double nearest to it, and (when `exact` is not null) its exact value.
-/// Returns false with `fault` set when the token is not a finite number of the format.
-[[nodiscard]] bool parse_ccd_number(std::string_view token, double& value, mpq_class* exact, std::string& fault);
+/// `rounding` receives an upper bound on |value - written number|: 0 when the double is exactly
+/// the number, otherwise half an ulp of the value. Returns false with `fault` set when the token is
+/// not a finite number of the format.
+[[nodiscard]] bool parse_ccd_number(
+    std::string_view token,
+    double& value,
+    mpq_class* exact,
+    double& rounding,
+    std::string& fault);
 
 }  // namespace skelcd::tools

@@ -60,14 +60,20 @@ ccd::CcdResult run_one(const CcdQueryRecord& r, ccd::Accuracy accuracy, ccd::Ccd
     if (result.hit) ++stats.hits;
     return result;
   }
+  // The doubles nearest to the written numbers. For `conservative`, a query whose numbers are not
+  // all exactly doubles is widened by its rounding: every coordinate moved by at most `rounding`,
+  // so every point of both primitives by at most sqrt(3) rounding at every time, and a contact of
+  // the written query is within 2 sqrt(3) rounding <= 4 rounding in the doubles (docs/ccd-queries.md).
+  ccd::CcdOptions options;
+  if (accuracy == ccd::Accuracy::conservative) options.min_separation = 4 * r.rounding;
   if (r.vertex_face) {
     const ccd::VertexFaceQuery q{point(r, 0), point(r, 1), point(r, 2), point(r, 3),
                                  point(r, 4), point(r, 5), point(r, 6), point(r, 7)};
-    return ccd::vertex_face_ccd(q, accuracy, {}, stats);
+    return ccd::vertex_face_ccd(q, accuracy, options, stats);
   }
   const ccd::EdgeEdgeQuery q{point(r, 0), point(r, 1), point(r, 2), point(r, 3),
                              point(r, 4), point(r, 5), point(r, 6), point(r, 7)};
-  return ccd::edge_edge_ccd(q, accuracy, {}, stats);
+  return ccd::edge_edge_ccd(q, accuracy, options, stats);
 }
 
 // Writes the results next to `path` first and renames, so a failure leaves no half-written file.

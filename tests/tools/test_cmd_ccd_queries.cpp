@@ -36,23 +36,35 @@ std::string write_file(const std::string& name, const std::string& text) {
 
 TEST(CcdQueriesFile, ParsesNumbersExactlyAndToTheNearestDouble) {
   double v = 0;
+  double rounding = -1;
   mpq_class q;
   std::string fault;
-  ASSERT_TRUE(skelcd::tools::parse_ccd_number("0.1", v, &q, fault));
+  using skelcd::tools::parse_ccd_number;
+  ASSERT_TRUE(parse_ccd_number("0.1", v, &q, rounding, fault));
   EXPECT_EQ(v, 0.1);
   EXPECT_EQ(q, mpq_class(1, 10));
-  ASSERT_TRUE(skelcd::tools::parse_ccd_number("-2.5e-3", v, &q, fault));
+  EXPECT_GT(rounding, 0.0);
+  EXPECT_GE(mpq_class(rounding), abs(mpq_class(v) - q));  // the bound holds
+  ASSERT_TRUE(parse_ccd_number("-2.5e-3", v, &q, rounding, fault));
   EXPECT_EQ(v, -0.0025);
   EXPECT_EQ(q, mpq_class(-1, 400));
-  ASSERT_TRUE(skelcd::tools::parse_ccd_number("+7/3", v, &q, fault));
+  ASSERT_TRUE(parse_ccd_number("+7/3", v, &q, rounding, fault));
   EXPECT_EQ(v, 7.0 / 3.0);
   EXPECT_EQ(q, mpq_class(7, 3));
+  EXPECT_GE(mpq_class(rounding), abs(mpq_class(v) - q));
+  // Numbers that are doubles have no rounding.
+  for (const char* exact : {"0.5", "-0.375", "1e3", "12.5e-1", "3589935/67108864", "-12695021/2147483648", "0", "7"}) {
+    ASSERT_TRUE(parse_ccd_number(exact, v, &q, rounding, fault)) << exact;
+    EXPECT_EQ(rounding, 0.0) << exact;
+    EXPECT_EQ(mpq_class(v), q) << exact;
+  }
   // A big rational, rounded to nearest: (2^60 + 1) / 2^60 is 1 + 2^-60, nearest double 1.
-  ASSERT_TRUE(skelcd::tools::parse_ccd_number("1152921504606846977/1152921504606846976", v, &q, fault));
+  ASSERT_TRUE(parse_ccd_number("1152921504606846977/1152921504606846976", v, &q, rounding, fault));
   EXPECT_EQ(v, 1.0);
   EXPECT_GT(q, 1);
+  EXPECT_GE(mpq_class(rounding), abs(mpq_class(v) - q));
   for (const char* bad : {"", "1/0", "abc", "1e", "--1", "1.2.3", "0x10", "inf", "nan", "1e400", "1/-2", "3/"}) {
-    EXPECT_FALSE(skelcd::tools::parse_ccd_number(bad, v, &q, fault)) << bad;
+    EXPECT_FALSE(parse_ccd_number(bad, v, &q, rounding, fault)) << bad;
     EXPECT_FALSE(fault.empty()) << bad;
   }
 }
@@ -116,6 +128,27 @@ TEST(CcdQueries, ExactReadsDecimalsAsWritten) {
   const skelcd::ccd::VertexFaceQuery d{V(0.3, 0, 1), V(0.1, -1, 0), V(0.5, 1, 0), V(2, 0, 0),
                                        V(0.3, 0, -1), V(0.1, -1, 0), V(0.5, 1, 0), V(2, 0, 0)};
   EXPECT_FALSE(skelcd::ccd::vertex_face_ccd(d, skelcd::ccd::Accuracy::exact).hit);
+}
+
+TEST(CcdQueries, ConservativeCoversTheRoundingOfTheInput) {
+  // As written, the vertex falls through the point (3000000.3, 0) of the edge from
+  // (3000000.1, -1) to (3000000.5, 1): a contact. Rounded to doubles (ulp 2^-31 near 3e6) the vertex
+  // passes 2.3e-10 outside that edge — a miss the doubles alone prove. Conservative must still
+  // answer "hit" for the numbers as written: it widens the query by their rounding.
+  const std::string q =
+      "vf 3000000.3 0 1  3000000.1 -1 0  3000000.5 1 0  3000002 0 0  "
+      "3000000.3 0 -1  3000000.1 -1 0  3000000.5 1 0  3000002 0 0  1\n";
+  for (const char* accuracy : {"exact", "conservative"}) {
+    const auto r = run_skelcd({"ccd-queries", "-", "--accuracy", accuracy, "--json"}, q);
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    EXPECT_EQ(nlohmann::json::parse(r.out)["false_negatives"], 0) << accuracy;
+  }
+  using V = Eigen::Vector3d;
+  const skelcd::ccd::VertexFaceQuery d{V(3000000.3, 0, 1), V(3000000.1, -1, 0), V(3000000.5, 1, 0), V(3000002, 0, 0),
+                                       V(3000000.3, 0, -1), V(3000000.1, -1, 0), V(3000000.5, 1, 0), V(3000002, 0, 0)};
+  EXPECT_FALSE(skelcd::ccd::vertex_face_ccd(d, skelcd::ccd::Accuracy::exact).hit);
+  EXPECT_FALSE(skelcd::ccd::vertex_face_ccd(d, skelcd::ccd::Accuracy::conservative).hit)
+      << "the doubles alone are a provable miss: without the widening this would be a false negative";
 }
 
 TEST(CcdQueries, MalformedLinesAreOneLineErrorsNamingTheLine) {
