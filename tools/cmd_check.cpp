@@ -19,6 +19,7 @@
 #include "tools/cli_util.hpp"
 #include "tools/commands.hpp"
 #include "tools/file_hash.hpp"
+#include "tools/radial_view_setup.hpp"
 #include "tools/log/log_writer.hpp"
 #include "tools/run_summary.hpp"
 #include "tools/runner.hpp"
@@ -37,6 +38,7 @@ struct CheckArguments {
   double min_separation = 0;
   std::string output;
   bool json = false;
+  RadialViewArguments radial_view;
 };
 
 /// The process's own command line (from /proc), arguments quoted when they need it.
@@ -193,12 +195,13 @@ nlohmann::json json_summary(const skinning::LoadedModel& model, const skinning::
 void run_check(const CheckArguments& args) {
   // Everything that can be refused is checked before the log is created: options, the model,
   // the clip, the frame range and the method.
-  const RunOptions options = to_run_options(args);
+  RunOptions options = to_run_options(args);
   const std::filesystem::path model_path(args.model);
   const auto kind = skinning::classify_model_path(model_path);
   if (kind != skinning::ModelKind::frame_sequence) require_exists(model_path);
   const auto model = skinning::load_model(model_path);
   const auto motion = model.motion(skinning::MotionRequest{.clip = args.clip, .rate_hz = args.fps});
+  const auto radial_view = setup_radial_view(args.radial_view, model, *motion, options);
   ClipRunner runner(*motion, options);
   const RunPlan& plan = runner.plan();
   const double fps = motion_rate(*motion, args.fps);
@@ -217,6 +220,7 @@ void run_check(const CheckArguments& args) {
     header.query = std::string(to_string(options.query));
     header.fps = fps;
     header.min_separation = options.min_separation;
+    header.gamma = radial_view.gamma;
     header.start_time = iso8601_utc_now();
     header.first_sample = plan.first_sample;
     header.last_sample = plan.last_sample;
@@ -266,6 +270,7 @@ void add_check_command(CLI::App& app) {
                   "contact distance in model units (0: touching counts)");
   cmd->add_option("-o,--output", args->output, "write the HDF5 log here (LOG.h5)");
   cmd->add_flag("--json", args->json, "print the summary as one JSON object");
+  add_radial_view_options(*cmd, args->radial_view);
   cmd->callback([args] { run_check(*args); });
 }
 

@@ -124,7 +124,8 @@ ClipRunner::ClipRunner(
     : motion_(motion), options_(options), plan_(make_plan(motion, options)) {
   topology_ = skinning::build_topology(motion.mesh());
   const culling::MethodOptions method_options{
-      .accuracy = options.accuracy, .min_separation = options.min_separation};
+      .accuracy = options.accuracy, .min_separation = options.min_separation,
+      .extension = options.method_extension};
   if (factory) {
     method_ = factory(motion.mesh(), topology_, method_options);
   } else {
@@ -214,6 +215,7 @@ void ClipRunner::run(const FrameCallback& on_frame) {
   const auto run_dcd = [&](std::int32_t sample, const skinning::Positions& x, double skin_us) {
     const auto start = Clock::now();
     result.clear();
+    if (options_.before_query) options_.before_query(sample, sample);
     method_->detect_dcd(x, result);
     finish_row(QueryKind::dcd, sample, skin_us, start);
   };
@@ -229,6 +231,7 @@ void ClipRunner::run(const FrameCallback& on_frame) {
     if (ccd) {
       const auto start = Clock::now();
       result.clear();
+      if (options_.before_query) options_.before_query(i, i + 1);
       method_->detect_ccd(welded_t0, welded_t1, result);
       finish_row(QueryKind::ccd, i, std::exchange(pending_skin_us, 0.0), start);
     }

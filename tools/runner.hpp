@@ -36,6 +36,10 @@ struct RunOptions {
   ccd::Accuracy accuracy = ccd::Accuracy::conservative;
   QuerySet query = QuerySet::both;
   double min_separation = 0;  ///< contact distance, model units
+  /// Methods built above culling/ (rvbc, dynamic: tools/radial_view_setup.hpp), passed to make_method.
+  std::shared_ptr<const culling::MethodExtension> method_extension;
+  /// Called before each query with its samples (a DCD at i: (i, i); a CCD interval: (i, i + 1)).
+  std::function<void(std::int32_t sample_t0, std::int32_t sample_t1)> before_query;
 };
 
 /// What a run will do, resolved against the motion's sample count.

@@ -1,0 +1,111 @@
+// skelcd check --method rvbc|dynamic as a user runs it: the same contacts as bvh, the Table 3
+// columns in the log (clusters, |H⁻|, |Hᵘ|, RV-update times), γ in the header, a segmentation
+// from `skelcd preprocess` reused, and bad input refused in one line.
+
+#include <algorithm>
+#include <tuple>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include "tests/support/test_support.hpp"
+#include "tests/tools/cli_runner.hpp"
+#include "tools/log/log_reader.hpp"
+
+namespace {
+
+using namespace skelcd::tools;
+using skelcd::test::run_skelcd;
+
+const std::string kCesium = skelcd::test::asset("characters/CesiumMan.glb").string();
+const std::string kFox = skelcd::test::asset("characters/Fox.glb").string();
+
+using Key = std::tuple<int, int, int, int, int, int, int, int>;
+std::vector<Key> contact_keys(const LogData& log) {
+  std::vector<Key> keys;
+  for (const auto& c : log.contacts) {
+    keys.emplace_back(c.frame, static_cast<int>(c.kind), c.a.part, c.a.index, c.a.side, c.b.part,
+                      c.b.index, c.b.side);
+  }
+  std::sort(keys.begin(), keys.end());
+  return keys;
+}
+
+TEST(RadialViewCheck, SameContactsAsBvhAndTable3Columns) {
+  const auto dir = skelcd::test::temp_dir("rv-check");
+  std::vector<LogData> logs;
+  for (const char* method : {"bvh", "rvbc", "dynamic"}) {
+    const auto log = (dir / (std::string(method) + ".h5")).string();
+    const auto r = run_skelcd({"check", kCesium, "--frames", "0:6", "--query", "ccd", "--method",
+                               method, "--json", "-o", log});
+    ASSERT_EQ(r.exit_code, 0) << method << ": " << r.err;
+    EXPECT_EQ(nlohmann::json::parse(r.out)["method"], method);
+    logs.push_back(read_log(log));
+  }
+  ASSERT_FALSE(logs[0].contacts.empty());
+  EXPECT_EQ(contact_keys(logs[1]), contact_keys(logs[0]));
+  EXPECT_EQ(contact_keys(logs[2]), contact_keys(logs[0]));
+  // The Table 3 columns: clusters per interval, classification and merge times.
+  const auto& dynamic = logs[2];
+  EXPECT_EQ(dynamic.header.method, "dynamic");
+  ASSERT_TRUE(dynamic.header.gamma.has_value());
+  EXPECT_DOUBLE_EQ(*dynamic.header.gamma, 0.05);
+  EXPECT_FALSE(logs[1].header.gamma.has_value());  // rvbc does not merge
+  ASSERT_EQ(dynamic.frames.size(), 6u);
+  for (const auto& row : dynamic.frames) {
+    EXPECT_GT(row.counters.atomic_clusters, 0);
+    EXPECT_GT(row.counters.mega_clusters, 0);
+    EXPECT_LE(row.counters.mega_clusters, row.counters.atomic_clusters);
+    EXPECT_GT(row.times.classify_us, 0.0);
+    EXPECT_GT(row.counters.h_minus + row.counters.h_uncertain, 0);
+  }
+  for (const auto& row : logs[1].frames) {
+    EXPECT_EQ(row.counters.mega_clusters, row.counters.atomic_clusters);
+  }
+  for (const auto& row : logs[0].frames) EXPECT_EQ(row.counters.atomic_clusters, 0);
+}
+
+TEST(RadialViewCheck, ReusesAPreprocessedSegmentation) {
+  const auto dir = skelcd::test::temp_dir("rv-seg");
+  const auto seg = (dir / "cesium.seg.h5").string();
+  const auto pre = run_skelcd({"preprocess", kCesium, "--weights", "rig", "-o", seg});
+  ASSERT_EQ(pre.exit_code, 0) << pre.err;
+  const auto with_file = run_skelcd({"check", kCesium, "--frames", "2:4", "--query", "ccd",
+                                     "--method", "dynamic", "--segmentation", seg, "--json"});
+  const auto computed = run_skelcd(
+      {"check", kCesium, "--frames", "2:4", "--query", "ccd", "--method", "dynamic", "--json"});
+  ASSERT_EQ(with_file.exit_code, 0) << with_file.err;
+  ASSERT_EQ(computed.exit_code, 0) << computed.err;
+  const auto a = nlohmann::json::parse(with_file.out);
+  const auto b = nlohmann::json::parse(computed.out);
+  EXPECT_EQ(a["ccd_vf"], b["ccd_vf"]);
+  EXPECT_EQ(a["ccd_ee"], b["ccd_ee"]);
+  // A segmentation of another model is refused, naming both files.
+  const auto fox_seg = (dir / "fox.seg.h5").string();
+  ASSERT_EQ(run_skelcd({"preprocess", kFox, "--weights", "rig", "-o", fox_seg}).exit_code, 0);
+  const auto wrong = run_skelcd({"check", kCesium, "--frames", "0:1", "--method", "rvbc",
+                                 "--segmentation", fox_seg});
+  EXPECT_EQ(wrong.exit_code, 1);
+  EXPECT_NE(wrong.err.find("fox.seg.h5"), std::string::npos) << wrong.err;
+}
+
+TEST(RadialViewCheck, BadInputIsRefusedInOneLine) {
+  const auto dir = skelcd::test::temp_dir("rv-bad");
+  const auto log = (dir / "out.h5");
+  const auto gamma = run_skelcd({"check", kCesium, "--frames", "0:1", "--method", "dynamic",
+                                 "--gamma", "2", "-o", log.string()});
+  EXPECT_EQ(gamma.exit_code, 1);
+  EXPECT_NE(gamma.err.find("--gamma"), std::string::npos) << gamma.err;
+  EXPECT_EQ(std::count(gamma.err.begin(), gamma.err.end(), '\n'), 1);
+  EXPECT_FALSE(std::filesystem::exists(log));
+  // A frame sequence has no bones to move the observers.
+  const auto frames = run_skelcd({"check", skelcd::test::asset("cloth-funnel/frames").string(),
+                                  "--frames", "0:1", "--method", "dynamic"});
+  EXPECT_EQ(frames.exit_code, 1);
+  EXPECT_NE(frames.err.find("rigged model"), std::string::npos) << frames.err;
+  const auto missing = run_skelcd({"check", kCesium, "--method", "rvbc", "--segmentation",
+                                   (dir / "none.h5").string()});
+  EXPECT_EQ(missing.exit_code, 1);
+}
+
+}  // namespace

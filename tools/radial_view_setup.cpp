@@ -1,0 +1,77 @@
+#include "tools/radial_view_setup.hpp"
+
+#include <cmath>
+#include <filesystem>
+#include <memory>
+
+#include "clustering/bone_poses.hpp"
+#include "clustering/radial_view_extension.hpp"
+#include "segmentation/segmentation.hpp"
+#include "skinning/errors.hpp"
+#include "skinning/rig_motion.hpp"
+#include "tools/segmentation_file.hpp"
+
+namespace skelcd::tools {
+
+void add_radial_view_options(CLI::App& command, RadialViewArguments& args) {
+  command.add_option("--gamma", args.gamma, "dynamic: merge threshold γ on (|H-| + |Hu|) / |C|")
+      ->capture_default_str();
+  command.add_option("--seed", args.seed, "dynamic: seed of the seed-cluster draws")
+      ->capture_default_str();
+  command.add_option("--segmentation", args.segmentation,
+                     "rvbc/dynamic: SEG.h5 from `skelcd preprocess` of the same model "
+                     "(default: segment here with the rig's weights)");
+}
+
+RadialViewSetup setup_radial_view(
+    const RadialViewArguments& args,
+    const skinning::LoadedModel& model,
+    const skinning::Motion& motion,
+    RunOptions& options) {
+  RadialViewSetup setup;
+  if (!clustering::is_radial_view_method(options.method)) return setup;
+  const std::string method = options.method;
+  if (!(std::isfinite(args.gamma) && args.gamma >= 0.0 && args.gamma <= 1.0)) {
+    throw InvalidInput("--gamma " + std::to_string(args.gamma) + ": expected a value in [0, 1]");
+  }
+  if (!model.rig) {
+    throw InvalidInput(
+        "--method " + method + " needs a rigged model (bones move the observers): " +
+        model.path.string() + " has no skeleton");
+  }
+  const auto* rig_motion = dynamic_cast<const skinning::RigMotion*>(&motion);
+  if (rig_motion == nullptr) {
+    throw InvalidInput("--method " + method + ": " + motion.name() + " is not a rig's clip");
+  }
+
+  // The segmentation: the preprocess file when given (it must come from this very model), else
+  // computed now with the rig's own weights (fast; `preprocess` offers heat weights).
+  std::shared_ptr<const segmentation::Segmentation> seg;
+  if (!args.segmentation.empty()) {
+    auto file = read_segmentation(args.segmentation, model.path);
+    seg = std::make_shared<const segmentation::Segmentation>(std::move(file.segmentation));
+    setup.segmentation_source = args.segmentation;
+  } else {
+    segmentation::SegmentationOptions o;
+    o.weights = model.rig->weights.nonZeros() > 0 ? segmentation::WeightSource::rig
+                                                   : segmentation::WeightSource::heat;
+    seg = std::make_shared<const segmentation::Segmentation>(segmentation::segment(*model.rig, o));
+    setup.segmentation_source = o.weights == segmentation::WeightSource::rig
+                                    ? "computed (rig weights)"
+                                    : "computed (heat weights)";
+  }
+  setup.atomic_clusters = static_cast<std::int32_t>(seg->clusters.size());
+
+  // Bone poses: the runner tells which samples each query spans.
+  auto poses = std::make_shared<clustering::BonePoses>(clustering::pose_at_sample(*rig_motion));
+  options.method_extension = std::make_shared<clustering::RadialViewExtension>(
+      seg, poses, model.rig->skeleton.num_bones(),
+      clustering::RadialViewParameters{.gamma = args.gamma, .seed = args.seed});
+  options.before_query = [poses](std::int32_t s0, std::int32_t s1) {
+    poses->select_samples(s0, s1);
+  };
+  if (method == "dynamic") setup.gamma = args.gamma;
+  return setup;
+}
+
+}  // namespace skelcd::tools

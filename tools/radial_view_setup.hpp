@@ -1,0 +1,50 @@
+#pragma once
+// What `check` (and any command built on ClipRunner) adds for the radial-view methods `rvbc` and
+// `dynamic`: the options --gamma, --seed, --segmentation, and the setup that gives the runner's
+// method what it needs beyond the mesh — a segmentation (read from a `preprocess` file made from
+// the same model, else computed from the rig) and the bone poses of each interval, selected by
+// the runner before each query (docs/radial-view.md, "Command line").
+
+#include <cstdint>
+#include <optional>
+#include <string>
+
+#include <CLI/CLI.hpp>
+
+#include "skinning/load.hpp"
+#include "skinning/motion.hpp"
+#include "tools/runner.hpp"
+
+namespace skelcd::tools {
+
+struct RadialViewArguments {
+  double gamma = 0.05;  ///< merge threshold γ of `dynamic` (§5)
+  std::uint64_t seed = 1;
+  std::string segmentation;  ///< SEG.h5 from `skelcd preprocess`; empty: computed here
+};
+
+/// Adds --gamma, --seed and --segmentation to `command`, stored into `args`.
+void add_radial_view_options(CLI::App& command, RadialViewArguments& args);
+
+struct RadialViewSetup {
+  /// Where the segmentation came from: the file, or "computed (rig weights)" / "(heat weights)".
+  std::string segmentation_source;
+  std::int32_t atomic_clusters = 0;
+  /// γ when the method uses it (`dynamic`), for the log header.
+  std::optional<double> gamma;
+};
+
+/// For options.method rvbc or dynamic: loads or computes the segmentation and sets
+/// options.method_extension and options.before_query (bone poses follow the runner's samples).
+/// Does nothing and returns an empty setup for any other method.
+/// @param motion the motion the runner will check (a rig's clip: RigMotion).
+/// @throws InvalidInput when the model has no rig, the motion is not a rig's, γ is outside
+///   [0, 1], or the segmentation file was made from another model (hash mismatch); IoError when
+///   the segmentation file cannot be read.
+[[nodiscard]] RadialViewSetup setup_radial_view(
+    const RadialViewArguments& args,
+    const skinning::LoadedModel& model,
+    const skinning::Motion& motion,
+    RunOptions& options);
+
+}  // namespace skelcd::tools
