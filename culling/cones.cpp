@@ -165,6 +165,32 @@ std::array<BoundedNormal, 3> continuous_normal_control_vectors(
   }};
 }
 
+DirectionCone boundary_binormal_cone(
+    const std::array<Eigen::Vector3d, 3>& p_t0,
+    const std::array<Eigen::Vector3d, 3>& p_t1,
+    std::uint8_t sides,
+    bool continuous) {
+  DirectionCone bnc = DirectionCone::empty_cone();
+  if (sides == 0) return bnc;
+  const auto n = continuous_normal_control_vectors(p_t0[0], p_t0[1], p_t0[2], p_t1[0], p_t1[1], p_t1[2]);
+  for (std::size_t k = 0; k < 3; ++k) {
+    if ((sides & (1u << k)) == 0) continue;
+    const Eigen::Vector3d e0 = p_t0[(k + 1) % 3] - p_t0[k];
+    if (!continuous) {
+      bnc = merge(bnc, cone_of_vector(n[0].n.cross(e0), 0.0));
+      continue;
+    }
+    // n(t) (degree 2) × e(t) (degree 1): the degree-3 Bernstein product's control vectors.
+    const Eigen::Vector3d e1 = p_t1[(k + 1) % 3] - p_t1[k];
+    const Eigen::Vector3d c0 = n[0].n.cross(e0);
+    const Eigen::Vector3d c1 = (2.0 * n[1].n.cross(e0) + n[0].n.cross(e1)) / 3.0;
+    const Eigen::Vector3d c2 = (n[2].n.cross(e0) + 2.0 * n[1].n.cross(e1)) / 3.0;
+    const Eigen::Vector3d c3 = n[2].n.cross(e1);
+    for (const auto& c : {c0, c1, c2, c3}) bnc = merge(bnc, cone_of_vector(c, 0.0));
+  }
+  return bnc;
+}
+
 void NormalConeTree::refit(
     const AabbBvh& bvh,
     const FeatureTopology& topology,

@@ -98,6 +98,17 @@ struct BoundedNormal {
     const Eigen::Vector3d& b_t1,
     const Eigen::Vector3d& c_t1);
 
+/// FASTCD's binormal cone of the boundary sides of one triangle (corners p, moving linearly from
+/// p_t0 to p_t1): b = n × e for each side k whose bit is set in `sides` (side k runs from corner k
+/// to corner k+1, e its vector, n the triangle's normal); over an interval the Bernstein control
+/// vectors of the cubic n(t) × e(t). Plain floating point: the `dual-cone` baseline is approximate
+/// by design. Empty when no bit is set.
+[[nodiscard]] DirectionCone boundary_binormal_cone(
+    const std::array<Eigen::Vector3d, 3>& p_t0,
+    const std::array<Eigen::Vector3d, 3>& p_t1,
+    std::uint8_t sides,
+    bool continuous);
+
 /// Surface normal cones of every node of a hierarchy over the welded triangles, refit bottom-up
 /// per instant (static normals, DCD) or per interval (continuous normals, CCD). A node's cone
 /// contains the (continuous) normal of each of its triangles; a parent's axis is its triangles'

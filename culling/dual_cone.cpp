@@ -45,25 +45,13 @@ class DualConeMethod final : public detail::ConeMethodBase {
       DirectionCone bnc = DirectionCone::empty_cone();
       if (boundary_sides_[uf] != 0) {
         const auto& t = topology_.triangle(f);
-        auto p0 = [&](int k) -> Eigen::Vector3d { return x0.row(t[static_cast<std::size_t>(k)]).transpose(); };
-        auto p1 = [&](int k) -> Eigen::Vector3d { return x1.row(t[static_cast<std::size_t>(k)]).transpose(); };
-        const auto n = continuous_normal_control_vectors(p0(0), p0(1), p0(2), p1(0), p1(1), p1(2));
-        for (int k = 0; k < 3; ++k) {
-          if ((boundary_sides_[uf] & (1u << k)) == 0) continue;
-          // Binormal b = n × e of the boundary edge e (corner k → k+1).
-          const Eigen::Vector3d e0 = p0((k + 1) % 3) - p0(k);
-          if (!interval.continuous) {
-            bnc = merge(bnc, cone_of_vector(n[0].n.cross(e0), 0.0));
-            continue;
-          }
-          // b(t) = n(t) × e(t), a cubic: its Bernstein control vectors.
-          const Eigen::Vector3d e1 = p1((k + 1) % 3) - p1(k);
-          const Eigen::Vector3d c0 = n[0].n.cross(e0);
-          const Eigen::Vector3d c1 = (2.0 * n[1].n.cross(e0) + n[0].n.cross(e1)) / 3.0;
-          const Eigen::Vector3d c2 = (n[2].n.cross(e0) + 2.0 * n[1].n.cross(e1)) / 3.0;
-          const Eigen::Vector3d c3 = n[2].n.cross(e1);
-          for (const auto& c : {c0, c1, c2, c3}) bnc = merge(bnc, cone_of_vector(c, 0.0));
+        std::array<Eigen::Vector3d, 3> p0;
+        std::array<Eigen::Vector3d, 3> p1;
+        for (std::size_t k = 0; k < 3; ++k) {
+          p0[k] = x0.row(t[k]).transpose();
+          p1[k] = x1.row(t[k]).transpose();
         }
+        bnc = boundary_binormal_cone(p0, p1, boundary_sides_[uf], interval.continuous);
       }
       triangle_bnc_[uf] = bnc;
     }

@@ -237,6 +237,42 @@ TEST(Cones, DirectTestAroundTheMeanNormalProvesWhatTheCheckAllowsAndNothingElse)
   EXPECT_TRUE(tree.normals_in_half_space(bvh, 0, Vec(1e-12, 0, 1)));
 }
 
+TEST(Cones, BinormalConesContainTheBoundaryBinormalsAtSampledTimes) {
+  // FASTCD's BNC of a triangle's boundary sides: b(t) = n(t) × e(t) inside the cone at every
+  // sampled t (its control vectors bound the cubic while the cone is below π/2).
+  std::mt19937_64 rng(13);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  int bounded = 0;
+  for (int trial = 0; trial < 400; ++trial) {
+    std::array<Vec, 3> p0{Vec(0, 0, 0), Vec(1, 0, 0), Vec(0, 1, 0)};
+    std::array<Vec, 3> p1 = p0;
+    for (std::size_t k = 0; k < 3; ++k) {
+      p0[k] += 0.2 * Vec(u(rng), u(rng), u(rng));
+      p1[k] = p0[k] + 0.15 * Vec(u(rng), u(rng), u(rng));
+    }
+    const auto sides = static_cast<std::uint8_t>(1 + trial % 7);
+    const DirectionCone c = boundary_binormal_cone(p0, p1, sides, true);
+    ASSERT_FALSE(c.is_empty());
+    if (c.is_full()) continue;
+    ++bounded;
+    for (int step = 0; step <= 20; ++step) {
+      const long double t = step / 20.0L;
+      std::array<LVec, 3> p;
+      for (std::size_t k = 0; k < 3; ++k) p[k] = to_long(p0[k]) + t * (to_long(p1[k]) - to_long(p0[k]));
+      const LVec n = (p[1] - p[0]).cross(p[2] - p[0]);
+      for (std::size_t k = 0; k < 3; ++k) {
+        if ((sides & (1u << k)) == 0) continue;
+        const LVec b = n.cross(p[(k + 1) % 3] - p[k]);
+        // The baseline's cones carry no error bounds: allow a relative 1e-12.
+        EXPECT_GE(b.dot(to_long(c.axis)), b.norm() * (static_cast<long double>(c.cos_angle) - 1e-12L))
+            << "trial " << trial << " t " << static_cast<double>(t);
+      }
+    }
+  }
+  EXPECT_GT(bounded, 100);
+  EXPECT_TRUE(boundary_binormal_cone({Vec(0, 0, 0), Vec(1, 0, 0), Vec(0, 1, 0)}, {Vec(0, 0, 0), Vec(1, 0, 0), Vec(0, 1, 0)}, 0, false).is_empty());
+}
+
 // --- predicates vs exact rationals ---------------------------------------------------------------
 
 mpq_class q(double d) { return mpq_class(d); }

@@ -12,6 +12,7 @@
 #include "culling/method_extension.hpp"
 #include "culling/routed_method.hpp"
 #include "skinning/errors.hpp"
+#include "skinning/load.hpp"
 #include "tests/culling/test_dual_cone_scenes.hpp"
 #include "tests/support/test_support.hpp"
 
@@ -116,6 +117,32 @@ TEST(Routing, ClothFunnelRoutesThreeClothPartsAndTheFunnelAndMatchesBvh) {
   auto b = make_method("bvh", s.mesh, s.topo);
   EXPECT_EQ(dcd(*a, s.frames[1]).dcd_pairs, dcd(*b, s.frames[1]).dcd_pairs);
   EXPECT_EQ(keys(ccd(*a, s.frames[0], s.frames[1])), keys(ccd(*b, s.frames[0], s.frames[1])));
+}
+
+TEST(Routing, RobotExpressiveCharacterRoutesItsOpenAndClosedPartsAndMatchesBvh) {
+  // A real skinned character with open parts (SOURCES.md): each component goes where it fits,
+  // and over a clip interval the routed answer is bvh's.
+  const auto model = skinning::load_model(test::asset("characters/RobotExpressive.glb"));
+  const auto motion = model.motion({});
+  const skinning::Mesh& mesh = *model.mesh;
+  const auto topo = skinning::build_topology(mesh);
+  auto a = make_method("auto", mesh, topo);
+  int open = 0;
+  int closed = 0;
+  for (const auto& r : routes_of(*a)) {
+    (r.closed ? closed : open) += 1;
+    EXPECT_EQ(r.method, r.closed ? "bvh" : "enhanced-dual-cone");
+  }
+  EXPECT_GT(open, 0);
+  EXPECT_GT(closed, 0);
+  auto b = make_method("bvh", mesh, topo);
+  skinning::Positions p0, p1;
+  motion->positions(0, p0);
+  motion->positions(std::min(3, motion->num_samples() - 1), p1);
+  const skinning::Positions x0 = test::welded(topo, p0);
+  const skinning::Positions x1 = test::welded(topo, p1);
+  EXPECT_EQ(dcd(*a, x1).dcd_pairs, dcd(*b, x1).dcd_pairs);
+  EXPECT_EQ(keys(ccd(*a, x0, x1)), keys(ccd(*b, x0, x1)));
 }
 
 TEST(Routing, ClosedPartsGoToDynamicWhenTheExtensionBuildsIt) {
