@@ -3,7 +3,11 @@
 #include <cmath>
 
 #include "culling/detail/method_base.hpp"
+#include "culling/dual_cone.hpp"
+#include "culling/enhanced_dual_cone.hpp"
 #include "culling/method_extension.hpp"
+#include "culling/normal_cone.hpp"
+#include "culling/routed_method.hpp"
 #include "skinning/errors.hpp"
 
 namespace skelcd::culling {
@@ -45,7 +49,9 @@ void MethodBase::check_positions(
 
 }  // namespace detail
 
-std::vector<std::string> method_names() { return {"brute", "bvh", "kdop"}; }
+std::vector<std::string> method_names() {
+  return {"brute", "bvh", "kdop", "normal-cone", "dual-cone", "enhanced-dual-cone", "auto"};
+}
 
 std::unique_ptr<CullingMethod> make_method(
     std::string_view name,
@@ -55,6 +61,10 @@ std::unique_ptr<CullingMethod> make_method(
   if (name == "brute") return detail::make_brute_method(mesh, topology, options);
   if (name == "bvh") return detail::make_bvh_method<3>(name, mesh, topology, options);
   if (name == "kdop") return detail::make_bvh_method<8>(name, mesh, topology, options);
+  if (name == "normal-cone") return make_normal_cone_method(mesh, topology, options);
+  if (name == "dual-cone") return make_dual_cone_method(mesh, topology, options);
+  if (name == "enhanced-dual-cone") return make_enhanced_dual_cone_method(mesh, topology, options);
+  if (name == "auto") return make_routed_method(mesh, topology, options);
   if (options.extension) {
     if (auto m = options.extension->make_method(name, mesh, topology, options)) return m;
   }
