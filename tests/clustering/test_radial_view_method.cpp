@@ -4,8 +4,11 @@
 // names through the extension, errors, counters of paper Table 3.
 #include "clustering/radial_view_method.hpp"
 
+#include <algorithm>
+
 #include <gtest/gtest.h>
 
+#include "clustering/radial_view_extension.hpp"
 #include "skinning/errors.hpp"
 #include "skinning/generators.hpp"
 #include "skinning/load.hpp"
@@ -24,7 +27,7 @@ std::shared_ptr<const skinning::Rig> generated(const std::string& spec) {
   return std::make_shared<const skinning::Rig>(std::move(g.rig));
 }
 
-[[maybe_unused]] std::shared_ptr<const skinning::Rig> loaded(const std::filesystem::path& path) {
+std::shared_ptr<const skinning::Rig> loaded(const std::filesystem::path& path) {
   auto model = skinning::load_model(path);
   return model.rig;
 }
@@ -57,11 +60,157 @@ std::int64_t total(const ClipRun& run, std::int64_t culling::Counters::*field) {
 TEST(RadialViewMethod, RopeCoilsIntoItself) {
   auto rig = generated("gen:rope?triangles=4000&frames=40");
   RadialViewScene scene(rig);
-  const auto c = compare(scene, 0, 39);
+  // Intervals 18 … 30: the coil closes (the first contact) and stays in contact.
+  const auto c = compare(scene, 18, 30);
   EXPECT_GT(c.bvh.contacts.size(), 0u);  // the clip does collide
   // Culling happened: fewer candidate pairs than the hierarchy alone.
   EXPECT_LT(total(c.dynamic, &culling::Counters::candidate_pairs),
             total(c.bvh, &culling::Counters::candidate_pairs));
+  std::int32_t escalated = 0;
+  for (const auto& st : c.dynamic.stats) escalated += st.components_escalated;
+  EXPECT_EQ(escalated, 1);  // once, at the first contact; then the component stays intersecting
+}
+
+TEST(RadialViewMethod, FingersAndTentaclesTouch) {
+  for (const char* spec : {"gen:hand?triangles=2000&frames=30", "gen:octopus?triangles=3000&frames=30"}) {
+    SCOPED_TRACE(spec);
+    auto rig = generated(spec);
+    RadialViewScene scene(rig);
+    const auto c = compare(scene, 10, 22);
+    EXPECT_GT(c.bvh.contacts.size(), 0u);
+  }
+}
+
+TEST(RadialViewMethod, SmallClipsAgreeWithBruteForce) {
+  auto rig = generated("gen:hand?triangles=600&frames=24");
+  RadialViewScene scene(rig);
+  auto brute = scene.method("brute");
+  const ClipRun reference = run_clip(scene, *brute, 6, 20);
+  ASSERT_GT(reference.contacts.size(), 0u);
+  for (const char* name : {"rvbc", "dynamic"}) {
+    auto m = scene.method(name);
+    EXPECT_EQ(run_clip(scene, *m, 6, 20).contacts, reference.contacts) << name;
+  }
+  // With the exact elementary tests as well.
+  culling::MethodOptions exact;
+  exact.accuracy = ccd::Accuracy::exact;
+  auto brute_exact = scene.method("brute", {}, exact);
+  auto dynamic_exact = scene.method("dynamic", {}, exact);
+  EXPECT_EQ(run_clip(scene, *dynamic_exact, 12, 16).contacts,
+            run_clip(scene, *brute_exact, 12, 16).contacts);
+}
+
+TEST(RadialViewMethod, RealCharacters) {
+  // CesiumMan, Fox and BCN_Epileptic interpenetrate in their rest pose (BCN_Epileptic is also
+  // open: all of it goes to the hierarchy); RiggedFigure and RobotExpressive (rigid parts hanging
+  // from nodes) do not. A few intervals each; bench/clustering runs the full clips.
+  struct Case {
+    std::filesystem::path path;
+    std::int32_t clip;
+    std::int32_t first;
+    std::int32_t last;
+  };
+  const std::vector<Case> cases = {
+      {test::asset("characters/CesiumMan.glb"), 0, 10, 16},
+      {test::asset("characters/Fox.glb"), 2, 4, 10},
+      {test::asset("characters/RiggedFigure.glb"), 0, 0, 1},
+      {test::asset("characters/RobotExpressive.glb"), 0, 20, 26},
+      {test::assimp_model("X/BCN_Epileptic.X"), 0, 30, 34},
+  };
+  for (const auto& k : cases) {
+    SCOPED_TRACE(k.path.string());
+    RadialViewScene scene(loaded(k.path), k.clip);
+    const auto c = compare(scene, k.first, k.last, test::DcdQueries::every);
+    for (const auto& f : c.dynamic.frames) EXPECT_GT(f.counters.atomic_clusters, 0);
+  }
+}
+
+TEST(RadialViewMethod, BcnEpilepticIsOpenAndItsRestPoseInterpenetrates) {
+  RadialViewScene scene(loaded(test::assimp_model("X/BCN_Epileptic.X")));
+  auto bvh = scene.method("bvh");
+  skinning::Positions x;
+  scene.welded(0, x);
+  culling::FrameResult dcd;
+  bvh->detect_dcd(x, dcd);
+  EXPECT_GT(dcd.dcd_pairs.size(), 0u);  // the rest pose interpenetrates
+  auto dynamic = scene.method("dynamic");
+  const ClipRun run = run_clip(scene, *dynamic, 0, 2);
+  for (const auto& st : run.stats) {
+    EXPECT_EQ(st.components_open, st.components);  // no closed part: nothing is skipped
+    EXPECT_EQ(st.components_culled, 0);
+  }
+}
+
+TEST(RadialViewMethod, ContactDistanceTurnsTheSkippingOff) {
+  // The radial-view argument is about touching; with a contact distance nothing is skipped and
+  // the contacts stay those of bvh.
+  auto rig = generated("gen:hand?triangles=600&frames=24");
+  RadialViewScene scene(rig);
+  culling::MethodOptions o;
+  o.min_separation = 0.01;
+  auto bvh = scene.method("bvh", {}, o);
+  auto dynamic = scene.method("dynamic", {}, o);
+  const ClipRun a = run_clip(scene, *bvh, 8, 20);
+  const ClipRun b = run_clip(scene, *dynamic, 8, 20);
+  EXPECT_EQ(b.contacts, a.contacts);
+  EXPECT_GT(a.contacts.size(), 0u);
+  for (const auto& st : b.stats) EXPECT_EQ(st.components_culled, 0);
+}
+
+TEST(RadialViewMethod, NamesErrorsAndCounters) {
+  auto rig = generated("gen:hand?triangles=600&frames=8");
+  RadialViewScene scene(rig);
+  const auto options = scene.options();
+  EXPECT_EQ(culling::method_names(options).back(), "dynamic");
+  EXPECT_EQ(scene.method("rvbc")->name(), "rvbc");
+  EXPECT_EQ(scene.method("dynamic")->name(), "dynamic");
+  // Without the extension the names are unknown, and the message says which ones exist.
+  EXPECT_THROW_MESSAGE((void)culling::make_method("dynamic", rig->mesh, scene.topology),
+                       InvalidInput, "unknown method 'dynamic'");
+  EXPECT_THROW_MESSAGE((void)scene.method("octree"), InvalidInput, "rvbc, dynamic");
+  EXPECT_THROW_MESSAGE(RadialViewExtension(scene.segmentation, scene.poses, 3, {.gamma = 1.5}),
+                       InvalidInput, "gamma");
+  // Bad method options are refused as for every method.
+  culling::MethodOptions bad;
+  bad.min_separation = -1;
+  EXPECT_THROW_MESSAGE((void)scene.method("dynamic", {}, bad), InvalidInput, "min_separation");
+  // A segmentation of another mesh.
+  auto other = std::make_shared<segmentation::Segmentation>(*scene.segmentation);
+  other->triangle_cluster.pop_back();
+  const auto ext = std::make_shared<RadialViewExtension>(other, scene.poses,
+                                                         rig->skeleton.num_bones());
+  culling::MethodOptions with_other;
+  with_other.extension = ext;
+  EXPECT_THROW_MESSAGE((void)culling::make_method("rvbc", rig->mesh, scene.topology, with_other),
+                       InvalidInput, "the segmentation has");
+  // No poses selected yet; wrong row counts.
+  auto fresh_poses = std::make_shared<BonePoses>(pose_at_sample(*scene.motion));
+  culling::MethodOptions unposed;
+  unposed.extension = std::make_shared<RadialViewExtension>(scene.segmentation, fresh_poses,
+                                                            rig->skeleton.num_bones());
+  auto m = culling::make_method("dynamic", rig->mesh, scene.topology, unposed);
+  skinning::Positions x0, x1;
+  scene.welded(0, x0);
+  scene.welded(1, x1);
+  culling::FrameResult out;
+  EXPECT_THROW_MESSAGE(m->detect_ccd(x0, x1, out), InvalidInput, "no bone poses");
+  fresh_poses->select_samples(0, 1);
+  const skinning::Positions few(3, 3);
+  EXPECT_THROW_MESSAGE(m->detect_ccd(x0, few, out), InvalidInput, "x_t1 has 3 rows");
+  // Table 3 counters of one interval.
+  m->detect_ccd(x0, x1, out);
+  EXPECT_EQ(out.counters.atomic_clusters,
+            static_cast<std::int64_t>(scene.segmentation->clusters.size()));
+  EXPECT_GE(out.counters.mega_clusters, 1);
+  EXPECT_LE(out.counters.mega_clusters, out.counters.atomic_clusters);
+  EXPECT_GT(out.counters.bv_tests, 0);
+  EXPECT_GT(out.times.classify_us, 0.0);
+  const auto* rv = dynamic_cast<const RadialViewMethod*>(m.get());
+  ASSERT_NE(rv, nullptr);
+  EXPECT_EQ(out.counters.h_minus + out.counters.h_uncertain,
+            static_cast<std::int64_t>(std::count_if(
+                rv->last_classes().triangle_class.begin(), rv->last_classes().triangle_class.end(),
+                [](OrientationClass c) { return c != OrientationClass::positive; })));
 }
 
 }  // namespace
