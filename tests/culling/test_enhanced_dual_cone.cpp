@@ -229,6 +229,22 @@ TEST(ConeMethods, BothTraversalSchemesFindWhatBvhFinds) {
   }
 }
 
+TEST(ConeMethods, LargerLeavesAndExactElementaryTestsGiveTheSameAnswer) {
+  const OpenScene s = test::crumpled_tube_scene(8, 32, {0.55, 0.6});
+  const FrameResult brute = run_dcd("brute", s, 1);
+  const FrameResult brute_ccd = run_ccd("brute", s, 0, {.accuracy = ccd::Accuracy::exact});
+  ASSERT_FALSE(brute.dcd_pairs.empty());
+  ASSERT_FALSE(brute_ccd.contacts.empty());
+  for (const auto& name : kExactMethods) {
+    for (const int leaf : {1, 3, 8}) {
+      const MethodOptions opts{.bvh = {.leaf_size = leaf}};
+      EXPECT_EQ(run_dcd(name, s, 1, opts).dcd_pairs, brute.dcd_pairs) << name << " leaf " << leaf;
+    }
+    // With the exact (rational) elementary tests the contact sets are equal, not just equivalent.
+    EXPECT_EQ(keys(run_ccd(name, s, 0, {.accuracy = ccd::Accuracy::exact})), keys(brute_ccd)) << name;
+  }
+}
+
 TEST(ConeMethods, ContactDistanceTurnsCullingOffAndMatchesBvh) {
   const auto s = test::wrap_sheet_scene(6, 60, {0.30, 0.36});
   const MethodOptions opts{.min_separation = 1e-3};
