@@ -2,6 +2,8 @@
 
 #include <sstream>
 
+#include <unistd.h>
+
 namespace skelcd::test {
 
 std::filesystem::path asset(std::string_view relative) {
@@ -13,7 +15,18 @@ std::filesystem::path assimp_model(std::string_view relative) {
 }
 
 std::filesystem::path temp_dir(std::string_view name) {
-  const auto dir = std::filesystem::temp_directory_path() / "skelcd-tests" / name;
+  // ctest runs every test in its own process, several at once: a directory shared by two tests
+  // would be removed under the other's feet. The process id and the running test's name keep
+  // each test's files apart.
+  std::string owner = "process";
+  if (const auto* info = ::testing::UnitTest::GetInstance()->current_test_info()) {
+    owner = std::string(info->test_suite_name()) + "." + info->name();
+    for (char& c : owner) {
+      if (c == '/') c = '_';
+    }
+  }
+  const auto dir = std::filesystem::temp_directory_path() / "skelcd-tests" /
+                   (std::to_string(::getpid()) + "-" + owner) / name;
   std::filesystem::remove_all(dir);
   std::filesystem::create_directories(dir);
   return dir;
