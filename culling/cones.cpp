@@ -21,10 +21,7 @@ constexpr double kMaxLeafSin = 0.5;
 /// Widens (cos_lb, sin_ub) — the bounds of a cone around unit `axis` — so that it also contains
 /// cone c. Returns false when the result may reach π/2 (full).
 bool extend_around(
-    const Eigen::Vector3d& axis,
-    const DirectionCone& c,
-    double& cos_lb,
-    double& sin_ub) {
+    const Eigen::Vector3d& axis, const DirectionCone& c, double& cos_lb, double& sin_ub) {
   if (c.is_empty()) return true;
   if (c.is_full()) return false;
   // β = ∠(axis, c.axis); the cone c is inside the cone of half-angle θ_c + β around axis.
@@ -84,9 +81,7 @@ DirectionCone cone_of_vector(const Eigen::Vector3d& v, double error) {
 }
 
 DirectionCone enclose_around(
-    const Eigen::Vector3d& axis,
-    const DirectionCone& a,
-    const DirectionCone& b) {
+    const Eigen::Vector3d& axis, const DirectionCone& a, const DirectionCone& b) {
   if (a.is_empty() && b.is_empty()) return DirectionCone::empty_cone();
   if (a.is_full() || b.is_full()) return DirectionCone::full_cone();
   if (axis.isZero(0.0)) return DirectionCone::full_cone();
@@ -125,9 +120,7 @@ DirectionCone merge(const DirectionCone& a, const DirectionCone& b) {
 }
 
 BoundedNormal triangle_normal(
-    const Eigen::Vector3d& a,
-    const Eigen::Vector3d& b,
-    const Eigen::Vector3d& c) {
+    const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::Vector3d& c) {
   const Eigen::Vector3d d1 = b - a;
   const Eigen::Vector3d d2 = c - a;
   // Per component: two rounded differences in each product (2u), the product (u), the
@@ -172,7 +165,8 @@ DirectionCone boundary_binormal_cone(
     bool continuous) {
   DirectionCone bnc = DirectionCone::empty_cone();
   if (sides == 0) return bnc;
-  const auto n = continuous_normal_control_vectors(p_t0[0], p_t0[1], p_t0[2], p_t1[0], p_t1[1], p_t1[2]);
+  const auto n =
+      continuous_normal_control_vectors(p_t0[0], p_t0[1], p_t0[2], p_t1[0], p_t1[1], p_t1[2]);
   for (std::size_t k = 0; k < 3; ++k) {
     if ((sides & (1u << k)) == 0) continue;
     const Eigen::Vector3d e0 = p_t0[(k + 1) % 3] - p_t0[k];
@@ -192,9 +186,7 @@ DirectionCone boundary_binormal_cone(
 }
 
 void NormalConeTree::refit(
-    const AabbBvh& bvh,
-    const FeatureTopology& topology,
-    const skinning::Positions& x) {
+    const AabbBvh& bvh, const FeatureTopology& topology, const skinning::Positions& x) {
   const auto nf = static_cast<std::size_t>(topology.num_triangles());
   triangle_cones_.resize(nf);
   triangle_sums_.resize(nf);
@@ -202,8 +194,8 @@ void NormalConeTree::refit(
   vectors_per_triangle_ = 1;
   for (std::int32_t f = 0; f < topology.num_triangles(); ++f) {
     const auto& t = topology.triangle(f);
-    const BoundedNormal n = triangle_normal(
-        x.row(t[0]).transpose(), x.row(t[1]).transpose(), x.row(t[2]).transpose());
+    const BoundedNormal n =
+        triangle_normal(x.row(t[0]).transpose(), x.row(t[1]).transpose(), x.row(t[2]).transpose());
     triangle_cones_[static_cast<std::size_t>(f)] = cone_of_vector(n.n, n.error);
     triangle_sums_[static_cast<std::size_t>(f)] = n.n;
     triangle_normals_[static_cast<std::size_t>(f)][0] = n;
@@ -224,8 +216,12 @@ void NormalConeTree::refit(
   for (std::int32_t f = 0; f < topology.num_triangles(); ++f) {
     const auto& t = topology.triangle(f);
     const auto b = continuous_normal_control_vectors(
-        x_t0.row(t[0]).transpose(), x_t0.row(t[1]).transpose(), x_t0.row(t[2]).transpose(),
-        x_t1.row(t[0]).transpose(), x_t1.row(t[1]).transpose(), x_t1.row(t[2]).transpose());
+        x_t0.row(t[0]).transpose(),
+        x_t0.row(t[1]).transpose(),
+        x_t0.row(t[2]).transpose(),
+        x_t1.row(t[0]).transpose(),
+        x_t1.row(t[1]).transpose(),
+        x_t1.row(t[2]).transpose());
     // The cone of the three control vectors (each within its error ball) around their mean
     // direction; with θ < π/2 it is convex and so contains n(t) for every t in [0,1].
     const DirectionCone c0 = cone_of_vector(b[0].n, b[0].error);
@@ -253,21 +249,21 @@ Eigen::Vector3d NormalConeTree::mean_normal(std::int32_t node) const {
 }
 
 bool NormalConeTree::normals_in_half_space(
-    const AabbBvh& bvh,
-    std::int32_t node,
-    const Eigen::Vector3d& v) const {
+    const AabbBvh& bvh, std::int32_t node, const Eigen::Vector3d& v) const {
   if (!std::isfinite(v.squaredNorm()) || v.isZero(0.0)) return false;
   const BvhNode& n = bvh.nodes()[static_cast<std::size_t>(node)];
   const auto order = bvh.triangle_order();
   const double vn = v.norm() * (1.0 + 4.0 * kU);
   for (std::int32_t s = n.begin; s < n.end; ++s) {
-    const auto& normals = triangle_normals_[static_cast<std::size_t>(order[static_cast<std::size_t>(s)])];
+    const auto& normals =
+        triangle_normals_[static_cast<std::size_t>(order[static_cast<std::size_t>(s)])];
     for (int k = 0; k < vectors_per_triangle_; ++k) {
       // The exact normal is within `error` of the computed one: n·v ≥ ñ·v − error·|v|; the dot
       // product itself is within 3u·Σ|ñ_i v_i| (4u with the bound's own rounding).
       const BoundedNormal& b = normals[static_cast<std::size_t>(k)];
       const double d = b.n.dot(v);
-      const double m = std::abs(b.n.x() * v.x()) + std::abs(b.n.y() * v.y()) + std::abs(b.n.z() * v.z());
+      const double m =
+          std::abs(b.n.x() * v.x()) + std::abs(b.n.y() * v.y()) + std::abs(b.n.z() * v.z());
       if (!(d > b.error * vn + 4.0 * kU * m)) return false;
     }
   }
@@ -300,8 +296,10 @@ void NormalConeTree::refit_nodes(const AabbBvh& bvh) {
       bool bounded = !axis.isZero(0.0);
       for (std::int32_t s = node.begin; bounded && s < node.end; ++s) {
         bounded = extend_around(
-            axis, triangle_cones_[static_cast<std::size_t>(order[static_cast<std::size_t>(s)])],
-            cos_lb, sin_ub);
+            axis,
+            triangle_cones_[static_cast<std::size_t>(order[static_cast<std::size_t>(s)])],
+            cos_lb,
+            sin_ub);
       }
       node_cones_[i] = bounded ? make_cone(axis, cos_lb, sin_ub) : DirectionCone::full_cone();
       continue;
@@ -311,7 +309,8 @@ void NormalConeTree::refit_nodes(const AabbBvh& bvh) {
     node_sums_[i] = node_sums_[l] + node_sums_[r];
     // Axis: the node's mean normal (cheap); when that leaves a wide cone, the optimal merge axis
     // of the two children may do better (it costs a few transcendental calls).
-    DirectionCone cone = enclose_around(unit_or_zero(node_sums_[i]), node_cones_[l], node_cones_[r]);
+    DirectionCone cone =
+        enclose_around(unit_or_zero(node_sums_[i]), node_cones_[l], node_cones_[r]);
     if (cone.is_full() || cone.cos_angle < 0.5) {
       const DirectionCone alt = merge(node_cones_[l], node_cones_[r]);
       if (!alt.is_full() && (cone.is_full() || alt.cos_angle > cone.cos_angle)) cone = alt;

@@ -7,13 +7,12 @@
 // stored half-angle is an upper bound with its rounding errors accounted for (docs/dual-cone.md,
 // "Cones").
 
+#include <Eigen/Core>
+#include <Eigen/Geometry>
 #include <array>
 #include <cstdint>
 #include <span>
 #include <vector>
-
-#include <Eigen/Core>
-#include <Eigen/Geometry>
 
 #include "culling/bvh.hpp"
 #include "culling/feature_topology.hpp"
@@ -64,9 +63,7 @@ struct DirectionCone {
 /// empty), conservative: cos(θ_a + ∠(axis, a.axis)) bounded from below, etc. Full when that
 /// half-angle may reach π/2.
 [[nodiscard]] DirectionCone enclose_around(
-    const Eigen::Vector3d& axis,
-    const DirectionCone& a,
-    const DirectionCone& b);
+    const Eigen::Vector3d& axis, const DirectionCone& a, const DirectionCone& b);
 
 /// A cone containing a and b with a near-optimal axis (the minimal enclosing cone of two cones:
 /// half-angle (α + θ_a + θ_b)/2), then made conservative by enclose_around.
@@ -82,9 +79,7 @@ struct BoundedNormal {
   double error = 0.0;
 };
 [[nodiscard]] BoundedNormal triangle_normal(
-    const Eigen::Vector3d& a,
-    const Eigen::Vector3d& b,
-    const Eigen::Vector3d& c);
+    const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::Vector3d& c);
 
 /// The Bernstein control vectors of the continuous normal n(t) of a triangle whose corners move
 /// linearly over [0,1]: n(t) = B0 (1−t)² + B1 2t(1−t) + B2 t², each with its error bound. Since
@@ -131,9 +126,7 @@ class NormalConeTree {
   /// proven to have a positive dot product with `v`: the surface normal test done triangle by
   /// triangle, for a node whose hierarchical cone is too loose. Stops at the first failure.
   [[nodiscard]] bool normals_in_half_space(
-      const AabbBvh& bvh,
-      std::int32_t node,
-      const Eigen::Vector3d& v) const;
+      const AabbBvh& bvh, std::int32_t node, const Eigen::Vector3d& v) const;
 
   /// One cone per node of the hierarchy (node ids of AabbBvh::nodes()).
   [[nodiscard]] std::span<const DirectionCone> node_cones() const { return node_cones_; }

@@ -18,11 +18,11 @@ struct ConeCullingStats {
   /// Condition 1 proven triangle by triangle (around the mean normal) after the node's
   /// hierarchical cone failed — counted among the nodes that passed condition 1.
   std::int64_t normal_direct_passes = 0;
-  std::int64_t failed_topology = 0;     ///< the node's contour is not one simple loop
+  std::int64_t failed_topology = 0;  ///< the node's contour is not one simple loop
   /// Condition 2: FASTCD's BNC test failed; for enhanced-dual-cone, a chain failed the dual-cone
   /// test (and was cut into monotone runs) and condition 3 then failed as well.
   std::int64_t failed_dual_cone = 0;
-  std::int64_t failed_contour = 0;      ///< condition 3: projected contour edges may meet
+  std::int64_t failed_contour = 0;  ///< condition 3: projected contour edges may meet
   /// Algorithm 3's ten results, as failures counted over the nodes whose condition 1 held:
   /// [0..3] the sub-surface tests R_ll, R_lr, R_rl, R_rr (a chain failed the dual-cone test);
   /// [4..9] the pair tests (ll,lr), (ll,rl), (ll,rr), (lr,rl), (lr,rr), (rl,rr) (only the first

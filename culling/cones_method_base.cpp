@@ -20,8 +20,8 @@ skinning::Positions welded_rest(const skinning::Mesh& mesh, const skinning::Topo
     const std::int32_t v = topology.representative_vertex[sz(w)];
     if (v < 0 || v >= mesh.rest_positions.rows()) {
       throw InvalidInput(
-          "culling::make_method: representative_vertex[" + std::to_string(w) + "] = " +
-          std::to_string(v) + " is not a mesh vertex");
+          "culling::make_method: representative_vertex[" + std::to_string(w) +
+          "] = " + std::to_string(v) + " is not a mesh vertex");
     }
     rest.row(w) = mesh.rest_positions.row(v);
   }
@@ -39,10 +39,14 @@ ConeMethodBase::ConeMethodBase(
     bool needs_contours,
     const std::vector<std::int32_t>* subset)
     : MethodBase(name, mesh, topology, options),
-      bvh_(subset == nullptr
-               ? AabbBvh(topology_.welded_triangles(), welded_rest(mesh, topology), options.bvh)
-               : AabbBvh(topology_.welded_triangles(), welded_rest(mesh, topology), *subset,
-                         options.bvh)),
+      bvh_(
+          subset == nullptr
+              ? AabbBvh(topology_.welded_triangles(), welded_rest(mesh, topology), options.bvh)
+              : AabbBvh(
+                    topology_.welded_triangles(),
+                    welded_rest(mesh, topology),
+                    *subset,
+                    options.bvh)),
       descent_(descent),
       // The cone theorems say "no intersection", not "no pair within a distance": with a contact
       // distance the method culls nothing and equals `bvh` (docs/dual-cone.md).
@@ -88,9 +92,7 @@ void ConeMethodBase::detect_dcd(const skinning::Positions& x, FrameResult& out) 
 }
 
 void ConeMethodBase::detect_ccd(
-    const skinning::Positions& x_t0,
-    const skinning::Positions& x_t1,
-    FrameResult& out) {
+    const skinning::Positions& x_t0, const skinning::Positions& x_t1, FrameResult& out) {
   check_positions(x_t0, "detect_ccd", "x_t0");
   check_positions(x_t1, "detect_ccd", "x_t1");
   stats_ = {};

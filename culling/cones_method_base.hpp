@@ -24,9 +24,7 @@ class ConeMethodBase : public MethodBase, public ConeStatistics {
  public:
   void detect_dcd(const skinning::Positions& x, FrameResult& out) override;
   void detect_ccd(
-      const skinning::Positions& x_t0,
-      const skinning::Positions& x_t1,
-      FrameResult& out) override;
+      const skinning::Positions& x_t0, const skinning::Positions& x_t1, FrameResult& out) override;
 
   [[nodiscard]] const ConeCullingStats& cone_stats() const override { return stats_; }
   [[nodiscard]] const NodeContours& contours() const override { return contours_; }
@@ -34,8 +32,8 @@ class ConeMethodBase : public MethodBase, public ConeStatistics {
  protected:
   /// Where a self-test descends when its node is not culled.
   enum class Descent : std::uint8_t {
-    children,      ///< SelfCollide(L), SelfCollide(R), Collide(L, R)
-    grandchildren, ///< the 4 sub-surfaces' self-tests and their 6 pairs (Algorithm 3)
+    children,       ///< SelfCollide(L), SelfCollide(R), Collide(L, R)
+    grandchildren,  ///< the 4 sub-surfaces' self-tests and their 6 pairs (Algorithm 3)
   };
 
   /// The instant (x_t1 == x_t0, continuous false) or interval the node tests see.

@@ -190,7 +190,8 @@ NodeContours::NodeContours(const AabbBvh& bvh, const FeatureTopology& topology) 
           raw_fans.push_back({v, static_cast<std::int32_t>(k), out});
         }
       }
-      if (out < 0 || raw[static_cast<std::size_t>(out)].from != v || used[static_cast<std::size_t>(out)] != 0) {
+      if (out < 0 || raw[static_cast<std::size_t>(out)].from != v ||
+          used[static_cast<std::size_t>(out)] != 0) {
         status = ContourStatus::unpaired_fan;
         break;
       }
@@ -209,7 +210,8 @@ NodeContours::NodeContours(const AabbBvh& bvh, const FeatureTopology& topology) 
         std::size_t e = s0;
         while (used[e] == 0) {
           used[e] = 1;
-          stack_pos[static_cast<std::size_t>(raw[e].from)] = static_cast<std::int32_t>(stack.size());
+          stack_pos[static_cast<std::size_t>(raw[e].from)] =
+              static_cast<std::int32_t>(stack.size());
           stack.push_back(static_cast<std::int32_t>(e));
           const std::int32_t start = stack_pos[static_cast<std::size_t>(raw[e].to)];
           if (start >= 0) {
@@ -223,11 +225,13 @@ NodeContours::NodeContours(const AabbBvh& bvh, const FeatureTopology& topology) 
         }
         if (!stack.empty()) {  // cannot happen for a cycle of the pairing
           status = ContourStatus::unpaired_fan;
-          for (const std::int32_t k : stack) stack_pos[static_cast<std::size_t>(raw[static_cast<std::size_t>(k)].from)] = -1;
+          for (const std::int32_t k : stack)
+            stack_pos[static_cast<std::size_t>(raw[static_cast<std::size_t>(k)].from)] = -1;
           break;
         }
       }
-      if (status == ContourStatus::loops && loops.size() > static_cast<std::size_t>(kMaxContourLoops)) {
+      if (status == ContourStatus::loops &&
+          loops.size() > static_cast<std::size_t>(kMaxContourLoops)) {
         status = ContourStatus::too_many_loops;
       }
     }
@@ -268,8 +272,10 @@ NodeContours::NodeContours(const AabbBvh& bvh, const FeatureTopology& topology) 
       for (const ContourFan& f : raw_fans) {
         fans_.push_back({f.vertex, position[sz(f.in_edge)], position[sz(f.out_edge)]});
       }
-      std::sort(fans_.begin() + fan_offset_[i], fans_.end(),
-                [](const ContourFan& a, const ContourFan& b) { return a.vertex < b.vertex; });
+      std::sort(
+          fans_.begin() + fan_offset_[i],
+          fans_.end(),
+          [](const ContourFan& a, const ContourFan& b) { return a.vertex < b.vertex; });
       edge_offset_[i + 1] = static_cast<std::int64_t>(edges_.size());
       loop_offset_[i + 1] = static_cast<std::int64_t>(loop_probe_.size());
       chain_offset_[i + 1] = static_cast<std::int64_t>(chain_starts_.size());
@@ -333,12 +339,7 @@ struct Frames {
 /// Sign of form(x[b] − x[a], x[d] − x[c]) at the instant, or over all t in [0,1].
 template <bool kContinuous, class Form>
 ProvenSign form_sign(
-    Form form,
-    const Frames& x,
-    std::int32_t a,
-    std::int32_t b,
-    std::int32_t c,
-    std::int32_t d) {
+    Form form, const Frames& x, std::int32_t a, std::int32_t b, std::int32_t c, std::int32_t d) {
   const Eigen::Vector3d p0 = x.at0(b) - x.at0(a);
   const Eigen::Vector3d q0 = x.at0(d) - x.at0(c);
   if constexpr (!kContinuous) {
@@ -355,12 +356,7 @@ ProvenSign form_sign(
 /// (at the instant / for all t): they are never collinear, or always point apart.
 template <bool kContinuous, class Det, class Dot>
 bool adjacent_separated(
-    Det det,
-    Dot dot,
-    const Frames& x,
-    std::int32_t v0,
-    std::int32_t a,
-    std::int32_t b) {
+    Det det, Dot dot, const Frames& x, std::int32_t v0, std::int32_t a, std::int32_t b) {
   if (form_sign<kContinuous>(det, x, v0, a, v0, b) != ProvenSign::uncertain) return true;
   return form_sign<kContinuous>(dot, x, v0, a, v0, b) == ProvenSign::negative;
 }
@@ -419,8 +415,8 @@ bool fans_disjoint(
     ContourTestCounters& counters) {
   const std::int32_t v = group.front().vertex;
   for (const ContourFan& a : group) {
-    const std::int32_t wa = edges[sz(a.out_edge)].to;     // wedge start direction
-    const std::int32_t wb = edges[sz(a.in_edge)].from;    // wedge end direction
+    const std::int32_t wa = edges[sz(a.out_edge)].to;   // wedge start direction
+    const std::int32_t wb = edges[sz(a.in_edge)].from;  // wedge end direction
     ProvenSign sab = turn<kContinuous>(det, x, v, wa, wb);
     if (sab == ProvenSign::uncertain) {
       // A wedge of about π (a straight boundary through v): only directions strictly on the
@@ -448,16 +444,16 @@ bool fans_disjoint(
 /// Orientation of one loop (at positions x): the sign of its signed area in the projection,
 /// proven with the rounding bounds of its fan of det_V terms.
 ProvenSign loop_orientation(
-    const Eigen::Vector3d& v,
-    const skinning::Positions& x,
-    std::span<const ContourEdge> loop) {
+    const Eigen::Vector3d& v, const skinning::Positions& x, std::span<const ContourEdge> loop) {
   const Eigen::Vector3d p0 = x.row(loop[0].from).transpose();
   double sum = 0.0;
   double err = 0.0;
   double mag = 0.0;
   for (std::size_t k = 1; k + 1 < loop.size(); ++k) {
-    const BoundedValue t = det_v(v, Eigen::Vector3d(x.row(loop[k].from).transpose()) - p0,
-                                 Eigen::Vector3d(x.row(loop[k + 1].from).transpose()) - p0);
+    const BoundedValue t = det_v(
+        v,
+        Eigen::Vector3d(x.row(loop[k].from).transpose()) - p0,
+        Eigen::Vector3d(x.row(loop[k + 1].from).transpose()) - p0);
     sum += t.value;
     err += t.error;
     mag += std::abs(t.value);
@@ -533,8 +529,12 @@ bool loops_cover_once(
       ++counters.nesting_tests;
       bool ok = true;
       w += winding_number(
-          v, frame, x, edges.subspan(sz(loop_starts[i]), sz(loop_starts[i + 1] - loop_starts[i])),
-          p, ok);
+          v,
+          frame,
+          x,
+          edges.subspan(sz(loop_starts[i]), sz(loop_starts[i + 1] - loop_starts[i])),
+          p,
+          ok);
       if (!ok) return false;
     }
     if (w > 0) return false;
@@ -606,8 +606,12 @@ ContourVerdict ContourTester::run(
     while (a < -kPi) a += 2.0 * kPi;
     return a;
   };
-  auto edge0 = [&](std::size_t k) -> Eigen::Vector3d { return x.at0(edges[k].to) - x.at0(edges[k].from); };
-  auto edge1 = [&](std::size_t k) -> Eigen::Vector3d { return x.at1(edges[k].to) - x.at1(edges[k].from); };
+  auto edge0 = [&](std::size_t k) -> Eigen::Vector3d {
+    return x.at0(edges[k].to) - x.at0(edges[k].from);
+  };
+  auto edge1 = [&](std::size_t k) -> Eigen::Vector3d {
+    return x.at1(edges[k].to) - x.at1(edges[k].from);
+  };
   for (std::size_t c = 0; c < num_chains; ++c) {
     const auto begin = static_cast<std::size_t>(chains[c]);
     const auto end = static_cast<std::size_t>(chains[c + 1]);
@@ -658,7 +662,8 @@ ContourVerdict ContourTester::run(
         for (std::size_t q = run; q < k && monotone; ++q) {
           monotone = sign_of(det_v(v, w, edge0(q))) == ProvenSign::positive;
           // det_V(w, e(t)) is linear in t: positive at both ends means positive throughout.
-          if (kContinuous && monotone) monotone = sign_of(det_v(v, w, edge1(q))) == ProvenSign::positive;
+          if (kContinuous && monotone)
+            monotone = sign_of(det_v(v, w, edge1(q))) == ProvenSign::positive;
         }
       }
       if (monotone) {
@@ -760,10 +765,20 @@ ContourVerdict ContourTester::run(
 }
 
 template ContourVerdict ContourTester::run<false>(
-    const NodeContours&, std::int32_t, const Eigen::Vector3d&, const skinning::Positions&,
-    const skinning::Positions&, ContourMode, ContourTestCounters&);
+    const NodeContours&,
+    std::int32_t,
+    const Eigen::Vector3d&,
+    const skinning::Positions&,
+    const skinning::Positions&,
+    ContourMode,
+    ContourTestCounters&);
 template ContourVerdict ContourTester::run<true>(
-    const NodeContours&, std::int32_t, const Eigen::Vector3d&, const skinning::Positions&,
-    const skinning::Positions&, ContourMode, ContourTestCounters&);
+    const NodeContours&,
+    std::int32_t,
+    const Eigen::Vector3d&,
+    const skinning::Positions&,
+    const skinning::Positions&,
+    ContourMode,
+    ContourTestCounters&);
 
 }  // namespace skelcd::culling

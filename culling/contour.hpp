@@ -16,13 +16,12 @@
 // node whose triangles do not form one (non-manifold, inconsistently oriented, ...) gets a status
 // saying why and is never culled.
 
+#include <Eigen/Core>
 #include <array>
 #include <cstdint>
 #include <span>
 #include <utility>
 #include <vector>
-
-#include <Eigen/Core>
 
 #include "culling/bvh.hpp"
 #include "culling/feature_topology.hpp"
@@ -131,13 +130,13 @@ enum class ContourMode : std::uint8_t {
 
 /// What the contour test did, for the stats of a method.
 struct ContourTestCounters {
-  std::int64_t chain_tests = 0;        ///< dual-cone (monotone chain) tests of condition 2
-  std::int64_t chain_cuts = 0;         ///< chains that failed it and were cut into monotone runs
-  std::int64_t projected_edges = 0;    ///< contour edges projected
-  std::int64_t edge_box_tests = 0;     ///< 2D box tests of projected edge pairs
-  std::int64_t edge_pair_tests = 0;    ///< exact/conservative projected segment tests
-  std::int64_t pinch_tests = 0;        ///< fan pairs compared at pinch vertices
-  std::int64_t nesting_tests = 0;      ///< winding numbers of a loop around another's vertex
+  std::int64_t chain_tests = 0;      ///< dual-cone (monotone chain) tests of condition 2
+  std::int64_t chain_cuts = 0;       ///< chains that failed it and were cut into monotone runs
+  std::int64_t projected_edges = 0;  ///< contour edges projected
+  std::int64_t edge_box_tests = 0;   ///< 2D box tests of projected edge pairs
+  std::int64_t edge_pair_tests = 0;  ///< exact/conservative projected segment tests
+  std::int64_t pinch_tests = 0;      ///< fan pairs compared at pinch vertices
+  std::int64_t nesting_tests = 0;    ///< winding numbers of a loop around another's vertex
 };
 
 /// The outcome of one contour test: which condition failed first (for the ten-result record of
@@ -150,8 +149,8 @@ struct ContourVerdict {
   std::uint8_t cut_parts = 0;
   bool failed_pinch = false;    ///< fans at a pinch vertex may overlap in projection
   bool failed_nesting = false;  ///< loops may nest so that two sheets cover one point
-  std::int8_t part_a = -1;    ///< sub-surface of the failing chain / first failing edge
-  std::int8_t part_b = -1;    ///< sub-surface of the second failing edge (condition 3)
+  std::int8_t part_a = -1;      ///< sub-surface of the failing chain / first failing edge
+  std::int8_t part_b = -1;      ///< sub-surface of the second failing edge (condition 3)
 };
 
 /// Evaluates the contour test of a node in the projection along a given direction V, at an

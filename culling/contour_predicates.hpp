@@ -13,11 +13,10 @@
 // which depend only on the components of a and b orthogonal to V, so the tests are exact
 // statements about the projection along the stored double vector V.
 
+#include <Eigen/Core>
 #include <array>
 #include <cmath>
 #include <cstdint>
-
-#include <Eigen/Core>
 
 namespace skelcd::culling {
 
@@ -43,9 +42,7 @@ struct BoundedValue {
 /// seven roundings (two differences, the product, the pairwise subtraction, the product with V,
 /// the three-term sum), γ7 < 8u including the rounding of the permanent itself.
 [[nodiscard]] inline BoundedValue det_v(
-    const Eigen::Vector3d& v,
-    const Eigen::Vector3d& a,
-    const Eigen::Vector3d& b) {
+    const Eigen::Vector3d& v, const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
   const double cx = a.y() * b.z() - a.z() * b.y();
   const double cy = a.z() * b.x() - a.x() * b.z();
   const double cz = a.x() * b.y() - a.y() * b.x();
@@ -60,9 +57,7 @@ struct BoundedValue {
 /// the eighteen degree-4 products carries at most twelve roundings (two differences, three in
 /// a · b or a · V, three in V · V or b · V, the two products, the subtraction); bound 16u·M.
 [[nodiscard]] inline BoundedValue dot_v(
-    const Eigen::Vector3d& v,
-    const Eigen::Vector3d& a,
-    const Eigen::Vector3d& b) {
+    const Eigen::Vector3d& v, const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
   const double ab = a.dot(b);
   const double vv = v.dot(v);
   const double av = a.dot(v);
@@ -79,9 +74,7 @@ struct BoundedValue {
 /// within its error of the exact one): proven when all three clear their bounds with one sign
 /// (convex-hull property), else after one de Casteljau split at t = 1/2 (errors carried).
 [[nodiscard]] inline ProvenSign bernstein_quadratic_sign(
-    const BoundedValue& c0,
-    const BoundedValue& c1,
-    const BoundedValue& c2) {
+    const BoundedValue& c0, const BoundedValue& c1, const BoundedValue& c2) {
   const ProvenSign s0 = sign_of(c0);
   if (s0 == ProvenSign::uncertain) return s0;
   const ProvenSign s2 = sign_of(c2);

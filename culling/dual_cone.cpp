@@ -16,8 +16,14 @@ class DualConeMethod final : public detail::ConeMethodBase {
       const skinning::Topology& topology,
       const MethodOptions& options,
       const std::vector<std::int32_t>* subset)
-      : ConeMethodBase("dual-cone", mesh, topology, options, Descent::children,
-                       /*needs_contours=*/false, subset) {
+      : ConeMethodBase(
+            "dual-cone",
+            mesh,
+            topology,
+            options,
+            Descent::children,
+            /*needs_contours=*/false,
+            subset) {
     // Which sides of each triangle are boundary edges of the mesh (one incident face).
     const auto nf = static_cast<std::size_t>(topology_.num_triangles());
     boundary_sides_.assign(nf, 0);
@@ -62,7 +68,8 @@ class DualConeMethod final : public detail::ConeMethodBase {
       if (node.is_leaf()) {
         DirectionCone bnc = DirectionCone::empty_cone();
         for (std::int32_t s = node.begin; s < node.end; ++s) {
-          bnc = merge(bnc, triangle_bnc_[static_cast<std::size_t>(order[static_cast<std::size_t>(s)])]);
+          bnc = merge(
+              bnc, triangle_bnc_[static_cast<std::size_t>(order[static_cast<std::size_t>(s)])]);
         }
         node_bnc_[i] = bnc;
       } else {
@@ -96,9 +103,7 @@ class DualConeMethod final : public detail::ConeMethodBase {
 }  // namespace
 
 std::unique_ptr<CullingMethod> make_dual_cone_method(
-    const skinning::Mesh& mesh,
-    const skinning::Topology& topology,
-    const MethodOptions& options) {
+    const skinning::Mesh& mesh, const skinning::Topology& topology, const MethodOptions& options) {
   return std::make_unique<DualConeMethod>(mesh, topology, options, nullptr);
 }
 

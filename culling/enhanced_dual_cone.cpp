@@ -14,9 +14,13 @@ class EnhancedDualConeMethod final : public detail::ConeMethodBase {
       const MethodOptions& options,
       const EnhancedDualConeOptions& variant)
       : ConeMethodBase(
-            "enhanced-dual-cone", mesh, topology, options,
+            "enhanced-dual-cone",
+            mesh,
+            topology,
+            options,
             variant.grandchildren_descent ? Descent::grandchildren : Descent::children,
-            /*needs_contours=*/true, variant.triangles.empty() ? nullptr : &variant.triangles) {}
+            /*needs_contours=*/true,
+            variant.triangles.empty() ? nullptr : &variant.triangles) {}
 
  private:
   // EnhancedDualConeTest (Algorithms 1 and 4) of node n.
@@ -39,14 +43,20 @@ class EnhancedDualConeMethod final : public detail::ConeMethodBase {
     const ContourVerdict verdict =
         interval.continuous
             ? contour_tester_.test(
-                  contours_, n, axis, *interval.x_t0, *interval.x_t1, ContourMode::chains,
+                  contours_,
+                  n,
+                  axis,
+                  *interval.x_t0,
+                  *interval.x_t1,
+                  ContourMode::chains,
                   stats_.contour)
             : contour_tester_.test(
                   contours_, n, axis, *interval.x_t0, ContourMode::chains, stats_.contour);
     // The ten-result record (Algorithm 3): the sub-surfaces whose chains failed the dual-cone
     // test, and the first pair of sub-surfaces whose contours may meet.
     for (int p = 0; p < 4; ++p) {
-      if ((verdict.cut_parts & (1u << p)) != 0) ++stats_.ten_results_failed[static_cast<std::size_t>(p)];
+      if ((verdict.cut_parts & (1u << p)) != 0)
+        ++stats_.ten_results_failed[static_cast<std::size_t>(p)];
     }
     if (verdict.simple) return true;
     ++(verdict.cut_parts != 0 ? stats_.failed_dual_cone : stats_.failed_contour);
@@ -54,7 +64,8 @@ class EnhancedDualConeMethod final : public detail::ConeMethodBase {
       const int p = std::min(verdict.part_a, verdict.part_b);
       const int q = std::max(verdict.part_a, verdict.part_b);
       // Two chains of one sub-surface meeting fail that sub-surface's own test.
-      ++stats_.ten_results_failed[static_cast<std::size_t>(p == q ? p : ten_result_pair_index(p, q))];
+      ++stats_
+            .ten_results_failed[static_cast<std::size_t>(p == q ? p : ten_result_pair_index(p, q))];
     }
     return false;
   }
@@ -63,10 +74,9 @@ class EnhancedDualConeMethod final : public detail::ConeMethodBase {
 }  // namespace
 
 std::unique_ptr<CullingMethod> make_enhanced_dual_cone_method(
-    const skinning::Mesh& mesh,
-    const skinning::Topology& topology,
-    const MethodOptions& options) {
-  return std::make_unique<EnhancedDualConeMethod>(mesh, topology, options, EnhancedDualConeOptions{});
+    const skinning::Mesh& mesh, const skinning::Topology& topology, const MethodOptions& options) {
+  return std::make_unique<EnhancedDualConeMethod>(
+      mesh, topology, options, EnhancedDualConeOptions{});
 }
 
 std::unique_ptr<CullingMethod> make_enhanced_dual_cone_method(

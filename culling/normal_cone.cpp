@@ -14,8 +14,13 @@ class NormalConeMethod final : public detail::ConeMethodBase {
       const MethodOptions& options,
       const std::vector<std::int32_t>* subset)
       : ConeMethodBase(
-            "normal-cone", mesh, topology, options, Descent::children,
-            /*needs_contours=*/true, subset) {}
+            "normal-cone",
+            mesh,
+            topology,
+            options,
+            Descent::children,
+            /*needs_contours=*/true,
+            subset) {}
 
  private:
   bool node_culled(std::int32_t n, const Interval& interval) override {
@@ -36,7 +41,12 @@ class NormalConeMethod final : public detail::ConeMethodBase {
     const ContourVerdict verdict =
         interval.continuous
             ? contour_tester_.test(
-                  contours_, n, axis, *interval.x_t0, *interval.x_t1, ContourMode::every_edge,
+                  contours_,
+                  n,
+                  axis,
+                  *interval.x_t0,
+                  *interval.x_t1,
+                  ContourMode::every_edge,
                   stats_.contour)
             : contour_tester_.test(
                   contours_, n, axis, *interval.x_t0, ContourMode::every_edge, stats_.contour);
@@ -49,9 +59,7 @@ class NormalConeMethod final : public detail::ConeMethodBase {
 }  // namespace
 
 std::unique_ptr<CullingMethod> make_normal_cone_method(
-    const skinning::Mesh& mesh,
-    const skinning::Topology& topology,
-    const MethodOptions& options) {
+    const skinning::Mesh& mesh, const skinning::Topology& topology, const MethodOptions& options) {
   return std::make_unique<NormalConeMethod>(mesh, topology, options, nullptr);
 }
 

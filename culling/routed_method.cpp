@@ -44,8 +44,7 @@ void check_group_method(const MethodOptions& options, const std::string& name, b
   if (is_cone_method(name) || name == "bvh") return;
   if (!open && extension_builds(options, name)) return;
   throw InvalidInput(
-      "culling::make_method(auto): '" + name + "' cannot take the " +
-      (open ? "open" : "closed") +
+      "culling::make_method(auto): '" + name + "' cannot take the " + (open ? "open" : "closed") +
       " components (use enhanced-dual-cone, normal-cone, dual-cone or bvh" +
       (open ? ")" : ", or a method of the options' extension)"));
 }
@@ -61,7 +60,8 @@ std::vector<skinning::Component> components_of(const skinning::Topology& topolog
     while (root[sz(f)] != f) f = root[sz(f)] = root[sz(root[sz(f)])];
     return f;
   };
-  const std::size_t ne = topology.edge_face_offsets.empty() ? 0 : topology.edge_face_offsets.size() - 1;
+  const std::size_t ne =
+      topology.edge_face_offsets.empty() ? 0 : topology.edge_face_offsets.size() - 1;
   std::vector<std::uint8_t> open_face(nf, 0);
   for (std::size_t e = 0; e < ne; ++e) {
     const auto b = topology.edge_face_offsets[e];
@@ -119,7 +119,8 @@ void add(StageTimes& a, const StageTimes& b) {
 /// A copy of `mesh` whose parts are split into (part, open) and (part, closed), with every pair
 /// that involves an open triangle excluded on top of the mesh's own exclusions: what a whole-mesh
 /// method (an extension's `dynamic`) is given so that it tests only closed-closed pairs.
-skinning::Mesh closed_only_mesh(const skinning::Mesh& mesh, const std::vector<std::uint8_t>& open_face) {
+skinning::Mesh closed_only_mesh(
+    const skinning::Mesh& mesh, const std::vector<std::uint8_t>& open_face) {
   skinning::Mesh m = mesh;
   const std::int32_t parts = std::max<std::int32_t>(1, mesh.num_parts());
   auto refined = [](std::int32_t p, bool open) { return 2 * p + (open ? 1 : 0); };
@@ -175,7 +176,8 @@ class AutoMethod final : public detail::MethodBase, public RoutedMethod {
     std::vector<std::uint8_t> open_face(nf, 0);
     for (std::size_t c = 0; c < components.size(); ++c) {
       auto& r = routes_[c];
-      if (r.part < 0 && !components[c].faces.empty()) r.part = topology_.face_part(components[c].faces[0]);
+      if (r.part < 0 && !components[c].faces.empty())
+        r.part = topology_.face_part(components[c].faces[0]);
       for (const std::int32_t f : components[c].faces) {
         (components[c].closed ? closed_triangles_ : open_triangles_).push_back(f);
         open_face[sz(f)] = components[c].closed ? 0 : 1;
@@ -199,7 +201,8 @@ class AutoMethod final : public detail::MethodBase, public RoutedMethod {
       closed_bvh_ = AabbBvh(topology_.welded_triangles(), rest, closed_triangles_, options.bvh);
       if (extension_builds(options, closed_name) && !is_cone_method(closed_name)) {
         // A whole-mesh method (an extension's `dynamic`): the open triangles are excluded.
-        closed_method_ = make_method(closed_name, closed_only_mesh(mesh, open_face), topology, options);
+        closed_method_ =
+            make_method(closed_name, closed_only_mesh(mesh, open_face), topology, options);
       } else {
         closed_method_ = make_group_method(closed_name, mesh, topology, options, closed_triangles_);
       }
@@ -208,7 +211,8 @@ class AutoMethod final : public detail::MethodBase, public RoutedMethod {
     bounds_.vertices.reserve(static_cast<std::size_t>(topology_.num_vertices()));
     bounds_.edges.reserve(static_cast<std::size_t>(topology_.num_edges()));
     bounds_.triangles.reserve(num_faces);
-    scratch_.reserve(static_cast<std::size_t>(4 * std::max(open_bvh_.depth(), closed_bvh_.depth()) + 8));
+    scratch_.reserve(
+        static_cast<std::size_t>(4 * std::max(open_bvh_.depth(), closed_bvh_.depth()) + 8));
     pairs_.reserve(num_faces);
   }
 
@@ -233,7 +237,8 @@ class AutoMethod final : public detail::MethodBase, public RoutedMethod {
     const auto t3 = Clock::now();
     // Merge: sorted, each pair once.
     std::sort(out.dcd_pairs.begin(), out.dcd_pairs.end());
-    out.dcd_pairs.erase(std::unique(out.dcd_pairs.begin(), out.dcd_pairs.end()), out.dcd_pairs.end());
+    out.dcd_pairs.erase(
+        std::unique(out.dcd_pairs.begin(), out.dcd_pairs.end()), out.dcd_pairs.end());
     out.counters.dcd_pairs = static_cast<std::int64_t>(out.dcd_pairs.size());
     out.times.refit_us += micros(t0, t1);
     out.times.traverse_us += micros(t1, t2);
@@ -241,9 +246,7 @@ class AutoMethod final : public detail::MethodBase, public RoutedMethod {
   }
 
   void detect_ccd(
-      const skinning::Positions& x_t0,
-      const skinning::Positions& x_t1,
-      FrameResult& out) override {
+      const skinning::Positions& x_t0, const skinning::Positions& x_t1, FrameResult& out) override {
     check_positions(x_t0, "detect_ccd", "x_t0");
     check_positions(x_t1, "detect_ccd", "x_t1");
     run_groups([&](CullingMethod& m, FrameResult& r) { m.detect_ccd(x_t0, x_t1, r); }, out);
@@ -265,9 +268,12 @@ class AutoMethod final : public detail::MethodBase, public RoutedMethod {
     std::sort(c.begin(), c.end(), [](const CcdContact& a, const CcdContact& b) {
       return a.before(b) || (a.same_pair(b) && a.toi_lower < b.toi_lower);
     });
-    c.erase(std::unique(c.begin(), c.end(),
-                        [](const CcdContact& a, const CcdContact& b) { return a.same_pair(b); }),
-            c.end());
+    c.erase(
+        std::unique(
+            c.begin(),
+            c.end(),
+            [](const CcdContact& a, const CcdContact& b) { return a.same_pair(b); }),
+        c.end());
     out.counters.vf_contacts = std::count_if(
         c.begin(), c.end(), [](const CcdContact& x) { return x.kind == CcdContact::Kind::vf; });
     out.counters.ee_contacts = static_cast<std::int64_t>(c.size()) - out.counters.vf_contacts;
@@ -286,7 +292,8 @@ class AutoMethod final : public detail::MethodBase, public RoutedMethod {
     if (name == "enhanced-dual-cone") {
       // The simple top-down scheme: measured faster than Algorithm 3's descent on most scenes of
       // bench/culling/bm_cones (docs/benchmarks.md, "## dual-cone"); same contacts.
-      return make_enhanced_dual_cone_method(mesh, topology, options, {.grandchildren_descent = false, .triangles = triangles});
+      return make_enhanced_dual_cone_method(
+          mesh, topology, options, {.grandchildren_descent = false, .triangles = triangles});
     }
     if (name == "normal-cone") return make_normal_cone_method(mesh, topology, options, triangles);
     if (name == "dual-cone") return make_dual_cone_method(mesh, topology, options, triangles);

@@ -34,11 +34,11 @@ struct RoutingOptions {
 
 /// Where one connected component (Topology::components) goes.
 struct ComponentRoute {
-  std::int32_t component = -1;    ///< index into Topology::components
-  std::int32_t part = -1;         ///< Mesh part of its first triangle
-  bool closed = false;            ///< no boundary and no non-manifold edge
+  std::int32_t component = -1;  ///< index into Topology::components
+  std::int32_t part = -1;       ///< Mesh part of its first triangle
+  bool closed = false;          ///< no boundary and no non-manifold edge
   std::int32_t num_triangles = 0;
-  std::string method;             ///< the method testing its pairs within its group
+  std::string method;  ///< the method testing its pairs within its group
 };
 
 /// The plan of make_routed_method: one route per component, in component order. Uses

@@ -19,6 +19,7 @@
 #include <cstdio>
 #include <cstring>
 #include <functional>
+#include <iterator>
 #include <map>
 #include <memory>
 #include <string>
@@ -39,7 +40,7 @@ using skelcd::test::RadialViewScene;
 struct SceneSpec {
   std::string name;
   std::string model;  ///< gen: spec or a path
-  std::int32_t clip = 0;
+  std::int32_t clip = 0;  ///< −1: every clip
 };
 
 std::vector<SceneSpec> all_scenes() {
@@ -48,11 +49,14 @@ std::vector<SceneSpec> all_scenes() {
       {"rope", "gen:rope?triangles=48000&frames=60"},
       {"hand", "gen:hand?triangles=11000&frames=60"},
       {"octopus", "gen:octopus?triangles=48000&frames=60"},
-      {"CesiumMan", src + "/assets/characters/CesiumMan.glb"},
-      {"RiggedFigure", src + "/assets/characters/RiggedFigure.glb"},
-      {"Fox", src + "/assets/characters/Fox.glb"},
-      {"RobotExpressive", src + "/assets/characters/RobotExpressive.glb"},
-      {"BCN_Epileptic", "/usr/share/assimp/models/X/BCN_Epileptic.X"},
+      {"panda", "gen:panda"},
+      {"pipe", "gen:pipe?triangles=20000&frames=60"},
+      {"cloth", "gen:cloth?triangles=20000&frames=60"},
+      {"CesiumMan", src + "/assets/characters/CesiumMan.glb", -1},
+      {"RiggedFigure", src + "/assets/characters/RiggedFigure.glb", -1},
+      {"Fox", src + "/assets/characters/Fox.glb", -1},
+      {"RobotExpressive", src + "/assets/characters/RobotExpressive.glb", -1},
+      {"BCN_Epileptic", "/usr/share/assimp/models/X/BCN_Epileptic.X", -1},
   };
 }
 
@@ -106,13 +110,24 @@ int run_table(const std::vector<SceneSpec>& scenes, std::int32_t max_intervals) 
       "traverse ms | ET ms | BVOT/int | PCTP/int | BVOT/bvh | PCTP/bvh | speedup vs bvh | "
       "speedup vs kdop | |H⁻| | |Hᵘ| | atomic | mega [min,max] | contacts |\n");
   std::printf("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
-  for (const auto& spec : scenes) {
-    std::fprintf(stderr, "[%s] loading %s\n", spec.name.c_str(), spec.model.c_str());
-    const auto rig = load_rig(spec.model);
+  for (const auto& scene_spec : scenes) {
+    std::fprintf(stderr, "[%s] loading %s\n", scene_spec.name.c_str(), scene_spec.model.c_str());
+    const auto rig = load_rig(scene_spec.model);
     if (!rig || rig->clips.empty()) {
-      std::fprintf(stderr, "[%s] no rig or no clip: skipped\n", spec.name.c_str());
+      std::fprintf(stderr, "[%s] no rig or no clip: skipped\n", scene_spec.name.c_str());
       continue;
     }
+    // clip −1: every clip of the model, one table block each.
+    std::vector<std::int32_t> clips;
+    if (scene_spec.clip >= 0) {
+      clips.push_back(scene_spec.clip);
+    } else {
+      for (std::size_t c = 0; c < rig->clips.size(); ++c) clips.push_back(static_cast<std::int32_t>(c));
+    }
+    for (const std::int32_t clip : clips) {
+    SceneSpec spec = scene_spec;
+    spec.clip = clip;
+    if (clips.size() > 1) spec.name += "/" + rig->clips[static_cast<std::size_t>(clip)].name;
     const auto seg_start = std::chrono::steady_clock::now();
     RadialViewScene scene(rig, spec.clip);
     const double seg_s =
@@ -164,6 +179,28 @@ int run_table(const std::vector<SceneSpec>& scenes, std::int32_t max_intervals) 
                    static_cast<long long>(escalated), static_cast<long long>(retested),
                    static_cast<long long>(rel));
     }
+    {
+      // The bare argument, without the guard (no precondition pass, no re-test after a
+      // self-contact): how many of the contacts it finds on this clip. Not a method anyone
+      // should use; the measurement behind docs/radial-view.md ("Preconditions").
+      skelcd::clustering::RadialViewOptions bare;
+      bare.guard = false;
+      skelcd::clustering::RadialViewMethod method("dynamic", rig->mesh, scene.topology,
+                                                  scene.segmentation, scene.poses,
+                                                  rig->skeleton.num_bones(), {}, bare);
+      const ClipRun run = skelcd::test::run_clip(scene, method, 0, last);
+      std::vector<skelcd::test::ContactKey> missed, extra;
+      std::set_difference(reference.contacts.begin(), reference.contacts.end(),
+                          run.contacts.begin(), run.contacts.end(), std::back_inserter(missed));
+      std::set_difference(run.contacts.begin(), run.contacts.end(), reference.contacts.begin(),
+                          reference.contacts.end(), std::back_inserter(extra));
+      std::fprintf(stderr,
+                   "[%s] bare dynamic (no guard): finds %zu of %zu contacts (%zu missed, %zu "
+                   "not in bvh)\n",
+                   spec.name.c_str(), reference.contacts.size() - missed.size(),
+                   reference.contacts.size(), missed.size(), extra.size());
+      if (!extra.empty()) ++failures;  // never a contact bvh does not have
+    }
     const auto& b = totals["bvh"];
     const auto& k = totals["kdop"];
     const auto query_ms = [](const MethodTotals& t) {
@@ -188,6 +225,7 @@ int run_table(const std::vector<SceneSpec>& scenes, std::int32_t max_intervals) 
           t.h_uncertain / n, t.atomic / n, mega, t.contacts, t.agrees ? "" : " MISMATCH");
       std::fflush(stdout);
     }
+    }  // clips
   }
   return failures == 0 ? 0 : 1;
 }
@@ -197,7 +235,9 @@ int run_table(const std::vector<SceneSpec>& scenes, std::int32_t max_intervals) 
 void bm_interval(benchmark::State& state, SceneSpec spec, std::string method_name) {
   static std::map<std::string, std::unique_ptr<RadialViewScene>> scenes;
   auto& scene = scenes[spec.model];
-  if (!scene) scene = std::make_unique<RadialViewScene>(load_rig(spec.model), spec.clip);
+  if (!scene) {
+    scene = std::make_unique<RadialViewScene>(load_rig(spec.model), std::max(0, spec.clip));
+  }
   auto method = scene->method(method_name);
   const std::int32_t i = scene->motion->num_samples() / 2;
   skelcd::skinning::Positions x0, x1;
@@ -239,13 +279,13 @@ int main(int argc, char** argv) {
       scenes = picked;
     } else if (arg.rfind("--model=", 0) == 0) {
       // An ad-hoc scene: a gen: spec or a model path (first clip).
-      scenes = {SceneSpec{arg.substr(8), arg.substr(8)}};
+      scenes = {SceneSpec{arg.substr(8), arg.substr(8), -1}};
     } else if (arg.rfind("--intervals=", 0) == 0) {
       intervals = std::stoi(arg.substr(12));
     } else if (arg == "--dcd") {
       // Time one DCD per method at sample 0 of each scene (the precondition pass's cost).
       for (const auto& spec : scenes) {
-        RadialViewScene scene(load_rig(spec.model), spec.clip);
+        RadialViewScene scene(load_rig(spec.model), std::max(0, spec.clip));
         skelcd::skinning::Positions x;
         scene.welded(0, x);
         for (const char* m : {"bvh", "dynamic"}) {

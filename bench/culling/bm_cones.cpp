@@ -7,17 +7,17 @@
 // then times detect_dcd at one instant or detect_ccd over one interval. After the run the tables
 // are printed in Markdown (docs/benchmarks.md, "## dual-cone", quotes them with this command).
 // --benchmark_filter selects scenes by name (e.g. --benchmark_filter=funnel).
+#include <benchmark/benchmark.h>
+
 #include <algorithm>
-#include <ctime>
 #include <cstdio>
+#include <ctime>
 #include <map>
 #include <memory>
 #include <set>
 #include <string>
 #include <tuple>
 #include <vector>
-
-#include <benchmark/benchmark.h>
 
 #include "culling/cones_method.hpp"
 #include "culling/enhanced_dual_cone.hpp"
@@ -39,14 +39,29 @@ struct SceneSpec {
 
 const std::vector<SceneSpec>& scene_specs() {
   static const std::vector<SceneSpec> specs = {
-      {"pipe-pushed-77k", [] { return skelcd::test::pipe_scene(48, 800, {0.6, 0.65}); }},
+      {"pipe-pushed-77k",
+       [] {
+         return skelcd::test::pipe_scene(48, 800, {0.6, 0.65});
+       }},
       {"gen-pipe-78k", [] { return skelcd::test::generated_scene("pipe", 78'000, 60); }},
       {"gen-cloth-20k", [] { return skelcd::test::generated_scene("cloth", 20'000, 60); }},
-      {"wrap-sheet-40k", [] { return skelcd::test::wrap_sheet_scene(40, 500, {0.30, 0.32}); }},
-      {"crumpled-tube-38k", [] { return skelcd::test::crumpled_tube_scene(48, 400, {0.55, 0.57}); }},
-      {"skirt-on-body-21k", [] { return skelcd::test::skirt_body_scene(60, 80, 96, 60, {0.30, 0.33}); }},
+      {"wrap-sheet-40k",
+       [] {
+         return skelcd::test::wrap_sheet_scene(40, 500, {0.30, 0.32});
+       }},
+      {"crumpled-tube-38k",
+       [] {
+         return skelcd::test::crumpled_tube_scene(48, 400, {0.55, 0.57});
+       }},
+      {"skirt-on-body-21k",
+       [] {
+         return skelcd::test::skirt_body_scene(60, 80, 96, 60, {0.30, 0.33});
+       }},
       {"cloth-funnel-18k",
-       [] { return skelcd::test::cloth_funnel_scene(std::string(SKELCD_SOURCE_DIR) + "/assets/cloth-funnel/frames"); }},
+       [] {
+         return skelcd::test::cloth_funnel_scene(
+             std::string(SKELCD_SOURCE_DIR) + "/assets/cloth-funnel/frames");
+       }},
   };
   return specs;
 }
@@ -138,12 +153,19 @@ int print_tables() {
   std::set<std::size_t> done;
   for (const auto& [key, o] : g_outcomes) done.insert(std::get<0>(key));
   if (done.empty()) return 0;
-  std::printf("\n### Fig. 10 in kind: what each method finds (false negatives vs bvh in brackets)\n\n");
-  std::printf("| scene | triangles | DCD pairs: dual-cone | enhanced | bvh | normal-cone | CCD VF: dual-cone | enhanced | bvh | normal-cone | CCD EE: dual-cone | enhanced | bvh | normal-cone |\n");
+  std::printf(
+      "\n### Fig. 10 in kind: what each method finds (false negatives vs bvh in brackets)\n\n");
+  std::printf(
+      "| scene | triangles | DCD pairs: dual-cone | enhanced | bvh | normal-cone | CCD VF: "
+      "dual-cone | enhanced | bvh | normal-cone | CCD EE: dual-cone | enhanced | bvh | normal-cone "
+      "|\n");
   std::printf("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
   const std::vector<std::string> fig10 = {"dual-cone", "enhanced-dual-cone", "bvh", "normal-cone"};
   for (const std::size_t s : done) {
-    std::printf("| %s | %ld ", scene_specs()[s].name.c_str(), static_cast<long>(scene(s).mesh.num_triangles()));
+    std::printf(
+        "| %s | %ld ",
+        scene_specs()[s].name.c_str(),
+        static_cast<long>(scene(s).mesh.num_triangles()));
     for (int column = 0; column < 3; ++column) {
       const bool ccd = column > 0;
       const Outcome* ref = get(s, "bvh", ccd);
@@ -157,7 +179,8 @@ int print_tables() {
         std::int64_t fn = 0;
         for (const auto& k : ref->found) {
           const int kind = std::get<0>(k);
-          if ((column == 0 && kind == -1) || (column == 1 && kind == 0) || (column == 2 && kind == 1)) {
+          if ((column == 0 && kind == -1) || (column == 1 && kind == 0) ||
+              (column == 2 && kind == 1)) {
             fn += o->found.count(k) == 0 ? 1 : 0;
           }
         }
@@ -166,8 +189,12 @@ int print_tables() {
     }
     std::printf("|\n");
   }
-  std::printf("\n### Fig. 11 in kind: CPU ms per query (fastest of 3 timed calls) and speedups of enhanced-dual-cone\n\n");
-  std::printf("| scene | query | bvh | normal-cone | dual-cone | enhanced | enhanced top-down | auto | enhanced vs bvh | enhanced vs normal-cone |\n");
+  std::printf(
+      "\n### Fig. 11 in kind: CPU ms per query (fastest of 3 timed calls) and speedups of "
+      "enhanced-dual-cone\n\n");
+  std::printf(
+      "| scene | query | bvh | normal-cone | dual-cone | enhanced | enhanced top-down | auto | "
+      "enhanced vs bvh | enhanced vs normal-cone |\n");
   std::printf("|---|---|---|---|---|---|---|---|---|---|\n");
   for (const std::size_t s : done) {
     for (const bool ccd : {false, true}) {
@@ -196,8 +223,12 @@ int print_tables() {
       std::printf("|\n");
     }
   }
-  std::printf("\n### Fig. 13 in kind: Algorithm 3's traversal vs the simple top-down scheme (enhanced-dual-cone)\n\n");
-  std::printf("| scene | query | nodes tested: Alg. 3 | top-down | culled: Alg. 3 | top-down | candidate pairs: Alg. 3 | top-down | bvh | elementary tests: Alg. 3 | top-down | bvh |\n");
+  std::printf(
+      "\n### Fig. 13 in kind: Algorithm 3's traversal vs the simple top-down scheme "
+      "(enhanced-dual-cone)\n\n");
+  std::printf(
+      "| scene | query | nodes tested: Alg. 3 | top-down | culled: Alg. 3 | top-down | candidate "
+      "pairs: Alg. 3 | top-down | bvh | elementary tests: Alg. 3 | top-down | bvh |\n");
   std::printf("|---|---|---|---|---|---|---|---|---|---|---|---|\n");
   for (const std::size_t s : done) {
     for (const bool ccd : {false, true}) {
@@ -205,12 +236,20 @@ int print_tables() {
       const Outcome* t = get(s, "enhanced-dual-cone/top-down", ccd);
       const Outcome* b = get(s, "bvh", ccd);
       if (!a || !t || !b) continue;
-      std::printf("| %s | %s | %ld | %ld | %ld | %ld | %ld | %ld | %ld | %ld | %ld | %ld |\n",
-                  scene_specs()[s].name.c_str(), ccd ? "CCD" : "DCD", static_cast<long>(a->nodes_tested),
-                  static_cast<long>(t->nodes_tested), static_cast<long>(a->nodes_culled),
-                  static_cast<long>(t->nodes_culled), static_cast<long>(a->candidates),
-                  static_cast<long>(t->candidates), static_cast<long>(b->candidates), static_cast<long>(a->tests),
-                  static_cast<long>(t->tests), static_cast<long>(b->tests));
+      std::printf(
+          "| %s | %s | %ld | %ld | %ld | %ld | %ld | %ld | %ld | %ld | %ld | %ld |\n",
+          scene_specs()[s].name.c_str(),
+          ccd ? "CCD" : "DCD",
+          static_cast<long>(a->nodes_tested),
+          static_cast<long>(t->nodes_tested),
+          static_cast<long>(a->nodes_culled),
+          static_cast<long>(t->nodes_culled),
+          static_cast<long>(a->candidates),
+          static_cast<long>(t->candidates),
+          static_cast<long>(b->candidates),
+          static_cast<long>(a->tests),
+          static_cast<long>(t->tests),
+          static_cast<long>(b->tests));
     }
   }
   // A method that misses what bvh finds must be dual-cone: say so loudly otherwise.
@@ -220,8 +259,12 @@ int print_tables() {
     if (m == "dual-cone" || m == "bvh") continue;
     const Outcome* ref = get(s, "bvh", ccd);
     if (ref && missed(o, *ref) > 0) {
-      std::printf("\nFALSE NEGATIVE: %s misses %ld of bvh's on %s (%s)\n", m.c_str(),
-                  static_cast<long>(missed(o, *ref)), scene_specs()[s].name.c_str(), ccd ? "CCD" : "DCD");
+      std::printf(
+          "\nFALSE NEGATIVE: %s misses %ld of bvh's on %s (%s)\n",
+          m.c_str(),
+          static_cast<long>(missed(o, *ref)),
+          scene_specs()[s].name.c_str(),
+          ccd ? "CCD" : "DCD");
       ++exact_misses;
     }
   }
@@ -241,8 +284,10 @@ int main(int argc, char** argv) {
   for (std::size_t s = 0; s < scene_specs().size(); ++s) {
     for (const bool ccd : {false, true}) {
       for (const auto& m : kMethods) {
-        const std::string name = "Cones/" + scene_specs()[s].name + "/" + (ccd ? "CCD" : "DCD") + "/" + m;
-        benchmark::RegisterBenchmark(name.c_str(), [s, m, ccd](benchmark::State& st) { run(st, s, m, ccd); })
+        const std::string name =
+            "Cones/" + scene_specs()[s].name + "/" + (ccd ? "CCD" : "DCD") + "/" + m;
+        benchmark::RegisterBenchmark(
+            name.c_str(), [s, m, ccd](benchmark::State& st) { run(st, s, m, ccd); })
             ->Iterations(3)
             ->Unit(benchmark::kMillisecond)
             ->UseRealTime();

@@ -81,6 +81,34 @@ TEST(RadialViewMethod, FingersAndTentaclesTouch) {
   }
 }
 
+TEST(RadialViewMethod, PandaFoldsItsHandOntoItsBase) {
+  // The bundled Franka Panda: rigid links (one closed component each, excluded neighbour pairs),
+  // the whole trajectory, with the hand reaching links 0-2 near its end.
+  auto g = skinning::generate(skinning::parse_generator_spec("gen:panda"));
+  const std::int32_t first_hit = g.answer.first_intersecting_frame;
+  RadialViewScene scene(std::make_shared<const skinning::Rig>(std::move(g.rig)));
+  const std::int32_t samples = scene.motion->num_samples();
+  ASSERT_GT(first_hit, 0);
+  ASSERT_LT(first_hit, samples);
+  const auto c = compare(scene, 0, samples - 1);
+  EXPECT_GT(c.bvh.contacts.size(), 0u);
+  for (const auto& st : c.dynamic.stats) EXPECT_GT(st.components_culled, 0);
+}
+
+TEST(RadialViewMethod, OpenClipsGoToTheHierarchy) {
+  // The pipe and the cloth have open boundaries: nothing is skipped, contacts are bvh's.
+  for (const char* spec : {"gen:pipe?triangles=2000&frames=30", "gen:cloth?triangles=2000&frames=30"}) {
+    SCOPED_TRACE(spec);
+    RadialViewScene scene(generated(spec));
+    const auto c = compare(scene, 14, 24);
+    EXPECT_GT(c.bvh.contacts.size(), 0u);
+    for (const auto& st : c.dynamic.stats) {
+      EXPECT_EQ(st.components_open, st.components);
+      EXPECT_EQ(st.components_culled, 0);
+    }
+  }
+}
+
 TEST(RadialViewMethod, SmallClipsAgreeWithBruteForce) {
   auto rig = generated("gen:hand?triangles=600&frames=24");
   RadialViewScene scene(rig);

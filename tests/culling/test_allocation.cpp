@@ -133,17 +133,21 @@ struct Motion {
 };
 
 /// A tube squashed through itself: the first interval (samples 0 → 2) has the most motion.
-Motion squashed_tube() {
+Motion squashed_tube(int around, int along) {
   Motion m;
-  m.mesh = test::tube(20, 24, 0.4, 2.0);
+  m.mesh = test::tube(around, along, 0.4, 2.0);
   m.topo = test::simple_topology(m.mesh);
   const auto rest = test::welded(m.topo, m.mesh.rest_positions);
   for (const double s : {0.0, 0.5, 1.0, 0.95, 0.9}) m.x.push_back(test::squashed(rest, s));
   return m;
 }
 
-void expect_no_allocation_after_warm_up(const std::string& name, const MethodOptions& options) {
-  const Motion m = squashed_tube();
+void expect_no_allocation_after_warm_up(
+    const std::string& name,
+    const MethodOptions& options,
+    int around = 20,
+    int along = 24) {
+  const Motion m = squashed_tube(around, along);
   auto method = make_method(name, m.mesh, m.topo, options);
   FrameResult out;
   // Warm-up on the interval with the most motion (most candidates), and one DCD instant.
@@ -153,7 +157,7 @@ void expect_no_allocation_after_warm_up(const std::string& name, const MethodOpt
   method->detect_dcd(m.x[2], out);
   out.clear();
   method->detect_ccd(m.x[0], m.x[2], out);
-  ASSERT_GT(out.counters.vf_tests + out.counters.ee_tests, 1000) << "the interval tests little";
+  ASSERT_GT(out.counters.vf_tests + out.counters.ee_tests, 200) << "the interval tests little";
   ASSERT_GT(out.contacts.size(), 0u);
   out.clear();
 
@@ -193,8 +197,9 @@ TEST(Allocation, MethodsAllocateNothingPerIntervalAfterWarmUp) {
 
 TEST(Allocation, WithTheCcdKernelsToo) {
   // The conservative kernels are hot loops as well (DESIGN.md: allocate nothing).
-  expect_no_allocation_after_warm_up("bvh", {});
-  expect_no_allocation_after_warm_up("kdop", {});
+  // A smaller tube: the walls crossing keep the conservative solver busy (minutes under ASan).
+  expect_no_allocation_after_warm_up("bvh", {}, 12, 12);
+  expect_no_allocation_after_warm_up("kdop", {}, 12, 12);
 }
 
 TEST(Allocation, TheCounterSeesAllocations) {

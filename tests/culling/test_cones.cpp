@@ -1,6 +1,7 @@
 // Cones (SNC/BNC, continuous normal cones), the contour predicates against exact rational
 // arithmetic, and the per-node contours of the cone methods.
 #include <gmpxx.h>
+#include <gtest/gtest.h>
 
 #include <array>
 #include <cmath>
@@ -8,8 +9,6 @@
 #include <numbers>
 #include <random>
 #include <set>
-
-#include <gtest/gtest.h>
 
 #include "culling/bvh.hpp"
 #include "culling/cones.hpp"
@@ -127,8 +126,10 @@ TEST(Cones, StaticNormalConesContainEveryTriangleNormalUpTheTree) {
     bounded_nodes += c.in_open_half_space() ? 1 : 0;
     for (std::int32_t s = nodes[i].begin; s < nodes[i].end; ++s) {
       const auto& t = features.triangle(order[static_cast<std::size_t>(s)]);
-      const LVec n = exact_normal(to_long(x.row(t[0]).transpose()), to_long(x.row(t[1]).transpose()),
-                                  to_long(x.row(t[2]).transpose()));
+      const LVec n = exact_normal(
+          to_long(x.row(t[0]).transpose()),
+          to_long(x.row(t[1]).transpose()),
+          to_long(x.row(t[2]).transpose()));
       ASSERT_TRUE(inside(c, n)) << "node " << i;
     }
   }
@@ -214,7 +215,7 @@ TEST(Cones, DirectTestAroundTheMeanNormalProvesWhatTheCheckAllowsAndNothingElse)
   EXPECT_NEAR(mean.norm(), 1.0, 1e-12);
   EXPECT_TRUE(tree.normals_in_half_space(bvh, 0, mean));
   EXPECT_FALSE(tree.normals_in_half_space(bvh, 0, Vec(0, 0, 1)));  // the far half faces down
-  tree.refit(bvh, features, bent, bent);                          // CCD: the same, constant
+  tree.refit(bvh, features, bent, bent);                           // CCD: the same, constant
   EXPECT_TRUE(tree.normals_in_half_space(bvh, 0, tree.mean_normal(0)));
   // Folded by 181°: the two halves' normals are 179° apart — still a half-space, barely; the
   // opposite direction never is.
@@ -258,19 +259,26 @@ TEST(Cones, BinormalConesContainTheBoundaryBinormalsAtSampledTimes) {
     for (int step = 0; step <= 20; ++step) {
       const long double t = step / 20.0L;
       std::array<LVec, 3> p;
-      for (std::size_t k = 0; k < 3; ++k) p[k] = to_long(p0[k]) + t * (to_long(p1[k]) - to_long(p0[k]));
+      for (std::size_t k = 0; k < 3; ++k)
+        p[k] = to_long(p0[k]) + t * (to_long(p1[k]) - to_long(p0[k]));
       const LVec n = (p[1] - p[0]).cross(p[2] - p[0]);
       for (std::size_t k = 0; k < 3; ++k) {
         if ((sides & (1u << k)) == 0) continue;
         const LVec b = n.cross(p[(k + 1) % 3] - p[k]);
         // The baseline's cones carry no error bounds: allow a relative 1e-12.
-        EXPECT_GE(b.dot(to_long(c.axis)), b.norm() * (static_cast<long double>(c.cos_angle) - 1e-12L))
+        EXPECT_GE(
+            b.dot(to_long(c.axis)), b.norm() * (static_cast<long double>(c.cos_angle) - 1e-12L))
             << "trial " << trial << " t " << static_cast<double>(t);
       }
     }
   }
   EXPECT_GT(bounded, 100);
-  EXPECT_TRUE(boundary_binormal_cone({Vec(0, 0, 0), Vec(1, 0, 0), Vec(0, 1, 0)}, {Vec(0, 0, 0), Vec(1, 0, 0), Vec(0, 1, 0)}, 0, false).is_empty());
+  EXPECT_TRUE(boundary_binormal_cone(
+                  {Vec(0, 0, 0), Vec(1, 0, 0), Vec(0, 1, 0)},
+                  {Vec(0, 0, 0), Vec(1, 0, 0), Vec(0, 1, 0)},
+                  0,
+                  false)
+                  .is_empty());
 }
 
 // --- predicates vs exact rationals ---------------------------------------------------------------
@@ -379,7 +387,8 @@ TEST(NodeContours, SheetRootIsItsBoundaryLoopWithChainsBySubSurface) {
   for (std::size_t c = 0; c + 1 < chains.size(); ++c) {
     const int p = edges[static_cast<std::size_t>(chains[c])].part;
     parts.insert(p);
-    for (auto k = chains[c]; k < chains[c + 1]; ++k) EXPECT_EQ(edges[static_cast<std::size_t>(k)].part, p);
+    for (auto k = chains[c]; k < chains[c + 1]; ++k)
+      EXPECT_EQ(edges[static_cast<std::size_t>(k)].part, p);
     if (c > 0) {
       EXPECT_NE(p, edges[static_cast<std::size_t>(chains[c] - 1)].part);
     }
@@ -404,7 +413,8 @@ TEST(NodeContours, InternalBoundaryEdgesAreOnTheContourOfInnerNodes) {
     if (contours.status(n) != ContourStatus::loops) continue;
     std::map<std::int32_t, int> count;
     for (std::int32_t s = nodes[i].begin; s < nodes[i].end; ++s) {
-      for (int k = 0; k < 3; ++k) ++count[features.face_edge(bvh.triangle_order()[static_cast<std::size_t>(s)], k)];
+      for (int k = 0; k < 3; ++k)
+        ++count[features.face_edge(bvh.triangle_order()[static_cast<std::size_t>(s)], k)];
     }
     std::set<std::int32_t> expected;
     for (const auto& [e, c] : count) {
@@ -472,7 +482,7 @@ TEST(NodeContours, PinchVertexIsUnpinchedIntoTwoLoopsWithTwoFans) {
   const skinning::Positions xw = test::welded(topo, mesh.rest_positions);
   EXPECT_TRUE(tester.test(c, 0, Vec(0, 0, 1), xw, ContourMode::every_edge, counters).simple);
   skinning::Positions y = xw;
-  y.row(3) << 1.2, 0.3, 0.1;   // triangle (0, 3, 4) now spans a wedge inside triangle (0, 1, 2)'s
+  y.row(3) << 1.2, 0.3, 0.1;  // triangle (0, 3, 4) now spans a wedge inside triangle (0, 1, 2)'s
   y.row(4) << 1.2, -0.3, 0.1;
   const ContourVerdict v = tester.test(c, 0, Vec(0, 0, 1), y, ContourMode::every_edge, counters);
   EXPECT_FALSE(v.simple);
@@ -494,7 +504,8 @@ TEST(ContourTester, NestedPiecesFacingTheSameWayAreNotSimpleButAHoleIs) {
   ASSERT_EQ(c.status(0), ContourStatus::loops);
   ContourTester tester;
   ContourTestCounters counters;
-  const ContourVerdict nested = tester.test(c, 0, Vec(0, 0, 1), x, ContourMode::every_edge, counters);
+  const ContourVerdict nested =
+      tester.test(c, 0, Vec(0, 0, 1), x, ContourMode::every_edge, counters);
   EXPECT_FALSE(nested.simple);
   EXPECT_TRUE(nested.failed_nesting);
   // Moved aside (no overlap in projection), the same two loops are fine.

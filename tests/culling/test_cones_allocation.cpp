@@ -91,8 +91,10 @@ TEST(ConesAllocation, NothingPerQueryAfterWarmUp) {
     expect_quiet(make_method(name, s.mesh, s.topo, {.bvh = {.leaf_size = 4}}), s, name);
   }
   expect_quiet(
-      make_enhanced_dual_cone_method(s.mesh, s.topo, {}, {.grandchildren_descent = false, .triangles = {}}),
-      s, "enhanced-dual-cone top-down");
+      make_enhanced_dual_cone_method(
+          s.mesh, s.topo, {}, {.grandchildren_descent = false, .triangles = {}}),
+      s,
+      "enhanced-dual-cone top-down");
   expect_quiet(make_method("auto", s.mesh, s.topo, {.min_separation = 1e-3}), s, "auto, distance");
 }
 

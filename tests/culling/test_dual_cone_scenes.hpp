@@ -16,8 +16,8 @@
 
 #include "skinning/frame_sequence.hpp"
 #include "skinning/generators.hpp"
-#include "skinning/rig_motion.hpp"
 #include "skinning/mesh.hpp"
+#include "skinning/rig_motion.hpp"
 #include "skinning/topology.hpp"
 #include "tests/culling/procedural_meshes.hpp"
 
@@ -64,10 +64,12 @@ inline skinning::Positions pipe_positions(int around, int along, double overlap)
   for (int k = 0; k <= along; ++k) {
     const double theta = theta_max * k / along;
     const Eigen::Vector3d radial(std::cos(theta), std::sin(theta), 0.0);
-    const Eigen::Vector3d centre = kR * radial + Eigen::Vector3d(0, 0, 0.6 * kr * theta / (2.0 * std::numbers::pi));
+    const Eigen::Vector3d centre =
+        kR * radial + Eigen::Vector3d(0, 0, 0.6 * kr * theta / (2.0 * std::numbers::pi));
     for (int i = 0; i < around; ++i) {
       const double phi = 2.0 * std::numbers::pi * (i + 0.5) / around;
-      const Eigen::Vector3d p = centre + kr * (std::cos(phi) * radial + std::sin(phi) * Eigen::Vector3d::UnitZ());
+      const Eigen::Vector3d p =
+          centre + kr * (std::cos(phi) * radial + std::sin(phi) * Eigen::Vector3d::UnitZ());
       x.row(k * around + i) = p.transpose();
     }
   }
@@ -77,10 +79,11 @@ inline skinning::Positions pipe_positions(int around, int along, double overlap)
 inline OpenScene pipe_scene(int around, int along, std::vector<double> overlaps) {
   OpenScene s;
   s.name = "pipe";
-  s.mesh = single_part_mesh(pipe_positions(around, along, overlaps.front()),
-                            grid_triangles(around, along, true), "pipe");
+  s.mesh = single_part_mesh(
+      pipe_positions(around, along, overlaps.front()), grid_triangles(around, along, true), "pipe");
   s.topo = skinning::build_topology(s.mesh);
-  for (const double o : overlaps) s.frames.push_back(welded(s.topo, pipe_positions(around, along, o)));
+  for (const double o : overlaps)
+    s.frames.push_back(welded(s.topo, pipe_positions(around, along, o)));
   return s;
 }
 
@@ -108,10 +111,11 @@ inline skinning::Positions wrap_sheet_positions(int nu, int nv, double height) {
 inline OpenScene wrap_sheet_scene(int nu, int nv, std::vector<double> heights) {
   OpenScene s;
   s.name = "wrap-sheet";
-  s.mesh = single_part_mesh(wrap_sheet_positions(nu, nv, heights.front()),
-                            grid_triangles(nu, nv, false), "sheet");
+  s.mesh = single_part_mesh(
+      wrap_sheet_positions(nu, nv, heights.front()), grid_triangles(nu, nv, false), "sheet");
   s.topo = skinning::build_topology(s.mesh);
-  for (const double h : heights) s.frames.push_back(welded(s.topo, wrap_sheet_positions(nu, nv, h)));
+  for (const double h : heights)
+    s.frames.push_back(welded(s.topo, wrap_sheet_positions(nu, nv, h)));
   return s;
 }
 
@@ -139,8 +143,10 @@ inline skinning::Positions crumpled_tube_positions(int around, int along, double
 inline OpenScene crumpled_tube_scene(int around, int along, std::vector<double> squashes) {
   OpenScene s;
   s.name = "crumpled-tube";
-  s.mesh = single_part_mesh(crumpled_tube_positions(around, along, squashes.front()),
-                            grid_triangles(around, along, true), "shirt");
+  s.mesh = single_part_mesh(
+      crumpled_tube_positions(around, along, squashes.front()),
+      grid_triangles(around, along, true),
+      "shirt");
   s.topo = skinning::build_topology(s.mesh);
   for (const double q : squashes) {
     s.frames.push_back(welded(s.topo, crumpled_tube_positions(around, along, q)));
@@ -151,11 +157,7 @@ inline OpenScene crumpled_tube_scene(int around, int along, std::vector<double> 
 /// A closed body (an ellipsoid) wearing an open skirt (a cone frustum around its lower half) that
 /// sways sideways by `sway` and so presses into the body: one closed part, one open part.
 inline std::pair<skinning::Positions, skinning::Positions> skirt_body_positions(
-    int lat,
-    int lon,
-    int around,
-    int along,
-    double sway) {
+    int lat, int lon, int around, int along, double sway) {
   skinning::Mesh body = uv_sphere(lat, lon, 1.0);
   skinning::Positions b = body.rest_positions;
   b.col(2) *= 1.6;
@@ -172,7 +174,8 @@ inline std::pair<skinning::Positions, skinning::Positions> skirt_body_positions(
   return {b, skirt};
 }
 
-inline OpenScene skirt_body_scene(int lat, int lon, int around, int along, std::vector<double> sways) {
+inline OpenScene skirt_body_scene(
+    int lat, int lon, int around, int along, std::vector<double> sways) {
   OpenScene s;
   s.name = "skirt-on-body";
   auto [b, k] = skirt_body_positions(lat, lon, around, along, sways.front());

@@ -1,13 +1,13 @@
 // The cone methods against the references: `enhanced-dual-cone` and `normal-cone` find exactly
 // what `bvh` (and `brute`, on small cases) finds, DCD and CCD, on every open scene and on the
 // cloth-funnel frames; `dual-cone` (FASTCD) demonstrably misses on the pipe and the wrapped sheet.
+#include <gtest/gtest.h>
+
 #include <algorithm>
 #include <set>
 #include <string>
 #include <tuple>
 #include <vector>
-
-#include <gtest/gtest.h>
 
 #include "ccd/edge_edge.hpp"
 #include "ccd/vertex_face.hpp"
@@ -24,16 +24,22 @@ namespace {
 using test::OpenScene;
 using Key = std::tuple<int, std::int32_t, std::int32_t>;
 
-FrameResult run_dcd(const std::string& name, const OpenScene& s, std::size_t frame,
-                    const MethodOptions& options = {}) {
+FrameResult run_dcd(
+    const std::string& name,
+    const OpenScene& s,
+    std::size_t frame,
+    const MethodOptions& options = {}) {
   auto m = make_method(name, s.mesh, s.topo, options);
   FrameResult out;
   m->detect_dcd(s.frames[frame], out);
   return out;
 }
 
-FrameResult run_ccd(const std::string& name, const OpenScene& s, std::size_t from,
-                    const MethodOptions& options = {}) {
+FrameResult run_ccd(
+    const std::string& name,
+    const OpenScene& s,
+    std::size_t from,
+    const MethodOptions& options = {}) {
   auto m = make_method(name, s.mesh, s.topo, options);
   FrameResult out;
   m->detect_ccd(s.frames[from], s.frames[from + 1], out);
@@ -56,22 +62,36 @@ bool exactly_refuted(const OpenScene& s, std::size_t from, const Key& k) {
   const auto [kind, a, b] = k;
   if (kind == 0) {
     const auto f = s.topo.welded_triangles.row(b);
-    const ccd::VertexFaceQuery q{p(x0, a), p(x0, f(0)), p(x0, f(1)), p(x0, f(2)),
-                                 p(x1, a), p(x1, f(0)), p(x1, f(1)), p(x1, f(2))};
+    const ccd::VertexFaceQuery q{
+        p(x0, a),
+        p(x0, f(0)),
+        p(x0, f(1)),
+        p(x0, f(2)),
+        p(x1, a),
+        p(x1, f(0)),
+        p(x1, f(1)),
+        p(x1, f(2))};
     return !ccd::vertex_face_ccd(q, ccd::Accuracy::exact).hit;
   }
   const auto ea = s.topo.edges.row(a);
   const auto eb = s.topo.edges.row(b);
-  const ccd::EdgeEdgeQuery q{p(x0, ea(0)), p(x0, ea(1)), p(x0, eb(0)), p(x0, eb(1)),
-                             p(x1, ea(0)), p(x1, ea(1)), p(x1, eb(0)), p(x1, eb(1))};
+  const ccd::EdgeEdgeQuery q{
+      p(x0, ea(0)),
+      p(x0, ea(1)),
+      p(x0, eb(0)),
+      p(x0, eb(1)),
+      p(x1, ea(0)),
+      p(x1, ea(1)),
+      p(x1, eb(0)),
+      p(x1, eb(1))};
   return !ccd::edge_edge_ccd(q, ccd::Accuracy::exact).hit;
 }
 
 /// CCD of a culling method against the reference's contacts (conservative elementary tests):
 /// nothing the method reports is missing from the reference, and whatever the reference reports
 /// beyond it is a false positive of the conservative test, refuted in exact arithmetic.
-::testing::AssertionResult same_ccd_contacts(const OpenScene& s, std::size_t from,
-                                             const FrameResult& method, const FrameResult& reference) {
+::testing::AssertionResult same_ccd_contacts(
+    const OpenScene& s, std::size_t from, const FrameResult& method, const FrameResult& reference) {
   const auto got = keys(method);
   const auto want = keys(reference);
   for (const Key& k : got) {
@@ -129,7 +149,8 @@ TEST(ConeMethods, EveryOpenSceneCollidesAndMatchesBruteForce) {
       const FrameResult brute = run_ccd("brute", s, f);
       EXPECT_FALSE(brute.contacts.empty());
       for (const auto& name : kExactMethods) {
-        EXPECT_TRUE(same_ccd_contacts(s, f, run_ccd(name, s, f), brute)) << name << " interval " << f;
+        EXPECT_TRUE(same_ccd_contacts(s, f, run_ccd(name, s, f), brute))
+            << name << " interval " << f;
       }
     }
   }
@@ -142,8 +163,10 @@ TEST(ConeMethods, EnhancedCullsWhatItCanAndReportsWhy) {
   m->detect_dcd(s.frames[0], out);
   const ConeCullingStats& st = stats_of(*m);
   EXPECT_GT(st.nodes_culled, 0);
-  EXPECT_EQ(st.nodes_tested, st.nodes_culled + st.failed_normal_cone + st.failed_topology +
-                                 st.failed_dual_cone + st.failed_contour);
+  EXPECT_EQ(
+      st.nodes_tested,
+      st.nodes_culled + st.failed_normal_cone + st.failed_topology + st.failed_dual_cone +
+          st.failed_contour);
   // Nodes holding both crossing layers have two loops whose projections cross or nest.
   EXPECT_GT(st.failed_contour, 0);
   EXPECT_GT(st.contour.chain_tests, 0);
@@ -188,13 +211,17 @@ TEST(ConeMethods, ChainsThatTurnBackAreCutIntoMonotoneRunsAndTheFlatSheetIsStill
   const auto full = test::sheet(12, 12);
   std::vector<Eigen::Index> kept;
   for (Eigen::Index t = 0; t < full.triangles.rows(); ++t) {
-    const Eigen::Vector3d c = (full.rest_positions.row(full.triangles(t, 0)) + full.rest_positions.row(full.triangles(t, 1)) +
-                               full.rest_positions.row(full.triangles(t, 2))).transpose() / 3.0;
+    const Eigen::Vector3d c = (full.rest_positions.row(full.triangles(t, 0)) +
+                               full.rest_positions.row(full.triangles(t, 1)) +
+                               full.rest_positions.row(full.triangles(t, 2)))
+                                  .transpose() /
+                              3.0;
     if (c.x() > 0.4 && c.x() < 0.6 && c.y() > 0.25) continue;  // the slot
     kept.push_back(t);
   }
   skinning::Triangles f(static_cast<Eigen::Index>(kept.size()), 3);
-  for (std::size_t k = 0; k < kept.size(); ++k) f.row(static_cast<Eigen::Index>(k)) = full.triangles.row(kept[k]);
+  for (std::size_t k = 0; k < kept.size(); ++k)
+    f.row(static_cast<Eigen::Index>(k)) = full.triangles.row(kept[k]);
   const auto mesh = test::single_part_mesh(full.rest_positions, f);
   const auto topo = skinning::build_topology(mesh);
   const skinning::Positions x = test::welded(topo, mesh.rest_positions);
@@ -204,8 +231,10 @@ TEST(ConeMethods, ChainsThatTurnBackAreCutIntoMonotoneRunsAndTheFlatSheetIsStill
   EXPECT_EQ(stats_of(*m).nodes_culled, 1);
   EXPECT_EQ(stats_of(*m).nodes_tested, 1);
   EXPECT_GT(stats_of(*m).contour.chain_cuts, 0);
-  EXPECT_GT(stats_of(*m).ten_results_failed[0] + stats_of(*m).ten_results_failed[1] +
-                stats_of(*m).ten_results_failed[2] + stats_of(*m).ten_results_failed[3], 0);
+  EXPECT_GT(
+      stats_of(*m).ten_results_failed[0] + stats_of(*m).ten_results_failed[1] +
+          stats_of(*m).ten_results_failed[2] + stats_of(*m).ten_results_failed[3],
+      0);
   FrameResult c;
   m->detect_ccd(x, test::translated(x, Eigen::Vector3d(0.0, 0.01, 0.02)), c);
   EXPECT_EQ(stats_of(*m).nodes_culled, 1);
@@ -213,11 +242,13 @@ TEST(ConeMethods, ChainsThatTurnBackAreCutIntoMonotoneRunsAndTheFlatSheetIsStill
 
 TEST(ConeMethods, BothTraversalSchemesFindWhatBvhFinds) {
   // Algorithm 3 (straight to the sub-surfaces) and the simple top-down scheme.
-  for (const OpenScene& s : {test::pipe_scene(12, 72, {0.5, 0.7}), test::crumpled_tube_scene(12, 56, {0.55, 0.6})}) {
+  for (const OpenScene& s :
+       {test::pipe_scene(12, 72, {0.5, 0.7}), test::crumpled_tube_scene(12, 56, {0.55, 0.6})}) {
     const FrameResult bvh = run_dcd("bvh", s, 0);
     const FrameResult bvh_ccd = run_ccd("bvh", s, 0);
     for (const bool grand : {true, false}) {
-      auto m = make_enhanced_dual_cone_method(s.mesh, s.topo, {}, {.grandchildren_descent = grand, .triangles = {}});
+      auto m = make_enhanced_dual_cone_method(
+          s.mesh, s.topo, {}, {.grandchildren_descent = grand, .triangles = {}});
       FrameResult d;
       m->detect_dcd(s.frames[0], d);
       EXPECT_EQ(d.dcd_pairs, bvh.dcd_pairs) << s.name << " " << grand;
@@ -241,7 +272,8 @@ TEST(ConeMethods, LargerLeavesAndExactElementaryTestsGiveTheSameAnswer) {
       EXPECT_EQ(run_dcd(name, s, 1, opts).dcd_pairs, brute.dcd_pairs) << name << " leaf " << leaf;
     }
     // With the exact (rational) elementary tests the contact sets are equal, not just equivalent.
-    EXPECT_EQ(keys(run_ccd(name, s, 0, {.accuracy = ccd::Accuracy::exact})), keys(brute_ccd)) << name;
+    EXPECT_EQ(keys(run_ccd(name, s, 0, {.accuracy = ccd::Accuracy::exact})), keys(brute_ccd))
+        << name;
   }
 }
 
@@ -261,7 +293,8 @@ TEST(ConeMethods, ContactDistanceTurnsCullingOffAndMatchesBvh) {
 TEST(DualCone, MissesCollisionsInsideThePipeAndTheWrappedSheetWhereEnhancedDoesNot) {
   // Paper 000 Fig. 1/3/4: nodes away from the original boundary, holding two layers with
   // similar normals, pass FASTCD's test and are culled although the layers intersect.
-  for (const OpenScene& s : {test::pipe_scene(16, 96, {0.6, 0.9}), test::wrap_sheet_scene(10, 120, {0.30, 0.36})}) {
+  for (const OpenScene& s :
+       {test::pipe_scene(16, 96, {0.6, 0.9}), test::wrap_sheet_scene(10, 120, {0.30, 0.36})}) {
     SCOPED_TRACE(s.name);
     const FrameResult bvh = run_dcd("bvh", s, 0);
     const FrameResult dual = run_dcd("dual-cone", s, 0);
@@ -270,8 +303,8 @@ TEST(DualCone, MissesCollisionsInsideThePipeAndTheWrappedSheetWhereEnhancedDoesN
     EXPECT_EQ(enhanced.dcd_pairs, bvh.dcd_pairs);
     // dual-cone: a strict subset (it only culls; its elementary tests are the same).
     EXPECT_LT(dual.dcd_pairs.size(), bvh.dcd_pairs.size());
-    EXPECT_TRUE(std::includes(bvh.dcd_pairs.begin(), bvh.dcd_pairs.end(), dual.dcd_pairs.begin(),
-                              dual.dcd_pairs.end()));
+    EXPECT_TRUE(std::includes(
+        bvh.dcd_pairs.begin(), bvh.dcd_pairs.end(), dual.dcd_pairs.begin(), dual.dcd_pairs.end()));
     // CCD likewise.
     const FrameResult bvh_ccd = run_ccd("bvh", s, 0);
     const FrameResult dual_ccd = run_ccd("dual-cone", s, 0);

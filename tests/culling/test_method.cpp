@@ -247,8 +247,8 @@ struct Scene {
 std::vector<Scene> scenes() {
   std::vector<Scene> out;
   {
-    auto a = test::uv_sphere(8, 10, 1.0);
-    auto b = test::uv_sphere(7, 9, 0.8);
+    auto a = test::uv_sphere(7, 9, 1.0);
+    auto b = test::uv_sphere(6, 8, 0.8);
     b.rest_positions = test::translated(b.rest_positions, Eigen::Vector3d(2.2, 0.05, 0.03));
     Scene s{"sphere moving into another", test::combine(a, b), {}, {}};
     s.topo = test::simple_topology(s.mesh);
@@ -263,7 +263,7 @@ std::vector<Scene> scenes() {
     out.push_back(std::move(s));
   }
   {
-    Scene s{"sheet folding through itself", test::sheet(10, 5, 2.0, 1.0), {}, {}};
+    Scene s{"sheet folding through itself", test::sheet(8, 4, 2.0, 1.0), {}, {}};
     s.topo = test::simple_topology(s.mesh);
     const auto x = test::welded(s.topo, s.mesh.rest_positions);
     for (const double angle : {2.9, 3.1, 3.3}) s.samples.push_back(test::folded(x, 1.0, angle));

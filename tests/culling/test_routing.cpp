@@ -1,12 +1,12 @@
 // `auto`: open components go to enhanced-dual-cone, closed ones to `dynamic` (through an
 // extension) or the `bvh` fallback, pairs across groups through a BVH pair traversal — and the
 // answer is exactly `bvh`'s.
+#include <gtest/gtest.h>
+
 #include <set>
 #include <string>
 #include <tuple>
 #include <vector>
-
-#include <gtest/gtest.h>
 
 #include "culling/method.hpp"
 #include "culling/method_extension.hpp"
@@ -93,13 +93,16 @@ TEST(Routing, AutoFindsExactlyWhatBvhAndBruteFind) {
   const FrameResult want = ccd(*b, s.frames[0], s.frames[1]);
   EXPECT_FALSE(want.contacts.empty());
   EXPECT_EQ(keys(got), keys(want));
-  EXPECT_EQ(got.counters.vf_contacts + got.counters.ee_contacts,
-            static_cast<std::int64_t>(got.contacts.size()));
+  EXPECT_EQ(
+      got.counters.vf_contacts + got.counters.ee_contacts,
+      static_cast<std::int64_t>(got.contacts.size()));
   // Skirt against body: some contacts join the two groups (found by the pair traversal).
   std::int32_t body_faces = 0;
-  for (const auto& c : s.topo.components) body_faces += c.closed ? static_cast<std::int32_t>(c.faces.size()) : 0;
+  for (const auto& c : s.topo.components)
+    body_faces += c.closed ? static_cast<std::int32_t>(c.faces.size()) : 0;
   bool across = false;
-  for (const auto& p : dcd(*a, s.frames[1]).dcd_pairs) across |= (p.a < body_faces) != (p.b < body_faces);
+  for (const auto& p : dcd(*a, s.frames[1]).dcd_pairs)
+    across |= (p.a < body_faces) != (p.b < body_faces);
   EXPECT_TRUE(across);
 }
 
@@ -169,15 +172,22 @@ TEST(Routing, OptionsChooseOtherGroupMethodsAndRejectUnknownOnes) {
   auto b = make_method("bvh", s.mesh, s.topo);
   const auto want = keys(ccd(*b, s.frames[0], s.frames[1]));
   for (const auto& [open, closed] : std::vector<std::pair<std::string, std::string>>{
-           {"normal-cone", "bvh"}, {"bvh", "enhanced-dual-cone"}, {"enhanced-dual-cone", "normal-cone"}}) {
+           {"normal-cone", "bvh"},
+           {"bvh", "enhanced-dual-cone"},
+           {"enhanced-dual-cone", "normal-cone"}}) {
     auto m = make_routed_method(s.mesh, s.topo, {}, {.open_method = open, .closed_method = closed});
     EXPECT_EQ(keys(ccd(*m, s.frames[0], s.frames[1])), want) << open << " / " << closed;
     EXPECT_EQ(routes_of(*m)[0].method, closed);
   }
-  EXPECT_THROW_MESSAGE((void)make_routed_method(s.mesh, s.topo, {}, {.open_method = "octree", .closed_method = ""}),
-                       InvalidInput, "'octree' cannot take the open components");
-  EXPECT_THROW_MESSAGE((void)make_routed_method(s.mesh, s.topo, {}, {.open_method = "enhanced-dual-cone", .closed_method = "dynamic"}),
-                       InvalidInput, "'dynamic' cannot take the closed components");
+  EXPECT_THROW_MESSAGE(
+      (void)make_routed_method(s.mesh, s.topo, {}, {.open_method = "octree", .closed_method = ""}),
+      InvalidInput,
+      "'octree' cannot take the open components");
+  EXPECT_THROW_MESSAGE(
+      (void)make_routed_method(
+          s.mesh, s.topo, {}, {.open_method = "enhanced-dual-cone", .closed_method = "dynamic"}),
+      InvalidInput,
+      "'dynamic' cannot take the closed components");
 }
 
 TEST(Routing, ComponentsAreFoundWhenTheTopologyHasNone) {
