@@ -25,14 +25,20 @@ double half_ulp(double v) {
 
 bool is_power_of_two(std::uint64_t x) { return x != 0 && (x & (x - 1)) == 0; }
 
-// Is digits * 10^shift exactly the double v? Decided without big numbers when the digits fit in
-// 64 bits; otherwise "no" (the safe answer: it only adds a rounding margin).
-bool decimal_is_exact(std::string_view digits, long shift, double v) {
-  while (!digits.empty() && digits.front() == '0') digits.remove_prefix(1);
-  if (digits.empty()) return true;  // zero
-  if (digits.size() > 19) return false;
+// Is digits * 10^shift exactly the double v? `digits` are the mantissa digits as written (the
+// decimal point removed), given as two pieces. Decided without big numbers when the significant
+// digits fit in 64 bits; otherwise "no" (the safe answer: it only adds a rounding margin).
+bool decimal_is_exact(std::string_view int_part, std::string_view frac_part, long shift, double v) {
   std::uint64_t d = 0;
-  std::from_chars(digits.data(), digits.data() + digits.size(), d);
+  int significant = 0;
+  for (const std::string_view part : {int_part, frac_part}) {
+    for (const char c : part) {
+      if (significant == 0 && c == '0') continue;
+      if (++significant > 19) return false;
+      d = d * 10 + static_cast<std::uint64_t>(c - '0');
+    }
+  }
+  if (d == 0) return true;  // zero
   while (shift < 0 && d % 10 == 0) {
     d /= 10;
     ++shift;
@@ -114,27 +120,26 @@ bool parse_rational(std::string_view token, double& value, mpq_class* exact, dou
 
 // [+-] digits [. digits] [(e|E) [+-] digits], with at least one mantissa digit.
 bool parse_decimal(std::string_view token, double& value, mpq_class* exact, double& rounding, std::string& fault) {
-  fault = "not a number (expected a decimal or p/q with integer p and q)";
+  const auto not_a_number = [&] {
+    fault = "not a number (expected a decimal or p/q with integer p and q)";
+    return false;
+  };
   std::size_t i = 0;
   bool negative = false;
   if (i < token.size() && (token[i] == '+' || token[i] == '-')) {
     negative = token[i] == '-';
     ++i;
   }
-  std::string digits;  // mantissa digits, the point removed
-  std::size_t int_digits = 0, frac_digits = 0;
-  while (i < token.size() && is_digit(token[i])) {
-    digits += token[i++];
-    ++int_digits;
-  }
+  const std::size_t int_begin = i;
+  while (i < token.size() && is_digit(token[i])) ++i;
+  const std::string_view int_part = token.substr(int_begin, i - int_begin);
+  std::string_view frac_part;
   if (i < token.size() && token[i] == '.') {
-    ++i;
-    while (i < token.size() && is_digit(token[i])) {
-      digits += token[i++];
-      ++frac_digits;
-    }
+    const std::size_t frac_begin = ++i;
+    while (i < token.size() && is_digit(token[i])) ++i;
+    frac_part = token.substr(frac_begin, i - frac_begin);
   }
-  if (int_digits + frac_digits == 0) return false;
+  if (int_part.empty() && frac_part.empty()) return not_a_number();
   long exponent = 0;
   if (i < token.size() && (token[i] == 'e' || token[i] == 'E')) {
     ++i;
@@ -144,7 +149,7 @@ bool parse_decimal(std::string_view token, double& value, mpq_class* exact, doub
       ++i;
     }
     const std::string_view exp_digits = token.substr(i);
-    if (!all_digits(exp_digits)) return false;
+    if (!all_digits(exp_digits)) return not_a_number();
     if (exp_digits.size() > 6) {
       fault = "exponent out of range";
       return false;
@@ -153,7 +158,7 @@ bool parse_decimal(std::string_view token, double& value, mpq_class* exact, doub
     if (exp_negative) exponent = -exponent;
     i = token.size();
   }
-  if (i != token.size()) return false;
+  if (i != token.size()) return not_a_number();
   // The nearest double (std::from_chars rounds correctly; it does not take a leading '+').
   const std::string_view unsigned_part = token.substr(token.front() == '+' || token.front() == '-' ? 1 : 0);
   const auto [end, ec] = std::from_chars(unsigned_part.data(), unsigned_part.data() + unsigned_part.size(), value);
@@ -162,15 +167,17 @@ bool parse_decimal(std::string_view token, double& value, mpq_class* exact, doub
     return false;
   }
   if (negative) value = -value;
-  rounding = decimal_is_exact(digits, exponent - static_cast<long>(frac_digits), value) ? 0.0 : half_ulp(value);
+  const long shift = exponent - static_cast<long>(frac_part.size());
+  rounding = decimal_is_exact(int_part, frac_part, shift, value) ? 0.0 : half_ulp(value);
   if (exact != nullptr) {
-    // digits * 10^(exponent - frac_digits), exactly.
+    // digits * 10^shift, exactly.
+    std::string digits(int_part);
+    digits.append(frac_part);
     const auto first = digits.find_first_not_of('0');
     if (first == std::string::npos) {
       *exact = 0;
     } else {
       mpq_class r{mpz_class(digits.substr(first))};
-      const long shift = exponent - static_cast<long>(frac_digits);
       mpz_class power;
       mpz_ui_pow_ui(power.get_mpz_t(), 10, static_cast<unsigned long>(std::labs(shift)));
       if (shift >= 0) {
@@ -182,7 +189,6 @@ bool parse_decimal(std::string_view token, double& value, mpq_class* exact, doub
       *exact = negative ? mpq_class(-r) : r;
     }
   }
-  fault.clear();
   return true;
 }
 
@@ -225,6 +231,7 @@ std::vector<CcdQueryRecord> parse_ccd_queries(std::istream& in, const std::strin
     if (tokens.empty()) continue;
     CcdQueryRecord r;
     r.line = line_number;
+    if (keep_exact) r.exact.resize(24);
     if (tokens[0] == "vf") {
       r.vertex_face = true;
     } else if (tokens[0] == "ee") {

@@ -19,8 +19,8 @@ struct CcdQueryRecord {
   /// The 8 points x, y, z in file order (vf: vertex, corners 0..2; ee: a0, a1, b0, b1; t = 0 then
   /// t = 1), each coordinate the double nearest to the written number.
   std::array<double, 24> coordinates{};
-  /// The written numbers exactly (0.1 is 1/10); filled only when asked for.
-  std::array<mpq_class, 24> exact;
+  /// The written numbers exactly (0.1 is 1/10), in the same order; empty unless asked for.
+  std::vector<mpq_class> exact;
   std::optional<bool> expected;
   int line = 0;  ///< 1-based line number in the file
   /// Largest |double - written number| over the 24 coordinates, bounded from above (0 when every
