@@ -80,13 +80,19 @@ void run_export(const ExportArgs& args) {
   }
   // --highlight LOG.h5 (colliding triangles of this frame) or --segmentation SEG.h5 (one colour
   // per atomic cluster) fill options.face_colors, one RGBA per triangle.
-  if (!args.segmentation.empty()) options.face_colors = segmentation_face_colors(args.segmentation, motion->mesh());
+  std::string marked;
+  if (!args.segmentation.empty()) {
+    auto colors = segmentation_colors(args.segmentation, motion->mesh());
+    options.face_colors = std::move(colors.face_colors);
+    marked = "; " + std::to_string(colors.non_positive.size()) +
+             " triangles not positively oriented to their cluster's observer in the rest pose drawn dark";
+  }
   if (!args.highlight.empty()) options.face_colors = highlight_face_colors(args.highlight, motion->mesh(), args.frame.value_or(0), motion->sample_time(args.frame.value_or(0)));
   const auto result = export_mesh(motion->mesh(), positions, args.output, options);
   // Standard output may be carrying the mesh: the summary goes to stderr then.
   auto& report = is_stdout(args.output) ? std::cerr : std::cout;
   report << "wrote " << (is_stdout(args.output) ? std::string("standard output") : args.output) << ": " << result.triangles
-         << " triangles, " << result.vertices << " vertices, '" << motion->name() << "' at " << where << "\n";
+         << " triangles, " << result.vertices << " vertices, '" << motion->name() << "' at " << where << marked << "\n";
 }
 
 }  // namespace
@@ -105,7 +111,7 @@ void add_export_command(CLI::App& app) {
       ->required();
   cmd->add_option("--format", args->format, "obj, ply or glb (default: from OUT's extension; obj on standard output)");
   cmd->add_option("--highlight", args->highlight, "colour the triangles the log LOG.h5 found colliding at --frame")->excludes(time);
-  cmd->add_option("--segmentation", args->segmentation, "colour each atomic cluster of the segmentation SEG.h5 (from skelcd preprocess)")
+  cmd->add_option("--segmentation", args->segmentation, "colour each atomic cluster of the segmentation SEG.h5 (from skelcd preprocess); triangles not positively oriented to their observer in the rest pose are drawn dark")
       ->excludes("--highlight");
   add_model_options(*cmd, args->load);
   cmd->callback([args] { run_export(*args); });

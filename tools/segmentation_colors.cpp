@@ -3,16 +3,16 @@
 #include <cmath>
 #include <string>
 
+#include "segmentation/observer.hpp"
 #include "skinning/errors.hpp"
 #include "tools/segmentation_file.hpp"
 
 namespace skelcd::tools {
 namespace {
 
-// HSV (s = 0.65, v = 0.95) → RGB for hue h in [0, 1).
-std::array<float, 4> hue_color(double h) {
+// HSV (s = 0.65, value v) → RGB for hue h in [0, 1).
+std::array<float, 4> hue_color(double h, double v) {
   const double s = 0.65;
-  const double v = 0.95;
   const double sector = h * 6.0;
   const int i = static_cast<int>(std::floor(sector)) % 6;
   const double f = sector - std::floor(sector);
@@ -33,7 +33,7 @@ std::array<float, 4> hue_color(double h) {
 
 }  // namespace
 
-std::vector<std::array<float, 4>> segmentation_face_colors(
+SegmentationColors segmentation_colors(
     const std::filesystem::path& path,
     const skinning::Mesh& mesh) {
   const SegmentationFile file = read_segmentation(path);
@@ -42,13 +42,34 @@ std::vector<std::array<float, 4>> segmentation_face_colors(
     throw InvalidInput(path.string() + ": segmentation has " + std::to_string(cluster_of.size()) +
                        " triangles, the model has " + std::to_string(mesh.num_triangles()));
   }
+  const auto num_clusters = file.segmentation.clusters.size();
   constexpr double kGoldenRatioConjugate = 0.6180339887498949;
-  std::vector<std::array<float, 4>> colors(cluster_of.size());
+  SegmentationColors out;
+  out.face_colors.resize(cluster_of.size());
   for (std::size_t f = 0; f < cluster_of.size(); ++f) {
-    const double h = std::fmod(static_cast<double>(cluster_of[f]) * kGoldenRatioConjugate, 1.0);
-    colors[f] = hue_color(h);
+    const auto c = cluster_of[f];
+    if (c < 0 || static_cast<std::size_t>(c) >= num_clusters) {
+      throw InvalidInput(path.string() + ": triangle " + std::to_string(f) + " names cluster " +
+                         std::to_string(c) + " of " + std::to_string(num_clusters));
+    }
+    // Welding merges only equal positions, so the file's rest positions and triangles are the
+    // welded geometry the segmentation classified.
+    const auto& observer = file.segmentation.clusters[static_cast<std::size_t>(c)].observer;
+    const bool positive =
+        segmentation::orientation(observer, mesh.rest_positions, mesh.triangles,
+                                  static_cast<Eigen::Index>(f)) ==
+        segmentation::Orientation::positive;
+    if (!positive) out.non_positive.push_back(static_cast<std::int32_t>(f));
+    const double h = std::fmod(static_cast<double>(c) * kGoldenRatioConjugate, 1.0);
+    out.face_colors[f] = hue_color(h, positive ? kPositiveValue : kNonPositiveValue);
   }
-  return colors;
+  return out;
+}
+
+std::vector<std::array<float, 4>> segmentation_face_colors(
+    const std::filesystem::path& path,
+    const skinning::Mesh& mesh) {
+  return segmentation_colors(path, mesh).face_colors;
 }
 
 }  // namespace skelcd::tools
