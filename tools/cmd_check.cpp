@@ -12,6 +12,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include "culling/routed_method.hpp"
 #include "skelcd_version.hpp"
 #include "skinning/errors.hpp"
 #include "skinning/load.hpp"
@@ -192,6 +193,21 @@ nlohmann::json json_summary(const skinning::LoadedModel& model, const skinning::
   };
 }
 
+/// Under `auto`, where each connected component went (the plan make_method("auto") follows, with
+/// the same options), for the log's /routes; empty for any other method.
+std::vector<LogRoute> log_routes(const skinning::Topology& topology, const RunOptions& options) {
+  std::vector<LogRoute> routes;
+  if (options.method != "auto") return routes;
+  const culling::MethodOptions method_options{.accuracy = options.accuracy,
+                                              .min_separation = options.min_separation,
+                                              .extension = options.method_extension};
+  for (const auto& r : culling::route_components(topology, method_options)) {
+    routes.push_back(LogRoute{.component = r.component, .part = r.part, .closed = r.closed,
+                              .triangles = r.num_triangles, .method = r.method});
+  }
+  return routes;
+}
+
 void run_check(const CheckArguments& args) {
   // Everything that can be refused is checked before the log is created: options, the model,
   // the clip, the frame range and the method.
@@ -228,6 +244,7 @@ void run_check(const CheckArguments& args) {
     header.num_vertices = motion->mesh().num_vertices();
     header.num_triangles = motion->mesh().num_triangles();
     header.part_names = motion->mesh().part_names;
+    header.routes = log_routes(runner.topology(), options);
     writer = std::make_unique<LogWriter>(args.output, header);
   }
 

@@ -13,6 +13,16 @@ inline constexpr const char* kLogFormatName = "skelcd-log";
 /// Version of the schema written by this build; readers accept versions <= this.
 inline constexpr std::int32_t kLogFormatVersion = 1;
 
+/// Where one connected component of the mesh went under `auto` (culling::ComponentRoute): stored
+/// as the /routes group, one row per component.
+struct LogRoute {
+  std::int32_t component = -1;  ///< connected component (welded mesh), in component order
+  std::int32_t part = -1;       ///< file part of its first triangle (index into /parts)
+  bool closed = false;          ///< no boundary and no non-manifold edge
+  std::int32_t triangles = 0;
+  std::string method;           ///< the method that tested its pairs
+};
+
 struct LogHeader {
   std::int32_t format_version = kLogFormatVersion;
   std::string skelcd_version;
@@ -34,6 +44,7 @@ struct LogHeader {
   std::int64_t num_vertices = 0;  ///< file vertices of the mesh
   std::int64_t num_triangles = 0;
   std::vector<std::string> part_names;  ///< stored as the /parts dataset
+  std::vector<LogRoute> routes;  ///< the /routes group; empty (and absent) unless method is auto
   bool complete = false;  ///< set when the run finished; false in a log of a killed run
 };
 

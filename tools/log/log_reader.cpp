@@ -65,6 +65,58 @@ std::vector<std::string> read_parts(hid_t file) {
   return names;
 }
 
+// One column of /routes, checked to hold `count` rows (count < 0: take its length).
+template <class T>
+std::vector<T> read_route_column(hid_t group, const char* name, hid_t type, hsize_t count) {
+  H5Handle dataset(H5Dopen2(group, name, H5P_DEFAULT), H5Dclose);
+  H5Handle space(dataset.valid() ? H5Dget_space(dataset.get()) : -1, H5Sclose);
+  hsize_t rows = 0;
+  if (!dataset.valid() || !space.valid() || H5Sget_simple_extent_ndims(space.get()) != 1 ||
+      H5Sget_simple_extent_dims(space.get(), &rows, nullptr) < 0 || rows != count) {
+    detail::clear_hdf5_error();
+    throw IoError(std::string("/routes/") + name + " is missing or not " + std::to_string(count) +
+                  " rows");
+  }
+  std::vector<T> values(rows);
+  if (rows > 0 && H5Dread(dataset.get(), type, H5S_ALL, H5S_ALL, H5P_DEFAULT, values.data()) < 0) {
+    throw IoError(std::string("cannot read /routes/") + name + " (" + detail::take_hdf5_error() + ")");
+  }
+  return values;
+}
+
+std::vector<LogRoute> read_routes(hid_t file) {
+  std::vector<LogRoute> routes;
+  if (H5Lexists(file, detail::kRoutesPath, H5P_DEFAULT) <= 0) {
+    detail::clear_hdf5_error();
+    return routes;  // optional: written only by `auto`
+  }
+  H5Handle group(H5Gopen2(file, detail::kRoutesPath, H5P_DEFAULT), H5Gclose);
+  H5Handle first(group.valid() ? H5Dopen2(group.get(), "component", H5P_DEFAULT) : -1, H5Dclose);
+  H5Handle space(first.valid() ? H5Dget_space(first.get()) : -1, H5Sclose);
+  hsize_t count = 0;
+  if (!space.valid() || H5Sget_simple_extent_dims(space.get(), &count, nullptr) < 0) {
+    detail::clear_hdf5_error();
+    throw IoError("/routes has no readable component column");
+  }
+  const auto component = read_route_column<std::int32_t>(group.get(), "component", H5T_NATIVE_INT32, count);
+  const auto part = read_route_column<std::int32_t>(group.get(), "part", H5T_NATIVE_INT32, count);
+  const auto closed = read_route_column<std::uint8_t>(group.get(), "closed", H5T_NATIVE_UINT8, count);
+  const auto triangles = read_route_column<std::int32_t>(group.get(), "triangles", H5T_NATIVE_INT32, count);
+  const auto type = detail::vlen_string_type();
+  auto method = read_route_column<char*>(group.get(), "method", type.get(), count);
+  for (hsize_t i = 0; i < count; ++i) {
+    routes.push_back(LogRoute{.component = component[i], .part = part[i], .closed = closed[i] != 0,
+                              .triangles = triangles[i],
+                              .method = method[i] != nullptr ? method[i] : ""});
+  }
+  if (count > 0) {
+    H5Handle method_set(H5Dopen2(group.get(), "method", H5P_DEFAULT), H5Dclose);
+    H5Handle method_space(H5Dget_space(method_set.get()), H5Sclose);
+    H5Dvlen_reclaim(type.get(), method_space.get(), H5P_DEFAULT, method.data());
+  }
+  return routes;
+}
+
 LogHeader read_header(hid_t file) {
   using detail::read_double_attribute;
   using detail::read_int_attribute;
@@ -102,6 +154,7 @@ LogHeader read_header(hid_t file) {
   h.num_triangles = read_int_attribute(file, "num_triangles").value_or(0);
   h.complete = read_int_attribute(file, "complete").value_or(0) != 0;
   h.part_names = read_parts(file);
+  h.routes = read_routes(file);
   return h;
 }
 

@@ -119,6 +119,46 @@ void write_parts(hid_t file, const std::vector<std::string>& names, const std::s
   }
 }
 
+template <class T>
+void write_column(hid_t group, const char* name, hid_t type, const std::vector<T>& values,
+                  const std::string& where) {
+  const hsize_t count = values.size();
+  H5Handle space(H5Screate_simple(1, &count, nullptr), H5Sclose);
+  H5Handle dataset(
+      H5Dcreate2(group, name, type, space.get(), H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), H5Dclose);
+  if (!space.valid() || !dataset.valid() ||
+      (count > 0 && H5Dwrite(dataset.get(), type, H5S_ALL, H5S_ALL, H5P_DEFAULT, values.data()) < 0)) {
+    throw IoError(where + ": cannot write /routes/" + name + " (" + detail::take_hdf5_error() + ")");
+  }
+}
+
+// /routes: one row per connected component, as columns (component, part, closed, triangles,
+// method), written only when there are routes.
+void write_routes(hid_t file, const std::vector<LogRoute>& routes, const std::string& where) {
+  if (routes.empty()) return;
+  H5Handle group(H5Gcreate2(file, detail::kRoutesPath, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT),
+                 H5Gclose);
+  if (!group.valid()) {
+    throw IoError(where + ": cannot create /routes (" + detail::take_hdf5_error() + ")");
+  }
+  std::vector<std::int32_t> component, part, triangles;
+  std::vector<std::uint8_t> closed;
+  std::vector<const char*> method;
+  for (const auto& r : routes) {
+    component.push_back(r.component);
+    part.push_back(r.part);
+    closed.push_back(r.closed ? 1 : 0);
+    triangles.push_back(r.triangles);
+    method.push_back(r.method.c_str());
+  }
+  write_column(group.get(), "component", H5T_NATIVE_INT32, component, where);
+  write_column(group.get(), "part", H5T_NATIVE_INT32, part, where);
+  write_column(group.get(), "closed", H5T_NATIVE_UINT8, closed, where);
+  write_column(group.get(), "triangles", H5T_NATIVE_INT32, triangles, where);
+  const auto type = detail::vlen_string_type();
+  write_column(group.get(), "method", type.get(), method, where);
+}
+
 void write_header(hid_t file, const LogHeader& h) {
   using detail::write_attribute;
   write_attribute(file, "format", std::string(kLogFormatName));
@@ -206,6 +246,7 @@ LogWriter::LogWriter(const std::filesystem::path& path, const LogHeader& header)
       throw IoError(impl_->where + ": " + e.what());
     }
     write_parts(file, header.part_names, impl_->where);
+    write_routes(file, header.routes, impl_->where);
     impl_->frames = create_table(file, detail::kFramesPath, detail::frame_memory_type(),
                                  kFrameChunkRows, impl_->where);
     impl_->contacts = create_table(file, detail::kContactsPath, detail::contact_memory_type(),

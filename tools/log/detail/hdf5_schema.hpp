@@ -131,5 +131,6 @@ inline constexpr const char* kFramesPath = "frames";
 inline constexpr const char* kContactsPath = "contacts";
 inline constexpr const char* kDcdPairsPath = "dcd_pairs";
 inline constexpr const char* kPartsPath = "parts";
+inline constexpr const char* kRoutesPath = "routes";
 
 }  // namespace skelcd::tools::detail

@@ -1,0 +1,79 @@
+// check --method auto records in the log where each connected component went (/routes): closed
+// components to the closed method, open ones to the cone method, as the mesh's own edges say.
+
+#include <map>
+#include <set>
+#include <utility>
+
+#include <gtest/gtest.h>
+
+#include "skinning/load.hpp"
+#include "skinning/topology.hpp"
+#include "tests/support/test_support.hpp"
+#include "tests/tools/cli_runner.hpp"
+#include "tools/log/log_reader.hpp"
+
+namespace skelcd::tools {
+namespace {
+
+using skelcd::test::run_skelcd;
+
+// Closed, counted from the welded triangles alone: every undirected edge of the component has
+// exactly two incident triangles of the whole mesh.
+bool closed_by_edges(const skinning::Triangles& F, const std::vector<std::int32_t>& faces) {
+  std::map<std::pair<std::int32_t, std::int32_t>, int> all;
+  for (Eigen::Index f = 0; f < F.rows(); ++f) {
+    for (int k = 0; k < 3; ++k) {
+      const auto a = F(f, k);
+      const auto b = F(f, (k + 1) % 3);
+      ++all[{std::min(a, b), std::max(a, b)}];
+    }
+  }
+  for (const auto f : faces) {
+    for (int k = 0; k < 3; ++k) {
+      const auto a = F(f, k);
+      const auto b = F(f, (k + 1) % 3);
+      if (all[{std::min(a, b), std::max(a, b)}] != 2) return false;
+    }
+  }
+  return true;
+}
+
+TEST(RoutesLog, AutoWritesWhereEachComponentWent) {
+  const auto model = skelcd::test::asset("characters/RobotExpressive.glb");
+  const auto log = skelcd::test::temp_dir("routes-log") / "auto.h5";
+  const auto r = run_skelcd({"check", model.string(), "--method", "auto", "--frames", "0:1", "-o", log.string()});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+
+  const auto loaded = skinning::load_model(model);
+  const auto topology = skinning::build_topology(*loaded.mesh);
+  const auto header = read_log(log).header;
+  ASSERT_EQ(header.routes.size(), topology.components.size());
+  std::int64_t triangles = 0;
+  std::set<bool> kinds;
+  for (std::size_t i = 0; i < header.routes.size(); ++i) {
+    const auto& route = header.routes[i];
+    const auto& component = topology.components[i];
+    EXPECT_EQ(route.component, static_cast<std::int32_t>(i));
+    EXPECT_EQ(route.triangles, static_cast<std::int32_t>(component.faces.size()));
+    EXPECT_EQ(route.part, loaded.mesh->face_part[static_cast<std::size_t>(component.faces.front())]);
+    const bool closed = closed_by_edges(topology.welded_triangles, component.faces);
+    EXPECT_EQ(route.closed, closed) << "component " << i;
+    EXPECT_EQ(route.method, closed ? "bvh" : "enhanced-dual-cone") << "component " << i;
+    triangles += route.triangles;
+    kinds.insert(closed);
+  }
+  EXPECT_EQ(triangles, loaded.mesh->num_triangles());
+  EXPECT_EQ(kinds.size(), 2u) << "the robot has both open and closed components";
+}
+
+TEST(RoutesLog, OtherMethodsWriteNoRoutes) {
+  const auto log = skelcd::test::temp_dir("routes-none") / "bvh.h5";
+  const auto r = run_skelcd({"check", skelcd::test::asset("characters/RobotExpressive.glb").string(),
+                             "--method", "bvh", "--frames", "0:1", "-o", log.string()});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_TRUE(read_log(log).header.routes.empty());
+}
+
+}  // namespace
+}  // namespace skelcd::tools
