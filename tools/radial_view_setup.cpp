@@ -29,8 +29,14 @@ RadialViewSetup setup_radial_view(
     const skinning::Motion& motion,
     RunOptions& options) {
   RadialViewSetup setup;
-  if (!clustering::is_radial_view_method(options.method)) return setup;
   const std::string method = options.method;
+  if (method == "auto") {
+    // `auto` sends closed components to `dynamic` when the model is a rig played by its clip
+    // (bones move the observers); otherwise they go to the `bvh` fallback.
+    if (!model.rig || dynamic_cast<const skinning::RigMotion*>(&motion) == nullptr) return setup;
+  } else if (!clustering::is_radial_view_method(method)) {
+    return setup;
+  }
   if (!(std::isfinite(args.gamma) && args.gamma >= 0.0 && args.gamma <= 1.0)) {
     throw InvalidInput("--gamma " + std::to_string(args.gamma) + ": expected a value in [0, 1]");
   }
@@ -69,6 +75,16 @@ RadialViewSetup setup_radial_view(
       clustering::RadialViewParameters{.gamma = args.gamma, .seed = args.seed});
   options.before_query = [poses](std::int32_t s0, std::int32_t s1) {
     poses->select_samples(s0, s1);
+  };
+  // A parallel run (RunOptions::threads) gives every extra worker its own bone poses.
+  options.make_worker_hooks = [seg, rig_motion, num_bones = model.rig->skeleton.num_bones(),
+                               parameters = clustering::RadialViewParameters{
+                                   .gamma = args.gamma, .seed = args.seed}] {
+    auto own = std::make_shared<clustering::BonePoses>(clustering::pose_at_sample(*rig_motion));
+    return WorkerHooks{
+        .method_extension =
+            std::make_shared<clustering::RadialViewExtension>(seg, own, num_bones, parameters),
+        .before_query = [own](std::int32_t s0, std::int32_t s1) { own->select_samples(s0, s1); }};
   };
   if (method == "dynamic") setup.gamma = args.gamma;
   return setup;

@@ -3,6 +3,7 @@
 
 #include <map>
 #include <set>
+#include <tuple>
 #include <utility>
 
 #include <gtest/gtest.h>
@@ -59,12 +60,35 @@ TEST(RoutesLog, AutoWritesWhereEachComponentWent) {
     EXPECT_EQ(route.part, loaded.mesh->face_part[static_cast<std::size_t>(component.faces.front())]);
     const bool closed = closed_by_edges(topology.welded_triangles, component.faces);
     EXPECT_EQ(route.closed, closed) << "component " << i;
-    EXPECT_EQ(route.method, closed ? "bvh" : "enhanced-dual-cone") << "component " << i;
+    // A rig played by its clip: closed components go to the radial-view method.
+    EXPECT_EQ(route.method, closed ? "dynamic" : "enhanced-dual-cone") << "component " << i;
     triangles += route.triangles;
     kinds.insert(closed);
   }
   EXPECT_EQ(triangles, loaded.mesh->num_triangles());
   EXPECT_EQ(kinds.size(), 2u) << "the robot has both open and closed components";
+}
+
+TEST(RoutesLog, AutoFindsWhatBvhFindsOnACharacterWithOpenParts) {
+  const auto model = skelcd::test::asset("characters/RobotExpressive.glb");
+  const auto dir = skelcd::test::temp_dir("routes-agree");
+  std::vector<LogData> logs;
+  for (const char* method : {"auto", "bvh"}) {
+    const auto log = dir / (std::string(method) + ".h5");
+    const auto r = run_skelcd({"check", model.string(), "--method", method, "--frames", "0:6", "-o", log.string()});
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    logs.push_back(read_log(log));
+  }
+  const auto key = [](const LogData& log) {
+    std::set<std::tuple<std::int32_t, int, std::int32_t, std::int32_t, std::int32_t, std::int32_t>> s;
+    for (const auto& c : log.contacts) {
+      s.insert({c.frame, static_cast<int>(c.kind), c.a.part * 8 + c.a.side, c.a.index, c.b.part * 8 + c.b.side, c.b.index});
+    }
+    for (const auto& p : log.dcd_pairs) s.insert({p.frame, -1, p.a.part, p.a.index, p.b.part, p.b.index});
+    return s;
+  };
+  EXPECT_EQ(key(logs[0]), key(logs[1]));
+  EXPECT_EQ(logs[0].frames.size(), logs[1].frames.size());
 }
 
 TEST(RoutesLog, OtherMethodsWriteNoRoutes) {
