@@ -14,5 +14,6 @@ void add_inspect_command(CLI::App& app);
 void add_export_command(CLI::App& app);
 void add_generate_command(CLI::App& app);
 void add_ccd_queries_command(CLI::App& app);
+void add_bench_command(CLI::App& app);
 
 }  // namespace skelcd::tools

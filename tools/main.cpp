@@ -24,6 +24,7 @@ int main(int argc, char** argv) {
   skelcd::tools::add_export_command(app);
   skelcd::tools::add_generate_command(app);
   skelcd::tools::add_ccd_queries_command(app);
+  skelcd::tools::add_bench_command(app);
 
   try {
     app.parse(argc, argv);

@@ -1,0 +1,135 @@
+// skelcd bench as a user runs it: the table, CSV (header, one line per method × accuracy, numbers
+// that agree with --json), the PNG plot, and bad input refused in one line with nothing written.
+
+#include <algorithm>
+#include <fstream>
+#include <sstream>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include "tests/support/test_support.hpp"
+#include "tests/tools/cli_runner.hpp"
+
+namespace {
+
+using skelcd::test::run_skelcd;
+
+const std::string kRope = "gen:rope?triangles=1000&frames=60";
+
+std::string read_text(const std::filesystem::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::ostringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+std::vector<std::string> lines(const std::string& text) {
+  std::vector<std::string> out;
+  std::istringstream in(text);
+  for (std::string line; std::getline(in, line);) out.push_back(line);
+  return out;
+}
+
+TEST(CmdBench, CsvJsonAndPlotOfAGeneratedRope) {
+  const auto dir = skelcd::test::temp_dir("bench-cli");
+  const auto csv = dir / "rope.csv";
+  const auto png = dir / "rope.png";
+  const auto r = run_skelcd({"bench", kRope, "--frames", "42:48", "--methods", "bvh,kdop",
+                             "--accuracies", "exact,conservative,fast", "--csv", csv.string(),
+                             "--plot", png.string(), "--json"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(j["reference"]["method"], "brute");
+  EXPECT_EQ(j["reference"]["accuracy"], "exact");
+  EXPECT_EQ(j["intervals"], 6);
+  ASSERT_EQ(j["rows"].size(), 6u);
+  EXPECT_EQ(j["rows"][0]["method"], "bvh");
+  EXPECT_EQ(j["rows"][0]["accuracy"], "exact");
+  EXPECT_EQ(j["rows"][5]["method"], "kdop");
+  EXPECT_EQ(j["rows"][5]["accuracy"], "fast");
+  for (const auto& row : j["rows"]) {
+    if (row["accuracy"] != "fast") EXPECT_EQ(row["false_negatives"], 0) << row.dump();
+    if (row["accuracy"] == "exact") EXPECT_EQ(row["false_positives"], 0) << row.dump();
+    EXPECT_FALSE(row["reference"].get<bool>());  // brute is the reference, not in the table
+  }
+
+  const auto csv_lines = lines(read_text(csv));
+  ASSERT_EQ(csv_lines.size(), 7u);
+  EXPECT_EQ(csv_lines[0].rfind("method,accuracy,ms_per_interval,bv_tests,candidate_pairs,contacts,"
+                               "false_negatives,false_positives,skin_ms,refit_ms,classify_ms,"
+                               "merge_ms,traverse_ms,elementary_ms,other_ms",
+                               0),
+            0u)
+      << csv_lines[0];
+  // Row 2 (bvh conservative) carries the JSON's counts.
+  std::ostringstream expected;
+  expected << "bvh,conservative,";
+  EXPECT_EQ(csv_lines[2].rfind(expected.str(), 0), 0u) << csv_lines[2];
+  std::vector<std::string> fields;
+  std::istringstream row(csv_lines[2]);
+  for (std::string f; std::getline(row, f, ',');) fields.push_back(f);
+  ASSERT_GE(fields.size(), 8u);
+  EXPECT_EQ(fields[3], std::to_string(j["rows"][1]["bv_tests"].get<long long>()));
+  EXPECT_EQ(fields[5], std::to_string(j["rows"][1]["contacts"].get<long long>()));
+  EXPECT_EQ(fields[6], "0");
+
+  // The plot is a PNG.
+  const auto image = read_text(png);
+  ASSERT_GT(image.size(), 1000u);
+  EXPECT_EQ(image.substr(0, 8), std::string("\x89PNG\r\n\x1a\n", 8));
+  // No temporary files left beside the outputs.
+  std::size_t files = 0;
+  for ([[maybe_unused]] const auto& e : std::filesystem::directory_iterator(dir)) ++files;
+  EXPECT_EQ(files, 2u);
+}
+
+TEST(CmdBench, TableOnARealCharacterMarksTheReference) {
+  const auto model = skelcd::test::asset("characters/CesiumMan.glb").string();
+  const auto r = run_skelcd({"bench", model, "--frames", "0:2", "--methods", "brute,bvh",
+                             "--accuracies", "exact,conservative"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find("reference brute + exact"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("* brute"), std::string::npos) << r.out;
+  const auto out = lines(r.out);
+  const auto rows = std::count_if(out.begin(), out.end(), [](const std::string& l) {
+    return l.rfind("  bvh ", 0) == 0 || l.rfind("  brute ", 0) == 0 || l.rfind("* brute ", 0) == 0;
+  });
+  EXPECT_EQ(rows, 4);
+}
+
+TEST(CmdBench, BadInputFailsWithOneLineAndWritesNothing) {
+  const auto dir = skelcd::test::temp_dir("bench-bad");
+  const auto csv = (dir / "out.csv").string();
+  const auto png = (dir / "out.png").string();
+  const std::vector<std::pair<std::vector<std::string>, std::string>> cases{
+      {{"bench", kRope, "--methods", "bvh,octree", "--csv", csv}, "octree"},
+      {{"bench", kRope, "--accuracies", "exact,sloppy", "--csv", csv}, "sloppy"},
+      {{"bench", (dir / "missing.glb").string(), "--csv", csv}, "missing.glb"},
+      {{"bench", kRope, "--frames", "50:70", "--methods", "bvh", "--csv", csv, "--plot", png},
+       "--frames"},
+      {{"bench", kRope, "--reference", "kdop", "--csv", csv}, "--reference"},
+      {{"bench", kRope, "--csv", (dir / "no-such-dir" / "out.csv").string()}, "no-such-dir"},
+      {{"bench", kRope, "--plot", dir.string()}, dir.string()},
+  };
+  for (const auto& [args, needle] : cases) {
+    const auto r = run_skelcd(args);
+    SCOPED_TRACE(args[2] + " " + needle);
+    EXPECT_EQ(r.exit_code, 1);
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+    EXPECT_NE(r.err.find(needle), std::string::npos) << r.err;
+    EXPECT_TRUE(r.out.empty()) << r.out;
+    EXPECT_TRUE(std::filesystem::is_empty(dir)) << "left a file behind";
+  }
+}
+
+TEST(CmdBench, RadialViewMethodsNeedARig) {
+  const auto dir = skelcd::test::temp_dir("bench-rv");
+  // A frame sequence has no skeleton: naming dynamic is refused, the default list leaves it out.
+  const auto frames = skelcd::test::asset("cloth-funnel/frames").string();
+  const auto r = run_skelcd({"bench", frames, "--methods", "dynamic"});
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.err.find("rigged"), std::string::npos) << r.err;
+}
+
+}  // namespace
