@@ -396,14 +396,6 @@ const char* marker(ccd::Accuracy accuracy) {
   return "●";
 }
 
-/// A label's box in normalised viewport units, for the greedy placement below.
-struct Box {
-  double x0, x1, y0, y1;
-  [[nodiscard]] bool overlaps(const Box& o) const {
-    return x0 < o.x1 && o.x0 < x1 && y0 < o.y1 && o.y0 < y1;
-  }
-};
-
 }  // namespace
 
 void write_bench_plot(const std::filesystem::path& path, const BenchReport& report,
@@ -436,14 +428,22 @@ void write_bench_plot(const std::filesystem::path& path, const BenchReport& repo
     y_min = *std::min_element(ys.begin(), ys.end());
     y_max = *std::max_element(ys.begin(), ys.end());
   }
-  // Whole decades around the times; room on the right for the labels of the rightmost points.
+  // Whole decades around the times. The x range leaves room on the right for the labels of the
+  // rightmost points (about 40% of the width); FN ticks are whole numbers.
   y_min = std::floor(y_min - 0.05);
   y_max = std::ceil(y_max + 0.05);
-  const double x_lo = -0.04 * std::max(x_max, 1.0) - 0.5;
-  const double x_hi = std::max(x_max, 1.0) * 1.45 + 0.5;
+  const double x_span = std::max(x_max, 1.0);
+  const double x_lo = -0.06 * x_span;
+  const double x_hi = x_lo + (x_span - x_lo) / 0.58;
+  double x_tick = std::pow(10.0, std::floor(std::log10((x_hi - x_lo) / 8.0)));
+  for (const double m : {2.0, 5.0, 10.0}) {
+    if ((x_hi - x_lo) / x_tick <= 10.0) break;
+    x_tick = std::pow(10.0, std::floor(std::log10((x_hi - x_lo) / 8.0))) * m;
+  }
+  x_tick = std::max(x_tick, 1.0);
 
   constexpr PLINT kWidth = 1100;
-  constexpr PLINT kHeight = 750;
+  constexpr PLINT kHeight = 800;
   PLINT stream = 0;
   plmkstrm(&stream);
   if (stream < 0) throw IoError(name + ": PLplot has no free stream");
@@ -460,12 +460,13 @@ void write_bench_plot(const std::filesystem::path& path, const BenchReport& repo
   }
   plschr(0.0, 1.0);
   pladv(0);
-  plvpor(0.08, 0.97, 0.10, 0.88);
+  constexpr double kLeft = 0.10, kRight = 0.97, kBottom = 0.10, kTop = 0.88;
+  plvpor(kLeft, kRight, kBottom, kTop);
   plwind(x_lo, x_hi, y_min, y_max);
   plcol0(kGridColour);
-  plbox("g", 0.0, 0, "g", 1.0, 0);
+  plbox("g", x_tick, 0, "g", 1.0, 0);
   plcol0(1);
-  plbox("bcnst", 0.0, 0, "bcnstvl", 0.0, 0);
+  plbox("bcnst", x_tick, 0, "bcnstvl", 0.0, 0);
   pllab("missed collisions (false negatives against the reference)", "ms per interval (log)",
         "");
   plmtex("t", 3.2, 0.5, 0.5, title.c_str());
@@ -474,90 +475,101 @@ void write_bench_plot(const std::filesystem::path& path, const BenchReport& repo
   plschr(0.0, 0.85);
   plmtex("t", 1.4, 0.5, 0.5, key.c_str());
 
-  // Character size in normalised viewport units, for the label boxes.
+  // Character size (at scale 1) in normalised viewport units, for the label boxes; cairo's
+  // sans glyphs average ~0.72 of the character height in width.
+  plschr(0.0, 1.0);
   PLFLT default_height = 0;
   PLFLT height_mm = 0;
   plgchr(&default_height, &height_mm);
   PLFLT page_x0 = 0, page_x1 = 0, page_y0 = 0, page_y1 = 0;
   plgspa(&page_x0, &page_x1, &page_y0, &page_y1);
-  const double char_h = height_mm / ((page_y1 - page_y0) * (0.88 - 0.10));
-  const double char_w = 0.62 * height_mm / ((page_x1 - page_x0) * (0.97 - 0.08));
+  const double char_h = height_mm / ((page_y1 - page_y0) * (kTop - kBottom));
+  const double char_w = 0.72 * height_mm / ((page_x1 - page_x0) * (kRight - kLeft));
   const auto to_nx = [&](double x) { return (x - x_lo) / (x_hi - x_lo); };
   const auto to_ny = [&](double y) { return (y - y_min) / (y_max - y_min); };
   const auto from_ny = [&](double ny) { return y_min + ny * (y_max - y_min); };
 
-  // Points, then labels placed greedily from the bottom up: each label starts to the right of
-  // its point and moves up or down by a line until it overlaps no earlier label or point; a
-  // thin leader joins a moved label to its point.
-  std::vector<std::size_t> order(report.rows.size());
-  for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
-  std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
-    return ys[a] < ys[b];
-  });
-  std::vector<Box> placed;
-  for (std::size_t i = 0; i < xs.size(); ++i) {
-    const double nx = to_nx(xs[i]);
-    const double ny = to_ny(ys[i]);
-    placed.push_back({nx - 0.5 * char_w, nx + 0.5 * char_w, ny - 0.4 * char_h, ny + 0.4 * char_h});
-  }
-  plschr(0.0, 0.8);
-  for (const std::size_t i : order) {
+  // Labels: each starts just right of its point. Points whose labels would share horizontal space
+  // form a column; a column's labels keep the order of their points' times and are pushed apart
+  // vertically to one line each (a forward pass up, then a pass down from the top edge), with a
+  // thin leader from a moved label to its point. A column too tall for the plot shrinks the font.
+  const std::size_t n = report.rows.size();
+  std::vector<std::string> texts(n);
+  std::vector<PLINT> colours(n);
+  for (std::size_t i = 0; i < n; ++i) {
     const auto& r = report.rows[i];
-    const auto colour = static_cast<PLINT>(
+    colours[i] = static_cast<PLINT>(
         2 + (std::find(methods.begin(), methods.end(), r.method) - methods.begin()) %
                 static_cast<std::ptrdiff_t>(kMethodColours.size()));
-    const std::string text = r.method + " " + std::string(ccd::to_string(r.accuracy)) +
-                             (r.reference ? " (ref)" : "") + "  " +
-                             fixed(r.summary.ms_per_interval,
-                                   time_decimals(r.summary.ms_per_interval)) +
-                             " ms, FN " + std::to_string(r.false_negatives);
-    const double nx = to_nx(xs[i]) + 0.9 * char_w;
-    const double ny = to_ny(ys[i]);
-    const double width = 0.8 * char_w * static_cast<double>(text.size());
-    const double line = 0.8 * 1.25 * char_h;
-    double best = ny;
-    for (int step = 0; step < 200; ++step) {
-      const double offset = ((step + 1) / 2) * line * (step % 2 == 1 ? 1.0 : -1.0);
-      const double candidate = ny + offset;
-      if (candidate < 0.01 || candidate > 0.99) continue;
-      const Box box{nx, nx + width, candidate - 0.5 * line, candidate + 0.5 * line};
-      bool free = true;
-      for (const auto& p : placed) {
-        if (box.overlaps(p)) {
-          free = false;
-          break;
-        }
+    texts[i] = r.method + " " + std::string(ccd::to_string(r.accuracy)) +
+               (r.reference ? " (ref)" : "") + "  " +
+               fixed(r.summary.ms_per_interval, time_decimals(r.summary.ms_per_interval)) + " ms";
+  }
+  std::vector<std::size_t> by_x(n);
+  for (std::size_t i = 0; i < n; ++i) by_x[i] = i;
+  std::stable_sort(by_x.begin(), by_x.end(), [&](std::size_t a, std::size_t b) {
+    return xs[a] < xs[b];
+  });
+  double scale = 0.8;
+  std::vector<std::vector<std::size_t>> columns;
+  for (int attempt = 0; attempt < 2; ++attempt) {
+    columns.clear();
+    double column_right = -1;
+    for (const std::size_t i : by_x) {
+      const double left = to_nx(xs[i]) + 0.9 * char_w;
+      const double right = left + scale * char_w * static_cast<double>(texts[i].size());
+      if (columns.empty() || left > column_right) {
+        columns.emplace_back();
+        column_right = right;
+      } else {
+        column_right = std::max(column_right, right);
       }
-      if (free) {
-        best = candidate;
-        break;
-      }
+      columns.back().push_back(i);
     }
-    placed.push_back({nx, nx + width, best - 0.5 * line, best + 0.5 * line});
+    std::size_t tallest = 0;
+    for (const auto& c : columns) tallest = std::max(tallest, c.size());
+    const double needed = static_cast<double>(tallest) * 1.15 * scale * char_h;
+    if (needed <= 0.96) break;
+    scale = std::max(0.45, scale * 0.96 / needed);
+  }
+  const double line = 1.15 * scale * char_h;
+  std::vector<double> label_ny(n);
+  for (auto& column : columns) {
+    std::stable_sort(column.begin(), column.end(), [&](std::size_t a, std::size_t b) {
+      return ys[a] < ys[b];
+    });
+    double previous = -1e9;
+    for (const std::size_t i : column) {
+      label_ny[i] = std::max({to_ny(ys[i]), previous + line, 0.5 * line});
+      previous = label_ny[i];
+    }
+    double next = 1e9;
+    for (auto it = column.rbegin(); it != column.rend(); ++it) {
+      label_ny[*it] = std::min({label_ny[*it], next - line, 1.0 - 0.5 * line});
+      next = label_ny[*it];
+    }
+  }
+  plschr(0.0, scale);
+  for (std::size_t i = 0; i < n; ++i) {
+    const double nx = to_nx(xs[i]) + 0.9 * char_w;
     const PLFLT label_x = x_lo + nx * (x_hi - x_lo);
-    const PLFLT label_y = from_ny(best);
-    if (std::abs(best - ny) > 0.25 * line) {
-      plcol0(kGridColour);
+    const PLFLT label_y = from_ny(label_ny[i]);
+    plcol0(colours[i]);
+    if (std::abs(label_ny[i] - to_ny(ys[i])) > 0.25 * line) {
       PLFLT lx[2] = {xs[i], label_x};
       PLFLT ly[2] = {ys[i], label_y};
-      plcol0(colour);
       plwidth(0.5);
       plline(2, lx, ly);
       plwidth(1.0);
     }
-    plcol0(colour);
-    plptex(label_x, label_y, 1.0, 0.0, 0.0, text.c_str());
+    plptex(label_x, label_y, 1.0, 0.0, 0.0, texts[i].c_str());
   }
   plschr(0.0, 1.3);
-  for (std::size_t i = 0; i < xs.size(); ++i) {
-    const auto& r = report.rows[i];
-    const auto colour = static_cast<PLINT>(
-        2 + (std::find(methods.begin(), methods.end(), r.method) - methods.begin()) %
-                static_cast<std::ptrdiff_t>(kMethodColours.size()));
-    plcol0(colour);
+  for (std::size_t i = 0; i < n; ++i) {
+    plcol0(colours[i]);
     PLFLT px = xs[i];
     PLFLT py = ys[i];
-    plstring(1, &px, &py, marker(r.accuracy));
+    plstring(1, &px, &py, marker(report.rows[i].accuracy));
   }
   plend1();
   std::error_code ec;
