@@ -23,6 +23,17 @@ struct LogRoute {
   std::string method;           ///< the method that tested its pairs
 };
 
+/// One check of a scene (docs/scenes.md): stored as the /checks group, one row per check; the
+/// /frame_check dataset gives each /frames row's check.
+struct LogCheck {
+  std::string name;      ///< "self body", "pair body cape"
+  std::string object_a;
+  std::string object_b;  ///< empty for a self check
+  std::string query;     ///< "dcd" | "ccd" | "both"
+  std::string method;
+  std::string accuracy;
+};
+
 struct LogHeader {
   std::int32_t format_version = kLogFormatVersion;
   std::string skelcd_version;
@@ -45,6 +56,8 @@ struct LogHeader {
   std::int64_t num_triangles = 0;
   std::vector<std::string> part_names;  ///< stored as the /parts dataset
   std::vector<LogRoute> routes;  ///< the /routes group; empty (and absent) unless method is auto
+  /// The /checks group and /frame_check dataset; empty (and absent) unless the log is a scene's.
+  std::vector<LogCheck> checks;
   bool complete = false;  ///< set when the run finished; false in a log of a killed run
 };
 

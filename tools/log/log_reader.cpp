@@ -117,6 +117,69 @@ std::vector<LogRoute> read_routes(hid_t file) {
   return routes;
 }
 
+// /checks of a scene log (optional): string columns of equal length.
+std::vector<LogCheck> read_checks(hid_t file) {
+  std::vector<LogCheck> checks;
+  if (H5Lexists(file, "checks", H5P_DEFAULT) <= 0) {
+    detail::clear_hdf5_error();
+    return checks;  // optional: written only for scenes
+  }
+  H5Handle group(H5Gopen2(file, "checks", H5P_DEFAULT), H5Gclose);
+  const auto type = detail::vlen_string_type();
+  const auto column = [&](const char* name) {
+    H5Handle dataset(group.valid() ? H5Dopen2(group.get(), name, H5P_DEFAULT) : -1, H5Dclose);
+    H5Handle space(dataset.valid() ? H5Dget_space(dataset.get()) : -1, H5Sclose);
+    hsize_t rows = 0;
+    if (!space.valid() || H5Sget_simple_extent_dims(space.get(), &rows, nullptr) < 0) {
+      detail::clear_hdf5_error();
+      throw IoError(std::string("/checks/") + name + " is missing");
+    }
+    std::vector<char*> raw(rows, nullptr);
+    if (rows > 0 && H5Dread(dataset.get(), type.get(), H5S_ALL, H5S_ALL, H5P_DEFAULT, raw.data()) < 0) {
+      throw IoError(std::string("cannot read /checks/") + name + " (" + detail::take_hdf5_error() + ")");
+    }
+    std::vector<std::string> values;
+    for (const char* r : raw) values.emplace_back(r != nullptr ? r : "");
+    if (rows > 0) H5Dvlen_reclaim(type.get(), space.get(), H5P_DEFAULT, raw.data());
+    return values;
+  };
+  const auto name = column("name");
+  const auto object_a = column("object_a");
+  const auto object_b = column("object_b");
+  const auto query = column("query");
+  const auto method = column("method");
+  const auto accuracy = column("accuracy");
+  for (const auto* c : {&object_a, &object_b, &query, &method, &accuracy}) {
+    if (c->size() != name.size()) throw IoError("/checks columns differ in length");
+  }
+  for (std::size_t i = 0; i < name.size(); ++i) {
+    checks.push_back(LogCheck{name[i], object_a[i], object_b[i], query[i], method[i], accuracy[i]});
+  }
+  return checks;
+}
+
+// /frame_check of a scene log (optional): the check of each /frames row.
+std::vector<std::int32_t> read_frame_checks(hid_t file) {
+  std::vector<std::int32_t> values;
+  if (H5Lexists(file, "frame_check", H5P_DEFAULT) <= 0) {
+    detail::clear_hdf5_error();
+    return values;
+  }
+  H5Handle dataset(H5Dopen2(file, "frame_check", H5P_DEFAULT), H5Dclose);
+  H5Handle space(dataset.valid() ? H5Dget_space(dataset.get()) : -1, H5Sclose);
+  hsize_t rows = 0;
+  if (!space.valid() || H5Sget_simple_extent_dims(space.get(), &rows, nullptr) < 0) {
+    detail::clear_hdf5_error();
+    throw IoError("/frame_check is not readable");
+  }
+  values.resize(rows);
+  if (rows > 0 && H5Dread(dataset.get(), H5T_NATIVE_INT32, H5S_ALL, H5S_ALL, H5P_DEFAULT,
+                          values.data()) < 0) {
+    throw IoError("cannot read /frame_check (" + detail::take_hdf5_error() + ")");
+  }
+  return values;
+}
+
 LogHeader read_header(hid_t file) {
   using detail::read_double_attribute;
   using detail::read_int_attribute;
@@ -155,6 +218,7 @@ LogHeader read_header(hid_t file) {
   h.complete = read_int_attribute(file, "complete").value_or(0) != 0;
   h.part_names = read_parts(file);
   h.routes = read_routes(file);
+  h.checks = read_checks(file);
   return h;
 }
 
@@ -213,6 +277,7 @@ LogData read_log(const std::filesystem::path& path, const ReadLogOptions& option
     read_table(file.get(), detail::kFramesPath, detail::frame_memory_type(), frames);
     data.frames.reserve(frames.size());
     for (const auto& f : frames) data.frames.push_back(from_disk(f));
+    data.frame_checks = read_frame_checks(file.get());
     if (options.findings) {
       std::vector<detail::ContactDisk> contacts;
       read_table(file.get(), detail::kContactsPath, detail::contact_memory_type(), contacts);

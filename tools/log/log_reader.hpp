@@ -14,6 +14,9 @@ struct LogData {
   std::vector<FrameRow> frames;        ///< /frames, in file order
   std::vector<ContactRow> contacts;    ///< /contacts (empty unless ReadLogOptions::findings)
   std::vector<DcdPairRow> dcd_pairs;   ///< /dcd_pairs (empty unless ReadLogOptions::findings)
+  /// /frame_check of a scene log: the check (index into header.checks) of each /frames row, in
+  /// file order (empty for other logs).
+  std::vector<std::int32_t> frame_checks;
 };
 
 struct ReadLogOptions {

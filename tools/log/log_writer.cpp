@@ -159,6 +159,55 @@ void write_routes(hid_t file, const std::vector<LogRoute>& routes, const std::st
   write_column(group.get(), "method", type.get(), method, where);
 }
 
+// /checks (scene logs): one row per check, as string columns. /frame_check: one int32 per /frames
+// row, extendible like /frames.
+void write_checks(hid_t file, const std::vector<LogCheck>& checks, const std::string& where) {
+  if (checks.empty()) return;
+  H5Handle group(H5Gcreate2(file, "checks", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), H5Gclose);
+  if (!group.valid()) {
+    throw IoError(where + ": cannot create /checks (" + detail::take_hdf5_error() + ")");
+  }
+  const auto type = detail::vlen_string_type();
+  const auto column = [&](const char* name, auto member) {
+    std::vector<const char*> values;
+    for (const auto& c : checks) values.push_back((c.*member).c_str());
+    const hsize_t count = values.size();
+    H5Handle space(H5Screate_simple(1, &count, nullptr), H5Sclose);
+    H5Handle dataset(H5Dcreate2(group.get(), name, type.get(), space.get(), H5P_DEFAULT,
+                                H5P_DEFAULT, H5P_DEFAULT),
+                     H5Dclose);
+    if (!space.valid() || !dataset.valid() ||
+        H5Dwrite(dataset.get(), type.get(), H5S_ALL, H5S_ALL, H5P_DEFAULT, values.data()) < 0) {
+      throw IoError(where + ": cannot write /checks/" + name + " (" + detail::take_hdf5_error() + ")");
+    }
+  };
+  column("name", &LogCheck::name);
+  column("object_a", &LogCheck::object_a);
+  column("object_b", &LogCheck::object_b);
+  column("query", &LogCheck::query);
+  column("method", &LogCheck::method);
+  column("accuracy", &LogCheck::accuracy);
+}
+
+Table create_frame_check_table(hid_t file, const std::string& where) {
+  const hsize_t initial = 0;
+  const hsize_t unlimited = H5S_UNLIMITED;
+  const hsize_t chunk = kFrameChunkRows;
+  H5Handle space(H5Screate_simple(1, &initial, &unlimited), H5Sclose);
+  H5Handle properties(H5Pcreate(H5P_DATASET_CREATE), H5Pclose);
+  Table table;
+  if (space.valid() && properties.valid() && H5Pset_chunk(properties.get(), 1, &chunk) >= 0) {
+    table.dataset = H5Handle(H5Dcreate2(file, "frame_check", H5T_STD_I32LE, space.get(),
+                                        H5P_DEFAULT, properties.get(), H5P_DEFAULT),
+                             H5Dclose);
+  }
+  if (!table.dataset.valid()) {
+    throw IoError(where + ": cannot create /frame_check (" + detail::take_hdf5_error() + ")");
+  }
+  table.memory_type = H5Handle(H5Tcopy(H5T_NATIVE_INT32), H5Tclose);
+  return table;
+}
+
 void write_header(hid_t file, const LogHeader& h) {
   using detail::write_attribute;
   write_attribute(file, "format", std::string(kLogFormatName));
@@ -206,6 +255,7 @@ struct LogWriter::Impl {
   Table frames;
   Table contacts;
   Table dcd_pairs;
+  Table frame_checks;  // scene logs only
   std::vector<detail::ContactDisk> contact_rows;
   std::vector<detail::DcdPairDisk> pair_rows;
   bool finished = false;
@@ -215,6 +265,7 @@ struct LogWriter::Impl {
     bool ok = frames.dataset.reset();
     ok = contacts.dataset.reset() && ok;
     ok = dcd_pairs.dataset.reset() && ok;
+    if (frame_checks.dataset.valid()) ok = frame_checks.dataset.reset() && ok;
     return file.reset() && ok;
   }
 };
@@ -247,6 +298,8 @@ LogWriter::LogWriter(const std::filesystem::path& path, const LogHeader& header)
     }
     write_parts(file, header.part_names, impl_->where);
     write_routes(file, header.routes, impl_->where);
+    write_checks(file, header.checks, impl_->where);
+    if (!header.checks.empty()) impl_->frame_checks = create_frame_check_table(file, impl_->where);
     impl_->frames = create_table(file, detail::kFramesPath, detail::frame_memory_type(),
                                  kFrameChunkRows, impl_->where);
     impl_->contacts = create_table(file, detail::kContactsPath, detail::contact_memory_type(),
@@ -306,6 +359,17 @@ void LogWriter::append(const FrameReport& report) {
   if (H5Fflush(impl_->file.get(), H5F_SCOPE_LOCAL) < 0) {
     throw IoError(impl_->where + ": cannot flush (" + detail::take_hdf5_error() + ")");
   }
+}
+
+void LogWriter::append(const FrameReport& report, std::int32_t check) {
+  if (impl_->finished) throw IoError(impl_->where + ": log already finished");
+  if (!impl_->frame_checks.dataset.valid()) {
+    throw IoError(impl_->where + ": append with a check to a log without /checks");
+  }
+  // The row's check first: a /frames row on disk implies its /frame_check entry is too.
+  append_rows(impl_->frame_checks, std::span<const std::int32_t>(&check, 1), "frame_check",
+              impl_->where);
+  append(report);
 }
 
 void LogWriter::finish() {

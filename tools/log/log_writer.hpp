@@ -25,6 +25,11 @@ class LogWriter {
   /// @throws IoError naming the file when HDF5 fails.
   void append(const FrameReport& report);
 
+  /// For a scene log (header.checks not empty): records the row's check (index into
+  /// header.checks) in /frame_check, then appends as above.
+  /// @throws IoError naming the file when HDF5 fails or the log has no checks.
+  void append(const FrameReport& report, std::int32_t check);
+
   /// Sets the root attribute `complete` to 1 and closes the file. Further calls do nothing.
   void finish();
 
