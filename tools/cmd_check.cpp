@@ -1,11 +1,20 @@
-// skelcd check MODEL — the main job: self-collision over a clip, sample by sample (DCD) and
+// skelcd check MODEL… — the main job: self-collision over a clip, sample by sample (DCD) and
 // interval by interval (CCD); prints a summary and writes the HDF5 log row by row (docs/check.md).
+// Several models (or a quoted glob, or --all-clips) make a batch: one log per clip in a folder,
+// broken inputs reported at the end.
 
+#include <fnmatch.h>
+
+#include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <fstream>
 #include <iostream>
 #include <memory>
+#include <optional>
+#include <set>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -15,21 +24,24 @@
 #include "culling/routed_method.hpp"
 #include "skelcd_version.hpp"
 #include "skinning/errors.hpp"
+#include "skinning/generators.hpp"
 #include "skinning/load.hpp"
 #include "skinning/rig_motion.hpp"
 #include "tools/cli_util.hpp"
 #include "tools/commands.hpp"
 #include "tools/file_hash.hpp"
+#include "tools/model_options.hpp"
 #include "tools/radial_view_setup.hpp"
 #include "tools/log/log_writer.hpp"
 #include "tools/run_summary.hpp"
 #include "tools/runner.hpp"
+#include "tools/scene_runner.hpp"
 
 namespace skelcd::tools {
 namespace {
 
 struct CheckArguments {
-  std::string model;
+  std::vector<std::string> models;
   std::string clip;
   double fps = 0;
   std::string frames;
@@ -38,8 +50,12 @@ struct CheckArguments {
   std::string query = "both";
   double min_separation = 0;
   std::string output;
+  std::string output_dir;
+  bool all_clips = false;
   bool json = false;
+  std::int32_t threads = 0;
   RadialViewArguments radial_view;
+  skinning::LoadOptions load;
 };
 
 /// The process's own command line (from /proc), arguments quoted when they need it.
@@ -98,6 +114,11 @@ RunOptions to_run_options(const CheckArguments& a) {
     throw InvalidInput("--min-separation: expected a distance >= 0");
   }
   o.min_separation = a.min_separation;
+  if (a.threads < 0) {
+    throw InvalidInput("--threads " + std::to_string(a.threads) +
+                       ": expected a worker count >= 1 (0: all cores)");
+  }
+  o.threads = a.threads;
   return o;
 }
 
@@ -117,39 +138,40 @@ std::string describe(const FrameRow& row) {
   return s.str();
 }
 
-void print_text_summary(const skinning::LoadedModel& model, const skinning::Motion& motion,
-                        const RunOptions& options, const RunPlan& plan, double fps,
-                        const RunSummary& s, const std::string& log_path) {
+void print_text_summary(std::ostream& out, const skinning::LoadedModel& model,
+                        const skinning::Motion& motion, const RunOptions& options,
+                        const RunPlan& plan, double fps, const RunSummary& s,
+                        const std::string& log_path) {
   const auto& mesh = motion.mesh();
   char line[256];
-  std::cout << "model     " << model.path.string() << " (" << mesh.num_parts() << " parts, "
+  out << "model     " << model.path.string() << " (" << mesh.num_parts() << " parts, "
             << mesh.num_vertices() << " vertices, " << mesh.num_triangles() << " triangles)\n";
   std::snprintf(line, sizeof line, "%.6g", fps);
-  std::cout << "clip      " << motion.name() << ": samples " << plan.first_sample << ".."
+  out << "clip      " << motion.name() << ": samples " << plan.first_sample << ".."
             << plan.last_sample << " at " << line << " Hz\n";
-  std::cout << "method    " << options.method << ", accuracy " << ccd::to_string(options.accuracy)
+  out << "method    " << options.method << ", accuracy " << ccd::to_string(options.accuracy)
             << ", query " << to_string(options.query) << "\n";
-  std::cout << "frames    " << s.samples << " samples, " << s.intervals << " intervals\n";
+  out << "frames    " << s.samples << " samples, " << s.intervals << " intervals\n";
   if (options.query != QuerySet::ccd) {
-    std::cout << "DCD       " << s.frames_with_interpenetration << " of " << s.samples
+    out << "DCD       " << s.frames_with_interpenetration << " of " << s.samples
               << " samples interpenetrate; " << s.dcd_pairs << " intersecting triangle pairs\n";
   }
   if (options.query != QuerySet::dcd) {
-    std::cout << "CCD       " << s.intervals_with_contacts << " of " << s.intervals
+    out << "CCD       " << s.intervals_with_contacts << " of " << s.intervals
               << " intervals have contacts; " << s.ccd_vf << " VF + " << s.ccd_ee
               << " EE contacts\n";
   }
   if (!s.worst.empty()) {
-    std::cout << "worst\n";
-    for (const auto& row : s.worst) std::cout << "  " << describe(row) << '\n';
+    out << "worst\n";
+    for (const auto& row : s.worst) out << "  " << describe(row) << '\n';
   }
   std::snprintf(line, sizeof line,
                 "time      %.3f ms per %s (skin %.3f, refit %.3f, classify %.3f, merge %.3f, "
                 "traverse %.3f, elementary %.3f, other %.3f)\n",
                 s.ms_per_interval, s.intervals > 0 ? "interval" : "sample", s.skin_ms, s.refit_ms,
                 s.classify_ms, s.merge_ms, s.traverse_ms, s.elementary_ms, s.other_ms);
-  std::cout << line;
-  if (!log_path.empty()) std::cout << "log       " << log_path << '\n';
+  out << line;
+  if (!log_path.empty()) out << "log       " << log_path << '\n';
 }
 
 nlohmann::json json_summary(const skinning::LoadedModel& model, const skinning::Motion& motion,
@@ -208,26 +230,44 @@ std::vector<LogRoute> log_routes(const skinning::Topology& topology, const RunOp
   return routes;
 }
 
-void run_check(const CheckArguments& args) {
-  // Everything that can be refused is checked before the log is created: options, the model,
-  // the clip, the frame range and the method.
-  RunOptions options = to_run_options(args);
-  const std::filesystem::path model_path(args.model);
-  const auto kind = skinning::classify_model_path(model_path);
-  if (kind != skinning::ModelKind::frame_sequence) require_exists(model_path);
-  const auto model = skinning::load_model(model_path);
-  const auto motion = model.motion(skinning::MotionRequest{.clip = args.clip, .rate_hz = args.fps});
+/// A model argument that names no file: a generator spec (`gen:rope`) or a frame sequence (a
+/// folder or a glob of frames).
+bool names_a_file(const std::string& model_arg) {
+  if (skinning::is_generator_spec(model_arg)) return false;
+  return skinning::classify_model_path(model_arg) != skinning::ModelKind::frame_sequence;
+}
+
+skinning::LoadedModel load_checked_model(const CheckArguments& args, const std::string& model_arg) {
+  if (names_a_file(model_arg)) require_exists(model_arg);
+  return skinning::load_model(model_arg, args.load);
+}
+
+/// One clip checked: the summary as text and as JSON.
+struct CheckedClip {
+  std::string text;
+  nlohmann::json json;
+};
+
+/// Checks one clip of a loaded model, writing the log at `log_path` (none when empty).
+/// Everything that can be refused is checked before the log is created: the clip, the frame
+/// range and the method.
+CheckedClip check_clip(const CheckArguments& args, RunOptions options, const std::string& model_arg,
+                       const skinning::LoadedModel& model, const std::string& clip,
+                       const std::string& log_path) {
+  options.clip = clip;
+  const std::filesystem::path model_path(model_arg);
+  const auto motion = model.motion(skinning::MotionRequest{.clip = clip, .rate_hz = args.fps});
   const auto radial_view = setup_radial_view(args.radial_view, model, *motion, options);
   ClipRunner runner(*motion, options);
   const RunPlan& plan = runner.plan();
   const double fps = motion_rate(*motion, args.fps);
 
   std::unique_ptr<LogWriter> writer;
-  if (!args.output.empty()) {
+  if (!log_path.empty()) {
     LogHeader header;
     header.skelcd_version = kVersion;
     header.command_line = command_line();
-    header.input_path = args.model;
+    header.input_path = model_arg;
     header.input_hash =
         std::filesystem::is_regular_file(model_path) ? file_content_hash(model_path) : "";
     header.clip = motion->name();
@@ -245,7 +285,7 @@ void run_check(const CheckArguments& args) {
     header.num_triangles = motion->mesh().num_triangles();
     header.part_names = motion->mesh().part_names;
     header.routes = log_routes(runner.topology(), options);
-    writer = std::make_unique<LogWriter>(args.output, header);
+    writer = std::make_unique<LogWriter>(log_path, header);
   }
 
   std::vector<FrameRow> rows;
@@ -260,10 +300,212 @@ void run_check(const CheckArguments& args) {
   if (writer) writer->finish();
 
   const auto summary = summarize(rows);
+  CheckedClip checked;
+  std::ostringstream text;
+  print_text_summary(text, model, *motion, options, plan, fps, summary, log_path);
+  checked.text = text.str();
+  checked.json = json_summary(model, *motion, options, plan, fps, summary, log_path);
+  return checked;
+}
+
+void run_check(const CheckArguments& args) {
+  // Everything that can be refused is checked before the log is created: options, the model,
+  // the clip, the frame range and the method.
+  const RunOptions options = to_run_options(args);
+  const std::string& model_arg = args.models.front();
+  const auto model = load_checked_model(args, model_arg);
+  const auto checked = check_clip(args, options, model_arg, model, args.clip, args.output);
   if (args.json) {
-    print_json(json_summary(model, *motion, options, plan, fps, summary, args.output));
+    print_json(checked.json);
   } else {
-    print_text_summary(model, *motion, options, plan, fps, summary, args.output);
+    std::cout << checked.text;
+  }
+}
+
+// --- batch mode ---------------------------------------------------------------------------------
+
+bool has_glob(const std::string& arg) {
+  return !skinning::is_generator_spec(arg) && arg.find_first_of("*?[") != std::string::npos;
+}
+
+bool is_frame_file(const std::filesystem::path& path) {
+  std::string ext = path.extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  return ext == ".obj" || ext == ".ply";
+}
+
+/// The files and folders a glob's last component matches in its folder, sorted; empty when the
+/// folder part has glob characters or cannot be listed.
+std::vector<std::string> glob_matches(const std::string& pattern) {
+  std::vector<std::string> matches;
+  const std::filesystem::path path(pattern);
+  const auto dir = path.parent_path();
+  const std::string name = path.filename().string();
+  if (name.empty() || dir.string().find_first_of("*?[") != std::string::npos) return matches;
+  std::error_code ec;
+  const std::filesystem::path listed = dir.empty() ? std::filesystem::path(".") : dir;
+  for (const auto& entry : std::filesystem::directory_iterator(listed, ec)) {
+    const std::string file = entry.path().filename().string();
+    if (fnmatch(name.c_str(), file.c_str(), FNM_PERIOD) != 0) continue;
+    matches.push_back((dir / file).string());
+  }
+  std::sort(matches.begin(), matches.end());
+  return matches;
+}
+
+/// The model arguments with quoted globs expanded (`'dir/*.glb'`): a glob that matches only OBJ/PLY
+/// frames (or nothing) stays one argument, a frame sequence, as with a single model.
+std::vector<std::string> expand_models(const std::vector<std::string>& args, bool& expanded) {
+  std::vector<std::string> models;
+  expanded = false;
+  for (const auto& arg : args) {
+    if (!has_glob(arg)) {
+      models.push_back(arg);
+      continue;
+    }
+    const auto matches = glob_matches(arg);
+    const bool frames = std::all_of(matches.begin(), matches.end(), [](const std::string& m) {
+      return std::filesystem::is_regular_file(m) && is_frame_file(m);
+    });
+    if (frames) {
+      models.push_back(arg);
+    } else {
+      models.insert(models.end(), matches.begin(), matches.end());
+      expanded = true;
+    }
+  }
+  return models;
+}
+
+std::string file_name_part(const std::string& text) {
+  std::string out;
+  for (const char c : text) {
+    const bool keep = std::isalnum(static_cast<unsigned char>(c)) != 0 || c == '-' || c == '_' ||
+                      c == '.';
+    out += keep ? c : '_';
+  }
+  while (!out.empty() && out.front() == '.') out.erase(out.begin());
+  return out.empty() ? std::string("model") : out;
+}
+
+/// MODEL-CLIP.h5 for a batch log: the model file's stem (a generator spec as written), the clip.
+std::string log_name(const std::string& model_arg, const std::string& clip) {
+  std::string stem;
+  if (skinning::is_generator_spec(model_arg)) {
+    stem = model_arg;
+  } else {
+    auto path = std::filesystem::path(model_arg).lexically_normal();
+    if (path.filename().empty()) path = path.parent_path();
+    stem = has_glob(model_arg) ? path.parent_path().filename().string() : path.stem().string();
+  }
+  std::string name = file_name_part(stem);
+  if (!clip.empty()) name += "-" + file_name_part(clip);
+  return name;
+}
+
+struct Failure {
+  std::string model;
+  std::string clip;
+  std::string error;
+};
+
+void run_batch(const CheckArguments& args, const std::vector<std::string>& models) {
+  const RunOptions options = to_run_options(args);
+  if (args.all_clips && !args.clip.empty()) {
+    throw InvalidInput("--all-clips and --clip " + args.clip + ": give one of them");
+  }
+  if (!args.output.empty() && !args.output_dir.empty() && args.output != args.output_dir) {
+    throw InvalidInput("-o " + args.output + " and --output-dir " + args.output_dir +
+                       ": in batch mode both name the folder for the logs; give one");
+  }
+  const std::filesystem::path dir = args.output_dir.empty() ? args.output : args.output_dir;
+  if (!dir.empty()) {
+    std::error_code ec;
+    std::filesystem::create_directories(dir, ec);
+    if (ec || !std::filesystem::is_directory(dir)) {
+      throw IoError(dir.string() + ": cannot create the log folder" +
+                    (ec ? ": " + ec.message() : std::string()));
+    }
+  }
+
+  std::vector<CheckedClip> runs;
+  std::vector<Failure> failures;
+  std::set<std::string> names;
+  std::size_t checks = 0;
+  for (const auto& model_arg : models) {
+    std::optional<skinning::LoadedModel> model;
+    try {
+      model.emplace(load_checked_model(args, model_arg));
+    } catch (const std::exception& e) {
+      ++checks;
+      failures.push_back(Failure{model_arg, args.clip, e.what()});
+      continue;
+    }
+    std::vector<std::string> clips{args.clip};
+    if (args.all_clips && !model->clips.empty()) {
+      clips.clear();
+      for (const auto& c : model->clips) clips.push_back(c.name);
+    }
+    for (const auto& clip : clips) {
+      ++checks;
+      // The log's name: the clip asked for, else the model's first clip.
+      const std::string clip_name =
+          !clip.empty() ? clip : (model->clips.empty() ? std::string() : model->clips.front().name);
+      std::string log_path;
+      if (!dir.empty()) {
+        const std::string base = log_name(model_arg, clip_name);
+        std::string name = base;
+        for (int k = 2; names.count(name) != 0; ++k) name = base + "-" + std::to_string(k);
+        names.insert(name);
+        log_path = (dir / (name + ".h5")).string();
+      }
+      try {
+        runs.push_back(check_clip(args, options, model_arg, *model, clip, log_path));
+        if (!args.json) std::cout << runs.back().text << '\n' << std::flush;
+      } catch (const std::exception& e) {
+        failures.push_back(Failure{model_arg, clip_name, e.what()});
+      }
+    }
+  }
+
+  if (args.json) {
+    auto done = nlohmann::json::array();
+    for (const auto& r : runs) done.push_back(r.json);
+    auto failed = nlohmann::json::array();
+    for (const auto& f : failures) {
+      failed.push_back({{"model", f.model}, {"clip", f.clip}, {"error", f.error}});
+    }
+    print_json({{"runs", done}, {"failures", failed}});
+  } else {
+    std::cout << "batch     " << checks << " checks of " << models.size() << " models: "
+              << runs.size() << " done, " << failures.size() << " failed\n";
+    for (const auto& f : failures) {
+      std::cout << "FAILED    " << f.model << (f.clip.empty() ? "" : " (clip " + f.clip + ")")
+                << ": " << f.error << '\n';
+    }
+  }
+  if (!failures.empty()) {
+    throw InvalidInput(std::to_string(failures.size()) + " of " + std::to_string(checks) +
+                       " checks failed, first " + failures.front().model + ": " +
+                       failures.front().error);
+  }
+  if (models.empty()) throw InvalidInput("no model matched");
+}
+
+void run_check_command(const CheckArguments& args) {
+  if (args.models.size() == 1 && is_scene_path(args.models.front())) {  // a scene (docs/scenes.md)
+    run_scene_check(args.models.front(), SceneCheckArguments{.output = args.output, .frames = args.frames,
+                                                             .threads = args.threads, .json = args.json});
+    return;
+  }
+  bool expanded = false;
+  const auto models = expand_models(args.models, expanded);
+  const bool batch = models.size() != 1 || expanded || args.all_clips || !args.output_dir.empty();
+  if (batch) {
+    run_batch(args, models);
+  } else {
+    run_check(args);
   }
 }
 
@@ -273,7 +515,9 @@ void add_check_command(CLI::App& app) {
   auto args = std::make_shared<CheckArguments>();
   auto* cmd = app.add_subcommand(
       "check", "Self-collision over a clip: DCD at every sample, CCD over every interval");
-  cmd->add_option("model", args->model, "model file (glTF, FBX, Collada, .X, …), URDF or frames")
+  cmd->add_option("model", args->models,
+                  "model file(s) (glTF, FBX, Collada, .X, …), URDF, frames or gen:NAME; several, "
+                  "or a quoted glob ('dir/*.glb'), make a batch")
       ->required();
   cmd->add_option("--clip", args->clip, "clip to check (default: the first)");
   cmd->add_option("--fps", args->fps, "samples per second (default: the clip's key rate, else 30)");
@@ -285,10 +529,17 @@ void add_check_command(CLI::App& app) {
   cmd->add_option("--query", args->query, "ccd, dcd or both")->capture_default_str();
   cmd->add_option("--min-separation", args->min_separation,
                   "contact distance in model units (0: touching counts)");
-  cmd->add_option("-o,--output", args->output, "write the HDF5 log here (LOG.h5)");
+  cmd->add_option("-o,--output", args->output,
+                  "write the HDF5 log here (LOG.h5); in a batch: the folder for the logs");
+  cmd->add_option("--output-dir", args->output_dir,
+                  "batch: write one log per clip into this folder (MODEL-CLIP.h5)");
+  cmd->add_flag("--all-clips", args->all_clips, "check every clip of each model (a batch)");
+  cmd->add_option("--threads", args->threads,
+                  "worker threads (default 0: all cores; 1: serial); results do not depend on it");
   cmd->add_flag("--json", args->json, "print the summary as one JSON object");
   add_radial_view_options(*cmd, args->radial_view);
-  cmd->callback([args] { run_check(*args); });
+  add_model_options(*cmd, args->load);
+  cmd->callback([args] { run_check_command(*args); });
 }
 
 }  // namespace skelcd::tools

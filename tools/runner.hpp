@@ -1,7 +1,10 @@
 #pragma once
 // The per-interval runner: poses a Motion sample by sample, welds, and asks a culling method for
 // DCD findings at each sample and CCD contacts over each interval between consecutive samples,
-// reporting every row in the file's own numbering as soon as it completes.
+// reporting every row in the file's own numbering as soon as it completes. With several threads
+// (RunOptions::threads) it checks blocks of consecutive samples in parallel, one method object
+// per worker, and still reports the rows strictly in order with the same contents as a serial run
+// (docs/check.md, "Threads").
 
 #include <cstdint>
 #include <functional>
@@ -9,6 +12,7 @@
 #include <optional>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include "ccd/accuracy.hpp"
 #include "culling/method.hpp"
@@ -28,6 +32,14 @@ struct FrameRange {
 /// @throws InvalidInput quoting `text` when it is malformed.
 [[nodiscard]] FrameRange parse_frame_range(std::string_view text);
 
+/// What one parallel worker needs besides its own method: the extension its method is built with
+/// and the before_query hook that selects that worker's per-query state (rvbc/dynamic: its own
+/// bone poses).
+struct WorkerHooks {
+  std::shared_ptr<const culling::MethodExtension> method_extension;
+  std::function<void(std::int32_t sample_t0, std::int32_t sample_t1)> before_query;
+};
+
 struct RunOptions {
   std::string clip;    ///< clip to check (empty: the model's first clip) — used by the loader
   double fps = 0;      ///< sampling rate in samples/s (0: the clip's own key rate) — used by the loader
@@ -40,6 +52,18 @@ struct RunOptions {
   std::shared_ptr<const culling::MethodExtension> method_extension;
   /// Called before each query with its samples (a DCD at i: (i, i); a CCD interval: (i, i + 1)).
   std::function<void(std::int32_t sample_t0, std::int32_t sample_t1)> before_query;
+  /// Worker threads: 1 = serial (the default here), 0 = all cores (tbb::info::default_concurrency).
+  /// A run is serial anyway when its method carries state between queries that would change its
+  /// rows (RunPlan::serial_reason says why).
+  std::int32_t threads = 1;
+  /// Samples per block a worker checks in a row (0: chosen from the clip length and threads).
+  std::int32_t block_samples = 0;
+  /// With before_query set, a parallel run calls this once per extra worker for that worker's own
+  /// extension and hook; without it such a run is serial.
+  std::function<WorkerHooks()> make_worker_hooks;
+  /// The factory's methods keep no state between queries that changes their findings or counters
+  /// (methods of make_method are classified by name; a custom factory's only through this).
+  bool factory_methods_stateless = false;
 };
 
 /// What a run will do, resolved against the motion's sample count.
@@ -49,7 +73,19 @@ struct RunPlan {
   std::int32_t samples = 0;    ///< last - first + 1
   std::int32_t intervals = 0;  ///< CCD intervals checked (0 for --query dcd)
   std::int64_t rows = 0;       ///< FrameReports the run produces
+  std::int32_t threads = 1;    ///< workers the run uses (1: serial)
+  std::int32_t block_samples = 0;  ///< samples per block of a parallel run (0 when serial)
+  /// Why a run asked for several threads is serial (empty when it is not).
+  std::string serial_reason;
 };
+
+/// Why method `name` must run serially under `options` (empty: parallel runs give the same rows):
+/// rvbc/dynamic carry which components were free of self-intersection from one query to the next,
+/// which changes their counters with --query ccd and can change them with --accuracy fast.
+[[nodiscard]] std::string serial_reason(std::string_view name, const RunOptions& options);
+
+/// The worker count `--threads N` means: N, or all cores for 0.
+[[nodiscard]] std::int32_t resolve_threads(std::int32_t threads);
 
 /// Builds the culling method for a mesh; the default calls culling::make_method(options.method…).
 using MethodFactory = std::function<std::unique_ptr<culling::CullingMethod>(
@@ -69,14 +105,20 @@ class ClipRunner {
   [[nodiscard]] const skinning::Topology& topology() const { return topology_; }
   [[nodiscard]] std::string_view method_name() const { return method_->name(); }
 
-  /// Runs every row of the plan, calling `on_frame` after each.
+  /// Runs every row of the plan, calling `on_frame` after each, in plan order (one call at a time;
+  /// in a parallel run possibly from a worker thread).
   /// @throws InvalidInput naming the motion and sample when a posed position is not finite;
-  /// rows completed before it have been reported.
+  /// rows completed before it have been reported (also in a parallel run).
   void run(const FrameCallback& on_frame);
 
  private:
+  void run_serial(const FrameCallback& on_frame);
+  void run_parallel(const FrameCallback& on_frame);
+
   const skinning::Motion& motion_;
   RunOptions options_;
+  MethodFactory factory_;
+  culling::MethodOptions method_options_;
   RunPlan plan_;
   skinning::Topology topology_;
   std::unique_ptr<culling::CullingMethod> method_;

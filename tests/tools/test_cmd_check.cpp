@@ -290,4 +290,125 @@ TEST(CmdCheck, GeneratedFrameSequenceHasTheHandCountedContacts) {
   }
 }
 
+// --- batch mode, robots, generator specs, threads -------------------------------------------------
+
+std::vector<std::string> h5_files(const std::filesystem::path& dir) {
+  std::vector<std::string> names;
+  for (const auto& e : std::filesystem::directory_iterator(dir)) {
+    if (e.path().extension() == ".h5") names.push_back(e.path().filename().string());
+  }
+  std::sort(names.begin(), names.end());
+  return names;
+}
+
+TEST(CmdCheck, BatchWritesOneLogPerClipAndReportsBrokenInputsAtTheEnd) {
+  const auto dir = skelcd::test::temp_dir("check-batch");
+  const auto models = dir / "models";
+  std::filesystem::create_directories(models);
+  std::filesystem::copy_file(kModel, models / "a.X");
+  std::filesystem::copy_file(kModel, models / "b.X");
+  std::ofstream(models / "broken.X") << "xof 0303txt 0032\nFrame {{ this is not an X file\n";
+  const std::string glob = (models / "*.X").string();
+  const std::string rope = "gen:rope?triangles=200&frames=3";
+  const std::string missing = (dir / "missing.glb").string();
+
+  const auto out = dir / "logs";
+  const auto r = run_skelcd({"check", glob, rope, missing, "--frames", "0:2", "-o", out.string()});
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_EQ(count_lines(r.err), 1u) << r.err;
+  EXPECT_NE(r.err.find("2 of 5 checks failed"), std::string::npos) << r.err;
+  // The summary names each failure in one line, after the runs that worked.
+  EXPECT_NE(r.out.find("batch     5 checks of 5 models: 3 done, 2 failed"), std::string::npos)
+      << r.out;
+  for (const auto& bad : {(models / "broken.X").string(), missing}) {
+    const auto at = r.out.find("FAILED    " + bad);
+    ASSERT_NE(at, std::string::npos) << bad << "\n" << r.out;
+    EXPECT_NE(r.out.find('\n', at), std::string::npos);
+  }
+  EXPECT_NE(r.out.find(missing + ": no such file"), std::string::npos) << r.out;
+
+  // One complete log per clip that ran, named after the model and clip; none for the failures.
+  const auto names = h5_files(out);
+  ASSERT_EQ(names.size(), 3u) << r.out;
+  EXPECT_EQ(names[0].rfind("a-", 0), 0u) << names[0];
+  EXPECT_EQ(names[1].rfind("b-", 0), 0u) << names[1];
+  EXPECT_EQ(names[2].rfind("gen_rope_triangles_200_frames_3", 0), 0u) << names[2];
+  const std::vector<std::string> inputs{(models / "a.X").string(), (models / "b.X").string(), rope};
+  for (std::size_t i = 0; i < names.size(); ++i) {
+    const auto log = read_log(out / names[i]);
+    EXPECT_TRUE(log.header.complete) << names[i];
+    EXPECT_EQ(log.header.input_path, inputs[i]);
+    EXPECT_EQ(log.frames.size(), 3u + 2u) << names[i];
+  }
+  // The two copies of the same character found the same things.
+  EXPECT_EQ(contact_keys(read_log(out / names[0])), contact_keys(read_log(out / names[1])));
+
+  // --json: the summaries and the failures, still a failing exit.
+  const auto j_run = run_skelcd({"check", glob, missing, "--frames", "0:1", "--query", "dcd",
+                                 "--json", "--output-dir", (dir / "json").string()});
+  EXPECT_EQ(j_run.exit_code, 1);
+  const auto j = nlohmann::json::parse(j_run.out);
+  ASSERT_EQ(j["runs"].size(), 2u);
+  EXPECT_EQ(j["runs"][0]["model"], (models / "a.X").string());
+  EXPECT_EQ(j["runs"][1]["frames"], 2);
+  ASSERT_EQ(j["failures"].size(), 2u);
+  EXPECT_EQ(j["failures"][0]["model"], (models / "broken.X").string());
+  EXPECT_EQ(j["failures"][1]["model"], missing);
+  EXPECT_NE(j["failures"][1]["error"].get<std::string>().find("no such file"), std::string::npos);
+  EXPECT_EQ(h5_files(dir / "json").size(), 2u);
+}
+
+TEST(CmdCheck, BatchOfGoodInputsSucceedsAndAllClipsChecksEachClip) {
+  const auto dir = skelcd::test::temp_dir("check-all-clips");
+  const auto model = skelcd::test::asset("characters/RobotExpressive.glb").string();
+  const auto info = nlohmann::json::parse(run_skelcd({"info", model, "--json"}).out);
+  const auto clips = info["clips"].size();
+  ASSERT_GT(clips, 3u);
+  const auto r = run_skelcd({"check", model, "--all-clips", "--frames", "0:1", "--query", "dcd",
+                             "--method", "bvh", "--json", "-o", dir.string()});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  ASSERT_EQ(j["runs"].size(), clips);
+  EXPECT_TRUE(j["failures"].empty());
+  EXPECT_EQ(h5_files(dir).size(), clips);
+  for (std::size_t i = 0; i < clips; ++i) {
+    EXPECT_EQ(j["runs"][i]["clip"], info["clips"][i]["name"]);
+    const auto name = "RobotExpressive-" + info["clips"][i]["name"].get<std::string>() + ".h5";
+    EXPECT_TRUE(std::filesystem::exists(dir / name)) << name;
+  }
+  // --all-clips with --clip is a contradiction, refused before any work.
+  const auto both = run_skelcd({"check", model, "--all-clips", "--clip", "Dance"});
+  EXPECT_EQ(both.exit_code, 1);
+  EXPECT_NE(both.err.find("--all-clips"), std::string::npos);
+}
+
+TEST(CmdCheck, BareGeneratorSpecsRobotOptionsAndThreads) {
+  // gen:panda without a '?' is a model, not a missing file.
+  const auto panda = run_skelcd({"check", "gen:panda", "--frames", "0:3", "--query", "dcd",
+                                 "--json"});
+  ASSERT_EQ(panda.exit_code, 0) << panda.err;
+  EXPECT_EQ(nlohmann::json::parse(panda.out)["frames"], 4);
+
+  // The URDF with its trajectory and SRDF, as `info` takes them.
+  const auto root = skelcd::test::asset("robots/example-robot-data/robots/panda_description");
+  const auto urdf = (root / "urdf/panda.urdf").string();
+  const auto srdf = (root / "srdf/panda.srdf").string();
+  const auto csv = skelcd::test::asset("trajectories/panda_reach.csv").string();
+  const auto robot = run_skelcd({"check", urdf, "--trajectory", csv, "--srdf", srdf, "--frames",
+                                 "0:4", "--json", "--threads", "2"});
+  ASSERT_EQ(robot.exit_code, 0) << robot.err;
+  const auto j = nlohmann::json::parse(robot.out);
+  EXPECT_EQ(j["frames"], 5);
+  EXPECT_EQ(j["intervals"], 4);
+  const auto no_trajectory = run_skelcd({"check", urdf, "--trajectory",
+                                         (root / "missing.csv").string()});
+  EXPECT_EQ(no_trajectory.exit_code, 1);
+  EXPECT_NE(no_trajectory.err.find("missing.csv"), std::string::npos) << no_trajectory.err;
+
+  const auto bad = run_skelcd({"check", kModel, "--threads", "-2"});
+  EXPECT_EQ(bad.exit_code, 1);
+  EXPECT_EQ(count_lines(bad.err), 1u);
+  EXPECT_NE(bad.err.find("--threads -2"), std::string::npos) << bad.err;
+}
+
 }  // namespace

@@ -1,0 +1,350 @@
+// The runner with several threads: the same rows, in the same order, as a serial run (every
+// counter, contact and DCD pair; only the timings differ), on a real character and a generated
+// rig, for bvh, dynamic and auto; rows handed over one at a time and in order; a bounded number of
+// rows waiting to be reported; an error reported after exactly the rows a serial run reports; and
+// the methods that carry state between queries kept serial — with a run that shows why.
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <mutex>
+#include <thread>
+#include <vector>
+
+#include <gtest/gtest.h>
+#include <tbb/info.h>
+
+#include "clustering/bone_poses.hpp"
+#include "clustering/radial_view_extension.hpp"
+#include "segmentation/segmentation.hpp"
+#include "skinning/errors.hpp"
+#include "skinning/load.hpp"
+#include "skinning/rig_motion.hpp"
+#include "tests/support/test_support.hpp"
+#include "tools/radial_view_setup.hpp"
+#include "tools/runner.hpp"
+
+namespace {
+
+using namespace skelcd;
+using namespace skelcd::tools;
+using skinning::Positions;
+
+const std::string kCharacter = test::assimp_model("X/BCN_Epileptic.X").string();
+
+std::vector<FrameReport> collect(ClipRunner& runner) {
+  std::vector<FrameReport> reports;
+  runner.run([&](const FrameReport& r) { reports.push_back(r); });
+  return reports;
+}
+
+void expect_same_counters(const culling::Counters& a, const culling::Counters& b,
+                          const std::string& where) {
+#define SKELCD_SAME(field) EXPECT_EQ(a.field, b.field) << where << ": " #field
+  SKELCD_SAME(atomic_clusters);
+  SKELCD_SAME(mega_clusters);
+  SKELCD_SAME(h_minus);
+  SKELCD_SAME(h_uncertain);
+  SKELCD_SAME(bv_tests);
+  SKELCD_SAME(candidate_pairs);
+  SKELCD_SAME(vf_tests);
+  SKELCD_SAME(ee_tests);
+  SKELCD_SAME(vf_contacts);
+  SKELCD_SAME(ee_contacts);
+  SKELCD_SAME(tt_tests);
+  SKELCD_SAME(dcd_pairs);
+  SKELCD_SAME(feature_bv_tests);
+#undef SKELCD_SAME
+}
+
+/// Every row equal except its times; returns the number of contacts + DCD pairs seen.
+std::size_t expect_same_rows(const std::vector<FrameReport>& serial,
+                             const std::vector<FrameReport>& parallel) {
+  EXPECT_EQ(serial.size(), parallel.size());
+  std::size_t findings = 0;
+  for (std::size_t i = 0; i < std::min(serial.size(), parallel.size()); ++i) {
+    const auto& s = serial[i];
+    const auto& p = parallel[i];
+    const std::string where = "row " + std::to_string(i);
+    EXPECT_EQ(s.row.sample, p.row.sample) << where;
+    EXPECT_EQ(s.row.kind, p.row.kind) << where;
+    EXPECT_EQ(s.row.t0, p.row.t0) << where;
+    EXPECT_EQ(s.row.t1, p.row.t1) << where;
+    expect_same_counters(s.row.counters, p.row.counters, where);
+    EXPECT_EQ(s.contacts, p.contacts) << where;  // same order too
+    EXPECT_EQ(s.dcd_pairs, p.dcd_pairs) << where;
+    findings += s.contacts.size() + s.dcd_pairs.size();
+  }
+  return findings;
+}
+
+struct Loaded {
+  skinning::LoadedModel model;
+  std::unique_ptr<skinning::Motion> motion;
+};
+
+Loaded load(const std::string& spec) {
+  Loaded l{skinning::load_model(spec), nullptr};
+  l.motion = l.model.motion();
+  return l;
+}
+
+/// Runs `method` over `frames` serially and with `threads` workers in blocks of `block` samples.
+std::pair<std::vector<FrameReport>, std::vector<FrameReport>> serial_and_parallel(
+    const Loaded& l, const std::string& method, const std::string& frames, std::int32_t threads,
+    std::int32_t block, QuerySet query = QuerySet::both, RunPlan* parallel_plan = nullptr) {
+  std::vector<FrameReport> out[2];
+  for (const int k : {0, 1}) {
+    RunOptions options;
+    options.method = method;
+    options.frames = parse_frame_range(frames);
+    options.query = query;
+    options.threads = k == 0 ? 1 : threads;
+    options.block_samples = block;
+    (void)setup_radial_view(RadialViewArguments{}, l.model, *l.motion, options);
+    ClipRunner runner(*l.motion, options);
+    if (k == 1) {
+      EXPECT_EQ(runner.plan().threads, threads) << method << ": " << runner.plan().serial_reason;
+      if (parallel_plan != nullptr) *parallel_plan = runner.plan();
+    } else {
+      EXPECT_EQ(runner.plan().threads, 1);
+    }
+    out[k] = collect(runner);
+  }
+  return {std::move(out[0]), std::move(out[1])};
+}
+
+TEST(ParallelRunner, RealCharacterRowsEqualSerialForBvhDynamicAndAuto) {
+  const auto l = load(kCharacter);
+  for (const char* method : {"bvh", "dynamic", "auto"}) {
+    SCOPED_TRACE(method);
+    // Blocks of 2 samples over 4 workers: every block boundary is a worker change.
+    const auto [serial, parallel] = serial_and_parallel(l, method, "36:47", 4, 2);
+    EXPECT_EQ(serial.size(), 12u + 11u);
+    EXPECT_GT(expect_same_rows(serial, parallel), 0u) << "no findings: the clip proves nothing";
+  }
+}
+
+// The rope (a closed tube) coils into itself from sample 17 of 24.
+const std::string kRope = "gen:rope?triangles=200&frames=24";
+
+TEST(ParallelRunner, GeneratedRigRowsEqualSerialForBvhAndDynamic) {
+  const auto l = load(kRope);
+  for (const char* method : {"bvh", "dynamic", "kdop"}) {
+    SCOPED_TRACE(method);
+    const auto [serial, parallel] = serial_and_parallel(l, method, "12:", 3, 3);
+    EXPECT_EQ(serial.size(), 12u + 11u);
+    EXPECT_GT(expect_same_rows(serial, parallel), 0u);
+  }
+  // The query subsets cut into blocks the same way.
+  for (const auto query : {QuerySet::dcd, QuerySet::ccd}) {
+    const auto [serial, parallel] = serial_and_parallel(l, "bvh", "12:", 2, 5, query);
+    EXPECT_EQ(serial.size(), query == QuerySet::dcd ? 12u : 11u);
+    EXPECT_GT(expect_same_rows(serial, parallel), 0u);
+  }
+}
+
+/// Sample i: the first sample of `base` translated by (1000 i, 0, 0); one NaN at `nan_sample`.
+class ShiftMotion : public skinning::Motion {
+ public:
+  ShiftMotion(const skinning::Motion& base, int samples) : base_(base), samples_(samples) {}
+  const skinning::Mesh& mesh() const override { return base_.mesh(); }
+  int num_samples() const override { return samples_; }
+  double sample_time(int i) const override { return 0.25 * i; }
+  std::string name() const override { return "shift-clip"; }
+  void positions(int i, Positions& out) const override {
+    base_.positions(0, out);
+    out.col(0).array() += 1000.0 * i;
+    if (i == nan_sample) out(4, 1) = std::numeric_limits<double>::quiet_NaN();
+  }
+  int nan_sample = -1;
+
+ private:
+  const skinning::Motion& base_;
+  int samples_;
+};
+
+/// A stateless method that tells which sample it was given (from the shift) and can stall.
+class ProbeMethod : public culling::CullingMethod {
+ public:
+  using Hook = std::function<void(int sample)>;
+  explicit ProbeMethod(Hook hook) : hook_(std::move(hook)) {}
+  std::string_view name() const override { return "probe"; }
+  void detect_dcd(const Positions& x, culling::FrameResult& out) override {
+    hook_(sample_of(x));
+    out.counters.tt_tests = sample_of(x);
+  }
+  void detect_ccd(const Positions& x_t0, const Positions& x_t1, culling::FrameResult& out) override {
+    hook_(sample_of(x_t0));
+    out.counters.vf_tests = 1000 * sample_of(x_t0) + sample_of(x_t1);
+  }
+
+ private:
+  static int sample_of(const Positions& x) {
+    return static_cast<int>(std::lround(x(0, 0) / 1000.0));
+  }
+  Hook hook_;
+};
+
+TEST(ParallelRunner, RowsArriveOneAtATimeInOrderWithABoundedBacklog) {
+  const auto l = load("gen:rope?triangles=200&frames=2");
+  ShiftMotion motion(*l.motion, 200);
+  std::atomic<int> started{0};
+  std::atomic<int> max_backlog{0};
+  std::atomic<int> emitted{0};
+  RunOptions options;
+  options.threads = 4;
+  options.block_samples = 2;
+  options.factory_methods_stateless = true;
+  ClipRunner runner(motion, options, [&](const skinning::Mesh&, const skinning::Topology&,
+                                         const culling::MethodOptions&) {
+    return std::make_unique<ProbeMethod>([&](int sample) {
+      // The first block stalls: the others may run ahead only as far as the live blocks allow.
+      if (sample == 0) std::this_thread::sleep_for(std::chrono::milliseconds(100));
+      const int backlog = ++started - emitted.load();
+      int seen = max_backlog.load();
+      while (backlog > seen && !max_backlog.compare_exchange_weak(seen, backlog)) {
+      }
+    });
+  });
+  ASSERT_EQ(runner.plan().threads, 4);
+  std::atomic<bool> inside{false};
+  std::vector<FrameReport> reports;
+  runner.run([&](const FrameReport& r) {
+    EXPECT_FALSE(inside.exchange(true)) << "two rows reported at once";
+    reports.push_back(r);
+    ++emitted;
+    inside = false;
+  });
+  ASSERT_EQ(reports.size(), 200u + 199u);
+  for (std::size_t i = 0; i < reports.size(); ++i) {
+    const auto sample = static_cast<int>(i / 2);
+    ASSERT_EQ(reports[i].row.sample, sample) << i;
+    ASSERT_EQ(reports[i].row.kind, i % 2 == 0 ? QueryKind::dcd : QueryKind::ccd) << i;
+    if (i % 2 == 0) {
+      EXPECT_EQ(reports[i].row.counters.tt_tests, sample);
+    } else {
+      EXPECT_EQ(reports[i].row.counters.vf_tests, 1000 * sample + sample + 1);
+    }
+  }
+  // 2 × threads live blocks of at most 4 rows each (2 samples: DCD + CCD).
+  EXPECT_LE(max_backlog.load(), 2 * 4 * 4);
+  EXPECT_GE(max_backlog.load(), 4) << "the workers never ran ahead of the stalled block";
+}
+
+TEST(ParallelRunner, AnErrorComesAfterExactlyTheRowsASerialRunReports) {
+  const auto l = load("gen:rope?triangles=200&frames=2");
+  for (const int threads : {1, 4}) {
+    ShiftMotion motion(*l.motion, 40);
+    motion.nan_sample = 17;
+    RunOptions options;
+    options.threads = threads;
+    options.block_samples = 3;
+    options.factory_methods_stateless = true;
+    ClipRunner runner(motion, options, [](const skinning::Mesh&, const skinning::Topology&,
+                                          const culling::MethodOptions&) {
+      return std::make_unique<ProbeMethod>([](int) {});
+    });
+    EXPECT_EQ(runner.plan().threads, threads);
+    std::vector<FrameReport> reports;
+    EXPECT_THROW_MESSAGE(runner.run([&](const FrameReport& r) { reports.push_back(r); }),
+                         InvalidInput, "shift-clip: sample 17 (t = 4.25");
+    EXPECT_EQ(reports.size(), 2u * 16u + 1u) << threads;  // dcd 0 … dcd 16, ccd 0 … ccd 15
+  }
+}
+
+TEST(ParallelRunner, ThreadsResolveAndStatefulRunsStaySerial) {
+  EXPECT_EQ(resolve_threads(0), std::max(1, tbb::info::default_concurrency()));
+  EXPECT_EQ(resolve_threads(3), 3);
+  EXPECT_THROW_MESSAGE((void)resolve_threads(-1), InvalidInput, "--threads -1");
+
+  RunOptions o;
+  EXPECT_EQ(serial_reason("bvh", o), "");
+  EXPECT_EQ(serial_reason("dynamic", o), "");
+  o.query = QuerySet::ccd;
+  EXPECT_NE(serial_reason("dynamic", o).find("--query ccd"), std::string::npos);
+  EXPECT_NE(serial_reason("rvbc", o).find("--query ccd"), std::string::npos);
+  EXPECT_EQ(serial_reason("bvh", o), "");
+  o.query = QuerySet::both;
+  o.accuracy = ccd::Accuracy::fast;
+  EXPECT_NE(serial_reason("dynamic", o).find("--accuracy fast"), std::string::npos);
+  o.min_separation = 0.01;  // nothing is skipped: the carried state is unused
+  EXPECT_EQ(serial_reason("dynamic", o), "");
+  EXPECT_NE(serial_reason("someone-elses", RunOptions{}).find("not known"), std::string::npos);
+  RunOptions hooked;
+  hooked.before_query = [](std::int32_t, std::int32_t) {};
+  EXPECT_NE(serial_reason("bvh", hooked).find("hook"), std::string::npos);
+
+  // Through the runner: a custom factory's methods are serial unless declared stateless, and
+  // dynamic on --query ccd is serial with the reason in the plan.
+  const auto l = load(kRope);
+  RunOptions custom;
+  custom.threads = 4;
+  ClipRunner probe(*l.motion, custom, [](const skinning::Mesh&, const skinning::Topology&,
+                                         const culling::MethodOptions&) {
+    return std::make_unique<ProbeMethod>([](int) {});
+  });
+  EXPECT_EQ(probe.plan().threads, 1);
+  EXPECT_NE(probe.plan().serial_reason.find("factory"), std::string::npos);
+  RunOptions ccd_only;
+  ccd_only.threads = 4;
+  ccd_only.method = "dynamic";
+  ccd_only.query = QuerySet::ccd;
+  (void)setup_radial_view(RadialViewArguments{}, l.model, *l.motion, ccd_only);
+  ClipRunner dynamic(*l.motion, ccd_only);
+  EXPECT_EQ(dynamic.plan().threads, 1);
+  EXPECT_NE(dynamic.plan().serial_reason.find("--query ccd"), std::string::npos);
+}
+
+/// Why dynamic with --query ccd stays serial: forced into blocks anyway (a factory declared
+/// stateless), each block's first interval starts without the state the previous interval left,
+/// and its counters differ from the serial run's (the contacts do not).
+TEST(ParallelRunner, DynamicWithoutDcdCarriesStateSoBlocksWouldChangeItsCounters) {
+  const auto l = load(kRope);
+  std::vector<FrameReport> out[2];
+  for (const int k : {0, 1}) {
+    RunOptions options;
+    options.method = "dynamic";
+    options.frames = parse_frame_range("12:");
+    options.query = QuerySet::ccd;
+    options.threads = k == 0 ? 1 : 3;
+    options.block_samples = 2;
+    (void)setup_radial_view(RadialViewArguments{}, l.model, *l.motion, options);
+    options.factory_methods_stateless = true;  // the lie under test
+    // Slow queries, so that every worker takes blocks (a worker that happened to take all blocks
+    // in order would carry the state like a serial run).
+    const auto slow = [](std::function<void(std::int32_t, std::int32_t)> select) {
+      return [select](std::int32_t s0, std::int32_t s1) {
+        select(s0, s1);
+        std::this_thread::sleep_for(std::chrono::milliseconds(10));
+      };
+    };
+    options.before_query = slow(options.before_query);
+    options.make_worker_hooks = [make = options.make_worker_hooks, slow] {
+      auto hooks = make();
+      hooks.before_query = slow(hooks.before_query);
+      return hooks;
+    };
+    ClipRunner runner(*l.motion, options, [](const skinning::Mesh& mesh,
+                                             const skinning::Topology& topology,
+                                             const culling::MethodOptions& mo) {
+      return culling::make_method("dynamic", mesh, topology, mo);
+    });
+    ASSERT_EQ(runner.plan().threads, k == 0 ? 1 : 3);
+    out[k] = collect(runner);
+  }
+  ASSERT_EQ(out[0].size(), out[1].size());
+  bool counters_differ = false;
+  for (std::size_t i = 0; i < out[0].size(); ++i) {
+    EXPECT_EQ(out[0][i].contacts, out[1][i].contacts) << i;
+    counters_differ = counters_differ ||
+                      out[0][i].row.counters.bv_tests != out[1][i].row.counters.bv_tests ||
+                      out[0][i].row.counters.tt_tests != out[1][i].row.counters.tt_tests;
+  }
+  EXPECT_TRUE(counters_differ) << "blocks of dynamic --query ccd matched serial: is the carried "
+                                  "state gone? then serial_reason can allow it";
+}
+
+}  // namespace
