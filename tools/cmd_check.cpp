@@ -481,8 +481,13 @@ void run_batch(const CheckArguments& args, const std::vector<std::string>& model
     std::cout << "batch     " << checks << " checks of " << models.size() << " models: "
               << runs.size() << " done, " << failures.size() << " failed\n";
     for (const auto& f : failures) {
-      std::cout << "FAILED    " << f.model << (f.clip.empty() ? "" : " (clip " + f.clip + ")")
-                << ": " << f.error << '\n';
+      // Errors mostly start with the file's name already; it is not repeated then.
+      const bool named = f.clip.empty() && f.error.rfind(f.model, 0) == 0;
+      std::cout << "FAILED    "
+                << (named ? f.error
+                          : f.model + (f.clip.empty() ? "" : " (clip " + f.clip + ")") + ": " +
+                                f.error)
+                << '\n';
     }
   }
   if (!failures.empty()) {
@@ -490,7 +495,6 @@ void run_batch(const CheckArguments& args, const std::vector<std::string>& model
                        " checks failed, first " + failures.front().model + ": " +
                        failures.front().error);
   }
-  if (models.empty()) throw InvalidInput("no model matched");
 }
 
 void run_check_command(const CheckArguments& args) {
