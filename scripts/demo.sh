@@ -18,4 +18,8 @@ echo
 echo "== skelcd check $model -o $out_dir/CesiumMan_check.h5"
 "$exe" check "$model" -o "$out_dir/CesiumMan_check.h5"
 echo
+scene="$root/assets/scenes/cape.toml"
+echo "== skelcd check $scene -o $out_dir/cape.h5   (a scene: its plan, then a summary per check)"
+"$exe" check "$scene" -o "$out_dir/cape.h5"
+echo
 echo "demo: the posed mesh (frame 12 of the walk) is in $(cd "$out_dir" && pwd)/CesiumMan_frame12.glb"
