@@ -195,6 +195,22 @@ TEST(ScenePlan, BuildsOnlyWhatTheChecksNeed) {
   EXPECT_EQ(json["objects"][0]["stages"]["swept_bounds"], false);
 }
 
+TEST(ScenePlan, ATargetOnlyCarryingASheetIsLoadedButNeverPosed) {
+  const auto path = scene_in_assets(
+      "[objects.body]\nmodel = \"" + kRig + "\"\n"
+      "[objects.cape]\nsheet = { corner = [0,0,0], u = [1,0,0], v = [0,1,0] }\nattach_to = \"body\"\n"
+      "checks = [\"self-ccd\"]\n");
+  const Scene s = parse_scene(path);
+  EXPECT_EQ(objects_to_load(s), (std::vector<bool>{true, true}));
+  const auto plan = plan_scene(s, {facts(10, 0, 1, true), facts(10, 1, 0, true)}, std::nullopt);
+  EXPECT_TRUE(plan.objects[0].load);
+  EXPECT_FALSE(plan.objects[0].skin || plan.objects[0].topology || plan.objects[0].bvh);
+  ASSERT_EQ(plan.objects[0].skipped.size(), 1u);
+  EXPECT_NE(plan.objects[0].skipped[0].find("no check names it"), std::string::npos);
+  ASSERT_EQ(plan.checks.size(), 1u);
+  EXPECT_EQ(plan.checks[0].name(plan.objects), "self cape");
+}
+
 TEST(ScenePlan, RefusesFramesOutsideAnObjectsSamples) {
   const auto path = scene_in_assets("frames = \"3:12\"\n[objects.a]\nmodel = \"gen:rope\"\nchecks = [\"self-dcd\"]\n");
   const Scene s = parse_scene(path);

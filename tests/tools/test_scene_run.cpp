@@ -313,6 +313,31 @@ TEST(ScenePairs, PandaHandAgainstUpperArmEqualsTheRobotsOwnSelfCheckBetweenThose
   for (const auto& p : pair.dcd_pairs) EXPECT_GE(p.frame, 38);
 }
 
+TEST(SceneRun, SelfChecksGiveTheSameRowsOnOneOrSeveralThreads) {
+  const auto scene = parse_scene(test::asset("scenes/panda.toml"));
+  SceneRunOptions serial;
+  serial.threads = 1;
+  SceneRunOptions parallel;
+  parallel.threads = 2;
+  const auto a = run_scene(scene, serial);
+  const auto b = run_scene(scene, parallel);
+  ASSERT_EQ(a.checks.size(), b.checks.size());
+  for (std::size_t k = 0; k < a.checks.size(); ++k) {
+    ASSERT_EQ(a.checks[k].rows.size(), b.checks[k].rows.size());
+    for (std::size_t i = 0; i < a.checks[k].rows.size(); ++i) {
+      const auto& x = a.checks[k].rows[i];
+      const auto& y = b.checks[k].rows[i];
+      EXPECT_EQ(std::tie(x.sample, x.kind, x.t0, x.t1), std::tie(y.sample, y.kind, y.t0, y.t1));
+      EXPECT_EQ(x.counters.bv_tests, y.counters.bv_tests);
+      EXPECT_EQ(x.counters.dcd_pairs, y.counters.dcd_pairs);
+      EXPECT_EQ(x.counters.vf_contacts + x.counters.ee_contacts,
+                y.counters.vf_contacts + y.counters.ee_contacts);
+    }
+    EXPECT_EQ(a.checks[k].contacts, b.checks[k].contacts);
+    EXPECT_EQ(a.checks[k].dcd_pairs, b.checks[k].dcd_pairs);
+  }
+}
+
 // --- refusals --------------------------------------------------------------------------------
 
 TEST(SceneRun, PairsWithDifferentSamplesAreRefusedBeforeTheLogExists) {
