@@ -136,7 +136,9 @@ TEST(SceneParse, RelativePathsResolveAgainstTheSceneFile) {
   ASSERT_GE(s.objects.size(), 1u);
   EXPECT_TRUE(std::filesystem::exists(s.objects[0].model));
   EXPECT_TRUE(std::filesystem::exists(s.objects[0].load.trajectory));
-  EXPECT_EQ(s.output, test::asset("scenes/panda.h5").lexically_normal());
+  // `output` too: relative to the scene's folder.
+  const auto path = scene_in_assets("output = \"../logs/x.h5\"\n[objects.a]\nmodel = \"gen:rope\"\n");
+  EXPECT_EQ(parse_scene(path).output, (path.parent_path() / "../logs/x.h5").lexically_normal());
 }
 
 ObjectFacts facts(std::int32_t samples, std::int32_t open, std::int32_t closed, bool rig) {
