@@ -29,8 +29,9 @@ skinning::Positions welded_rest(const skinning::Mesh& mesh, const skinning::Topo
   for (std::int32_t w = 0; w < topology.num_welded_vertices(); ++w) {
     const std::int32_t v = topology.representative_vertex[at(w)];
     if (v < 0 || v >= mesh.rest_positions.rows()) {
-      throw InvalidInput("culling::PairChecker: representative_vertex[" + std::to_string(w) +
-                         "] = " + std::to_string(v) + " is not a mesh vertex");
+      throw InvalidInput(
+          "culling::PairChecker: representative_vertex[" + std::to_string(w) +
+          "] = " + std::to_string(v) + " is not a mesh vertex");
     }
     rest.row(w) = mesh.rest_positions.row(v);
   }
@@ -59,16 +60,19 @@ PairChecker::PairChecker(
   bvh_a_ = AabbBvh(topology_a_.welded_triangles(), welded_rest(mesh_a, topology_a), options.bvh);
   bvh_b_ = AabbBvh(topology_b_.welded_triangles(), welded_rest(mesh_b, topology_b), options.bvh);
   scratch_.reserve_pair(bvh_a_, bvh_b_);
-  const auto faces = static_cast<std::size_t>(topology_a_.num_triangles() + topology_b_.num_triangles());
+  const auto faces =
+      static_cast<std::size_t>(topology_a_.num_triangles() + topology_b_.num_triangles());
   pairs_.reserve(4 * faces);
   vf_.reserve(4 * faces);
   ee_.reserve(4 * faces);
 }
 
-void PairChecker::check_rows(const skinning::Positions& x, std::int32_t rows, const char* what) const {
+void PairChecker::check_rows(
+    const skinning::Positions& x, std::int32_t rows, const char* what) const {
   if (x.rows() != rows) {
-    throw InvalidInput("culling::PairChecker: " + std::string(what) + " has " +
-                       std::to_string(x.rows()) + " rows, expected " + std::to_string(rows));
+    throw InvalidInput(
+        "culling::PairChecker: " + std::string(what) + " has " + std::to_string(x.rows()) +
+        " rows, expected " + std::to_string(rows));
   }
 }
 
@@ -88,8 +92,14 @@ void PairChecker::detect_dcd(
   // A against B: every cross pair whose volumes overlap is a candidate (no adjacency between
   // objects, no part exclusion across them).
   pairs_.clear();
-  pair_traverse<3>(bvh_a_, bounds_a_.triangles, bvh_b_, bounds_b_.triangles, scratch_, pairs_,
-                   out.counters.bv_tests);
+  pair_traverse<3>(
+      bvh_a_,
+      bounds_a_.triangles,
+      bvh_b_,
+      bounds_b_.triangles,
+      scratch_,
+      pairs_,
+      out.counters.bv_tests);
   out.counters.candidate_pairs += static_cast<std::int64_t>(pairs_.size());
   const auto t2 = Clock::now();
   // Exact triangle-triangle tests (the objects share no corner).
@@ -97,8 +107,13 @@ void PairChecker::detect_dcd(
   for (const TrianglePair& p : pairs_) {
     const auto& ta = topology_a_.triangle(p.a);
     const auto& tb = topology_b_.triangle(p.b);
-    const ccd::TriangleTriangleQuery q{row(x_a, ta[0]), row(x_a, ta[1]), row(x_a, ta[2]),
-                                       row(x_b, tb[0]), row(x_b, tb[1]), row(x_b, tb[2])};
+    const ccd::TriangleTriangleQuery q{
+        row(x_a, ta[0]),
+        row(x_a, ta[1]),
+        row(x_a, ta[2]),
+        row(x_b, tb[0]),
+        row(x_b, tb[1]),
+        row(x_b, tb[2])};
     ++out.counters.tt_tests;
     if (tests_.triangles(q, ccd::kNoSharedCorners)) {
       ++out.counters.dcd_pairs;
@@ -133,8 +148,14 @@ void PairChecker::detect_ccd(
   bvh_b_.refit(bounds_b_.triangles);
   const auto t1 = Clock::now();
   pairs_.clear();
-  pair_traverse<3>(bvh_a_, bounds_a_.triangles, bvh_b_, bounds_b_.triangles, scratch_, pairs_,
-                   out.counters.bv_tests);
+  pair_traverse<3>(
+      bvh_a_,
+      bounds_a_.triangles,
+      bvh_b_,
+      bounds_b_.triangles,
+      scratch_,
+      pairs_,
+      out.counters.bv_tests);
   out.counters.candidate_pairs += static_cast<std::int64_t>(pairs_.size());
   // Feature stage. Each vertex and edge is owned by exactly one of its triangles
   // (FeatureTopology), so the triangle pair (A_i, B_j) produces (vertex owned by A_i, face B_j),
@@ -186,8 +207,15 @@ void PairChecker::detect_ccd(
     const auto& xf0 = p.vertex_of_b ? x_a_t0 : x_b_t0;
     const auto& xf1 = p.vertex_of_b ? x_a_t1 : x_b_t1;
     const auto& f = p.vertex_of_b ? topology_a_.triangle(p.face) : topology_b_.triangle(p.face);
-    const ccd::VertexFaceQuery q{row(xv0, p.vertex), row(xf0, f[0]), row(xf0, f[1]), row(xf0, f[2]),
-                                 row(xv1, p.vertex), row(xf1, f[0]), row(xf1, f[1]), row(xf1, f[2])};
+    const ccd::VertexFaceQuery q{
+        row(xv0, p.vertex),
+        row(xf0, f[0]),
+        row(xf0, f[1]),
+        row(xf0, f[2]),
+        row(xv1, p.vertex),
+        row(xf1, f[0]),
+        row(xf1, f[1]),
+        row(xf1, f[2])};
     const ccd::CcdResult r = tests_.vertex_face(q, options_.accuracy, ccd_options_);
     ++out.counters.vf_tests;
     if (r.hit) {
@@ -199,9 +227,15 @@ void PairChecker::detect_ccd(
   for (const EdgeEdgePair& p : ee_) {
     const auto& ea = topology_a_.edge(p.a);
     const auto& eb = topology_b_.edge(p.b);
-    const ccd::EdgeEdgeQuery q{row(x_a_t0, ea[0]), row(x_a_t0, ea[1]), row(x_b_t0, eb[0]),
-                               row(x_b_t0, eb[1]), row(x_a_t1, ea[0]), row(x_a_t1, ea[1]),
-                               row(x_b_t1, eb[0]), row(x_b_t1, eb[1])};
+    const ccd::EdgeEdgeQuery q{
+        row(x_a_t0, ea[0]),
+        row(x_a_t0, ea[1]),
+        row(x_b_t0, eb[0]),
+        row(x_b_t0, eb[1]),
+        row(x_a_t1, ea[0]),
+        row(x_a_t1, ea[1]),
+        row(x_b_t1, eb[0]),
+        row(x_b_t1, eb[1])};
     const ccd::CcdResult r = tests_.edge_edge(q, options_.accuracy, ccd_options_);
     ++out.counters.ee_tests;
     if (r.hit) {
@@ -209,8 +243,10 @@ void PairChecker::detect_ccd(
       out.contacts.push_back({CcdContact::Kind::ee, false, p.a, p.b, r.toi_lower, r.toi_upper});
     }
   }
-  std::sort(out.contacts.begin() + static_cast<std::ptrdiff_t>(first), out.contacts.end(),
-            [](const PairContact& x, const PairContact& y) { return x.before(y); });
+  std::sort(
+      out.contacts.begin() + static_cast<std::ptrdiff_t>(first),
+      out.contacts.end(),
+      [](const PairContact& x, const PairContact& y) { return x.before(y); });
   const auto t3 = Clock::now();
   out.times.refit_us += micros(t0, t1);
   out.times.traverse_us += micros(t1, t2);

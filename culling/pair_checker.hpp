@@ -88,7 +88,8 @@ class PairChecker {
   /// @param x_a #W_a × 3 welded positions of A, x_b #W_b × 3 of B (finite).
   /// @param out cleared by the caller.
   /// @throws InvalidInput when a row count is wrong.
-  void detect_dcd(const skinning::Positions& x_a, const skinning::Positions& x_b, PairFrameResult& out);
+  void detect_dcd(
+      const skinning::Positions& x_a, const skinning::Positions& x_b, PairFrameResult& out);
 
   /// Cross VF / EE contacts over the interval, both objects moving linearly.
   /// @param x_a_t0,x_a_t1 #W_a × 3; x_b_t0,x_b_t1 #W_b × 3.

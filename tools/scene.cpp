@@ -1,13 +1,13 @@
 // Scene files: TOML → Scene, validated key by key with the line of every fault (docs/scenes.md).
 #include "tools/scene.hpp"
 
+#include <toml++/toml.h>
+
 #include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <set>
 #include <sstream>
-
-#include <toml++/toml.h>
 
 #include "clustering/radial_view_extension.hpp"
 #include "culling/method.hpp"
@@ -29,13 +29,17 @@ std::string joined(const std::vector<std::string>& names) {
 /// Reads one table's keys, refusing any key not in `known`.
 class Reader {
  public:
-  Reader(const Scene& scene, const toml::table& table, std::string context,
-         std::vector<std::string> known)
+  Reader(
+      const Scene& scene,
+      const toml::table& table,
+      std::string context,
+      std::vector<std::string> known)
       : scene_(scene), table_(table), context_(std::move(context)) {
     for (auto&& [key, node] : table) {
       if (std::find(known.begin(), known.end(), key.str()) == known.end()) {
-        fail(line_of(key), "unknown key '" + std::string(key.str()) + "' (known: " + joined(known) +
-                               ")");
+        fail(
+            line_of(key),
+            "unknown key '" + std::string(key.str()) + "' (known: " + joined(known) + ")");
       }
     }
   }
@@ -88,7 +92,8 @@ class Reader {
     if (n == nullptr) return std::nullopt;
     const auto* array = n->as_array();
     if (array == nullptr || array->size() != 3 ||
-        !std::all_of(array->begin(), array->end(), [](const toml::node& x) { return x.is_number(); })) {
+        !std::all_of(
+            array->begin(), array->end(), [](const toml::node& x) { return x.is_number(); })) {
       fail(line_of(*n), "'" + std::string(key) + "' must be an array of 3 numbers");
     }
     Eigen::Vector3d v;
@@ -141,9 +146,18 @@ SceneSheet parse_sheet(const Scene& scene, const toml::node& node, const std::st
   }
   const Reader r(scene, *table, context + ": sheet", {"corner", "u", "v", "cells"});
   SceneSheet sheet;
-  if (auto c = r.vector3("corner")) sheet.corner = *c; else r.fail(r.line("corner"), "'corner' is required");
-  if (auto u = r.vector3("u")) sheet.u = *u; else r.fail(r.line("u"), "'u' is required");
-  if (auto v = r.vector3("v")) sheet.v = *v; else r.fail(r.line("v"), "'v' is required");
+  if (auto c = r.vector3("corner"))
+    sheet.corner = *c;
+  else
+    r.fail(r.line("corner"), "'corner' is required");
+  if (auto u = r.vector3("u"))
+    sheet.u = *u;
+  else
+    r.fail(r.line("u"), "'u' is required");
+  if (auto v = r.vector3("v"))
+    sheet.v = *v;
+  else
+    r.fail(r.line("v"), "'v' is required");
   if (sheet.u.cross(sheet.v).norm() == 0.0) r.fail(r.line("u"), "'u' and 'v' must span a plane");
   if (const auto* cells = r.get("cells")) {
     const auto* array = cells->as_array();
@@ -166,11 +180,26 @@ SceneObject parse_object(const Scene& scene, const std::string& name, const toml
   const auto* table = node.as_table();
   const std::string context = "object '" + name + "'";
   if (table == nullptr) {
-    throw InvalidInput(scene.where(line_of(node), context + ": must be a table ([objects." + name + "])"));
+    throw InvalidInput(
+        scene.where(line_of(node), context + ": must be a table ([objects." + name + "])"));
   }
-  const Reader r(scene, *table, context,
-                 {"model", "sheet", "attach_to", "clip", "rate", "trajectory", "srdf",
-                  "package_path", "parts", "offset", "checks", "method", "accuracy"});
+  const Reader r(
+      scene,
+      *table,
+      context,
+      {"model",
+       "sheet",
+       "attach_to",
+       "clip",
+       "rate",
+       "trajectory",
+       "srdf",
+       "package_path",
+       "parts",
+       "offset",
+       "checks",
+       "method",
+       "accuracy"});
   SceneObject o;
   o.name = name;
   o.line = line_of(*table);
@@ -193,8 +222,9 @@ SceneObject parse_object(const Scene& scene, const std::string& name, const toml
       if (has_glob(path.filename().string())) {
         std::error_code ec;
         if (!std::filesystem::is_directory(path.parent_path(), ec)) {
-          r.fail(r.line("model"), "'model' " + o.model + ": no such folder " +
-                                      path.parent_path().string());
+          r.fail(
+              r.line("model"),
+              "'model' " + o.model + ": no such folder " + path.parent_path().string());
         }
       } else {
         require_file(r, "model", path);
@@ -211,8 +241,9 @@ SceneObject parse_object(const Scene& scene, const std::string& name, const toml
     r.fail(r.line("sheet"), "a 'sheet' needs 'attach_to' (the object whose skeleton moves it)");
   }
   if (o.sheet && (r.get("clip") != nullptr || r.get("rate") != nullptr)) {
-    r.fail(r.line(r.get("clip") != nullptr ? "clip" : "rate"),
-           "a 'sheet' plays the clip and rate of the object it is attached to");
+    r.fail(
+        r.line(r.get("clip") != nullptr ? "clip" : "rate"),
+        "a 'sheet' plays the clip and rate of the object it is attached to");
   }
   if (auto clip = r.string("clip")) o.clip = *clip;
   if (auto rate = r.number("rate")) {
@@ -240,7 +271,8 @@ SceneObject parse_object(const Scene& scene, const std::string& name, const toml
     }
   }
   if (auto parts = r.strings("parts")) {
-    if (parts->empty()) r.fail(r.line("parts"), "'parts' is empty (leave it out to keep every part)");
+    if (parts->empty())
+      r.fail(r.line("parts"), "'parts' is empty (leave it out to keep every part)");
     o.parts = *parts;
     o.parts_line = r.line("parts");
   }
@@ -265,8 +297,9 @@ SceneObject parse_object(const Scene& scene, const std::string& name, const toml
   o.accuracy = scene.accuracy;
   if (auto a = r.string("accuracy")) o.accuracy = parse_accuracy_at(r, "accuracy", *a);
   if (clustering::is_radial_view_method(o.method) && (!o.parts.empty() || !o.offset.isZero())) {
-    r.fail(o.method_line != 0 ? o.method_line : o.line,
-           "method '" + o.method + "' needs the rig's own motion: not with 'parts' or 'offset'");
+    r.fail(
+        o.method_line != 0 ? o.method_line : o.line,
+        "method '" + o.method + "' needs the rig's own motion: not with 'parts' or 'offset'");
   }
   return o;
 }
@@ -325,8 +358,8 @@ const SceneObject* Scene::find(std::string_view name) const {
 bool Scene::is_checked(std::string_view name) const {
   const auto* o = find(name);
   if (o != nullptr && o->has_self_check()) return true;
-  return std::any_of(pairs.begin(), pairs.end(),
-                     [&](const ScenePair& p) { return p.a == name || p.b == name; });
+  return std::any_of(
+      pairs.begin(), pairs.end(), [&](const ScenePair& p) { return p.a == name || p.b == name; });
 }
 
 std::string Scene::where(int line, std::string_view message) const {
@@ -359,11 +392,14 @@ Scene parse_scene_text(std::string_view text, const std::filesystem::path& path)
   try {
     root = toml::parse(text, path.string());
   } catch (const toml::parse_error& e) {
-    throw InvalidInput(scene.where(static_cast<int>(e.source().begin.line),
-                                   "TOML syntax: " + std::string(e.description())));
+    throw InvalidInput(scene.where(
+        static_cast<int>(e.source().begin.line), "TOML syntax: " + std::string(e.description())));
   }
-  const Reader r(scene, root, "",
-                 {"output", "frames", "min_separation", "method", "accuracy", "objects", "pairs"});
+  const Reader r(
+      scene,
+      root,
+      "",
+      {"output", "frames", "min_separation", "method", "accuracy", "objects", "pairs"});
   if (auto output = r.string("output")) {
     if (output->empty()) r.fail(r.line("output"), "'output' is empty");
     scene.output = resolve(scene, *output);
@@ -388,19 +424,24 @@ Scene parse_scene_text(std::string_view text, const std::filesystem::path& path)
 
   // Objects, in file order (a TOML table keeps its keys sorted, so order them by line).
   const auto* objects_node = r.get("objects");
-  if (objects_node == nullptr) r.fail(1, "no [objects.NAME] table: a scene needs at least one object");
+  if (objects_node == nullptr)
+    r.fail(1, "no [objects.NAME] table: a scene needs at least one object");
   const auto* objects = objects_node->as_table();
-  if (objects == nullptr) r.fail(line_of(*objects_node), "'objects' must be a table of [objects.NAME]");
+  if (objects == nullptr)
+    r.fail(line_of(*objects_node), "'objects' must be a table of [objects.NAME]");
   for (auto&& [key, node] : *objects) {
     scene.objects.push_back(parse_object(scene, std::string(key.str()), node));
   }
-  std::stable_sort(scene.objects.begin(), scene.objects.end(),
-                   [](const SceneObject& a, const SceneObject& b) { return a.line < b.line; });
+  std::stable_sort(
+      scene.objects.begin(), scene.objects.end(), [](const SceneObject& a, const SceneObject& b) {
+        return a.line < b.line;
+      });
   if (scene.objects.empty()) r.fail(line_of(*objects), "no objects in [objects]");
   // Pairs.
   if (const auto* pairs_node = r.get("pairs")) {
     const auto* pairs = pairs_node->as_array();
-    if (pairs == nullptr) r.fail(line_of(*pairs_node), "'pairs' must be an array of [[pairs]] tables");
+    if (pairs == nullptr)
+      r.fail(line_of(*pairs_node), "'pairs' must be an array of [[pairs]] tables");
     for (std::size_t i = 0; i < pairs->size(); ++i) {
       scene.pairs.push_back(parse_pair(scene, (*pairs)[i], i));
     }
@@ -413,23 +454,27 @@ Scene parse_scene_text(std::string_view text, const std::filesystem::path& path)
       throw InvalidInput(scene.where(p.line, "pair " + p.a + " × " + p.b + " is listed twice"));
     }
     if (scene.min_separation > 0 && p.accuracy == ccd::Accuracy::exact) {
-      throw InvalidInput(scene.where(p.line, "the exact accuracy supports only min_separation = 0"));
+      throw InvalidInput(
+          scene.where(p.line, "the exact accuracy supports only min_separation = 0"));
     }
   }
   for (const auto& o : scene.objects) {
     if (scene.min_separation > 0 && o.accuracy == ccd::Accuracy::exact) {
-      throw InvalidInput(scene.where(o.line, "object '" + o.name +
-                                                 "': the exact accuracy supports only min_separation = 0"));
+      throw InvalidInput(scene.where(
+          o.line, "object '" + o.name + "': the exact accuracy supports only min_separation = 0"));
     }
     if (o.attach_to.empty()) continue;
     const auto* target = scene.find(o.attach_to);
     if (target == nullptr) {
-      throw InvalidInput(scene.where(o.attach_line, "object '" + o.name + "': 'attach_to' names unknown object '" +
-                                                        o.attach_to + "'"));
+      throw InvalidInput(scene.where(
+          o.attach_line,
+          "object '" + o.name + "': 'attach_to' names unknown object '" + o.attach_to + "'"));
     }
     if (target->sheet) {
-      throw InvalidInput(scene.where(o.attach_line, "object '" + o.name + "': 'attach_to' must name a model object, '" +
-                                                        o.attach_to + "' is a sheet"));
+      throw InvalidInput(scene.where(
+          o.attach_line,
+          "object '" + o.name + "': 'attach_to' must name a model object, '" + o.attach_to +
+              "' is a sheet"));
     }
   }
   return scene;

@@ -4,14 +4,13 @@
 // file alone — keys, names, values, that the files it names exist — and refuses the first fault
 // with one line naming the scene file and the line of the fault.
 
+#include <Eigen/Core>
 #include <cstdint>
 #include <filesystem>
 #include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
-
-#include <Eigen/Core>
 
 #include "ccd/accuracy.hpp"
 #include "skinning/load.hpp"
@@ -41,8 +40,8 @@ struct SceneObject {
   /// the nearest skinned vertex of that object at rest.
   std::string attach_to;
   int attach_line = 0;
-  std::string clip;     ///< empty: the model's first clip
-  double rate_hz = 0;   ///< 0: the clip's key rate
+  std::string clip;    ///< empty: the model's first clip
+  double rate_hz = 0;  ///< 0: the clip's key rate
   /// Trajectory, SRDF and package path of a URDF (resolved).
   skinning::LoadOptions load;
   /// Mesh parts kept (by name); empty: every part.
@@ -66,14 +65,16 @@ struct ScenePair {
   int line = 0;
   bool dcd = false;
   bool ccd = false;
-  ccd::Accuracy accuracy = ccd::Accuracy::conservative;  ///< resolved: the pair's own, else the scene's
+  ccd::Accuracy accuracy =
+      ccd::Accuracy::conservative;  ///< resolved: the pair's own, else the scene's
 };
 
 struct Scene {
-  std::filesystem::path path;  ///< the scene file, as given
+  std::filesystem::path path;        ///< the scene file, as given
   std::vector<SceneObject> objects;  ///< in file order
   std::vector<ScenePair> pairs;      ///< in file order
-  /// The log (resolved against the scene's folder); empty: no log unless the command line names one.
+  /// The log (resolved against the scene's folder); empty: no log unless the command line names
+  /// one.
   std::filesystem::path output;
   std::optional<FrameRange> frames;
   int frames_line = 0;

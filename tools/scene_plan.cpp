@@ -65,9 +65,10 @@ void decide_stages(ObjectPlan& o) {
     if (!self) {
       s.push_back("segmentation: pair checks only");
     } else if (o.method == "auto") {
-      s.push_back(o.facts.closed_components == 0
-                      ? "segmentation: no closed part (auto segments only closed parts)"
-                      : "segmentation: not moved by its own skeleton (closed parts go to bvh)");
+      s.push_back(
+          o.facts.closed_components == 0
+              ? "segmentation: no closed part (auto segments only closed parts)"
+              : "segmentation: not moved by its own skeleton (closed parts go to bvh)");
     } else {
       s.push_back("segmentation: method " + o.method + " uses none (only rvbc, dynamic)");
     }
@@ -146,23 +147,24 @@ ScenePlan plan_scene(
     return std::int32_t{-1};
   };
   // Rows of a check over samples first..last: a DCD row per sample, a CCD row per interval.
-  const auto fill_rows = [&](CheckPlan& c, std::int32_t samples, int line, const std::string& what) {
-    const std::int32_t first = frames ? frames->first : 0;
-    const std::int32_t last = frames && frames->last ? *frames->last : samples - 1;
-    if (samples < 1 || first > last || last >= samples) {
-      throw InvalidInput(scene.where(
-          frames ? scene.frames_line : line,
-          what + ": frames " + std::to_string(first) + ":" + std::to_string(last) +
-              " do not fit its " + std::to_string(samples) + " samples (0:" +
-              std::to_string(samples - 1) + ")"));
-    }
-    c.first_sample = first;
-    c.last_sample = last;
-    const bool dcd = c.query != QuerySet::ccd;
-    const bool ccd = c.query != QuerySet::dcd;
-    c.rows = (dcd ? last - first + 1 : 0) + (ccd ? last - first : 0);
-    plan.rows += c.rows;
-  };
+  const auto fill_rows =
+      [&](CheckPlan& c, std::int32_t samples, int line, const std::string& what) {
+        const std::int32_t first = frames ? frames->first : 0;
+        const std::int32_t last = frames && frames->last ? *frames->last : samples - 1;
+        if (samples < 1 || first > last || last >= samples) {
+          throw InvalidInput(scene.where(
+              frames ? scene.frames_line : line,
+              what + ": frames " + std::to_string(first) + ":" + std::to_string(last) +
+                  " do not fit its " + std::to_string(samples) +
+                  " samples (0:" + std::to_string(samples - 1) + ")"));
+        }
+        c.first_sample = first;
+        c.last_sample = last;
+        const bool dcd = c.query != QuerySet::ccd;
+        const bool ccd = c.query != QuerySet::dcd;
+        c.rows = (dcd ? last - first + 1 : 0) + (ccd ? last - first : 0);
+        plan.rows += c.rows;
+      };
   for (std::size_t i = 0; i < scene.objects.size(); ++i) {
     const auto& so = scene.objects[i];
     if (!so.has_self_check()) continue;
@@ -185,8 +187,11 @@ ScenePlan plan_scene(
     c.method = "bvh";
     c.accuracy = p.accuracy;
     c.line = p.line;
-    fill_rows(c, plan.objects[static_cast<std::size_t>(c.object_a)].facts.samples, p.line,
-              "pair " + p.a + " × " + p.b);
+    fill_rows(
+        c,
+        plan.objects[static_cast<std::size_t>(c.object_a)].facts.samples,
+        p.line,
+        "pair " + p.a + " × " + p.b);
     plan.checks.push_back(c);
   }
   return plan;

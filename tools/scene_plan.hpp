@@ -4,11 +4,10 @@
 // Rule: nothing that no requested check needs is built or run.
 
 #include <cstdint>
+#include <nlohmann/json.hpp>
 #include <ostream>
 #include <string>
 #include <vector>
-
-#include <nlohmann/json.hpp>
 
 #include "tools/frame_report.hpp"
 #include "tools/scene.hpp"
@@ -17,14 +16,14 @@ namespace skelcd::tools {
 
 /// What loading taught about an object (zeros for an object that was not loaded).
 struct ObjectFacts {
-  std::string source;       ///< what was loaded: file, spec, "sheet attached to X"
-  std::string motion;       ///< clip / trajectory / sequence name
+  std::string source;  ///< what was loaded: file, spec, "sheet attached to X"
+  std::string motion;  ///< clip / trajectory / sequence name
   std::int32_t samples = 0;
   double rate_hz = 0;
   std::int64_t vertices = 0;
   std::int64_t triangles = 0;
   std::int32_t parts = 0;
-  std::int32_t open_components = 0;   ///< edge-connected components with a boundary
+  std::int32_t open_components = 0;  ///< edge-connected components with a boundary
   std::int32_t closed_components = 0;
   bool rig_motion = false;  ///< moved by its own skeleton (the radial-view methods need that)
 };
@@ -46,7 +45,8 @@ struct ObjectPlan {
   bool bvh = false;           ///< a hierarchy, refit per query
   bool swept_bounds = false;  ///< swept volumes over intervals (CCD)
   bool cones = false;         ///< normal / dual cones (cone methods; `auto`: open parts only)
-  bool segmentation = false;  ///< atomic clusters (rvbc, dynamic; `auto` with closed parts of a rig)
+  bool segmentation =
+      false;  ///< atomic clusters (rvbc, dynamic; `auto` with closed parts of a rig)
   /// One line per stage left out of a loaded object, saying why.
   std::vector<std::string> skipped;
   ObjectFacts facts;
@@ -70,7 +70,7 @@ struct CheckPlan {
 };
 
 struct ScenePlan {
-  std::string scene;  ///< the scene file
+  std::string scene;                ///< the scene file
   std::vector<ObjectPlan> objects;  ///< scene order
   std::vector<CheckPlan> checks;    ///< self checks in object order, then pairs in file order
   std::int64_t rows = 0;            ///< /frames rows of the whole run
@@ -90,7 +90,8 @@ struct ScenePlan {
 /// The plan as text (a few lines per object and check).
 void print_plan(std::ostream& out, const ScenePlan& plan);
 
-/// The plan as JSON: {"scene", "objects": [{name, checked, stages: {…}, skipped: […], …}], "checks": […]}.
+/// The plan as JSON: {"scene", "objects": [{name, checked, stages: {…}, skipped: […], …}],
+/// "checks": […]}.
 [[nodiscard]] nlohmann::json plan_json(const ScenePlan& plan);
 
 }  // namespace skelcd::tools

@@ -39,8 +39,11 @@ std::size_t at(std::int32_t i) { return static_cast<std::size_t>(i); }
 /// vertices of `base`, shifted by `offset`.
 class SelectedMotion final : public skinning::Motion {
  public:
-  SelectedMotion(const skinning::Motion& base, skinning::Mesh mesh,
-                 std::vector<std::int32_t> vertex_map, Eigen::Vector3d offset)
+  SelectedMotion(
+      const skinning::Motion& base,
+      skinning::Mesh mesh,
+      std::vector<std::int32_t> vertex_map,
+      Eigen::Vector3d offset)
       : base_(base), mesh_(std::move(mesh)), map_(std::move(vertex_map)), offset_(offset) {}
   const skinning::Mesh& mesh() const override { return mesh_; }
   int num_samples() const override { return base_.num_samples(); }
@@ -65,9 +68,12 @@ class SelectedMotion final : public skinning::Motion {
 
 /// The parts of `mesh` named in `parts` (all when empty), translated by `offset`; `vertex_map`
 /// receives the original vertex of each kept vertex.
-skinning::Mesh select_parts(const skinning::Mesh& mesh, const std::vector<std::string>& parts,
-                            const Eigen::Vector3d& offset, std::vector<std::int32_t>& vertex_map,
-                            const std::function<void(const std::string&)>& fail) {
+skinning::Mesh select_parts(
+    const skinning::Mesh& mesh,
+    const std::vector<std::string>& parts,
+    const Eigen::Vector3d& offset,
+    std::vector<std::int32_t>& vertex_map,
+    const std::function<void(const std::string&)>& fail) {
   std::vector<std::int32_t> new_part(static_cast<std::size_t>(mesh.num_parts()), -1);
   skinning::Mesh out;
   if (parts.empty()) {
@@ -108,7 +114,8 @@ skinning::Mesh select_parts(const skinning::Mesh& mesh, const std::vector<std::s
   for (Eigen::Index v = 0; v < nv; ++v) {
     const std::int32_t old = vertex_map[static_cast<std::size_t>(v)];
     out.rest_positions.row(v) = mesh.rest_positions.row(old) + offset.transpose();
-    out.vertex_part.push_back(mesh.vertex_part.empty() ? 0 : std::max(0, new_part[at(mesh.vertex_part[at(old)])]));
+    out.vertex_part.push_back(
+        mesh.vertex_part.empty() ? 0 : std::max(0, new_part[at(mesh.vertex_part[at(old)])]));
     out.vertex_index_in_part.push_back(
         mesh.vertex_index_in_part.empty() ? old : mesh.vertex_index_in_part[at(old)]);
   }
@@ -119,7 +126,8 @@ skinning::Mesh select_parts(const skinning::Mesh& mesh, const std::vector<std::s
       out.triangles(static_cast<Eigen::Index>(k), c) = new_vertex[at(mesh.triangles(f, c))];
     }
     out.face_part.push_back(new_part[at(mesh.face_part.empty() ? 0 : mesh.face_part[at(f)])]);
-    out.face_index_in_part.push_back(mesh.face_index_in_part.empty() ? f : mesh.face_index_in_part[at(f)]);
+    out.face_index_in_part.push_back(
+        mesh.face_index_in_part.empty() ? f : mesh.face_index_in_part[at(f)]);
   }
   for (const auto& [p, q] : mesh.excluded_part_pairs) {
     const std::int32_t a = new_part[at(p)];
@@ -131,8 +139,11 @@ skinning::Mesh select_parts(const skinning::Mesh& mesh, const std::vector<std::s
 
 /// A sheet skinned with `target`'s skeleton: every sheet vertex takes the weights of the nearest
 /// skinned vertex of the target at rest (the usual garment binding by closest point).
-skinning::Rig sheet_rig(const SceneSheet& sheet, const skinning::Rig& target, const std::string& name,
-                        const std::string& source) {
+skinning::Rig sheet_rig(
+    const SceneSheet& sheet,
+    const skinning::Rig& target,
+    const std::string& name,
+    const std::string& source) {
   skinning::Rig rig;
   rig.source = source;
   rig.skeleton = target.skeleton;
@@ -163,7 +174,8 @@ skinning::Rig sheet_rig(const SceneSheet& sheet, const skinning::Rig& target, co
   m.face_part.assign(static_cast<std::size_t>(f), 0);
   for (Eigen::Index k = 0; k < f; ++k) m.face_index_in_part.push_back(static_cast<std::int32_t>(k));
   m.vertex_part.assign(static_cast<std::size_t>(vertices), 0);
-  for (Eigen::Index k = 0; k < vertices; ++k) m.vertex_index_in_part.push_back(static_cast<std::int32_t>(k));
+  for (Eigen::Index k = 0; k < vertices; ++k)
+    m.vertex_index_in_part.push_back(static_cast<std::int32_t>(k));
 
   // Weight transfer from the nearest skinned target vertex.
   const auto& w = target.weights;
@@ -208,8 +220,11 @@ struct LoadedObject {
 };
 
 /// Loads what object `i` needs (its model, or the sheet on its target) and its motion.
-void load_object(const Scene& scene, std::size_t i, std::vector<LoadedObject>& loaded,
-                 const SceneRunOptions& options) {
+void load_object(
+    const Scene& scene,
+    std::size_t i,
+    std::vector<LoadedObject>& loaded,
+    const SceneRunOptions& options) {
   const SceneObject& so = scene.objects[i];
   LoadedObject& lo = loaded[i];
   const auto fail = [&](int line, const std::string& message) {
@@ -225,7 +240,8 @@ void load_object(const Scene& scene, std::size_t i, std::vector<LoadedObject>& l
       }
       skinning::Rig rig;
       try {
-        rig = sheet_rig(*so.sheet, *target.model->rig, so.name, scene.path.string() + "#" + so.name);
+        rig =
+            sheet_rig(*so.sheet, *target.model->rig, so.name, scene.path.string() + "#" + so.name);
       } catch (const std::exception& e) {
         fail(so.attach_line, "'" + so.attach_to + "' " + e.what());
       }
@@ -249,10 +265,12 @@ void load_object(const Scene& scene, std::size_t i, std::vector<LoadedObject>& l
   if (so.sheet) offset += scene.find(so.attach_to)->offset;
   if (!so.parts.empty() || !offset.isZero()) {
     std::vector<std::int32_t> map;
-    auto mesh = select_parts(lo.base->mesh(), so.parts, offset, map,
-                             [&](const std::string& m) { fail(so.parts_line, m); });
+    auto mesh = select_parts(lo.base->mesh(), so.parts, offset, map, [&](const std::string& m) {
+      fail(so.parts_line, m);
+    });
     if (mesh.num_triangles() == 0) fail(so.parts_line, "the parts selected have no triangles");
-    lo.selected = std::make_unique<SelectedMotion>(*lo.base, std::move(mesh), std::move(map), offset);
+    lo.selected =
+        std::make_unique<SelectedMotion>(*lo.base, std::move(mesh), std::move(map), offset);
     lo.motion = lo.selected.get();
   } else {
     lo.motion = lo.base.get();
@@ -274,30 +292,44 @@ ObjectFacts facts_of(const SceneObject& so, const LoadedObject& lo) {
   f.vertices = lo.motion->mesh().num_vertices();
   f.triangles = lo.motion->mesh().num_triangles();
   f.parts = lo.motion->mesh().num_parts();
-  for (const auto& c : lo.topology.components) (c.closed ? f.closed_components : f.open_components)++;
+  for (const auto& c : lo.topology.components)
+    (c.closed ? f.closed_components : f.open_components)++;
   f.rig_motion = dynamic_cast<const skinning::RigMotion*>(lo.motion) != nullptr;
   return f;
 }
 
 /// Refuses a pair whose objects are not sampled at the same instants.
-void check_time_bases(const Scene& scene, const ScenePair& p, const skinning::Motion& a,
-                      const skinning::Motion& b) {
+void check_time_bases(
+    const Scene& scene, const ScenePair& p, const skinning::Motion& a, const skinning::Motion& b) {
   const std::string pair = "pair " + p.a + " × " + p.b + ": ";
   if (a.num_samples() != b.num_samples()) {
     char rates[96];
-    std::snprintf(rates, sizeof rates, " (%.6g Hz) and %d (%.6g Hz)", motion_rate(a), b.num_samples(),
-                  motion_rate(b));
+    std::snprintf(
+        rates,
+        sizeof rates,
+        " (%.6g Hz) and %d (%.6g Hz)",
+        motion_rate(a),
+        b.num_samples(),
+        motion_rate(b));
     throw InvalidInput(scene.where(
-        p.line, pair + "'" + p.a + "' has " + std::to_string(a.num_samples()) + " samples" + rates +
-                    " for '" + p.b + "': a pair check needs the same samples (same rate and clip length)"));
+        p.line,
+        pair + "'" + p.a + "' has " + std::to_string(a.num_samples()) + " samples" + rates +
+            " for '" + p.b + "': a pair check needs the same samples (same rate and clip length)"));
   }
   for (int i = 0; i < a.num_samples(); ++i) {
     const double ta = a.sample_time(i);
     const double tb = b.sample_time(i);
     if (std::abs(ta - tb) > 1e-9 * std::max(1.0, std::abs(ta))) {
       char text[160];
-      std::snprintf(text, sizeof text, "sample %d is at %.9g s in '%s' and %.9g s in '%s'", i, ta,
-                    p.a.c_str(), tb, p.b.c_str());
+      std::snprintf(
+          text,
+          sizeof text,
+          "sample %d is at %.9g s in '%s' and %.9g s in '%s'",
+          i,
+          ta,
+          p.a.c_str(),
+          tb,
+          p.b.c_str());
       throw InvalidInput(scene.where(p.line, pair + text + ": the time bases differ"));
     }
   }
@@ -308,8 +340,13 @@ FeatureId shifted(FeatureId id, std::int32_t offset) {
   return id;
 }
 
-void pose(const skinning::Motion& motion, const skinning::Topology& topology, int sample,
-          skinning::Positions& file, skinning::Positions& welded, const std::string& what) {
+void pose(
+    const skinning::Motion& motion,
+    const skinning::Topology& topology,
+    int sample,
+    skinning::Positions& file,
+    skinning::Positions& welded,
+    const std::string& what) {
   motion.positions(sample, file);
   if (!file.allFinite()) {
     throw InvalidInput(what + ": sample " + std::to_string(sample) + " has a non-finite position");
@@ -318,10 +355,19 @@ void pose(const skinning::Motion& motion, const skinning::Topology& topology, in
 }
 
 /// Runs one pair check in the row order of ClipRunner: dcd A, ccd A, dcd A+1, …, dcd B.
-void run_pair(const CheckPlan& c, const ScenePlan& plan, const LoadedObject& a, const LoadedObject& b,
-              double min_separation, const std::function<void(const FrameReport&)>& on_frame) {
-  culling::PairChecker checker(a.motion->mesh(), a.topology, b.motion->mesh(), b.topology,
-                               {.accuracy = c.accuracy, .min_separation = min_separation});
+void run_pair(
+    const CheckPlan& c,
+    const ScenePlan& plan,
+    const LoadedObject& a,
+    const LoadedObject& b,
+    double min_separation,
+    const std::function<void(const FrameReport&)>& on_frame) {
+  culling::PairChecker checker(
+      a.motion->mesh(),
+      a.topology,
+      b.motion->mesh(),
+      b.topology,
+      {.accuracy = c.accuracy, .min_separation = min_separation});
   const FeatureNumbering na(a.motion->mesh(), a.topology);
   const FeatureNumbering nb(b.motion->mesh(), b.topology);
   const bool dcd = c.query != QuerySet::ccd;
@@ -368,9 +414,10 @@ void run_pair(const CheckPlan& c, const ScenePlan& plan, const LoadedObject& a, 
       report.contacts.push_back(r);
     }
     for (const auto& p : result.dcd_pairs) {
-      report.dcd_pairs.push_back(DcdPairRow{.frame = sample,
-                                            .a = shifted(na.triangle(p.a), a.part_offset),
-                                            .b = shifted(nb.triangle(p.b), b.part_offset)});
+      report.dcd_pairs.push_back(DcdPairRow{
+          .frame = sample,
+          .a = shifted(na.triangle(p.a), a.part_offset),
+          .b = shifted(nb.triangle(p.b), b.part_offset)});
     }
     report.row.total_us = micros(start, Clock::now()) + skin_us;
     on_frame(report);
@@ -460,7 +507,8 @@ SceneRunResult run_scene(const Scene& scene, const SceneRunOptions& options) {
     if (!plan.objects[i].checked) continue;
     loaded[i].part_offset = parts;
     const auto& mesh = loaded[i].motion->mesh();
-    for (const auto& n : mesh.part_names) result.part_names.push_back(scene.objects[i].name + "/" + n);
+    for (const auto& n : mesh.part_names)
+      result.part_names.push_back(scene.objects[i].name + "/" + n);
     parts += mesh.num_parts();
     vertices += mesh.num_vertices();
     triangles += mesh.num_triangles();
@@ -560,7 +608,8 @@ SceneRunResult run_scene(const Scene& scene, const SceneRunOptions& options) {
       if (writer) writer->append(report, static_cast<std::int32_t>(k));
       check.rows.push_back(report.row);
       check.contacts.insert(check.contacts.end(), report.contacts.begin(), report.contacts.end());
-      check.dcd_pairs.insert(check.dcd_pairs.end(), report.dcd_pairs.begin(), report.dcd_pairs.end());
+      check.dcd_pairs.insert(
+          check.dcd_pairs.end(), report.dcd_pairs.begin(), report.dcd_pairs.end());
     };
     Progress progress("check " + check.name, c.rows);
     if (c.kind == CheckKind::self) {
@@ -581,11 +630,16 @@ SceneRunResult run_scene(const Scene& scene, const SceneRunOptions& options) {
       });
       runners[k].reset();  // frees the method's buffers before the next check
     } else {
-      run_pair(c, plan, loaded[at(c.object_a)], loaded[at(c.object_b)], scene.min_separation,
-               [&](const FrameReport& report) {
-                 record(report);
-                 progress.update(static_cast<std::int64_t>(check.rows.size()));
-               });
+      run_pair(
+          c,
+          plan,
+          loaded[at(c.object_a)],
+          loaded[at(c.object_b)],
+          scene.min_separation,
+          [&](const FrameReport& report) {
+            record(report);
+            progress.update(static_cast<std::int64_t>(check.rows.size()));
+          });
     }
     progress.finish();
     check.summary = summarize(check.rows);
@@ -602,8 +656,9 @@ void run_scene_check(const std::filesystem::path& scene_path, const SceneCheckAr
   options.log = args.output.empty() ? scene.output : std::filesystem::path(args.output);
   if (!args.frames.empty()) options.frames = parse_frame_range(args.frames);
   if (args.threads < 0) {
-    throw InvalidInput("--threads " + std::to_string(args.threads) +
-                       ": expected a worker count >= 1 (0: all cores)");
+    throw InvalidInput(
+        "--threads " + std::to_string(args.threads) +
+        ": expected a worker count >= 1 (0: all cores)");
   }
   options.threads = args.threads;
   options.command_line = own_command_line();
@@ -619,27 +674,29 @@ void run_scene_check(const std::filesystem::path& scene_path, const SceneCheckAr
     auto checks = nlohmann::json::array();
     for (const auto& c : result.checks) {
       const auto& s = c.summary;
-      checks.push_back({{"name", c.name},
-                        {"rows", s.rows},
-                        {"samples", s.samples},
-                        {"intervals", s.intervals},
-                        {"dcd_pairs", s.dcd_pairs},
-                        {"ccd_vf", s.ccd_vf},
-                        {"ccd_ee", s.ccd_ee},
-                        {"frames_with_interpenetration", s.frames_with_interpenetration},
-                        {"intervals_with_contacts", s.intervals_with_contacts},
-                        {"bv_tests", s.bv_tests},
-                        {"candidate_pairs", s.candidate_pairs},
-                        {"ms_per_interval", s.ms_per_interval},
-                        {"total_ms", s.total_ms},
-                        {"stages_ms", stages_json(s)}});
+      checks.push_back(
+          {{"name", c.name},
+           {"rows", s.rows},
+           {"samples", s.samples},
+           {"intervals", s.intervals},
+           {"dcd_pairs", s.dcd_pairs},
+           {"ccd_vf", s.ccd_vf},
+           {"ccd_ee", s.ccd_ee},
+           {"frames_with_interpenetration", s.frames_with_interpenetration},
+           {"intervals_with_contacts", s.intervals_with_contacts},
+           {"bv_tests", s.bv_tests},
+           {"candidate_pairs", s.candidate_pairs},
+           {"ms_per_interval", s.ms_per_interval},
+           {"total_ms", s.total_ms},
+           {"stages_ms", stages_json(s)}});
     }
-    print_json({{"scene", scene_path.string()},
-                {"plan", plan_json(result.plan)},
-                {"checks", checks},
-                {"total_ms", result.total_ms},
-                {"log", options.log.empty() ? nlohmann::json(nullptr)
-                                            : nlohmann::json(options.log.string())}});
+    print_json(
+        {{"scene", scene_path.string()},
+         {"plan", plan_json(result.plan)},
+         {"checks", checks},
+         {"total_ms", result.total_ms},
+         {"log",
+          options.log.empty() ? nlohmann::json(nullptr) : nlohmann::json(options.log.string())}});
     return;
   }
   std::size_t width = 0;
@@ -659,11 +716,18 @@ void run_scene_check(const std::filesystem::path& scene_path, const SceneCheckAr
       std::cout << "CCD " << s.intervals_with_contacts << "/" << s.intervals
                 << " intervals with contacts (" << s.ccd_vf << " VF + " << s.ccd_ee << " EE)";
     }
-    std::snprintf(line, sizeof line,
-                  "; %.3f ms per %s (refit %.3f, classify %.3f, merge %.3f, traverse %.3f, "
-                  "elementary %.3f)\n",
-                  s.ms_per_interval, s.intervals > 0 ? "interval" : "sample", s.refit_ms,
-                  s.classify_ms, s.merge_ms, s.traverse_ms, s.elementary_ms);
+    std::snprintf(
+        line,
+        sizeof line,
+        "; %.3f ms per %s (refit %.3f, classify %.3f, merge %.3f, traverse %.3f, "
+        "elementary %.3f)\n",
+        s.ms_per_interval,
+        s.intervals > 0 ? "interval" : "sample",
+        s.refit_ms,
+        s.classify_ms,
+        s.merge_ms,
+        s.traverse_ms,
+        s.elementary_ms);
     std::cout << line;
   }
   std::snprintf(line, sizeof line, "time      %.1f ms in all\n", result.total_ms);

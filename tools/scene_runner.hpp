@@ -23,7 +23,8 @@ namespace skelcd::tools {
 struct SceneCheckArguments {
   std::string output;  ///< -o: the log (overrides the scene's `output`); empty: the scene's
   std::string frames;  ///< --frames A:B (overrides the scene's `frames`); empty: the scene's
-  std::int32_t threads = 1;  ///< self checks: worker threads (0: all cores); pair checks run serially
+  std::int32_t threads =
+      1;  ///< self checks: worker threads (0: all cores); pair checks run serially
   bool json = false;
 };
 
@@ -37,10 +38,10 @@ struct SceneCheckArguments {
 void run_scene_check(const std::filesystem::path& scene, const SceneCheckArguments& args);
 
 struct SceneRunOptions {
-  std::filesystem::path log;          ///< empty: no log
-  std::optional<FrameRange> frames;   ///< overrides the scene's frames when set
+  std::filesystem::path log;         ///< empty: no log
+  std::optional<FrameRange> frames;  ///< overrides the scene's frames when set
   std::int32_t threads = 1;
-  std::string command_line;           ///< for the log header
+  std::string command_line;  ///< for the log header
   /// Called with the plan after validation and before any check runs.
   std::function<void(const ScenePlan&)> on_plan;
   /// Called with an object's name when it is loaded (tests count loads through it).
@@ -50,7 +51,7 @@ struct SceneRunOptions {
 struct SceneCheckResult {
   std::string name;  ///< CheckPlan::name
   std::vector<FrameRow> rows;
-  std::vector<ContactRow> contacts;   ///< parts numbered as in the log (object offsets applied)
+  std::vector<ContactRow> contacts;  ///< parts numbered as in the log (object offsets applied)
   std::vector<DcdPairRow> dcd_pairs;
   RunSummary summary;
 };

@@ -1,17 +1,16 @@
 // PairChecker (object A against object B) against brute force over every cross pair, and on
 // placements with known answers: apart, face to face, overlapping, passing through.
-#include "culling/pair_checker.hpp"
+#include <gtest/gtest.h>
 
 #include <algorithm>
 #include <random>
 #include <set>
 #include <tuple>
 
-#include <gtest/gtest.h>
-
 #include "ccd/edge_edge.hpp"
 #include "ccd/triangle_triangle.hpp"
 #include "ccd/vertex_face.hpp"
+#include "culling/pair_checker.hpp"
 #include "skinning/errors.hpp"
 #include "skinning/load.hpp"
 #include "skinning/topology.hpp"
@@ -97,18 +96,24 @@ Positions jittered(const Positions& x, double amount, std::mt19937& rng) {
 Eigen::Vector3d row(const Positions& x, std::int32_t i) { return x.row(i).transpose(); }
 
 using DcdSet = std::set<std::pair<std::int32_t, std::int32_t>>;
-using CcdSet = std::set<std::tuple<int, int, std::int32_t, std::int32_t>>;  // kind, vertex_of_b, a, b
+using CcdSet =
+    std::set<std::tuple<int, int, std::int32_t, std::int32_t>>;  // kind, vertex_of_b, a, b
 
 /// Every cross triangle pair through the exact triangle test.
-DcdSet brute_dcd(const FeatureTopology& a, const Positions& xa, const FeatureTopology& b,
-                 const Positions& xb) {
+DcdSet brute_dcd(
+    const FeatureTopology& a, const Positions& xa, const FeatureTopology& b, const Positions& xb) {
   DcdSet out;
   for (std::int32_t i = 0; i < a.num_triangles(); ++i) {
     for (std::int32_t j = 0; j < b.num_triangles(); ++j) {
       const auto& ta = a.triangle(i);
       const auto& tb = b.triangle(j);
-      const ccd::TriangleTriangleQuery q{row(xa, ta[0]), row(xa, ta[1]), row(xa, ta[2]),
-                                         row(xb, tb[0]), row(xb, tb[1]), row(xb, tb[2])};
+      const ccd::TriangleTriangleQuery q{
+          row(xa, ta[0]),
+          row(xa, ta[1]),
+          row(xa, ta[2]),
+          row(xb, tb[0]),
+          row(xb, tb[1]),
+          row(xb, tb[2])};
       if (ccd::triangles_intersect(q)) out.insert({i, j});
     }
   }
@@ -116,18 +121,34 @@ DcdSet brute_dcd(const FeatureTopology& a, const Positions& xa, const FeatureTop
 }
 
 /// Every cross VF (both ways) and EE pair through the exact CCD tests.
-CcdSet brute_ccd(const FeatureTopology& a, const Positions& a0, const Positions& a1,
-                 const FeatureTopology& b, const Positions& b0, const Positions& b1) {
+CcdSet brute_ccd(
+    const FeatureTopology& a,
+    const Positions& a0,
+    const Positions& a1,
+    const FeatureTopology& b,
+    const Positions& b0,
+    const Positions& b1) {
   CcdSet out;
-  const auto vf = [&](bool vertex_of_b, const FeatureTopology& tv, const Positions& v0,
-                      const Positions& v1, const FeatureTopology& tf, const Positions& f0,
+  const auto vf = [&](bool vertex_of_b,
+                      const FeatureTopology& tv,
+                      const Positions& v0,
+                      const Positions& v1,
+                      const FeatureTopology& tf,
+                      const Positions& f0,
                       const Positions& f1) {
     for (std::int32_t v = 0; v < tv.num_vertices(); ++v) {
       if (tv.vertex_owner(v) < 0) continue;
       for (std::int32_t f = 0; f < tf.num_triangles(); ++f) {
         const auto& t = tf.triangle(f);
-        const ccd::VertexFaceQuery q{row(v0, v),    row(f0, t[0]), row(f0, t[1]), row(f0, t[2]),
-                                     row(v1, v),    row(f1, t[0]), row(f1, t[1]), row(f1, t[2])};
+        const ccd::VertexFaceQuery q{
+            row(v0, v),
+            row(f0, t[0]),
+            row(f0, t[1]),
+            row(f0, t[2]),
+            row(v1, v),
+            row(f1, t[0]),
+            row(f1, t[1]),
+            row(f1, t[2])};
         if (ccd::vertex_face_ccd(q, ccd::Accuracy::exact).hit) {
           out.insert({0, vertex_of_b ? 1 : 0, v, f});
         }
@@ -140,8 +161,15 @@ CcdSet brute_ccd(const FeatureTopology& a, const Positions& a0, const Positions&
     for (std::int32_t eb = 0; eb < b.num_edges(); ++eb) {
       const auto& e = a.edge(ea);
       const auto& g = b.edge(eb);
-      const ccd::EdgeEdgeQuery q{row(a0, e[0]), row(a0, e[1]), row(b0, g[0]), row(b0, g[1]),
-                                 row(a1, e[0]), row(a1, e[1]), row(b1, g[0]), row(b1, g[1])};
+      const ccd::EdgeEdgeQuery q{
+          row(a0, e[0]),
+          row(a0, e[1]),
+          row(b0, g[0]),
+          row(b0, g[1]),
+          row(a1, e[0]),
+          row(a1, e[1]),
+          row(b1, g[0]),
+          row(b1, g[1])};
       if (ccd::edge_edge_ccd(q, ccd::Accuracy::exact).hit) out.insert({1, 0, ea, eb});
     }
   }
@@ -179,9 +207,12 @@ TEST(PairChecker, BoxesApartTouchingAndOverlappingHaveTheKnownDcdAnswer) {
     double shift;
     bool expect_pairs;
   };
-  for (const Case c : {Case{1.5, false}, Case{1.0, true}, Case{0.5, true}, Case{1.0 + 1e-9, false}}) {
-    Objects o(box(zero, one), box(zero + Eigen::Vector3d(c.shift, 0.25, 0.25),
-                                  one + Eigen::Vector3d(c.shift, 0.25, 0.25)));
+  for (const Case c :
+       {Case{1.5, false}, Case{1.0, true}, Case{0.5, true}, Case{1.0 + 1e-9, false}}) {
+    Objects o(
+        box(zero, one),
+        box(zero + Eigen::Vector3d(c.shift, 0.25, 0.25),
+            one + Eigen::Vector3d(c.shift, 0.25, 0.25)));
     PairChecker checker(o.mesh_a, o.topo_a, o.mesh_b, o.topo_b, {.accuracy = ccd::Accuracy::exact});
     const Positions xa = welded(o.topo_a, o.mesh_a.rest_positions);
     const Positions xb = welded(o.topo_b, o.mesh_b.rest_positions);
@@ -212,10 +243,13 @@ TEST(PairChecker, SheetPassingThroughABoxHasContactsOnlyWhenItCrosses) {
     const auto expected = brute_ccd(checker.topology_a(), xa, xa, checker.topology_b(), xb0, xb1);
     EXPECT_EQ(as_set(r.contacts), expected) << "dz " << dz;
     EXPECT_EQ(!r.contacts.empty(), dz == -1.0) << "dz " << dz;
-    EXPECT_EQ(r.counters.vf_contacts + r.counters.ee_contacts,
-              static_cast<std::int64_t>(r.contacts.size()));
-    EXPECT_TRUE(std::is_sorted(r.contacts.begin(), r.contacts.end(),
-                               [](const PairContact& x, const PairContact& y) { return x.before(y); }));
+    EXPECT_EQ(
+        r.counters.vf_contacts + r.counters.ee_contacts,
+        static_cast<std::int64_t>(r.contacts.size()));
+    EXPECT_TRUE(std::is_sorted(
+        r.contacts.begin(), r.contacts.end(), [](const PairContact& x, const PairContact& y) {
+          return x.before(y);
+        }));
   }
 }
 
@@ -259,7 +293,8 @@ TEST(PairChecker, RealAssetAgainstAMovedCopyOfItselfEqualsBruteForce) {
   const Eigen::Vector3d extent =
       m.rest_positions.colwise().maxCoeff() - m.rest_positions.colwise().minCoeff();
   Mesh shifted = m;
-  shifted.rest_positions = translated(m.rest_positions, 0.1 * extent.maxCoeff() * Eigen::Vector3d(1, 0, 0));
+  shifted.rest_positions =
+      translated(m.rest_positions, 0.1 * extent.maxCoeff() * Eigen::Vector3d(1, 0, 0));
   Objects o(m, shifted);
   PairChecker checker(o.mesh_a, o.topo_a, o.mesh_b, o.topo_b, {.accuracy = ccd::Accuracy::exact});
   const Positions xa = welded(o.topo_a, o.mesh_a.rest_positions);
@@ -270,7 +305,8 @@ TEST(PairChecker, RealAssetAgainstAMovedCopyOfItselfEqualsBruteForce) {
   const auto expected_dcd = brute_dcd(checker.topology_a(), xa, checker.topology_b(), xb0);
   EXPECT_GT(expected_dcd.size(), 0u);
   EXPECT_EQ(as_set(r.dcd_pairs), expected_dcd);
-  EXPECT_LT(r.counters.candidate_pairs, static_cast<std::int64_t>(m.num_triangles() * m.num_triangles()));
+  EXPECT_LT(
+      r.counters.candidate_pairs, static_cast<std::int64_t>(m.num_triangles() * m.num_triangles()));
   PairFrameResult c;
   checker.detect_ccd(xa, xa, xb0, xb1, c);
   const auto expected_ccd = brute_ccd(checker.topology_a(), xa, xa, checker.topology_b(), xb0, xb1);
@@ -280,11 +316,16 @@ TEST(PairChecker, RealAssetAgainstAMovedCopyOfItselfEqualsBruteForce) {
 
 TEST(PairChecker, RefusesBadOptionsAndWrongRowCounts) {
   Objects o(box({0, 0, 0}, {1, 1, 1}), box({2, 0, 0}, {3, 1, 1}));
-  EXPECT_THROW(PairChecker(o.mesh_a, o.topo_a, o.mesh_b, o.topo_b, {.min_separation = -1.0}),
-               InvalidInput);
-  EXPECT_THROW(PairChecker(o.mesh_a, o.topo_a, o.mesh_b, o.topo_b,
-                           {.accuracy = ccd::Accuracy::exact, .min_separation = 0.1}),
-               InvalidInput);
+  EXPECT_THROW(
+      PairChecker(o.mesh_a, o.topo_a, o.mesh_b, o.topo_b, {.min_separation = -1.0}), InvalidInput);
+  EXPECT_THROW(
+      PairChecker(
+          o.mesh_a,
+          o.topo_a,
+          o.mesh_b,
+          o.topo_b,
+          {.accuracy = ccd::Accuracy::exact, .min_separation = 0.1}),
+      InvalidInput);
   PairChecker checker(o.mesh_a, o.topo_a, o.mesh_b, o.topo_b);
   PairFrameResult r;
   const Positions xa = welded(o.topo_a, o.mesh_a.rest_positions);

@@ -44,7 +44,9 @@ TEST(SceneParse, ReadsObjectsChecksPairsAndOverrides) {
       "frames = \"2:5\"\n"
       "accuracy = \"exact\"\n"
       "[objects.fig]\n"
-      "model = \"" + kRig + "\"\n"
+      "model = \"" +
+      kRig +
+      "\"\n"
       "rate = 20\n"
       "checks = [\"self-dcd\", \"self-ccd\"]\n"
       "method = \"kdop\"\n"
@@ -87,47 +89,74 @@ TEST(SceneParse, RefusesEachFaultWithTheLineOfIt) {
   const std::string head = "[objects.a]\nmodel = \"" + kRig + "\"\n";
   // Missing file (line 2).
   EXPECT_EQ(parse_error("[objects.a]\nmodel = \"nowhere/missing.glb\"\n").substr(0, 2), "2:");
-  EXPECT_NE(parse_error("[objects.a]\nmodel = \"nowhere/missing.glb\"\n").find("missing.glb: no such file"),
-            std::string::npos);
+  EXPECT_NE(
+      parse_error("[objects.a]\nmodel = \"nowhere/missing.glb\"\n")
+          .find("missing.glb: no such file"),
+      std::string::npos);
   // Unknown key (line 3), check (3), method (3), accuracy (3).
   EXPECT_EQ(parse_error(head + "clp = \"walk\"\n").substr(0, 24), "3: object 'a': unknown k");
-  EXPECT_NE(parse_error(head + "checks = [\"self-dcd\", \"selfccd\"]\n").find("3: object 'a': unknown check 'selfccd'"),
-            std::string::npos);
-  EXPECT_NE(parse_error(head + "method = \"octree\"\n").find("3: object 'a': unknown method 'octree'"),
-            std::string::npos);
-  EXPECT_NE(parse_error(head + "accuracy = \"sloppy\"\n").find("3: object 'a': unknown accuracy 'sloppy'"),
-            std::string::npos);
+  EXPECT_NE(
+      parse_error(head + "checks = [\"self-dcd\", \"selfccd\"]\n")
+          .find("3: object 'a': unknown check 'selfccd'"),
+      std::string::npos);
+  EXPECT_NE(
+      parse_error(head + "method = \"octree\"\n").find("3: object 'a': unknown method 'octree'"),
+      std::string::npos);
+  EXPECT_NE(
+      parse_error(head + "accuracy = \"sloppy\"\n")
+          .find("3: object 'a': unknown accuracy 'sloppy'"),
+      std::string::npos);
   // A pair naming an unknown object (line 4: the objects line).
-  EXPECT_NE(parse_error(head + "[[pairs]]\nobjects = [\"a\", \"b\"]\nchecks = [\"dcd\"]\n")
-                .find("4: pair 1: unknown object 'b' (objects: a)"),
-            std::string::npos);
+  EXPECT_NE(
+      parse_error(head + "[[pairs]]\nobjects = [\"a\", \"b\"]\nchecks = [\"dcd\"]\n")
+          .find("4: pair 1: unknown object 'b' (objects: a)"),
+      std::string::npos);
   // Unknown pair check, a pair of one object with itself.
-  EXPECT_NE(parse_error(head + "[[pairs]]\nobjects = [\"a\", \"a\"]\nchecks = [\"dcd\"]\n").find("4: pair 1: 'a' against itself"),
-            std::string::npos);
-  EXPECT_NE(parse_error(head + "[objects.b]\nmodel = \"gen:rope\"\n[[pairs]]\nobjects = [\"a\", \"b\"]\nchecks = [\"tcd\"]\n")
-                .find("7: pair 1: unknown pair check 'tcd'"),
-            std::string::npos);
+  EXPECT_NE(
+      parse_error(head + "[[pairs]]\nobjects = [\"a\", \"a\"]\nchecks = [\"dcd\"]\n")
+          .find("4: pair 1: 'a' against itself"),
+      std::string::npos);
+  EXPECT_NE(
+      parse_error(
+          head + "[objects.b]\nmodel = \"gen:rope\"\n[[pairs]]\nobjects = [\"a\", \"b\"]\nchecks = "
+                 "[\"tcd\"]\n")
+          .find("7: pair 1: unknown pair check 'tcd'"),
+      std::string::npos);
   // Unknown top-level key, TOML syntax error, bad frames, bad generator spec, URDF keys on a rig.
-  EXPECT_NE(parse_error("outptu = \"x.h5\"\n" + head).find("1: unknown key 'outptu'"), std::string::npos);
+  EXPECT_NE(
+      parse_error("outptu = \"x.h5\"\n" + head).find("1: unknown key 'outptu'"), std::string::npos);
   EXPECT_EQ(parse_error(head + "checks = [\"self-dcd\"\n").substr(0, 2), "3:");
   EXPECT_NE(parse_error("frames = \"5:2\"\n" + head).find("1: "), std::string::npos);
-  EXPECT_NE(parse_error("[objects.a]\nmodel = \"gen:nosuch\"\n").find("2: object 'a': "), std::string::npos);
-  EXPECT_NE(parse_error(head + "trajectory = \"x.csv\"\n").find("3: object 'a': 'trajectory' is only for a URDF"),
-            std::string::npos);
+  EXPECT_NE(
+      parse_error("[objects.a]\nmodel = \"gen:nosuch\"\n").find("2: object 'a': "),
+      std::string::npos);
+  EXPECT_NE(
+      parse_error(head + "trajectory = \"x.csv\"\n")
+          .find("3: object 'a': 'trajectory' is only for a URDF"),
+      std::string::npos);
   // A sheet needs attach_to naming a model object; a scene needs objects.
-  EXPECT_NE(parse_error("[objects.s]\nsheet = { corner = [0,0,0], u = [1,0,0], v = [0,1,0] }\n").find("object 's': a 'sheet' needs 'attach_to'"),
-            std::string::npos);
-  EXPECT_NE(parse_error(head + "[objects.s]\nsheet = { corner = [0,0,0], u = [1,0,0], v = [0,1,0] }\nattach_to = \"zz\"\n")
-                .find("5: object 's': 'attach_to' names unknown object 'zz'"),
-            std::string::npos);
+  EXPECT_NE(
+      parse_error("[objects.s]\nsheet = { corner = [0,0,0], u = [1,0,0], v = [0,1,0] }\n")
+          .find("object 's': a 'sheet' needs 'attach_to'"),
+      std::string::npos);
+  EXPECT_NE(
+      parse_error(
+          head + "[objects.s]\nsheet = { corner = [0,0,0], u = [1,0,0], v = [0,1,0] }\nattach_to = "
+                 "\"zz\"\n")
+          .find("5: object 's': 'attach_to' names unknown object 'zz'"),
+      std::string::npos);
   EXPECT_NE(parse_error("method = \"bvh\"\n").find("no [objects.NAME] table"), std::string::npos);
-  EXPECT_NE(parse_error(head + "method = \"dynamic\"\noffset = [1,0,0]\n").find("3: object 'a': method 'dynamic' needs"),
-            std::string::npos);
+  EXPECT_NE(
+      parse_error(head + "method = \"dynamic\"\noffset = [1,0,0]\n")
+          .find("3: object 'a': method 'dynamic' needs"),
+      std::string::npos);
 }
 
 TEST(SceneParse, MissingSceneFileIsRefused) {
-  EXPECT_THROW_MESSAGE((void)parse_scene("/nonexistent/scene.toml"), InvalidInput,
-                       "/nonexistent/scene.toml: no such scene file");
+  EXPECT_THROW_MESSAGE(
+      (void)parse_scene("/nonexistent/scene.toml"),
+      InvalidInput,
+      "/nonexistent/scene.toml: no such scene file");
 }
 
 TEST(SceneParse, RelativePathsResolveAgainstTheSceneFile) {
@@ -137,7 +166,8 @@ TEST(SceneParse, RelativePathsResolveAgainstTheSceneFile) {
   EXPECT_TRUE(std::filesystem::exists(s.objects[0].model));
   EXPECT_TRUE(std::filesystem::exists(s.objects[0].load.trajectory));
   // `output` too: relative to the scene's folder.
-  const auto path = scene_in_assets("output = \"../logs/x.h5\"\n[objects.a]\nmodel = \"gen:rope\"\n");
+  const auto path =
+      scene_in_assets("output = \"../logs/x.h5\"\n[objects.a]\nmodel = \"gen:rope\"\n");
   EXPECT_EQ(parse_scene(path).output, (path.parent_path() / "../logs/x.h5").lexically_normal());
 }
 
@@ -161,8 +191,13 @@ TEST(ScenePlan, BuildsOnlyWhatTheChecksNeed) {
       "[[pairs]]\nobjects = [\"paired\", \"dcd_only\"]\nchecks = [\"dcd\"]\n");
   const Scene s = parse_scene(path);
   const auto plan = plan_scene(
-      s, {facts(10, 0, 1, true), facts(10, 1, 0, true), facts(10, 0, 1, true), facts(10, 0, 1, true),
-          ObjectFacts{}, facts(10, 0, 1, true)},
+      s,
+      {facts(10, 0, 1, true),
+       facts(10, 1, 0, true),
+       facts(10, 0, 1, true),
+       facts(10, 0, 1, true),
+       ObjectFacts{},
+       facts(10, 0, 1, true)},
       std::nullopt);
   const auto& o = plan.objects;
   // DCD only: no swept bounds, no cones, no segmentation.
@@ -182,15 +217,21 @@ TEST(ScenePlan, BuildsOnlyWhatTheChecksNeed) {
   EXPECT_FALSE(o[5].swept_bounds || o[5].cones || o[5].segmentation);
   // Checks: four self checks in object order, then the pair; rows per query.
   ASSERT_EQ(plan.checks.size(), 5u);
-  EXPECT_EQ(plan.checks[0].rows, 10);   // DCD: a row per sample
-  EXPECT_EQ(plan.checks[1].rows, 9);    // CCD: a row per interval
+  EXPECT_EQ(plan.checks[0].rows, 10);  // DCD: a row per sample
+  EXPECT_EQ(plan.checks[1].rows, 9);   // CCD: a row per interval
   EXPECT_EQ(plan.checks[4].kind, CheckKind::pair);
   EXPECT_EQ(plan.checks[4].name(plan.objects), "pair paired dcd_only");
   EXPECT_EQ(plan.rows, 10 + 9 + 9 + 10 + 10);
   // auto on a closed part that no skeleton moves: no segmentation, and the plan says why.
-  const auto no_rig = plan_scene(s, {facts(10, 0, 1, true), facts(10, 1, 0, true), facts(10, 0, 1, false),
-                                     facts(10, 0, 1, true), ObjectFacts{}, facts(10, 0, 1, true)},
-                                 std::nullopt);
+  const auto no_rig = plan_scene(
+      s,
+      {facts(10, 0, 1, true),
+       facts(10, 1, 0, true),
+       facts(10, 0, 1, false),
+       facts(10, 0, 1, true),
+       ObjectFacts{},
+       facts(10, 0, 1, true)},
+      std::nullopt);
   EXPECT_FALSE(no_rig.objects[2].segmentation);
   const auto json = plan_json(no_rig);
   EXPECT_EQ(json["objects"][4]["stages"]["load"], false);
@@ -199,8 +240,10 @@ TEST(ScenePlan, BuildsOnlyWhatTheChecksNeed) {
 
 TEST(ScenePlan, ATargetOnlyCarryingASheetIsLoadedButNeverPosed) {
   const auto path = scene_in_assets(
-      "[objects.body]\nmodel = \"" + kRig + "\"\n"
-      "[objects.cape]\nsheet = { corner = [0,0,0], u = [1,0,0], v = [0,1,0] }\nattach_to = \"body\"\n"
+      "[objects.body]\nmodel = \"" + kRig +
+      "\"\n"
+      "[objects.cape]\nsheet = { corner = [0,0,0], u = [1,0,0], v = [0,1,0] }\nattach_to = "
+      "\"body\"\n"
       "checks = [\"self-ccd\"]\n");
   const Scene s = parse_scene(path);
   EXPECT_EQ(objects_to_load(s), (std::vector<bool>{true, true}));
@@ -214,10 +257,13 @@ TEST(ScenePlan, ATargetOnlyCarryingASheetIsLoadedButNeverPosed) {
 }
 
 TEST(ScenePlan, RefusesFramesOutsideAnObjectsSamples) {
-  const auto path = scene_in_assets("frames = \"3:12\"\n[objects.a]\nmodel = \"gen:rope\"\nchecks = [\"self-dcd\"]\n");
+  const auto path = scene_in_assets(
+      "frames = \"3:12\"\n[objects.a]\nmodel = \"gen:rope\"\nchecks = [\"self-dcd\"]\n");
   const Scene s = parse_scene(path);
-  EXPECT_THROW_MESSAGE((void)plan_scene(s, {facts(10, 0, 1, true)}, s.frames), InvalidInput,
-                       path.string() + ":1: object 'a': frames 3:12 do not fit its 10 samples (0:9)");
+  EXPECT_THROW_MESSAGE(
+      (void)plan_scene(s, {facts(10, 0, 1, true)}, s.frames),
+      InvalidInput,
+      path.string() + ":1: object 'a': frames 3:12 do not fit its 10 samples (0:9)");
 }
 
 }  // namespace

@@ -4,10 +4,9 @@
 
 #include <fstream>
 #include <map>
+#include <nlohmann/json.hpp>
 #include <set>
 #include <tuple>
-
-#include <nlohmann/json.hpp>
 
 #include "ccd/edge_edge.hpp"
 #include "ccd/triangle_triangle.hpp"
@@ -23,7 +22,8 @@
 namespace skelcd::tools {
 namespace {
 
-std::filesystem::path write_scene(const std::string& text, const std::string& dir_name = "scene_run") {
+std::filesystem::path write_scene(
+    const std::string& text, const std::string& dir_name = "scene_run") {
   const auto dir = test::temp_dir(dir_name);
   const auto path = dir / "scene.toml";
   std::ofstream(path) << text;
@@ -54,7 +54,8 @@ TEST(SceneRun, DcdOnlyCheckDoesNoCcdOrClusteringWorkAndUncheckedObjectsAreNeverL
   options.on_plan = [&](const ScenePlan& plan) {
     planned = true;
     EXPECT_FALSE(plan.objects[1].load);
-    EXPECT_FALSE(plan.objects[0].swept_bounds || plan.objects[0].segmentation || plan.objects[0].cones);
+    EXPECT_FALSE(
+        plan.objects[0].swept_bounds || plan.objects[0].segmentation || plan.objects[0].cones);
     EXPECT_TRUE(plan.objects[2].segmentation && plan.objects[2].swept_bounds);
   };
   const auto result = run_scene(scene, options);
@@ -105,7 +106,9 @@ TEST(SceneRun, DcdOnlyCheckDoesNoCcdOrClusteringWorkAndUncheckedObjectsAreNeverL
 
 // --- pair checks against brute force -----------------------------------------------------------
 
-Eigen::Vector3d row_of(const skinning::Positions& x, Eigen::Index i) { return x.row(i).transpose(); }
+Eigen::Vector3d row_of(const skinning::Positions& x, Eigen::Index i) {
+  return x.row(i).transpose();
+}
 
 struct Posed {
   skinning::Mesh mesh;
@@ -137,9 +140,15 @@ TrianglePairs brute_dcd(const Posed& a, const Posed& b, int sample) {
     for (Eigen::Index j = 0; j < b.mesh.triangles.rows(); ++j) {
       const auto ta = a.mesh.triangles.row(i);
       const auto tb = b.mesh.triangles.row(j);
-      const ccd::TriangleTriangleQuery q{row_of(xa, ta[0]), row_of(xa, ta[1]), row_of(xa, ta[2]),
-                                         row_of(xb, tb[0]), row_of(xb, tb[1]), row_of(xb, tb[2])};
-      if (ccd::triangles_intersect(q)) out.insert({static_cast<std::int32_t>(i), static_cast<std::int32_t>(j)});
+      const ccd::TriangleTriangleQuery q{
+          row_of(xa, ta[0]),
+          row_of(xa, ta[1]),
+          row_of(xa, ta[2]),
+          row_of(xb, tb[0]),
+          row_of(xb, tb[1]),
+          row_of(xb, tb[2])};
+      if (ccd::triangles_intersect(q))
+        out.insert({static_cast<std::int32_t>(i), static_cast<std::int32_t>(j)});
     }
   }
   return out;
@@ -158,8 +167,15 @@ VertexFaces brute_vf(const Posed& a, const Posed& b, int i) {
     for (Eigen::Index v = 0; v < v0.rows(); ++v) {
       for (Eigen::Index f = 0; f < pf.mesh.triangles.rows(); ++f) {
         const auto t = pf.mesh.triangles.row(f);
-        const ccd::VertexFaceQuery q{row_of(v0, v), row_of(f0, t[0]), row_of(f0, t[1]), row_of(f0, t[2]),
-                                     row_of(v1, v), row_of(f1, t[0]), row_of(f1, t[1]), row_of(f1, t[2])};
+        const ccd::VertexFaceQuery q{
+            row_of(v0, v),
+            row_of(f0, t[0]),
+            row_of(f0, t[1]),
+            row_of(f0, t[2]),
+            row_of(v1, v),
+            row_of(f1, t[0]),
+            row_of(f1, t[1]),
+            row_of(f1, t[2])};
         if (ccd::vertex_face_ccd(q, ccd::Accuracy::exact).hit) {
           out.insert({side, static_cast<std::int32_t>(v), static_cast<std::int32_t>(f)});
         }
@@ -186,8 +202,15 @@ std::int64_t brute_ee(const Posed& a, const Posed& b, int i) {
     for (Eigen::Index g = 0; g < tb.edges.rows(); ++g) {
       const Eigen::Index p0 = vertex(ta, ta.edges(e, 0)), p1 = vertex(ta, ta.edges(e, 1));
       const Eigen::Index q0 = vertex(tb, tb.edges(g, 0)), q1 = vertex(tb, tb.edges(g, 1));
-      const ccd::EdgeEdgeQuery q{row_of(a0, p0), row_of(a0, p1), row_of(b0, q0), row_of(b0, q1),
-                                 row_of(a1, p0), row_of(a1, p1), row_of(b1, q0), row_of(b1, q1)};
+      const ccd::EdgeEdgeQuery q{
+          row_of(a0, p0),
+          row_of(a0, p1),
+          row_of(b0, q0),
+          row_of(b0, q1),
+          row_of(a1, p0),
+          row_of(a1, p1),
+          row_of(b1, q0),
+          row_of(b1, q1)};
       if (ccd::edge_edge_ccd(q, ccd::Accuracy::exact).hit) ++hits;
     }
   }
@@ -201,8 +224,12 @@ TEST(ScenePairs, GeneratedObjectsAgreeWithBruteForceOverAllCrossPairs) {
   const Eigen::Vector3d offset(0.5, 0.3, 0.02);
   const auto path = write_scene(
       "accuracy = \"exact\"\n"
-      "[objects.a]\nmodel = \"" + spec + "\"\n"
-      "[objects.b]\nmodel = \"" + spec + "\"\noffset = [0.5, 0.3, 0.02]\n"
+      "[objects.a]\nmodel = \"" +
+      spec +
+      "\"\n"
+      "[objects.b]\nmodel = \"" +
+      spec +
+      "\"\noffset = [0.5, 0.3, 0.02]\n"
       "[[pairs]]\nobjects = [\"a\", \"b\"]\nchecks = [\"dcd\", \"ccd\"]\n");
   const auto result = run_scene(parse_scene(path));
   ASSERT_EQ(result.checks.size(), 1u);
@@ -254,9 +281,10 @@ TEST(ScenePairs, GeneratedObjectsAgreeWithBruteForceOverAllCrossPairs) {
 
 TEST(ScenePairs, ObjectsFarApartHaveNoCandidatesAndCoincidentCopiesIntersectEverywhere) {
   const std::string spec = "gen:hand?triangles=1000&frames=3";
-  const auto far = write_scene("[objects.a]\nmodel = \"" + spec + "\"\n[objects.b]\nmodel = \"" + spec +
-                               "\"\noffset = [100, 0, 0]\n[[pairs]]\nobjects = [\"a\", \"b\"]\n"
-                               "checks = [\"dcd\", \"ccd\"]\n");
+  const auto far = write_scene(
+      "[objects.a]\nmodel = \"" + spec + "\"\n[objects.b]\nmodel = \"" + spec +
+      "\"\noffset = [100, 0, 0]\n[[pairs]]\nobjects = [\"a\", \"b\"]\n"
+      "checks = [\"dcd\", \"ccd\"]\n");
   const auto r_far = run_scene(parse_scene(far));
   for (const auto& row : r_far.checks[0].rows) {
     EXPECT_EQ(row.counters.candidate_pairs, 0);
@@ -264,9 +292,10 @@ TEST(ScenePairs, ObjectsFarApartHaveNoCandidatesAndCoincidentCopiesIntersectEver
     EXPECT_GT(row.counters.bv_tests, 0);  // the roots were compared
   }
   const std::string cloth = "gen:cloth?triangles=200&frames=2";
-  const auto same = write_scene("[objects.a]\nmodel = \"" + cloth + "\"\n[objects.b]\nmodel = \"" +
-                                cloth + "\"\n[[pairs]]\nobjects = [\"a\", \"b\"]\nchecks = [\"dcd\"]\n",
-                                "scene_same");
+  const auto same = write_scene(
+      "[objects.a]\nmodel = \"" + cloth + "\"\n[objects.b]\nmodel = \"" + cloth +
+          "\"\n[[pairs]]\nobjects = [\"a\", \"b\"]\nchecks = [\"dcd\"]\n",
+      "scene_same");
   const auto r_same = run_scene(parse_scene(same));
   const auto triangles = skinning::load_model(cloth).mesh->num_triangles();
   for (const auto& row : r_same.checks[0].rows) {
@@ -330,8 +359,9 @@ TEST(SceneRun, SelfChecksGiveTheSameRowsOnOneOrSeveralThreads) {
       EXPECT_EQ(std::tie(x.sample, x.kind, x.t0, x.t1), std::tie(y.sample, y.kind, y.t0, y.t1));
       EXPECT_EQ(x.counters.bv_tests, y.counters.bv_tests);
       EXPECT_EQ(x.counters.dcd_pairs, y.counters.dcd_pairs);
-      EXPECT_EQ(x.counters.vf_contacts + x.counters.ee_contacts,
-                y.counters.vf_contacts + y.counters.ee_contacts);
+      EXPECT_EQ(
+          x.counters.vf_contacts + x.counters.ee_contacts,
+          y.counters.vf_contacts + y.counters.ee_contacts);
     }
     EXPECT_EQ(a.checks[k].contacts, b.checks[k].contacts);
     EXPECT_EQ(a.checks[k].dcd_pairs, b.checks[k].dcd_pairs);
@@ -347,14 +377,17 @@ TEST(SceneRun, PairsWithDifferentSamplesAreRefusedBeforeTheLogExists) {
       "[[pairs]]\nobjects = [\"a\", \"b\"]\nchecks = [\"dcd\"]\n");
   SceneRunOptions options;
   options.log = path.parent_path() / "never.h5";
-  EXPECT_THROW_MESSAGE((void)run_scene(parse_scene(path), options), InvalidInput,
-                       path.string() + ":5: pair a × b: 'a' has 5 samples");
+  EXPECT_THROW_MESSAGE(
+      (void)run_scene(parse_scene(path), options),
+      InvalidInput,
+      path.string() + ":5: pair a × b: 'a' has 5 samples");
   EXPECT_FALSE(std::filesystem::exists(options.log));
   // Same count, different rate: the time bases differ.
   const auto rates = write_scene(
-      "[objects.a]\nmodel = \"" + test::asset("characters/RiggedFigure.glb").string() + "\"\nrate = 8\n"
-      "[objects.b]\nmodel = \"gen:cloth?triangles=100&frames=11\"\n"
-      "[[pairs]]\nobjects = [\"a\", \"b\"]\nchecks = [\"dcd\"]\n",
+      "[objects.a]\nmodel = \"" + test::asset("characters/RiggedFigure.glb").string() +
+          "\"\nrate = 8\n"
+          "[objects.b]\nmodel = \"gen:cloth?triangles=100&frames=11\"\n"
+          "[[pairs]]\nobjects = [\"a\", \"b\"]\nchecks = [\"dcd\"]\n",
       "scene_rates");
   EXPECT_THROW_MESSAGE((void)run_scene(parse_scene(rates)), InvalidInput, ":6: pair a × b: ");
 }
@@ -364,13 +397,15 @@ TEST(SceneRun, LoadFaultsNameTheObjectsLine) {
       "[objects.fig]\nmodel = \"" + test::asset("characters/RiggedFigure.glb").string() +
       "\"\nclip = \"no such clip\"\nchecks = [\"self-dcd\"]\n"
       "[objects.arm]\nmodel = \"gen:panda\"\nparts = [\"panda_link9\"]\nchecks = [\"self-dcd\"]\n");
-  EXPECT_THROW_MESSAGE((void)run_scene(parse_scene(path)), InvalidInput,
-                       path.string() + ":1: object 'fig': ");
+  EXPECT_THROW_MESSAGE(
+      (void)run_scene(parse_scene(path)), InvalidInput, path.string() + ":1: object 'fig': ");
   const auto parts = write_scene(
       "[objects.arm]\nmodel = \"gen:panda\"\nparts = [\"panda_link9\"]\nchecks = [\"self-dcd\"]\n",
       "scene_parts");
-  EXPECT_THROW_MESSAGE((void)run_scene(parse_scene(parts)), InvalidInput,
-                       parts.string() + ":3: object 'arm': unknown part 'panda_link9'");
+  EXPECT_THROW_MESSAGE(
+      (void)run_scene(parse_scene(parts)),
+      InvalidInput,
+      parts.string() + ":3: object 'arm': unknown part 'panda_link9'");
 }
 
 // --- the bundled scenes ----------------------------------------------------------------------
@@ -385,7 +420,8 @@ TEST(BundledScenes, EachParsesPlansRunsAndLogsEveryPlannedRow) {
     ASSERT_EQ(result.checks.size(), result.plan.checks.size());
     std::int64_t rows = 0;
     for (std::size_t k = 0; k < result.checks.size(); ++k) {
-      EXPECT_EQ(static_cast<std::int64_t>(result.checks[k].rows.size()), result.plan.checks[k].rows);
+      EXPECT_EQ(
+          static_cast<std::int64_t>(result.checks[k].rows.size()), result.plan.checks[k].rows);
       rows += result.plan.checks[k].rows;
     }
     EXPECT_EQ(rows, result.plan.rows);
@@ -416,7 +452,8 @@ TEST(BundledScenes, EachParsesPlansRunsAndLogsEveryPlannedRow) {
 
 TEST(SceneCli, CheckPrintsThePlanThenTheSummaryAndWritesTheLog) {
   const auto log = test::temp_dir("scene_cli") / "panda.h5";
-  const auto r = test::run_skelcd({"check", test::asset("scenes/panda.toml").string(), "-o", log.string()});
+  const auto r =
+      test::run_skelcd({"check", test::asset("scenes/panda.toml").string(), "-o", log.string()});
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const auto plan_at = r.out.find("plan      ");
   const auto result_at = r.out.find("result    self panda");
@@ -430,14 +467,21 @@ TEST(SceneCli, CheckPrintsThePlanThenTheSummaryAndWritesTheLog) {
   const auto inspect = test::run_skelcd({"inspect", log.string()});
   EXPECT_EQ(inspect.exit_code, 0) << inspect.err;
   const auto plain = log.parent_path() / "plain.h5";
-  ASSERT_EQ(test::run_skelcd({"check", "gen:hand?triangles=1000&frames=3", "-o", plain.string()}).exit_code, 0);
+  ASSERT_EQ(
+      test::run_skelcd({"check", "gen:hand?triangles=1000&frames=3", "-o", plain.string()})
+          .exit_code,
+      0);
   const auto data = read_log(plain);
   EXPECT_TRUE(data.header.checks.empty());
   EXPECT_TRUE(data.frame_checks.empty());
   EXPECT_EQ(data.frames.size(), 5u);
 
-  const auto json = test::run_skelcd({"check", test::asset("scenes/cloth_funnel.toml").string(), "-o",
-                                      (log.parent_path() / "cf.h5").string(), "--json"});
+  const auto json = test::run_skelcd(
+      {"check",
+       test::asset("scenes/cloth_funnel.toml").string(),
+       "-o",
+       (log.parent_path() / "cf.h5").string(),
+       "--json"});
   ASSERT_EQ(json.exit_code, 0) << json.err;
   const auto j = nlohmann::json::parse(json.out);
   EXPECT_EQ(j["plan"]["objects"][0]["stages"]["segmentation"], false);
@@ -448,12 +492,14 @@ TEST(SceneCli, CheckPrintsThePlanThenTheSummaryAndWritesTheLog) {
 TEST(SceneCli, ABadSceneIsOneLineExitOneAndNothingWritten) {
   const auto dir = test::temp_dir("scene_cli_bad");
   const auto scene = dir / "bad.toml";
-  std::ofstream(scene) << "[objects.a]\nmodel = \"gen:rope?triangles=1000\"\nchecks = [\"self-dcd\"]\n"
-                          "[[pairs]]\nobjects = [\"a\", \"ghost\"]\nchecks = [\"dcd\"]\n";
+  std::ofstream(scene)
+      << "[objects.a]\nmodel = \"gen:rope?triangles=1000\"\nchecks = [\"self-dcd\"]\n"
+         "[[pairs]]\nobjects = [\"a\", \"ghost\"]\nchecks = [\"dcd\"]\n";
   const auto log = dir / "out.h5";
   const auto r = test::run_skelcd({"check", scene.string(), "-o", log.string()});
   EXPECT_EQ(r.exit_code, 1);
-  EXPECT_NE(r.err.find(scene.string() + ":5: pair 1: unknown object 'ghost'"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find(scene.string() + ":5: pair 1: unknown object 'ghost'"), std::string::npos)
+      << r.err;
   EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
   EXPECT_TRUE(r.out.empty()) << r.out;
   EXPECT_FALSE(std::filesystem::exists(log));
