@@ -408,6 +408,18 @@ TEST(SceneRun, LoadFaultsNameTheObjectsLine) {
       parts.string() + ":3: object 'arm': unknown part 'panda_link9'");
 }
 
+TEST(SceneRun, ASheetNeedsASkeletonToHangFrom) {
+  const auto path = write_scene(
+      "[objects.frames]\nmodel = \"" + test::asset("cloth-funnel/frames").string() +
+      "\"\n"
+      "[objects.cape]\nsheet = { corner = [0,0,0], u = [1,0,0], v = [0,1,0] }\n"
+      "attach_to = \"frames\"\nchecks = [\"self-ccd\"]\n");
+  EXPECT_THROW_MESSAGE(
+      (void)run_scene(parse_scene(path)),
+      InvalidInput,
+      path.string() + ":5: object 'cape': 'frames' has no skeleton");
+}
+
 // --- the bundled scenes ----------------------------------------------------------------------
 
 TEST(BundledScenes, EachParsesPlansRunsAndLogsEveryPlannedRow) {
@@ -487,6 +499,16 @@ TEST(SceneCli, CheckPrintsThePlanThenTheSummaryAndWritesTheLog) {
   EXPECT_EQ(j["plan"]["objects"][0]["stages"]["segmentation"], false);
   EXPECT_EQ(j["checks"][0]["ccd_vf"], 27);
   EXPECT_EQ(j["checks"][0]["ccd_ee"], 107);
+
+  // --frames overrides the scene's range for every check.
+  const auto part = test::run_skelcd(
+      {"check", test::asset("scenes/panda.toml").string(), "--frames", "40:43", "--json"});
+  ASSERT_EQ(part.exit_code, 0) << part.err;
+  const auto k = nlohmann::json::parse(part.out);
+  EXPECT_EQ(k["plan"]["checks"][0]["rows"], 4 + 3);
+  EXPECT_EQ(k["plan"]["checks"][1]["rows"], 4);
+  EXPECT_EQ(k["checks"][1]["frames_with_interpenetration"], 4);  // samples 40–43 all intersect
+  EXPECT_TRUE(k["log"].is_null());
 }
 
 TEST(SceneCli, ABadSceneIsOneLineExitOneAndNothingWritten) {
