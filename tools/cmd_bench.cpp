@@ -18,6 +18,7 @@
 #include "tools/bench_report.hpp"
 #include "tools/cli_util.hpp"
 #include "tools/commands.hpp"
+#include "tools/model_options.hpp"
 #include "tools/radial_view_setup.hpp"
 
 namespace skelcd::tools {
@@ -36,6 +37,7 @@ struct BenchArguments {
   std::string plot;
   bool json = false;
   RadialViewArguments radial_view;
+  skinning::LoadOptions load;  ///< robots: --trajectory, --srdf, --package-path
 };
 
 /// Everything that can be refused without reading the model: lists, query, frames, reference.
@@ -89,7 +91,7 @@ void run_bench_command(const BenchArguments& args) {
       skinning::classify_model_path(model_path) != skinning::ModelKind::frame_sequence) {
     require_exists(model_path);
   }
-  const auto model = skinning::load_model(model_path);
+  const auto model = skinning::load_model(model_path, args.load);
   const auto motion = model.motion(skinning::MotionRequest{.clip = args.clip, .rate_hz = args.fps});
 
   // rvbc and dynamic need a rig's clip: they are in the default list only then, and refused by
@@ -171,6 +173,7 @@ void add_bench_command(CLI::App& app) {
   cmd->add_option("--plot", args->plot, "write the time-vs-missed-collisions PNG here");
   cmd->add_flag("--json", args->json, "print the report as one JSON object");
   add_radial_view_options(*cmd, args->radial_view);
+  add_model_options(*cmd, args->load);
   cmd->callback([args] { run_bench_command(*args); });
 }
 

@@ -204,6 +204,7 @@ TEST(BenchReport, FastMissesAreThoseAnIndependentComparisonFinds) {
   const auto model = skinning::load_model(kRope);
   const auto motion = model.motion();
   BenchOptions o = rope_options();
+  o.run.frames = FrameRange{50, 53};  // deep in the loop, where plain doubles lose contacts
   o.methods = {"bvh"};
   o.accuracies = {ccd::Accuracy::fast};
   o.reference = ReferenceChoice::brute;
@@ -222,6 +223,7 @@ TEST(BenchReport, FastMissesAreThoseAnIndependentComparisonFinds) {
   std::int64_t extra = 0;
   for (const auto& f : fast) extra += reference.count(f) == 0 ? 1 : 0;
   EXPECT_EQ(report.reference_contacts, static_cast<std::int64_t>(reference.size()));
+  EXPECT_GT(missed, 0);  // fast does miss here: the comparison has something to count
   EXPECT_EQ(report.rows[0].false_negatives, missed);
   EXPECT_EQ(report.rows[0].false_positives, extra);
 }
