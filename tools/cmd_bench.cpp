@@ -20,6 +20,8 @@
 #include "tools/commands.hpp"
 #include "tools/model_options.hpp"
 #include "tools/radial_view_setup.hpp"
+#include "tools/scene.hpp"
+#include "tools/scene_runner.hpp"
 
 namespace skelcd::tools {
 namespace {
@@ -76,23 +78,32 @@ BenchOptions to_bench_options(const BenchArguments& a) {
   return o;
 }
 
-void run_bench_command(const BenchArguments& args) {
-  BenchOptions options = to_bench_options(args);
+/// One model to benchmark: the MODEL argument, or one self-checked object of a scene.
+struct BenchTarget {
+  std::string object;  ///< scene object name; empty for a MODEL argument
+  std::string model;   ///< as load_model takes it
+  skinning::LoadOptions load;
+  std::string clip;
+  double fps = 0;
+  QuerySet query = QuerySet::both;
+  FrameRange frames;
+};
 
-  // Outputs are claimed before any work (an unwritable path is refused now) and appear whole at
-  // the end or not at all.
-  std::optional<PendingOutput> csv;
-  std::optional<PendingOutput> plot;
-  if (!args.csv.empty()) csv.emplace(args.csv);
-  if (!args.plot.empty()) plot.emplace(args.plot);
-
-  const std::filesystem::path model_path(args.model);
-  if (!skinning::is_generator_spec(args.model) &&
+/// Loads `target` and runs the report on it (the radial-view methods only on a rig's clip).
+BenchReport bench_target(const BenchTarget& target, BenchOptions options,
+                         const BenchArguments& args) {
+  const std::filesystem::path model_path(target.model);
+  if (!skinning::is_generator_spec(target.model) &&
       skinning::classify_model_path(model_path) != skinning::ModelKind::frame_sequence) {
     require_exists(model_path);
   }
-  const auto model = skinning::load_model(model_path, args.load);
-  const auto motion = model.motion(skinning::MotionRequest{.clip = args.clip, .rate_hz = args.fps});
+  const auto model = skinning::load_model(model_path, target.load);
+  const auto motion =
+      model.motion(skinning::MotionRequest{.clip = target.clip, .rate_hz = target.fps});
+  options.run.clip = target.clip;
+  options.run.fps = target.fps;
+  options.run.query = target.query;
+  options.run.frames = target.frames;
 
   // rvbc and dynamic need a rig's clip: they are in the default list only then, and refused by
   // name otherwise. Their segmentation is made once, at the first radial-view run, and shared.
@@ -120,32 +131,147 @@ void run_bench_command(const BenchArguments& args) {
     run.before_query = cache->options.before_query;
   };
   options.progress = true;
+  return run_bench(*motion, options);
+}
 
-  const auto report = run_bench(*motion, options);
+/// The query a scene object's self checks ask for.
+QuerySet self_query(const SceneObject& object) {
+  if (object.self_dcd && object.self_ccd) return QuerySet::both;
+  return object.self_dcd ? QuerySet::dcd : QuerySet::ccd;
+}
+
+/// `OUT.png` for one target; `OUT_<object>.png` for each of several.
+std::filesystem::path per_object_path(const std::string& path, const std::string& object,
+                                      std::size_t targets) {
+  std::filesystem::path p(path);
+  if (targets <= 1) return p;
+  return p.parent_path() / (p.stem().string() + "_" + object + p.extension().string());
+}
+
+void run_bench_command(const BenchArguments& args, bool query_given) {
+  const BenchOptions options = to_bench_options(args);
+
+  // What to run: the MODEL, or every self-checked object of a scene that is a plain model (sheets
+  // and part selections are built by the scene runner only; they are listed as skipped).
+  std::vector<BenchTarget> targets;
+  std::vector<std::string> skipped;
+  const bool scene_mode = is_scene_path(args.model);
+  if (scene_mode) {
+    const Scene scene = parse_scene(args.model);
+    for (const auto& object : scene.objects) {
+      if (!object.has_self_check()) continue;
+      if (object.sheet || !object.parts.empty()) {
+        skipped.push_back(object.name + (object.sheet ? " (a sheet)" : " (a part selection)"));
+        continue;
+      }
+      BenchTarget t;
+      t.object = object.name;
+      t.model = object.model;
+      t.load = object.load;
+      t.clip = object.clip;
+      t.fps = object.rate_hz;
+      t.query = query_given ? options.run.query : self_query(object);
+      t.frames = !args.frames.empty() ? options.run.frames
+                                      : scene.frames.value_or(FrameRange{});
+      targets.push_back(std::move(t));
+    }
+    if (targets.empty()) {
+      throw InvalidInput(args.model + ": no self-checked object that bench can run (sheets and "
+                         "part selections are not supported)");
+    }
+  } else {
+    targets.push_back(BenchTarget{.object = "",
+                                  .model = args.model,
+                                  .load = args.load,
+                                  .clip = args.clip,
+                                  .fps = args.fps,
+                                  .query = options.run.query,
+                                  .frames = options.run.frames});
+  }
+
+  // Outputs are claimed before any work (an unwritable path is refused now) and appear whole at
+  // the end or not at all.
+  std::optional<PendingOutput> csv;
+  std::vector<std::unique_ptr<PendingOutput>> plots;
+  if (!args.csv.empty()) csv.emplace(args.csv);
+  if (!args.plot.empty()) {
+    for (const auto& t : targets) {
+      plots.push_back(
+          std::make_unique<PendingOutput>(per_object_path(args.plot, t.object, targets.size())));
+    }
+  }
+
+  std::vector<BenchReport> reports;
+  for (const auto& t : targets) reports.push_back(bench_target(t, options, args));
 
   if (csv) {
-    csv->write(bench_csv(report));
-    csv->commit();
+    std::string text;
+    for (std::size_t i = 0; i < reports.size(); ++i) {
+      std::string part = bench_csv(reports[i]);
+      if (scene_mode) {
+        // A trailing `object` column names the scene object of each row.
+        std::string tagged;
+        std::size_t start = 0;
+        bool header = true;
+        while (start < part.size()) {
+          const auto end = part.find('\n', start);
+          tagged += part.substr(start, end - start) +
+                    (header ? std::string(",object") : "," + targets[i].object) + "\n";
+          header = false;
+          start = end + 1;
+        }
+        part = std::move(tagged);
+        if (i > 0) part = part.substr(part.find('\n') + 1);  // one header
+      }
+      text += part;
+    }
+    csv->write(text);
   }
-  if (plot) {
-    write_bench_plot(plot->temporary(), report,
-                     model_path.filename().string() + " — " + report.motion + ", " +
-                         std::to_string(report.triangles) + " triangles, " +
-                         std::to_string(report.plan.intervals) + " intervals");
-    plot->commit();
+  for (std::size_t i = 0; i < plots.size(); ++i) {
+    const auto& r = reports[i];
+    const std::string name = scene_mode ? targets[i].object
+                                        : std::filesystem::path(args.model).filename().string();
+    write_bench_plot(plots[i]->temporary(), r,
+                     name + " — " + r.motion + ", " + std::to_string(r.triangles) +
+                         " triangles, " + std::to_string(r.plan.intervals) + " intervals");
   }
+  if (csv) csv->commit();
+  for (auto& p : plots) p->commit();
+
   if (args.json) {
-    auto j = bench_json(report);
-    j["model"] = args.model;
+    nlohmann::json j;
+    if (scene_mode) {
+      j["scene"] = args.model;
+      j["objects"] = nlohmann::json::array();
+      for (std::size_t i = 0; i < reports.size(); ++i) {
+        auto o = bench_json(reports[i]);
+        o["object"] = targets[i].object;
+        o["model"] = targets[i].model;
+        j["objects"].push_back(std::move(o));
+      }
+      j["skipped"] = skipped;
+    } else {
+      j = bench_json(reports.front());
+      j["model"] = args.model;
+    }
     if (csv) j["csv"] = args.csv;
-    if (plot) j["plot"] = args.plot;
+    if (!plots.empty()) {
+      auto paths = nlohmann::json::array();
+      for (const auto& p : plots) paths.push_back(p->path().string());
+      j["plot"] = scene_mode ? paths : paths.front();
+    }
     print_json(j);
-  } else {
-    std::cout << "model     " << args.model << "\n";
-    print_bench_table(std::cout, report);
-    if (csv) std::cout << "csv       " << args.csv << "\n";
-    if (plot) std::cout << "plot      " << args.plot << "\n";
+    return;
   }
+  for (std::size_t i = 0; i < reports.size(); ++i) {
+    if (i > 0) std::cout << '\n';
+    if (scene_mode) std::cout << "object    " << targets[i].object << '\n';
+    std::cout << "model     " << targets[i].model << "\n";
+    print_bench_table(std::cout, reports[i]);
+  }
+  for (const auto& name : skipped) std::cout << "skipped   " << name << " (not supported by bench)\n";
+  if (csv) std::cout << "csv       " << args.csv << "\n";
+  for (const auto& p : plots) std::cout << "plot      " << p->path().string() << "\n";
 }
 
 }  // namespace
@@ -154,7 +280,9 @@ void add_bench_command(CLI::App& app) {
   auto args = std::make_shared<BenchArguments>();
   auto* cmd = app.add_subcommand(
       "bench", "Accuracy versus time: every method × accuracy compared with an exact reference");
-  cmd->add_option("model", args->model, "model file, URDF, frames folder/glob, or gen: spec")
+  cmd->add_option("model", args->model,
+                  "model file, URDF, frames folder/glob, gen: spec, or SCENE.toml (its "
+                  "self-checked objects)")
       ->required();
   cmd->add_option("--methods", args->methods,
                   "methods to run, comma-separated (default: all; brute only when it fits)")
@@ -174,7 +302,8 @@ void add_bench_command(CLI::App& app) {
   cmd->add_flag("--json", args->json, "print the report as one JSON object");
   add_radial_view_options(*cmd, args->radial_view);
   add_model_options(*cmd, args->load);
-  cmd->callback([args] { run_bench_command(*args); });
+  auto* query = cmd->get_option("--query");
+  cmd->callback([args, query] { run_bench_command(*args, query->count() > 0); });
 }
 
 }  // namespace skelcd::tools

@@ -136,4 +136,63 @@ TEST(CmdBench, RadialViewMethodsNeedARig) {
   EXPECT_NE(r.err.find("rigged"), std::string::npos) << r.err;
 }
 
+TEST(CmdBench, SceneRunsEachSelfCheckedObjectWithItsQueries) {
+  const auto dir = skelcd::test::temp_dir("bench-scene");
+  const auto scene = dir / "two.toml";
+  {
+    std::ofstream out(scene);
+    out << "frames = \"44:46\"\n"
+           "[objects.rope]\n"
+           "model = \"gen:rope?triangles=1000&frames=60\"\n"
+           "checks = [\"self-dcd\"]\n"
+           "[objects.hand]\n"
+           "model = \"gen:hand?triangles=1000&frames=60\"\n"
+           "checks = [\"self-ccd\"]\n"
+           "[objects.idle]\n"
+           "model = \"gen:cloth?triangles=1000&frames=60\"\n";
+  }
+  const auto csv = dir / "s.csv";
+  const auto png = dir / "s.png";
+  const auto r = run_skelcd({"bench", scene.string(), "--methods", "bvh", "--accuracies",
+                             "exact,conservative", "--csv", csv.string(), "--plot", png.string(),
+                             "--json"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  ASSERT_EQ(j["objects"].size(), 2u);  // idle has no self check
+  EXPECT_EQ(j["objects"][0]["object"], "rope");
+  EXPECT_EQ(j["objects"][0]["query"], "dcd");  // from the object's checks
+  EXPECT_EQ(j["objects"][0]["first_sample"], 44);
+  EXPECT_EQ(j["objects"][0]["last_sample"], 46);
+  EXPECT_EQ(j["objects"][1]["object"], "hand");
+  EXPECT_EQ(j["objects"][1]["query"], "ccd");
+  EXPECT_EQ(j["objects"][1]["intervals"], 2);
+  for (const auto& o : j["objects"]) {
+    for (const auto& row : o["rows"]) EXPECT_EQ(row["false_negatives"], 0) << row.dump();
+  }
+  // One CSV with an object column; one plot per object.
+  const auto csv_lines = lines(read_text(csv));
+  ASSERT_EQ(csv_lines.size(), 5u);
+  EXPECT_NE(csv_lines[0].find(",object"), std::string::npos);
+  EXPECT_NE(csv_lines[1].find(",rope"), std::string::npos);
+  EXPECT_NE(csv_lines[4].find(",hand"), std::string::npos);
+  for (const char* name : {"s_rope.png", "s_hand.png"}) {
+    EXPECT_EQ(read_text(dir / name).substr(0, 4), std::string("\x89PNG", 4)) << name;
+  }
+  EXPECT_FALSE(std::filesystem::exists(png));
+
+  // A scene whose only self check is a sheet: nothing bench can run, one line, nothing written.
+  const auto sheet_only = dir / "sheet.toml";
+  {
+    std::ofstream out(sheet_only);
+    out << "[objects.body]\nmodel = \"" << skelcd::test::asset("characters/CesiumMan.glb").string()
+        << "\"\n[objects.cape]\nsheet = { corner = [0, 0, 0], u = [0.2, 0, 0], v = [0, -0.4, 0] "
+           "}\nattach_to = \"body\"\nchecks = [\"self-ccd\"]\n";
+  }
+  const auto bad = run_skelcd({"bench", sheet_only.string(), "--csv", (dir / "x.csv").string()});
+  EXPECT_EQ(bad.exit_code, 1);
+  EXPECT_EQ(std::count(bad.err.begin(), bad.err.end(), '\n'), 1) << bad.err;
+  EXPECT_NE(bad.err.find("sheet"), std::string::npos) << bad.err;
+  EXPECT_FALSE(std::filesystem::exists(dir / "x.csv"));
+}
+
 }  // namespace
