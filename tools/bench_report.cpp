@@ -45,6 +45,7 @@ std::int64_t estimated_rows(const skinning::Motion& motion, const RunOptions& op
 
 /// What one run produced: its rows and its findings, sorted and duplicate-free.
 struct RunOutput {
+  RunPlan plan;
   std::vector<FrameRow> rows;
   std::vector<FindingKey> findings;
 };
@@ -60,6 +61,7 @@ RunOutput run_one(const skinning::Motion& motion, const BenchOptions& options,
   ClipRunner runner(motion, run, factory);
 
   RunOutput out;
+  out.plan = runner.plan();
   out.rows.reserve(static_cast<std::size_t>(runner.plan().rows));
   std::optional<Progress> progress;
   if (options.progress) progress.emplace(label, runner.plan().rows);
@@ -236,20 +238,7 @@ BenchReport run_bench(const skinning::Motion& motion, const BenchOptions& option
   const auto reference = run_one(motion, options, reference_method, ccd::Accuracy::exact,
                                  "bench reference " + reference_method + "/exact");
   report.reference_contacts = static_cast<std::int64_t>(reference.findings.size());
-  {
-    // The plan as the runner resolved it (any runner of these options resolves the same one).
-    report.plan.samples = 0;
-    for (const auto& r : reference.rows) {
-      if (r.kind == QueryKind::ccd) ++report.plan.intervals;
-    }
-    report.plan.rows = static_cast<std::int64_t>(reference.rows.size());
-    if (!reference.rows.empty()) {
-      report.plan.first_sample = reference.rows.front().sample;
-      report.plan.last_sample = reference.rows.back().sample +
-                                (reference.rows.back().kind == QueryKind::ccd ? 1 : 0);
-      report.plan.samples = report.plan.last_sample - report.plan.first_sample + 1;
-    }
-  }
+  report.plan = reference.plan;  // every run of these options resolves the same plan
 
   for (const auto& method : methods) {
     for (const auto accuracy : accuracies) {
