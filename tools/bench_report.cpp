@@ -33,10 +33,12 @@ const std::vector<std::string>& radial_view_names() {
 /// (ClipRunner refuses a bad range with its own message afterwards).
 std::int64_t estimated_rows(const skinning::Motion& motion, const RunOptions& options) {
   const std::int64_t n = motion.num_samples();
-  const std::int64_t first = std::clamp<std::int64_t>(options.frames.first, 0, std::max<std::int64_t>(n - 1, 0));
-  const std::int64_t last =
-      std::clamp<std::int64_t>(options.frames.last.value_or(static_cast<std::int32_t>(n - 1)),
-                               first, std::max<std::int64_t>(n - 1, 0));
+  const std::int64_t first =
+      std::clamp<std::int64_t>(options.frames.first, 0, std::max<std::int64_t>(n - 1, 0));
+  const std::int64_t last = std::clamp<std::int64_t>(
+      options.frames.last.value_or(static_cast<std::int32_t>(n - 1)),
+      first,
+      std::max<std::int64_t>(n - 1, 0));
   const std::int64_t samples = last - first + 1;
   const std::int64_t dcd = options.query != QuerySet::ccd ? samples : 0;
   const std::int64_t ccd = options.query != QuerySet::dcd ? samples - 1 : 0;
@@ -50,8 +52,12 @@ struct RunOutput {
   std::vector<FindingKey> findings;
 };
 
-RunOutput run_one(const skinning::Motion& motion, const BenchOptions& options,
-                  const std::string& method, ccd::Accuracy accuracy, const std::string& label) {
+RunOutput run_one(
+    const skinning::Motion& motion,
+    const BenchOptions& options,
+    const std::string& method,
+    ccd::Accuracy accuracy,
+    const std::string& label) {
   RunOptions run = options.run;
   run.method = method;
   run.accuracy = accuracy;
@@ -107,17 +113,25 @@ int time_decimals(double ms) {
 
 void append_finding_keys(const FrameReport& report, std::vector<FindingKey>& keys) {
   for (const auto& p : report.dcd_pairs) {
-    keys.push_back(FindingKey{p.frame, 0, 0, p.a.part, p.a.index, p.a.side, p.b.part, p.b.index,
-                              p.b.side});
+    keys.push_back(
+        FindingKey{p.frame, 0, 0, p.a.part, p.a.index, p.a.side, p.b.part, p.b.index, p.b.side});
   }
   for (const auto& c : report.contacts) {
-    keys.push_back(FindingKey{c.frame, 1, static_cast<std::int32_t>(c.kind), c.a.part, c.a.index,
-                              c.a.side, c.b.part, c.b.index, c.b.side});
+    keys.push_back(FindingKey{
+        c.frame,
+        1,
+        static_cast<std::int32_t>(c.kind),
+        c.a.part,
+        c.a.index,
+        c.a.side,
+        c.b.part,
+        c.b.index,
+        c.b.side});
   }
 }
 
-FindingDifference compare_findings(std::span<const FindingKey> reference,
-                                   std::span<const FindingKey> run) {
+FindingDifference compare_findings(
+    std::span<const FindingKey> reference, std::span<const FindingKey> run) {
   assert(std::is_sorted(reference.begin(), reference.end()));
   assert(std::is_sorted(run.begin(), run.end()));
   // One merge pass over both sorted lists.
@@ -153,8 +167,8 @@ double brute_cost(std::int64_t triangles, std::int64_t rows) {
   return t * t * static_cast<double>(rows);
 }
 
-ReferencePick pick_reference(ReferenceChoice choice, std::int64_t triangles, std::int64_t rows,
-                             double budget) {
+ReferencePick pick_reference(
+    ReferenceChoice choice, std::int64_t triangles, std::int64_t rows, double budget) {
   char cost[128];
   std::snprintf(cost, sizeof cost, "%.3g triangles² × rows", brute_cost(triangles, rows));
   switch (choice) {
@@ -180,8 +194,8 @@ void validate_methods(std::span<const std::string> methods, bool radial_view) {
   for (const auto& m : methods) {
     if (std::find(known.begin(), known.end(), m) != known.end()) {
       if (clustering::is_radial_view_method(m) && !radial_view) {
-        throw InvalidInput("--methods: '" + m +
-                           "' needs a rigged model (bones move the observers)");
+        throw InvalidInput(
+            "--methods: '" + m + "' needs a rigged model (bones move the observers)");
       }
       continue;
     }
@@ -202,8 +216,8 @@ BenchReport run_bench(const skinning::Motion& motion, const BenchOptions& option
   report.triangles = motion.mesh().num_triangles();
   report.query = options.run.query;
   const std::int64_t rows = estimated_rows(motion, options.run);
-  report.reference = pick_reference(options.reference, report.triangles, rows,
-                                    options.brute_budget);
+  report.reference =
+      pick_reference(options.reference, report.triangles, rows, options.brute_budget);
 
   // The table's methods: the ones asked for, else every method (brute only when it fits).
   std::vector<std::string> methods = options.methods;
@@ -235,8 +249,12 @@ BenchReport run_bench(const skinning::Motion& motion, const BenchOptions& option
 
   // The reference first: every other run is compared with its findings.
   const std::string& reference_method = report.reference.method;
-  const auto reference = run_one(motion, options, reference_method, ccd::Accuracy::exact,
-                                 "bench reference " + reference_method + "/exact");
+  const auto reference = run_one(
+      motion,
+      options,
+      reference_method,
+      ccd::Accuracy::exact,
+      "bench reference " + reference_method + "/exact");
   report.reference_contacts = static_cast<std::int64_t>(reference.findings.size());
   report.plan = reference.plan;  // every run of these options resolves the same plan
 
@@ -266,31 +284,60 @@ void print_bench_table(std::ostream& out, const BenchReport& report) {
   const auto w = static_cast<int>(method_width);
   char line[512];
   out << "motion    " << report.motion << ": " << report.triangles << " triangles, samples "
-      << report.plan.first_sample << ".." << report.plan.last_sample << " ("
-      << report.plan.samples << " samples, " << report.plan.intervals << " intervals), query "
-      << to_string(report.query) << "\n";
+      << report.plan.first_sample << ".." << report.plan.last_sample << " (" << report.plan.samples
+      << " samples, " << report.plan.intervals << " intervals), query " << to_string(report.query)
+      << "\n";
   out << "reference " << report.reference.method << " + exact (" << report.reference.reason
       << "): " << report.reference_contacts << " findings\n";
   for (const auto& note : report.notes) out << "note      " << note << "\n";
   out << "times in ms per " << (report.plan.intervals > 0 ? "interval" : "sample")
       << "; FN/FP against the reference (* marks it)\n\n";
-  std::snprintf(line, sizeof line,
-                "  %-*s %-12s %10s %8s %8s %8s %8s %8s %8s %8s %12s %12s %12s %9s %7s %7s\n", w,
-                "method", "accuracy", "ms/int", "skin", "refit", "classify", "merge", "traverse",
-                "elem", "other", "bv_tests", "cand_pairs", "elem_tests", "contacts", "FN", "FP");
+  std::snprintf(
+      line,
+      sizeof line,
+      "  %-*s %-12s %10s %8s %8s %8s %8s %8s %8s %8s %12s %12s %12s %9s %7s %7s\n",
+      w,
+      "method",
+      "accuracy",
+      "ms/int",
+      "skin",
+      "refit",
+      "classify",
+      "merge",
+      "traverse",
+      "elem",
+      "other",
+      "bv_tests",
+      "cand_pairs",
+      "elem_tests",
+      "contacts",
+      "FN",
+      "FP");
   out << line;
   for (const auto& r : report.rows) {
     const auto& s = r.summary;
     const auto t = [](double ms) { return fixed(ms, time_decimals(ms)); };
     std::snprintf(
-        line, sizeof line,
+        line,
+        sizeof line,
         "%c %-*s %-12s %10s %8s %8s %8s %8s %8s %8s %8s %12lld %12lld %12lld %9lld %7lld %7lld\n",
-        r.reference ? '*' : ' ', w, r.method.c_str(), std::string(ccd::to_string(r.accuracy)).c_str(),
-        t(s.ms_per_interval).c_str(), t(s.skin_ms).c_str(), t(s.refit_ms).c_str(),
-        t(s.classify_ms).c_str(), t(s.merge_ms).c_str(), t(s.traverse_ms).c_str(),
-        t(s.elementary_ms).c_str(), t(s.other_ms).c_str(), static_cast<long long>(s.bv_tests),
-        static_cast<long long>(s.candidate_pairs), static_cast<long long>(r.elementary_tests),
-        static_cast<long long>(r.contacts), static_cast<long long>(r.false_negatives),
+        r.reference ? '*' : ' ',
+        w,
+        r.method.c_str(),
+        std::string(ccd::to_string(r.accuracy)).c_str(),
+        t(s.ms_per_interval).c_str(),
+        t(s.skin_ms).c_str(),
+        t(s.refit_ms).c_str(),
+        t(s.classify_ms).c_str(),
+        t(s.merge_ms).c_str(),
+        t(s.traverse_ms).c_str(),
+        t(s.elementary_ms).c_str(),
+        t(s.other_ms).c_str(),
+        static_cast<long long>(s.bv_tests),
+        static_cast<long long>(s.candidate_pairs),
+        static_cast<long long>(r.elementary_tests),
+        static_cast<long long>(r.contacts),
+        static_cast<long long>(r.false_negatives),
         static_cast<long long>(r.false_positives));
     out << line;
   }
@@ -323,20 +370,21 @@ nlohmann::json bench_json(const BenchReport& report) {
   auto rows = nlohmann::json::array();
   for (const auto& r : report.rows) {
     const auto& s = r.summary;
-    rows.push_back({{"method", r.method},
-                    {"accuracy", std::string(ccd::to_string(r.accuracy))},
-                    {"reference", r.reference},
-                    {"ms_per_interval", s.ms_per_interval},
-                    {"stages_ms", stages_json(s)},
-                    {"bv_tests", s.bv_tests},
-                    {"candidate_pairs", s.candidate_pairs},
-                    {"elementary_tests", r.elementary_tests},
-                    {"contacts", r.contacts},
-                    {"dcd_pairs", s.dcd_pairs},
-                    {"ccd_vf", s.ccd_vf},
-                    {"ccd_ee", s.ccd_ee},
-                    {"false_negatives", r.false_negatives},
-                    {"false_positives", r.false_positives}});
+    rows.push_back(
+        {{"method", r.method},
+         {"accuracy", std::string(ccd::to_string(r.accuracy))},
+         {"reference", r.reference},
+         {"ms_per_interval", s.ms_per_interval},
+         {"stages_ms", stages_json(s)},
+         {"bv_tests", s.bv_tests},
+         {"candidate_pairs", s.candidate_pairs},
+         {"elementary_tests", r.elementary_tests},
+         {"contacts", r.contacts},
+         {"dcd_pairs", s.dcd_pairs},
+         {"ccd_vf", s.ccd_vf},
+         {"ccd_ee", s.ccd_ee},
+         {"false_negatives", r.false_negatives},
+         {"false_positives", r.false_positives}});
   }
   return nlohmann::json{
       {"motion", report.motion},
@@ -346,10 +394,11 @@ nlohmann::json bench_json(const BenchReport& report) {
       {"samples", report.plan.samples},
       {"intervals", report.plan.intervals},
       {"query", std::string(to_string(report.query))},
-      {"reference", {{"method", report.reference.method},
-                     {"accuracy", "exact"},
-                     {"reason", report.reference.reason},
-                     {"findings", report.reference_contacts}}},
+      {"reference",
+       {{"method", report.reference.method},
+        {"accuracy", "exact"},
+        {"reason", report.reference.reason},
+        {"findings", report.reference_contacts}}},
       {"notes", report.notes},
       {"rows", rows},
   };
@@ -387,8 +436,8 @@ const char* marker(ccd::Accuracy accuracy) {
 
 }  // namespace
 
-void write_bench_plot(const std::filesystem::path& path, const BenchReport& report,
-                      const std::string& title) {
+void write_bench_plot(
+    const std::filesystem::path& path, const BenchReport& report, const std::string& title) {
   const std::string name = path.string();
   {
     // PLplot reports a file it cannot open by exiting the process; check writability first.
@@ -456,8 +505,7 @@ void write_bench_plot(const std::filesystem::path& path, const BenchReport& repo
   plbox("g", x_tick, 0, "g", 1.0, 0);
   plcol0(1);
   plbox("bcnst", x_tick, 0, "bcnstvl", 0.0, 0);
-  pllab("missed collisions (false negatives against the reference)", "ms per interval (log)",
-        "");
+  pllab("missed collisions (false negatives against the reference)", "ms per interval (log)", "");
   plmtex("t", 3.2, 0.5, 0.5, title.c_str());
   std::string key = "exact ● conservative ■ fast ▲ — reference: " + report.reference.method +
                     " + exact (" + std::to_string(report.reference_contacts) + " findings)";
@@ -496,9 +544,8 @@ void write_bench_plot(const std::filesystem::path& path, const BenchReport& repo
   }
   std::vector<std::size_t> by_x(n);
   for (std::size_t i = 0; i < n; ++i) by_x[i] = i;
-  std::stable_sort(by_x.begin(), by_x.end(), [&](std::size_t a, std::size_t b) {
-    return xs[a] < xs[b];
-  });
+  std::stable_sort(
+      by_x.begin(), by_x.end(), [&](std::size_t a, std::size_t b) { return xs[a] < xs[b]; });
   double scale = 0.8;
   std::vector<std::vector<std::size_t>> columns;
   for (int attempt = 0; attempt < 2; ++attempt) {
@@ -524,9 +571,8 @@ void write_bench_plot(const std::filesystem::path& path, const BenchReport& repo
   const double line = 1.15 * scale * char_h;
   std::vector<double> label_ny(n);
   for (auto& column : columns) {
-    std::stable_sort(column.begin(), column.end(), [&](std::size_t a, std::size_t b) {
-      return ys[a] < ys[b];
-    });
+    std::stable_sort(
+        column.begin(), column.end(), [&](std::size_t a, std::size_t b) { return ys[a] < ys[b]; });
     double previous = -1e9;
     for (const std::size_t i : column) {
       label_ny[i] = std::max({to_ny(ys[i]), previous + line, 0.5 * line});

@@ -9,13 +9,12 @@
 #include <filesystem>
 #include <functional>
 #include <iosfwd>
+#include <nlohmann/json.hpp>
 #include <optional>
 #include <span>
 #include <string>
 #include <string_view>
 #include <vector>
-
-#include <nlohmann/json.hpp>
 
 #include "ccd/accuracy.hpp"
 #include "skinning/motion.hpp"
@@ -43,8 +42,7 @@ struct FindingDifference {
 /// Set difference of two sorted, duplicate-free key lists.
 /// @pre both sorted ascending without duplicates.
 [[nodiscard]] FindingDifference compare_findings(
-    std::span<const FindingKey> reference,
-    std::span<const FindingKey> run);
+    std::span<const FindingKey> reference, std::span<const FindingKey> run);
 
 /// Which run judges the others (`--reference`).
 enum class ReferenceChoice : std::uint8_t {
@@ -148,9 +146,7 @@ void print_bench_table(std::ostream& out, const BenchReport& report);
 /// interval (log scale) against false negatives.
 /// @throws IoError naming `path` when it cannot be written.
 void write_bench_plot(
-    const std::filesystem::path& path,
-    const BenchReport& report,
-    const std::string& title);
+    const std::filesystem::path& path, const BenchReport& report, const std::string& title);
 
 /// An output file written whole or not at all: the constructor creates `<path>.tmp-<pid>` beside
 /// `path` (so an unwritable destination is refused before any work), commit() renames it over

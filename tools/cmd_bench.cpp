@@ -1,14 +1,13 @@
 // skelcd bench MODEL — the accuracy-versus-time report: every culling method × elementary-test
 // accuracy over the same samples and intervals, each compared with a reference run (docs/bench.md).
 
+#include <CLI/CLI.hpp>
 #include <cmath>
 #include <iostream>
 #include <memory>
 #include <optional>
 #include <string>
 #include <vector>
-
-#include <CLI/CLI.hpp>
 
 #include "clustering/radial_view_extension.hpp"
 #include "skinning/errors.hpp"
@@ -51,15 +50,15 @@ BenchOptions to_bench_options(const BenchArguments& a) {
   for (const auto& name : a.accuracies) {
     const auto accuracy = ccd::parse_accuracy(name);
     if (!accuracy) {
-      throw InvalidInput("--accuracies: unknown accuracy '" + name +
-                         "' (known: exact, conservative, fast)");
+      throw InvalidInput(
+          "--accuracies: unknown accuracy '" + name + "' (known: exact, conservative, fast)");
     }
     o.accuracies.push_back(*accuracy);
   }
   if (!(std::isfinite(a.radial_view.gamma) && a.radial_view.gamma >= 0.0 &&
         a.radial_view.gamma <= 1.0)) {
-    throw InvalidInput("--gamma " + std::to_string(a.radial_view.gamma) +
-                       ": expected a value in [0, 1]");
+    throw InvalidInput(
+        "--gamma " + std::to_string(a.radial_view.gamma) + ": expected a value in [0, 1]");
   }
   if (!(std::isfinite(a.fps) && a.fps >= 0)) {
     throw InvalidInput("--fps " + std::to_string(a.fps) + ": expected a rate > 0 (samples/s)");
@@ -90,8 +89,8 @@ struct BenchTarget {
 };
 
 /// Loads `target` and runs the report on it (the radial-view methods only on a rig's clip).
-BenchReport bench_target(const BenchTarget& target, BenchOptions options,
-                         const BenchArguments& args) {
+BenchReport bench_target(
+    const BenchTarget& target, BenchOptions options, const BenchArguments& args) {
   const std::filesystem::path model_path(target.model);
   if (!skinning::is_generator_spec(target.model) &&
       skinning::classify_model_path(model_path) != skinning::ModelKind::frame_sequence) {
@@ -115,21 +114,21 @@ BenchReport bench_target(const BenchTarget& target, BenchOptions options,
     RunOptions options;
   };
   auto cache = std::make_shared<RadialViewCache>();
-  options.prepare = [cache, &args, &model, &motion, radial_view = options.radial_view](
-                        RunOptions& run) {
-    // `auto` sends closed components to `dynamic` on a rig's clip, as `check` does.
-    const bool uses_radial_view = clustering::is_radial_view_method(run.method) ||
-                                  (run.method == "auto" && radial_view);
-    if (!uses_radial_view) return;
-    if (!cache->ready) {
-      cache->options = run;
-      cache->options.method = "dynamic";
-      (void)setup_radial_view(args.radial_view, model, *motion, cache->options);
-      cache->ready = true;
-    }
-    run.method_extension = cache->options.method_extension;
-    run.before_query = cache->options.before_query;
-  };
+  options.prepare =
+      [cache, &args, &model, &motion, radial_view = options.radial_view](RunOptions& run) {
+        // `auto` sends closed components to `dynamic` on a rig's clip, as `check` does.
+        const bool uses_radial_view =
+            clustering::is_radial_view_method(run.method) || (run.method == "auto" && radial_view);
+        if (!uses_radial_view) return;
+        if (!cache->ready) {
+          cache->options = run;
+          cache->options.method = "dynamic";
+          (void)setup_radial_view(args.radial_view, model, *motion, cache->options);
+          cache->ready = true;
+        }
+        run.method_extension = cache->options.method_extension;
+        run.before_query = cache->options.before_query;
+      };
   options.progress = true;
   return run_bench(*motion, options);
 }
@@ -141,8 +140,8 @@ QuerySet self_query(const SceneObject& object) {
 }
 
 /// `OUT.png` for one target; `OUT_<object>.png` for each of several.
-std::filesystem::path per_object_path(const std::string& path, const std::string& object,
-                                      std::size_t targets) {
+std::filesystem::path per_object_path(
+    const std::string& path, const std::string& object, std::size_t targets) {
   std::filesystem::path p(path);
   if (targets <= 1) return p;
   return p.parent_path() / (p.stem().string() + "_" + object + p.extension().string());
@@ -171,22 +170,24 @@ void run_bench_command(const BenchArguments& args, bool query_given) {
       t.clip = object.clip;
       t.fps = object.rate_hz;
       t.query = query_given ? options.run.query : self_query(object);
-      t.frames = !args.frames.empty() ? options.run.frames
-                                      : scene.frames.value_or(FrameRange{});
+      t.frames = !args.frames.empty() ? options.run.frames : scene.frames.value_or(FrameRange{});
       targets.push_back(std::move(t));
     }
     if (targets.empty()) {
-      throw InvalidInput(args.model + ": no self-checked object that bench can run (sheets and "
-                         "part selections are not supported)");
+      throw InvalidInput(
+          args.model +
+          ": no self-checked object that bench can run (sheets and "
+          "part selections are not supported)");
     }
   } else {
-    targets.push_back(BenchTarget{.object = "",
-                                  .model = args.model,
-                                  .load = args.load,
-                                  .clip = args.clip,
-                                  .fps = args.fps,
-                                  .query = options.run.query,
-                                  .frames = options.run.frames});
+    targets.push_back(BenchTarget{
+        .object = "",
+        .model = args.model,
+        .load = args.load,
+        .clip = args.clip,
+        .fps = args.fps,
+        .query = options.run.query,
+        .frames = options.run.frames});
   }
 
   // Outputs are claimed before any work (an unwritable path is refused now) and appear whole at
@@ -229,11 +230,13 @@ void run_bench_command(const BenchArguments& args, bool query_given) {
   }
   for (std::size_t i = 0; i < plots.size(); ++i) {
     const auto& r = reports[i];
-    const std::string name = scene_mode ? targets[i].object
-                                        : std::filesystem::path(args.model).filename().string();
-    write_bench_plot(plots[i]->temporary(), r,
-                     name + " — " + r.motion + ", " + std::to_string(r.triangles) +
-                         " triangles, " + std::to_string(r.plan.intervals) + " intervals");
+    const std::string name =
+        scene_mode ? targets[i].object : std::filesystem::path(args.model).filename().string();
+    write_bench_plot(
+        plots[i]->temporary(),
+        r,
+        name + " — " + r.motion + ", " + std::to_string(r.triangles) + " triangles, " +
+            std::to_string(r.plan.intervals) + " intervals");
   }
   if (csv) csv->commit();
   for (auto& p : plots) p->commit();
@@ -269,7 +272,8 @@ void run_bench_command(const BenchArguments& args, bool query_given) {
     std::cout << "model     " << targets[i].model << "\n";
     print_bench_table(std::cout, reports[i]);
   }
-  for (const auto& name : skipped) std::cout << "skipped   " << name << " (not supported by bench)\n";
+  for (const auto& name : skipped)
+    std::cout << "skipped   " << name << " (not supported by bench)\n";
   if (csv) std::cout << "csv       " << args.csv << "\n";
   for (const auto& p : plots) std::cout << "plot      " << p->path().string() << "\n";
 }
@@ -280,22 +284,30 @@ void add_bench_command(CLI::App& app) {
   auto args = std::make_shared<BenchArguments>();
   auto* cmd = app.add_subcommand(
       "bench", "Accuracy versus time: every method × accuracy compared with an exact reference");
-  cmd->add_option("model", args->model,
-                  "model file, URDF, frames folder/glob, gen: spec, or SCENE.toml (its "
-                  "self-checked objects)")
+  cmd->add_option(
+         "model",
+         args->model,
+         "model file, URDF, frames folder/glob, gen: spec, or SCENE.toml (its "
+         "self-checked objects)")
       ->required();
-  cmd->add_option("--methods", args->methods,
-                  "methods to run, comma-separated (default: all; brute only when it fits)")
+  cmd->add_option(
+         "--methods",
+         args->methods,
+         "methods to run, comma-separated (default: all; brute only when it fits)")
       ->delimiter(',');
-  cmd->add_option("--accuracies", args->accuracies,
-                  "accuracies, comma-separated (default: exact,conservative,fast)")
+  cmd->add_option(
+         "--accuracies",
+         args->accuracies,
+         "accuracies, comma-separated (default: exact,conservative,fast)")
       ->delimiter(',');
   cmd->add_option("--clip", args->clip, "clip to run (default: the first)");
   cmd->add_option("--fps", args->fps, "samples per second (default: the clip's key rate, else 30)");
   cmd->add_option("--frames", args->frames, "samples A:B, both included (A:, :B, A)");
   cmd->add_option("--query", args->query, "ccd, dcd or both")->capture_default_str();
-  cmd->add_option("--reference", args->reference,
-                  "auto (brute + exact when it fits, else bvh + exact), brute or bvh")
+  cmd->add_option(
+         "--reference",
+         args->reference,
+         "auto (brute + exact when it fits, else bvh + exact), brute or bvh")
       ->capture_default_str();
   cmd->add_option("--csv", args->csv, "write the rows as CSV here");
   cmd->add_option("--plot", args->plot, "write the time-vs-missed-collisions PNG here");

@@ -4,12 +4,12 @@
 // that drops known contacts is charged exactly what it dropped, and `fast`'s misses are recounted
 // independently.
 
+#include <gtest/gtest.h>
+
 #include <algorithm>
 #include <memory>
 #include <set>
 #include <sstream>
-
-#include <gtest/gtest.h>
 
 #include "culling/method.hpp"
 #include "skinning/errors.hpp"
@@ -31,10 +31,10 @@ FindingKey key(std::int32_t sample, std::int32_t query, std::int32_t a, std::int
 
 TEST(BenchReport, CompareFindingsCountsBothSetDifferences) {
   // reference {1, 2, 3, 5}, run {2, 3, 4, 6, 7}: FN {1, 5}, FP {4, 6, 7}.
-  std::vector<FindingKey> reference{key(0, 0, 0, 1), key(0, 0, 0, 2), key(0, 1, 0, 3),
-                                    key(2, 0, 4, 5)};
-  std::vector<FindingKey> run{key(0, 0, 0, 2), key(0, 1, 0, 3), key(1, 0, 0, 4), key(3, 0, 0, 6),
-                              key(3, 1, 0, 7)};
+  std::vector<FindingKey> reference{
+      key(0, 0, 0, 1), key(0, 0, 0, 2), key(0, 1, 0, 3), key(2, 0, 4, 5)};
+  std::vector<FindingKey> run{
+      key(0, 0, 0, 2), key(0, 1, 0, 3), key(1, 0, 0, 4), key(3, 0, 0, 6), key(3, 1, 0, 7)};
   std::sort(reference.begin(), reference.end());
   std::sort(run.begin(), run.end());
   const auto d = compare_findings(reference, run);
@@ -123,14 +123,16 @@ TEST(BenchReport, RopeReferenceAgreesWithTheKnownAnswerAndHierarchiesMissNothing
     EXPECT_GT(r.elementary_tests, 0);
   }
   // The hierarchies test fewer bounding volumes than brute force.
-  EXPECT_LT(row_of(report, "bvh", ccd::Accuracy::exact).summary.bv_tests, reference.summary.bv_tests);
+  EXPECT_LT(
+      row_of(report, "bvh", ccd::Accuracy::exact).summary.bv_tests, reference.summary.bv_tests);
 }
 
 /// A method that loses the first finding of every query that has one: the DCD pair at a sample,
 /// else the first CCD contact of an interval; counts what it dropped.
 class DroppingMethod final : public culling::CullingMethod {
  public:
-  DroppingMethod(std::unique_ptr<culling::CullingMethod> inner, std::shared_ptr<std::int64_t> dropped)
+  DroppingMethod(
+      std::unique_ptr<culling::CullingMethod> inner, std::shared_ptr<std::int64_t> dropped)
       : inner_(std::move(inner)), dropped_(std::move(dropped)) {}
   std::string_view name() const override { return "dropping-bvh"; }
   void detect_dcd(const skinning::Positions& x, culling::FrameResult& out) override {
@@ -140,8 +142,10 @@ class DroppingMethod final : public culling::CullingMethod {
       ++*dropped_;
     }
   }
-  void detect_ccd(const skinning::Positions& x_t0, const skinning::Positions& x_t1,
-                  culling::FrameResult& out) override {
+  void detect_ccd(
+      const skinning::Positions& x_t0,
+      const skinning::Positions& x_t1,
+      culling::FrameResult& out) override {
     inner_->detect_ccd(x_t0, x_t1, out);
     if (!out.contacts.empty()) {
       out.contacts.erase(out.contacts.begin());
@@ -163,8 +167,10 @@ TEST(BenchReport, DroppedContactsAreCountedExactlyAsFalseNegatives) {
   o.accuracies = {ccd::Accuracy::exact, ccd::Accuracy::conservative};
   o.factory = [dropped](const std::string& method, ccd::Accuracy accuracy) -> MethodFactory {
     if (method != "bvh" || accuracy != ccd::Accuracy::conservative) return {};
-    return [dropped](const skinning::Mesh& mesh, const skinning::Topology& topology,
-                     const culling::MethodOptions& options) {
+    return [dropped](
+               const skinning::Mesh& mesh,
+               const skinning::Topology& topology,
+               const culling::MethodOptions& options) {
       return std::make_unique<DroppingMethod>(
           culling::make_method("bvh", mesh, topology, options), dropped);
     };
@@ -193,8 +199,15 @@ std::set<std::vector<std::int32_t>> run_findings(const skinning::Motion& motion,
       out.insert({p.frame, 0, p.a.part, p.a.index, p.b.part, p.b.index});
     }
     for (const auto& c : r.contacts) {
-      out.insert({c.frame, 1 + static_cast<std::int32_t>(c.kind), c.a.part, c.a.index, c.a.side,
-                  c.b.part, c.b.index, c.b.side});
+      out.insert(
+          {c.frame,
+           1 + static_cast<std::int32_t>(c.kind),
+           c.a.part,
+           c.a.index,
+           c.a.side,
+           c.b.part,
+           c.b.index,
+           c.b.side});
     }
   });
   return out;

@@ -1,12 +1,12 @@
 // skelcd bench as a user runs it: the table, CSV (header, one line per method × accuracy, numbers
 // that agree with --json), the PNG plot, and bad input refused in one line with nothing written.
 
+#include <gtest/gtest.h>
+
 #include <algorithm>
 #include <fstream>
-#include <sstream>
-
-#include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
+#include <sstream>
 
 #include "tests/support/test_support.hpp"
 #include "tests/tools/cli_runner.hpp"
@@ -35,9 +35,20 @@ TEST(CmdBench, CsvJsonAndPlotOfAGeneratedRope) {
   const auto dir = skelcd::test::temp_dir("bench-cli");
   const auto csv = dir / "rope.csv";
   const auto png = dir / "rope.png";
-  const auto r = run_skelcd({"bench", kRope, "--frames", "44:46", "--methods", "bvh,kdop",
-                             "--accuracies", "exact,conservative,fast", "--csv", csv.string(),
-                             "--plot", png.string(), "--json"});
+  const auto r = run_skelcd(
+      {"bench",
+       kRope,
+       "--frames",
+       "44:46",
+       "--methods",
+       "bvh,kdop",
+       "--accuracies",
+       "exact,conservative,fast",
+       "--csv",
+       csv.string(),
+       "--plot",
+       png.string(),
+       "--json"});
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const auto j = nlohmann::json::parse(r.out);
   EXPECT_EQ(j["reference"]["method"], "brute");
@@ -60,11 +71,13 @@ TEST(CmdBench, CsvJsonAndPlotOfAGeneratedRope) {
 
   const auto csv_lines = lines(read_text(csv));
   ASSERT_EQ(csv_lines.size(), 7u);
-  EXPECT_EQ(csv_lines[0].rfind("method,accuracy,ms_per_interval,bv_tests,candidate_pairs,contacts,"
-                               "false_negatives,false_positives,skin_ms,refit_ms,classify_ms,"
-                               "merge_ms,traverse_ms,elementary_ms,other_ms",
-                               0),
-            0u)
+  EXPECT_EQ(
+      csv_lines[0].rfind(
+          "method,accuracy,ms_per_interval,bv_tests,candidate_pairs,contacts,"
+          "false_negatives,false_positives,skin_ms,refit_ms,classify_ms,"
+          "merge_ms,traverse_ms,elementary_ms,other_ms",
+          0),
+      0u)
       << csv_lines[0];
   // Row 2 (bvh conservative) carries the JSON's counts.
   std::ostringstream expected;
@@ -90,8 +103,15 @@ TEST(CmdBench, CsvJsonAndPlotOfAGeneratedRope) {
 
 TEST(CmdBench, TableOnARealCharacterMarksTheReference) {
   const auto model = skelcd::test::asset("characters/CesiumMan.glb").string();
-  const auto r = run_skelcd({"bench", model, "--frames", "0:2", "--methods", "brute,bvh",
-                             "--accuracies", "exact,conservative"});
+  const auto r = run_skelcd(
+      {"bench",
+       model,
+       "--frames",
+       "0:2",
+       "--methods",
+       "brute,bvh",
+       "--accuracies",
+       "exact,conservative"});
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_NE(r.out.find("reference brute + exact"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("* brute"), std::string::npos) << r.out;
@@ -153,9 +173,18 @@ TEST(CmdBench, SceneRunsEachSelfCheckedObjectWithItsQueries) {
   }
   const auto csv = dir / "s.csv";
   const auto png = dir / "s.png";
-  const auto r = run_skelcd({"bench", scene.string(), "--methods", "bvh", "--accuracies",
-                             "exact,conservative", "--csv", csv.string(), "--plot", png.string(),
-                             "--json"});
+  const auto r = run_skelcd(
+      {"bench",
+       scene.string(),
+       "--methods",
+       "bvh",
+       "--accuracies",
+       "exact,conservative",
+       "--csv",
+       csv.string(),
+       "--plot",
+       png.string(),
+       "--json"});
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const auto j = nlohmann::json::parse(r.out);
   ASSERT_EQ(j["objects"].size(), 2u);  // idle has no self check
