@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <filesystem>
+#include <iostream>
 #include <memory>
 
 #include "clustering/bone_poses.hpp"
@@ -19,8 +20,8 @@ void add_radial_view_options(CLI::App& command, RadialViewArguments& args) {
   command.add_option("--seed", args.seed, "dynamic: seed of the seed-cluster draws")
       ->capture_default_str();
   command.add_option("--segmentation", args.segmentation,
-                     "rvbc/dynamic: SEG.h5 from `skelcd preprocess` of the same model "
-                     "(default: segment here with the rig's weights)");
+                     "rvbc/dynamic: SEG.h5 from `skelcd preprocess`, used when made from this model "
+                     "(else, and by default, segment here with the rig's weights)");
 }
 
 RadialViewSetup setup_radial_view(
@@ -50,10 +51,20 @@ RadialViewSetup setup_radial_view(
     throw InvalidInput("--method " + method + ": " + motion.name() + " is not a rig's clip");
   }
 
-  // The segmentation: the preprocess file when given (it must come from this very model), else
+  // The segmentation: the preprocess file when given and made from this very model, else
   // computed now with the rig's own weights (fast; `preprocess` offers heat weights).
   std::shared_ptr<const segmentation::Segmentation> seg;
-  if (!args.segmentation.empty()) {
+  // A readable segmentation of another model (or of an older version of this file) is not used:
+  // the model is segmented anew, and the user is told why. A missing or damaged file is an error.
+  bool reuse = !args.segmentation.empty();
+  if (reuse && std::filesystem::exists(args.segmentation) &&
+      !segmentation_matches(args.segmentation, model.path.string())) {
+    (void)read_segmentation(args.segmentation);  // throws naming the file when it is no segmentation
+    std::cerr << "skelcd: note: " << args.segmentation << " was made from another model than "
+              << model.path.string() << " (input hash differs); segmenting it anew\n";
+    reuse = false;
+  }
+  if (reuse) {
     auto file = read_segmentation(args.segmentation, model.path);
     seg = std::make_shared<const segmentation::Segmentation>(std::move(file.segmentation));
     setup.segmentation_source = args.segmentation;

@@ -5,6 +5,8 @@
 #include <algorithm>
 #include <tuple>
 
+#include <fstream>
+
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
@@ -80,13 +82,25 @@ TEST(RadialViewCheck, ReusesAPreprocessedSegmentation) {
   const auto b = nlohmann::json::parse(computed.out);
   EXPECT_EQ(a["ccd_vf"], b["ccd_vf"]);
   EXPECT_EQ(a["ccd_ee"], b["ccd_ee"]);
-  // A segmentation of another model is refused, naming both files.
+  // A segmentation of another model is not used: the model is segmented anew, with a note
+  // naming the file, and the contacts are those of the computed segmentation.
   const auto fox_seg = (dir / "fox.seg.h5").string();
   ASSERT_EQ(run_skelcd({"preprocess", kFox, "--weights", "rig", "-o", fox_seg}).exit_code, 0);
-  const auto wrong = run_skelcd({"check", kCesium, "--frames", "0:1", "--method", "rvbc",
-                                 "--segmentation", fox_seg});
-  EXPECT_EQ(wrong.exit_code, 1);
+  const auto wrong = run_skelcd({"check", kCesium, "--frames", "2:4", "--query", "ccd", "--method",
+                                 "dynamic", "--segmentation", fox_seg, "--json"});
+  ASSERT_EQ(wrong.exit_code, 0) << wrong.err;
   EXPECT_NE(wrong.err.find("fox.seg.h5"), std::string::npos) << wrong.err;
+  EXPECT_NE(wrong.err.find("segmenting it anew"), std::string::npos) << wrong.err;
+  const auto c = nlohmann::json::parse(wrong.out);
+  EXPECT_EQ(c["ccd_vf"], b["ccd_vf"]);
+  EXPECT_EQ(c["ccd_ee"], b["ccd_ee"]);
+  // A file that is no segmentation at all is refused.
+  const auto not_seg = (dir / "not-a-seg.h5").string();
+  std::ofstream(not_seg) << "not hdf5";
+  const auto bad = run_skelcd({"check", kCesium, "--frames", "0:1", "--method", "rvbc",
+                               "--segmentation", not_seg});
+  EXPECT_EQ(bad.exit_code, 1);
+  EXPECT_NE(bad.err.find("not-a-seg.h5"), std::string::npos) << bad.err;
 }
 
 TEST(RadialViewCheck, BadInputIsRefusedInOneLine) {
