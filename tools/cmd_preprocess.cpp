@@ -20,6 +20,7 @@
 #include "skinning/rig_motion.hpp"
 #include "tools/cli_util.hpp"
 #include "tools/commands.hpp"
+#include "tools/model_options.hpp"
 #include "tools/segmentation_file.hpp"
 
 namespace skelcd::tools {
@@ -38,6 +39,7 @@ struct PreprocessArguments {
   bool no_refine = false;
   std::string output;
   bool json = false;
+  skinning::LoadOptions load;
 };
 
 seg::SegmentationOptions to_options(const PreprocessArguments& a) {
@@ -202,7 +204,7 @@ void run_preprocess(const PreprocessArguments& args) {
   const auto options = to_options(args);
   const std::filesystem::path model_path(args.model);
   if (!skinning::is_generator_spec(args.model)) require_exists(model_path);
-  const auto model = skinning::load_model(model_path);
+  const auto model = skinning::load_model(model_path, args.load);
   if (!model.rig) {
     throw InvalidInput(args.model + ": preprocess needs a rigged model (a mesh with a skeleton); "
                        "this is a " + skinning::to_string(model.kind));
@@ -263,6 +265,7 @@ void add_preprocess_command(CLI::App& app) {
   cmd->add_flag("--no-refine", args->no_refine, "skip the cluster refinement (RVBC's plain split)");
   cmd->add_option("-o,--output", args->output, "write the segmentation here (SEG.h5)");
   cmd->add_flag("--json", args->json, "print the statistics as one JSON object");
+  add_model_options(*cmd, args->load);
   cmd->callback([args] { run_preprocess(*args); });
 }
 

@@ -160,6 +160,29 @@ TEST(CmdPreprocess, ClipAveragesAndCoarseDistance) {
   EXPECT_EQ(j["distance"], "coarse");
 }
 
+TEST(CmdPreprocess, RobotsTakeTheirTrajectoryAndSrdf) {
+  // The robot options reach preprocess: the Panda moved by its bundled reach trajectory (61 rows,
+  // so 60 intervals), with the rig's own (rigid, one link each) weights.
+  const auto urdf =
+      skelcd::test::asset("robots/example-robot-data/robots/panda_description/urdf/panda.urdf");
+  const auto trajectory = skelcd::test::asset("trajectories/panda_reach.csv");
+  const auto r = run_skelcd({"preprocess", urdf.string(), "--trajectory", trajectory.string(),
+                             "--weights", "rig", "--clip", "panda_reach", "--json"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(j["bones"].get<int>(), 11);
+  ASSERT_TRUE(j["clip"].is_object());
+  EXPECT_EQ(j["clip"]["intervals"].get<int>(), 60);
+  EXPECT_TRUE(j["bones_without_cluster"].empty());
+  // Without --trajectory there is no such clip; a missing trajectory file is named.
+  const auto no_clip = run_skelcd({"preprocess", urdf.string(), "--clip", "panda_reach"});
+  EXPECT_NE(no_clip.exit_code, 0);
+  EXPECT_NE(no_clip.err.find("panda_reach"), std::string::npos) << no_clip.err;
+  const auto missing = run_skelcd({"preprocess", urdf.string(), "--trajectory", "no-such.csv"});
+  EXPECT_NE(missing.exit_code, 0);
+  EXPECT_NE(missing.err.find("no-such.csv"), std::string::npos) << missing.err;
+}
+
 TEST(CmdPreprocess, BadInputIsOneLineAndWritesNothing) {
   const auto dir = skelcd::test::temp_dir("cmd_preprocess_bad");
   const auto out = dir / "seg.h5";
