@@ -30,7 +30,7 @@ function(skelcd_add_test_executable target)
                                           GTest::gtest_main skelcd_warnings)
   gtest_discover_tests(${target}
     WORKING_DIRECTORY ${PROJECT_SOURCE_DIR}
-    PROPERTIES LABELS unit
+    PROPERTIES LABELS unit ENVIRONMENT "${SKELCD_TEST_ENVIRONMENT}"
     DISCOVERY_TIMEOUT 60)
 endfunction()
 
