@@ -12,6 +12,40 @@ inline Eigen::Vector3d row(const skinning::Positions& x, std::int32_t i) {
 
 }  // namespace
 
+ccd::VertexFaceQuery vertex_face_query(
+    const skinning::Positions& xv_t0,
+    const skinning::Positions& xv_t1,
+    std::int32_t v,
+    const skinning::Positions& xf_t0,
+    const skinning::Positions& xf_t1,
+    const std::array<std::int32_t, 3>& f) {
+  return {row(xv_t0, v),
+          row(xf_t0, f[0]),
+          row(xf_t0, f[1]),
+          row(xf_t0, f[2]),
+          row(xv_t1, v),
+          row(xf_t1, f[0]),
+          row(xf_t1, f[1]),
+          row(xf_t1, f[2])};
+}
+
+ccd::EdgeEdgeQuery edge_edge_query(
+    const skinning::Positions& xa_t0,
+    const skinning::Positions& xa_t1,
+    const std::array<std::int32_t, 2>& ea,
+    const skinning::Positions& xb_t0,
+    const skinning::Positions& xb_t1,
+    const std::array<std::int32_t, 2>& eb) {
+  return {row(xa_t0, ea[0]),
+          row(xa_t0, ea[1]),
+          row(xb_t0, eb[0]),
+          row(xb_t0, eb[1]),
+          row(xa_t1, ea[0]),
+          row(xa_t1, ea[1]),
+          row(xb_t1, eb[0]),
+          row(xb_t1, eb[1])};
+}
+
 void run_ccd_tests(
     const FeatureTopology& topology,
     const FeatureCandidates& candidates,
@@ -25,16 +59,8 @@ void run_ccd_tests(
   const std::size_t first = out.contacts.size();
   Counters& c = out.counters;
   for (const VertexFacePair& p : candidates.vf) {
-    const auto& f = topology.triangle(p.face);
-    const ccd::VertexFaceQuery q{
-        row(x_t0, p.vertex),
-        row(x_t0, f[0]),
-        row(x_t0, f[1]),
-        row(x_t0, f[2]),
-        row(x_t1, p.vertex),
-        row(x_t1, f[0]),
-        row(x_t1, f[1]),
-        row(x_t1, f[2])};
+    const ccd::VertexFaceQuery q =
+        vertex_face_query(x_t0, x_t1, p.vertex, x_t0, x_t1, topology.triangle(p.face));
     const ccd::CcdResult r = tests.vertex_face(q, accuracy, options);
     ++c.vf_tests;
     if (r.hit) {
@@ -43,17 +69,8 @@ void run_ccd_tests(
     }
   }
   for (const EdgeEdgePair& p : candidates.ee) {
-    const auto& ea = topology.edge(p.a);
-    const auto& eb = topology.edge(p.b);
-    const ccd::EdgeEdgeQuery q{
-        row(x_t0, ea[0]),
-        row(x_t0, ea[1]),
-        row(x_t0, eb[0]),
-        row(x_t0, eb[1]),
-        row(x_t1, ea[0]),
-        row(x_t1, ea[1]),
-        row(x_t1, eb[0]),
-        row(x_t1, eb[1])};
+    const ccd::EdgeEdgeQuery q =
+        edge_edge_query(x_t0, x_t1, topology.edge(p.a), x_t0, x_t1, topology.edge(p.b));
     const ccd::CcdResult r = tests.edge_edge(q, accuracy, options);
     ++c.ee_tests;
     if (r.hit) {

@@ -3,6 +3,8 @@
 // and the triangle-triangle DCD tests of a set of triangle pairs, through the ccd/ kernels (or
 // substitutes: tests inject reference or counting implementations).
 
+#include <array>
+#include <cstdint>
 #include <span>
 
 #include "ccd/accuracy.hpp"
@@ -28,6 +30,26 @@ struct ElementaryTests {
   EdgeEdgeFn edge_edge = nullptr;
   TrianglesFn triangles = nullptr;
 };
+
+/// The CCD query of vertex `v` (positions xv_t0 → xv_t1) against triangle `f` (positions
+/// xf_t0 → xf_t1). Within one object pass the same positions twice; across two objects (pair
+/// checks) each side its own.
+[[nodiscard]] ccd::VertexFaceQuery vertex_face_query(
+    const skinning::Positions& xv_t0,
+    const skinning::Positions& xv_t1,
+    std::int32_t v,
+    const skinning::Positions& xf_t0,
+    const skinning::Positions& xf_t1,
+    const std::array<std::int32_t, 3>& f);
+
+/// The CCD query of edge `ea` (positions xa_t0 → xa_t1) against edge `eb` (xb_t0 → xb_t1).
+[[nodiscard]] ccd::EdgeEdgeQuery edge_edge_query(
+    const skinning::Positions& xa_t0,
+    const skinning::Positions& xa_t1,
+    const std::array<std::int32_t, 2>& ea,
+    const skinning::Positions& xb_t0,
+    const skinning::Positions& xb_t1,
+    const std::array<std::int32_t, 2>& eb);
 
 /// `tests` with every null member replaced by the ccd/ kernel (ccd::vertex_face_ccd,
 /// ccd::edge_edge_ccd, ccd::triangles_intersect).

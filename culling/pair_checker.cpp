@@ -207,15 +207,7 @@ void PairChecker::detect_ccd(
     const auto& xf0 = p.vertex_of_b ? x_a_t0 : x_b_t0;
     const auto& xf1 = p.vertex_of_b ? x_a_t1 : x_b_t1;
     const auto& f = p.vertex_of_b ? topology_a_.triangle(p.face) : topology_b_.triangle(p.face);
-    const ccd::VertexFaceQuery q{
-        row(xv0, p.vertex),
-        row(xf0, f[0]),
-        row(xf0, f[1]),
-        row(xf0, f[2]),
-        row(xv1, p.vertex),
-        row(xf1, f[0]),
-        row(xf1, f[1]),
-        row(xf1, f[2])};
+    const ccd::VertexFaceQuery q = vertex_face_query(xv0, xv1, p.vertex, xf0, xf1, f);
     const ccd::CcdResult r = tests_.vertex_face(q, options_.accuracy, ccd_options_);
     ++out.counters.vf_tests;
     if (r.hit) {
@@ -225,17 +217,8 @@ void PairChecker::detect_ccd(
     }
   }
   for (const EdgeEdgePair& p : ee_) {
-    const auto& ea = topology_a_.edge(p.a);
-    const auto& eb = topology_b_.edge(p.b);
-    const ccd::EdgeEdgeQuery q{
-        row(x_a_t0, ea[0]),
-        row(x_a_t0, ea[1]),
-        row(x_b_t0, eb[0]),
-        row(x_b_t0, eb[1]),
-        row(x_a_t1, ea[0]),
-        row(x_a_t1, ea[1]),
-        row(x_b_t1, eb[0]),
-        row(x_b_t1, eb[1])};
+    const ccd::EdgeEdgeQuery q = edge_edge_query(
+        x_a_t0, x_a_t1, topology_a_.edge(p.a), x_b_t0, x_b_t1, topology_b_.edge(p.b));
     const ccd::CcdResult r = tests_.edge_edge(q, options_.accuracy, ccd_options_);
     ++out.counters.ee_tests;
     if (r.hit) {
