@@ -228,6 +228,34 @@ TEST(Log, UnfinishedLogIsReadableAndMarkedIncomplete) {
   EXPECT_EQ(data.dcd_pairs.size(), 4u);
 }
 
+TEST(Log, RowsCountedButNeverWrittenAreDropped) {
+  // A kill inside a flush can leave a table's extent ahead of its data: those rows read as the
+  // fill value (first field -1). Made here with h5py, which grows the tables without writing.
+  const auto dir = skelcd::test::temp_dir("log-unwritten");
+  const auto path = dir / "run.h5";
+  {
+    LogWriter writer(path, sample_header());
+    writer.append(sample_report(3, QueryKind::dcd, 0, 4));
+    writer.append(sample_report(3, QueryKind::ccd, 7, 0));
+  }
+  const std::string script =
+      "import h5py, sys\n"
+      "with h5py.File('" + path.string() + "', 'r+') as f:\n"
+      "    for name, more in (('frames', 3), ('contacts', 5), ('dcd_pairs', 2)):\n"
+      "        d = f[name]; d.resize((d.shape[0] + more,))\n"
+      "    first = {'frames': 'sample', 'contacts': 'frame', 'dcd_pairs': 'frame'}\n"
+      "    ok = all((f[n][-1][k] == -1) and (f[n][0][k] == 3) for n, k in first.items())\n"
+      "sys.exit(0 if ok else 3)\n";
+  write_text(dir / "grow.py", script);
+  ASSERT_EQ(std::system((std::string(kPython) + " " + (dir / "grow.py").string()).c_str()), 0);
+  const auto data = read_log(path);
+  EXPECT_FALSE(data.header.complete);
+  ASSERT_EQ(data.frames.size(), 2u);
+  EXPECT_EQ(data.frames[1].sample, 3);
+  EXPECT_EQ(data.contacts.size(), 7u);
+  EXPECT_EQ(data.dcd_pairs.size(), 4u);
+}
+
 TEST(Log, RefusesToOverwriteAFileThatIsNotALog) {
   const auto dir = skelcd::test::temp_dir("log-clobber");
   const auto text = dir / "notes.txt";

@@ -1,6 +1,8 @@
 #include "tools/log/log_reader.hpp"
 
 #include <string>
+#include <type_traits>
+#include <vector>
 
 #include "skinning/errors.hpp"
 #include "tools/log/detail/hdf5_schema.hpp"
@@ -10,6 +12,23 @@ namespace skelcd::tools {
 using detail::H5Handle;
 
 namespace {
+
+/// Drops the rows at the end of a table that no flush reached: the fill value's first field is -1
+/// (`sample` of /frames, `frame` of the findings, the check of /frame_check), which no written
+/// row has. Only the log of a killed run has such rows (docs/log-format.md, crash safety).
+template <class Row>
+void drop_unwritten(std::vector<Row>& rows) {
+  const auto first = [](const Row& r) {
+    if constexpr (std::is_same_v<Row, std::int32_t>) {
+      return r;
+    } else if constexpr (requires { r.sample; }) {
+      return r.sample;
+    } else {
+      return r.frame;
+    }
+  };
+  while (!rows.empty() && first(rows.back()) == -1) rows.pop_back();
+}
 
 /// Reads the whole 1-D compound dataset `name` into `rows` through `memory_type` (fields matched
 /// by name).
@@ -34,6 +53,7 @@ void read_table(hid_t file, const char* name, const H5Handle& memory_type, std::
   if (H5Dread(dataset.get(), memory_type.get(), H5S_ALL, H5S_ALL, H5P_DEFAULT, rows.data()) < 0) {
     throw IoError("cannot read " + where + " (" + detail::take_hdf5_error() + ")");
   }
+  drop_unwritten(rows);
 }
 
 std::vector<std::string> read_parts(hid_t file) {
@@ -177,6 +197,7 @@ std::vector<std::int32_t> read_frame_checks(hid_t file) {
                           values.data()) < 0) {
     throw IoError("cannot read /frame_check (" + detail::take_hdf5_error() + ")");
   }
+  drop_unwritten(values);
   return values;
 }
 

@@ -23,10 +23,31 @@ struct Table {
 /// Rows per chunk: small enough that the chunk rewritten at every flush stays cheap.
 constexpr hsize_t kFrameChunkRows = 64;
 constexpr hsize_t kPairChunkRows = 1024;
-constexpr unsigned kDeflateLevel = 4;
 
+/// The tables are chunked but not compressed, on purpose: an uncompressed chunk keeps its size
+/// and so its place in the file, and every flush rewrites it where it is. A compressed chunk
+/// changes size with every row, is written to a new place and its old space freed for reuse; a
+/// kill inside a flush can then leave the chunk index pointing at space already holding other
+/// data (`inflate() failed` on the next read: 1 kill in ~25 in CmdCheck.KilledRun…). Keeping
+/// compression but never reusing space (H5F_FSPACE_STRATEGY_NONE) was tried and rejected: every
+/// flush then leaks the chunk's previous copy, and logs came out larger than uncompressed ones.
+/// Rows the extent counts but no flush reached read as the fill value, a row whose first field
+/// (`sample` or `frame`) is -1; the reader drops such rows at the end of a table.
+/// The fill value of a table: all zero but the first field, -1.
+template <class Row>
+Row unwritten() {
+  Row row{};
+  if constexpr (requires { row.sample; }) {
+    row.sample = -1;
+  } else {
+    row.frame = -1;
+  }
+  return row;
+}
+
+template <class Row>
 Table create_table(hid_t file, const char* name, H5Handle memory_type, hsize_t chunk_rows,
-                   const std::string& where) {
+                   const Row& fill, const std::string& where) {
   const auto fail = [&](const char* what) {
     throw IoError(where + ": cannot create /" + name + " (" + what + ": " +
                   detail::take_hdf5_error() + ")");
@@ -38,9 +59,7 @@ Table create_table(hid_t file, const char* name, H5Handle memory_type, hsize_t c
   H5Handle properties(H5Pcreate(H5P_DATASET_CREATE), H5Pclose);
   if (!space.valid() || !properties.valid()) fail("dataspace");
   if (H5Pset_chunk(properties.get(), 1, &chunk_rows) < 0) fail("chunking");
-  if (H5Pset_shuffle(properties.get()) < 0 || H5Pset_deflate(properties.get(), kDeflateLevel) < 0) {
-    fail("compression");
-  }
+  if (H5Pset_fill_value(properties.get(), memory_type.get(), &fill) < 0) fail("fill value");
   Table table;
   table.dataset = H5Handle(H5Dcreate2(file, name, file_type.get(), space.get(), H5P_DEFAULT,
                                       properties.get(), H5P_DEFAULT),
@@ -196,7 +215,9 @@ Table create_frame_check_table(hid_t file, const std::string& where) {
   H5Handle space(H5Screate_simple(1, &initial, &unlimited), H5Sclose);
   H5Handle properties(H5Pcreate(H5P_DATASET_CREATE), H5Pclose);
   Table table;
-  if (space.valid() && properties.valid() && H5Pset_chunk(properties.get(), 1, &chunk) >= 0) {
+  const std::int32_t fill = -1;  // as create_table: an unwritten row reads as -1
+  if (space.valid() && properties.valid() && H5Pset_chunk(properties.get(), 1, &chunk) >= 0 &&
+      H5Pset_fill_value(properties.get(), H5T_NATIVE_INT32, &fill) >= 0) {
     table.dataset = H5Handle(H5Dcreate2(file, "frame_check", H5T_STD_I32LE, space.get(),
                                         H5P_DEFAULT, properties.get(), H5P_DEFAULT),
                              H5Dclose);
@@ -301,11 +322,11 @@ LogWriter::LogWriter(const std::filesystem::path& path, const LogHeader& header)
     write_checks(file, header.checks, impl_->where);
     if (!header.checks.empty()) impl_->frame_checks = create_frame_check_table(file, impl_->where);
     impl_->frames = create_table(file, detail::kFramesPath, detail::frame_memory_type(),
-                                 kFrameChunkRows, impl_->where);
+                                 kFrameChunkRows, unwritten<detail::FrameDisk>(), impl_->where);
     impl_->contacts = create_table(file, detail::kContactsPath, detail::contact_memory_type(),
-                                   kPairChunkRows, impl_->where);
+                                   kPairChunkRows, unwritten<detail::ContactDisk>(), impl_->where);
     impl_->dcd_pairs = create_table(file, detail::kDcdPairsPath, detail::dcd_pair_memory_type(),
-                                    kPairChunkRows, impl_->where);
+                                    kPairChunkRows, unwritten<detail::DcdPairDisk>(), impl_->where);
     if (H5Fflush(file, H5F_SCOPE_LOCAL) < 0) {
       throw IoError(impl_->where + ": cannot flush (" + detail::take_hdf5_error() + ")");
     }
