@@ -34,10 +34,18 @@ class RadialViewExtension final : public culling::MethodExtension {
       std::int32_t num_bones,
       const RadialViewParameters& parameters = {});
 
+  /// For runs that ask for DCD only: `rvbc` and `dynamic` answer DCD with `bvh` (radial view
+  /// culls intervals, not instants), so nothing of the radial view is built — no segmentation,
+  /// no bone poses. The methods it makes refuse CCD queries.
+  [[nodiscard]] static std::shared_ptr<const RadialViewExtension> dcd_only(
+      const RadialViewParameters& parameters = {});
+
   /// {"rvbc", "dynamic"}.
   [[nodiscard]] std::vector<std::string> method_names() const override;
 
-  /// `rvbc` (fixed atomic clusters) or `dynamic` (mega clusters); null for any other name.
+  /// `rvbc` (fixed atomic clusters) or `dynamic` (mega clusters); null for any other name. From a
+  /// dcd_only() extension: a method of that name that answers DCD with `bvh` and throws
+  /// InvalidInput on a CCD query.
   [[nodiscard]] std::unique_ptr<culling::CullingMethod> make_method(
       std::string_view name,
       const skinning::Mesh& mesh,
@@ -46,7 +54,12 @@ class RadialViewExtension final : public culling::MethodExtension {
 
   [[nodiscard]] const RadialViewParameters& parameters() const { return parameters_; }
 
+  /// True for an extension made by dcd_only().
+  [[nodiscard]] bool is_dcd_only() const { return segmentation_ == nullptr; }
+
  private:
+  explicit RadialViewExtension(const RadialViewParameters& parameters);
+
   std::shared_ptr<const segmentation::Segmentation> segmentation_;
   std::shared_ptr<const BonePoses> poses_;
   std::int32_t num_bones_;

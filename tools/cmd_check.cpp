@@ -255,7 +255,6 @@ CheckedClip check_clip(const CheckArguments& args, RunOptions options, const std
                        const skinning::LoadedModel& model, const std::string& clip,
                        const std::string& log_path) {
   options.clip = clip;
-  const std::filesystem::path model_path(model_arg);
   const auto motion = model.motion(skinning::MotionRequest{.clip = clip, .rate_hz = args.fps});
   const auto radial_view = setup_radial_view(args.radial_view, model, *motion, options);
   ClipRunner runner(*motion, options);
@@ -268,8 +267,7 @@ CheckedClip check_clip(const CheckArguments& args, RunOptions options, const std
     header.skelcd_version = kVersion;
     header.command_line = command_line();
     header.input_path = model_arg;
-    header.input_hash =
-        std::filesystem::is_regular_file(model_path) ? file_content_hash(model_path) : "";
+    header.input_hash = model_identity(model_arg);
     header.clip = motion->name();
     header.method = std::string(runner.method_name());
     header.accuracy = std::string(ccd::to_string(options.accuracy));
@@ -277,6 +275,8 @@ CheckedClip check_clip(const CheckArguments& args, RunOptions options, const std
     header.fps = fps;
     header.min_separation = options.min_separation;
     header.gamma = radial_view.gamma;
+    header.seed = radial_view.seed;
+    header.segmentation = radial_view.segmentation_source;
     header.start_time = iso8601_utc_now();
     header.first_sample = plan.first_sample;
     header.last_sample = plan.last_sample;
@@ -303,8 +303,14 @@ CheckedClip check_clip(const CheckArguments& args, RunOptions options, const std
   CheckedClip checked;
   std::ostringstream text;
   print_text_summary(text, model, *motion, options, plan, fps, summary, log_path);
+  if (!radial_view.segmentation_source.empty()) {
+    text << "segmentation: " << radial_view.segmentation_source << "\n";
+  }
   checked.text = text.str();
   checked.json = json_summary(model, *motion, options, plan, fps, summary, log_path);
+  if (!radial_view.segmentation_source.empty()) {
+    checked.json["segmentation"] = radial_view.segmentation_source;
+  }
   return checked;
 }
 

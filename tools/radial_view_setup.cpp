@@ -41,6 +41,23 @@ RadialViewSetup setup_radial_view(
   if (!(std::isfinite(args.gamma) && args.gamma >= 0.0 && args.gamma <= 1.0)) {
     throw InvalidInput("--gamma " + std::to_string(args.gamma) + ": expected a value in [0, 1]");
   }
+  const clustering::RadialViewParameters parameters{.gamma = args.gamma, .seed = args.seed};
+  // DCD only: rvbc/dynamic answer each instant with `bvh` (radial view culls intervals), so no
+  // segmentation is read or computed (DESIGN.md, "compute only what is asked"); `auto` sends its
+  // closed parts to its `bvh` fallback, which is the same answer.
+  if (options.query == QuerySet::dcd) {
+    setup.segmentation_source = "none (DCD only: no radial-view stage runs)";
+    if (!args.segmentation.empty()) {
+      std::cerr << "skelcd: note: " << args.segmentation
+                << " is not used: --query dcd needs no segmentation\n";
+    }
+    if (method != "auto") options.method_extension = clustering::RadialViewExtension::dcd_only(parameters);
+    if (method == "dynamic") {
+      setup.gamma = args.gamma;
+      setup.seed = static_cast<std::int64_t>(args.seed);
+    }
+    return setup;
+  }
   if (!model.rig) {
     throw InvalidInput(
         "--method " + method + " needs a rigged model (bones move the observers): " +
@@ -82,22 +99,23 @@ RadialViewSetup setup_radial_view(
   // Bone poses: the runner tells which samples each query spans.
   auto poses = std::make_shared<clustering::BonePoses>(clustering::pose_at_sample(*rig_motion));
   options.method_extension = std::make_shared<clustering::RadialViewExtension>(
-      seg, poses, model.rig->skeleton.num_bones(),
-      clustering::RadialViewParameters{.gamma = args.gamma, .seed = args.seed});
+      seg, poses, model.rig->skeleton.num_bones(), parameters);
   options.before_query = [poses](std::int32_t s0, std::int32_t s1) {
     poses->select_samples(s0, s1);
   };
   // A parallel run (RunOptions::threads) gives every extra worker its own bone poses.
   options.make_worker_hooks = [seg, rig_motion, num_bones = model.rig->skeleton.num_bones(),
-                               parameters = clustering::RadialViewParameters{
-                                   .gamma = args.gamma, .seed = args.seed}] {
+                               parameters] {
     auto own = std::make_shared<clustering::BonePoses>(clustering::pose_at_sample(*rig_motion));
     return WorkerHooks{
         .method_extension =
             std::make_shared<clustering::RadialViewExtension>(seg, own, num_bones, parameters),
         .before_query = [own](std::int32_t s0, std::int32_t s1) { own->select_samples(s0, s1); }};
   };
-  if (method == "dynamic") setup.gamma = args.gamma;
+  if (method == "dynamic" || method == "auto") {
+    setup.gamma = args.gamma;
+    setup.seed = static_cast<std::int64_t>(args.seed);
+  }
   return setup;
 }
 

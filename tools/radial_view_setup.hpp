@@ -30,12 +30,15 @@ struct RadialViewSetup {
   /// Where the segmentation came from: the file, or "computed (rig weights)" / "(heat weights)".
   std::string segmentation_source;
   std::int32_t atomic_clusters = 0;
-  /// γ when the method uses it (`dynamic`), for the log header.
+  /// γ and the seed when the method uses them (`dynamic`), for the log header.
   std::optional<double> gamma;
+  std::optional<std::int64_t> seed;
 };
 
 /// For options.method rvbc or dynamic: loads or computes the segmentation and sets
 /// options.method_extension and options.before_query (bone poses follow the runner's samples).
+/// With options.query == dcd nothing of the radial view is built: rvbc/dynamic get a DCD-only
+/// extension (their DCD is `bvh`'s) and `auto` none (its closed parts go to its `bvh` fallback).
 /// Does nothing and returns an empty setup for any other method.
 /// @param motion the motion the runner will check (a rig's clip: RigMotion).
 /// @throws InvalidInput when the model has no rig, the motion is not a rig's, γ is outside

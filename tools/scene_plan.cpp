@@ -39,9 +39,10 @@ void decide_stages(ObjectPlan& o) {
   } else if (self && o.method == "auto") {
     o.cones = o.facts.open_components > 0;
   }
-  if (self && radial) {
+  // Radial view culls intervals only: a DCD-only object answers with `bvh` and is not segmented.
+  if (o.self_ccd && radial) {
     o.segmentation = true;
-  } else if (self && o.method == "auto") {
+  } else if (o.self_ccd && o.method == "auto") {
     o.segmentation = o.facts.closed_components > 0 && o.facts.rig_motion;
   }
   if (!o.load) return;
@@ -64,6 +65,9 @@ void decide_stages(ObjectPlan& o) {
   if (!o.segmentation) {
     if (!self) {
       s.push_back("segmentation: pair checks only");
+    } else if (!o.self_ccd && (radial || o.method == "auto")) {
+      s.push_back("segmentation: DCD only (" + o.method +
+                  " answers instants with bvh; radial view culls intervals)");
     } else if (o.method == "auto") {
       s.push_back(
           o.facts.closed_components == 0

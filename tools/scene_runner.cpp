@@ -519,6 +519,8 @@ SceneRunResult run_scene(const Scene& scene, const SceneRunOptions& options) {
   std::vector<std::unique_ptr<ClipRunner>> runners(plan.checks.size());
   std::vector<RunOptions> run_options(plan.checks.size());
   std::optional<double> gamma;
+  std::optional<std::int64_t> seed;
+  std::string segmentation_sources;  // "object: source; …" for the log header
   for (std::size_t k = 0; k < plan.checks.size(); ++k) {
     const CheckPlan& c = plan.checks[k];
     if (c.kind != CheckKind::self) continue;
@@ -534,9 +536,16 @@ SceneRunResult run_scene(const Scene& scene, const SceneRunOptions& options) {
     ro.min_separation = scene.min_separation;
     ro.threads = options.threads;
     try {
-      if (plan.objects[at(c.object_a)].segmentation) {
+      // rvbc/dynamic need their extension even for DCD only (a DCD-only one, no segmentation).
+      if (plan.objects[at(c.object_a)].segmentation ||
+          clustering::is_radial_view_method(c.method)) {
         const auto setup = setup_radial_view(RadialViewArguments{}, *lo.model, *lo.motion, ro);
         if (setup.gamma) gamma = setup.gamma;
+        if (setup.seed) seed = setup.seed;
+        if (!setup.segmentation_source.empty()) {
+          segmentation_sources += (segmentation_sources.empty() ? "" : "; ") + so.name + ": " +
+                                  setup.segmentation_source;
+        }
       }
       runners[k] = std::make_unique<ClipRunner>(*lo.motion, ro);
     } catch (const std::exception& e) {
@@ -590,6 +599,8 @@ SceneRunResult run_scene(const Scene& scene, const SceneRunOptions& options) {
     }
     header.min_separation = scene.min_separation;
     header.gamma = gamma;
+    header.seed = seed;
+    header.segmentation = segmentation_sources;
     header.start_time = iso8601_utc_now();
     header.planned_rows = plan.rows;
     header.num_vertices = vertices;

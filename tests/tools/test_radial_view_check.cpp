@@ -53,6 +53,11 @@ TEST(RadialViewCheck, SameContactsAsBvhAndTable3Columns) {
   ASSERT_TRUE(dynamic.header.gamma.has_value());
   EXPECT_DOUBLE_EQ(*dynamic.header.gamma, 0.05);
   EXPECT_FALSE(logs[1].header.gamma.has_value());  // rvbc does not merge
+  ASSERT_TRUE(dynamic.header.seed.has_value());
+  EXPECT_EQ(*dynamic.header.seed, 1);
+  EXPECT_FALSE(logs[1].header.seed.has_value());
+  EXPECT_EQ(dynamic.header.segmentation, "computed (rig weights)");
+  EXPECT_TRUE(logs[0].header.segmentation.empty());  // bvh: no radial view
   ASSERT_EQ(dynamic.frames.size(), 6u);
   for (const auto& row : dynamic.frames) {
     EXPECT_GT(row.counters.atomic_clusters, 0);
@@ -82,6 +87,9 @@ TEST(RadialViewCheck, ReusesAPreprocessedSegmentation) {
   const auto b = nlohmann::json::parse(computed.out);
   EXPECT_EQ(a["ccd_vf"], b["ccd_vf"]);
   EXPECT_EQ(a["ccd_ee"], b["ccd_ee"]);
+  // The summary says which segmentation ran: the file, or the one computed from the rig.
+  EXPECT_EQ(a["segmentation"], seg);
+  EXPECT_EQ(b["segmentation"], "computed (rig weights)");
   // A segmentation of another model is not used: the model is segmented anew, with a note
   // naming the file, and the contacts are those of the computed segmentation.
   const auto fox_seg = (dir / "fox.seg.h5").string();
@@ -92,6 +100,7 @@ TEST(RadialViewCheck, ReusesAPreprocessedSegmentation) {
   EXPECT_NE(wrong.err.find("fox.seg.h5"), std::string::npos) << wrong.err;
   EXPECT_NE(wrong.err.find("segmenting it anew"), std::string::npos) << wrong.err;
   const auto c = nlohmann::json::parse(wrong.out);
+  EXPECT_EQ(c["segmentation"], "computed (rig weights)");
   EXPECT_EQ(c["ccd_vf"], b["ccd_vf"]);
   EXPECT_EQ(c["ccd_ee"], b["ccd_ee"]);
   // A file that is no segmentation at all is refused.
@@ -101,6 +110,37 @@ TEST(RadialViewCheck, ReusesAPreprocessedSegmentation) {
                                "--segmentation", not_seg});
   EXPECT_EQ(bad.exit_code, 1);
   EXPECT_NE(bad.err.find("not-a-seg.h5"), std::string::npos) << bad.err;
+}
+
+TEST(RadialViewCheck, DcdOnlyBuildsNoSegmentationAndFindsBvhsPairs) {
+  // Radial view culls intervals; at an instant rvbc/dynamic answer with bvh. So --query dcd must
+  // not segment: a --segmentation file is not even read (this one is no HDF5 file at all).
+  const auto dir = skelcd::test::temp_dir("rv-dcd");
+  const auto not_seg = (dir / "not-a-seg.h5").string();
+  std::ofstream(not_seg) << "not hdf5";
+  const auto bvh = run_skelcd({"check", kCesium, "--frames", "0:8", "--query", "dcd", "--method",
+                               "bvh", "--json"});
+  ASSERT_EQ(bvh.exit_code, 0) << bvh.err;
+  const auto bvh_pairs = nlohmann::json::parse(bvh.out)["dcd_pairs"];
+  ASSERT_GT(bvh_pairs.get<std::int64_t>(), 0);  // CesiumMan's walk does interpenetrate
+  for (const char* method : {"rvbc", "dynamic", "auto"}) {
+    const auto log = (dir / (std::string(method) + ".h5")).string();
+    const auto r = run_skelcd({"check", kCesium, "--frames", "0:8", "--query", "dcd", "--method",
+                               method, "--segmentation", not_seg, "--json", "-o", log});
+    ASSERT_EQ(r.exit_code, 0) << method << ": " << r.err;
+    EXPECT_NE(r.err.find("is not used: --query dcd needs no segmentation"), std::string::npos)
+        << r.err;
+    const auto j = nlohmann::json::parse(r.out);
+    EXPECT_EQ(j["method"], method);
+    EXPECT_EQ(j["dcd_pairs"], bvh_pairs) << method;
+    EXPECT_EQ(j["segmentation"], "none (DCD only: no radial-view stage runs)") << method;
+    const auto data = read_log(log);
+    ASSERT_EQ(data.frames.size(), 9u);
+    for (const auto& row : data.frames) {
+      EXPECT_EQ(row.counters.atomic_clusters + row.counters.mega_clusters, 0) << method;
+      EXPECT_EQ(row.times.classify_us + row.times.merge_us, 0.0) << method;
+    }
+  }
 }
 
 TEST(RadialViewCheck, BadInputIsRefusedInOneLine) {

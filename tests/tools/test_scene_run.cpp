@@ -104,6 +104,41 @@ TEST(SceneRun, DcdOnlyCheckDoesNoCcdOrClusteringWorkAndUncheckedObjectsAreNeverL
   }
 }
 
+TEST(SceneRun, DcdOnlyRadialViewObjectsAreNotSegmentedAndFindWhatBvhFinds) {
+  // rvbc/dynamic/auto with self-dcd only: nothing of the radial view is planned or built (their
+  // DCD is bvh's); the run still succeeds and every row equals the bvh object's.
+  const std::string rig = test::asset("characters/CesiumMan.glb").string();
+  std::string text = "frames = \"0:6\"\n";
+  for (const char* method : {"bvh", "rvbc", "dynamic", "auto"}) {
+    text += std::string("[objects.") + (method[0] == 'a' ? "auto_" : method) + "]\nmodel = \"" +
+            rig + "\"\nchecks = [\"self-dcd\"]\nmethod = \"" + method + "\"\n";
+  }
+  const Scene scene = parse_scene(write_scene(text, "scene_dcd_rv"));
+  SceneRunOptions options;
+  bool planned = false;
+  options.on_plan = [&](const ScenePlan& plan) {
+    planned = true;
+    for (const auto& o : plan.objects) {
+      EXPECT_FALSE(o.segmentation || o.swept_bounds) << o.name;
+    }
+  };
+  const auto result = run_scene(scene, options);
+  EXPECT_TRUE(planned);
+  ASSERT_EQ(result.checks.size(), 4u);
+  const auto& bvh = result.checks[0];
+  ASSERT_EQ(bvh.rows.size(), 7u);
+  EXPECT_GT(bvh.dcd_pairs.size(), 0u);  // the walk interpenetrates: the comparison means something
+  for (std::size_t k = 1; k < result.checks.size(); ++k) {
+    const auto& c = result.checks[k];
+    ASSERT_EQ(c.rows.size(), bvh.rows.size()) << c.name;
+    EXPECT_EQ(c.dcd_pairs.size(), bvh.dcd_pairs.size()) << c.name;
+    for (std::size_t i = 0; i < c.rows.size(); ++i) {
+      EXPECT_EQ(c.rows[i].counters.dcd_pairs, bvh.rows[i].counters.dcd_pairs) << c.name;
+      EXPECT_EQ(c.rows[i].counters.atomic_clusters + c.rows[i].counters.h_uncertain, 0) << c.name;
+    }
+  }
+}
+
 // --- pair checks against brute force -----------------------------------------------------------
 
 Eigen::Vector3d row_of(const skinning::Positions& x, Eigen::Index i) {

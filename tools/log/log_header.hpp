@@ -48,6 +48,10 @@ struct LogHeader {
   double min_separation = 0;  ///< contact distance, coordinate units
   std::optional<double> gamma;  ///< radial-view merge parameter γ, only when the method uses it
   std::optional<double> theta;  ///< cone angle θ (radians), only when the method uses it
+  std::optional<std::int64_t> seed;  ///< `dynamic`'s seed (`--seed`), only when the method uses it
+  /// Where rvbc/dynamic took their segmentation from (a SEG.h5 path, "computed (rig weights)", …);
+  /// empty (and absent) when no radial-view method ran.
+  std::string segmentation;
   std::string start_time;  ///< ISO 8601 UTC, e.g. 2026-01-31T12:00:00Z
   std::int32_t first_sample = 0;  ///< samples first_sample … last_sample were asked for
   std::int32_t last_sample = 0;

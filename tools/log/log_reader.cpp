@@ -231,6 +231,8 @@ LogHeader read_header(hid_t file) {
   h.min_separation = read_double_attribute(file, "min_separation").value_or(0.0);
   h.gamma = read_double_attribute(file, "gamma");
   h.theta = read_double_attribute(file, "theta");
+  h.seed = read_int_attribute(file, "seed");
+  h.segmentation = text("segmentation");
   h.first_sample = static_cast<std::int32_t>(read_int_attribute(file, "first_sample").value_or(0));
   h.last_sample = static_cast<std::int32_t>(read_int_attribute(file, "last_sample").value_or(0));
   h.planned_rows = read_int_attribute(file, "planned_rows").value_or(0);

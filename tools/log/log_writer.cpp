@@ -245,6 +245,8 @@ void write_header(hid_t file, const LogHeader& h) {
   write_attribute(file, "min_separation", h.min_separation);
   if (h.gamma) write_attribute(file, "gamma", *h.gamma);
   if (h.theta) write_attribute(file, "theta", *h.theta);
+  if (h.seed) write_attribute(file, "seed", *h.seed);
+  if (!h.segmentation.empty()) write_attribute(file, "segmentation", h.segmentation);
   write_attribute(file, "start_time", h.start_time);
   write_attribute(file, "first_sample", static_cast<std::int64_t>(h.first_sample));
   write_attribute(file, "last_sample", static_cast<std::int64_t>(h.last_sample));
