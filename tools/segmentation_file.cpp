@@ -569,13 +569,6 @@ SegmentationFile read_segmentation(const std::filesystem::path& path) {
   return out;
 }
 
-std::string model_identity(const std::string& model) {
-  if (skinning::is_generator_spec(model)) {
-    return skinning::to_string(skinning::parse_generator_spec(model));
-  }
-  return file_content_hash(model);
-}
-
 SegmentationFile read_segmentation(const std::filesystem::path& path, const std::string& model) {
   auto out = read_segmentation(path);
   const auto identity = model_identity(model);

@@ -13,6 +13,7 @@
 #include "segmentation/bone_segment.hpp"
 #include "segmentation/orientation_stats.hpp"
 #include "segmentation/segmentation.hpp"
+#include "tools/file_hash.hpp"  // model_identity
 
 namespace skelcd::tools {
 
@@ -38,11 +39,6 @@ struct SegmentationFile {
   SegmentationRecord record;
 };
 
-/// What identifies the input a segmentation was made from: the content hash of a model file
-/// (file_content_hash, "fnv1a64:…"), or the canonical spec of a generated rig ("gen:rope?…":
-/// generators are deterministic).
-/// @throws IoError when a file cannot be read; InvalidInput for a bad generator spec.
-[[nodiscard]] std::string model_identity(const std::string& model);
 
 /// Writes `segmentation` to `path`: first to a temporary file beside it, renamed over `path` only
 /// when complete (a failed or interrupted write leaves nothing half-written).
