@@ -87,7 +87,11 @@ void run_export(const ExportArgs& args) {
     marked = "; " + std::to_string(colors.non_positive.size()) +
              " triangles not positively oriented to their cluster's observer in the rest pose drawn dark";
   }
-  if (!args.highlight.empty()) options.face_colors = highlight_face_colors(args.highlight, motion->mesh(), args.frame.value_or(0), motion->sample_time(args.frame.value_or(0)));
+  if (!args.highlight.empty()) {
+    const auto frame = args.frame.value_or(0);
+    options.face_colors = highlight_face_colors(args.highlight, motion->mesh(), frame,
+                                                motion->sample_time(frame), motion->name());
+  }
   const auto result = export_mesh(motion->mesh(), positions, args.output, options);
   // Standard output may be carrying the mesh: the summary goes to stderr then.
   auto& report = is_stdout(args.output) ? std::cerr : std::cout;

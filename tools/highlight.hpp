@@ -5,6 +5,7 @@
 #include <array>
 #include <cstdint>
 #include <filesystem>
+#include <string_view>
 #include <vector>
 
 #include "skinning/mesh.hpp"
@@ -32,12 +33,15 @@ inline constexpr std::array<float, 4> kPlainColour{0.78f, 0.78f, 0.78f, 1.0f};
 /// @param frame_time_s time of `frame` in the exported motion (seconds): must equal the time the
 ///   log recorded for that sample, so that a log checked at another rate is not shown on the
 ///   wrong pose.
-/// @throws IoError / InvalidInput naming the log: unreadable, another mesh, no row for `frame`,
-///   or a different sample time.
+/// @param clip name of the exported motion's clip: a (non-scene) log of another clip is refused,
+///   so that a model with several clips at one rate is not coloured from the wrong one.
+/// @throws IoError / InvalidInput naming the log: unreadable, another mesh, another clip, no row
+///   for `frame`, or a different sample time.
 [[nodiscard]] std::vector<std::array<float, 4>> highlight_face_colors(
     const std::filesystem::path& log_path,
     const skinning::Mesh& mesh,
     std::int32_t frame,
-    double frame_time_s);
+    double frame_time_s,
+    std::string_view clip);
 
 }  // namespace skelcd::tools

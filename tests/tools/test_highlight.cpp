@@ -79,6 +79,7 @@ TEST(Highlight, FaceColoursFromALogFile) {
   LogHeader header;
   header.num_vertices = 9;
   header.num_triangles = 3;
+  header.clip = "walk";
   {
     LogWriter writer(path, header);
     FrameReport report;
@@ -88,18 +89,21 @@ TEST(Highlight, FaceColoursFromALogFile) {
     writer.append(report);
     writer.finish();
   }
-  const auto colours = highlight_face_colors(path, mesh, 3, 0.125);
+  const auto colours = highlight_face_colors(path, mesh, 3, 0.125, "walk");
   ASSERT_EQ(colours.size(), 3u);
   EXPECT_EQ(colours[0], kHighlightColour);
   EXPECT_EQ(colours[1], kPlainColour);
   EXPECT_EQ(colours[2], kHighlightColour);
-  EXPECT_THROW_MESSAGE((void)highlight_face_colors(path.parent_path() / "none.h5", mesh, 3, 0.125),
+  EXPECT_THROW_MESSAGE((void)highlight_face_colors(path.parent_path() / "none.h5", mesh, 3, 0.125, "walk"),
                        IoError, "none.h5");
   // A frame the log does not cover, and the right frame at another rate's time.
-  EXPECT_THROW_MESSAGE((void)highlight_face_colors(path, mesh, 4, 0.125), InvalidInput,
+  EXPECT_THROW_MESSAGE((void)highlight_face_colors(path, mesh, 4, 0.125, "walk"), InvalidInput,
                        "no row for frame 4");
-  EXPECT_THROW_MESSAGE((void)highlight_face_colors(path, mesh, 3, 0.1), InvalidInput,
+  EXPECT_THROW_MESSAGE((void)highlight_face_colors(path, mesh, 3, 0.1, "walk"), InvalidInput,
                        "pose it at the log's rate");
+  // The right frame and time of another clip (same rate, same mesh): refused, not mis-coloured.
+  EXPECT_THROW_MESSAGE((void)highlight_face_colors(path, mesh, 3, 0.125, "run"), InvalidInput,
+                       "checked clip 'walk', not 'run'");
 }
 
 TEST(Highlight, ExportColoursTheCollidingTrianglesOfAFrame) {
