@@ -288,6 +288,17 @@ TEST(CmdCheck, GeneratedFrameSequenceHasTheHandCountedContacts) {
     std::sort(hits.begin(), hits.end());
     EXPECT_EQ(hits, (std::vector<std::pair<int, int>>{{0, 3}, {0, 4}, {0, 5}, {1, 4}, {1, 5}}));
   }
+  // The logs identify the sequence by its frames' content: the same for the three runs, and
+  // another hash once one frame changes.
+  const auto hash = read_log(dir / "bvh.h5").header.input_hash;
+  EXPECT_EQ(hash.rfind("fnv1a64:", 0), 0u) << hash;
+  EXPECT_EQ(read_log(dir / "brute.h5").header.input_hash, hash);
+  std::ofstream(frames / "frame1.obj", std::ios::app) << "# edited\n";
+  const auto edited = dir / "edited.h5";
+  ASSERT_EQ(run_skelcd({"check", frames.string(), "-o", edited.string()}).exit_code, 0);
+  const auto edited_hash = read_log(edited).header.input_hash;
+  EXPECT_EQ(edited_hash.rfind("fnv1a64:", 0), 0u) << edited_hash;
+  EXPECT_NE(edited_hash, hash);
 }
 
 // --- batch mode, robots, generator specs, threads -------------------------------------------------
@@ -384,10 +395,14 @@ TEST(CmdCheck, BatchOfGoodInputsSucceedsAndAllClipsChecksEachClip) {
 
 TEST(CmdCheck, BareGeneratorSpecsRobotOptionsAndThreads) {
   // gen:panda without a '?' is a model, not a missing file.
+  const auto panda_log = skelcd::test::temp_dir("check-gen") / "panda.h5";
   const auto panda = run_skelcd({"check", "gen:panda", "--frames", "0:3", "--query", "dcd",
-                                 "--json"});
+                                 "--json", "-o", panda_log.string()});
   ASSERT_EQ(panda.exit_code, 0) << panda.err;
   EXPECT_EQ(nlohmann::json::parse(panda.out)["frames"], 4);
+  // A generated rig is identified by its canonical spec (generators are deterministic).
+  EXPECT_EQ(read_log(panda_log).header.input_hash.rfind("gen:panda?", 0), 0u)
+      << read_log(panda_log).header.input_hash;
 
   // The URDF with its trajectory and SRDF, as `info` takes them.
   const auto root = skelcd::test::asset("robots/example-robot-data/robots/panda_description");
