@@ -153,6 +153,30 @@ TEST(RadialViewMethod, RealCharacters) {
   }
 }
 
+TEST(RadialViewMethod, CesiumMansWalkTripsTheGuardAndStillFindsWhatBvhFinds) {
+  // CesiumMan is one closed component that intersects itself at every sample of its walk, which
+  // breaks the radial-view precondition (free of self-intersection at the interval's start). The
+  // DCD at each interval's start must see it: the component is dirty in every interval, nothing
+  // is skipped in it, and the contacts stay bvh's. (The guard works per component, so here it
+  // turns the orientation-class culling off for the whole clip: docs/radial-view.md.)
+  RadialViewScene scene(loaded(test::asset("characters/CesiumMan.glb")), 0);
+  const auto c = compare(scene, 0, 12, test::DcdQueries::every);
+  ASSERT_GT(c.bvh.contacts.size(), 0u);
+  for (const ClipRun* run : {&c.rvbc, &c.dynamic}) {
+    ASSERT_EQ(run->stats.size(), 12u);
+    for (const auto& st : run->stats) {
+      EXPECT_EQ(st.components, 1);
+      EXPECT_EQ(st.components_open, 0);  // closed: the radial view applies, were it not dirty
+      EXPECT_EQ(st.components_dirty, 1);
+      EXPECT_EQ(st.components_culled, 0);
+    }
+  }
+  // Without the DCD at each start (CCD only after the first), the method cannot know and must
+  // not assume: the component stays dirty and the contacts stay bvh's.
+  const auto ccd_only = compare(scene, 0, 12, test::DcdQueries::first);
+  for (const auto& st : ccd_only.dynamic.stats) EXPECT_EQ(st.components_culled, 0);
+}
+
 TEST(RadialViewMethod, BcnEpilepticIsOpenAndItsRestPoseInterpenetrates) {
   RadialViewScene scene(loaded(test::assimp_model("X/BCN_Epileptic.X")));
   auto bvh = scene.method("bvh");
