@@ -8,6 +8,8 @@
 //
 //   build-rv/bench/clustering/bm_radial_view                 # the table (all scenes)
 //   build-rv/bench/clustering/bm_radial_view --scenes=rope,hand --intervals=20
+//   build-rv/bench/clustering/bm_radial_view --scenes=rope,octopus --first=34 --intervals=20
+//                                       # samples 34..54: the window where the limbs first touch
 //   build-rv/bench/clustering/bm_radial_view --benchmark      # Google Benchmark per interval
 //
 // Scenes: the generated clips at the paper's sizes (rope-like 48k, hand-like 11k, octopus-like
@@ -102,7 +104,10 @@ MethodTotals summarize(const ClipRun& run) {
   return t;
 }
 
-int run_table(const std::vector<SceneSpec>& scenes, std::int32_t max_intervals) {
+int run_table(
+    const std::vector<SceneSpec>& scenes,
+    std::int32_t first_sample,
+    std::int32_t max_intervals) {
   const std::vector<std::string> methods = {"bvh", "kdop", "rvbc", "dynamic"};
   int failures = 0;
   std::printf(
@@ -133,11 +138,15 @@ int run_table(const std::vector<SceneSpec>& scenes, std::int32_t max_intervals) 
     const double seg_s =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - seg_start).count();
     const std::int32_t samples = scene.motion->num_samples();
+    // Samples first..last (a clip shorter than `first_sample` is run from its start).
+    const std::int32_t first = first_sample < samples - 1 ? first_sample : 0;
     const std::int32_t last =
-        max_intervals > 0 ? std::min(samples - 1, max_intervals) : samples - 1;
-    std::fprintf(stderr, "[%s] %lld triangles, %d intervals, segmentation %.2f s (rig weights)\n",
-                 spec.name.c_str(), static_cast<long long>(rig->mesh.num_triangles()), last,
-                 seg_s);
+        max_intervals > 0 ? std::min(samples - 1, first + max_intervals) : samples - 1;
+    std::fprintf(stderr,
+                 "[%s] %lld triangles, samples %d..%d (%d intervals), segmentation %.2f s (rig "
+                 "weights)\n",
+                 spec.name.c_str(), static_cast<long long>(rig->mesh.num_triangles()), first, last,
+                 last - first, seg_s);
     std::map<std::string, MethodTotals> totals;
     ClipRun reference;
     for (const auto& name : methods) {
@@ -147,7 +156,7 @@ int run_table(const std::vector<SceneSpec>& scenes, std::int32_t max_intervals) 
       // timed here: every method's DCD is bvh's); the radial-view methods learn from it which
       // components are free of self-intersection at the start.
       ClipRun run =
-          skelcd::test::run_clip(scene, *method, 0, last, skelcd::test::DcdQueries::first);
+          skelcd::test::run_clip(scene, *method, first, last, skelcd::test::DcdQueries::first);
       const double ms =
           std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
               .count();
@@ -188,7 +197,7 @@ int run_table(const std::vector<SceneSpec>& scenes, std::int32_t max_intervals) 
       skelcd::clustering::RadialViewMethod method("dynamic", rig->mesh, scene.topology,
                                                   scene.segmentation, scene.poses,
                                                   rig->skeleton.num_bones(), {}, bare);
-      const ClipRun run = skelcd::test::run_clip(scene, method, 0, last);
+      const ClipRun run = skelcd::test::run_clip(scene, method, first, last);
       std::vector<skelcd::test::ContactKey> missed, extra;
       std::set_difference(reference.contacts.begin(), reference.contacts.end(),
                           run.contacts.begin(), run.contacts.end(), std::back_inserter(missed));
@@ -263,6 +272,7 @@ void bm_interval(benchmark::State& state, SceneSpec spec, std::string method_nam
 int main(int argc, char** argv) {
   std::vector<SceneSpec> scenes = all_scenes();
   std::int32_t intervals = 0;
+  std::int32_t first = 0;
   bool google = false;
   std::vector<char*> rest = {argv[0]};
   for (int a = 1; a < argc; ++a) {
@@ -282,6 +292,8 @@ int main(int argc, char** argv) {
       scenes = {SceneSpec{arg.substr(8), arg.substr(8), -1}};
     } else if (arg.rfind("--intervals=", 0) == 0) {
       intervals = std::stoi(arg.substr(12));
+    } else if (arg.rfind("--first=", 0) == 0) {
+      first = std::max(0, std::stoi(arg.substr(8)));
     } else if (arg == "--dcd") {
       // Time one DCD per method at sample 0 of each scene (the precondition pass's cost).
       for (const auto& spec : scenes) {
@@ -309,7 +321,7 @@ int main(int argc, char** argv) {
       rest.push_back(argv[a]);
     }
   }
-  if (!google) return run_table(scenes, intervals);
+  if (!google) return run_table(scenes, first, intervals);
   for (const auto& s : scenes) {
     for (const char* m : {"bvh", "kdop", "rvbc", "dynamic"}) {
       benchmark::RegisterBenchmark((s.name + "/" + m).c_str(), bm_interval, s, std::string(m))
