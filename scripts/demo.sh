@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
-# make demo: the main job on a bundled model. For now: what the model holds (`skelcd info`) and
-# one posed frame of its clip written for a viewer (`skelcd export`), under the build folder.
+# make demo: the main job on bundled models, under the build folder: what CesiumMan holds
+# (`skelcd info`), one posed frame for a viewer (`skelcd export`), a clip check with its log
+# (`skelcd check`), and a scene — CesiumMan with an attached cape — with its plan and summary.
 set -euo pipefail
 build=${1:-build}
 exe="$build/tools/skelcd"
