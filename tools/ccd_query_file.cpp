@@ -113,6 +113,11 @@ bool parse_rational(std::string_view token, double& value, mpq_class* exact, dou
     fault = "beyond the range of a double";
     return false;
   }
+  // A small p/q (both below 10^15) cannot underflow; a big one can round to zero.
+  if (value == 0.0 && !small && sgn(r) != 0) {
+    fault = "beyond the range of a double (nonzero, below the smallest subnormal)";
+    return false;
+  }
   rounding = exact_double ? 0.0 : half_ulp(value);
   if (exact != nullptr) *exact = r;
   return true;
