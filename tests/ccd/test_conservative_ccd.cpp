@@ -83,9 +83,10 @@ TEST(ConservativeCcd, NoFalseNegativeOnAnyHardCaseFamily) {
   }
   EXPECT_GT(all.hits, 500);
   EXPECT_GT(all.cases - all.hits, 500);
-  // Stated false-positive rate (docs/ccd.md): the near misses below the solver's tolerance
-  // (relative 1e-10) are reported as hits; everything farther is resolved.
-  EXPECT_LT(all.false_positives, (all.cases - all.hits) * 6 / 10);
+  // Stated false-positive rate (docs/ccd.md, "Measured false positives": 84 of 1,750 misses,
+  // 4.8 %): the near misses below the solver's tolerance (relative 1e-10) are reported as hits;
+  // everything farther is resolved. Twice the stated rate fails the run.
+  EXPECT_LT(all.false_positives, (all.cases - all.hits) / 10);
 }
 
 TEST(ConservativeCcd, NearMissesAboveTheToleranceAreResolved) {
