@@ -1,8 +1,11 @@
 // skelcd info, as a user runs it: JSON and human output on real models, and bad input.
 
+#include <cstdint>
 #include <filesystem>
 #include <fstream>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
@@ -39,6 +42,68 @@ TEST(CmdInfo, BcnEpilepticAsAssimpInfoReportsIt) {
   for (const char* key : {"vertices", "welded_vertices", "edges", "boundary_loops", "non_manifold_edges", "degenerate_triangles"}) {
     EXPECT_TRUE(j.contains(key)) << key;
   }
+}
+
+// Triangle count of a binary STL, read from its header (independent of assimp).
+std::uint32_t stl_triangles(const std::filesystem::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  in.seekg(80);
+  std::uint32_t n = 0;
+  in.read(reinterpret_cast<char*>(&n), sizeof n);
+  EXPECT_TRUE(in.good()) << path;
+  EXPECT_EQ(std::filesystem::file_size(path), 84u + 50u * n) << path << " is not a binary STL";
+  return n;
+}
+
+TEST(CmdInfo, UrdfRobotReportsItsCollisionGeometryAndTrajectory) {
+  // The Panda: one part per link with geometry, each link's collision STL as written (the fingers
+  // are four boxes each, 12 triangles a box), the trajectory as its clip, and the links that have
+  // no geometry named as a problem.
+  const auto root = asset("robots/example-robot-data/robots/panda_description");
+  const auto csv = asset("trajectories/panda_reach.csv");
+  const auto r = run_skelcd({"info", (root / "urdf/panda.urdf").string(), "--trajectory",
+                             csv.string(), "--srdf", (root / "srdf/panda.srdf").string(), "--json"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(j["kind"], "robot");
+  const std::vector<std::pair<std::string, std::string>> links = {
+      {"panda_link0", "link0.stl"}, {"panda_link1", "link1.stl"}, {"panda_link2", "link2.stl"},
+      {"panda_link3", "link3.stl"}, {"panda_link4", "link4.stl"}, {"panda_link5", "link5.stl"},
+      {"panda_link6", "link6.stl"}, {"panda_link7", "link7.stl"}, {"panda_hand", "hand.stl"}};
+  ASSERT_EQ(j["parts"].size(), links.size() + 2);
+  std::int64_t total = 0;
+  for (std::size_t i = 0; i < links.size(); ++i) {
+    const auto& part = j["parts"][i];
+    EXPECT_EQ(part["name"], links[i].first);
+    const auto expected = stl_triangles(root / "meshes/collision" / links[i].second);
+    EXPECT_EQ(part["triangles"], expected) << links[i].first;
+    EXPECT_EQ(part["closed"], true) << links[i].first;
+    total += expected;
+  }
+  for (std::size_t i = links.size(); i < links.size() + 2; ++i) {
+    EXPECT_EQ(j["parts"][i]["triangles"], 4 * 12) << j["parts"][i]["name"];
+    total += 4 * 12;
+  }
+  EXPECT_EQ(j["parts"][links.size()]["name"], "panda_leftfinger");
+  EXPECT_EQ(j["triangles"], total);
+  EXPECT_EQ(j["bones"], links.size() + 2);  // one bone per link with geometry
+  // The clip is the trajectory: its last row's time and its row rate.
+  std::ifstream in(csv);
+  std::string line, last;
+  int rows = -1;  // the header
+  while (std::getline(in, line)) {
+    if (line.empty()) continue;
+    last = line;
+    ++rows;
+  }
+  const double duration = std::stod(last.substr(0, last.find(',')));
+  ASSERT_EQ(j["clips"].size(), 1u);
+  EXPECT_EQ(j["clips"][0]["name"], "panda_reach");
+  EXPECT_DOUBLE_EQ(j["clips"][0]["duration_s"].get<double>(), duration);
+  EXPECT_NEAR(j["clips"][0]["keys_per_s"].get<double>(), (rows - 1) / duration, 1e-9);
+  const std::string problems = j["problems"].dump();
+  EXPECT_NE(problems.find("panda_link8"), std::string::npos) << problems;
+  EXPECT_NE(problems.find("panda_hand_tcp"), std::string::npos) << problems;
 }
 
 TEST(CmdInfo, ClosedCharacterAndOpenParts) {
