@@ -217,19 +217,6 @@ nlohmann::json json_summary(const skinning::LoadedModel& model, const skinning::
 
 /// Under `auto`, where each connected component went (the plan make_method("auto") follows, with
 /// the same options), for the log's /routes; empty for any other method.
-std::vector<LogRoute> log_routes(const skinning::Topology& topology, const RunOptions& options) {
-  std::vector<LogRoute> routes;
-  if (options.method != "auto") return routes;
-  const culling::MethodOptions method_options{.accuracy = options.accuracy,
-                                              .min_separation = options.min_separation,
-                                              .extension = options.method_extension};
-  for (const auto& r : culling::route_components(topology, method_options)) {
-    routes.push_back(LogRoute{.component = r.component, .part = r.part, .closed = r.closed,
-                              .triangles = r.num_triangles, .method = r.method});
-  }
-  return routes;
-}
-
 /// A model argument that names no file: a generator spec (`gen:rope`) or a frame sequence (a
 /// folder or a glob of frames).
 bool names_a_file(const std::string& model_arg) {
@@ -284,7 +271,7 @@ CheckedClip check_clip(const CheckArguments& args, RunOptions options, const std
     header.num_vertices = motion->mesh().num_vertices();
     header.num_triangles = motion->mesh().num_triangles();
     header.part_names = motion->mesh().part_names;
-    header.routes = log_routes(runner.topology(), options);
+    header.routes = method_routes(runner.topology(), options);
     writer = std::make_unique<LogWriter>(log_path, header);
   }
 

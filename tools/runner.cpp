@@ -14,6 +14,7 @@
 #include <tbb/parallel_pipeline.h>
 #include <tbb/task_arena.h>
 
+#include "culling/routed_method.hpp"
 #include "skinning/errors.hpp"
 
 namespace skelcd::tools {
@@ -491,6 +492,23 @@ void ClipRunner::run_parallel(const FrameCallback& on_frame) {
                   if (block->error) std::rethrow_exception(block->error);
                 }));
   });
+}
+
+std::vector<LogRoute> method_routes(
+    const skinning::Topology& topology,
+    const RunOptions& options,
+    std::int32_t part_offset) {
+  std::vector<LogRoute> routes;
+  if (options.method != "auto") return routes;
+  const culling::MethodOptions method_options{.accuracy = options.accuracy,
+                                              .min_separation = options.min_separation,
+                                              .extension = options.method_extension};
+  for (const auto& r : culling::route_components(topology, method_options)) {
+    routes.push_back(LogRoute{.component = r.component, .part = r.part + part_offset,
+                              .closed = r.closed, .triangles = r.num_triangles,
+                              .method = r.method});
+  }
+  return routes;
 }
 
 }  // namespace skelcd::tools

@@ -19,6 +19,7 @@
 #include "skinning/motion.hpp"
 #include "skinning/topology.hpp"
 #include "tools/frame_report.hpp"
+#include "tools/log/log_header.hpp"
 
 namespace skelcd::tools {
 
@@ -93,6 +94,14 @@ using MethodFactory = std::function<std::unique_ptr<culling::CullingMethod>(
 
 /// Called once per completed row (a DCD sample or a CCD interval), in order.
 using FrameCallback = std::function<void(const FrameReport&)>;
+
+/// Where `auto` sends each connected component of `topology` (the log's /routes rows); empty for
+/// any other method. `part_offset` is added to each route's part id (a scene's object offset).
+/// @throws InvalidInput as culling::route_components.
+[[nodiscard]] std::vector<LogRoute> method_routes(
+    const skinning::Topology& topology,
+    const RunOptions& options,
+    std::int32_t part_offset = 0);
 
 class ClipRunner {
  public:

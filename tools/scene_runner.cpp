@@ -606,6 +606,15 @@ SceneRunResult run_scene(const Scene& scene, const SceneRunOptions& options) {
     header.num_vertices = vertices;
     header.num_triangles = triangles;
     header.part_names = result.part_names;
+    // Where `auto` sent each component of each object it checks (parts numbered as in /parts,
+    // so a route's part says which object it belongs to; components count within an object).
+    for (std::size_t k = 0; k < plan.checks.size(); ++k) {
+      const CheckPlan& c = plan.checks[k];
+      if (c.kind != CheckKind::self || !runners[k]) continue;
+      const auto routes = method_routes(runners[k]->topology(), run_options[k],
+                                        loaded[at(c.object_a)].part_offset);
+      header.routes.insert(header.routes.end(), routes.begin(), routes.end());
+    }
     writer = std::make_unique<LogWriter>(options.log, header);
   }
 

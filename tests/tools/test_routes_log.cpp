@@ -1,10 +1,13 @@
 // check --method auto records in the log where each connected component went (/routes): closed
 // components to the closed method, open ones to the cone method, as the mesh's own edges say.
 
+#include <fstream>
 #include <map>
 #include <set>
+#include <string>
 #include <tuple>
 #include <utility>
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -89,6 +92,56 @@ TEST(RoutesLog, AutoFindsWhatBvhFindsOnACharacterWithOpenParts) {
   };
   EXPECT_EQ(key(logs[0]), key(logs[1]));
   EXPECT_EQ(logs[0].frames.size(), logs[1].frames.size());
+}
+
+TEST(RoutesLog, SceneLogsHoldTheRoutesOfEveryAutoObject) {
+  // Two objects checked with auto and one with bvh: the scene log holds the routes of the auto
+  // objects, each row's part naming its object, and they are the routes a plain check writes.
+  const auto bot = skelcd::test::asset("characters/RobotExpressive.glb").string();
+  const auto dir = skelcd::test::temp_dir("routes-scene");
+  const auto scene = dir / "scene.toml";
+  std::ofstream(scene) << "frames = \"0:1\"\n"
+                       << "[objects.bot]\nmodel = \"" << bot
+                       << "\"\nchecks = [\"self-dcd\", \"self-ccd\"]\nmethod = \"auto\"\n"
+                       << "[objects.sheet]\nmodel = \"gen:cloth?triangles=200&frames=4\"\n"
+                       << "checks = [\"self-ccd\"]\nmethod = \"auto\"\n"
+                       << "[objects.rope]\nmodel = \"gen:rope?triangles=200&frames=4\"\n"
+                       << "checks = [\"self-dcd\"]\n";
+  const auto log = dir / "scene.h5";
+  const auto r = run_skelcd({"check", scene.string(), "-o", log.string()});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto header = read_log(log).header;
+
+  const auto single = dir / "bot.h5";
+  ASSERT_EQ(run_skelcd({"check", bot, "--method", "auto", "--frames", "0:1", "-o", single.string()})
+                .exit_code,
+            0);
+  const auto bot_routes = read_log(single).header.routes;
+  ASSERT_FALSE(bot_routes.empty());
+
+  std::vector<LogRoute> scene_bot, scene_sheet;
+  for (const auto& route : header.routes) {
+    ASSERT_GE(route.part, 0);
+    ASSERT_LT(static_cast<std::size_t>(route.part), header.part_names.size());
+    const std::string& part = header.part_names[static_cast<std::size_t>(route.part)];
+    if (part.rfind("bot/", 0) == 0) {
+      scene_bot.push_back(route);
+    } else {
+      EXPECT_EQ(part.rfind("sheet/", 0), 0u) << part << ": only auto objects have routes";
+      scene_sheet.push_back(route);
+    }
+  }
+  ASSERT_EQ(scene_bot.size(), bot_routes.size());
+  for (std::size_t i = 0; i < bot_routes.size(); ++i) {
+    EXPECT_EQ(scene_bot[i].component, bot_routes[i].component);
+    EXPECT_EQ(scene_bot[i].method, bot_routes[i].method) << i;
+    EXPECT_EQ(scene_bot[i].triangles, bot_routes[i].triangles);
+    EXPECT_EQ(header.part_names[static_cast<std::size_t>(scene_bot[i].part)],
+              "bot/" + read_log(single).header.part_names[static_cast<std::size_t>(bot_routes[i].part)]);
+  }
+  ASSERT_EQ(scene_sheet.size(), 1u);  // the cloth is one open sheet
+  EXPECT_FALSE(scene_sheet[0].closed);
+  EXPECT_EQ(scene_sheet[0].method, "enhanced-dual-cone");
 }
 
 TEST(RoutesLog, OtherMethodsWriteNoRoutes) {
