@@ -3,8 +3,12 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <bit>
 #include <cctype>
+#include <cmath>
+#include <cstdint>
 #include <cstdio>
+#include <cstring>
 #include <fstream>
 #include <memory>
 #include <string>
@@ -24,11 +28,69 @@ const char* assimp_format_id(MeshFormat format) {
     case MeshFormat::obj:
       return "objnomtl";  // no .mtl beside it: one self-contained file
     case MeshFormat::ply:
-      return "plyb";
+      return "plyb";  // not used: PLY is written by write_ply (below)
     case MeshFormat::glb:
       return "glb2";
   }
   return "objnomtl";
+}
+
+template <typename T>
+void append_le(std::string& out, T value) {
+  static_assert(std::endian::native == std::endian::little, "binary PLY is written little-endian");
+  char bytes[sizeof(T)];
+  std::memcpy(bytes, &value, sizeof(T));
+  out.append(bytes, sizeof(T));
+}
+
+// Binary little-endian PLY of the scene's meshes, merged (PLY has no parts): float x y z, uchar
+// red green blue alpha when the meshes carry colours, faces as uchar-counted int lists. Written
+// here because the binary PLY exporter of the assimp Debian 12 ships (5.2) declares uchar colours
+// but writes four floats per vertex (assimp issue 3827, fixed upstream in 2024), a file no other
+// reader can parse.
+std::string write_ply(const aiScene& scene) {
+  std::size_t vertices = 0, faces = 0;
+  bool colored = false;
+  for (unsigned m = 0; m < scene.mNumMeshes; ++m) {
+    vertices += scene.mMeshes[m]->mNumVertices;
+    faces += scene.mMeshes[m]->mNumFaces;
+    colored = colored || scene.mMeshes[m]->mColors[0] != nullptr;
+  }
+  std::string out = "ply\nformat binary_little_endian 1.0\ncomment written by skelcd\n";
+  out += "element vertex " + std::to_string(vertices) + "\n";
+  out += "property float x\nproperty float y\nproperty float z\n";
+  if (colored) {
+    out += "property uchar red\nproperty uchar green\nproperty uchar blue\nproperty uchar alpha\n";
+  }
+  out += "element face " + std::to_string(faces) + "\n";
+  out += "property list uchar int vertex_index\nend_header\n";
+  const auto to_byte = [](float c) {
+    return static_cast<std::uint8_t>(std::lround(std::clamp(c, 0.0f, 1.0f) * 255.0f));
+  };
+  for (unsigned m = 0; m < scene.mNumMeshes; ++m) {
+    const aiMesh& am = *scene.mMeshes[m];
+    for (unsigned v = 0; v < am.mNumVertices; ++v) {
+      append_le(out, static_cast<float>(am.mVertices[v].x));
+      append_le(out, static_cast<float>(am.mVertices[v].y));
+      append_le(out, static_cast<float>(am.mVertices[v].z));
+      if (colored) {
+        const aiColor4D c = am.mColors[0] != nullptr ? am.mColors[0][v] : aiColor4D(1, 1, 1, 1);
+        for (const float channel : {c.r, c.g, c.b, c.a}) append_le(out, to_byte(channel));
+      }
+    }
+  }
+  std::int32_t base = 0;
+  for (unsigned m = 0; m < scene.mNumMeshes; ++m) {
+    const aiMesh& am = *scene.mMeshes[m];
+    for (unsigned f = 0; f < am.mNumFaces; ++f) {
+      append_le(out, static_cast<std::uint8_t>(am.mFaces[f].mNumIndices));
+      for (unsigned k = 0; k < am.mFaces[f].mNumIndices; ++k) {
+        append_le(out, static_cast<std::int32_t>(base + static_cast<std::int32_t>(am.mFaces[f].mIndices[k])));
+      }
+    }
+    base += static_cast<std::int32_t>(am.mNumVertices);
+  }
+  return out;
 }
 
 // Builds an aiScene with one aiMesh per non-empty part under one root node. aiScene's destructor
@@ -166,13 +228,24 @@ ExportResult export_mesh(
 
   const auto scene = build_scene(mesh, positions, options, result);
   Assimp::Exporter exporter;
-  const aiExportDataBlob* blob = exporter.ExportToBlob(scene.get(), assimp_format_id(result.format));
-  if (blob == nullptr) throw IoError(out.string() + ": assimp could not export: " + exporter.GetErrorString());
-  if (blob->next != nullptr) throw IoError(out.string() + ": the exporter produced several files; expected one");
-  result.bytes = static_cast<std::int64_t>(blob->size);
+  std::string ply;
+  const void* data = nullptr;
+  std::size_t size = 0;
+  if (result.format == MeshFormat::ply) {
+    ply = write_ply(*scene);
+    data = ply.data();
+    size = ply.size();
+  } else {
+    const aiExportDataBlob* blob = exporter.ExportToBlob(scene.get(), assimp_format_id(result.format));
+    if (blob == nullptr) throw IoError(out.string() + ": assimp could not export: " + exporter.GetErrorString());
+    if (blob->next != nullptr) throw IoError(out.string() + ": the exporter produced several files; expected one");
+    data = blob->data;
+    size = blob->size;
+  }
+  result.bytes = static_cast<std::int64_t>(size);
 
   if (to_stdout) {
-    write_all(stdout, blob->data, blob->size, "standard output");
+    write_all(stdout, data, size, "standard output");
     if (std::fflush(stdout) != 0) throw IoError("standard output: write failed");
     return result;
   }
@@ -186,7 +259,7 @@ ExportResult export_mesh(
   std::FILE* f = std::fopen(temp.c_str(), "wb");
   if (f == nullptr) throw IoError(out.string() + ": cannot create " + temp.string());
   try {
-    write_all(f, blob->data, blob->size, out.string());
+    write_all(f, data, size, out.string());
     if (std::fflush(f) != 0 || ::fsync(::fileno(f)) != 0) throw IoError(out.string() + ": write failed");
   } catch (...) {
     std::fclose(f);

@@ -1,5 +1,6 @@
 #pragma once
-// Writing a posed mesh to OBJ, PLY or glTF binary through assimp's exporter — for viewers.
+// Writing a posed mesh to OBJ or glTF binary through assimp's exporter, or to binary PLY (written
+// here: Debian 12's assimp writes corrupt coloured PLY) — for viewers.
 
 #include <array>
 #include <filesystem>

@@ -129,9 +129,10 @@ TEST(Highlight, ExportColoursTheCollidingTrianglesOfAFrame) {
                                    "--highlight", log, "-o", ply.string()});
   ASSERT_EQ(r.exit_code, 0) << r.err;
 
-  // Binary PLY, one vertex per triangle corner (9), then 3 faces of 1 + 3 × 4 bytes. The header
-  // declares uchar colours, but Debian's assimp 5.2 binary PLY exporter writes each vertex colour
-  // as four floats: read the vertex records by the size the bytes imply (16: uchar, 28: float).
+  // Binary PLY read strictly by its header, as any viewer reads it: 9 vertices (one per triangle
+  // corner) of float x, y, z and uchar red, green, blue, alpha — 16 bytes — then 3 faces of
+  // 1 + 3 × 4 bytes, and nothing else. (Debian's assimp 5.2 wrote float colours under a uchar
+  // header; export writes PLY itself for that reason.)
   std::ifstream in(ply, std::ios::binary);
   std::stringstream bytes;
   bytes << in.rdbuf();
@@ -139,22 +140,27 @@ TEST(Highlight, ExportColoursTheCollidingTrianglesOfAFrame) {
   const auto end = text.find("end_header\n");
   ASSERT_NE(end, std::string::npos);
   const std::string header = text.substr(0, end);
-  ASSERT_NE(header.find("element vertex 9"), std::string::npos) << header;
-  ASSERT_NE(header.find("element face 3"), std::string::npos) << header;
-  const std::size_t body = text.size() - (end + 11) - 3 * 13;
-  ASSERT_EQ(body % 9, 0u);
-  const std::size_t record = body / 9;
-  ASSERT_TRUE(record == 16 || record == 28) << record;
+  EXPECT_NE(header.find("format binary_little_endian 1.0"), std::string::npos) << header;
+  EXPECT_NE(header.find("element vertex 9\nproperty float x\nproperty float y\nproperty float z\n"
+                        "property uchar red\nproperty uchar green\nproperty uchar blue\n"
+                        "property uchar alpha\nelement face 3\n"
+                        "property list uchar int vertex_index\n"),
+            std::string::npos)
+      << header;
+  ASSERT_EQ(text.size(), end + 11 + 9 * 16 + 3 * 13) << "the body is not what the header declares";
   const char* vertices = text.data() + end + 11;
   std::vector<float> red;
   for (std::size_t v = 0; v < 9; ++v) {
-    const char* colour = vertices + record * v + 12;
-    if (record == 16) {
-      red.push_back(static_cast<float>(static_cast<unsigned char>(colour[0])) / 255.0f);
-    } else {
-      float value = 0;
-      std::memcpy(&value, colour, sizeof value);
-      red.push_back(value);
+    red.push_back(static_cast<float>(static_cast<unsigned char>(vertices[16 * v + 12])) / 255.0f);
+  }
+  // Faces index their own corners: face f is vertices 3f, 3f+1, 3f+2.
+  for (std::size_t f = 0; f < 3; ++f) {
+    const char* face = vertices + 9 * 16 + 13 * f;
+    EXPECT_EQ(face[0], 3);
+    for (std::size_t k = 0; k < 3; ++k) {
+      std::int32_t index = -1;
+      std::memcpy(&index, face + 1 + 4 * k, sizeof index);
+      EXPECT_EQ(index, static_cast<std::int32_t>(3 * f + k));
     }
   }
   for (std::size_t v = 0; v < 6; ++v) EXPECT_NEAR(red[v], kHighlightColour[0], 0.01) << v;
