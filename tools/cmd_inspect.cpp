@@ -197,11 +197,13 @@ void run_inspect(const InspectOptions& o) {
   }
   // Read every log; report and skip the ones that are not readable skelcd logs.
   std::vector<std::pair<std::string, LogData>> logs;
+  std::size_t skipped = 0;
   for (const auto& path : o.logs) {
     try {
       logs.emplace_back(path, read_log(path, ReadLogOptions{.findings = false}));
     } catch (const std::exception& e) {
       std::cerr << "skelcd: " << e.what() << " (skipped)\n";
+      ++skipped;
     }
   }
   if (logs.empty()) {
@@ -247,16 +249,22 @@ void run_inspect(const InspectOptions& o) {
       }
     }
     print_json(out);
-    return;
-  }
-  if (o.csv) {
-    print_csv(table);
   } else {
-    print_text(table);
+    if (o.csv) {
+      print_csv(table);
+    } else {
+      print_text(table);
+    }
+    for (const auto& p : plots) {
+      if (p.empty()) continue;
+      (o.csv ? std::cerr : std::cout) << "plot: " << p << '\n';
+    }
   }
-  for (const auto& p : plots) {
-    if (p.empty()) continue;
-    (o.csv ? std::cerr : std::cout) << "plot: " << p << '\n';
+  // The readable logs are summarised above; a script still learns that some were not (as a
+  // batch `check` that had failures).
+  if (skipped > 0) {
+    throw IoError(std::to_string(skipped) + " of " + std::to_string(o.logs.size()) +
+                  " files skipped: not readable skelcd logs (named above)");
   }
 }
 

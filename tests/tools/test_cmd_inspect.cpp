@@ -112,11 +112,13 @@ TEST(CmdInspect, SummarisesGoodLogsAndSkipsBadOnesByName) {
   const auto r = run_skelcd({"inspect", (dir / "bvh.h5").string(), (dir / "truncated.h5").string(),
                              (dir / "kdop.h5").string(), (dir / "foreign.h5").string(),
                              (dir / "notes.h5").string(), (dir / "brute.h5").string(), "--json"});
-  ASSERT_EQ(r.exit_code, 0) << r.err;
+  // The good logs are summarised, each bad one named, and the exit status says some were bad.
+  EXPECT_EQ(r.exit_code, 1) << r.err;
   for (const char* bad : {"truncated.h5", "foreign.h5", "notes.h5"}) {
     EXPECT_NE(r.err.find(std::string(bad) + ": "), std::string::npos) << r.err;
   }
-  EXPECT_EQ(count_lines(r.err), 3u) << r.err;
+  EXPECT_NE(r.err.find("3 of 6 files skipped"), std::string::npos) << r.err;
+  EXPECT_EQ(count_lines(r.err), 4u) << r.err;
   const auto out = nlohmann::json::parse(r.out);
   ASSERT_EQ(out.size(), 3u);
   const auto& bvh = out[0];
