@@ -2,6 +2,11 @@
 
 #include <algorithm>
 #include <cassert>
+#include <vector>
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
 
 namespace skelcd::culling {
 namespace {
@@ -46,6 +51,43 @@ ccd::EdgeEdgeQuery edge_edge_query(
           row(xb_t1, eb[1])};
 }
 
+namespace {
+
+/// One query's outcome, in its candidate's slot.
+struct Outcome {
+  bool hit = false;
+  double toi_lower = 0;
+  double toi_upper = 0;
+};
+
+/// Per calling thread, reused across calls: grows to the largest candidate list it has seen.
+/// The parallel loops below run isolated, so a thread waiting for them never picks up another
+/// caller's work and re-enters this function with its buffer in use.
+thread_local std::vector<Outcome> tl_outcomes;
+
+/// Calls `test(i, outcome)` for i in [0, n): on this thread, or split over oneTBB workers when
+/// `threads` > 1 and n is large enough. Every outcome goes to its own slot.
+template <typename Test>
+std::span<Outcome> evaluate(std::size_t n, std::int32_t threads, const Test& test) {
+  if (tl_outcomes.size() < n) tl_outcomes.resize(n);
+  const std::span<Outcome> outcomes(tl_outcomes.data(), n);
+  if (threads > 1 && n >= kParallelElementaryThreshold) {
+    tbb::this_task_arena::isolate([&] {
+      tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 64),
+                        [&](const tbb::blocked_range<std::size_t>& range) {
+                          for (std::size_t i = range.begin(); i != range.end(); ++i) {
+                            test(i, outcomes[i]);
+                          }
+                        });
+    });
+  } else {
+    for (std::size_t i = 0; i < n; ++i) test(i, outcomes[i]);
+  }
+  return outcomes;
+}
+
+}  // namespace
+
 void run_ccd_tests(
     const FeatureTopology& topology,
     const FeatureCandidates& candidates,
@@ -58,24 +100,40 @@ void run_ccd_tests(
   assert(tests.vertex_face != nullptr && tests.edge_edge != nullptr);
   const std::size_t first = out.contacts.size();
   Counters& c = out.counters;
-  for (const VertexFacePair& p : candidates.vf) {
-    const ccd::VertexFaceQuery q =
-        vertex_face_query(x_t0, x_t1, p.vertex, x_t0, x_t1, topology.triangle(p.face));
-    const ccd::CcdResult r = tests.vertex_face(q, accuracy, options);
-    ++c.vf_tests;
-    if (r.hit) {
+  // Vertex-face queries: outcomes in candidate order, then the hits appended in that order.
+  {
+    const auto outcomes = evaluate(candidates.vf.size(), tests.threads, [&](std::size_t i, Outcome& o) {
+      const VertexFacePair& p = candidates.vf[i];
+      const ccd::CcdResult r = tests.vertex_face(
+          vertex_face_query(x_t0, x_t1, p.vertex, x_t0, x_t1, topology.triangle(p.face)),
+          accuracy, options);
+      o = {r.hit, r.toi_lower, r.toi_upper};
+    });
+    for (std::size_t i = 0; i < outcomes.size(); ++i) {
+      ++c.vf_tests;
+      if (!outcomes[i].hit) continue;
       ++c.vf_contacts;
-      out.contacts.push_back({CcdContact::Kind::vf, p.vertex, p.face, r.toi_lower, r.toi_upper});
+      const VertexFacePair& p = candidates.vf[i];
+      out.contacts.push_back(
+          {CcdContact::Kind::vf, p.vertex, p.face, outcomes[i].toi_lower, outcomes[i].toi_upper});
     }
   }
-  for (const EdgeEdgePair& p : candidates.ee) {
-    const ccd::EdgeEdgeQuery q =
-        edge_edge_query(x_t0, x_t1, topology.edge(p.a), x_t0, x_t1, topology.edge(p.b));
-    const ccd::CcdResult r = tests.edge_edge(q, accuracy, options);
-    ++c.ee_tests;
-    if (r.hit) {
+  // Edge-edge queries, likewise.
+  {
+    const auto outcomes = evaluate(candidates.ee.size(), tests.threads, [&](std::size_t i, Outcome& o) {
+      const EdgeEdgePair& p = candidates.ee[i];
+      const ccd::CcdResult r = tests.edge_edge(
+          edge_edge_query(x_t0, x_t1, topology.edge(p.a), x_t0, x_t1, topology.edge(p.b)),
+          accuracy, options);
+      o = {r.hit, r.toi_lower, r.toi_upper};
+    });
+    for (std::size_t i = 0; i < outcomes.size(); ++i) {
+      ++c.ee_tests;
+      if (!outcomes[i].hit) continue;
       ++c.ee_contacts;
-      out.contacts.push_back({CcdContact::Kind::ee, p.a, p.b, r.toi_lower, r.toi_upper});
+      const EdgeEdgePair& p = candidates.ee[i];
+      out.contacts.push_back(
+          {CcdContact::Kind::ee, p.a, p.b, outcomes[i].toi_lower, outcomes[i].toi_upper});
     }
   }
   // std::sort works in place: no allocation.
@@ -93,7 +151,8 @@ void run_dcd_tests(
     FrameResult& out) {
   assert(tests.triangles != nullptr);
   const std::size_t first = out.dcd_pairs.size();
-  for (const TrianglePair& p : pairs) {
+  const auto outcomes = evaluate(pairs.size(), tests.threads, [&](std::size_t i, Outcome& o) {
+    const TrianglePair& p = pairs[i];
     assert(p.a < p.b);
     int count = 0;
     const ccd::SharedCorners shared = topology.shared_corners(p.a, p.b, count);
@@ -101,11 +160,13 @@ void run_dcd_tests(
     const auto& tb = topology.triangle(p.b);
     const ccd::TriangleTriangleQuery q{
         row(x, ta[0]), row(x, ta[1]), row(x, ta[2]), row(x, tb[0]), row(x, tb[1]), row(x, tb[2])};
+    o.hit = tests.triangles(q, shared);
+  });
+  for (std::size_t i = 0; i < outcomes.size(); ++i) {
     ++out.counters.tt_tests;
-    if (tests.triangles(q, shared)) {
-      ++out.counters.dcd_pairs;
-      out.dcd_pairs.push_back(p);
-    }
+    if (!outcomes[i].hit) continue;
+    ++out.counters.dcd_pairs;
+    out.dcd_pairs.push_back(pairs[i]);
   }
   std::sort(out.dcd_pairs.begin() + static_cast<std::ptrdiff_t>(first), out.dcd_pairs.end());
 }

@@ -4,6 +4,7 @@
 // substitutes: tests inject reference or counting implementations).
 
 #include <array>
+#include <cstddef>
 #include <cstdint>
 #include <span>
 
@@ -19,6 +20,10 @@
 
 namespace skelcd::culling {
 
+/// Below this many queries of one kind in one call the elementary tests stay on the calling thread
+/// (splitting costs more than it saves).
+inline constexpr std::size_t kParallelElementaryThreshold = 512;
+
 /// The three elementary tests a method calls. A null member means "the ccd/ kernel".
 struct ElementaryTests {
   using VertexFaceFn =
@@ -29,6 +34,10 @@ struct ElementaryTests {
   VertexFaceFn vertex_face = nullptr;
   EdgeEdgeFn edge_edge = nullptr;
   TrianglesFn triangles = nullptr;
+  /// Threads one call may split its queries over (oneTBB, inside the caller's task arena): 1 keeps
+  /// every test on the calling thread. The results do not depend on it: each query's outcome has
+  /// its own slot, gathered in candidate order and sorted as in a serial run.
+  std::int32_t threads = 1;
 };
 
 /// The CCD query of vertex `v` (positions xv_t0 → xv_t1) against triangle `f` (positions
@@ -57,7 +66,9 @@ struct ElementaryTests {
 
 /// Runs the VF and EE tests of `candidates` over the interval x_t0 → x_t1 and appends the hits to
 /// out.contacts, then sorts the appended contacts canonically (kind, a, b). Counts vf_tests,
-/// ee_tests, vf_contacts, ee_contacts.
+/// ee_tests, vf_contacts, ee_contacts. With tests.threads > 1 and at least
+/// kParallelElementaryThreshold queries of a kind, those queries are split over threads; the
+/// output is the same.
 /// @param x_t0,x_t1 #W × 3 welded positions.  @pre `tests` has no null member.
 void run_ccd_tests(
     const FeatureTopology& topology,
@@ -71,7 +82,7 @@ void run_ccd_tests(
 
 /// Runs the exact triangle-triangle test of each pair (with the corners the two share as mesh
 /// vertices) and appends the intersecting ones to out.dcd_pairs, sorted (a, b). Counts tt_tests
-/// and dcd_pairs.
+/// and dcd_pairs. Split over tests.threads as run_ccd_tests.
 /// @param pairs a < b.  @param x #W × 3 welded positions.  @pre `tests` has no null member.
 void run_dcd_tests(
     const FeatureTopology& topology,

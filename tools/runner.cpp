@@ -302,6 +302,9 @@ ClipRunner::ClipRunner(
                       .min_separation = options.min_separation,
                       .extension = options.method_extension},
       plan_(make_plan(motion, options)) {
+  // Within one query the elementary tests may split over the threads asked for (identical
+  // output); across queries, blocks of samples go to workers (below) when the method allows.
+  method_options_.elementary.threads = resolve_threads(options.threads);
   topology_ = skinning::build_topology(motion.mesh());
   if (factory_) {
     method_ = factory_(motion.mesh(), topology_, method_options_);
@@ -342,6 +345,20 @@ void ClipRunner::run(const FrameCallback& on_frame) {
 }
 
 void ClipRunner::run_serial(const FrameCallback& on_frame) {
+  // One query at a time; with more than one thread asked for, the elementary tests of a query
+  // split over an arena of that many (the parallel loops run in the caller's arena).
+  const std::int32_t threads = method_options_.elementary.threads;
+  if (threads > 1) {
+    const tbb::global_control allowed(tbb::global_control::max_allowed_parallelism,
+                                      static_cast<std::size_t>(threads));
+    tbb::task_arena arena(threads);
+    arena.execute([&] { run_queries_in_order(on_frame); });
+  } else {
+    run_queries_in_order(on_frame);
+  }
+}
+
+void ClipRunner::run_queries_in_order(const FrameCallback& on_frame) {
   const FeatureNumbering numbering(motion_.mesh(), topology_);
   const RowContext context{motion_, topology_, numbering};
   const bool dcd = options_.query != QuerySet::ccd;

@@ -122,6 +122,7 @@ class ClipRunner {
 
  private:
   void run_serial(const FrameCallback& on_frame);
+  void run_queries_in_order(const FrameCallback& on_frame);
   void run_parallel(const FrameCallback& on_frame);
 
   const skinning::Motion& motion_;

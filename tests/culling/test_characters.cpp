@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <string>
 
+#include "culling/elementary.hpp"
 #include "culling/method.hpp"
 #include "skinning/load.hpp"
 #include "skinning/topology.hpp"
@@ -90,6 +91,47 @@ TEST_P(Characters, BruteBvhAndKdopAgree) {
   EXPECT_LT(bvh_tests, brute_tests) << c.file;
   RecordProperty("ccd_contacts", static_cast<int>(contacts));
   RecordProperty("dcd_pairs", static_cast<int>(dcd));
+}
+
+TEST(ElementaryThreads, SplittingTheTestsChangesNothing) {
+  // The bind pose against a mid-clip frame of CesiumMan: thousands of candidates, so the split
+  // path (kParallelElementaryThreshold) runs. Contacts, pairs and counters must be identical.
+  const auto model = skinning::load_model(test::asset("characters/CesiumMan.glb"));
+  const skinning::Mesh& mesh = *model.mesh;
+  const skinning::Topology topo = skinning::build_topology(mesh);
+  const auto motion = model.motion({});
+  skinning::Positions file_positions, x0, x1;
+  skinning::gather_welded(topo, mesh.rest_positions, x0);
+  motion->positions(motion->num_samples() / 2, file_positions);
+  skinning::gather_welded(topo, file_positions, x1);
+  for (const char* name : {"bvh", "kdop", "brute"}) {
+    MethodOptions serial;
+    MethodOptions split;
+    split.elementary.threads = 2;
+    auto a = make_method(name, mesh, topo, serial);
+    auto b = make_method(name, mesh, topo, split);
+    FrameResult ra, rb, da, db;
+    a->detect_ccd(x0, x1, ra);
+    b->detect_ccd(x0, x1, rb);
+    ASSERT_GE(static_cast<std::size_t>(ra.counters.ee_tests), kParallelElementaryThreshold) << name;
+    EXPECT_GT(ra.contacts.size(), 0u) << name;
+    EXPECT_EQ(rb.contacts, ra.contacts) << name;
+    EXPECT_EQ(rb.counters.vf_tests, ra.counters.vf_tests) << name;
+    EXPECT_EQ(rb.counters.ee_tests, ra.counters.ee_tests) << name;
+    EXPECT_EQ(rb.counters.vf_contacts, ra.counters.vf_contacts) << name;
+    EXPECT_EQ(rb.counters.ee_contacts, ra.counters.ee_contacts) << name;
+    a->detect_dcd(x1, da);
+    b->detect_dcd(x1, db);
+    ASSERT_GE(static_cast<std::size_t>(da.counters.tt_tests), kParallelElementaryThreshold) << name;
+    EXPECT_GT(da.dcd_pairs.size(), 0u) << name;
+    EXPECT_EQ(db.dcd_pairs, da.dcd_pairs) << name;
+    EXPECT_EQ(db.counters.tt_tests, da.counters.tt_tests) << name;
+    EXPECT_EQ(db.counters.dcd_pairs, da.counters.dcd_pairs) << name;
+    // Again on the same objects: the reused per-thread buffers hold nothing of the last call.
+    FrameResult again;
+    b->detect_ccd(x0, x1, again);
+    EXPECT_EQ(again.contacts, ra.contacts) << name;
+  }
 }
 
 INSTANTIATE_TEST_SUITE_P(

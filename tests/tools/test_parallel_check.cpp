@@ -13,6 +13,7 @@
 
 #include <gtest/gtest.h>
 
+#include "culling/elementary.hpp"
 #include "tests/support/test_support.hpp"
 #include "tests/tools/cli_runner.hpp"
 #include "tools/log/log_reader.hpp"
@@ -211,6 +212,29 @@ TEST(ParallelCheck, GeneratedRigLogsEqualSerialExceptTimings) {
                                       {"--frames", "12:"}, std::string("rope-") + method);
     EXPECT_EQ(log.frames.size(), 12u + 11u);
     EXPECT_GT(log.contacts.size(), 0u);
+  }
+}
+
+TEST(ParallelCheck, OneIntervalSplitsItsElementaryTestsAndStaysEqual) {
+  // One interval (the cloth-funnel step): no blocks to share, so the run is serial across queries
+  // and --threads 4 splits each query's elementary tests instead (culling/elementary.hpp). The
+  // log must be the serial one; the ground truth says what the CCD must find (27 VF + 107 EE).
+  const auto frames = skelcd::test::asset("cloth-funnel/frames").string();
+  for (const char* method : {"bvh", "enhanced-dual-cone"}) {
+    SCOPED_TRACE(method);
+    const auto log = expect_same_logs(frames, method, {}, std::string("funnel-") + method);
+    ASSERT_EQ(log.frames.size(), 2u + 1u);
+    std::int64_t vf = 0, ee = 0;
+    for (const auto& row : log.frames) {
+      vf += row.counters.vf_contacts;
+      ee += row.counters.ee_contacts;
+      if (row.kind == skelcd::tools::QueryKind::ccd) {
+        ASSERT_GE(static_cast<std::size_t>(row.counters.vf_tests + row.counters.ee_tests),
+                  skelcd::culling::kParallelElementaryThreshold);  // the split path ran
+      }
+    }
+    EXPECT_EQ(vf, 27);
+    EXPECT_EQ(ee, 107);
   }
 }
 
