@@ -7,6 +7,7 @@
 
 #include "culling/elementary.hpp"
 #include "culling/method.hpp"
+#include "tests/culling/method_agreement.hpp"
 #include "skinning/load.hpp"
 #include "skinning/topology.hpp"
 #include "tests/support/test_support.hpp"
@@ -14,18 +15,15 @@
 namespace skelcd::culling {
 namespace {
 
+using agreement::expect_same_dcd;
+using agreement::same_pairs_subset;
+
 struct Character {
   std::string file;
   std::string clip;
   double rate_hz;  // 0: the clip's key rate
   bool exact_too;  // also compare under the (slow, GMP) exact accuracy
 };
-
-bool same_pairs_subset(const std::vector<CcdContact>& a, const std::vector<CcdContact>& b) {
-  return std::all_of(a.begin(), a.end(), [&](const CcdContact& c) {
-    return std::any_of(b.begin(), b.end(), [&](const CcdContact& d) { return c.same_pair(d); });
-  });
-}
 
 class Characters : public ::testing::TestWithParam<Character> {};
 
@@ -76,13 +74,7 @@ TEST_P(Characters, BruteBvhAndKdopAgree) {
       bvh_tests += rv.counters.bv_tests + rv.counters.feature_bv_tests;
       brute_tests += rb.counters.feature_bv_tests;
 
-      FrameResult db, dv, dk;
-      brute->detect_dcd(x[i + 1], db);
-      bvh->detect_dcd(x[i + 1], dv);
-      kdop->detect_dcd(x[i + 1], dk);
-      EXPECT_EQ(dv.dcd_pairs, db.dcd_pairs) << what;
-      EXPECT_EQ(dk.dcd_pairs, db.dcd_pairs) << what;
-      EXPECT_EQ(dv.counters.tt_tests, db.counters.tt_tests) << what;
+      const FrameResult db = expect_same_dcd(*brute, *bvh, *kdop, x[i + 1], what);
       dcd += static_cast<std::int64_t>(db.dcd_pairs.size());
     }
   }

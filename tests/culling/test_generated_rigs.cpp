@@ -11,6 +11,7 @@
 #include <string>
 
 #include "culling/method.hpp"
+#include "tests/culling/method_agreement.hpp"
 #include "skinning/generators.hpp"
 #include "skinning/rig_motion.hpp"
 #include "skinning/topology.hpp"
@@ -18,11 +19,8 @@
 namespace skelcd::culling {
 namespace {
 
-bool same_pairs_subset(const std::vector<CcdContact>& a, const std::vector<CcdContact>& b) {
-  return std::all_of(a.begin(), a.end(), [&](const CcdContact& c) {
-    return std::any_of(b.begin(), b.end(), [&](const CcdContact& d) { return c.same_pair(d); });
-  });
-}
+using agreement::expect_same_dcd;
+using agreement::same_pairs_subset;
 
 class GeneratedRigs : public ::testing::TestWithParam<std::string> {};
 
@@ -71,12 +69,7 @@ TEST_P(GeneratedRigs, BruteBvhAndKdopAgreeAroundTheKnownFirstContact) {
                                           << first_hit << ", so something touched in between";
       }
 
-      FrameResult db, dv, dk;
-      brute->detect_dcd(x[i + 1], db);
-      bvh->detect_dcd(x[i + 1], dv);
-      kdop->detect_dcd(x[i + 1], dk);
-      EXPECT_EQ(dv.dcd_pairs, db.dcd_pairs) << what;
-      EXPECT_EQ(dk.dcd_pairs, db.dcd_pairs) << what;
+      const FrameResult db = expect_same_dcd(*brute, *bvh, *kdop, x[i + 1], what);
       if (f0 + 1 <= answer.last_free_frame) {
         EXPECT_TRUE(db.dcd_pairs.empty()) << what << ": frame " << f0 + 1 << " is known free";
       } else {
