@@ -86,19 +86,28 @@ struct BenchTarget {
   double fps = 0;
   QuerySet query = QuerySet::both;
   FrameRange frames;
+  /// A scene object that only the scene runner can build (a sheet, a part selection, an offset):
+  /// loaded already; `model`, `load`, `clip` and `fps` are then only labels.
+  std::optional<LoadedSceneObject> loaded;
 };
 
 /// Loads `target` and runs the report on it (the radial-view methods only on a rig's clip).
 BenchReport bench_target(
     const BenchTarget& target, BenchOptions options, const BenchArguments& args) {
-  const std::filesystem::path model_path(target.model);
-  if (!skinning::is_generator_spec(target.model) &&
-      skinning::classify_model_path(model_path) != skinning::ModelKind::frame_sequence) {
-    require_exists(model_path);
+  std::optional<skinning::LoadedModel> own_model;
+  std::unique_ptr<skinning::Motion> own_motion;
+  if (!target.loaded) {
+    const std::filesystem::path model_path(target.model);
+    if (!skinning::is_generator_spec(target.model) &&
+        skinning::classify_model_path(model_path) != skinning::ModelKind::frame_sequence) {
+      require_exists(model_path);
+    }
+    own_model = skinning::load_model(model_path, target.load);
+    own_motion =
+        own_model->motion(skinning::MotionRequest{.clip = target.clip, .rate_hz = target.fps});
   }
-  const auto model = skinning::load_model(model_path, target.load);
-  const auto motion =
-      model.motion(skinning::MotionRequest{.clip = target.clip, .rate_hz = target.fps});
+  const skinning::LoadedModel& model = target.loaded ? *target.loaded->model : *own_model;
+  const skinning::Motion& motion = target.loaded ? *target.loaded->motion : *own_motion;
   options.run.clip = target.clip;
   options.run.fps = target.fps;
   options.run.query = target.query;
@@ -107,7 +116,7 @@ BenchReport bench_target(
   // rvbc and dynamic need a rig's clip: they are in the default list only then, and refused by
   // name otherwise. Their segmentation is made once, at the first radial-view run, and shared.
   options.radial_view = model.rig != nullptr && model.kind == skinning::ModelKind::rig &&
-                        dynamic_cast<const skinning::RigMotion*>(motion.get()) != nullptr;
+                        dynamic_cast<const skinning::RigMotion*>(&motion) != nullptr;
   validate_methods(options.methods, options.radial_view);
   struct RadialViewCache {
     bool ready = false;
@@ -123,14 +132,14 @@ BenchReport bench_target(
         if (!cache->ready) {
           cache->options = run;
           cache->options.method = "dynamic";
-          (void)setup_radial_view(args.radial_view, model, *motion, cache->options);
+          (void)setup_radial_view(args.radial_view, model, motion, cache->options);
           cache->ready = true;
         }
         run.method_extension = cache->options.method_extension;
         run.before_query = cache->options.before_query;
       };
   options.progress = true;
-  return run_bench(*motion, options);
+  return run_bench(motion, options);
 }
 
 /// The query a scene object's self checks ask for.
@@ -150,22 +159,25 @@ std::filesystem::path per_object_path(
 void run_bench_command(const BenchArguments& args, bool query_given) {
   const BenchOptions options = to_bench_options(args);
 
-  // What to run: the MODEL, or every self-checked object of a scene that is a plain model (sheets
-  // and part selections are built by the scene runner only; they are listed as skipped).
+  // What to run: the MODEL, or every self-checked object of a scene (a sheet, a part selection or
+  // an offset object as the scene runner builds it). Pair checks are not benchmarked: they are
+  // listed as skipped.
   std::vector<BenchTarget> targets;
   std::vector<std::string> skipped;
   const bool scene_mode = is_scene_path(args.model);
   if (scene_mode) {
     const Scene scene = parse_scene(args.model);
+    for (const auto& pair : scene.pairs) {
+      skipped.push_back("pair " + pair.a + " " + pair.b + " (pair checks are not benchmarked)");
+    }
     for (const auto& object : scene.objects) {
       if (!object.has_self_check()) continue;
-      if (object.sheet || !object.parts.empty()) {
-        skipped.push_back(object.name + (object.sheet ? " (a sheet)" : " (a part selection)"));
-        continue;
-      }
       BenchTarget t;
       t.object = object.name;
-      t.model = object.model;
+      if (object.sheet || !object.parts.empty() || !object.offset.isZero()) {
+        t.loaded = load_scene_object(scene, object.name);
+      }
+      t.model = object.sheet ? "sheet on " + object.attach_to : object.model;
       t.load = object.load;
       t.clip = object.clip;
       t.fps = object.rate_hz;
@@ -174,10 +186,7 @@ void run_bench_command(const BenchArguments& args, bool query_given) {
       targets.push_back(std::move(t));
     }
     if (targets.empty()) {
-      throw InvalidInput(
-          args.model +
-          ": no self-checked object that bench can run (sheets and "
-          "part selections are not supported)");
+      throw InvalidInput(args.model + ": no object has a self check (bench runs self checks)");
     }
   } else {
     targets.push_back(BenchTarget{
@@ -187,7 +196,8 @@ void run_bench_command(const BenchArguments& args, bool query_given) {
         .clip = args.clip,
         .fps = args.fps,
         .query = options.run.query,
-        .frames = options.run.frames});
+        .frames = options.run.frames,
+        .loaded = std::nullopt});
   }
 
   // Outputs are claimed before any work (an unwritable path is refused now) and appear whole at

@@ -471,6 +471,25 @@ bool is_scene_path(std::string_view model_arg) {
   return model_arg.size() > 5 && model_arg.substr(model_arg.size() - 5) == ".toml";
 }
 
+LoadedSceneObject load_scene_object(const Scene& scene, const std::string& name) {
+  const auto found = std::find_if(scene.objects.begin(), scene.objects.end(),
+                                  [&](const SceneObject& o) { return o.name == name; });
+  if (found == scene.objects.end()) {
+    throw InvalidInput(scene.path.string() + ": no object '" + name + "'");
+  }
+  const auto i = static_cast<std::size_t>(found - scene.objects.begin());
+  auto objects = std::make_shared<std::vector<LoadedObject>>(scene.objects.size());
+  const SceneRunOptions options;
+  if (found->sheet) {
+    for (std::size_t t = 0; t < scene.objects.size(); ++t) {
+      if (scene.objects[t].name == found->attach_to) load_object(scene, t, *objects, options);
+    }
+  }
+  load_object(scene, i, *objects, options);
+  const LoadedObject& lo = (*objects)[i];
+  return LoadedSceneObject{.model = &*lo.model, .motion = lo.motion, .owner = objects};
+}
+
 SceneRunResult run_scene(const Scene& scene, const SceneRunOptions& options) {
   const auto started = Clock::now();
   // 1. Load what the checks need — attach targets first — and nothing else.

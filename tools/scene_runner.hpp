@@ -6,11 +6,13 @@
 #include <cstdint>
 #include <filesystem>
 #include <functional>
+#include <memory>
 #include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
 
+#include "skinning/load.hpp"
 #include "tools/frame_report.hpp"
 #include "tools/run_summary.hpp"
 #include "tools/runner.hpp"
@@ -69,5 +71,17 @@ struct SceneRunResult {
 ///   fault found while loading (a model that does not load, an unknown clip or part, pairs whose
 ///   objects have different samples, frames outside the samples).
 [[nodiscard]] SceneRunResult run_scene(const Scene& scene, const SceneRunOptions& options = {});
+
+/// One object of a scene as its checks see it: its model loaded (a sheet: skinned to its target,
+/// which is loaded for it), its clip and rate, its part selection and offset applied.
+struct LoadedSceneObject {
+  const skinning::LoadedModel* model = nullptr;  ///< the object's model (a sheet's own rig)
+  const skinning::Motion* motion = nullptr;      ///< what the object's checks pose
+  std::shared_ptr<const void> owner;             ///< keeps model and motion alive
+};
+
+/// Loads the object named `name` of `scene` as run_scene does.
+/// @throws InvalidInput naming the scene file and line, as run_scene; for an unknown name.
+[[nodiscard]] LoadedSceneObject load_scene_object(const Scene& scene, const std::string& name);
 
 }  // namespace skelcd::tools

@@ -240,18 +240,48 @@ TEST(CmdBench, SceneRunsEachSelfCheckedObjectWithItsQueries) {
   }
   EXPECT_FALSE(std::filesystem::exists(png));
 
-  // A scene whose only self check is a sheet: nothing bench can run, one line, nothing written.
-  const auto sheet_only = dir / "sheet.toml";
+  // A sheet (built only by the scene runner) is benchmarked as the scene's checks see it: the
+  // reference's findings equal what `check SCENE` finds for that object over the same samples.
+  const auto with_sheet = dir / "sheet.toml";
   {
-    std::ofstream out(sheet_only);
-    out << "[objects.body]\nmodel = \"" << skelcd::test::asset("characters/CesiumMan.glb").string()
-        << "\"\n[objects.cape]\nsheet = { corner = [0, 0, 0], u = [0.2, 0, 0], v = [0, -0.4, 0] "
-           "}\nattach_to = \"body\"\nchecks = [\"self-ccd\"]\n";
+    std::ofstream out(with_sheet);
+    out << "frames = \"0:3\"\n[objects.body]\nmodel = \""
+        << skelcd::test::asset("characters/CesiumMan.glb").string()
+        << "\"\n[objects.cape]\nsheet = { corner = [-0.12, 0.95, -0.25], u = [0.24, 0, 0], "
+           "v = [0, -0.45, 0], cells = [12, 20] }\nattach_to = \"body\"\nchecks = [\"self-ccd\"]\n"
+           "[[pairs]]\nobjects = [\"body\", \"cape\"]\nchecks = [\"dcd\"]\n";
   }
-  const auto bad = run_skelcd({"bench", sheet_only.string(), "--csv", (dir / "x.csv").string()});
+  const auto sheet = run_skelcd({"bench", with_sheet.string(), "--methods", "bvh,enhanced-dual-cone",
+                                 "--accuracies", "conservative", "--json"});
+  ASSERT_EQ(sheet.exit_code, 0) << sheet.err;
+  const auto js = nlohmann::json::parse(sheet.out);
+  ASSERT_EQ(js["objects"].size(), 1u);
+  EXPECT_EQ(js["objects"][0]["object"], "cape");
+  EXPECT_EQ(js["objects"][0]["model"], "sheet on body");
+  ASSERT_EQ(js["skipped"].size(), 1u);
+  EXPECT_EQ(js["skipped"][0].get<std::string>().rfind("pair body cape", 0), 0u);
+  const auto check = run_skelcd({"check", with_sheet.string(), "--json"});
+  ASSERT_EQ(check.exit_code, 0) << check.err;
+  const auto jc = nlohmann::json::parse(check.out);
+  std::int64_t cape_contacts = -1;
+  for (const auto& c : jc["checks"]) {
+    if (c["name"] == "self cape") cape_contacts = c["ccd_vf"].get<std::int64_t>() + c["ccd_ee"].get<std::int64_t>();
+  }
+  ASSERT_GT(cape_contacts, 0) << "the cape must fold onto itself for this to mean anything";
+  EXPECT_EQ(js["objects"][0]["reference"]["findings"], cape_contacts);
+  for (const auto& row : js["objects"][0]["rows"]) EXPECT_EQ(row["false_negatives"], 0) << row.dump();
+
+  // A scene with no self check at all: nothing bench can run, one line, nothing written.
+  const auto pairs_only = dir / "pairs.toml";
+  {
+    std::ofstream out(pairs_only);
+    out << "[objects.a]\nmodel = \"gen:rope?triangles=200\"\n[objects.b]\nmodel = \"gen:rope?triangles=200\"\n"
+           "offset = [5, 0, 0]\n[[pairs]]\nobjects = [\"a\", \"b\"]\nchecks = [\"dcd\"]\n";
+  }
+  const auto bad = run_skelcd({"bench", pairs_only.string(), "--csv", (dir / "x.csv").string()});
   EXPECT_EQ(bad.exit_code, 1);
   EXPECT_EQ(std::count(bad.err.begin(), bad.err.end(), '\n'), 1) << bad.err;
-  EXPECT_NE(bad.err.find("sheet"), std::string::npos) << bad.err;
+  EXPECT_NE(bad.err.find("no object has a self check"), std::string::npos) << bad.err;
   EXPECT_FALSE(std::filesystem::exists(dir / "x.csv"));
 }
 
