@@ -6,7 +6,6 @@
 #include <utility>
 
 #include "culling/method.hpp"
-
 #include "skinning/errors.hpp"
 
 namespace skelcd::clustering {
@@ -38,10 +37,11 @@ class DcdOnlyRadialViewMethod final : public culling::CullingMethod {
     bvh_->detect_dcd(x, out);
   }
 
-  void detect_ccd(const skinning::Positions&, const skinning::Positions&, culling::FrameResult&)
-      override {
-    throw InvalidInput("clustering::" + name_ +
-                       ": built for DCD only (no segmentation); a CCD query needs the full method");
+  void detect_ccd(
+      const skinning::Positions&, const skinning::Positions&, culling::FrameResult&) override {
+    throw InvalidInput(
+        "clustering::" + name_ +
+        ": built for DCD only (no segmentation); a CCD query needs the full method");
   }
 
  private:

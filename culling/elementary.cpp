@@ -1,12 +1,12 @@
 #include "culling/elementary.hpp"
 
-#include <algorithm>
-#include <cassert>
-#include <vector>
-
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
+
+#include <algorithm>
+#include <cassert>
+#include <vector>
 
 namespace skelcd::culling {
 namespace {
@@ -73,12 +73,13 @@ std::span<Outcome> evaluate(std::size_t n, std::int32_t threads, const Test& tes
   const std::span<Outcome> outcomes(tl_outcomes.data(), n);
   if (threads > 1 && n >= kParallelElementaryThreshold) {
     tbb::this_task_arena::isolate([&] {
-      tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 64),
-                        [&](const tbb::blocked_range<std::size_t>& range) {
-                          for (std::size_t i = range.begin(); i != range.end(); ++i) {
-                            test(i, outcomes[i]);
-                          }
-                        });
+      tbb::parallel_for(
+          tbb::blocked_range<std::size_t>(0, n, 64),
+          [&](const tbb::blocked_range<std::size_t>& range) {
+            for (std::size_t i = range.begin(); i != range.end(); ++i) {
+              test(i, outcomes[i]);
+            }
+          });
     });
   } else {
     for (std::size_t i = 0; i < n; ++i) test(i, outcomes[i]);
@@ -102,13 +103,15 @@ void run_ccd_tests(
   Counters& c = out.counters;
   // Vertex-face queries: outcomes in candidate order, then the hits appended in that order.
   {
-    const auto outcomes = evaluate(candidates.vf.size(), tests.threads, [&](std::size_t i, Outcome& o) {
-      const VertexFacePair& p = candidates.vf[i];
-      const ccd::CcdResult r = tests.vertex_face(
-          vertex_face_query(x_t0, x_t1, p.vertex, x_t0, x_t1, topology.triangle(p.face)),
-          accuracy, options);
-      o = {r.hit, r.toi_lower, r.toi_upper};
-    });
+    const auto outcomes =
+        evaluate(candidates.vf.size(), tests.threads, [&](std::size_t i, Outcome& o) {
+          const VertexFacePair& p = candidates.vf[i];
+          const ccd::CcdResult r = tests.vertex_face(
+              vertex_face_query(x_t0, x_t1, p.vertex, x_t0, x_t1, topology.triangle(p.face)),
+              accuracy,
+              options);
+          o = {r.hit, r.toi_lower, r.toi_upper};
+        });
     for (std::size_t i = 0; i < outcomes.size(); ++i) {
       ++c.vf_tests;
       if (!outcomes[i].hit) continue;
@@ -120,13 +123,15 @@ void run_ccd_tests(
   }
   // Edge-edge queries, likewise.
   {
-    const auto outcomes = evaluate(candidates.ee.size(), tests.threads, [&](std::size_t i, Outcome& o) {
-      const EdgeEdgePair& p = candidates.ee[i];
-      const ccd::CcdResult r = tests.edge_edge(
-          edge_edge_query(x_t0, x_t1, topology.edge(p.a), x_t0, x_t1, topology.edge(p.b)),
-          accuracy, options);
-      o = {r.hit, r.toi_lower, r.toi_upper};
-    });
+    const auto outcomes =
+        evaluate(candidates.ee.size(), tests.threads, [&](std::size_t i, Outcome& o) {
+          const EdgeEdgePair& p = candidates.ee[i];
+          const ccd::CcdResult r = tests.edge_edge(
+              edge_edge_query(x_t0, x_t1, topology.edge(p.a), x_t0, x_t1, topology.edge(p.b)),
+              accuracy,
+              options);
+          o = {r.hit, r.toi_lower, r.toi_upper};
+        });
     for (std::size_t i = 0; i < outcomes.size(); ++i) {
       ++c.ee_tests;
       if (!outcomes[i].hit) continue;

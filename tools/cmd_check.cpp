@@ -519,8 +519,11 @@ void add_check_command(CLI::App& app) {
   cmd->add_option("--clip", args->clip, "clip to check (default: the first)");
   cmd->add_option("--fps", args->fps, "samples per second (default: the clip's key rate, else 30)");
   cmd->add_option("--frames", args->frames, "samples A:B to check, both included (A:, :B, A)");
-  cmd->add_option("--method", args->method, "culling method: brute, bvh, kdop, normal-cone, dual-cone, enhanced-dual-cone, rvbc, "
-                  "dynamic, or auto (closed parts: dynamic; open parts: enhanced-dual-cone)")
+  cmd->add_option(
+         "--method",
+         args->method,
+         "culling method: brute, bvh, kdop, normal-cone, dual-cone, enhanced-dual-cone, rvbc, "
+         "dynamic, or auto (closed parts: dynamic; open parts: enhanced-dual-cone)")
       ->capture_default_str();
   cmd->add_option("--accuracy", args->accuracy, "elementary tests: exact, conservative, fast")
       ->capture_default_str();

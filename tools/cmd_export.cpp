@@ -89,8 +89,8 @@ void run_export(const ExportArgs& args) {
   }
   if (!args.highlight.empty()) {
     const auto frame = args.frame.value_or(0);
-    options.face_colors = highlight_face_colors(args.highlight, motion->mesh(), frame,
-                                                motion->sample_time(frame), motion->name());
+    options.face_colors = highlight_face_colors(
+        args.highlight, motion->mesh(), frame, motion->sample_time(frame), motion->name());
   }
   const auto result = export_mesh(motion->mesh(), positions, args.output, options);
   // Standard output may be carrying the mesh: the summary goes to stderr then.

@@ -263,8 +263,9 @@ void run_inspect(const InspectOptions& o) {
   // The readable logs are summarised above; a script still learns that some were not (as a
   // batch `check` that had failures).
   if (skipped > 0) {
-    throw IoError(std::to_string(skipped) + " of " + std::to_string(o.logs.size()) +
-                  " files skipped: not readable skelcd logs (named above)");
+    throw IoError(
+        std::to_string(skipped) + " of " + std::to_string(o.logs.size()) +
+        " files skipped: not readable skelcd logs (named above)");
   }
 }
 

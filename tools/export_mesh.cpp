@@ -1,8 +1,11 @@
 #include "tools/export_mesh.hpp"
 
+#include <assimp/material.h>
+#include <assimp/scene.h>
 #include <unistd.h>
 
 #include <algorithm>
+#include <assimp/Exporter.hpp>
 #include <bit>
 #include <cctype>
 #include <cmath>
@@ -13,10 +16,6 @@
 #include <memory>
 #include <string>
 #include <system_error>
-
-#include <assimp/Exporter.hpp>
-#include <assimp/material.h>
-#include <assimp/scene.h>
 
 #include "skinning/errors.hpp"
 
@@ -85,7 +84,9 @@ std::string write_ply(const aiScene& scene) {
     for (unsigned f = 0; f < am.mNumFaces; ++f) {
       append_le(out, static_cast<std::uint8_t>(am.mFaces[f].mNumIndices));
       for (unsigned k = 0; k < am.mFaces[f].mNumIndices; ++k) {
-        append_le(out, static_cast<std::int32_t>(base + static_cast<std::int32_t>(am.mFaces[f].mIndices[k])));
+        append_le(
+            out,
+            static_cast<std::int32_t>(base + static_cast<std::int32_t>(am.mFaces[f].mIndices[k])));
       }
     }
     base += static_cast<std::int32_t>(am.mNumVertices);
@@ -236,9 +237,12 @@ ExportResult export_mesh(
     data = ply.data();
     size = ply.size();
   } else {
-    const aiExportDataBlob* blob = exporter.ExportToBlob(scene.get(), assimp_format_id(result.format));
-    if (blob == nullptr) throw IoError(out.string() + ": assimp could not export: " + exporter.GetErrorString());
-    if (blob->next != nullptr) throw IoError(out.string() + ": the exporter produced several files; expected one");
+    const aiExportDataBlob* blob =
+        exporter.ExportToBlob(scene.get(), assimp_format_id(result.format));
+    if (blob == nullptr)
+      throw IoError(out.string() + ": assimp could not export: " + exporter.GetErrorString());
+    if (blob->next != nullptr)
+      throw IoError(out.string() + ": the exporter produced several files; expected one");
     data = blob->data;
     size = blob->size;
   }

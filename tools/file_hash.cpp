@@ -62,8 +62,8 @@ std::string model_identity(const std::string& model) {
   for (const auto& file : skinning::list_frame_files(model)) {
     const std::string name = file.filename().string() + '\0';
     state = fnv1a64(
-        std::span<const unsigned char>(reinterpret_cast<const unsigned char*>(name.data()),
-                                       name.size()),
+        std::span<const unsigned char>(
+            reinterpret_cast<const unsigned char*>(name.data()), name.size()),
         state);
     state = hash_file_into(file, state);
   }

@@ -111,8 +111,9 @@ std::vector<std::array<float, 4>> highlight_face_colors(
   const std::string where = log_path.string() + ": ";
   // A plain check log names its one clip; a scene log (several objects) is matched by the mesh.
   if (log.header.checks.empty() && !log.header.clip.empty() && log.header.clip != clip) {
-    throw InvalidInput(where + "checked clip '" + log.header.clip + "', not '" +
-                       std::string(clip) + "': export with --clip " + log.header.clip);
+    throw InvalidInput(
+        where + "checked clip '" + log.header.clip + "', not '" + std::string(clip) +
+        "': export with --clip " + log.header.clip);
   }
   // The log must have checked this very pose: a row for the sample, at the same time.
   const auto row = std::find_if(log.frames.begin(), log.frames.end(),

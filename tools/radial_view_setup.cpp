@@ -51,7 +51,8 @@ RadialViewSetup setup_radial_view(
       std::cerr << "skelcd: note: " << args.segmentation
                 << " is not used: --query dcd needs no segmentation\n";
     }
-    if (method != "auto") options.method_extension = clustering::RadialViewExtension::dcd_only(parameters);
+    if (method != "auto")
+      options.method_extension = clustering::RadialViewExtension::dcd_only(parameters);
     if (method == "dynamic") {
       setup.gamma = args.gamma;
       setup.seed = static_cast<std::int64_t>(args.seed);
@@ -104,7 +105,9 @@ RadialViewSetup setup_radial_view(
     poses->select_samples(s0, s1);
   };
   // A parallel run (RunOptions::threads) gives every extra worker its own bone poses.
-  options.make_worker_hooks = [seg, rig_motion, num_bones = model.rig->skeleton.num_bones(),
+  options.make_worker_hooks = [seg,
+                               rig_motion,
+                               num_bones = model.rig->skeleton.num_bones(),
                                parameters] {
     auto own = std::make_shared<clustering::BonePoses>(clustering::pose_at_sample(*rig_motion));
     return WorkerHooks{

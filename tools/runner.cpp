@@ -1,5 +1,10 @@
 #include "tools/runner.hpp"
 
+#include <tbb/global_control.h>
+#include <tbb/info.h>
+#include <tbb/parallel_pipeline.h>
+#include <tbb/task_arena.h>
+
 #include <algorithm>
 #include <charconv>
 #include <chrono>
@@ -8,11 +13,6 @@
 #include <limits>
 #include <mutex>
 #include <utility>
-
-#include <tbb/global_control.h>
-#include <tbb/info.h>
-#include <tbb/parallel_pipeline.h>
-#include <tbb/task_arena.h>
 
 #include "culling/routed_method.hpp"
 #include "skinning/errors.hpp"
@@ -349,8 +349,8 @@ void ClipRunner::run_serial(const FrameCallback& on_frame) {
   // split over an arena of that many (the parallel loops run in the caller's arena).
   const std::int32_t threads = method_options_.elementary.threads;
   if (threads > 1) {
-    const tbb::global_control allowed(tbb::global_control::max_allowed_parallelism,
-                                      static_cast<std::size_t>(threads));
+    const tbb::global_control allowed(
+        tbb::global_control::max_allowed_parallelism, static_cast<std::size_t>(threads));
     tbb::task_arena arena(threads);
     arena.execute([&] { run_queries_in_order(on_frame); });
   } else {
@@ -512,18 +512,20 @@ void ClipRunner::run_parallel(const FrameCallback& on_frame) {
 }
 
 std::vector<LogRoute> method_routes(
-    const skinning::Topology& topology,
-    const RunOptions& options,
-    std::int32_t part_offset) {
+    const skinning::Topology& topology, const RunOptions& options, std::int32_t part_offset) {
   std::vector<LogRoute> routes;
   if (options.method != "auto") return routes;
-  const culling::MethodOptions method_options{.accuracy = options.accuracy,
-                                              .min_separation = options.min_separation,
-                                              .extension = options.method_extension};
+  const culling::MethodOptions method_options{
+      .accuracy = options.accuracy,
+      .min_separation = options.min_separation,
+      .extension = options.method_extension};
   for (const auto& r : culling::route_components(topology, method_options)) {
-    routes.push_back(LogRoute{.component = r.component, .part = r.part + part_offset,
-                              .closed = r.closed, .triangles = r.num_triangles,
-                              .method = r.method});
+    routes.push_back(LogRoute{
+        .component = r.component,
+        .part = r.part + part_offset,
+        .closed = r.closed,
+        .triangles = r.num_triangles,
+        .method = r.method});
   }
   return routes;
 }

@@ -99,9 +99,7 @@ using FrameCallback = std::function<void(const FrameReport&)>;
 /// any other method. `part_offset` is added to each route's part id (a scene's object offset).
 /// @throws InvalidInput as culling::route_components.
 [[nodiscard]] std::vector<LogRoute> method_routes(
-    const skinning::Topology& topology,
-    const RunOptions& options,
-    std::int32_t part_offset = 0);
+    const skinning::Topology& topology, const RunOptions& options, std::int32_t part_offset = 0);
 
 class ClipRunner {
  public:

@@ -66,8 +66,9 @@ void decide_stages(ObjectPlan& o) {
     if (!self) {
       s.push_back("segmentation: pair checks only");
     } else if (!o.self_ccd && (radial || o.method == "auto")) {
-      s.push_back("segmentation: DCD only (" + o.method +
-                  " answers instants with bvh; radial view culls intervals)");
+      s.push_back(
+          "segmentation: DCD only (" + o.method +
+          " answers instants with bvh; radial view culls intervals)");
     } else if (o.method == "auto") {
       s.push_back(
           o.facts.closed_components == 0

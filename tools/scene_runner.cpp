@@ -472,8 +472,10 @@ bool is_scene_path(std::string_view model_arg) {
 }
 
 LoadedSceneObject load_scene_object(const Scene& scene, const std::string& name) {
-  const auto found = std::find_if(scene.objects.begin(), scene.objects.end(),
-                                  [&](const SceneObject& o) { return o.name == name; });
+  const auto found =
+      std::find_if(scene.objects.begin(), scene.objects.end(), [&](const SceneObject& o) {
+        return o.name == name;
+      });
   if (found == scene.objects.end()) {
     throw InvalidInput(scene.path.string() + ": no object '" + name + "'");
   }
@@ -630,8 +632,8 @@ SceneRunResult run_scene(const Scene& scene, const SceneRunOptions& options) {
     for (std::size_t k = 0; k < plan.checks.size(); ++k) {
       const CheckPlan& c = plan.checks[k];
       if (c.kind != CheckKind::self || !runners[k]) continue;
-      const auto routes = method_routes(runners[k]->topology(), run_options[k],
-                                        loaded[at(c.object_a)].part_offset);
+      const auto routes =
+          method_routes(runners[k]->topology(), run_options[k], loaded[at(c.object_a)].part_offset);
       header.routes.insert(header.routes.end(), routes.begin(), routes.end());
     }
     writer = std::make_unique<LogWriter>(options.log, header);

@@ -39,7 +39,6 @@ struct SegmentationFile {
   SegmentationRecord record;
 };
 
-
 /// Writes `segmentation` to `path`: first to a temporary file beside it, renamed over `path` only
 /// when complete (a failed or interrupted write leaves nothing half-written).
 /// @throws IoError when the file cannot be written, or `path` exists and is not a skelcd

@@ -105,9 +105,7 @@ MethodTotals summarize(const ClipRun& run) {
 }
 
 int run_table(
-    const std::vector<SceneSpec>& scenes,
-    std::int32_t first_sample,
-    std::int32_t max_intervals) {
+    const std::vector<SceneSpec>& scenes, std::int32_t first_sample, std::int32_t max_intervals) {
   const std::vector<std::string> methods = {"bvh", "kdop", "rvbc", "dynamic"};
   int failures = 0;
   std::printf(
@@ -142,11 +140,16 @@ int run_table(
     const std::int32_t first = first_sample < samples - 1 ? first_sample : 0;
     const std::int32_t last =
         max_intervals > 0 ? std::min(samples - 1, first + max_intervals) : samples - 1;
-    std::fprintf(stderr,
-                 "[%s] %lld triangles, samples %d..%d (%d intervals), segmentation %.2f s (rig "
-                 "weights)\n",
-                 spec.name.c_str(), static_cast<long long>(rig->mesh.num_triangles()), first, last,
-                 last - first, seg_s);
+    std::fprintf(
+        stderr,
+        "[%s] %lld triangles, samples %d..%d (%d intervals), segmentation %.2f s (rig "
+        "weights)\n",
+        spec.name.c_str(),
+        static_cast<long long>(rig->mesh.num_triangles()),
+        first,
+        last,
+        last - first,
+        seg_s);
     std::map<std::string, MethodTotals> totals;
     ClipRun reference;
     for (const auto& name : methods) {

@@ -7,9 +7,9 @@
 
 #include "culling/elementary.hpp"
 #include "culling/method.hpp"
-#include "tests/culling/method_agreement.hpp"
 #include "skinning/load.hpp"
 #include "skinning/topology.hpp"
+#include "tests/culling/method_agreement.hpp"
 #include "tests/support/test_support.hpp"
 
 namespace skelcd::culling {

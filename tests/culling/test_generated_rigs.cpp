@@ -11,10 +11,10 @@
 #include <string>
 
 #include "culling/method.hpp"
-#include "tests/culling/method_agreement.hpp"
 #include "skinning/generators.hpp"
 #include "skinning/rig_motion.hpp"
 #include "skinning/topology.hpp"
+#include "tests/culling/method_agreement.hpp"
 
 namespace skelcd::culling {
 namespace {
@@ -36,7 +36,8 @@ TEST_P(GeneratedRigs, BruteBvhAndKdopAgreeAroundTheKnownFirstContact) {
   // Welded positions of samples first_hit - 2 … first_hit + 1 (the clip keys are the frames).
   std::vector<skinning::Positions> x;
   skinning::Positions file_positions, welded;
-  const skinning::RigMotion motion(std::make_shared<const skinning::Rig>(generated.rig), {.clip = 0});
+  const skinning::RigMotion motion(
+      std::make_shared<const skinning::Rig>(generated.rig), {.clip = 0});
   const int first = first_hit - 2, last = std::min(first_hit + 1, motion.num_samples() - 1);
   for (int f = first; f <= last; ++f) {
     motion.positions(f, file_positions);
@@ -51,8 +52,8 @@ TEST_P(GeneratedRigs, BruteBvhAndKdopAgreeAroundTheKnownFirstContact) {
     auto kdop = make_method("kdop", mesh, topo, options);
     for (std::size_t i = 0; i + 1 < x.size(); ++i) {
       const int f0 = first + static_cast<int>(i);
-      const std::string what = GetParam() + " " + std::string(ccd::to_string(acc)) +
-                               " interval " + std::to_string(f0) + "-" + std::to_string(f0 + 1);
+      const std::string what = GetParam() + " " + std::string(ccd::to_string(acc)) + " interval " +
+                               std::to_string(f0) + "-" + std::to_string(f0 + 1);
       FrameResult rb, rv, rk;
       brute->detect_ccd(x[i], x[i + 1], rb);
       bvh->detect_ccd(x[i], x[i + 1], rv);
@@ -73,7 +74,8 @@ TEST_P(GeneratedRigs, BruteBvhAndKdopAgreeAroundTheKnownFirstContact) {
       if (f0 + 1 <= answer.last_free_frame) {
         EXPECT_TRUE(db.dcd_pairs.empty()) << what << ": frame " << f0 + 1 << " is known free";
       } else {
-        EXPECT_FALSE(db.dcd_pairs.empty()) << what << ": frame " << f0 + 1 << " is known to intersect";
+        EXPECT_FALSE(db.dcd_pairs.empty())
+            << what << ": frame " << f0 + 1 << " is known to intersect";
       }
     }
     if (acc == ccd::Accuracy::exact) break;

@@ -130,8 +130,8 @@ TEST(CmdBench, EveryMethodOnABundledCharacterMissesNothingButDualCone) {
   // guarantee; it happens to miss nothing on these samples) may have false negatives, and
   // dual-cone does miss here.
   const auto model = skelcd::test::asset("characters/CesiumMan.glb").string();
-  const auto r = run_skelcd({"bench", model, "--frames", "0:3", "--accuracies",
-                             "conservative,fast", "--json"});
+  const auto r = run_skelcd(
+      {"bench", model, "--frames", "0:3", "--accuracies", "conservative,fast", "--json"});
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const auto j = nlohmann::json::parse(r.out);
   EXPECT_EQ(j["reference"]["method"], "brute");
@@ -148,8 +148,18 @@ TEST(CmdBench, EveryMethodOnABundledCharacterMissesNothingButDualCone) {
       EXPECT_EQ(row["false_negatives"], 0) << method << " " << accuracy;
     }
   }
-  EXPECT_EQ(methods, (std::set<std::string>{"brute", "bvh", "kdop", "normal-cone", "dual-cone",
-                                            "enhanced-dual-cone", "auto", "rvbc", "dynamic"}));
+  EXPECT_EQ(
+      methods,
+      (std::set<std::string>{
+          "brute",
+          "bvh",
+          "kdop",
+          "normal-cone",
+          "dual-cone",
+          "enhanced-dual-cone",
+          "auto",
+          "rvbc",
+          "dynamic"}));
   EXPECT_GT(dual_cone_misses, 0);
 }
 
@@ -251,8 +261,14 @@ TEST(CmdBench, SceneRunsEachSelfCheckedObjectWithItsQueries) {
            "v = [0, -0.45, 0], cells = [12, 20] }\nattach_to = \"body\"\nchecks = [\"self-ccd\"]\n"
            "[[pairs]]\nobjects = [\"body\", \"cape\"]\nchecks = [\"dcd\"]\n";
   }
-  const auto sheet = run_skelcd({"bench", with_sheet.string(), "--methods", "bvh,enhanced-dual-cone",
-                                 "--accuracies", "conservative", "--json"});
+  const auto sheet = run_skelcd(
+      {"bench",
+       with_sheet.string(),
+       "--methods",
+       "bvh,enhanced-dual-cone",
+       "--accuracies",
+       "conservative",
+       "--json"});
   ASSERT_EQ(sheet.exit_code, 0) << sheet.err;
   const auto js = nlohmann::json::parse(sheet.out);
   ASSERT_EQ(js["objects"].size(), 1u);
@@ -265,17 +281,20 @@ TEST(CmdBench, SceneRunsEachSelfCheckedObjectWithItsQueries) {
   const auto jc = nlohmann::json::parse(check.out);
   std::int64_t cape_contacts = -1;
   for (const auto& c : jc["checks"]) {
-    if (c["name"] == "self cape") cape_contacts = c["ccd_vf"].get<std::int64_t>() + c["ccd_ee"].get<std::int64_t>();
+    if (c["name"] == "self cape")
+      cape_contacts = c["ccd_vf"].get<std::int64_t>() + c["ccd_ee"].get<std::int64_t>();
   }
   ASSERT_GT(cape_contacts, 0) << "the cape must fold onto itself for this to mean anything";
   EXPECT_EQ(js["objects"][0]["reference"]["findings"], cape_contacts);
-  for (const auto& row : js["objects"][0]["rows"]) EXPECT_EQ(row["false_negatives"], 0) << row.dump();
+  for (const auto& row : js["objects"][0]["rows"])
+    EXPECT_EQ(row["false_negatives"], 0) << row.dump();
 
   // A scene with no self check at all: nothing bench can run, one line, nothing written.
   const auto pairs_only = dir / "pairs.toml";
   {
     std::ofstream out(pairs_only);
-    out << "[objects.a]\nmodel = \"gen:rope?triangles=200\"\n[objects.b]\nmodel = \"gen:rope?triangles=200\"\n"
+    out << "[objects.a]\nmodel = \"gen:rope?triangles=200\"\n[objects.b]\nmodel = "
+           "\"gen:rope?triangles=200\"\n"
            "offset = [5, 0, 0]\n[[pairs]]\nobjects = [\"a\", \"b\"]\nchecks = [\"dcd\"]\n";
   }
   const auto bad = run_skelcd({"bench", pairs_only.string(), "--csv", (dir / "x.csv").string()});

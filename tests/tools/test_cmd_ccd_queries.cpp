@@ -156,12 +156,17 @@ TEST(CcdQueries, MalformedLinesAreOneLineErrorsNamingTheLine) {
       {"xx 0 0 0", ":3: expected 'vf' or 'ee'"},
       {"vf 1 2 3", ":3: expected 24 coordinates"},
       {std::string(kHit) + " 2", ":3: expected result must be 0 or 1"},
-      {"vf 0.25 0.25 1 0 0 0 1 0 0 0 1 0 0.25 0.25 -1 0 0 0 1 0 0 0 1 zero", ":3: coordinate 24 'zero'"},
-      {"ee 1/0 0 0 0 0 0 0 0 0 0 0 0 0 0 0 0 0 0 0 0 0 0 0 0", ":3: coordinate 1 '1/0': zero denominator"},
+      {"vf 0.25 0.25 1 0 0 0 1 0 0 0 1 0 0.25 0.25 -1 0 0 0 1 0 0 0 1 zero",
+       ":3: coordinate 24 'zero'"},
+      {"ee 1/0 0 0 0 0 0 0 0 0 0 0 0 0 0 0 0 0 0 0 0 0 0 0 0",
+       ":3: coordinate 1 '1/0': zero denominator"},
       // Nonzero but below the smallest subnormal, as a decimal and as a big rational.
-      {"ee 1e-400 0 0 0 0 0 0 0 0 0 0 0 0 0 0 0 0 0 0 0 0 0 0 0", ":3: coordinate 1 '1e-400': beyond the range of a double"},
-      {"ee 1/1" + std::string(400, '0') + " 0 0 0 0 0 0 0 0 0 0 0 0 0 0 0 0 0 0 0 0 0 0 0", ":3: coordinate 1 '1/100"},  // the quote is cut at 40 characters
-      {"ee 1/1" + std::string(400, '0') + " 0 0 0 0 0 0 0 0 0 0 0 0 0 0 0 0 0 0 0 0 0 0 0", "beyond the range of a double (nonzero, below the smallest subnormal)"},
+      {"ee 1e-400 0 0 0 0 0 0 0 0 0 0 0 0 0 0 0 0 0 0 0 0 0 0 0",
+       ":3: coordinate 1 '1e-400': beyond the range of a double"},
+      {"ee 1/1" + std::string(400, '0') + " 0 0 0 0 0 0 0 0 0 0 0 0 0 0 0 0 0 0 0 0 0 0 0",
+       ":3: coordinate 1 '1/100"},  // the quote is cut at 40 characters
+      {"ee 1/1" + std::string(400, '0') + " 0 0 0 0 0 0 0 0 0 0 0 0 0 0 0 0 0 0 0 0 0 0 0",
+       "beyond the range of a double (nonzero, below the smallest subnormal)"},
   };
   for (const auto& [bad_line, message] : cases) {
     const auto path = write_file("bad.txt", std::string("# header\n") + kHit + "\n" + bad_line + "\n" + kMiss + "\n");

@@ -396,8 +396,16 @@ TEST(CmdCheck, BatchOfGoodInputsSucceedsAndAllClipsChecksEachClip) {
 TEST(CmdCheck, BareGeneratorSpecsRobotOptionsAndThreads) {
   // gen:panda without a '?' is a model, not a missing file.
   const auto panda_log = skelcd::test::temp_dir("check-gen") / "panda.h5";
-  const auto panda = run_skelcd({"check", "gen:panda", "--frames", "0:3", "--query", "dcd",
-                                 "--json", "-o", panda_log.string()});
+  const auto panda = run_skelcd(
+      {"check",
+       "gen:panda",
+       "--frames",
+       "0:3",
+       "--query",
+       "dcd",
+       "--json",
+       "-o",
+       panda_log.string()});
   ASSERT_EQ(panda.exit_code, 0) << panda.err;
   EXPECT_EQ(nlohmann::json::parse(panda.out)["frames"], 4);
   // A generated rig is identified by its canonical spec (generators are deterministic).

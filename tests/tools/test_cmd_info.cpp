@@ -1,14 +1,14 @@
 // skelcd info, as a user runs it: JSON and human output on real models, and bad input.
 
+#include <gtest/gtest.h>
+
 #include <cstdint>
 #include <filesystem>
 #include <fstream>
+#include <nlohmann/json.hpp>
 #include <string>
 #include <utility>
 #include <vector>
-
-#include <gtest/gtest.h>
-#include <nlohmann/json.hpp>
 
 #include "tests/support/test_support.hpp"
 #include "tests/tools/cli_runner.hpp"
@@ -61,15 +61,27 @@ TEST(CmdInfo, UrdfRobotReportsItsCollisionGeometryAndTrajectory) {
   // no geometry named as a problem.
   const auto root = asset("robots/example-robot-data/robots/panda_description");
   const auto csv = asset("trajectories/panda_reach.csv");
-  const auto r = run_skelcd({"info", (root / "urdf/panda.urdf").string(), "--trajectory",
-                             csv.string(), "--srdf", (root / "srdf/panda.srdf").string(), "--json"});
+  const auto r = run_skelcd(
+      {"info",
+       (root / "urdf/panda.urdf").string(),
+       "--trajectory",
+       csv.string(),
+       "--srdf",
+       (root / "srdf/panda.srdf").string(),
+       "--json"});
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const auto j = nlohmann::json::parse(r.out);
   EXPECT_EQ(j["kind"], "robot");
   const std::vector<std::pair<std::string, std::string>> links = {
-      {"panda_link0", "link0.stl"}, {"panda_link1", "link1.stl"}, {"panda_link2", "link2.stl"},
-      {"panda_link3", "link3.stl"}, {"panda_link4", "link4.stl"}, {"panda_link5", "link5.stl"},
-      {"panda_link6", "link6.stl"}, {"panda_link7", "link7.stl"}, {"panda_hand", "hand.stl"}};
+      {"panda_link0", "link0.stl"},
+      {"panda_link1", "link1.stl"},
+      {"panda_link2", "link2.stl"},
+      {"panda_link3", "link3.stl"},
+      {"panda_link4", "link4.stl"},
+      {"panda_link5", "link5.stl"},
+      {"panda_link6", "link6.stl"},
+      {"panda_link7", "link7.stl"},
+      {"panda_hand", "hand.stl"}};
   ASSERT_EQ(j["parts"].size(), links.size() + 2);
   std::int64_t total = 0;
   for (std::size_t i = 0; i < links.size(); ++i) {

@@ -94,16 +94,24 @@ TEST(Highlight, FaceColoursFromALogFile) {
   EXPECT_EQ(colours[0], kHighlightColour);
   EXPECT_EQ(colours[1], kPlainColour);
   EXPECT_EQ(colours[2], kHighlightColour);
-  EXPECT_THROW_MESSAGE((void)highlight_face_colors(path.parent_path() / "none.h5", mesh, 3, 0.125, "walk"),
-                       IoError, "none.h5");
+  EXPECT_THROW_MESSAGE(
+      (void)highlight_face_colors(path.parent_path() / "none.h5", mesh, 3, 0.125, "walk"),
+      IoError,
+      "none.h5");
   // A frame the log does not cover, and the right frame at another rate's time.
-  EXPECT_THROW_MESSAGE((void)highlight_face_colors(path, mesh, 4, 0.125, "walk"), InvalidInput,
-                       "no row for frame 4");
-  EXPECT_THROW_MESSAGE((void)highlight_face_colors(path, mesh, 3, 0.1, "walk"), InvalidInput,
-                       "pose it at the log's rate");
+  EXPECT_THROW_MESSAGE(
+      (void)highlight_face_colors(path, mesh, 4, 0.125, "walk"),
+      InvalidInput,
+      "no row for frame 4");
+  EXPECT_THROW_MESSAGE(
+      (void)highlight_face_colors(path, mesh, 3, 0.1, "walk"),
+      InvalidInput,
+      "pose it at the log's rate");
   // The right frame and time of another clip (same rate, same mesh): refused, not mis-coloured.
-  EXPECT_THROW_MESSAGE((void)highlight_face_colors(path, mesh, 3, 0.125, "run"), InvalidInput,
-                       "checked clip 'walk', not 'run'");
+  EXPECT_THROW_MESSAGE(
+      (void)highlight_face_colors(path, mesh, 3, 0.125, "run"),
+      InvalidInput,
+      "checked clip 'walk', not 'run'");
 }
 
 TEST(Highlight, ExportColoursTheCollidingTrianglesOfAFrame) {
@@ -141,11 +149,12 @@ TEST(Highlight, ExportColoursTheCollidingTrianglesOfAFrame) {
   ASSERT_NE(end, std::string::npos);
   const std::string header = text.substr(0, end);
   EXPECT_NE(header.find("format binary_little_endian 1.0"), std::string::npos) << header;
-  EXPECT_NE(header.find("element vertex 9\nproperty float x\nproperty float y\nproperty float z\n"
-                        "property uchar red\nproperty uchar green\nproperty uchar blue\n"
-                        "property uchar alpha\nelement face 3\n"
-                        "property list uchar int vertex_index\n"),
-            std::string::npos)
+  EXPECT_NE(
+      header.find("element vertex 9\nproperty float x\nproperty float y\nproperty float z\n"
+                  "property uchar red\nproperty uchar green\nproperty uchar blue\n"
+                  "property uchar alpha\nelement face 3\n"
+                  "property list uchar int vertex_index\n"),
+      std::string::npos)
       << header;
   ASSERT_EQ(text.size(), end + 11 + 9 * 16 + 3 * 13) << "the body is not what the header declares";
   const char* vertices = text.data() + end + 11;

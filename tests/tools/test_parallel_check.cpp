@@ -4,14 +4,13 @@
 // only the /frames columns that hold microseconds and the root attributes command_line and
 // start_time. On a real character (bvh, dynamic, auto) and a generated rig (bvh, dynamic).
 
+#include <gtest/gtest.h>
 #include <hdf5.h>
 
 #include <cstring>
 #include <map>
 #include <string>
 #include <vector>
-
-#include <gtest/gtest.h>
 
 #include "culling/elementary.hpp"
 #include "tests/support/test_support.hpp"
@@ -229,8 +228,9 @@ TEST(ParallelCheck, OneIntervalSplitsItsElementaryTestsAndStaysEqual) {
       vf += row.counters.vf_contacts;
       ee += row.counters.ee_contacts;
       if (row.kind == skelcd::tools::QueryKind::ccd) {
-        ASSERT_GE(static_cast<std::size_t>(row.counters.vf_tests + row.counters.ee_tests),
-                  skelcd::culling::kParallelElementaryThreshold);  // the split path ran
+        ASSERT_GE(
+            static_cast<std::size_t>(row.counters.vf_tests + row.counters.ee_tests),
+            skelcd::culling::kParallelElementaryThreshold);  // the split path ran
       }
     }
     EXPECT_EQ(vf, 27);

@@ -118,15 +118,27 @@ TEST(RadialViewCheck, DcdOnlyBuildsNoSegmentationAndFindsBvhsPairs) {
   const auto dir = skelcd::test::temp_dir("rv-dcd");
   const auto not_seg = (dir / "not-a-seg.h5").string();
   std::ofstream(not_seg) << "not hdf5";
-  const auto bvh = run_skelcd({"check", kCesium, "--frames", "0:8", "--query", "dcd", "--method",
-                               "bvh", "--json"});
+  const auto bvh = run_skelcd(
+      {"check", kCesium, "--frames", "0:8", "--query", "dcd", "--method", "bvh", "--json"});
   ASSERT_EQ(bvh.exit_code, 0) << bvh.err;
   const auto bvh_pairs = nlohmann::json::parse(bvh.out)["dcd_pairs"];
   ASSERT_GT(bvh_pairs.get<std::int64_t>(), 0);  // CesiumMan's walk does interpenetrate
   for (const char* method : {"rvbc", "dynamic", "auto"}) {
     const auto log = (dir / (std::string(method) + ".h5")).string();
-    const auto r = run_skelcd({"check", kCesium, "--frames", "0:8", "--query", "dcd", "--method",
-                               method, "--segmentation", not_seg, "--json", "-o", log});
+    const auto r = run_skelcd(
+        {"check",
+         kCesium,
+         "--frames",
+         "0:8",
+         "--query",
+         "dcd",
+         "--method",
+         method,
+         "--segmentation",
+         not_seg,
+         "--json",
+         "-o",
+         log});
     ASSERT_EQ(r.exit_code, 0) << method << ": " << r.err;
     EXPECT_NE(r.err.find("is not used: --query dcd needs no segmentation"), std::string::npos)
         << r.err;

@@ -1,6 +1,8 @@
 // check --method auto records in the log where each connected component went (/routes): closed
 // components to the closed method, open ones to the cone method, as the mesh's own edges say.
 
+#include <gtest/gtest.h>
+
 #include <fstream>
 #include <map>
 #include <set>
@@ -8,8 +10,6 @@
 #include <tuple>
 #include <utility>
 #include <vector>
-
-#include <gtest/gtest.h>
 
 #include "skinning/load.hpp"
 #include "skinning/topology.hpp"
@@ -113,9 +113,10 @@ TEST(RoutesLog, SceneLogsHoldTheRoutesOfEveryAutoObject) {
   const auto header = read_log(log).header;
 
   const auto single = dir / "bot.h5";
-  ASSERT_EQ(run_skelcd({"check", bot, "--method", "auto", "--frames", "0:1", "-o", single.string()})
-                .exit_code,
-            0);
+  ASSERT_EQ(
+      run_skelcd({"check", bot, "--method", "auto", "--frames", "0:1", "-o", single.string()})
+          .exit_code,
+      0);
   const auto bot_routes = read_log(single).header.routes;
   ASSERT_FALSE(bot_routes.empty());
 
@@ -136,8 +137,9 @@ TEST(RoutesLog, SceneLogsHoldTheRoutesOfEveryAutoObject) {
     EXPECT_EQ(scene_bot[i].component, bot_routes[i].component);
     EXPECT_EQ(scene_bot[i].method, bot_routes[i].method) << i;
     EXPECT_EQ(scene_bot[i].triangles, bot_routes[i].triangles);
-    EXPECT_EQ(header.part_names[static_cast<std::size_t>(scene_bot[i].part)],
-              "bot/" + read_log(single).header.part_names[static_cast<std::size_t>(bot_routes[i].part)]);
+    EXPECT_EQ(
+        header.part_names[static_cast<std::size_t>(scene_bot[i].part)],
+        "bot/" + read_log(single).header.part_names[static_cast<std::size_t>(bot_routes[i].part)]);
   }
   ASSERT_EQ(scene_sheet.size(), 1u);  // the cloth is one open sheet
   EXPECT_FALSE(scene_sheet[0].closed);

@@ -211,11 +211,12 @@ TEST(ScenePlan, BuildsOnlyWhatTheChecksNeed) {
   // dynamic with self-dcd only: its DCD is bvh's, so nothing of the radial view is built.
   EXPECT_FALSE(o[3].segmentation);
   EXPECT_FALSE(o[3].swept_bounds);
-  EXPECT_NE(std::find_if(o[3].skipped.begin(), o[3].skipped.end(),
-                         [](const std::string& why) {
-                           return why.rfind("segmentation: DCD only", 0) == 0;
-                         }),
-            o[3].skipped.end());
+  EXPECT_NE(
+      std::find_if(
+          o[3].skipped.begin(),
+          o[3].skipped.end(),
+          [](const std::string& why) { return why.rfind("segmentation: DCD only", 0) == 0; }),
+      o[3].skipped.end());
   // Unchecked: not even loaded.
   EXPECT_FALSE(o[4].load || o[4].skin || o[4].topology || o[4].bvh);
   // Only in a DCD pair: posed, hierarchy, no swept bounds.
