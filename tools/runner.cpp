@@ -6,6 +6,7 @@
 #include <tbb/task_arena.h>
 
 #include <algorithm>
+#include <atomic>
 #include <charconv>
 #include <chrono>
 #include <cmath>
@@ -480,13 +481,18 @@ void ClipRunner::run_parallel(const FrameCallback& on_frame) {
   const tbb::global_control allowed(tbb::global_control::max_allowed_parallelism,
                                     static_cast<std::size_t>(plan_.threads));
   tbb::task_arena arena(plan_.threads);
+  // The first failure in row order (a block's error, or on_frame's), rethrown once the pipeline
+  // has drained: an exception thrown through parallel_pipeline would leave the blocks in flight
+  // undestroyed (LeakSanitizer sees them). After it, no block is started or reported.
+  std::exception_ptr failure;
+  std::atomic<bool> failed{false};
   arena.execute([&] {
     tbb::parallel_pipeline(
         live_blocks,
         tbb::make_filter<void, std::shared_ptr<Block>>(
             tbb::filter_mode::serial_in_order,
             [&](tbb::flow_control& control) -> std::shared_ptr<Block> {
-              if (next >= end) {
+              if (next >= end || failed.load()) {
                 control.stop();
                 return nullptr;
               }
@@ -500,15 +506,23 @@ void ClipRunner::run_parallel(const FrameCallback& on_frame) {
             tbb::make_filter<std::shared_ptr<Block>, std::shared_ptr<Block>>(
                 tbb::filter_mode::parallel,
                 [&](std::shared_ptr<Block> block) {
-                  check_block(*block);
+                  // A block after a failure is never reported: no need to check it.
+                  if (!failed.load()) check_block(*block);
                   return block;
                 }) &
             tbb::make_filter<std::shared_ptr<Block>, void>(
                 tbb::filter_mode::serial_in_order, [&](const std::shared_ptr<Block>& block) {
-                  for (const auto& report : block->reports) on_frame(report);
-                  if (block->error) std::rethrow_exception(block->error);
+                  if (failure) return;  // rows after the first failure: a serial run has none
+                  try {
+                    for (const auto& report : block->reports) on_frame(report);
+                  } catch (...) {
+                    failure = std::current_exception();
+                  }
+                  if (!failure && block->error) failure = block->error;
+                  if (failure) failed.store(true);
                 }));
   });
+  if (failure) std::rethrow_exception(failure);
 }
 
 std::vector<LogRoute> method_routes(

@@ -181,8 +181,10 @@ TEST(CmdCheck, KilledRunLeavesALogWithEveryCompletedFrame) {
   if (pid == 0) {
     std::freopen("/dev/null", "w", stdout);
     std::freopen((dir / "stderr.txt").c_str(), "w", stderr);
-    ::execl(SKELCD_EXE, SKELCD_EXE, "check", kModel.c_str(), "--fps", "300", "-o",
-            log_path.c_str(), static_cast<char*>(nullptr));
+    // One thread: rows reach the log one by one (with several, a block of up to 64 samples at a
+    // time, which a Debug + ASan build may not finish within the wait below).
+    ::execl(SKELCD_EXE, SKELCD_EXE, "check", kModel.c_str(), "--fps", "300", "--threads", "1",
+            "-o", log_path.c_str(), static_cast<char*>(nullptr));
     ::_exit(127);
   }
   // Poll the log (the writer takes no file lock) until a few rows are on disk, then kill.
