@@ -1,13 +1,18 @@
 #include "skinning/assimp_import.hpp"
 
+#include <unistd.h>
+
 #include <algorithm>
 #include <array>
 #include <cctype>
 #include <cmath>
 #include <cstdint>
+#include <cstdio>
+#include <iostream>
 #include <limits>
 #include <map>
 #include <mutex>
+#include <new>
 #include <string>
 #include <unordered_map>
 #include <unordered_set>
@@ -20,7 +25,10 @@
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
 
+#include "skinning/detail/collada_bind_shape.hpp"
+#include "skinning/detail/import_guard.hpp"
 #include "skinning/errors.hpp"
+#include "skinning/frame_sequence.hpp"
 
 namespace skelcd::skinning {
 namespace {
@@ -34,6 +42,11 @@ constexpr double kWeightSumReportTolerance = 1e-4;
 constexpr double kBindFrameEvidence = 1e-3;
 // Assimp warnings repeated in the problem list, at most (the rest are counted).
 constexpr std::size_t kMaxForwardedWarnings = 8;
+// How far the last row of a node or offset matrix may be from (0, 0, 0, 1) and still count as
+// affine: 64 units of float rounding (2^-24 each, ~3.8e-6). assimp's loaders build matrices in
+// float through a few products or an inverse, each adding a few ulps; a projective matrix
+// (a camera's, a shear into w) is off by orders of magnitude more.
+constexpr double kAffineRowTolerance = 64.0 * 0x1p-24;
 // Ticks per second assimp's loaders assume when a file does not say (aiAnimation docs).
 constexpr double kDefaultTicksPerSecond = 25.0;
 
@@ -78,6 +91,70 @@ class ScopedLogCapture {
   CollectingStream stream_;
 };
 
+// Some of assimp's parsers print straight to stdout or stderr (OpenGEX's DDL parser: "nullptr
+// returned by creating DDLNode."), which would land before our one-line error, or inside a mesh
+// written to standard output. While it reads, both descriptors point at a temporary file; what
+// was printed becomes problem lines. The import mutex is held, so no other import interleaves.
+class ScopedStdCapture {
+ public:
+  ScopedStdCapture() {
+    std::cout.flush();
+    std::cerr.flush();
+    std::fflush(nullptr);
+    file_ = std::tmpfile();
+    if (file_ == nullptr) return;
+    saved_out_ = ::dup(STDOUT_FILENO);
+    saved_err_ = ::dup(STDERR_FILENO);
+    if (saved_out_ < 0 || saved_err_ < 0 || ::dup2(::fileno(file_), STDOUT_FILENO) < 0 ||
+        ::dup2(::fileno(file_), STDERR_FILENO) < 0) {
+      restore();
+    }
+  }
+  ~ScopedStdCapture() { restore(); }
+  ScopedStdCapture(const ScopedStdCapture&) = delete;
+  ScopedStdCapture& operator=(const ScopedStdCapture&) = delete;
+
+  /// Restores stdout and stderr and returns the non-empty lines printed meanwhile (at most 64 KiB).
+  std::vector<std::string> finish() {
+    restore();
+    std::vector<std::string> lines;
+    if (file_ == nullptr) return lines;
+    std::rewind(file_);
+    std::string text(64 * 1024, '\0');
+    text.resize(std::fread(text.data(), 1, text.size(), file_));
+    std::fclose(file_);
+    file_ = nullptr;
+    std::size_t start = 0;
+    while (start < text.size()) {
+      auto end = text.find_first_of("\r\n", start);
+      if (end == std::string::npos) end = text.size();
+      if (end > start) lines.push_back(text.substr(start, end - start));
+      start = end + 1;
+    }
+    return lines;
+  }
+
+ private:
+  void restore() {
+    std::cout.flush();
+    std::cerr.flush();
+    std::fflush(nullptr);
+    if (saved_out_ >= 0) {
+      ::dup2(saved_out_, STDOUT_FILENO);
+      ::close(saved_out_);
+      saved_out_ = -1;
+    }
+    if (saved_err_ >= 0) {
+      ::dup2(saved_err_, STDERR_FILENO);
+      ::close(saved_err_);
+      saved_err_ = -1;
+    }
+  }
+  std::FILE* file_ = nullptr;
+  int saved_out_ = -1;
+  int saved_err_ = -1;
+};
+
 std::string lower(std::string s) {
   std::transform(s.begin(), s.end(), s.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
   return s;
@@ -90,6 +167,8 @@ struct Context {
   std::vector<std::string> problems;
   std::map<std::string, std::size_t> shared_names;  // node name → number of nodes with it
   std::vector<std::string> clips_with_mesh_channels;
+  /// Collada bind shape matrices by geometry id and name (detail/collada_bind_shape.hpp).
+  std::map<std::string, Eigen::Affine3d> bind_shapes;
   [[noreturn]] void invalid(const std::string& fault) const { throw InvalidInput(file + ": " + fault); }
 };
 
@@ -99,9 +178,18 @@ Eigen::Affine3d to_affine(const aiMatrix4x4& m, const Context& ctx, const std::s
     for (unsigned c = 0; c < 4; ++c) e(r, c) = static_cast<double>(m[r][c]);
   }
   if (!e.allFinite()) ctx.invalid(what + " has a non-finite transform");
-  if (e(3, 0) != 0.0 || e(3, 1) != 0.0 || e(3, 2) != 0.0 || e(3, 3) != 1.0) {
-    ctx.invalid(what + " has a projective transform (last row is not 0 0 0 1)");
+  // assimp composes and inverts matrices in single precision, so an affine transform can reach
+  // us with a last row such as (0, 0, 0, 0.99999988): 1 - 2^-23, float noise. Every entry of
+  // the last row is compared with (0, 0, 0, 1) up to kAffineRowTolerance; within it the row is
+  // noise and is set to (0, 0, 0, 1), beyond it the transform is projective and refused.
+  const Eigen::RowVector4d affine_row(0.0, 0.0, 0.0, 1.0);
+  const double off = (e.row(3) - affine_row).cwiseAbs().maxCoeff();
+  if (off > kAffineRowTolerance) {
+    char row[128];
+    std::snprintf(row, sizeof row, "%.9g %.9g %.9g %.9g", e(3, 0), e(3, 1), e(3, 2), e(3, 3));
+    ctx.invalid(what + " has a projective transform (last row " + row + " is not 0 0 0 1)");
   }
+  e.row(3) = affine_row;
   Eigen::Affine3d a = Eigen::Affine3d::Identity();
   a.matrix() = e;
   return a;
@@ -130,6 +218,18 @@ double file_unit_scale(const aiScene* scene, Context& ctx) {
     return 1.0;
   }
   return factor / 100.0;  // FBX units are centimetres times UnitScaleFactor
+}
+
+// The bind shape of a mesh named after its geometry; assimp appends "_<n>" to the meshes it
+// splits one geometry into (one per material).
+std::map<std::string, Eigen::Affine3d>::const_iterator find_bind_shape(const std::map<std::string, Eigen::Affine3d>& shapes,
+                                                                     const std::string& mesh_name) {
+  if (const auto it = shapes.find(mesh_name); it != shapes.end()) return it;
+  const auto underscore = mesh_name.rfind('_');
+  if (underscore == std::string::npos || underscore + 1 == mesh_name.size()) return shapes.end();
+  const auto suffix = mesh_name.substr(underscore + 1);
+  if (!std::all_of(suffix.begin(), suffix.end(), [](unsigned char c) { return std::isdigit(c) != 0; })) return shapes.end();
+  return shapes.find(mesh_name.substr(0, underscore));
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -291,6 +391,15 @@ void add_part(
       ctx.invalid(label + ", vertex " + std::to_string(v) + " has a non-finite coordinate");
     }
   }
+  // Vertices in mesh space. A Collada skin's bind shape matrix comes first: assimp 5.2 leaves the
+  // vertices as the geometry has them and applies the matrix only inside the offsets, so the
+  // rest mesh lay in another frame than every posed one (the stormtrooper lay along -Z).
+  Eigen::Affine3d shape = Eigen::Affine3d::Identity();
+  if (am->mNumBones > 0) {
+    if (const auto it = find_bind_shape(ctx.bind_shapes, mesh_name); it != ctx.bind_shapes.end()) shape = it->second;
+  }
+  std::vector<Eigen::Vector3d> local(am->mNumVertices);
+  for (unsigned v = 0; v < am->mNumVertices; ++v) local[v] = shape * to_vector(am->mVertices[v]);
 
   const auto part = static_cast<std::int32_t>(rig.mesh.part_names.size());
   const auto base = static_cast<std::int32_t>(build.positions.size());
@@ -315,7 +424,9 @@ void add_part(
       if (bone == nullptr) ctx.invalid(label + " has a null bone " + std::to_string(b));
       const std::string bone_name = bone->mName.C_Str();
       bone_node[b] = resolve_node(h, bone_name, nullptr, ctx, "bone '" + bone_name + "'");
-      offset[b] = to_affine(bone->mOffsetMatrix, ctx, label + ", bone '" + bone_name + "' offset matrix");
+      // assimp folds the bind shape into every offset matrix (offset = inverse bind · shape); the
+      // vertices above carry the shape now, so the offsets get it back out.
+      offset[b] = to_affine(bone->mOffsetMatrix, ctx, label + ", bone '" + bone_name + "' offset matrix") * shape.inverse();
       if (bone->mNumWeights > 0 && bone->mWeights == nullptr) ctx.invalid(label + ", bone '" + bone_name + "' has no weight array");
       const bool placed = bone_node[b] >= 0;  // a bone without a node says nothing about B
       const Eigen::Affine3d at_rest = placed ? Eigen::Affine3d(h.scene_global[static_cast<std::size_t>(bone_node[b])] * offset[b]) : Eigen::Affine3d::Identity();
@@ -331,7 +442,7 @@ void add_part(
                       std::to_string(vw.mVertexId) + " (must be finite and >= 0)");
         }
         if (w == 0 || !placed) continue;
-        skinned[vw.mVertexId] += w * (at_rest * to_vector(am->mVertices[vw.mVertexId]));
+        skinned[vw.mVertexId] += w * (at_rest * local[vw.mVertexId]);
         weight_sum[vw.mVertexId] += w;
       }
     }
@@ -341,9 +452,8 @@ void add_part(
     for (unsigned v = 0; v < am->mNumVertices; ++v) {
       if (weight_sum[v] <= 0) continue;
       const Eigen::Vector3d p = skinned[v] / weight_sum[v];
-      const Eigen::Vector3d local = to_vector(am->mVertices[v]);
-      dev_mesh = std::max(dev_mesh, (p - mesh_global * local).norm());
-      dev_scene = std::max(dev_scene, (p - local).norm());
+      dev_mesh = std::max(dev_mesh, (p - mesh_global * local[v]).norm());
+      dev_scene = std::max(dev_scene, (p - local[v]).norm());
       lo = lo.cwiseMin(p);
       hi = hi.cwiseMax(p);
     }
@@ -369,7 +479,7 @@ void add_part(
   // Vertices in object space.
   const Eigen::Affine3d place = unit * bind_frame;
   for (unsigned v = 0; v < am->mNumVertices; ++v) {
-    build.positions.push_back(place * to_vector(am->mVertices[v]));
+    build.positions.push_back(place * local[v]);
     rig.mesh.vertex_part.push_back(part);
     rig.mesh.vertex_index_in_part.push_back(static_cast<std::int32_t>(v));
   }
@@ -540,94 +650,128 @@ void finish_skin(MeshBuild& build, const Hierarchy& h, Rig& rig, Context& ctx) {
 
 // ---------------------------------------------------------------------------------------------
 
-void read_clips(const aiScene* scene, const Hierarchy& h, Rig& rig, Context& ctx) {
+// A clip whose data cannot be used (keys out of order, non-finite values, …) is refused alone:
+// the rest of the file and its other clips stay usable.
+struct ClipRefusal {
+  std::string reason;
+};
+
+[[noreturn]] void refuse_clip(const std::string& reason) { throw ClipRefusal{reason}; }
+
+// One animation as a clip (channels resolved to nodes, keys in seconds, strictly increasing).
+// @throws ClipRefusal when its data are unusable.
+Clip read_clip(const aiAnimation* anim, const std::string& name, const Hierarchy& h, const std::vector<bool>& hosts_bone, Rig& rig,
+               Context& ctx) {
+  Clip clip;
+  clip.name = name;
+  const std::string label = "clip '" + clip.name + "'";
+  double ticks = anim->mTicksPerSecond;
+  if (!std::isfinite(ticks) || ticks <= 0) {
+    ticks = kDefaultTicksPerSecond;
+    ctx.problems.push_back(label + " does not give ticks per second; assumed " + std::to_string(static_cast<int>(ticks)));
+  }
+  if (!std::isfinite(anim->mDuration) || anim->mDuration < 0) refuse_clip("its duration is " + std::to_string(anim->mDuration) + " ticks");
+  clip.duration_s = anim->mDuration / ticks;
+  if (anim->mNumChannels > 0 && anim->mChannels == nullptr) refuse_clip("it lists channels it does not have");
+  std::vector<bool> animated(rig.skeleton.nodes.size(), false);
+  for (unsigned c = 0; c < anim->mNumChannels; ++c) {
+    const aiNodeAnim* na = anim->mChannels[c];
+    if (na == nullptr) refuse_clip("channel " + std::to_string(c) + " is null");
+    const std::string node_name = na->mNodeName.C_Str();
+    const auto node = resolve_node(h, node_name, &hosts_bone, ctx, label + " channel for '" + node_name + "'");
+    if (node < 0) {
+      ctx.problems.push_back(label + ": channel for unknown node '" + node_name + "' ignored");
+      continue;
+    }
+    if (animated[static_cast<std::size_t>(node)]) {
+      ctx.problems.push_back(label + ": second channel for node '" + node_name + "' ignored");
+      continue;
+    }
+    animated[static_cast<std::size_t>(node)] = true;
+    Channel ch;
+    ch.node = node;
+    const std::string where = "node '" + node_name + "'";
+    // Keys in seconds, strictly increasing: a key at the same time as the one before it is
+    // dropped (reported); a key earlier than the one before it refuses the clip.
+    auto add_time = [&](std::vector<double>& times, double t_ticks, const char* kind, unsigned k) -> bool {
+      if (!std::isfinite(t_ticks)) refuse_clip(where + ", " + kind + " key " + std::to_string(k) + " has a non-finite time");
+      const double t = t_ticks / ticks;
+      if (!times.empty() && t <= times.back()) {
+        if (t < times.back()) {
+          refuse_clip(where + ", " + kind + " key " + std::to_string(k) + " (t = " + std::to_string(t) +
+                      " s) is earlier than the key before it (t = " + std::to_string(times.back()) + " s)");
+        }
+        ctx.problems.push_back(label + ", " + where + ": " + kind + " key " + std::to_string(k) + " repeats a time; dropped");
+        return false;
+      }
+      times.push_back(t);
+      return true;
+    };
+    if ((na->mNumPositionKeys > 0 && na->mPositionKeys == nullptr) || (na->mNumRotationKeys > 0 && na->mRotationKeys == nullptr) ||
+        (na->mNumScalingKeys > 0 && na->mScalingKeys == nullptr)) {
+      refuse_clip(where + " lists keys it does not have");
+    }
+    for (unsigned k = 0; k < na->mNumPositionKeys; ++k) {
+      const Eigen::Vector3d v = to_vector(na->mPositionKeys[k].mValue);
+      if (!v.allFinite()) refuse_clip(where + ", translation key " + std::to_string(k) + " is not finite");
+      if (add_time(ch.translation_times, na->mPositionKeys[k].mTime, "translation", k)) ch.translations.push_back(v);
+    }
+    for (unsigned k = 0; k < na->mNumRotationKeys; ++k) {
+      const aiQuaternion& q = na->mRotationKeys[k].mValue;
+      Eigen::Quaterniond e(static_cast<double>(q.w), static_cast<double>(q.x), static_cast<double>(q.y), static_cast<double>(q.z));
+      const double norm = e.norm();
+      if (!e.coeffs().allFinite() || !(norm > 0)) refuse_clip(where + ", rotation key " + std::to_string(k) + " is not a rotation");
+      e.coeffs() /= norm;
+      if (add_time(ch.rotation_times, na->mRotationKeys[k].mTime, "rotation", k)) ch.rotations.push_back(e);
+    }
+    for (unsigned k = 0; k < na->mNumScalingKeys; ++k) {
+      const Eigen::Vector3d v = to_vector(na->mScalingKeys[k].mValue);
+      if (!v.allFinite()) refuse_clip(where + ", scale key " + std::to_string(k) + " is not finite");
+      if (add_time(ch.scale_times, na->mScalingKeys[k].mTime, "scale", k)) ch.scales.push_back(v);
+    }
+    for (const auto* times : {&ch.translation_times, &ch.rotation_times, &ch.scale_times}) {
+      clip.key_times.insert(clip.key_times.end(), times->begin(), times->end());
+    }
+    clip.channels.push_back(std::move(ch));
+  }
+  std::sort(clip.key_times.begin(), clip.key_times.end());
+  clip.key_times.erase(std::unique(clip.key_times.begin(), clip.key_times.end()), clip.key_times.end());
+  return clip;
+}
+
+void read_clips(const aiScene* scene, const Hierarchy& h, Rig& rig, std::vector<RefusedClip>& refused, Context& ctx) {
   std::vector<bool> hosts_bone(rig.skeleton.nodes.size(), false);
   for (const auto& b : rig.skeleton.bones) hosts_bone[static_cast<std::size_t>(b.node)] = true;
+  if (scene->mNumAnimations > 0 && scene->mAnimations == nullptr) ctx.invalid("the scene lists animations it does not have");
   std::map<std::string, int> used_names;
   for (unsigned a = 0; a < scene->mNumAnimations; ++a) {
     const aiAnimation* anim = scene->mAnimations[a];
-    if (anim == nullptr) ctx.invalid("animation " + std::to_string(a) + " is null");
-    Clip clip;
-    clip.name = anim->mName.C_Str();
-    if (clip.name.empty()) {
-      clip.name = "clip_" + std::to_string(a);
-      ctx.problems.push_back("animation " + std::to_string(a) + " has no name; called '" + clip.name + "'");
+    std::string name = anim != nullptr ? anim->mName.C_Str() : "";
+    if (name.empty()) {
+      name = "clip_" + std::to_string(a);
+      ctx.problems.push_back("animation " + std::to_string(a) + " has no name; called '" + name + "'");
     }
-    if (used_names[clip.name]++ > 0) {
-      const auto renamed = clip.name + "#" + std::to_string(a);
-      ctx.problems.push_back("animation " + std::to_string(a) + " repeats the name '" + clip.name + "'; called '" + renamed + "'");
-      clip.name = renamed;
+    if (used_names[name]++ > 0) {
+      const auto renamed = name + "#" + std::to_string(a);
+      ctx.problems.push_back("animation " + std::to_string(a) + " repeats the name '" + name + "'; called '" + renamed + "'");
+      name = renamed;
     }
-    const std::string label = "clip '" + clip.name + "'";
-    double ticks = anim->mTicksPerSecond;
-    if (!std::isfinite(ticks) || ticks <= 0) {
-      ticks = kDefaultTicksPerSecond;
-      ctx.problems.push_back(label + " does not give ticks per second; assumed " + std::to_string(static_cast<int>(ticks)));
+    try {
+      if (anim == nullptr) refuse_clip("animation " + std::to_string(a) + " is null");
+      // Problems found in a clip that is then refused are dropped with it: its refusal says enough.
+      const auto problems_before = ctx.problems.size();
+      try {
+        Clip clip = read_clip(anim, name, h, hosts_bone, rig, ctx);
+        if (anim->mNumMorphMeshChannels > 0 || anim->mNumMeshChannels > 0) ctx.clips_with_mesh_channels.push_back(name);
+        rig.clips.push_back(std::move(clip));
+      } catch (const ClipRefusal&) {
+        ctx.problems.resize(problems_before);
+        throw;
+      }
+    } catch (const ClipRefusal& refusal) {
+      ctx.problems.push_back("clip '" + name + "' refused: " + refusal.reason + "; the other clips are usable");
+      refused.push_back({name, refusal.reason});
     }
-    if (!std::isfinite(anim->mDuration) || anim->mDuration < 0) ctx.invalid(label + " has duration " + std::to_string(anim->mDuration) + " ticks");
-    clip.duration_s = anim->mDuration / ticks;
-    if (anim->mNumMorphMeshChannels > 0 || anim->mNumMeshChannels > 0) ctx.clips_with_mesh_channels.push_back(clip.name);
-    std::vector<bool> animated(rig.skeleton.nodes.size(), false);
-    for (unsigned c = 0; c < anim->mNumChannels; ++c) {
-      const aiNodeAnim* na = anim->mChannels[c];
-      if (na == nullptr) ctx.invalid(label + ", channel " + std::to_string(c) + " is null");
-      const std::string node_name = na->mNodeName.C_Str();
-      const auto node = resolve_node(h, node_name, &hosts_bone, ctx, label + " channel for '" + node_name + "'");
-      if (node < 0) {
-        ctx.problems.push_back(label + ": channel for unknown node '" + node_name + "' ignored");
-        continue;
-      }
-      if (animated[static_cast<std::size_t>(node)]) {
-        ctx.problems.push_back(label + ": second channel for node '" + node_name + "' ignored");
-        continue;
-      }
-      animated[static_cast<std::size_t>(node)] = true;
-      Channel ch;
-      ch.node = node;
-      const std::string where = label + ", node '" + node_name + "'";
-      // Keys in seconds, strictly increasing: a key at the same time as the one before it is
-      // dropped (reported); a key earlier than the one before it is an error.
-      auto add_time = [&](std::vector<double>& times, double t_ticks, const char* kind, unsigned k) -> bool {
-        if (!std::isfinite(t_ticks)) ctx.invalid(where + ", " + kind + " key " + std::to_string(k) + " has a non-finite time");
-        const double t = t_ticks / ticks;
-        if (!times.empty() && t <= times.back()) {
-          if (t < times.back()) ctx.invalid(where + ", " + kind + " key " + std::to_string(k) + " is earlier than the key before it");
-          ctx.problems.push_back(where + ": " + kind + " key " + std::to_string(k) + " repeats a time; dropped");
-          return false;
-        }
-        times.push_back(t);
-        return true;
-      };
-      if ((na->mNumPositionKeys > 0 && na->mPositionKeys == nullptr) || (na->mNumRotationKeys > 0 && na->mRotationKeys == nullptr) ||
-          (na->mNumScalingKeys > 0 && na->mScalingKeys == nullptr)) {
-        ctx.invalid(where + " lists keys it does not have");
-      }
-      for (unsigned k = 0; k < na->mNumPositionKeys; ++k) {
-        const Eigen::Vector3d v = to_vector(na->mPositionKeys[k].mValue);
-        if (!v.allFinite()) ctx.invalid(where + ", translation key " + std::to_string(k) + " is not finite");
-        if (add_time(ch.translation_times, na->mPositionKeys[k].mTime, "translation", k)) ch.translations.push_back(v);
-      }
-      for (unsigned k = 0; k < na->mNumRotationKeys; ++k) {
-        const aiQuaternion& q = na->mRotationKeys[k].mValue;
-        Eigen::Quaterniond e(static_cast<double>(q.w), static_cast<double>(q.x), static_cast<double>(q.y), static_cast<double>(q.z));
-        const double norm = e.norm();
-        if (!e.coeffs().allFinite() || !(norm > 0)) ctx.invalid(where + ", rotation key " + std::to_string(k) + " is not a rotation");
-        e.coeffs() /= norm;
-        if (add_time(ch.rotation_times, na->mRotationKeys[k].mTime, "rotation", k)) ch.rotations.push_back(e);
-      }
-      for (unsigned k = 0; k < na->mNumScalingKeys; ++k) {
-        const Eigen::Vector3d v = to_vector(na->mScalingKeys[k].mValue);
-        if (!v.allFinite()) ctx.invalid(where + ", scale key " + std::to_string(k) + " is not finite");
-        if (add_time(ch.scale_times, na->mScalingKeys[k].mTime, "scale", k)) ch.scales.push_back(v);
-      }
-      for (const auto* times : {&ch.translation_times, &ch.rotation_times, &ch.scale_times}) {
-        clip.key_times.insert(clip.key_times.end(), times->begin(), times->end());
-      }
-      clip.channels.push_back(std::move(ch));
-    }
-    std::sort(clip.key_times.begin(), clip.key_times.end());
-    clip.key_times.erase(std::unique(clip.key_times.begin(), clip.key_times.end()), clip.key_times.end());
-    rig.clips.push_back(std::move(clip));
   }
 }
 
@@ -638,7 +782,12 @@ void check_raw_numbers(const aiScene* scene, const Context& ctx) {
     if (am == nullptr) continue;
     const std::string label = am->mName.length > 0 ? "mesh '" + std::string(am->mName.C_Str()) + "'" : "mesh " + std::to_string(m);
     for (unsigned v = 0; am->mVertices != nullptr && v < am->mNumVertices; ++v) {
-      if (!to_vector(am->mVertices[v]).allFinite()) ctx.invalid(label + ", vertex " + std::to_string(v) + " has a non-finite coordinate");
+      if (to_vector(am->mVertices[v]).allFinite()) continue;
+      // assimp numbers an OBJ's vertices by face corner, not as the file does: our own reader of
+      // OBJ and PLY names the file's vertex (and throws InvalidInput saying so).
+      const auto ext = lower(std::filesystem::path(ctx.file).extension().string());
+      if (ext == ".obj" || ext == ".ply") (void)read_frame_mesh(ctx.file);
+      ctx.invalid(label + ", vertex " + std::to_string(v) + " has a non-finite coordinate");
     }
     for (unsigned b = 0; am->mBones != nullptr && b < am->mNumBones; ++b) {
       const aiBone* bone = am->mBones[b];
@@ -651,24 +800,21 @@ void check_raw_numbers(const aiScene* scene, const Context& ctx) {
   }
 }
 
-}  // namespace
 
-ImportedRig import_rig(const std::filesystem::path& file, const ImportOptions& options) {
+// The import proper; the caller holds import_mutex().
+ImportedRig import_locked(const std::filesystem::path& file, const ImportOptions& options) {
   Context ctx;
   ctx.file = file.string();
-  std::error_code ec;
-  if (!std::filesystem::exists(file, ec)) throw IoError(ctx.file + ": no such file");
-  if (std::filesystem::is_directory(file, ec)) throw IoError(ctx.file + ": is a directory, not a model file");
-  if (std::filesystem::file_size(file, ec) == 0 && !ec) throw IoError(ctx.file + ": empty file");
-
-  std::lock_guard lock(import_mutex());
   ScopedLogCapture log;
   Assimp::Importer importer;
   // Read and validate first, check the raw data, then post-process: JoinIdenticalVertices
   // compares positions with <, so a NaN vertex would be merged into a neighbour and vanish.
+  ScopedStdCapture printed;
   const aiScene* scene = importer.ReadFile(ctx.file, aiProcess_ValidateDataStructure);
   const auto fail_read = [&]() {
     std::string reason = importer.GetErrorString();
+    // assimp catches an allocation failure itself and hands back its what() as the reason.
+    if (reason.find("bad_alloc") != std::string::npos) throw std::bad_alloc();
     if (reason.empty()) reason = "assimp could not read it";
     throw IoError(ctx.file + ": " + reason);
   };
@@ -677,6 +823,7 @@ ImportedRig import_rig(const std::filesystem::path& file, const ImportOptions& o
   unsigned flags = aiProcess_Triangulate;
   if (options.join_identical_vertices) flags |= aiProcess_JoinIdenticalVertices;
   scene = importer.ApplyPostProcessing(flags);
+  for (auto& line : printed.finish()) ctx.problems.push_back("assimp printed: " + line);
   if (scene == nullptr) fail_read();
   // assimp recovers from some broken data by dropping it with a warning; for us that is a
   // wrong answer, not a recovery.
@@ -700,6 +847,7 @@ ImportedRig import_rig(const std::filesystem::path& file, const ImportOptions& o
   rig.skeleton.root_transform = unit;
 
   Hierarchy h = read_hierarchy(scene, rig.skeleton, ctx);
+  ctx.bind_shapes = detail::collada_bind_shape_matrices(file);
 
   // Meshes in hierarchy order; a mesh instanced by several nodes becomes several parts.
   MeshBuild build;
@@ -726,7 +874,7 @@ ImportedRig import_rig(const std::filesystem::path& file, const ImportOptions& o
   }
   finish_skin(build, h, rig, ctx);
   out.rest_pose_deviation = build.rest_pose_deviation;
-  read_clips(scene, h, rig, ctx);
+  read_clips(scene, h, rig, out.refused_clips, ctx);
 
   if (rig.mesh.num_vertices() > 0) {
     const double size = (rig.mesh.rest_positions.colwise().maxCoeff() - rig.mesh.rest_positions.colwise().minCoeff()).norm();
@@ -776,6 +924,29 @@ ImportedRig import_rig(const std::filesystem::path& file, const ImportOptions& o
     if (std::find(out.problems.begin(), out.problems.end(), p) == out.problems.end()) out.problems.push_back(std::move(p));
   }
   return out;
+}
+
+}  // namespace
+
+ImportedRig import_rig(const std::filesystem::path& file, const ImportOptions& options) {
+  const std::string name = file.string();
+  std::error_code ec;
+  if (!std::filesystem::exists(file, ec)) throw IoError(name + ": no such file");
+  if (std::filesystem::is_directory(file, ec)) throw IoError(name + ": is a directory, not a model file");
+  if (std::filesystem::file_size(file, ec) == 0 && !ec) throw IoError(name + ": empty file");
+  detail::check_declared_counts(file);
+
+  std::lock_guard lock(import_mutex());
+  if (options.isolate) {
+    // A crash, a loop or a runaway allocation inside assimp ends the child, not this process.
+    const detail::ImportLimits limits{.memory_bytes = options.memory_limit_bytes, .time_s = options.time_limit_s};
+    detail::run_isolated(file, limits, [&] { (void)import_locked(file, options); });
+  }
+  try {
+    return import_locked(file, options);
+  } catch (const std::bad_alloc&) {
+    throw InvalidInput(name + ": ran out of memory importing it");
+  }
 }
 
 }  // namespace skelcd::skinning

@@ -3,6 +3,7 @@
 // part of one Mesh, the node hierarchy becomes the Skeleton, skins become bones and weights,
 // animations become clips.
 
+#include <cstddef>
 #include <filesystem>
 #include <string>
 #include <vector>
@@ -10,6 +11,10 @@
 #include "skinning/rig.hpp"
 
 namespace skelcd::skinning {
+
+/// 4 GiB: a 60k-triangle character imports in well under 200 MB; a file that needs more is
+/// either huge or lying about its size (`--import-memory` raises it).
+inline constexpr std::size_t kDefaultImportMemoryLimit = std::size_t{4} << 30;
 
 struct ImportOptions {
   /// Merge identical vertices within each mesh of the file (assimp's JoinIdenticalVertices:
@@ -19,10 +24,29 @@ struct ImportOptions {
   /// (FBX: GlobalSettings UnitScaleFactor, in centimetres). glTF is in metres by definition and
   /// assimp applies Collada's <unit>; other formats carry no unit and are taken as they are.
   bool convert_to_metres = true;
+  /// Read the file once in a child process before importing it here, so that a file on which
+  /// assimp crashes, loops or allocates without bound costs one line, not the process
+  /// (skinning/detail/import_guard.hpp). Off only for fuzzing the importer in-process.
+  bool isolate = true;
+  /// Address space that importing one file may use, bytes (checked in the child process).
+  std::size_t memory_limit_bytes = kDefaultImportMemoryLimit;
+  /// Time that importing one file may take in the child process, seconds.
+  double time_limit_s = 600.0;
+};
+
+/// A clip of the file that could not be used (keys out of order, non-finite keys, …). The rest
+/// of the file, and its other clips, are imported all the same.
+struct RefusedClip {
+  std::string name;
+  /// Why, without the file's name: "node 'Hips', rotation key 12 (t = 0.4 s) is earlier than …".
+  std::string reason;
 };
 
 struct ImportedRig {
   Rig rig;
+  /// Clips left out of rig.clips because their data are unusable (each also has a line in
+  /// `problems`).
+  std::vector<RefusedClip> refused_clips;
   /// What was found and handled, one sentence each (dropped points/lines, normalised weights,
   /// unnamed clips, assimp warnings, …). Faults that make the data unusable throw instead.
   std::vector<std::string> problems;
@@ -45,10 +69,14 @@ struct ImportedRig {
 /// first; nodes without a channel in a clip keep their static transform. Times are seconds.
 ///
 /// @throws IoError when the file is missing, unreadable or assimp cannot parse it (the message
-///         names the file and repeats assimp's reason).
-/// @throws InvalidInput when the data are unusable: non-finite coordinates, transforms, weights
-///         or keys, indices out of range (also when assimp reports it dropped such faces),
-///         a bone naming no node, no triangle at all, a node hierarchy with a cycle.
+///         names the file and repeats assimp's reason), or when assimp crashed or exceeded
+///         `time_limit_s` reading it in the child process.
+/// @throws InvalidInput also when the file declares more elements than its size can hold, or
+///         importing it needs more than `memory_limit_bytes`.
+/// @throws InvalidInput when the data are unusable: non-finite coordinates, transforms or
+///         weights, indices out of range (also when assimp reports it dropped such faces), no
+///         triangle at all, a node hierarchy with a cycle. A clip with unusable keys (out of
+///         order, non-finite) does not throw: it is refused alone (ImportedRig::refused_clips).
 [[nodiscard]] ImportedRig import_rig(const std::filesystem::path& file, const ImportOptions& options = {});
 
 }  // namespace skelcd::skinning

@@ -31,7 +31,11 @@ LoadedModel load_assimp_model(const std::filesystem::path& path, const LoadOptio
     throw InvalidInput(path.string() + ": a trajectory, SRDF or package path applies to URDF robots only");
   }
   auto imported = import_rig(path, options.import);
-  auto model = model_from_rig(std::move(imported.rig), ModelKind::rig, std::move(imported.problems));
+  auto model = model_from_rig(
+      std::move(imported.rig),
+      ModelKind::rig,
+      std::move(imported.problems),
+      std::move(imported.refused_clips));
   model.path = path;
   model.unit_scale = imported.unit_scale;
   model.rest_pose_deviation = imported.rest_pose_deviation;
@@ -67,7 +71,11 @@ std::unique_ptr<Motion> LoadedModel::motion(const MotionRequest& request) const 
   return motion_factory(request);
 }
 
-LoadedModel model_from_rig(Rig rig, ModelKind kind, std::vector<std::string> problems) {
+LoadedModel model_from_rig(
+    Rig rig,
+    ModelKind kind,
+    std::vector<std::string> problems,
+    std::vector<RefusedClip> refused_clips) {
   LoadedModel model;
   model.path = rig.source;
   model.kind = kind;
@@ -76,11 +84,20 @@ LoadedModel model_from_rig(Rig rig, ModelKind kind, std::vector<std::string> pro
   model.mesh = std::shared_ptr<const Mesh>(shared, &shared->mesh);  // shares the rig's lifetime
   for (const auto& c : shared->clips) model.clips.push_back({c.name, c.duration_s, c.keys_per_s()});
   model.problems = std::move(problems);
-  model.motion_factory = [shared, clips = model.clips](const MotionRequest& request) -> std::unique_ptr<Motion> {
+  model.refused_clips = std::move(refused_clips);
+  model.motion_factory = [shared, clips = model.clips, refused = model.refused_clips](
+                             const MotionRequest& request) -> std::unique_ptr<Motion> {
     RigMotionOptions options;
     options.rate_hz = request.rate_hz;
     if (!request.clip.empty()) {
       options.clip = shared->find_clip(request.clip);
+      const auto refusal = std::find_if(refused.begin(), refused.end(), [&](const RefusedClip& r) {
+        return r.name == request.clip;
+      });
+      if (options.clip < 0 && refusal != refused.end()) {
+        throw InvalidInput(shared->source + ": clip '" + request.clip + "' was refused: " + refusal->reason +
+                           " (" + (clips.empty() ? std::string("no clip is usable") : "usable " + clip_list(clips)) + ")");
+      }
       if (options.clip < 0) {
         throw InvalidInput(shared->source + ": no clip named '" + request.clip + "' (" + clip_list(clips) + ")");
       }

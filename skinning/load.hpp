@@ -65,6 +65,9 @@ struct LoadedModel {
   /// The rig (null for a frame sequence).
   std::shared_ptr<const Rig> rig;
   std::vector<ClipSummary> clips;
+  /// Clips of the file that could not be used (see ImportedRig::refused_clips): not in `clips`;
+  /// asking for one by name says why it was refused.
+  std::vector<RefusedClip> refused_clips;
   /// What was found and handled while loading, one sentence each.
   std::vector<std::string> problems;
   /// Scale applied to the file's coordinates to reach metres (1 when the file has no unit).
@@ -78,11 +81,13 @@ struct LoadedModel {
 };
 
 /// Wraps a rig as a LoadedModel whose motions are RigMotions over its clips. For importers of
-/// other kinds of input (URDF robots) that produce a Rig.
+/// other kinds of input (URDF robots) that produce a Rig. `refused_clips` are named in errors
+/// when a request asks for one of them.
 [[nodiscard]] LoadedModel model_from_rig(
     Rig rig,
     ModelKind kind,
-    std::vector<std::string> problems);
+    std::vector<std::string> problems,
+    std::vector<RefusedClip> refused_clips = {});
 
 /// Loads whatever `path` names (see classify_model_path).
 /// @throws IoError / InvalidInput with a message naming the file and the fault.

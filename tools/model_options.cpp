@@ -1,11 +1,28 @@
 #include "tools/model_options.hpp"
 
+#include <cmath>
+#include <string>
+
 namespace skelcd::tools {
 
 void add_model_options(CLI::App& command, skinning::LoadOptions& options) {
   command.add_option("--trajectory", options.trajectory, "robots: joint trajectory CSV (time,<joint names…>)");
   command.add_option("--srdf", options.srdf, "robots: SRDF whose disabled collision pairs are skipped");
   command.add_option("--package-path", options.package_path, "robots: folder searched for package:// meshes (repeatable)");
+  // Memory that importing one model file may take, MiB; the import runs in a child process first,
+  // so a file that asks for more costs one line (docs/cli.md, "Broken files").
+  command
+      .add_option_function<double>(
+          "--import-memory",
+          [&options](double mib) {
+            if (!(std::isfinite(mib) && mib >= 64 && mib <= 1024.0 * 1024.0)) {
+              throw CLI::ValidationError("--import-memory", "expected MiB between 64 and 1048576, got " + std::to_string(mib));
+            }
+            options.import.memory_limit_bytes = static_cast<std::size_t>(mib * 1024.0 * 1024.0);
+          },
+          "model files: memory one import may use, MiB (default " +
+              std::to_string(skinning::kDefaultImportMemoryLimit >> 20) + ")")
+      ->type_name("MIB");
 }
 
 }  // namespace skelcd::tools

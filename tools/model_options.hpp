@@ -8,7 +8,8 @@
 
 namespace skelcd::tools {
 
-/// Adds --trajectory, --srdf and --package-path (robots) to `command`, filling `options`.
+/// Adds --trajectory, --srdf and --package-path (robots) and --import-memory (model files) to
+/// `command`, filling `options`.
 /// `options` must outlive the parse.
 void add_model_options(CLI::App& command, skinning::LoadOptions& options);
 

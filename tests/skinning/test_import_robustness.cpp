@@ -1,0 +1,229 @@
+// Real files and bad files through the importer (issue "Real files and bad files"): float noise in
+// transforms, one bad clip among good ones, files that lie about their size, crashes and runaway
+// allocations kept in a child process, OBJ vertex numbering, Collada bind shape matrices.
+
+#include <unistd.h>
+
+#include <chrono>
+#include <csignal>
+#include <cstdlib>
+#include <fstream>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "skinning/assimp_import.hpp"
+#include "skinning/detail/import_guard.hpp"
+#include "skinning/errors.hpp"
+#include "skinning/load.hpp"
+#include "skinning/rig_motion.hpp"
+#include "tests/support/test_support.hpp"
+
+namespace skelcd::skinning {
+namespace {
+
+using skelcd::test::asset;
+using skelcd::test::assimp_model;
+using skelcd::test::temp_dir;
+
+Eigen::Vector3d extent(const Positions& x) { return x.colwise().maxCoeff() - x.colwise().minCoeff(); }
+
+bool any_problem_contains(const std::vector<std::string>& problems, const std::string& text) {
+  for (const auto& p : problems) {
+    if (p.find(text) != std::string::npos) return true;
+  }
+  return false;
+}
+
+// --- 1. float noise in the last row of a transform --------------------------------------------
+
+TEST(ImportRobustness, FloatNoiseInTheLastRowOfATransformIsAccepted) {
+  // Both files carry node matrices whose last row is (0, 0, 0, 0.99999988)-like noise from
+  // assimp's single-precision products; they were refused as "projective".
+  const auto ase = import_rig(assimp_model("ASE/MotionCaptureROM.ase"));
+  EXPECT_GT(ase.rig.mesh.num_triangles(), 0);
+  EXPECT_EQ(ase.rig.clips.size(), 1u);
+  const auto q3s = import_rig(assimp_model("Q3D/WusonOrange.q3s"));
+  EXPECT_GT(q3s.rig.mesh.num_triangles(), 0);
+}
+
+TEST(ImportRobustness, ARealProjectiveTransformIsStillRefused) {
+  // A Collada node whose matrix puts 0.5 * z into w: far beyond float noise.
+  const auto dir = temp_dir("projective");
+  const auto file = dir / "projective.dae";
+  std::ofstream(file) << R"(<?xml version="1.0" encoding="utf-8"?>
+<COLLADA xmlns="http://www.collada.org/2005/11/COLLADASchema" version="1.4.1">
+  <asset><unit name="meter" meter="1"/><up_axis>Y_UP</up_axis></asset>
+  <library_geometries>
+    <geometry id="tri" name="tri"><mesh>
+      <source id="tri-pos"><float_array id="tri-pos-array" count="9">0 0 0 1 0 0 0 1 0</float_array>
+        <technique_common><accessor source="#tri-pos-array" count="3" stride="3">
+          <param name="X" type="float"/><param name="Y" type="float"/><param name="Z" type="float"/>
+        </accessor></technique_common></source>
+      <vertices id="tri-vtx"><input semantic="POSITION" source="#tri-pos"/></vertices>
+      <triangles count="1"><input semantic="VERTEX" source="#tri-vtx" offset="0"/><p>0 1 2</p></triangles>
+    </mesh></geometry>
+  </library_geometries>
+  <library_visual_scenes>
+    <visual_scene id="scene"><node id="n" name="n">
+      <matrix>1 0 0 0 0 1 0 0 0 0 1 0 0 0 0.5 1</matrix>
+      <instance_geometry url="#tri"/>
+    </node></visual_scene>
+  </library_visual_scenes>
+  <scene><instance_visual_scene url="#scene"/></scene>
+</COLLADA>
+)";
+  EXPECT_THROW_MESSAGE((void)import_rig(file), InvalidInput, "projective transform (last row 0 0 0.5 1");
+}
+
+// --- 2. one bad clip does not block the file --------------------------------------------------
+
+TEST(ImportRobustness, TheNinjasBrokenClipsAreRefusedAloneAndTheOthersLoad) {
+  const auto file = asset("characters/ninja/ninja.mesh");
+  const auto imported = import_rig(file);
+  // 20 clips in the file; HighJump and JumpNoHeight have a translation key before the one
+  // ahead of it (keys 0.33 s then 0 s; 0.083 s then 0 s).
+  ASSERT_EQ(imported.refused_clips.size(), 2u);
+  EXPECT_EQ(imported.refused_clips[0].name, "HighJump");
+  EXPECT_EQ(imported.refused_clips[1].name, "JumpNoHeight");
+  EXPECT_NE(imported.refused_clips[0].reason.find("earlier than the key before it"), std::string::npos);
+  EXPECT_EQ(imported.rig.clips.size(), 18u);
+  EXPECT_TRUE(any_problem_contains(imported.problems, "clip 'HighJump' refused"));
+  for (const auto& clip : imported.rig.clips) {
+    EXPECT_NE(clip.name, "HighJump");
+    EXPECT_TRUE(std::is_sorted(clip.key_times.begin(), clip.key_times.end())) << clip.name;
+  }
+
+  // Every sound clip can be asked for; the refused one says why.
+  const auto model = load_model(file);
+  ASSERT_EQ(model.clips.size(), 18u);
+  for (const auto& clip : model.clips) {
+    const auto motion = model.motion({.clip = clip.name});
+    EXPECT_GT(motion->num_samples(), 0) << clip.name;
+  }
+  EXPECT_THROW_MESSAGE((void)model.motion({.clip = "HighJump"}), InvalidInput, "clip 'HighJump' was refused: node 'Joint1'");
+  EXPECT_THROW_MESSAGE((void)model.motion({.clip = "NoSuchClip"}), InvalidInput, "no clip named 'NoSuchClip'");
+}
+
+TEST(ImportRobustness, AnLwsFileWhoseOnlyClipIsBrokenStillLoadsItsMesh) {
+  const auto imported = import_rig(assimp_model("LWS/move_y_pre_ofrep_post_osc.lws"));
+  EXPECT_GT(imported.rig.mesh.num_triangles(), 0);
+  EXPECT_TRUE(imported.rig.clips.empty());
+  ASSERT_EQ(imported.refused_clips.size(), 1u);
+  EXPECT_NE(imported.refused_clips[0].reason.find("earlier than the key before it"), std::string::npos);
+}
+
+// --- 3. files that lie about their size; crashes and memory kept in a child ---------------------
+
+TEST(ImportRobustness, DeclaredCountsBeyondTheFileSizeAreRefusedBeforeImporting) {
+  // 309 bytes declaring 353,535,235,358 vertices: assimp itself grows to 15.8 GB on it.
+  EXPECT_THROW_MESSAGE(
+      (void)import_rig(assimp_model("invalid/OutOfMemory.off")), InvalidInput,
+      "declares 353535235358 vertices and 6 faces");
+  const auto dir = temp_dir("declared");
+  const auto ply = dir / "huge.ply";
+  std::ofstream(ply, std::ios::binary) << "ply\nformat binary_little_endian 1.0\nelement vertex 1000000000\n"
+                                          "property float x\nproperty float y\nproperty float z\n"
+                                          "element face 1\nproperty list uchar int vertex_indices\nend_header\n"
+                                       << std::string(64, '\0');
+  EXPECT_THROW_MESSAGE((void)import_rig(ply), InvalidInput, "declares 1000000000 vertex elements and 1 face elements");
+  // A sound file of each format passes the check (and imports).
+  EXPECT_GT(import_rig(assimp_model("OFF/Cube.off")).rig.mesh.num_triangles(), 0);
+  EXPECT_GT(import_rig(assimp_model("PLY/cube_binary.ply")).rig.mesh.num_triangles(), 0);
+  EXPECT_GT(import_rig(assimp_model("PLY/cube.ply")).rig.mesh.num_triangles(), 0);
+}
+
+TEST(ImportGuard, AnExceptionInTheChildIsRethrownWithItsMessage) {
+  const detail::ImportLimits limits{.memory_bytes = std::size_t{1} << 30, .time_s = 60};
+  EXPECT_THROW_MESSAGE(
+      detail::run_isolated("model.glb", limits, [] { throw InvalidInput("model.glb: vertex 3 is bad"); }), InvalidInput,
+      "model.glb: vertex 3 is bad");
+  EXPECT_THROW_MESSAGE(detail::run_isolated("model.glb", limits, [] { throw IoError("model.glb: cannot read"); }), IoError,
+                       "model.glb: cannot read");
+  EXPECT_NO_THROW(detail::run_isolated("model.glb", limits, [] {}));
+}
+
+TEST(ImportGuard, ACrashInTheChildIsOneLineAndThisProcessGoesOn) {
+  const detail::ImportLimits limits{.memory_bytes = std::size_t{1} << 30, .time_s = 60};
+  EXPECT_THROW_MESSAGE(detail::run_isolated("model.glb", limits, [] { std::abort(); }), IoError,
+                       "model.glb: the importer (assimp) crashed reading it (SIGABRT)");
+}
+
+TEST(ImportGuard, ARunawayAllocationInTheChildIsRefusedWithTheLimit) {
+  const detail::ImportLimits limits{.memory_bytes = std::size_t{256} << 20, .time_s = 60};
+  // Grows past the limit a block at a time, touching the memory, as a lying loader does.
+  const auto grow = [] {
+    std::vector<std::vector<char>> blocks;
+    for (int i = 0; i < 64; ++i) blocks.emplace_back(std::size_t{64} << 20, 'x');
+  };
+  EXPECT_THROW_MESSAGE(detail::run_isolated("model.glb", limits, grow), InvalidInput,
+                       "model.glb: importing it needs more memory than the import memory limit of 256 MiB");
+}
+
+TEST(ImportGuard, AChildThatTakesTooLongIsStopped) {
+  const detail::ImportLimits limits{.memory_bytes = std::size_t{1} << 30, .time_s = 0.3};
+  const auto start = std::chrono::steady_clock::now();
+  EXPECT_THROW_MESSAGE(
+      detail::run_isolated("model.glb", limits, [] { std::this_thread::sleep_for(std::chrono::seconds(30)); }), IoError,
+      "model.glb: importing it took longer than 0.3 s");
+  EXPECT_LT(std::chrono::steady_clock::now() - start, std::chrono::seconds(10));
+}
+
+TEST(ImportRobustness, ATinyImportMemoryLimitRefusesARealCharacter) {
+  ImportOptions options;
+  options.memory_limit_bytes = std::size_t{1} << 20;  // 1 MiB: CesiumMan needs more
+  EXPECT_THROW_MESSAGE((void)import_rig(asset("characters/CesiumMan.glb"), options), InvalidInput,
+                       "importing it needs more memory than the import memory limit of 1 MiB");
+}
+
+// --- 8. a NaN in an OBJ is named by the file's own vertex number ------------------------------
+
+TEST(ImportRobustness, ANanInAnObjNamesTheFilesVertexNotAssimpsCorner) {
+  const auto dir = temp_dir("nan_vertex");
+  const auto file = dir / "nan7.obj";
+  // Seven vertices, the 7th (0-based 6) is NaN; the faces reach it at corner 8 of assimp's
+  // unindexed list (faces 1 2 3, 4 5 6, then 2 4 7).
+  std::ofstream(file) << "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 2 0 0\nv 3 0 0\nv 2 1 0\nv 5 nan 0\n"
+                         "f 1 2 3\nf 4 5 6\nf 2 4 7\n";
+  EXPECT_THROW_MESSAGE((void)import_rig(file), InvalidInput, file.string() + ": vertex 6 has a non-finite coordinate");
+}
+
+// --- 10. the Collada bind shape matrix ------------------------------------------------------
+
+TEST(ImportRobustness, TheStormtroopersBindShapeMatrixStandsItsRestPoseUp) {
+  const auto file = asset("characters/stormtrooper/stormtrooper.dae");
+  const auto model = load_model(file);
+  // Without the bind shape matrix the rest mesh lay along -Z, 2.1 x 0.79 x 3.7, while every
+  // posed frame stands ~5.5 tall on +Y; the file's up axis is Y.
+  const Eigen::Vector3d rest = extent(model.mesh->rest_positions);
+  EXPECT_GT(rest.y(), rest.x());
+  EXPECT_GT(rest.y(), rest.z());
+  EXPECT_GT(rest.y(), 5.0);
+  const auto motion = model.motion();
+  Positions x;
+  motion->positions(0, x);
+  const Eigen::Vector3d posed = extent(x);
+  EXPECT_NEAR(posed.y(), 5.49, 0.05);  // posing never depended on it: the offsets carried it
+  EXPECT_GT(posed.y(), posed.x());
+  // The rest and posed meshes now share one frame: the feet stay near y = 0 in both.
+  EXPECT_NEAR(model.mesh->rest_positions.col(1).minCoeff(), x.col(1).minCoeff(), 0.1);
+  EXPECT_LT(model.rest_pose_deviation, 0.25 * rest.norm());  // was 170 %
+}
+
+// --- 12. nothing of assimp's own printing reaches our streams ---------------------------------
+
+TEST(ImportRobustness, AssimpPrintingToStdoutIsCapturedAsAProblem) {
+  // OpenGEX's DDL parser prints "nullptr returned by creating DDLNode." to stdout.
+  testing::internal::CaptureStdout();
+  testing::internal::CaptureStderr();
+  EXPECT_THROW((void)import_rig(assimp_model("OpenGEX/empty_camera.ogex")), IoError);
+  const auto out = testing::internal::GetCapturedStdout();
+  const auto err = testing::internal::GetCapturedStderr();
+  EXPECT_EQ(out, "");
+  EXPECT_EQ(err, "");
+}
+
+}  // namespace
+}  // namespace skelcd::skinning
