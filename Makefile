@@ -7,8 +7,12 @@ JOBS       ?= $(shell nproc)
 # CI sets CI=true: warnings become errors there.
 WERROR     ?= $(if $(CI),ON,OFF)
 CMAKE_ARGS ?=
+# make fuzz (docs/fuzzing.md): seconds per harness, which harnesses, the clang build folder.
+FUZZ_SECONDS ?= 600
+FUZZERS      ?= scene ccd_queries frame_mesh trajectory srdf log_reader assimp_import
+FUZZ_BUILD   ?= build-fuzz
 
-.PHONY: all deps configure build demo test sanitize bench clean
+.PHONY: all deps configure build demo test sanitize bench fuzz clean
 
 all: build
 
@@ -36,6 +40,12 @@ sanitize: deps
 
 bench: build
 	bash scripts/bench.sh $(BUILD)
+
+fuzz: deps
+	@bash scripts/install-deps.sh clang-14 libclang-rt-14-dev
+	CC=clang-14 CXX=clang++-14 cmake -S . -B $(FUZZ_BUILD) -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo "-DCMAKE_C_FLAGS_RELWITHDEBINFO=-O1 -g" "-DCMAKE_CXX_FLAGS_RELWITHDEBINFO=-O1 -g" -DSKELCD_FUZZ=ON -DSKELCD_WERROR=OFF $(CMAKE_ARGS)
+	nice -n 10 cmake --build $(FUZZ_BUILD) -j $(JOBS) --target $(addprefix fuzz_,$(FUZZERS))
+	FUZZ_SECONDS=$(FUZZ_SECONDS) bash scripts/fuzz.sh $(FUZZ_BUILD) $(FUZZERS)
 
 clean:
 	rm -rf $(BUILD) $(SAN_BUILD)

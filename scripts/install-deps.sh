@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Installs the Debian packages skelcd builds and tests with, but only those that are missing.
 # Called by `make`; safe to run again. Needs root or sudo when something is missing.
+# Extra packages may be named as arguments (make fuzz: clang-14 libclang-rt-14-dev).
 set -euo pipefail
 
 packages=(
@@ -11,6 +12,7 @@ packages=(
   libplplot-dev plplot-driver-cairo
   nlohmann-json3-dev python3-h5py
   libtinyxml-dev libconsole-bridge-dev  # used directly by skinning/urdf*.cpp (SRDF, urdfdom messages)
+  "$@"
 )
 
 missing=()
