@@ -323,9 +323,18 @@ FrameMesh read_ply(const fs::path& file, const std::string& bytes) {
     if (e.name == "vertex") {
       if (ix < 0 || iy < 0 || iz < 0) throw IoError(file.string() + ": PLY vertex element lacks x, y or z");
       have_vertices = true;
-      xyz.reserve(3 * e.count);
     }
     if (e.name == "face" && ilist < 0) throw IoError(file.string() + ": PLY face element lacks vertex_indices");
+    // Every item of an element with properties takes at least one byte of the body, so a count
+    // beyond the bytes after the header is a damaged header: refused before reserving or looping
+    // for it (found by fuzz/fuzz_frame_mesh). Items without properties hold nothing to read.
+    if (e.properties.empty()) continue;
+    if (e.count > bytes.size() - pos) {
+      throw IoError(file.string() + ": PLY element '" + e.name + "' declares " + std::to_string(e.count) +
+                    " items, more than the " + std::to_string(bytes.size() - pos) +
+                    " bytes after the header hold (truncated or damaged file)");
+    }
+    if (e.name == "vertex") xyz.reserve(3 * e.count);
     for (std::size_t item = 0; item < e.count; ++item) {
       double v[3] = {0, 0, 0};
       for (std::size_t k = 0; k < e.properties.size(); ++k) {
@@ -333,12 +342,20 @@ FrameMesh read_ply(const fs::path& file, const std::string& bytes) {
         const int kk = static_cast<int>(k);
         if (p.is_list) {
           const double n = reader.read(p.count_type);
-          if (!(n >= 0) || n != std::floor(n)) throw IoError(file.string() + ": malformed PLY list length");
+          // A list item takes at least one byte: a longer list is damage (and beyond 2^64 the
+          // conversion below would be undefined).
+          if (!(n >= 0) || n != std::floor(n) || n > static_cast<double>(bytes.size())) {
+            throw IoError(file.string() + ": malformed PLY list length");
+          }
           const auto count = static_cast<std::size_t>(n);
           for (std::size_t c = 0; c < count; ++c) {
             const double index = reader.read(p.type);
             if (kk == ilist) {
               if (index != std::floor(index)) throw IoError(file.string() + ": PLY face index is not an integer");
+              // Beyond int64 the conversion is undefined; finish() reports the index as out of range.
+              if (!(std::abs(index) < 0x1p62)) {
+                throw InvalidInput(file.string() + ": PLY face index " + std::to_string(index) + " out of range");
+              }
               corners.push_back(static_cast<std::int64_t>(index));
             }
           }
