@@ -21,21 +21,15 @@ namespace {
 constexpr std::array<std::string_view, 11> kExtensions = {
     ".obj", ".off", ".ply", ".stl", ".dae", ".gltf", ".glb", ".fbx", ".x", ".ms3d", ".md5mesh"};
 
-// The fuzzer wants the import in this process (coverage, sanitizers): switch off the forked-child
-// isolation when ImportOptions has it.
-template <class Options>
-void in_process(Options& options) {
-  if constexpr (requires { options.isolate; }) options.isolate = false;
-}
-
 }  // namespace
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   if (size < 1) return 0;
   const auto extension = kExtensions[data[0] % kExtensions.size()];
   const auto path = skelcd::fuzz::write_input(data + 1, size - 1, extension);
+  // In this process (coverage, sanitizers), not in the forked child that guards the CLI.
   skelcd::skinning::ImportOptions options;
-  in_process(options);
+  options.isolate = false;
   try {
     (void)skelcd::skinning::import_rig(path, options);
   } catch (const std::exception&) {
