@@ -139,6 +139,10 @@ std::string model_name(const LogHeader& h) {
 }
 
 std::string completeness(const LogData& log) {
+  if (!log.damage.empty()) {
+    return "damaged (" + std::to_string(log.frames.size()) + "/" + std::to_string(log.header.planned_rows) +
+           " rows readable)";
+  }
   if (log.header.complete) return "yes";
   return "no (" + std::to_string(log.frames.size()) + "/" + std::to_string(log.header.planned_rows) +
          " rows)";
@@ -198,9 +202,17 @@ void run_inspect(const InspectOptions& o) {
   // Read every log; report and skip the ones that are not readable skelcd logs.
   std::vector<std::pair<std::string, LogData>> logs;
   std::size_t skipped = 0;
+  std::size_t damaged = 0;
   for (const auto& path : o.logs) {
     try {
-      logs.emplace_back(path, read_log(path, ReadLogOptions{.findings = false}));
+      auto log = read_log(path, ReadLogOptions{.findings = false});
+      if (!log.damage.empty()) {
+        // Summarised from the rows before the damage; the exit status still says it.
+        std::cerr << "skelcd: " << path << ": " << log.damage.front() << "; the " << log.frames.size()
+                  << " rows written before it are read\n";
+        ++damaged;
+      }
+      logs.emplace_back(path, std::move(log));
     } catch (const std::exception& e) {
       std::cerr << "skelcd: " << e.what() << " (skipped)\n";
       ++skipped;
@@ -266,6 +278,10 @@ void run_inspect(const InspectOptions& o) {
     throw IoError(
         std::to_string(skipped) + " of " + std::to_string(o.logs.size()) +
         " files skipped: not readable skelcd logs (named above)");
+  }
+  if (damaged > 0) {
+    throw IoError(std::to_string(damaged) + " of " + std::to_string(o.logs.size()) +
+                  " logs are damaged (named above); their rows before the damage are summarised");
   }
 }
 

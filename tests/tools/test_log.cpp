@@ -7,6 +7,7 @@
 #include <string>
 
 #include <gtest/gtest.h>
+#include <hdf5.h>
 
 #include "skinning/errors.hpp"
 #include "tests/support/test_support.hpp"
@@ -311,6 +312,66 @@ TEST(Log, ReaderReportsTruncatedAndDamagedLogsByName) {
   for (std::size_t i = 800; i < garbage.size(); ++i) garbage[i] = static_cast<char>((i * 131) & 0xff);
   write_text(dir / "garbage.h5", garbage);
   EXPECT_THROW_MESSAGE((void)read_log(dir / "garbage.h5"), IoError, "garbage.h5");
+}
+
+// File address of chunk `index` of dataset `name` (where its rows are on disk).
+haddr_t chunk_address(const std::filesystem::path& path, const char* name, hsize_t index) {
+  const hid_t file = H5Fopen(path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
+  const hid_t dataset = H5Dopen2(file, name, H5P_DEFAULT);
+  const hid_t space = H5Dget_space(dataset);
+  hsize_t offset = 0;
+  unsigned filter_mask = 0;
+  haddr_t address = HADDR_UNDEF;
+  hsize_t size = 0;
+  EXPECT_GE(H5Dget_chunk_info(dataset, space, index, &offset, &filter_mask, &address, &size), 0);
+  H5Sclose(space);
+  H5Dclose(dataset);
+  H5Fclose(file);
+  return address;
+}
+
+TEST(Log, GarbageInsideATableIsFoundByItsChecksumAndTheRowsBeforeItStayReadable) {
+  const auto dir = skelcd::test::temp_dir("log-checksum");
+  const auto path = dir / "run.h5";
+  // 40 frames of 100 DCD pairs each: /dcd_pairs fills four chunks of 1024 rows.
+  std::vector<FrameReport> reports;
+  for (int k = 0; k < 40; ++k) reports.push_back(sample_report(k, QueryKind::dcd, 0, 100));
+  {
+    LogWriter writer(path, sample_header());
+    for (const auto& r : reports) writer.append(r);
+    writer.finish();
+  }
+  const auto clean = read_log(path);
+  EXPECT_TRUE(clean.verified);
+  EXPECT_TRUE(clean.damage.empty());
+  ASSERT_EQ(clean.dcd_pairs.size(), 4000u);
+
+  // 4 KB of garbage over the start of the third chunk (rows 2048 on, frames 20 on).
+  const auto address = chunk_address(path, "dcd_pairs", 2);
+  ASSERT_NE(address, HADDR_UNDEF);
+  std::string bytes = read_text(path);
+  ASSERT_LT(address + 4096, bytes.size());
+  for (std::size_t i = 0; i < 4096; ++i) bytes[address + i] = static_cast<char>((i * 131 + 7) & 0xff);
+  write_text(path, bytes);
+
+  const auto damaged = read_log(path);
+  EXPECT_FALSE(damaged.verified);
+  ASSERT_FALSE(damaged.damage.empty());
+  // The frame whose pairs start at row 2000 spans the damage: its block, rows 2000 to 2099, fails.
+  EXPECT_EQ(damaged.damage.front(), "/dcd_pairs rows 2000 to 2099 are damaged (they fail their checksum)");
+  // Everything written before it reads back exactly.
+  ASSERT_EQ(damaged.frames.size(), 20u);
+  ASSERT_EQ(damaged.dcd_pairs.size(), 2000u);
+  for (std::size_t i = 0; i < damaged.dcd_pairs.size(); ++i) {
+    EXPECT_EQ(damaged.dcd_pairs[i].frame, clean.dcd_pairs[i].frame);
+    EXPECT_EQ(damaged.dcd_pairs[i].a.index, clean.dcd_pairs[i].a.index);
+    EXPECT_EQ(damaged.dcd_pairs[i].b.index, clean.dcd_pairs[i].b.index);
+  }
+  for (std::size_t i = 0; i < damaged.frames.size(); ++i) expect_rows_equal(damaged.frames[i], clean.frames[i]);
+  // Summaries that do not ask for the findings still verify them.
+  const auto summary = read_log(path, ReadLogOptions{.findings = false});
+  EXPECT_EQ(summary.frames.size(), 20u);
+  EXPECT_FALSE(summary.damage.empty());
 }
 
 TEST(Log, ReaderRejectsForeignHdf5ByName) {

@@ -23,6 +23,8 @@ void drop_unwritten(std::vector<Row>& rows) {
       return r;
     } else if constexpr (requires { r.sample; }) {
       return r.sample;
+    } else if constexpr (requires { r.frames_end; }) {
+      return r.frames_end;
     } else {
       return r.frame;
     }
@@ -181,11 +183,11 @@ std::vector<LogCheck> read_checks(hid_t file) {
 // /frame_check of a scene log (optional): the check of each /frames row.
 std::vector<std::int32_t> read_frame_checks(hid_t file) {
   std::vector<std::int32_t> values;
-  if (H5Lexists(file, "frame_check", H5P_DEFAULT) <= 0) {
+  if (H5Lexists(file, detail::kFrameCheckPath, H5P_DEFAULT) <= 0) {
     detail::clear_hdf5_error();
     return values;
   }
-  H5Handle dataset(H5Dopen2(file, "frame_check", H5P_DEFAULT), H5Dclose);
+  H5Handle dataset(H5Dopen2(file, detail::kFrameCheckPath, H5P_DEFAULT), H5Dclose);
   H5Handle space(dataset.valid() ? H5Dget_space(dataset.get()) : -1, H5Sclose);
   hsize_t rows = 0;
   if (!space.valid() || H5Sget_simple_extent_dims(space.get(), &rows, nullptr) < 0) {
@@ -276,6 +278,68 @@ FrameRow from_disk(const detail::FrameDisk& d) {
   return row;
 }
 
+
+/// The rows of every table that a log's /checksums cover, and what failed.
+struct Verified {
+  std::int64_t frames = 0, contacts = 0, dcd_pairs = 0, frame_checks = 0;
+  std::vector<std::string> damage;
+};
+
+template <class Row>
+bool table_block_matches(const std::vector<Row>& rows, hid_t memory_type, const char* name, std::int64_t begin,
+                         std::int64_t end, std::uint32_t expected, std::vector<std::string>& damage) {
+  const auto count = static_cast<std::int64_t>(rows.size());
+  const std::string table = std::string("/") + name;
+  if (end < begin || end > count) {
+    damage.push_back(table + " has " + std::to_string(count) + " rows, but its checksums cover rows " +
+                     std::to_string(begin) + " to " + std::to_string(end - 1));
+    return false;
+  }
+  const auto crc = detail::rows_crc(0, memory_type, rows.data() + begin, static_cast<std::size_t>(end - begin), sizeof(Row));
+  if (crc != expected) {
+    damage.push_back(table + " rows " + std::to_string(begin) + " to " + std::to_string(end - 1) +
+                     " are damaged (they fail their checksum)");
+    return false;
+  }
+  return true;
+}
+
+/// Walks /checksums in order and stops at the first row whose blocks do not match.
+Verified verify_rows(const std::vector<detail::ChecksumDisk>& checksums, const std::vector<detail::FrameDisk>& frames,
+                     const std::vector<detail::ContactDisk>& contacts, const std::vector<detail::DcdPairDisk>& pairs,
+                     const std::vector<std::int32_t>& frame_checks) {
+  Verified v;
+  const auto frame_type = detail::frame_memory_type();
+  const auto contact_type = detail::contact_memory_type();
+  const auto pair_type = detail::dcd_pair_memory_type();
+  const H5Handle check_type(H5Tcopy(H5T_NATIVE_INT32), H5Tclose);
+  for (std::size_t i = 0; i < checksums.size(); ++i) {
+    const auto& c = checksums[i];
+    if (detail::checksum_row_crc(c) != c.self_crc) {
+      v.damage.push_back("/" + std::string(detail::kChecksumsPath) + " row " + std::to_string(i) + " is damaged");
+      break;
+    }
+    bool ok = table_block_matches(frames, frame_type.get(), detail::kFramesPath, v.frames, c.frames_end, c.frames_crc, v.damage);
+    ok = table_block_matches(contacts, contact_type.get(), detail::kContactsPath, v.contacts, c.contacts_end, c.contacts_crc,
+                             v.damage) && ok;
+    ok = table_block_matches(pairs, pair_type.get(), detail::kDcdPairsPath, v.dcd_pairs, c.dcd_pairs_end, c.dcd_pairs_crc,
+                             v.damage) && ok;
+    ok = table_block_matches(frame_checks, check_type.get(), detail::kFrameCheckPath, v.frame_checks, c.frame_check_end,
+                             c.frame_check_crc, v.damage) && ok;
+    if (!ok) break;
+    v.frames = c.frames_end;
+    v.contacts = c.contacts_end;
+    v.dcd_pairs = c.dcd_pairs_end;
+    v.frame_checks = c.frame_check_end;
+  }
+  return v;
+}
+
+template <class Row>
+void cut(std::vector<Row>& rows, std::int64_t end) {
+  if (static_cast<std::int64_t>(rows.size()) > end) rows.resize(static_cast<std::size_t>(end));
+}
+
 }  // namespace
 
 LogData read_log(const std::filesystem::path& path, const ReadLogOptions& options) {
@@ -298,12 +362,32 @@ LogData read_log(const std::filesystem::path& path, const ReadLogOptions& option
     data.header = read_header(file.get());
     std::vector<detail::FrameDisk> frames;
     read_table(file.get(), detail::kFramesPath, detail::frame_memory_type(), frames);
+    data.frame_checks = read_frame_checks(file.get());
+    // Findings are read when asked for, or when the checksums need them.
+    const bool has_checksums = H5Lexists(file.get(), detail::kChecksumsPath, H5P_DEFAULT) > 0;
+    detail::clear_hdf5_error();
+    std::vector<detail::ContactDisk> contacts;
+    std::vector<detail::DcdPairDisk> pairs;
+    if (options.findings || has_checksums) {
+      read_table(file.get(), detail::kContactsPath, detail::contact_memory_type(), contacts);
+      read_table(file.get(), detail::kDcdPairsPath, detail::dcd_pair_memory_type(), pairs);
+    }
+    if (has_checksums) {
+      std::vector<detail::ChecksumDisk> checksums;
+      read_table(file.get(), detail::kChecksumsPath, detail::checksum_memory_type(), checksums);
+      auto verified = verify_rows(checksums, frames, contacts, pairs, data.frame_checks);
+      data.verified = verified.damage.empty();
+      if (!verified.damage.empty()) {
+        cut(frames, verified.frames);
+        cut(contacts, verified.contacts);
+        cut(pairs, verified.dcd_pairs);
+        cut(data.frame_checks, verified.frame_checks);
+        data.damage = std::move(verified.damage);
+      }
+    }
     data.frames.reserve(frames.size());
     for (const auto& f : frames) data.frames.push_back(from_disk(f));
-    data.frame_checks = read_frame_checks(file.get());
     if (options.findings) {
-      std::vector<detail::ContactDisk> contacts;
-      read_table(file.get(), detail::kContactsPath, detail::contact_memory_type(), contacts);
       data.contacts.reserve(contacts.size());
       for (const auto& c : contacts) {
         data.contacts.push_back(ContactRow{
@@ -317,8 +401,6 @@ LogData read_log(const std::filesystem::path& path, const ReadLogOptions& option
             .toi_upper = c.toi_upper,
         });
       }
-      std::vector<detail::DcdPairDisk> pairs;
-      read_table(file.get(), detail::kDcdPairsPath, detail::dcd_pair_memory_type(), pairs);
       data.dcd_pairs.reserve(pairs.size());
       for (const auto& p : pairs) {
         data.dcd_pairs.push_back(DcdPairRow{

@@ -2,6 +2,7 @@
 // Reads a skelcd log (docs/log-format.md), complete or left behind by a run that was killed.
 
 #include <filesystem>
+#include <string>
 #include <vector>
 
 #include "tools/frame_report.hpp"
@@ -17,6 +18,14 @@ struct LogData {
   /// /frame_check of a scene log: the check (index into header.checks) of each /frames row, in
   /// file order (empty for other logs).
   std::vector<std::int32_t> frame_checks;
+  /// True when the log carries /checksums (logs written since checksums were added) and every
+  /// row it covers matched. Rows after the last checksum row (a run killed mid-flush) are read
+  /// unverified either way.
+  bool verified = false;
+  /// What failed verification, one sentence each ("/dcd_pairs rows 1024 to 2047 fail their
+  /// checksum"). Every table is then cut back to the last verified checksum row, so what is
+  /// read is what was written before the damage.
+  std::vector<std::string> damage;
 };
 
 struct ReadLogOptions {
@@ -24,9 +33,10 @@ struct ReadLogOptions {
   bool findings = true;
 };
 
-/// Reads the log at `path`.
+/// Reads the log at `path`, verifying its rows against /checksums (see LogData::damage).
 /// @throws IoError naming `path` and the fault when it is missing, not HDF5, not a skelcd log
-/// (no `format` attribute equal to "skelcd-log"), of a newer format version, or damaged.
+/// (no `format` attribute equal to "skelcd-log"), of a newer format version, or so damaged that
+/// HDF5 cannot read its structure.
 [[nodiscard]] LogData read_log(const std::filesystem::path& path, const ReadLogOptions& options = {});
 
 }  // namespace skelcd::tools

@@ -39,6 +39,8 @@ Row unwritten() {
   Row row{};
   if constexpr (requires { row.sample; }) {
     row.sample = -1;
+  } else if constexpr (requires { row.frames_end; }) {
+    row.frames_end = -1;
   } else {
     row.frame = -1;
   }
@@ -218,7 +220,7 @@ Table create_frame_check_table(hid_t file, const std::string& where) {
   const std::int32_t fill = -1;  // as create_table: an unwritten row reads as -1
   if (space.valid() && properties.valid() && H5Pset_chunk(properties.get(), 1, &chunk) >= 0 &&
       H5Pset_fill_value(properties.get(), H5T_NATIVE_INT32, &fill) >= 0) {
-    table.dataset = H5Handle(H5Dcreate2(file, "frame_check", H5T_STD_I32LE, space.get(),
+    table.dataset = H5Handle(H5Dcreate2(file, detail::kFrameCheckPath, H5T_STD_I32LE, space.get(),
                                         H5P_DEFAULT, properties.get(), H5P_DEFAULT),
                              H5Dclose);
   }
@@ -279,15 +281,49 @@ struct LogWriter::Impl {
   Table contacts;
   Table dcd_pairs;
   Table frame_checks;  // scene logs only
+  Table checksums;
   std::vector<detail::ContactDisk> contact_rows;
   std::vector<detail::DcdPairDisk> pair_rows;
+  std::vector<std::int32_t> pending_checks;  // /frame_check rows since the last checksum row
   bool finished = false;
+
+  /// Flushes the rows appended so far, then records their checksums in /checksums and flushes
+  /// again: a checksum row on disk always follows the rows it covers, so a run killed between
+  /// the two flushes leaves unchecked rows, never a false mismatch.
+  void flush_with_checksums(const detail::FrameDisk& frame) {
+    flush();
+    detail::ChecksumDisk row{};
+    row.frames_end = static_cast<std::int64_t>(frames.rows);
+    row.contacts_end = static_cast<std::int64_t>(contacts.rows);
+    row.dcd_pairs_end = static_cast<std::int64_t>(dcd_pairs.rows);
+    row.frame_check_end = static_cast<std::int64_t>(frame_checks.rows);
+    row.frames_crc = detail::rows_crc(0, frames.memory_type.get(), &frame, 1, sizeof frame);
+    row.contacts_crc = detail::rows_crc(0, contacts.memory_type.get(), contact_rows.data(), contact_rows.size(),
+                                        sizeof(detail::ContactDisk));
+    row.dcd_pairs_crc = detail::rows_crc(0, dcd_pairs.memory_type.get(), pair_rows.data(), pair_rows.size(),
+                                         sizeof(detail::DcdPairDisk));
+    if (frame_checks.dataset.valid()) {
+      row.frame_check_crc = detail::rows_crc(0, frame_checks.memory_type.get(), pending_checks.data(),
+                                             pending_checks.size(), sizeof(std::int32_t));
+    }
+    pending_checks.clear();
+    row.self_crc = detail::checksum_row_crc(row);
+    append_rows(checksums, std::span<const detail::ChecksumDisk>(&row, 1), detail::kChecksumsPath, where);
+    flush();
+  }
+
+  void flush() {
+    if (H5Fflush(file.get(), H5F_SCOPE_LOCAL) < 0) {
+      throw IoError(where + ": cannot flush (" + detail::take_hdf5_error() + ")");
+    }
+  }
 
   /// Closes every dataset, then the file; false if any close failed.
   bool close() {
     bool ok = frames.dataset.reset();
     ok = contacts.dataset.reset() && ok;
     ok = dcd_pairs.dataset.reset() && ok;
+    ok = checksums.dataset.reset() && ok;
     if (frame_checks.dataset.valid()) ok = frame_checks.dataset.reset() && ok;
     return file.reset() && ok;
   }
@@ -329,6 +365,8 @@ LogWriter::LogWriter(const std::filesystem::path& path, const LogHeader& header)
                                    kPairChunkRows, unwritten<detail::ContactDisk>(), impl_->where);
     impl_->dcd_pairs = create_table(file, detail::kDcdPairsPath, detail::dcd_pair_memory_type(),
                                     kPairChunkRows, unwritten<detail::DcdPairDisk>(), impl_->where);
+    impl_->checksums = create_table(file, detail::kChecksumsPath, detail::checksum_memory_type(),
+                                    kFrameChunkRows, unwritten<detail::ChecksumDisk>(), impl_->where);
     if (H5Fflush(file, H5F_SCOPE_LOCAL) < 0) {
       throw IoError(impl_->where + ": cannot flush (" + detail::take_hdf5_error() + ")");
     }
@@ -379,9 +417,7 @@ void LogWriter::append(const FrameReport& report) {
   const detail::FrameDisk row = to_disk(report.row);
   append_rows(impl_->frames, std::span<const detail::FrameDisk>(&row, 1), detail::kFramesPath,
               impl_->where);
-  if (H5Fflush(impl_->file.get(), H5F_SCOPE_LOCAL) < 0) {
-    throw IoError(impl_->where + ": cannot flush (" + detail::take_hdf5_error() + ")");
-  }
+  impl_->flush_with_checksums(row);
 }
 
 void LogWriter::append(const FrameReport& report, std::int32_t check) {
@@ -390,8 +426,9 @@ void LogWriter::append(const FrameReport& report, std::int32_t check) {
     throw IoError(impl_->where + ": append with a check to a log without /checks");
   }
   // The row's check first: a /frames row on disk implies its /frame_check entry is too.
-  append_rows(impl_->frame_checks, std::span<const std::int32_t>(&check, 1), "frame_check",
+  append_rows(impl_->frame_checks, std::span<const std::int32_t>(&check, 1), detail::kFrameCheckPath,
               impl_->where);
+  impl_->pending_checks.push_back(check);
   append(report);
 }
 

@@ -1,7 +1,11 @@
 #include "tools/log/detail/hdf5_schema.hpp"
 
+#include <zlib.h>
+
+#include <algorithm>
 #include <cstddef>
 #include <mutex>
+#include <vector>
 
 #include "culling/frame_result.hpp"
 #include "skinning/errors.hpp"
@@ -126,7 +130,52 @@ H5Handle dcd_pair_memory_type() {
   return type;
 }
 
+
+H5Handle checksum_memory_type() {
+  auto type = compound(sizeof(ChecksumDisk));
+  SKELCD_FIELD(type, ChecksumDisk, frames_end, H5T_NATIVE_INT64);
+  SKELCD_FIELD(type, ChecksumDisk, contacts_end, H5T_NATIVE_INT64);
+  SKELCD_FIELD(type, ChecksumDisk, dcd_pairs_end, H5T_NATIVE_INT64);
+  SKELCD_FIELD(type, ChecksumDisk, frame_check_end, H5T_NATIVE_INT64);
+  SKELCD_FIELD(type, ChecksumDisk, frames_crc, H5T_NATIVE_UINT32);
+  SKELCD_FIELD(type, ChecksumDisk, contacts_crc, H5T_NATIVE_UINT32);
+  SKELCD_FIELD(type, ChecksumDisk, dcd_pairs_crc, H5T_NATIVE_UINT32);
+  SKELCD_FIELD(type, ChecksumDisk, frame_check_crc, H5T_NATIVE_UINT32);
+  SKELCD_FIELD(type, ChecksumDisk, self_crc, H5T_NATIVE_UINT32);
+  return type;
+}
+
 #undef SKELCD_FIELD
+
+std::uint32_t rows_crc(std::uint32_t crc, hid_t memory_type, const void* rows, std::size_t count, std::size_t row_size) {
+  // (offset, size) of every field; a scalar type is one field of its own size.
+  std::vector<std::pair<std::size_t, std::size_t>> fields;
+  if (H5Tget_class(memory_type) == H5T_COMPOUND) {
+    const int members = H5Tget_nmembers(memory_type);
+    for (int m = 0; m < members; ++m) {
+      H5Handle member(H5Tget_member_type(memory_type, static_cast<unsigned>(m)), H5Tclose);
+      fields.emplace_back(H5Tget_member_offset(memory_type, static_cast<unsigned>(m)), H5Tget_size(member.get()));
+    }
+  } else {
+    fields.emplace_back(0, H5Tget_size(memory_type));
+  }
+  // By offset: HDF5 reorders a compound type's members in place once it has converted through it,
+  // so member indices differ between a type that has been used and a fresh one.
+  std::sort(fields.begin(), fields.end());
+  const auto* bytes = static_cast<const unsigned char*>(rows);
+  uLong value = crc;
+  for (std::size_t r = 0; r < count; ++r) {
+    for (const auto& [offset, size] : fields) value = crc32(value, bytes + r * row_size + offset, static_cast<uInt>(size));
+  }
+  return static_cast<std::uint32_t>(value);
+}
+
+std::uint32_t checksum_row_crc(const ChecksumDisk& row) {
+  ChecksumDisk copy = row;
+  copy.self_crc = 0;
+  const auto type = checksum_memory_type();
+  return rows_crc(0, type.get(), &copy, 1, sizeof copy);
+}
 
 H5Handle packed_copy(hid_t memory_type) {
   H5Handle type(H5Tcopy(memory_type), H5Tclose);

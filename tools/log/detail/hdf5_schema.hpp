@@ -103,11 +103,34 @@ struct DcdPairDisk {
   std::int32_t b_index;
 };
 
+/// One row of /checksums: CRC-32 (zlib) of the rows each table gained since the previous row, up to
+/// the row counts `*_end` (exclusive), written after those rows were flushed. `self_crc` covers
+/// the other fields, so a damaged checksum row is told from a damaged table.
+struct ChecksumDisk {
+  std::int64_t frames_end;
+  std::int64_t contacts_end;
+  std::int64_t dcd_pairs_end;
+  std::int64_t frame_check_end;
+  std::uint32_t frames_crc;
+  std::uint32_t contacts_crc;
+  std::uint32_t dcd_pairs_crc;
+  std::uint32_t frame_check_crc;
+  std::uint32_t self_crc;
+};
+
+/// CRC-32 of `count` rows at `rows` (laid out as `memory_type` says, `row_size` bytes apart),
+/// continuing from `crc`. Only the bytes of the type's fields count, never the padding between
+/// them, so the writer's rows and the reader's (read through the same memory type) agree.
+[[nodiscard]] std::uint32_t rows_crc(std::uint32_t crc, hid_t memory_type, const void* rows, std::size_t count, std::size_t row_size);
+/// `self_crc` of a checksum row: the CRC of its other fields.
+[[nodiscard]] std::uint32_t checksum_row_crc(const ChecksumDisk& row);
+
 /// Compound types describing the structs above in memory (fields matched by name on read, so a
 /// reader of this version reads files that carry extra columns).
 [[nodiscard]] H5Handle frame_memory_type();
 [[nodiscard]] H5Handle contact_memory_type();
 [[nodiscard]] H5Handle dcd_pair_memory_type();
+[[nodiscard]] H5Handle checksum_memory_type();
 /// The same, packed (no padding), as stored in the file.
 [[nodiscard]] H5Handle packed_copy(hid_t memory_type);
 /// Variable-length UTF-8 string type.
@@ -132,5 +155,7 @@ inline constexpr const char* kContactsPath = "contacts";
 inline constexpr const char* kDcdPairsPath = "dcd_pairs";
 inline constexpr const char* kPartsPath = "parts";
 inline constexpr const char* kRoutesPath = "routes";
+inline constexpr const char* kChecksumsPath = "checksums";
+inline constexpr const char* kFrameCheckPath = "frame_check";
 
 }  // namespace skelcd::tools::detail
