@@ -316,7 +316,10 @@ Verified verify_rows(const std::vector<detail::ChecksumDisk>& checksums, const s
   for (std::size_t i = 0; i < checksums.size(); ++i) {
     const auto& c = checksums[i];
     if (detail::checksum_row_crc(c) != c.self_crc) {
-      v.damage.push_back("/" + std::string(detail::kChecksumsPath) + " row " + std::to_string(i) + " is damaged");
+      std::string what = "/";
+      what += detail::kChecksumsPath;
+      what += " row " + std::to_string(i) + " is damaged";
+      v.damage.push_back(std::move(what));
       break;
     }
     bool ok = table_block_matches(frames, frame_type.get(), detail::kFramesPath, v.frames, c.frames_end, c.frames_crc, v.damage);

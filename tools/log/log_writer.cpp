@@ -1,11 +1,14 @@
 #include "tools/log/log_writer.hpp"
 
+#include <cerrno>
+#include <cstring>
 #include <span>
 #include <system_error>
 #include <vector>
 
 #include "skinning/errors.hpp"
 #include "tools/log/detail/hdf5_schema.hpp"
+#include "tools/log/log_reader.hpp"
 
 namespace skelcd::tools {
 
@@ -312,6 +315,72 @@ struct LogWriter::Impl {
     flush();
   }
 
+  /// Appends the report's contacts, DCD pairs and /frames row, then flushes with checksums.
+  void write(const FrameReport& report) {
+    // Contacts and pairs first, the /frames row last: a row on disk implies its findings are too.
+    contact_rows.clear();
+    for (const auto& c : report.contacts) {
+      contact_rows.push_back(detail::ContactDisk{
+          .frame = c.frame,
+          .kind = static_cast<std::uint8_t>(c.kind),
+          .a_part = c.a.part,
+          .a_index = c.a.index,
+          .a_side = c.a.side,
+          .b_part = c.b.part,
+          .b_index = c.b.index,
+          .b_side = c.b.side,
+          .toi_lower = c.toi_lower,
+          .toi_upper = c.toi_upper,
+      });
+    }
+    pair_rows.clear();
+    for (const auto& p : report.dcd_pairs) {
+      pair_rows.push_back(detail::DcdPairDisk{
+          .frame = p.frame,
+          .a_part = p.a.part,
+          .a_index = p.a.index,
+          .b_part = p.b.part,
+          .b_index = p.b.index,
+      });
+    }
+    append_rows(contacts, std::span<const detail::ContactDisk>(contact_rows),
+                detail::kContactsPath, where);
+    append_rows(dcd_pairs, std::span<const detail::DcdPairDisk>(pair_rows),
+                detail::kDcdPairsPath, where);
+    const detail::FrameDisk row = to_disk(report.row);
+    append_rows(frames, std::span<const detail::FrameDisk>(&row, 1), detail::kFramesPath,
+                where);
+    flush_with_checksums(row);
+  }
+
+  /// After a failed write: nothing more is written; the file is closed and read back, and one
+  /// line says why it failed and what it holds.
+  [[noreturn]] void fail(const std::string& error) {
+    finished = true;
+    close();
+    detail::clear_hdf5_error();
+    const int err = detail::hdf5_errno(error);
+    std::string message = where + ": ";
+    if (err == ENOSPC || err == EDQUOT) {
+      message += std::string(err == ENOSPC ? "the disk is full" : "the disk quota is exceeded") + " (" + std::strerror(err) + ")";
+    } else {
+      message += "cannot write the log (" + (error.rfind(where + ": ", 0) == 0 ? error.substr(where.size() + 2) : error) + ")";
+    }
+    try {
+      const auto log = read_log(path, ReadLogOptions{.findings = false});
+      if (log.frames.empty()) {
+        message += "; no row was written";
+      } else {
+        message += "; its first " + std::to_string(log.frames.size()) + " rows (samples " +
+                   std::to_string(log.frames.front().sample) + " to " + std::to_string(log.frames.back().sample) +
+                   ") were written and are readable";
+      }
+    } catch (const std::exception&) {
+      message += "; what was written cannot be read back";
+    }
+    throw IoError(message);
+  }
+
   void flush() {
     if (H5Fflush(file.get(), H5F_SCOPE_LOCAL) < 0) {
       throw IoError(where + ": cannot flush (" + detail::take_hdf5_error() + ")");
@@ -384,40 +453,11 @@ LogWriter::~LogWriter() {
 
 void LogWriter::append(const FrameReport& report) {
   if (impl_->finished) throw IoError(impl_->where + ": log already finished");
-  // Contacts and pairs first, the /frames row last: a row on disk implies its findings are too.
-  impl_->contact_rows.clear();
-  for (const auto& c : report.contacts) {
-    impl_->contact_rows.push_back(detail::ContactDisk{
-        .frame = c.frame,
-        .kind = static_cast<std::uint8_t>(c.kind),
-        .a_part = c.a.part,
-        .a_index = c.a.index,
-        .a_side = c.a.side,
-        .b_part = c.b.part,
-        .b_index = c.b.index,
-        .b_side = c.b.side,
-        .toi_lower = c.toi_lower,
-        .toi_upper = c.toi_upper,
-    });
+  try {
+    impl_->write(report);
+  } catch (const IoError& e) {
+    impl_->fail(e.what());
   }
-  impl_->pair_rows.clear();
-  for (const auto& p : report.dcd_pairs) {
-    impl_->pair_rows.push_back(detail::DcdPairDisk{
-        .frame = p.frame,
-        .a_part = p.a.part,
-        .a_index = p.a.index,
-        .b_part = p.b.part,
-        .b_index = p.b.index,
-    });
-  }
-  append_rows(impl_->contacts, std::span<const detail::ContactDisk>(impl_->contact_rows),
-              detail::kContactsPath, impl_->where);
-  append_rows(impl_->dcd_pairs, std::span<const detail::DcdPairDisk>(impl_->pair_rows),
-              detail::kDcdPairsPath, impl_->where);
-  const detail::FrameDisk row = to_disk(report.row);
-  append_rows(impl_->frames, std::span<const detail::FrameDisk>(&row, 1), detail::kFramesPath,
-              impl_->where);
-  impl_->flush_with_checksums(row);
 }
 
 void LogWriter::append(const FrameReport& report, std::int32_t check) {
@@ -426,10 +466,14 @@ void LogWriter::append(const FrameReport& report, std::int32_t check) {
     throw IoError(impl_->where + ": append with a check to a log without /checks");
   }
   // The row's check first: a /frames row on disk implies its /frame_check entry is too.
-  append_rows(impl_->frame_checks, std::span<const std::int32_t>(&check, 1), detail::kFrameCheckPath,
-              impl_->where);
-  impl_->pending_checks.push_back(check);
-  append(report);
+  try {
+    append_rows(impl_->frame_checks, std::span<const std::int32_t>(&check, 1), detail::kFrameCheckPath,
+                impl_->where);
+    impl_->pending_checks.push_back(check);
+    impl_->write(report);
+  } catch (const IoError& e) {
+    impl_->fail(e.what());
+  }
 }
 
 void LogWriter::finish() {

@@ -3,6 +3,8 @@
 #include <zlib.h>
 
 #include <algorithm>
+#include <cstdlib>
+#include <cstring>
 #include <cstddef>
 #include <mutex>
 #include <vector>
@@ -58,15 +60,29 @@ void insert(const H5Handle& type, const char* name, std::size_t offset, hid_t me
 }  // namespace
 
 void silence_hdf5_errors() {
-  static std::once_flag once;
-  std::call_once(once, [] { H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr); });
+  // A thread-safe HDF5 keeps one error stack, and one printing setting, per thread.
+  thread_local bool silenced = false;
+  if (!silenced) H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr);
+  silenced = true;
 }
 
 std::string take_hdf5_error() {
   std::string message;
   H5Ewalk2(H5E_DEFAULT, H5E_WALK_UPWARD, keep_innermost, &message);
   H5Eclear2(H5E_DEFAULT);
+  // The system's reason when HDF5 quotes one ("…, errno = 28, error message = 'No space left on
+  // device', …"): HDF5's own text spans lines and quotes buffer addresses.
+  if (const auto at = message.find("errno = "); at != std::string::npos) {
+    const int err = std::atoi(message.c_str() + at + 8);
+    if (err > 0) return std::string(std::strerror(err)) + " (errno " + std::to_string(err) + ")";
+  }
+  std::replace(message.begin(), message.end(), '\n', ' ');
   return message;
+}
+
+int hdf5_errno(const std::string& message) {
+  const auto at = message.find("(errno ");
+  return at == std::string::npos ? 0 : std::atoi(message.c_str() + at + 7);
 }
 
 void clear_hdf5_error() { H5Eclear2(H5E_DEFAULT); }

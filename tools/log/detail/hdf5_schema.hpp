@@ -49,8 +49,11 @@ class H5Handle {
 /// Turns HDF5's automatic error-stack printing off for this process (our messages replace it).
 void silence_hdf5_errors();
 
-/// The most specific message on HDF5's error stack ("" when empty); clears the stack.
+/// The most specific message on HDF5's error stack ("" when empty), on one line; clears the stack.
+/// A system error HDF5 quotes becomes its text and number: "No space left on device (errno 28)".
 [[nodiscard]] std::string take_hdf5_error();
+/// The errno that take_hdf5_error() quoted in `message`, 0 when none.
+[[nodiscard]] int hdf5_errno(const std::string& message);
 /// Clears HDF5's error stack (after an expected failure).
 void clear_hdf5_error();
 
