@@ -68,10 +68,13 @@ thread_local std::vector<Outcome> tl_outcomes;
 /// Calls `test(i, outcome)` for i in [0, n): on this thread, or split over oneTBB workers when
 /// `threads` > 1 and n is large enough. Every outcome goes to its own slot.
 template <typename Test>
-std::span<Outcome> evaluate(std::size_t n, std::int32_t threads, const Test& test) {
+std::span<Outcome> evaluate(std::size_t n, const ElementaryTests& tests, const Test& test) {
   if (tl_outcomes.size() < n) tl_outcomes.resize(n);
   const std::span<Outcome> outcomes(tl_outcomes.data(), n);
-  if (threads > 1 && n >= kParallelElementaryThreshold) {
+  const auto report = [&](std::size_t done) {
+    if (tests.tests_done != nullptr) tests.tests_done->fetch_add(static_cast<std::int64_t>(done), std::memory_order_relaxed);
+  };
+  if (tests.threads > 1 && n >= kParallelElementaryThreshold) {
     tbb::this_task_arena::isolate([&] {
       tbb::parallel_for(
           tbb::blocked_range<std::size_t>(0, n, 64),
@@ -79,10 +82,16 @@ std::span<Outcome> evaluate(std::size_t n, std::int32_t threads, const Test& tes
             for (std::size_t i = range.begin(); i != range.end(); ++i) {
               test(i, outcomes[i]);
             }
+            report(range.size());
           });
     });
   } else {
-    for (std::size_t i = 0; i < n; ++i) test(i, outcomes[i]);
+    constexpr std::size_t kReportEvery = 1024;
+    for (std::size_t start = 0; start < n; start += kReportEvery) {
+      const std::size_t end = std::min(n, start + kReportEvery);
+      for (std::size_t i = start; i < end; ++i) test(i, outcomes[i]);
+      report(end - start);
+    }
   }
   return outcomes;
 }
@@ -104,7 +113,7 @@ void run_ccd_tests(
   // Vertex-face queries: outcomes in candidate order, then the hits appended in that order.
   {
     const auto outcomes =
-        evaluate(candidates.vf.size(), tests.threads, [&](std::size_t i, Outcome& o) {
+        evaluate(candidates.vf.size(), tests, [&](std::size_t i, Outcome& o) {
           const VertexFacePair& p = candidates.vf[i];
           const ccd::CcdResult r = tests.vertex_face(
               vertex_face_query(x_t0, x_t1, p.vertex, x_t0, x_t1, topology.triangle(p.face)),
@@ -124,7 +133,7 @@ void run_ccd_tests(
   // Edge-edge queries, likewise.
   {
     const auto outcomes =
-        evaluate(candidates.ee.size(), tests.threads, [&](std::size_t i, Outcome& o) {
+        evaluate(candidates.ee.size(), tests, [&](std::size_t i, Outcome& o) {
           const EdgeEdgePair& p = candidates.ee[i];
           const ccd::CcdResult r = tests.edge_edge(
               edge_edge_query(x_t0, x_t1, topology.edge(p.a), x_t0, x_t1, topology.edge(p.b)),
@@ -156,7 +165,7 @@ void run_dcd_tests(
     FrameResult& out) {
   assert(tests.triangles != nullptr);
   const std::size_t first = out.dcd_pairs.size();
-  const auto outcomes = evaluate(pairs.size(), tests.threads, [&](std::size_t i, Outcome& o) {
+  const auto outcomes = evaluate(pairs.size(), tests, [&](std::size_t i, Outcome& o) {
     const TrianglePair& p = pairs[i];
     assert(p.a < p.b);
     int count = 0;

@@ -4,6 +4,7 @@
 // substitutes: tests inject reference or counting implementations).
 
 #include <array>
+#include <atomic>
 #include <cstddef>
 #include <cstdint>
 #include <span>
@@ -38,6 +39,10 @@ struct ElementaryTests {
   /// every test on the calling thread. The results do not depend on it: each query's outcome has
   /// its own slot, gathered in candidate order and sorted as in a serial run.
   std::int32_t threads = 1;
+  /// When set, the number of queries tested so far is added here as they finish (a block at a
+  /// time), so that a caller can show progress inside one long query; read it, never reset it
+  /// while tests run.
+  std::atomic<std::int64_t>* tests_done = nullptr;
 };
 
 /// The CCD query of vertex `v` (positions xv_t0 → xv_t1) against triangle `f` (positions

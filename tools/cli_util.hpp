@@ -1,12 +1,17 @@
 #pragma once
 // Small pieces every command uses: JSON output, a progress line on a terminal, path checks.
 
+#include <atomic>
 #include <chrono>
+#include <condition_variable>
 #include <cstdint>
 #include <filesystem>
 #include <string>
 #include <string_view>
+#include <thread>
+#include <mutex>
 
+#include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
 
 namespace skelcd::tools {
@@ -21,7 +26,9 @@ void print_json(const nlohmann::json& object);
 /// stderr is a terminal; erased by finish() or the destructor.
 class Progress {
  public:
-  Progress(std::string label, std::int64_t total);
+  /// @param tests_done when set, also shown (and redrawn every 0.25 s by a thread of its own
+  ///   while the line is up), so that one long row still shows work going on.
+  Progress(std::string label, std::int64_t total, const std::atomic<std::int64_t>* tests_done = nullptr);
   ~Progress();
   Progress(const Progress&) = delete;
   Progress& operator=(const Progress&) = delete;
@@ -29,12 +36,25 @@ class Progress {
   void finish();
 
  private:
+  void draw(std::int64_t done);  // with mutex_ held
+
   std::string label_;
   std::int64_t total_;
   bool enabled_;
   bool finished_ = false;
   std::chrono::steady_clock::time_point last_{};
+  const std::atomic<std::int64_t>* tests_done_;
+  std::int64_t done_ = 0;
+  std::mutex mutex_;
+  std::condition_variable wake_;
+  std::thread ticker_;
 };
+
+/// Adds a sampling-rate option (`names`, e.g. "--fps" or "--rate,--fps") that stores a rate in
+/// samples/s into `rate`. Leaving it out keeps `rate` as it is (0: the model's default); giving a
+/// value that is not finite and > 0 (0 included) is refused: InvalidInput "--fps 0: expected a
+/// rate > 0 (samples/s)".
+CLI::Option* add_rate_option(CLI::App& command, const std::string& names, double& rate, const std::string& help);
 
 /// Throws IoError "<path>: no such file" unless `path` exists.
 void require_exists(const std::filesystem::path& path);

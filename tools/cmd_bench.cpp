@@ -60,9 +60,6 @@ BenchOptions to_bench_options(const BenchArguments& a) {
     throw InvalidInput(
         "--gamma " + std::to_string(a.radial_view.gamma) + ": expected a value in [0, 1]");
   }
-  if (!(std::isfinite(a.fps) && a.fps >= 0)) {
-    throw InvalidInput("--fps " + std::to_string(a.fps) + ": expected a rate > 0 (samples/s)");
-  }
   o.run.clip = a.clip;
   o.run.fps = a.fps;
   if (!a.frames.empty()) o.run.frames = parse_frame_range(a.frames);
@@ -311,7 +308,7 @@ void add_bench_command(CLI::App& app) {
          "accuracies, comma-separated (default: exact,conservative,fast)")
       ->delimiter(',');
   cmd->add_option("--clip", args->clip, "clip to run (default: the first)");
-  cmd->add_option("--fps", args->fps, "samples per second (default: the clip's key rate, else 30)");
+  add_rate_option(*cmd, "--fps", args->fps, "samples per second (default: the clip's key rate, else 30)");
   cmd->add_option("--frames", args->frames, "samples A:B, both included (A:, :B, A)");
   cmd->add_option("--query", args->query, "ccd, dcd or both")->capture_default_str();
   cmd->add_option(

@@ -1,6 +1,7 @@
 // skelcd export MODEL [--clip NAME] [--frame K | --time S] [--rate HZ] -o OUT.{obj,ply,glb}:
 // the mesh posed at one sample (or time) of a clip, written through assimp's exporter.
 
+#include <algorithm>
 #include <cmath>
 #include <iostream>
 #include <memory>
@@ -12,6 +13,7 @@
 #include "skinning/errors.hpp"
 #include "skinning/load.hpp"
 #include "skinning/rig_motion.hpp"
+#include "tools/cli_util.hpp"
 #include "tools/commands.hpp"
 #include "tools/export_mesh.hpp"
 #include "tools/highlight.hpp"
@@ -21,9 +23,6 @@
 namespace skelcd::tools {
 namespace {
 
-// Time a sample may differ from a requested --time and still be that sample (seconds):
-// sample times are computed as i / rate in doubles.
-constexpr double kSampleTimeTolerance = 1e-9;
 
 struct ExportArgs {
   std::string model;
@@ -57,7 +56,7 @@ void run_export(const ExportArgs& args) {
     } else {
       int found = -1;
       for (int i = 0; i < motion->num_samples() && found < 0; ++i) {
-        if (std::abs(motion->sample_time(i) - t) <= kSampleTimeTolerance) found = i;
+        if (std::abs(motion->sample_time(i) - t) <= kSampleTimeTolerance * std::max(1.0, t)) found = i;
       }
       if (found < 0) fail("time " + std::to_string(t) + " s is not a sample time of '" + motion->name() + "'; use --frame");
       motion->positions(found, positions);
@@ -110,7 +109,7 @@ void add_export_command(CLI::App& app) {
   auto* time = cmd->add_option("--time", args->time, "time in seconds from the start of the clip");
   frame->excludes(time);
   time->excludes(frame);
-  cmd->add_option("--rate,--fps", args->rate, "samples per second (default: the clip's key rate, else 30)");
+  add_rate_option(*cmd, "--rate,--fps", args->rate, "samples per second (default: the clip's key rate, else 30)");
   cmd->add_option("-o,--output", args->output, "OUT.obj, OUT.ply or OUT.glb; '-' or /dev/stdout for standard output")
       ->required();
   cmd->add_option("--format", args->format, "obj, ply or glb (default: from OUT's extension; obj on standard output)");

@@ -66,9 +66,6 @@ seg::SegmentationOptions to_options(const PreprocessArguments& a) {
     throw InvalidInput("--grid " + std::to_string(a.grid) + ": expected 1 … 1024 cells");
   }
   o.heat.grid_resolution = a.grid;
-  if (!(std::isfinite(a.fps) && a.fps >= 0.0)) {
-    throw InvalidInput("--fps " + std::to_string(a.fps) + ": expected a rate > 0 (samples/s)");
-  }
   o.refine = !a.no_refine;
   return o;
 }
@@ -259,7 +256,7 @@ void add_preprocess_command(CLI::App& app) {
       ->capture_default_str();
   cmd->add_option("--theta", args->theta, "observer test rotation, degrees")->capture_default_str();
   cmd->add_option("--clip", args->clip, "also average |H-| and |Hu| over this clip's intervals");
-  cmd->add_option("--fps", args->fps, "samples per second for --clip (default: its key rate)");
+  add_rate_option(*cmd, "--fps", args->fps, "samples per second for --clip (default: its key rate)");
   cmd->add_option("--grid", args->grid, "coarse distance: voxels along the longest side")
       ->capture_default_str();
   cmd->add_flag("--no-refine", args->no_refine, "skip the cluster refinement (RVBC's plain split)");

@@ -94,7 +94,7 @@ std::string write_ply(const aiScene& scene) {
   return out;
 }
 
-// Builds an aiScene with one aiMesh per non-empty part under one root node. aiScene's destructor
+// Builds an aiScene with one aiMesh per non-empty part, each in a node of its own. aiScene's destructor
 // frees everything allocated here with new/new[], as assimp expects.
 std::unique_ptr<aiScene> build_scene(
     const skinning::Mesh& mesh,
@@ -176,10 +176,19 @@ std::unique_ptr<aiScene> build_scene(
   scene->mNumMeshes = static_cast<unsigned>(meshes.size());
   scene->mMeshes = new aiMesh*[meshes.size()];
   std::copy(meshes.begin(), meshes.end(), scene->mMeshes);
+  // One node per part, named as the part and holding its one mesh: glTF makes a mesh of each
+  // node (the meshes of one node would become primitives of a single glTF mesh), OBJ a group.
   scene->mRootNode = new aiNode("posed");
-  scene->mRootNode->mNumMeshes = scene->mNumMeshes;
-  scene->mRootNode->mMeshes = new unsigned[scene->mNumMeshes];
-  for (unsigned i = 0; i < scene->mNumMeshes; ++i) scene->mRootNode->mMeshes[i] = i;
+  auto* root = scene->mRootNode;
+  root->mNumChildren = scene->mNumMeshes;
+  root->mChildren = new aiNode*[scene->mNumMeshes];
+  for (unsigned i = 0; i < scene->mNumMeshes; ++i) {
+    auto* node = new aiNode(scene->mMeshes[i]->mName.C_Str());
+    node->mParent = root;
+    node->mNumMeshes = 1;
+    node->mMeshes = new unsigned[1]{i};
+    root->mChildren[i] = node;
+  }
   return scene;
 }
 

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <map>
 #include <string>
 
@@ -12,7 +13,6 @@ namespace skelcd::tools {
 namespace {
 
 /// Relative difference under which two sample times (i / rate, in doubles) are the same.
-constexpr double kSampleTimeTolerance = 1e-9;
 
 /// (part, index within part) → row, for vertices or triangles.
 std::map<std::pair<std::int32_t, std::int32_t>, std::int32_t> index_map(
@@ -124,10 +124,18 @@ std::vector<std::array<float, 4>> highlight_face_colors(
                        std::to_string(log.header.last_sample) + ")");
   }
   if (std::abs(row->t0 - frame_time_s) > kSampleTimeTolerance * std::max(1.0, std::abs(frame_time_s))) {
-    throw InvalidInput(where + "frame " + std::to_string(frame) + " is at t = " +
-                       std::to_string(row->t0) + " s in the log (" + std::to_string(log.header.fps) +
-                       " samples/s) but at t = " + std::to_string(frame_time_s) +
-                       " s here: pose it at the log's rate");
+    char text[320];
+    std::snprintf(text, sizeof text,
+                  "frame %d is at t = %.9g s in the log (written at %.9g samples/s) but at t = %.9g s here, "
+                  "%.3g s apart (more than the %.0e s allowed): pose it at the log's rate",
+                  frame, row->t0, log.header.fps, frame_time_s, std::abs(row->t0 - frame_time_s),
+                  kSampleTimeTolerance * std::max(1.0, std::abs(frame_time_s)));
+    std::string message = text;
+    if (log.header.fps > 0) {
+      std::snprintf(text, sizeof text, " (--rate %.9g)", log.header.fps);
+      message += text;
+    }
+    throw InvalidInput(where + message);
   }
   std::vector<std::int32_t> hits;
   try {

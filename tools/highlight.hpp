@@ -24,6 +24,12 @@ namespace skelcd::tools {
     const skinning::Mesh& mesh,
     std::int32_t frame);
 
+/// How far apart two times of one sample may be and still be the same sample, seconds per second of
+/// clip time (at least 1 s counted). Rates derived from single-precision key times differ from
+/// round numbers by ~1e-7 relatively (a log written at 23.999999407829137 samples/s puts frame 12
+/// at 0.500000012 s, `--rate 24` at 0.5 s); samples of any real rate are more than 1e-3 s apart.
+inline constexpr double kSampleTimeTolerance = 1e-6;
+
 /// RGBA in [0, 1] of highlighted and of other triangles.
 inline constexpr std::array<float, 4> kHighlightColour{0.9f, 0.1f, 0.1f, 1.0f};
 inline constexpr std::array<float, 4> kPlainColour{0.78f, 0.78f, 0.78f, 1.0f};

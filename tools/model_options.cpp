@@ -1,7 +1,10 @@
 #include "tools/model_options.hpp"
 
 #include <cmath>
+#include <cstdio>
 #include <string>
+
+#include "skinning/errors.hpp"
 
 namespace skelcd::tools {
 
@@ -16,7 +19,9 @@ void add_model_options(CLI::App& command, skinning::LoadOptions& options) {
           "--import-memory",
           [&options](double mib) {
             if (!(std::isfinite(mib) && mib >= 64 && mib <= 1024.0 * 1024.0)) {
-              throw CLI::ValidationError("--import-memory", "expected MiB between 64 and 1048576, got " + std::to_string(mib));
+              char text[64];
+              std::snprintf(text, sizeof text, "%g", mib);
+              throw InvalidInput(std::string("--import-memory ") + text + ": expected MiB between 64 and 1048576");
             }
             options.import.memory_limit_bytes = static_cast<std::size_t>(mib * 1024.0 * 1024.0);
           },

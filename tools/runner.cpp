@@ -306,6 +306,7 @@ ClipRunner::ClipRunner(
   // Within one query the elementary tests may split over the threads asked for (identical
   // output); across queries, blocks of samples go to workers (below) when the method allows.
   method_options_.elementary.threads = resolve_threads(options.threads);
+  method_options_.elementary.tests_done = options.elementary_tests_done;
   topology_ = skinning::build_topology(motion.mesh());
   if (factory_) {
     method_ = factory_(motion.mesh(), topology_, method_options_);

@@ -6,6 +6,7 @@
 // per worker, and still reports the rows strictly in order with the same contents as a serial run
 // (docs/check.md, "Threads").
 
+#include <atomic>
 #include <cstdint>
 #include <functional>
 #include <memory>
@@ -65,6 +66,9 @@ struct RunOptions {
   /// The factory's methods keep no state between queries that changes their findings or counters
   /// (methods of make_method are classified by name; a custom factory's only through this).
   bool factory_methods_stateless = false;
+  /// When set, elementary tests add to it as they finish (culling::ElementaryTests::tests_done):
+  /// a progress line can move inside one long query.
+  std::atomic<std::int64_t>* elementary_tests_done = nullptr;
 };
 
 /// What a run will do, resolved against the motion's sample count.

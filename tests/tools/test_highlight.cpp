@@ -73,6 +73,38 @@ TEST(Highlight, RefusesALogOfAnotherMesh) {
   EXPECT_THROW_MESSAGE((void)highlighted_triangles(log, mesh, 1), InvalidInput, "triangle 7");
 }
 
+TEST(Highlight, ALogWrittenAtAFloatNoisyRateMatchesTheRoundRate) {
+  // A clip whose keys are single-precision gives a rate of 23.999999407829137 samples/s: frame 12
+  // is at 0.500000012 s in its log and at 0.5 s when exported with --rate 24. Same sample.
+  const auto mesh = seam_mesh();
+  const auto path = test::temp_dir("highlight-rate") / "run.h5";
+  const double rate = 23.999999407829137;
+  LogHeader header;
+  header.num_vertices = 9;
+  header.num_triangles = 3;
+  header.clip = "walk";
+  header.fps = rate;
+  {
+    LogWriter writer(path, header);
+    FrameReport report;
+    report.row.sample = 12;
+    report.row.t0 = report.row.t1 = 12 / rate;
+    report.dcd_pairs = seam_log().dcd_pairs;
+    for (auto& p : report.dcd_pairs) p.frame = 12;
+    writer.append(report);
+    writer.finish();
+  }
+  const auto colours = highlight_face_colors(path, mesh, 12, 12 / 24.0, "walk");
+  EXPECT_EQ(colours[0], kHighlightColour);
+  // A real difference of rate is still refused, and the message shows the two times apart and
+  // the rate to export at.
+  EXPECT_THROW_MESSAGE(
+      (void)highlight_face_colors(path, mesh, 12, 12 / 25.0, "walk"), InvalidInput,
+      "frame 12 is at t = 0.500000012 s in the log (written at 23.9999994 samples/s) but at t = 0.48 s here");
+  EXPECT_THROW_MESSAGE((void)highlight_face_colors(path, mesh, 12, 12 / 25.0, "walk"), InvalidInput,
+                       "pose it at the log's rate (--rate 23.9999994)");
+}
+
 TEST(Highlight, FaceColoursFromALogFile) {
   const auto mesh = seam_mesh();
   const auto path = test::temp_dir("highlight") / "run.h5";

@@ -11,6 +11,7 @@
 
 #include "skinning/errors.hpp"
 #include "tests/support/test_support.hpp"
+#include "tests/tools/cli_runner.hpp"
 #include "tools/file_hash.hpp"
 #include "tools/log/log_reader.hpp"
 #include "tools/log/log_writer.hpp"
@@ -372,6 +373,11 @@ TEST(Log, GarbageInsideATableIsFoundByItsChecksumAndTheRowsBeforeItStayReadable)
   const auto summary = read_log(path, ReadLogOptions{.findings = false});
   EXPECT_EQ(summary.frames.size(), 20u);
   EXPECT_FALSE(summary.damage.empty());
+  // inspect summarises the rows before the damage, names it, and exits 1.
+  const auto r = skelcd::test::run_skelcd({"inspect", path.string()});
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.err.find(path.string() + ": /dcd_pairs rows 2000 to 2099 are damaged"), std::string::npos) << r.err;
+  EXPECT_NE(r.out.find("damaged (20/"), std::string::npos) << r.out;
 }
 
 TEST(Log, ReaderRejectsForeignHdf5ByName) {
