@@ -7,7 +7,7 @@ set -euo pipefail
 packages=(
   build-essential cmake ninja-build pkg-config
   libeigen3-dev libassimp-dev assimp-testmodels liburdfdom-dev
-  libhdf5-dev hdf5-tools libgtest-dev libgmock-dev libbenchmark-dev
+  libhdf5-dev hdf5-tools zlib1g-dev libgtest-dev libgmock-dev libbenchmark-dev
   libtbb-dev libgmp-dev libcli11-dev libtomlplusplus-dev
   libplplot-dev plplot-driver-cairo
   nlohmann-json3-dev python3-h5py
