@@ -28,6 +28,7 @@
 #include "skinning/generators.hpp"
 #include "skinning/load.hpp"
 #include "skinning/rig_motion.hpp"
+#include "tools/check_engine.hpp"
 #include "tools/cli_util.hpp"
 #include "tools/commands.hpp"
 #include "tools/file_hash.hpp"
@@ -83,16 +84,6 @@ std::string command_line() {
     start = end + 1;
   }
   return line;
-}
-
-/// Samples per second of the motion: the rig's own rate, else estimated from sample times.
-double motion_rate(const skinning::Motion& motion, double requested) {
-  if (const auto* rig = dynamic_cast<const skinning::RigMotion*>(&motion)) return rig->rate_hz();
-  if (requested > 0) return requested;
-  const int n = motion.num_samples();
-  if (n < 2) return 0;
-  const double span = motion.sample_time(n - 1) - motion.sample_time(0);
-  return span > 0 ? (n - 1) / span : 0;
 }
 
 RunOptions to_run_options(const CheckArguments& a) {
@@ -246,64 +237,45 @@ struct CheckedClip {
 CheckedClip check_clip(const CheckArguments& args, RunOptions options, const std::string& model_arg,
                        const skinning::LoadedModel& model, const std::string& clip,
                        const std::string& log_path) {
-  options.clip = clip;
-  const auto motion = model.motion(skinning::MotionRequest{.clip = clip, .rate_hz = args.fps});
-  const auto radial_view = setup_radial_view(args.radial_view, model, *motion, options);
+  CheckRequest request{
+      .clip = clip,
+      .fps = args.fps,
+      .frames = options.frames,
+      .method = options.method,
+      .accuracy = options.accuracy,
+      .query = options.query,
+      .min_separation = options.min_separation,
+      .threads = options.threads,
+      .radial_view = args.radial_view,
+      .log_path = log_path,
+      .input_path = model_arg,
+      .command_line = command_line(),
+      .tests_done = nullptr,
+      .on_plan = {},
+  };
   std::atomic<std::int64_t> tests_done{0};  // shown by the progress line inside long queries
-  options.elementary_tests_done = &tests_done;
-  ClipRunner runner(*motion, options);
-  const RunPlan& plan = runner.plan();
-  const double fps = motion_rate(*motion, args.fps);
-
-  std::unique_ptr<LogWriter> writer;
-  if (!log_path.empty()) {
-    LogHeader header;
-    header.skelcd_version = kVersion;
-    header.command_line = command_line();
-    header.input_path = model_arg;
-    header.input_hash = model_identity(model_arg);
-    header.clip = motion->name();
-    header.method = std::string(runner.method_name());
-    header.accuracy = std::string(ccd::to_string(options.accuracy));
-    header.query = std::string(to_string(options.query));
-    header.fps = fps;
-    header.min_separation = options.min_separation;
-    header.gamma = radial_view.gamma;
-    header.seed = radial_view.seed;
-    header.segmentation = radial_view.segmentation_source;
-    header.start_time = iso8601_utc_now();
-    header.first_sample = plan.first_sample;
-    header.last_sample = plan.last_sample;
-    header.planned_rows = plan.rows;
-    header.num_vertices = motion->mesh().num_vertices();
-    header.num_triangles = motion->mesh().num_triangles();
-    header.part_names = motion->mesh().part_names;
-    header.routes = method_routes(runner.topology(), options);
-    writer = std::make_unique<LogWriter>(log_path, header);
-  }
-
-  std::vector<FrameRow> rows;
-  rows.reserve(static_cast<std::size_t>(plan.rows));
-  Progress progress("check " + motion->name(), plan.rows, &tests_done);
-  runner.run([&](const FrameReport& report) {
-    if (writer) writer->append(report);
-    rows.push_back(report.row);
-    progress.update(static_cast<std::int64_t>(rows.size()));
-  });
-  progress.finish();
-  if (writer) writer->finish();
-
-  const auto summary = summarize(rows);
+  request.tests_done = &tests_done;
+  // The progress line starts once the check is planned; a check refused before shows none.
+  std::unique_ptr<Progress> progress;
+  std::int64_t rows = 0;
+  request.on_plan = [&](const RunPlan& plan) {
+    progress = std::make_unique<Progress>("check " + (clip.empty() ? model.path.filename().string() : clip), plan.rows,
+                                          &tests_done);
+  };
+  const auto outcome = check_model(model, request, [&](const FrameReport&) { progress->update(++rows); });
+  progress.reset();
+  const auto motion = model.motion(skinning::MotionRequest{.clip = clip, .rate_hz = args.fps});
+  options.clip = clip;
   CheckedClip checked;
   std::ostringstream text;
-  print_text_summary(text, model, *motion, options, plan, fps, summary, log_path);
-  if (!radial_view.segmentation_source.empty()) {
-    text << "segmentation: " << radial_view.segmentation_source << "\n";
+  print_text_summary(text, model, *motion, options, outcome.plan, outcome.fps, outcome.summary, log_path);
+  if (!outcome.radial_view.segmentation_source.empty()) {
+    text << "segmentation: " << outcome.radial_view.segmentation_source << "\n";
   }
   checked.text = text.str();
-  checked.json = json_summary(model, *motion, options, plan, fps, summary, log_path);
-  if (!radial_view.segmentation_source.empty()) {
-    checked.json["segmentation"] = radial_view.segmentation_source;
+  checked.json = json_summary(model, *motion, options, outcome.plan, outcome.fps, outcome.summary, log_path);
+  if (!outcome.radial_view.segmentation_source.empty()) {
+    checked.json["segmentation"] = outcome.radial_view.segmentation_source;
   }
   return checked;
 }

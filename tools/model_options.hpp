@@ -5,6 +5,7 @@
 #include <CLI/CLI.hpp>
 
 #include "skinning/load.hpp"
+#include "tools/radial_view_setup.hpp"
 
 namespace skelcd::tools {
 
@@ -12,5 +13,8 @@ namespace skelcd::tools {
 /// `command`, filling `options`.
 /// `options` must outlive the parse.
 void add_model_options(CLI::App& command, skinning::LoadOptions& options);
+
+/// Adds --gamma, --seed and --segmentation (rvbc/dynamic/auto) to `command`, stored into `args`.
+void add_radial_view_options(CLI::App& command, RadialViewArguments& args);
 
 }  // namespace skelcd::tools

@@ -14,16 +14,6 @@
 
 namespace skelcd::tools {
 
-void add_radial_view_options(CLI::App& command, RadialViewArguments& args) {
-  command.add_option("--gamma", args.gamma, "dynamic: merge threshold γ on (|H-| + |Hu|) / |C|")
-      ->capture_default_str();
-  command.add_option("--seed", args.seed, "dynamic: seed of the seed-cluster draws")
-      ->capture_default_str();
-  command.add_option("--segmentation", args.segmentation,
-                     "rvbc/dynamic: SEG.h5 from `skelcd preprocess`, used when made from this model "
-                     "(else, and by default, segment here with the rig's weights)");
-}
-
 RadialViewSetup setup_radial_view(
     const RadialViewArguments& args,
     const skinning::LoadedModel& model,

@@ -9,8 +9,6 @@
 #include <optional>
 #include <string>
 
-#include <CLI/CLI.hpp>
-
 #include "skinning/load.hpp"
 #include "skinning/motion.hpp"
 #include "tools/runner.hpp"
@@ -22,9 +20,6 @@ struct RadialViewArguments {
   std::uint64_t seed = 1;
   std::string segmentation;  ///< SEG.h5 from `skelcd preprocess`; empty: computed here
 };
-
-/// Adds --gamma, --seed and --segmentation to `command`, stored into `args`.
-void add_radial_view_options(CLI::App& command, RadialViewArguments& args);
 
 struct RadialViewSetup {
   /// Where the segmentation came from: the file, or "computed (rig weights)" / "(heat weights)".

@@ -30,9 +30,16 @@
 #endif
 
 #if defined(SKELCD_UNDER_ASAN)
-#include <sanitizer/allocator_interface.h>
-
 #include <atomic>
+
+// The sanitizer runtime's allocator hooks (compiler-rt's sanitizer/allocator_interface.h, which
+// GCC does not install; its libasan exports the same functions).
+extern "C" {
+int __sanitizer_install_malloc_and_free_hooks(
+    void (*malloc_hook)(const volatile void*, std::size_t),
+    void (*free_hook)(const volatile void*));
+std::size_t __sanitizer_get_allocated_size(const volatile void* p);
+}
 #endif
 
 namespace skelcd::skinning::detail {
@@ -54,7 +61,7 @@ void asan_on_malloc(const volatile void*, std::size_t size) {
 }
 
 void asan_on_free(const volatile void* p) {
-  asan_live_bytes.fetch_sub(static_cast<long long>(__sanitizer_get_allocated_size(const_cast<const void*>(p))));
+  asan_live_bytes.fetch_sub(static_cast<long long>(__sanitizer_get_allocated_size(p)));
 }
 #endif
 
