@@ -156,8 +156,8 @@ class BatchResult:
 class _Counter:
     """A one-line counter on stderr, for batches whose output is not a terminal."""
 
-    def __init__(self, total: int, stream=sys.stderr):
-        self.total, self.done, self.stream = total, 0, stream
+    def __init__(self, total: int, stream=None):
+        self.total, self.done, self.stream = total, 0, stream or sys.stderr
 
     def update(self, outcome: dict) -> None:
         self.done += 1
