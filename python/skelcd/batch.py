@@ -190,8 +190,8 @@ def run(models: Sequence, out_dir, *, clips: Optional[Sequence[str]] = None, all
     methods: culling methods; with more than one the log names end in -METHOD.
     scheduler: None (a LocalCluster of worker processes on this machine, n_workers of them, one
         per core by default), a scheduler address "tcp://HOST:8786", or a dask Client.
-    progress: a progress bar (dask's, on a terminal) or one line per finished task on stderr;
-        None: the bar on a terminal, lines otherwise; False: quiet.
+    progress: True or None: dask's progress bar when stdout is a terminal, else one line per
+        finished task on stderr; False: quiet.
     trajectory, srdf, package_path: load options for URDF robots (as for skelcd.load).
     check_options: the other options of skelcd.check (fps, frames, accuracy, query,
         min_separation, threads, gamma, seed, segmentation) — the same for every task.
@@ -206,11 +206,8 @@ def run(models: Sequence, out_dir, *, clips: Optional[Sequence[str]] = None, all
     load_options = {"trajectory": trajectory, "srdf": srdf, "package_path": list(package_path)}
     options = {"accuracy": "conservative", "query": "both", "min_separation": 0.0, "threads": 1,
                **check_options}
-    if progress is None:
-        progress = sys.stderr.isatty()
-        bar = progress
-    else:
-        bar = progress and sys.stderr.isatty()
+    progress = progress is None or progress
+    bar = progress and sys.stdout.isatty()  # dask's bar draws on stdout
 
     from dask.distributed import as_completed
     from dask.distributed import progress as dask_progress
