@@ -106,12 +106,17 @@ def _complete_log(path: str, task: dict) -> bool:
         return False
     h = log.header
     wanted = task["options"]
+    fps = float(wanted.get("fps") or 0)
+    frames = skelcd._frames_text(wanted.get("frames"))
+    first, _, last = frames.partition(":") if ":" in frames else (frames, "", frames)
     return (bool(h["complete"]) and not log.damage and len(log.rows) == h["planned_rows"]
             and h["input_path"] == task["model"]
             and (not task["clip_asked"] or h["clip"] == task["clip_asked"])
             and h["method"] == task["method"] and h["accuracy"] == wanted["accuracy"]
             and h["query"] == wanted["query"]
-            and h["min_separation"] == wanted["min_separation"])
+            and h["min_separation"] == wanted["min_separation"]
+            and (fps == 0 or abs(h["fps"] - fps) <= 1e-9 * fps)
+            and h["first_sample"] == int(first or 0) and (not last or h["last_sample"] == int(last)))
 
 
 def _check_task(task: dict) -> dict:
@@ -196,7 +201,8 @@ def run(models: Sequence, out_dir, *, clips: Optional[Sequence[str]] = None, all
     check_options: the other options of skelcd.check (fps, frames, accuracy, query,
         min_separation, threads, gamma, seed, segmentation) — the same for every task.
     Failures are collected in BatchResult.failures with their messages, never raised; a task whose
-    complete log exists already (same model, clip, method, accuracy, query) is skipped.
+    complete log exists already (same model, clip, method, accuracy, query, min_separation, fps
+    and frames) is skipped.
     """
     if clips and all_clips:
         raise ValueError("clips and all_clips: give one of them")
