@@ -23,8 +23,17 @@ std::vector<DisabledCollisionPair> parse_srdf_disabled_collisions(
     const std::string& text,
     const std::string& source) {
   // tinyxml (urdfdom's own XML parser) reads the document; we only walk its elements.
+  // TinyXML 2.6.2 in UTF-8 mode (any document with an <?xml?> declaration) steps over the whole
+  // length a multi-byte lead byte announces even when a NUL cuts the sequence short, and reads on
+  // behind it: past the end of the text (a heap over-read found by fuzz/fuzz_srdf), or into what
+  // follows a NUL inside it. A step is at most 4 bytes, so the parsed text ends in 4 NULs, and a
+  // NUL inside the file is refused.
+  if (const auto nul = text.find('\0'); nul != std::string::npos) {
+    throw IoError(source + ": not well-formed XML: a NUL byte at offset " + std::to_string(nul));
+  }
+  const std::string padded = text + std::string(4, '\0');
   TiXmlDocument doc;
-  doc.Parse(text.c_str());
+  doc.Parse(padded.c_str());
   if (doc.Error()) {
     throw IoError(source + ": not well-formed XML at row " + std::to_string(doc.ErrorRow()) +
                   ", column " + std::to_string(doc.ErrorCol()) + ": " + doc.ErrorDesc());

@@ -383,6 +383,23 @@ TEST(Urdf, BadInput) {
   EXPECT_THROW_MESSAGE((void)load_urdf(panda_urdf(), options), IoError, "broken.srdf: not well-formed XML");
 }
 
+// Found by fuzz/fuzz_srdf (docs/fuzzing.md): with an <?xml?> declaration TinyXML reads UTF-8 and
+// steps over the 2 bytes a lead byte 0xdb announces even when the text ends after it, reading past
+// the buffer. Cut short by the end, or by a NUL (past which it used to read on and accept the
+// unterminated attribute as link2 "b\xdb"), the SRDF is refused.
+TEST(Urdf, SrdfWithATruncatedUtf8SequenceIsRefused) {
+  const std::string head = R"(<?xml version="1.0"?><robot name="r"><disable_collisions link1="a" link2="b)";
+  EXPECT_THROW_MESSAGE(
+      (void)parse_srdf_disabled_collisions(head + "\xdb", "cut.srdf"), IoError, "cut.srdf: not well-formed XML");
+  EXPECT_THROW_MESSAGE(
+      (void)parse_srdf_disabled_collisions(head + "\xdb" + std::string(1, '\0') + "c\"/></robot>", "nul.srdf"),
+      IoError, "nul.srdf: not well-formed XML: a NUL byte at offset 76");
+  // UTF-8 that is whole still reads as before.
+  const auto pairs = parse_srdf_disabled_collisions(head + "\xc3\xa9\"/></robot>", "ok.srdf");
+  ASSERT_EQ(pairs.size(), 1U);
+  EXPECT_EQ(pairs[0].link2, "b\xc3\xa9");
+}
+
 TEST(Urdf, MeshScaleAndMultipleElements) {
   const fs::path dir = test::temp_dir("urdf_scale");
   write_file(dir / "tri.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
