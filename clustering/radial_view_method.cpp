@@ -75,10 +75,6 @@ bool apart_beyond_shared(
   return false;
 }
 
-culling::MethodOptions without_extension(culling::MethodOptions options) {
-  options.extension = nullptr;
-  return options;
-}
 
 }  // namespace
 
@@ -96,7 +92,7 @@ RadialViewMethod::RadialViewMethod(
       poses_(std::move(poses)),
       topology_(mesh, topology),
       clusters_(mesh, topology, *segmentation_, num_bones, method_options.bvh),
-      method_options_(without_extension(method_options)),
+      method_options_(method_options),
       options_(options),
       tests_(culling::with_ccd_defaults(method_options.elementary)),
       // The bvh method checks the method options (min_separation, accuracy) as every method does.
@@ -104,7 +100,7 @@ RadialViewMethod::RadialViewMethod(
       builder_(clusters_, options.clusters),
       edge_face_offsets_(topology.edge_face_offsets),
       edge_faces_(topology.edge_faces) {
-  if (!poses_) throw InvalidInput("clustering::" + name_ + ": no bone poses");
+  num_bones_ = num_bones;
   ccd_options_.min_separation = method_options.min_separation;
   const auto num_faces = at(topology_.num_triangles());
   const auto num_atomic = at(clusters_.num_atomic());
@@ -161,7 +157,8 @@ void RadialViewMethod::record_dcd(
   has_dcd_ = true;
 }
 
-void RadialViewMethod::detect_dcd(const skinning::Positions& x, culling::FrameResult& out) {
+void RadialViewMethod::dcd(const culling::Instant& at, culling::FrameResult& out) {
+  const skinning::Positions& x = at.x;
   check_positions(x, "detect_dcd", "x");
   bvh_->detect_dcd(x, out);
   record_dcd(x, out);
@@ -371,16 +368,23 @@ void RadialViewMethod::traverse(MaskedPairs which, culling::FrameResult& out) {
   }
 }
 
-void RadialViewMethod::detect_ccd(
-    const skinning::Positions& x_t0,
-    const skinning::Positions& x_t1,
-    culling::FrameResult& out) {
+void RadialViewMethod::ccd(const culling::Interval& interval, culling::FrameResult& out) {
+  const skinning::Positions& x_t0 = interval.x_t0;
+  const skinning::Positions& x_t1 = interval.x_t1;
   check_positions(x_t0, "detect_ccd", "x_t0");
   check_positions(x_t1, "detect_ccd", "x_t1");
-  if (!poses_->ready()) {
-    throw InvalidInput(
-        "clustering::" + name_ +
-        "::detect_ccd: no bone poses selected for the interval (BonePoses::select_samples)");
+  // The observers ride their bones: the interval's own transforms, else (a driver that selects
+  // them itself) the BonePoses given at construction.
+  std::span<const skinning::BoneTransform> bones_t0 = interval.bones_t0;
+  std::span<const skinning::BoneTransform> bones_t1 = interval.bones_t1;
+  if (static_cast<std::int32_t>(bones_t0.size()) < num_bones_ || static_cast<std::int32_t>(bones_t1.size()) < num_bones_) {
+    if (!poses_ || !poses_->ready()) {
+      throw InvalidInput("clustering::" + name_ + "::detect_ccd: the interval carries no bone transforms (" +
+                         std::to_string(bones_t0.size()) + " for " + std::to_string(num_bones_) +
+                         " bones) and no bone poses were selected");
+    }
+    bones_t0 = poses_->t0();
+    bones_t1 = poses_->t1();
   }
   stats_ = RadialViewStats{};
   const std::int32_t num_components = clusters_.num_components();
@@ -415,7 +419,7 @@ void RadialViewMethod::detect_ccd(
   const auto t_classify = Clock::now();
 
   // 3. RV update: observers ride their bones; classes and mega clusters (§3.1, §5).
-  pose_observers(clusters_, poses_->t0(), poses_->t1(), observers_);
+  pose_observers(clusters_, bones_t0, bones_t1, observers_);
   builder_.build(topology_.welded_triangles(), x_t0, x_t1, observers_, classes_);
   const auto t_masks = Clock::now();
   compute_masks();

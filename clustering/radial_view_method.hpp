@@ -60,7 +60,9 @@ struct RadialViewStats {
 class RadialViewMethod final : public culling::CullingMethod {
  public:
   /// @param name "rvbc" or "dynamic" (the name reported; `options.clusters.merge` decides).
-  /// @param segmentation of `mesh` (same triangle order); @param poses selected before each query.
+  /// @param segmentation of `mesh` (same triangle order).
+  /// @param poses for drivers that select bone poses themselves before each query (tests); may
+  ///   be null, and is used only for an interval that carries no bone transforms of its own.
   /// @param num_bones bones of the rig (transform count the observers need).
   /// @throws InvalidInput as culling::make_method for bad method options, and when the
   ///   segmentation does not fit the mesh.
@@ -78,14 +80,11 @@ class RadialViewMethod final : public culling::CullingMethod {
 
   /// The `bvh` method's DCD (recorded: a following detect_ccd from the same positions knows which
   /// components are free of self-intersection without a pass of its own).
-  void detect_dcd(const skinning::Positions& x, culling::FrameResult& out) override;
+  void dcd(const culling::Instant& at, culling::FrameResult& out) override;
 
-  /// @throws InvalidInput for positions with the wrong row count, or when no bone poses have been
-  ///   selected (BonePoses::select_samples / set).
-  void detect_ccd(
-      const skinning::Positions& x_t0,
-      const skinning::Positions& x_t1,
-      culling::FrameResult& out) override;
+  /// @throws InvalidInput for positions with the wrong row count, or when the interval carries no
+  ///   bone transforms and no BonePoses were selected.
+  void ccd(const culling::Interval& interval, culling::FrameResult& out) override;
 
   [[nodiscard]] const ClusterSet& clusters() const { return clusters_; }
   /// The classes and mega clusters of the last detect_ccd.
@@ -105,6 +104,7 @@ class RadialViewMethod final : public culling::CullingMethod {
   std::string name_;
   std::shared_ptr<const segmentation::Segmentation> segmentation_;
   std::shared_ptr<const BonePoses> poses_;
+  std::int32_t num_bones_ = 0;
   culling::FeatureTopology topology_;
   ClusterSet clusters_;
   culling::MethodOptions method_options_;

@@ -7,10 +7,19 @@
 # registers its test executable skelcd_NAME_tests with gtest_discover_tests.
 include(GoogleTest)
 
+#   [WHOLE_ARCHIVE]                  # linked whole: files that only register themselves (a
+#                                    # culling method, culling/method_registry.hpp) are kept
 function(skelcd_add_module name)
-  cmake_parse_arguments(ARG "" "" "SOURCES;PUBLIC_DEPS;PRIVATE_DEPS;TESTS;TEST_DEPS" ${ARGN})
+  cmake_parse_arguments(ARG "WHOLE_ARCHIVE" "" "SOURCES;PUBLIC_DEPS;PRIVATE_DEPS;TESTS;TEST_DEPS" ${ARGN})
   add_library(skelcd_${name} STATIC ${ARG_SOURCES})
-  add_library(skelcd::${name} ALIAS skelcd_${name})
+  if(ARG_WHOLE_ARCHIVE)
+    # Everyone links it through the alias, so every link sees the same whole-archive item.
+    add_library(skelcd_${name}_whole INTERFACE)
+    target_link_libraries(skelcd_${name}_whole INTERFACE "$<LINK_LIBRARY:WHOLE_ARCHIVE,skelcd_${name}>")
+    add_library(skelcd::${name} ALIAS skelcd_${name}_whole)
+  else()
+    add_library(skelcd::${name} ALIAS skelcd_${name})
+  endif()
   target_include_directories(skelcd_${name} PUBLIC ${PROJECT_SOURCE_DIR})
   target_compile_features(skelcd_${name} PUBLIC cxx_std_20)
   target_link_libraries(skelcd_${name} PUBLIC ${ARG_PUBLIC_DEPS} PRIVATE ${ARG_PRIVATE_DEPS})

@@ -50,7 +50,8 @@ class BvhMethod final : public MethodBase {
     features_.ee.reserve(4 * num_faces);
   }
 
-  void detect_dcd(const skinning::Positions& x, FrameResult& out) override {
+  void dcd(const Instant& at, FrameResult& out) override {
+    const skinning::Positions& x = at.x;
     check_positions(x, "detect_dcd", "x");
     const auto t0 = Clock::now();
     // Refit over the static volumes of the instant.
@@ -70,8 +71,9 @@ class BvhMethod final : public MethodBase {
     out.times.elementary_us += micros(t2, t3);
   }
 
-  void detect_ccd(
-      const skinning::Positions& x_t0, const skinning::Positions& x_t1, FrameResult& out) override {
+  void ccd(const Interval& interval, FrameResult& out) override {
+    const skinning::Positions& x_t0 = interval.x_t0;
+    const skinning::Positions& x_t1 = interval.x_t1;
     check_positions(x_t0, "detect_ccd", "x_t0");
     check_positions(x_t1, "detect_ccd", "x_t1");
     const auto t0 = Clock::now();

@@ -64,7 +64,8 @@ ConeMethodBase::ConeMethodBase(
   features_.ee.reserve(4 * num_faces);
 }
 
-void ConeMethodBase::detect_dcd(const skinning::Positions& x, FrameResult& out) {
+void ConeMethodBase::dcd(const Instant& at, FrameResult& out) {
+  const skinning::Positions& x = at.x;
   check_positions(x, "detect_dcd", "x");
   stats_ = {};
   stats_.culling_disabled = !cull_enabled_;
@@ -91,8 +92,9 @@ void ConeMethodBase::detect_dcd(const skinning::Positions& x, FrameResult& out) 
   out.times.elementary_us += micros(t2, t3);
 }
 
-void ConeMethodBase::detect_ccd(
-    const skinning::Positions& x_t0, const skinning::Positions& x_t1, FrameResult& out) {
+void ConeMethodBase::ccd(const culling::Interval& query, FrameResult& out) {
+  const skinning::Positions& x_t0 = query.x_t0;
+  const skinning::Positions& x_t1 = query.x_t1;
   check_positions(x_t0, "detect_ccd", "x_t0");
   check_positions(x_t1, "detect_ccd", "x_t1");
   stats_ = {};

@@ -22,9 +22,8 @@ namespace skelcd::culling::detail {
 
 class ConeMethodBase : public MethodBase, public ConeStatistics {
  public:
-  void detect_dcd(const skinning::Positions& x, FrameResult& out) override;
-  void detect_ccd(
-      const skinning::Positions& x_t0, const skinning::Positions& x_t1, FrameResult& out) override;
+  void dcd(const Instant& at, FrameResult& out) override;
+  void ccd(const culling::Interval& interval, FrameResult& out) override;
 
   [[nodiscard]] const ConeCullingStats& cone_stats() const override { return stats_; }
   [[nodiscard]] const NodeContours& contours() const override { return contours_; }

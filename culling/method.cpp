@@ -5,7 +5,7 @@
 #include "culling/detail/method_base.hpp"
 #include "culling/dual_cone.hpp"
 #include "culling/enhanced_dual_cone.hpp"
-#include "culling/method_extension.hpp"
+#include "culling/method_registry.hpp"
 #include "culling/normal_cone.hpp"
 #include "culling/routed_method.hpp"
 #include "skinning/errors.hpp"
@@ -50,7 +50,9 @@ void MethodBase::check_positions(
 }  // namespace detail
 
 std::vector<std::string> method_names() {
-  return {"brute", "bvh", "kdop", "normal-cone", "dual-cone", "enhanced-dual-cone", "auto"};
+  std::vector<std::string> names;
+  for (const MethodInfo* m : registered_methods()) names.push_back(m->name);
+  return names;
 }
 
 std::unique_ptr<CullingMethod> make_method(
@@ -58,18 +60,9 @@ std::unique_ptr<CullingMethod> make_method(
     const skinning::Mesh& mesh,
     const skinning::Topology& topology,
     const MethodOptions& options) {
-  if (name == "brute") return detail::make_brute_method(mesh, topology, options);
-  if (name == "bvh") return detail::make_bvh_method<3>(name, mesh, topology, options);
-  if (name == "kdop") return detail::make_bvh_method<8>(name, mesh, topology, options);
-  if (name == "normal-cone") return make_normal_cone_method(mesh, topology, options);
-  if (name == "dual-cone") return make_dual_cone_method(mesh, topology, options);
-  if (name == "enhanced-dual-cone") return make_enhanced_dual_cone_method(mesh, topology, options);
-  if (name == "auto") return make_routed_method(mesh, topology, options);
-  if (options.extension) {
-    if (auto m = options.extension->make_method(name, mesh, topology, options)) return m;
-  }
+  if (const MethodInfo* m = find_method(name)) return m->make(mesh, topology, options);
   std::string known;
-  for (const auto& n : method_names(options)) known += (known.empty() ? "" : ", ") + n;
+  for (const auto& n : method_names()) known += (known.empty() ? "" : ", ") + n;
   throw InvalidInput("unknown method '" + std::string(name) + "' (known: " + known + ")");
 }
 

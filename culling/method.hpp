@@ -3,7 +3,9 @@
 // a mesh's topology and then answers, per instant (DCD) or per interval (CCD), which primitive pairs
 // collide — through the shared elementary tests of ccd/ at the requested accuracy.
 
+#include <cstdint>
 #include <memory>
+#include <span>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -13,11 +15,20 @@
 #include "culling/elementary.hpp"
 #include "culling/frame_result.hpp"
 #include "skinning/mesh.hpp"
+#include "skinning/pose.hpp"
 #include "skinning/topology.hpp"
+
+namespace skelcd::segmentation {
+struct Segmentation;
+}
 
 namespace skelcd::culling {
 
-class MethodExtension;
+/// Parameters of methods declared above culling/ (radial view, paper 002 §5).
+struct MethodParameters {
+  double gamma = 0.05;     ///< `dynamic`'s merge threshold γ, in [0, 1]
+  std::uint64_t seed = 1;  ///< `dynamic`'s seed-cluster draws
+};
 
 struct MethodOptions {
   ccd::Accuracy accuracy = ccd::Accuracy::conservative;
@@ -28,8 +39,36 @@ struct MethodOptions {
   BvhOptions bvh{};
   /// The elementary tests to call; null members mean the ccd/ kernels.
   ElementaryTests elementary{};
-  /// Methods built above culling/ (culling/method_extension.hpp): make_method builds its names too.
-  std::shared_ptr<const MethodExtension> extension{};
+  /// The mesh's segmentation (atomic clusters and observers), for methods that need one
+  /// (MethodNeeds::segmentation); null when the run asks for DCD only or the model has no rig.
+  std::shared_ptr<const segmentation::Segmentation> segmentation{};
+  /// Bones of the rig whose transforms every query will carry (Interval::bones_t0/t1); 0 when the
+  /// motion has no skeleton. Methods that need bone poses are built, and chosen by `auto`, only
+  /// when it is > 0.
+  std::int32_t num_bones = 0;
+  MethodParameters parameters{};
+};
+
+/// One instant as a method sees it (a DCD query).
+struct Instant {
+  /// #W × 3 welded positions (finite: the runner checks).
+  const skinning::Positions& x;
+  /// The motion's bone transforms at this instant (skinning::Motion::bone_transforms); empty when
+  /// it has no skeleton.
+  std::span<const skinning::BoneTransform> bones{};
+  std::int32_t sample = -1;  ///< the motion's sample, -1 when not one
+};
+
+/// One interval as a method sees it (a CCD query): linear motion from x_t0 to x_t1.
+struct Interval {
+  const skinning::Positions& x_t0;  ///< #W × 3 welded positions at the start
+  const skinning::Positions& x_t1;  ///< … and at the end
+  /// Bone transforms at the two ends (what moves radial view's observers); empty when the motion
+  /// has no skeleton.
+  std::span<const skinning::BoneTransform> bones_t0{};
+  std::span<const skinning::BoneTransform> bones_t1{};
+  std::int32_t sample_t0 = -1;  ///< the motion's samples at the ends, -1 when not samples
+  std::int32_t sample_t1 = -1;
 };
 
 class CullingMethod {
@@ -40,35 +79,40 @@ class CullingMethod {
   /// Intersecting triangle pairs at one instant: every pair of distinct triangles with a common
   /// point beyond the vertices or edge they share (exact), except part-excluded pairs and
   /// duplicate faces on the same three vertices.
-  /// @param x #W × 3 welded positions (finite: the runner checks).
   /// @param out cleared by the caller; filled with dcd_pairs, counters and times.
-  /// @throws InvalidInput when x does not have #W rows.
+  /// @throws InvalidInput when at.x does not have #W rows.
   /// @note Allocation-free after the first calls, except when `out` or the method's candidate
   ///       buffers must grow beyond what an earlier call needed.
-  virtual void detect_dcd(const skinning::Positions& x, FrameResult& out) = 0;
+  void detect_dcd(const Instant& at, FrameResult& out) { dcd(at, out); }
+  void detect_dcd(const skinning::Positions& x, FrameResult& out) { dcd(Instant{.x = x}, out); }
 
-  /// VF and EE contacts over the interval with linear motion from x_t0 to x_t1: every vertex-face
-  /// and edge-edge pair not sharing a vertex (and not part-excluded) that the elementary test
-  /// reports, each tested once.
-  /// @param x_t0,x_t1 #W × 3 welded positions at the interval's ends.
+  /// VF and EE contacts over the interval: every vertex-face and edge-edge pair not sharing a
+  /// vertex (and not part-excluded) that the elementary test reports, each tested once.
   /// @param out cleared by the caller; filled with contacts, counters and times.
-  /// @throws InvalidInput when x_t0 or x_t1 does not have #W rows.
-  virtual void detect_ccd(
-      const skinning::Positions& x_t0,
-      const skinning::Positions& x_t1,
-      FrameResult& out) = 0;
+  /// @throws InvalidInput when x_t0 or x_t1 does not have #W rows, or the method needs bone
+  ///         transforms (MethodInfo::needs) and the interval carries none.
+  void detect_ccd(const Interval& interval, FrameResult& out) { ccd(interval, out); }
+  void detect_ccd(const skinning::Positions& x_t0, const skinning::Positions& x_t1, FrameResult& out) {
+    ccd(Interval{.x_t0 = x_t0, .x_t1 = x_t1}, out);
+  }
+
+ protected:
+  /// What a method implements (the detect_* calls above forward here).
+  virtual void dcd(const Instant& at, FrameResult& out) = 0;
+  virtual void ccd(const Interval& interval, FrameResult& out) = 0;
 };
 
-/// Names of the methods available now, in the order `bench` lists them.
+/// Names of the registered methods (culling/method_registry.hpp), in listing order.
 [[nodiscard]] std::vector<std::string> method_names();
 
-/// Builds method `name` for `mesh` / `topology` (the method copies what it needs).
-/// Methods: `brute` (every feature pair, volume-filtered: the reference on small meshes), `bvh`
-/// (AABB hierarchy), `kdop` (16-DOP hierarchy). All report identical contacts with the `exact`
-/// accuracy; docs/culling.md says what may differ with `conservative` (false positives only).
-/// @throws InvalidInput for an unknown name (the message lists the known ones), a mesh and
-///         topology that disagree, a negative or non-finite min_separation, or min_separation > 0
-///         with the `exact` accuracy.
+/// Builds the registered method `name` for `mesh` / `topology` (the method copies what it
+/// needs). culling/'s own: `brute` (every feature pair, volume-filtered: the reference on small
+/// meshes), `bvh` (AABB hierarchy), `kdop` (16-DOP hierarchy), the cone methods and `auto`. All
+/// that may not miss report identical contacts with the `exact` accuracy; docs/culling.md says
+/// what may differ with `conservative` (false positives only).
+/// @throws InvalidInput for an unknown name (the message lists every registered method), a mesh
+///         and topology that disagree, a negative or non-finite min_separation, or
+///         min_separation > 0 with the `exact` accuracy.
 [[nodiscard]] std::unique_ptr<CullingMethod> make_method(
     std::string_view name,
     const skinning::Mesh& mesh,

@@ -1,5 +1,5 @@
 // `auto`: per-component routing. Open components → a cone method over their triangles; closed
-// components → `dynamic` (through the options' extension) or the `bvh` fallback; the pairs
+// components → the best registered closed-part method (`dynamic`) or the `bvh` fallback; the pairs
 // between the two groups → a BVH pair traversal; one feature and elementary stage for what this
 // class traverses itself, and the groups' contacts merged, de-duplicated and sorted.
 #include "culling/routed_method.hpp"
@@ -12,7 +12,7 @@
 #include "culling/detail/method_base.hpp"
 #include "culling/dual_cone.hpp"
 #include "culling/enhanced_dual_cone.hpp"
-#include "culling/method_extension.hpp"
+#include "culling/method_registry.hpp"
 #include "culling/normal_cone.hpp"
 #include "culling/traversal.hpp"
 #include "culling/vertex_bounds.hpp"
@@ -27,26 +27,32 @@ bool is_cone_method(std::string_view name) {
   return name == "enhanced-dual-cone" || name == "normal-cone" || name == "dual-cone";
 }
 
-bool extension_builds(const MethodOptions& options, std::string_view name) {
-  if (!options.extension) return false;
-  const auto names = options.extension->method_names();
-  return std::find(names.begin(), names.end(), name) != names.end();
+/// A whole-mesh method of the registry for the closed group (built on the mesh with its open
+/// triangles excluded), as opposed to the cone methods, which take a triangle subset, and `bvh`,
+/// which this class traverses itself.
+bool whole_mesh_method(std::string_view name) {
+  return !is_cone_method(name) && name != "bvh" && name != "auto" && find_method(name) != nullptr;
 }
 
-/// The method of the closed group: as asked, else `dynamic` if available, else the fallback.
+/// The method of the closed group: as asked, else the best registered closed-part method whose
+/// needs the options meet, else the fallback.
 std::string closed_method_name(const MethodOptions& options, const RoutingOptions& routing) {
   if (!routing.closed_method.empty()) return routing.closed_method;
-  if (extension_builds(options, "dynamic")) return "dynamic";
-  return std::string(kClosedFallbackMethod);
+  const MethodInfo* best = nullptr;
+  for (const MethodInfo* m : registered_methods()) {
+    if (m->route != RouteKind::closed || !needs_met(m->needs, options)) continue;
+    if (best == nullptr || m->route_priority > best->route_priority) best = m;
+  }
+  return best != nullptr ? best->name : std::string(kClosedFallbackMethod);
 }
 
-void check_group_method(const MethodOptions& options, const std::string& name, bool open) {
+void check_group_method(const std::string& name, bool open) {
   if (is_cone_method(name) || name == "bvh") return;
-  if (!open && extension_builds(options, name)) return;
+  if (!open && whole_mesh_method(name)) return;
   throw InvalidInput(
       "culling::make_method(auto): '" + name + "' cannot take the " + (open ? "open" : "closed") +
       " components (use enhanced-dual-cone, normal-cone, dual-cone or bvh" +
-      (open ? ")" : ", or a method of the options' extension)"));
+      (open ? ")" : ", or a registered method)"));
 }
 
 /// Edge-connected components and whether each is closed (every edge has exactly two triangles):
@@ -199,8 +205,8 @@ class AutoMethod final : public detail::MethodBase, public RoutedMethod {
     }
     if (!closed_triangles_.empty()) {
       closed_bvh_ = AabbBvh(topology_.welded_triangles(), rest, closed_triangles_, options.bvh);
-      if (extension_builds(options, closed_name) && !is_cone_method(closed_name)) {
-        // A whole-mesh method (an extension's `dynamic`): the open triangles are excluded.
+      if (whole_mesh_method(closed_name)) {
+        // A whole-mesh method (`dynamic`): the open triangles are excluded.
         closed_method_ =
             make_method(closed_name, closed_only_mesh(mesh, open_face), topology, options);
       } else {
@@ -218,9 +224,10 @@ class AutoMethod final : public detail::MethodBase, public RoutedMethod {
 
   [[nodiscard]] std::span<const ComponentRoute> routes() const override { return routes_; }
 
-  void detect_dcd(const skinning::Positions& x, FrameResult& out) override {
+  void dcd(const Instant& at, FrameResult& out) override {
+    const skinning::Positions& x = at.x;
     check_positions(x, "detect_dcd", "x");
-    run_groups([&](CullingMethod& m, FrameResult& r) { m.detect_dcd(x, r); }, out);
+    run_groups([&](CullingMethod& m, FrameResult& r) { m.detect_dcd(at, r); }, out);
     const auto t0 = Clock::now();
     static_vertex_bounds<3>(x, bounds_.vertices);
     bounds_.derive(topology_, /*with_edges=*/false);
@@ -245,11 +252,12 @@ class AutoMethod final : public detail::MethodBase, public RoutedMethod {
     out.times.elementary_us += micros(t2, t3);
   }
 
-  void detect_ccd(
-      const skinning::Positions& x_t0, const skinning::Positions& x_t1, FrameResult& out) override {
+  void ccd(const Interval& interval, FrameResult& out) override {
+    const skinning::Positions& x_t0 = interval.x_t0;
+    const skinning::Positions& x_t1 = interval.x_t1;
     check_positions(x_t0, "detect_ccd", "x_t0");
     check_positions(x_t1, "detect_ccd", "x_t1");
-    run_groups([&](CullingMethod& m, FrameResult& r) { m.detect_ccd(x_t0, x_t1, r); }, out);
+    run_groups([&](CullingMethod& m, FrameResult& r) { m.detect_ccd(interval, r); }, out);
     const auto t0 = Clock::now();
     swept_vertex_bounds<3>(x_t0, x_t1, 0.5 * options_.min_separation, bounds_.vertices);
     bounds_.derive(topology_);
@@ -353,8 +361,8 @@ std::vector<ComponentRoute> route_components(
     const MethodOptions& options,
     const RoutingOptions& routing) {
   const std::string closed_name = closed_method_name(options, routing);
-  check_group_method(options, routing.open_method, /*open=*/true);
-  check_group_method(options, closed_name, /*open=*/false);
+  check_group_method(routing.open_method, /*open=*/true);
+  check_group_method(closed_name, /*open=*/false);
   const auto components = components_of(topology);
   std::vector<ComponentRoute> routes;
   routes.reserve(components.size());
@@ -368,6 +376,10 @@ std::vector<ComponentRoute> route_components(
     routes.push_back(std::move(r));
   }
   return routes;
+}
+
+std::vector<std::string> auto_group_methods(const MethodOptions& options, const RoutingOptions& routing) {
+  return {routing.open_method, closed_method_name(options, routing)};
 }
 
 std::unique_ptr<CullingMethod> make_routed_method(

@@ -1,9 +1,9 @@
 #pragma once
 // `auto`: each connected component of a mesh goes to the culling method that fits it (DESIGN.md
 // "Routing"). Components with an open boundary go to `enhanced-dual-cone` (radial-view culling
-// needs a closed surface); closed components go to `dynamic` when MethodOptions::extension builds
-// it, else to kClosedFallbackMethod (`bvh`) — the one named fallback while `dynamic` is not
-// available. Pairs of triangles in different groups go through a BVH pair traversal between the
+// needs a closed surface); closed components go to the registered closed-part method with the
+// highest priority whose needs are met (culling/method_registry.hpp: `dynamic` on a rig's clip),
+// else to kClosedFallbackMethod (`bvh`). Pairs of triangles in different groups go through a BVH pair traversal between the
 // groups' hierarchies. Everything ends in the shared feature and elementary stages over the whole
 // mesh, so contacts are reported in the mesh's own welded numbering, canonical and sorted, as by
 // any other method. To force one method for a whole object, call make_method with its name
@@ -20,15 +20,15 @@
 
 namespace skelcd::culling {
 
-/// What closed components use when no extension in the options builds `dynamic`.
+/// What closed components use when no registered closed-part method's needs are met.
 inline constexpr std::string_view kClosedFallbackMethod = "bvh";
 
 struct RoutingOptions {
   /// Method for components with an open boundary: `enhanced-dual-cone` (default),
   /// `normal-cone`, `dual-cone` or `bvh`.
   std::string open_method = "enhanced-dual-cone";
-  /// Method for closed components: empty picks `dynamic` when MethodOptions::extension builds
-  /// it, else kClosedFallbackMethod. Otherwise any name above, or a name of the extension.
+  /// Method for closed components: empty picks the best registered closed-part method whose needs
+  /// are met, else kClosedFallbackMethod. Otherwise any name above, or any registered method.
   std::string closed_method;
 };
 
@@ -40,6 +40,13 @@ struct ComponentRoute {
   std::int32_t num_triangles = 0;
   std::string method;  ///< the method testing its pairs within its group
 };
+
+/// The methods `auto` uses for the open and the closed components under `options`: {open, closed}.
+/// The closed one, unless `routing` names one, is the registered method of RouteKind::closed with
+/// the highest priority whose needs the options meet (`dynamic` with a segmentation and bone
+/// poses), else kClosedFallbackMethod.
+[[nodiscard]] std::vector<std::string> auto_group_methods(
+    const MethodOptions& options, const RoutingOptions& routing = {});
 
 /// The plan of make_routed_method: one route per component, in component order. Uses
 /// Topology::components, or finds the edge-connected components itself when that is empty.

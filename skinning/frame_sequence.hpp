@@ -73,7 +73,7 @@ class FrameSequenceMotion final : public Motion {
   [[nodiscard]] const std::filesystem::path& frame_file(int i) const {
     return data_->files[static_cast<std::size_t>(i)];
   }
-  [[nodiscard]] double rate_hz() const { return rate_hz_; }
+  [[nodiscard]] double rate_hz() const override { return rate_hz_; }
   /// The same frames (shared, not copied) at another rate.
   /// @throws InvalidInput when the rate is not positive and finite.
   [[nodiscard]] std::unique_ptr<FrameSequenceMotion> with_rate(double rate_hz) const;

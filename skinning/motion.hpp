@@ -4,8 +4,10 @@
 
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "skinning/mesh.hpp"
+#include "skinning/pose.hpp"
 
 namespace skelcd::skinning {
 
@@ -24,6 +26,28 @@ class Motion {
   /// Writes the #V × 3 positions at sample i into `out` (resized if needed).
   /// @pre 0 <= i < num_samples()
   virtual void positions(int i, Positions& out) const = 0;
+
+  /// Samples per second. The default estimates it from the sample times ((N-1) / span; 0 for a
+  /// single sample); motions that know their rate say it.
+  [[nodiscard]] virtual double rate_hz() const {
+    const int n = num_samples();
+    if (n < 2) return 0.0;
+    const double span = sample_time(n - 1) - sample_time(0);
+    return span > 0 ? (n - 1) / span : 0.0;
+  }
+
+  /// Number of bones whose transforms move the mesh (0: no skeleton, e.g. a frame sequence).
+  [[nodiscard]] virtual std::int32_t num_bones() const { return 0; }
+
+  /// Writes the skinning transforms at sample i into `out` (Pose::transforms: the num_bones()
+  /// bones first, posed global · inverse bind in object space, then any part attachments); empty
+  /// when there is no skeleton.
+  /// Thread-safe like positions().
+  /// @pre 0 <= i < num_samples()
+  virtual void bone_transforms(int i, std::vector<BoneTransform>& out) const {
+    (void)i;
+    out.clear();
+  }
 };
 
 }  // namespace skelcd::skinning

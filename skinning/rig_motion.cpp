@@ -68,6 +68,19 @@ void RigMotion::positions(int i, Positions& out) const {
   positions_at_time(sample_time(i), out);
 }
 
+std::int32_t RigMotion::num_bones() const { return rig_->skeleton.num_bones(); }
+
+void RigMotion::bone_transforms(int i, std::vector<BoneTransform>& out) const {
+  assert(i >= 0 && i < num_samples_);
+  thread_local Pose pose;
+  if (clip_ >= 0) {
+    evaluator_.clip_pose(clip_, sample_time(i), pose);
+  } else {
+    evaluator_.bind_pose(pose);
+  }
+  out.assign(pose.transforms.begin(), pose.transforms.end());
+}
+
 void RigMotion::positions_at_time(double time_s, Positions& out) const {
   // One pose buffer per thread, grown to the largest skeleton seen and then reused.
   thread_local Pose pose;

@@ -51,7 +51,11 @@ class RigMotion final : public Motion {
 
   [[nodiscard]] const Rig& rig() const { return *rig_; }
   [[nodiscard]] std::int32_t clip() const { return clip_; }
-  [[nodiscard]] double rate_hz() const { return rate_hz_; }
+  [[nodiscard]] double rate_hz() const override { return rate_hz_; }
+  /// The rig's bones.
+  [[nodiscard]] std::int32_t num_bones() const override;
+  /// The pose's transforms at sample i: #B bones, then one per part attachment (Pose::transforms).
+  void bone_transforms(int i, std::vector<BoneTransform>& out) const override;
   [[nodiscard]] double duration_s() const { return duration_s_; }
   [[nodiscard]] const PoseEvaluator& evaluator() const { return evaluator_; }
   [[nodiscard]] const LinearBlendSkinning& skinning() const { return skinning_; }

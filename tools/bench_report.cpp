@@ -13,7 +13,7 @@
 #include <system_error>
 #include <utility>
 
-#include "clustering/radial_view_extension.hpp"
+#include "culling/method_registry.hpp"
 #include "culling/method.hpp"
 #include "skinning/errors.hpp"
 #include "tools/cli_util.hpp"
@@ -23,11 +23,6 @@ namespace {
 
 constexpr std::array<ccd::Accuracy, 3> kAllAccuracies{
     ccd::Accuracy::exact, ccd::Accuracy::conservative, ccd::Accuracy::fast};
-
-const std::vector<std::string>& radial_view_names() {
-  static const std::vector<std::string> names{"rvbc", "dynamic"};
-  return names;
-}
 
 /// Rows the run will produce, estimated from the frame range before any runner validates it
 /// (ClipRunner refuses a bad range with its own message afterwards).
@@ -189,11 +184,10 @@ ReferencePick pick_reference(
 }
 
 void validate_methods(std::span<const std::string> methods, bool radial_view) {
-  std::vector<std::string> known = culling::method_names();
-  for (const auto& n : radial_view_names()) known.push_back(n);
+  const std::vector<std::string> known = culling::method_names();
   for (const auto& m : methods) {
     if (std::find(known.begin(), known.end(), m) != known.end()) {
-      if (clustering::is_radial_view_method(m) && !radial_view) {
+      if (culling::method_needs(m).bone_poses && !radial_view) {
         throw InvalidInput(
             "--methods: '" + m + "' needs a rigged model (bones move the observers)");
       }
@@ -225,6 +219,8 @@ BenchReport run_bench(const skinning::Motion& motion, const BenchOptions& option
     const bool brute_fits = brute_cost(report.triangles, rows) <= options.brute_budget ||
                             report.reference.method == "brute";
     for (const auto& m : culling::method_names()) {
+      // Methods that need bone poses run on a rig's clip only.
+      if (culling::method_needs(m).bone_poses && !options.radial_view) continue;
       if (m == "brute" && !brute_fits) {
         report.notes.push_back(
             "brute left out: estimated brute force over the budget (name it in --methods to run "
@@ -232,9 +228,6 @@ BenchReport run_bench(const skinning::Motion& motion, const BenchOptions& option
         continue;
       }
       methods.push_back(m);
-    }
-    if (options.radial_view) {
-      for (const auto& m : radial_view_names()) methods.push_back(m);
     }
   }
   std::vector<ccd::Accuracy> accuracies = options.accuracies;

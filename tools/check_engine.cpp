@@ -6,23 +6,12 @@
 
 #include "skelcd_version.hpp"
 #include "skinning/errors.hpp"
-#include "skinning/rig_motion.hpp"
 #include "tools/file_hash.hpp"
 #include "tools/log/log_writer.hpp"
 #include "tools/scene.hpp"
 
 namespace skelcd::tools {
 namespace {
-
-/// Samples per second of the motion: the rig's own rate, else estimated from sample times.
-double motion_rate(const skinning::Motion& motion, double requested) {
-  if (const auto* rig = dynamic_cast<const skinning::RigMotion*>(&motion)) return rig->rate_hz();
-  if (requested > 0) return requested;
-  const int n = motion.num_samples();
-  if (n < 2) return 0;
-  const double span = motion.sample_time(n - 1) - motion.sample_time(0);
-  return span > 0 ? (n - 1) / span : 0;
-}
 
 RunOptions run_options(const CheckRequest& r) {
   if (!(std::isfinite(r.fps) && r.fps >= 0)) {
@@ -62,7 +51,7 @@ CheckOutcome check_model(const skinning::LoadedModel& model, const CheckRequest&
   ClipRunner runner(*motion, options);
   outcome.plan = runner.plan();
   outcome.clip = motion->name();
-  outcome.fps = motion_rate(*motion, request.fps);
+  outcome.fps = motion->rate_hz();
   outcome.method = std::string(runner.method_name());
 
   std::unique_ptr<LogWriter> writer;
@@ -89,7 +78,7 @@ CheckOutcome check_model(const skinning::LoadedModel& model, const CheckRequest&
     header.num_vertices = motion->mesh().num_vertices();
     header.num_triangles = motion->mesh().num_triangles();
     header.part_names = motion->mesh().part_names;
-    header.routes = method_routes(runner.topology(), options);
+    header.routes = runner.routes();
     writer = std::make_unique<LogWriter>(request.log_path, header);
   }
 

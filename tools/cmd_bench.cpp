@@ -9,12 +9,12 @@
 #include <string>
 #include <vector>
 
-#include "clustering/radial_view_extension.hpp"
 #include "skinning/errors.hpp"
 #include "skinning/generators.hpp"
 #include "skinning/load.hpp"
 #include "skinning/rig_motion.hpp"
 #include "tools/bench_report.hpp"
+#include "culling/method_registry.hpp"
 #include "tools/cli_util.hpp"
 #include "tools/commands.hpp"
 #include "tools/model_options.hpp"
@@ -112,8 +112,7 @@ BenchReport bench_target(
 
   // rvbc and dynamic need a rig's clip: they are in the default list only then, and refused by
   // name otherwise. Their segmentation is made once, at the first radial-view run, and shared.
-  options.radial_view = model.rig != nullptr && model.kind == skinning::ModelKind::rig &&
-                        dynamic_cast<const skinning::RigMotion*>(&motion) != nullptr;
+  options.radial_view = model.rig != nullptr && model.kind == skinning::ModelKind::rig && motion.num_bones() > 0;
   validate_methods(options.methods, options.radial_view);
   struct RadialViewCache {
     bool ready = false;
@@ -122,9 +121,11 @@ BenchReport bench_target(
   auto cache = std::make_shared<RadialViewCache>();
   options.prepare =
       [cache, &args, &model, &motion, radial_view = options.radial_view](RunOptions& run) {
-        // `auto` sends closed components to `dynamic` on a rig's clip, as `check` does.
+        // Methods that need a segmentation, and `auto` (closed components to `dynamic`) on a rig's
+        // clip, as `check` does.
+        const culling::MethodInfo* info = culling::find_method(run.method);
         const bool uses_radial_view =
-            clustering::is_radial_view_method(run.method) || (run.method == "auto" && radial_view);
+            (info != nullptr && info->needs.segmentation) || (run.method == "auto" && radial_view);
         if (!uses_radial_view) return;
         if (!cache->ready) {
           cache->options = run;
@@ -132,8 +133,8 @@ BenchReport bench_target(
           (void)setup_radial_view(args.radial_view, model, motion, cache->options);
           cache->ready = true;
         }
-        run.method_extension = cache->options.method_extension;
-        run.before_query = cache->options.before_query;
+        run.segmentation = cache->options.segmentation;
+        run.method_parameters = cache->options.method_parameters;
       };
   options.progress = true;
   return run_bench(motion, options);
@@ -300,7 +301,7 @@ void add_bench_command(CLI::App& app) {
   cmd->add_option(
          "--methods",
          args->methods,
-         "methods to run, comma-separated (default: all; brute only when it fits)")
+         method_option_help("methods to run, comma-separated (default: all; brute only when it fits):"))
       ->delimiter(',');
   cmd->add_option(
          "--accuracies",

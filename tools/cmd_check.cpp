@@ -500,8 +500,7 @@ void add_check_command(CLI::App& app) {
   cmd->add_option(
          "--method",
          args->method,
-         "culling method: brute, bvh, kdop, normal-cone, dual-cone, enhanced-dual-cone, rvbc, "
-         "dynamic, or auto (closed parts: dynamic; open parts: enhanced-dual-cone)")
+         method_option_help("culling method, one of:"))
       ->capture_default_str();
   cmd->add_option("--accuracy", args->accuracy,
                   "elementary tests: conservative (never misses), fast (no guarantee), or exact (GMP "

@@ -4,6 +4,7 @@
 #include <cstdio>
 #include <string>
 
+#include "culling/method_registry.hpp"
 #include "skinning/errors.hpp"
 
 namespace skelcd::tools {
@@ -28,6 +29,16 @@ void add_model_options(CLI::App& command, skinning::LoadOptions& options) {
           "model files: memory one import may use, MiB (default " +
               std::to_string(skinning::kDefaultImportMemoryLimit >> 20) + ")")
       ->type_name("MIB");
+}
+
+std::string method_option_help(const std::string& lead) {
+  std::string help = lead;
+  for (const culling::MethodInfo* m : culling::registered_methods()) {
+    help += "\n  " + m->name + ": " + m->description;
+    if (m->needs.bone_poses || m->needs.segmentation) help += " (needs a rig's clip)";
+    if (m->may_miss) help += " (may miss contacts)";
+  }
+  return help;
 }
 
 void add_radial_view_options(CLI::App& command, RadialViewArguments& args) {

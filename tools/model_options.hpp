@@ -2,6 +2,8 @@
 // The options every command that reads a MODEL shares (how to load it), so that `info`,
 // `export` and the others accept the same spellings.
 
+#include <string>
+
 #include <CLI/CLI.hpp>
 
 #include "skinning/load.hpp"
@@ -13,6 +15,10 @@ namespace skelcd::tools {
 /// `command`, filling `options`.
 /// `options` must outlive the parse.
 void add_model_options(CLI::App& command, skinning::LoadOptions& options);
+
+/// The help text of a method option: every registered method (culling/method_registry.hpp) with
+/// its one line, and what it needs.
+[[nodiscard]] std::string method_option_help(const std::string& lead);
 
 /// Adds --gamma, --seed and --segmentation (rvbc/dynamic/auto) to `command`, stored into `args`.
 void add_radial_view_options(CLI::App& command, RadialViewArguments& args);

@@ -5,11 +5,9 @@
 #include <iostream>
 #include <memory>
 
-#include "clustering/bone_poses.hpp"
-#include "clustering/radial_view_extension.hpp"
+#include "culling/method_registry.hpp"
 #include "segmentation/segmentation.hpp"
 #include "skinning/errors.hpp"
-#include "skinning/rig_motion.hpp"
 #include "tools/segmentation_file.hpp"
 
 namespace skelcd::tools {
@@ -21,17 +19,22 @@ RadialViewSetup setup_radial_view(
     RunOptions& options) {
   RadialViewSetup setup;
   const std::string method = options.method;
+  // Which methods of this run need a segmentation: the method itself, or `auto`'s choices once a
+  // segmentation is there (it routes closed parts to `dynamic` only then).
+  const culling::MethodInfo* info = culling::find_method(method);
+  const bool needs = info != nullptr && info->needs.segmentation;
   if (method == "auto") {
-    // `auto` sends closed components to `dynamic` when the model is a rig played by its clip
-    // (bones move the observers); otherwise they go to the `bvh` fallback.
-    if (!model.rig || dynamic_cast<const skinning::RigMotion*>(&motion) == nullptr) return setup;
-  } else if (!clustering::is_radial_view_method(method)) {
+    // `auto` sends closed components to a method that needs a segmentation only when the model is
+    // a rig whose motion carries its bones; otherwise they go to the `bvh` fallback.
+    if (!model.rig || motion.num_bones() == 0) return setup;
+  } else if (!needs) {
     return setup;
   }
   if (!(std::isfinite(args.gamma) && args.gamma >= 0.0 && args.gamma <= 1.0)) {
     throw InvalidInput("--gamma " + std::to_string(args.gamma) + ": expected a value in [0, 1]");
   }
-  const clustering::RadialViewParameters parameters{.gamma = args.gamma, .seed = args.seed};
+  options.method_parameters = culling::MethodParameters{.gamma = args.gamma, .seed = args.seed};
+  const bool uses_parameters = method == "dynamic" || method == "auto";
   // DCD only: rvbc/dynamic answer each instant with `bvh` (radial view culls intervals), so no
   // segmentation is read or computed (DESIGN.md, "compute only what is asked"); `auto` sends its
   // closed parts to its `bvh` fallback, which is the same answer.
@@ -41,8 +44,6 @@ RadialViewSetup setup_radial_view(
       std::cerr << "skelcd: note: " << args.segmentation
                 << " is not used: --query dcd needs no segmentation\n";
     }
-    if (method != "auto")
-      options.method_extension = clustering::RadialViewExtension::dcd_only(parameters);
     if (method == "dynamic") {
       setup.gamma = args.gamma;
       setup.seed = static_cast<std::int64_t>(args.seed);
@@ -54,8 +55,7 @@ RadialViewSetup setup_radial_view(
         "--method " + method + " needs a rigged model (bones move the observers): " +
         model.path.string() + " has no skeleton");
   }
-  const auto* rig_motion = dynamic_cast<const skinning::RigMotion*>(&motion);
-  if (rig_motion == nullptr) {
+  if (motion.num_bones() == 0) {
     throw InvalidInput("--method " + method + ": " + motion.name() + " is not a rig's clip");
   }
 
@@ -86,26 +86,9 @@ RadialViewSetup setup_radial_view(
                                     : "computed (heat weights)";
   }
   setup.atomic_clusters = static_cast<std::int32_t>(seg->clusters.size());
-
-  // Bone poses: the runner tells which samples each query spans.
-  auto poses = std::make_shared<clustering::BonePoses>(clustering::pose_at_sample(*rig_motion));
-  options.method_extension = std::make_shared<clustering::RadialViewExtension>(
-      seg, poses, model.rig->skeleton.num_bones(), parameters);
-  options.before_query = [poses](std::int32_t s0, std::int32_t s1) {
-    poses->select_samples(s0, s1);
-  };
-  // A parallel run (RunOptions::threads) gives every extra worker its own bone poses.
-  options.make_worker_hooks = [seg,
-                               rig_motion,
-                               num_bones = model.rig->skeleton.num_bones(),
-                               parameters] {
-    auto own = std::make_shared<clustering::BonePoses>(clustering::pose_at_sample(*rig_motion));
-    return WorkerHooks{
-        .method_extension =
-            std::make_shared<clustering::RadialViewExtension>(seg, own, num_bones, parameters),
-        .before_query = [own](std::int32_t s0, std::int32_t s1) { own->select_samples(s0, s1); }};
-  };
-  if (method == "dynamic" || method == "auto") {
+  // The bones' transforms travel with every query (the runner asks the motion for them).
+  options.segmentation = std::move(seg);
+  if (uses_parameters) {
     setup.gamma = args.gamma;
     setup.seed = static_cast<std::int64_t>(args.seed);
   }

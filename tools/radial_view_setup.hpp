@@ -2,8 +2,8 @@
 // What `check` (and any command built on ClipRunner) adds for the radial-view methods `rvbc` and
 // `dynamic`: the options --gamma, --seed, --segmentation, and the setup that gives the runner's
 // method what it needs beyond the mesh — a segmentation (read from a `preprocess` file made from
-// the same model, else computed from the rig) and the bone poses of each interval, selected by
-// the runner before each query (docs/radial-view.md, "Command line").
+// the same model, else computed from the rig); the bone poses of each interval travel with the
+// query (docs/radial-view.md, "Command line").
 
 #include <cstdint>
 #include <optional>
@@ -30,12 +30,13 @@ struct RadialViewSetup {
   std::optional<std::int64_t> seed;
 };
 
-/// For options.method rvbc or dynamic: loads or computes the segmentation and sets
-/// options.method_extension and options.before_query (bone poses follow the runner's samples).
-/// With options.query == dcd nothing of the radial view is built: rvbc/dynamic get a DCD-only
-/// extension (their DCD is `bvh`'s) and `auto` none (its closed parts go to its `bvh` fallback).
-/// Does nothing and returns an empty setup for any other method.
-/// @param motion the motion the runner will check (a rig's clip: RigMotion).
+/// For a method that needs a segmentation (rvbc, dynamic; `auto` on a rig's clip): loads or
+/// computes it and sets options.segmentation and options.method_parameters; the bones'
+/// transforms then travel with every query (the runner asks the motion for them). With
+/// options.query == dcd nothing of the radial view is built: rvbc/dynamic answer DCD as `bvh`
+/// does and `auto`'s closed parts go to its `bvh` fallback. Does nothing and returns an empty
+/// setup for any other method.
+/// @param motion the motion the runner will check (a rig's clip: Motion::num_bones() > 0).
 /// @throws InvalidInput when the model has no rig, the motion is not a rig's, γ is outside
 ///   [0, 1], or the segmentation file was made from another model (hash mismatch); IoError when
 ///   the segmentation file cannot be read.

@@ -15,7 +15,9 @@
 #include <mutex>
 #include <utility>
 
+#include "culling/method_registry.hpp"
 #include "culling/routed_method.hpp"
+#include "tools/sample_sequencer.hpp"
 #include "skinning/errors.hpp"
 
 namespace skelcd::tools {
@@ -59,18 +61,27 @@ RunPlan make_plan(const skinning::Motion& motion, const RunOptions& options) {
 }
 
 
-/// What one row needs from the run: the motion, the welded topology and the file numbering.
+/// What one row needs from the run: the motion, the welded topology and the file numbering, and
+/// whether the method needs the bones' transforms.
 struct RowContext {
   const skinning::Motion& motion;
   const skinning::Topology& topology;
   const FeatureNumbering& numbering;
+  bool bones;
 };
 
-/// Poses sample i into `welded` (`posed`: scratch); returns the microseconds it took.
+/// One posed sample: welded positions and, when the method needs them, the bone transforms.
+struct PosedSample {
+  skinning::Positions welded;
+  std::vector<skinning::BoneTransform> bones;
+};
+
+/// Poses sample i into `out` (`posed`: scratch); returns the microseconds it took.
 /// Finiteness is checked once per sample, here, where positions enter.
-double pose_sample(const RowContext& c, std::int32_t i, skinning::Positions& posed,
-                   skinning::Positions& welded) {
+double pose_sample(const RowContext& c, std::int32_t i, skinning::Positions& posed, PosedSample& out) {
   const auto start = Clock::now();
+  skinning::Positions& welded = out.welded;
+  if (c.bones) c.motion.bone_transforms(i, out.bones);
   const auto& mesh = c.motion.mesh();
   c.motion.positions(i, posed);
   if (posed.rows() != mesh.num_vertices()) {
@@ -132,26 +143,65 @@ void make_report(const RowContext& c, QueryKind kind, std::int32_t sample,
   report.row.total_us = skin_us + microseconds_since(start);
 }
 
-bool is_radial_view(std::string_view name) { return name == "rvbc" || name == "dynamic"; }
+/// The options the method is built with.
+culling::MethodOptions method_options_of(const RunOptions& options, const skinning::Motion& motion) {
+  culling::MethodOptions o;
+  o.accuracy = options.accuracy;
+  o.min_separation = options.min_separation;
+  o.segmentation = options.segmentation;
+  o.num_bones = motion.num_bones();
+  o.parameters = options.method_parameters;
+  return o;
+}
 
-bool known_stateless(std::string_view name) {
-  for (const char* n : {"brute", "bvh", "kdop", "normal-cone", "dual-cone", "enhanced-dual-cone",
-                        "auto"}) {
-    if (name == n) return true;
+/// True when `name` (or, for `auto`, a method it routes to) needs the bones' transforms.
+bool needs_bone_poses(std::string_view name, const culling::MethodOptions& options) {
+  std::vector<std::string> names{std::string(name)};
+  if (name == "auto") names = culling::auto_group_methods(options);
+  for (const auto& n : names) {
+    const auto* m = culling::find_method(n);
+    if (m != nullptr && m->needs.bone_poses) return true;
   }
   return false;
 }
 
-/// One parallel worker: its own method, hook and buffers.
+/// One method and the buffers of the samples it checks: the serial run's, or a parallel worker's.
 struct Worker {
   std::unique_ptr<culling::CullingMethod> owned;
   culling::CullingMethod* method = nullptr;
-  std::function<void(std::int32_t, std::int32_t)> before_query;
   skinning::Positions posed;
-  skinning::Positions welded_t0;
-  skinning::Positions welded_t1;
+  PosedSample samples[2];
   culling::FrameResult result;
 };
+
+/// Runs the rows of `sequence` with `w`, passing each completed row to `emit`, in order.
+template <class Emit>
+void check_samples(const RowContext& context, const SampleSequence& sequence, Worker& w, Emit&& emit) {
+  FrameReport report;
+  run_sequence(
+      sequence,
+      [&](std::int32_t k, int slot) { return pose_sample(context, k, w.posed, w.samples[slot]); },
+      [&](std::int32_t k, int slot, double skin_us) {
+        const auto start = Clock::now();
+        w.result.clear();
+        const PosedSample& x = w.samples[slot];
+        w.method->detect_dcd(culling::Instant{.x = x.welded, .bones = x.bones, .sample = k}, w.result);
+        make_report(context, QueryKind::dcd, k, w.result, skin_us, start, report);
+        emit(report);
+      },
+      [&](std::int32_t k, int slot_t0, int slot_t1, double skin_us) {
+        const auto start = Clock::now();
+        w.result.clear();
+        const PosedSample& a = w.samples[slot_t0];
+        const PosedSample& b = w.samples[slot_t1];
+        w.method->detect_ccd(
+            culling::Interval{.x_t0 = a.welded, .x_t1 = b.welded, .bones_t0 = a.bones, .bones_t1 = b.bones,
+                              .sample_t0 = k, .sample_t1 = k + 1},
+            w.result);
+        make_report(context, QueryKind::ccd, k, w.result, skin_us, start, report);
+        emit(report);
+      });
+}
 
 /// Workers handed out to the pipeline's parallel stage: one per block being checked, built on
 /// first need (at most one per thread of the arena), returned after the block.
@@ -269,27 +319,16 @@ std::int32_t resolve_threads(std::int32_t threads) {
 }
 
 std::string serial_reason(std::string_view name, const RunOptions& options) {
-  const bool radial_view =
-      is_radial_view(name) || (name == "auto" && options.method_extension != nullptr);
-  if (radial_view && options.min_separation == 0.0) {
-    // What rvbc/dynamic carry from one query to the next (docs/check.md, "Threads").
-    if (options.query == QuerySet::ccd) {
-      return "method " + std::string(name) +
-             " carries each interval's end state into the next; without the DCD at each sample "
-             "(--query ccd) that changes its counters";
-    }
-    if (options.accuracy == ccd::Accuracy::fast) {
-      return "method " + std::string(name) +
-             " carries each interval's end state into the next; with --accuracy fast (which may "
-             "miss contacts) that can change its rows";
-    }
-  } else if (!radial_view && !known_stateless(name)) {
-    return "method " + std::string(name) + " is not known to be free of state between queries";
-  }
-  if (options.before_query && !options.make_worker_hooks) {
-    return "the before-query hook cannot be copied per worker";
-  }
-  return {};
+  const culling::MethodInfo* m = culling::find_method(name);
+  if (m == nullptr) return "method " + std::string(name) + " is not known (not registered)";
+  if (!m->serial_reason) return {};
+  culling::MethodOptions o;
+  o.accuracy = options.accuracy;
+  o.min_separation = options.min_separation;
+  o.segmentation = options.segmentation;
+  o.parameters = options.method_parameters;
+  o.num_bones = options.segmentation ? 1 : 0;  // bone poses come with a segmentation (a rig's clip)
+  return m->serial_reason(o, options.query != QuerySet::ccd);
 }
 
 ClipRunner::ClipRunner(
@@ -299,9 +338,7 @@ ClipRunner::ClipRunner(
     : motion_(motion),
       options_(options),
       factory_(std::move(factory)),
-      method_options_{.accuracy = options.accuracy,
-                      .min_separation = options.min_separation,
-                      .extension = options.method_extension},
+      method_options_(method_options_of(options, motion)),
       plan_(make_plan(motion, options)) {
   // Within one query the elementary tests may split over the threads asked for (identical
   // output); across queries, blocks of samples go to workers (below) when the method allows.
@@ -314,16 +351,18 @@ ClipRunner::ClipRunner(
     method_ = culling::make_method(options.method, motion.mesh(), topology_, method_options_);
   }
   if (!method_) throw InvalidInput("method '" + options.method + "' could not be built");
+  bones_ = motion.num_bones() > 0 && needs_bone_poses(options.method, method_options_);
 
   // Threads: blocks of consecutive samples (a DCD at k, then the CCD k → k+1) go to workers.
   const std::int32_t wanted = resolve_threads(options.threads);
   if (wanted > 1) {
     if (!factory_) {
-      plan_.serial_reason = serial_reason(method_->name(), options);
+      const culling::MethodInfo* m = culling::find_method(options.method);
+      if (m != nullptr && m->serial_reason) {
+        plan_.serial_reason = m->serial_reason(method_options_, options.query != QuerySet::ccd);
+      }
     } else if (!options.factory_methods_stateless) {
       plan_.serial_reason = "the method factory's methods are not known to be stateless";
-    } else if (options.before_query && !options.make_worker_hooks) {
-      plan_.serial_reason = "the before-query hook cannot be copied per worker";
     }
     const bool dcd = options.query != QuerySet::ccd;
     const std::int32_t units = plan_.samples - (dcd ? 0 : 1);
@@ -362,51 +401,21 @@ void ClipRunner::run_serial(const FrameCallback& on_frame) {
 
 void ClipRunner::run_queries_in_order(const FrameCallback& on_frame) {
   const FeatureNumbering numbering(motion_.mesh(), topology_);
-  const RowContext context{motion_, topology_, numbering};
+  const RowContext context{motion_, topology_, numbering, bones_};
   const bool dcd = options_.query != QuerySet::ccd;
-  const bool ccd = options_.query != QuerySet::dcd;
-
-  // Buffers reused across samples: the file positions of the sample being posed, and the welded
-  // positions at the interval's two ends.
-  skinning::Positions posed;
-  skinning::Positions welded_t0;
-  skinning::Positions welded_t1;
-  culling::FrameResult result;
-  FrameReport report;
-
-  const auto run_dcd = [&](std::int32_t sample, const skinning::Positions& x, double skin_us) {
-    const auto start = Clock::now();
-    result.clear();
-    if (options_.before_query) options_.before_query(sample, sample);
-    method_->detect_dcd(x, result);
-    make_report(context, QueryKind::dcd, sample, result, skin_us, start, report);
-    on_frame(report);
-  };
-
-  // Skinning time is charged to the first row that needs the sample.
-  double pending_skin_us = pose_sample(context, plan_.first_sample, posed, welded_t1);
-  if (dcd) {
-    run_dcd(plan_.first_sample, welded_t1, std::exchange(pending_skin_us, 0.0));
-  }
-  for (std::int32_t i = plan_.first_sample; i < plan_.last_sample; ++i) {
-    std::swap(welded_t0, welded_t1);
-    pending_skin_us += pose_sample(context, i + 1, posed, welded_t1);
-    if (ccd) {
-      const auto start = Clock::now();
-      result.clear();
-      if (options_.before_query) options_.before_query(i, i + 1);
-      method_->detect_ccd(welded_t0, welded_t1, result);
-      make_report(context, QueryKind::ccd, i, result, std::exchange(pending_skin_us, 0.0), start,
-                  report);
-      on_frame(report);
-    }
-    if (dcd) run_dcd(i + 1, welded_t1, std::exchange(pending_skin_us, 0.0));
-  }
+  const SampleSequence all{.first = plan_.first_sample,
+                           .end = dcd ? plan_.last_sample + 1 : plan_.last_sample,
+                           .last = plan_.last_sample,
+                           .dcd = dcd,
+                           .ccd = options_.query != QuerySet::dcd};
+  Worker w;
+  w.method = method_.get();
+  check_samples(context, all, w, on_frame);
 }
 
 void ClipRunner::run_parallel(const FrameCallback& on_frame) {
   const FeatureNumbering numbering(motion_.mesh(), topology_);
-  const RowContext context{motion_, topology_, numbering};
+  const RowContext context{motion_, topology_, numbering, bones_};
   const bool dcd = options_.query != QuerySet::ccd;
   const bool ccd = options_.query != QuerySet::dcd;
   const std::int32_t last = plan_.last_sample;
@@ -414,19 +423,12 @@ void ClipRunner::run_parallel(const FrameCallback& on_frame) {
   // serial row order, cut into runs of consecutive k.
   const std::int32_t end = dcd ? last + 1 : last;
 
-  // Worker 0 is the method built by the constructor (with the caller's hook); the others are built
-  // on first need, each with its own hooks.
+  // Worker 0 is the method built by the constructor; the others are built on first need, each
+  // with the same options (what a query needs travels with the query).
   WorkerPool pool([&] {
     auto w = std::make_unique<Worker>();
-    culling::MethodOptions method_options = method_options_;
-    if (options_.make_worker_hooks) {
-      auto hooks = options_.make_worker_hooks();
-      method_options.extension = std::move(hooks.method_extension);
-      w->before_query = std::move(hooks.before_query);
-    }
-    w->owned = factory_ ? factory_(motion_.mesh(), topology_, method_options)
-                        : culling::make_method(options_.method, motion_.mesh(), topology_,
-                                               method_options);
+    w->owned = factory_ ? factory_(motion_.mesh(), topology_, method_options_)
+                        : culling::make_method(options_.method, motion_.mesh(), topology_, method_options_);
     if (!w->owned) throw InvalidInput("method '" + options_.method + "' could not be built");
     w->method = w->owned.get();
     return w;
@@ -434,7 +436,6 @@ void ClipRunner::run_parallel(const FrameCallback& on_frame) {
   {
     auto first = std::make_unique<Worker>();
     first->method = method_.get();
-    first->before_query = options_.before_query;
     pool.add(std::move(first));
   }
 
@@ -442,31 +443,8 @@ void ClipRunner::run_parallel(const FrameCallback& on_frame) {
     Worker* acquired = nullptr;
     try {
       acquired = &pool.acquire();
-      Worker& w = *acquired;
-      const auto query = [&](std::int32_t s0, std::int32_t s1) {
-        w.result.clear();
-        if (w.before_query) w.before_query(s0, s1);
-      };
-      double pending_skin_us = pose_sample(context, block.first, w.posed, w.welded_t1);
-      for (std::int32_t k = block.first; k < block.end; ++k) {
-        if (dcd) {
-          if (k > block.first && !ccd) pending_skin_us += pose_sample(context, k, w.posed, w.welded_t1);
-          const auto start = Clock::now();
-          query(k, k);
-          w.method->detect_dcd(w.welded_t1, w.result);
-          make_report(context, QueryKind::dcd, k, w.result, std::exchange(pending_skin_us, 0.0),
-                      start, block.reports.emplace_back());
-        }
-        if (ccd && k < last) {
-          std::swap(w.welded_t0, w.welded_t1);
-          pending_skin_us += pose_sample(context, k + 1, w.posed, w.welded_t1);
-          const auto start = Clock::now();
-          query(k, k + 1);
-          w.method->detect_ccd(w.welded_t0, w.welded_t1, w.result);
-          make_report(context, QueryKind::ccd, k, w.result, std::exchange(pending_skin_us, 0.0),
-                      start, block.reports.emplace_back());
-        }
-      }
+      const SampleSequence part{.first = block.first, .end = block.end, .last = last, .dcd = dcd, .ccd = ccd};
+      check_samples(context, part, *acquired, [&](const FrameReport& r) { block.reports.push_back(r); });
     } catch (...) {
       // Reported after the rows before it, in order: as a serial run would.
       block.error = std::current_exception();
@@ -526,15 +504,10 @@ void ClipRunner::run_parallel(const FrameCallback& on_frame) {
   if (failure) std::rethrow_exception(failure);
 }
 
-std::vector<LogRoute> method_routes(
-    const skinning::Topology& topology, const RunOptions& options, std::int32_t part_offset) {
+std::vector<LogRoute> ClipRunner::routes(std::int32_t part_offset) const {
   std::vector<LogRoute> routes;
-  if (options.method != "auto") return routes;
-  const culling::MethodOptions method_options{
-      .accuracy = options.accuracy,
-      .min_separation = options.min_separation,
-      .extension = options.method_extension};
-  for (const auto& r : culling::route_components(topology, method_options)) {
+  if (options_.method != "auto") return routes;
+  for (const auto& r : culling::route_components(topology_, method_options_)) {
     routes.push_back(LogRoute{
         .component = r.component,
         .part = r.part + part_offset,

@@ -17,6 +17,7 @@
 
 #include "ccd/accuracy.hpp"
 #include "culling/method.hpp"
+#include "segmentation/segmentation.hpp"
 #include "skinning/motion.hpp"
 #include "skinning/topology.hpp"
 #include "tools/frame_report.hpp"
@@ -34,14 +35,6 @@ struct FrameRange {
 /// @throws InvalidInput quoting `text` when it is malformed.
 [[nodiscard]] FrameRange parse_frame_range(std::string_view text);
 
-/// What one parallel worker needs besides its own method: the extension its method is built with
-/// and the before_query hook that selects that worker's per-query state (rvbc/dynamic: its own
-/// bone poses).
-struct WorkerHooks {
-  std::shared_ptr<const culling::MethodExtension> method_extension;
-  std::function<void(std::int32_t sample_t0, std::int32_t sample_t1)> before_query;
-};
-
 struct RunOptions {
   std::string clip;    ///< clip to check (empty: the model's first clip) — used by the loader
   double fps = 0;      ///< sampling rate in samples/s (0: the clip's own key rate) — used by the loader
@@ -50,19 +43,17 @@ struct RunOptions {
   ccd::Accuracy accuracy = ccd::Accuracy::conservative;
   QuerySet query = QuerySet::both;
   double min_separation = 0;  ///< contact distance, model units
-  /// Methods built above culling/ (rvbc, dynamic: tools/radial_view_setup.hpp), passed to make_method.
-  std::shared_ptr<const culling::MethodExtension> method_extension;
-  /// Called before each query with its samples (a DCD at i: (i, i); a CCD interval: (i, i + 1)).
-  std::function<void(std::int32_t sample_t0, std::int32_t sample_t1)> before_query;
+  /// The mesh's segmentation for methods that need one (rvbc, dynamic, auto's closed parts:
+  /// tools/radial_view_setup.hpp); null otherwise.
+  std::shared_ptr<const segmentation::Segmentation> segmentation;
+  /// Parameters of methods declared above culling/ (γ, seed).
+  culling::MethodParameters method_parameters;
   /// Worker threads: 1 = serial (the default here), 0 = all cores (tbb::info::default_concurrency).
   /// A run is serial anyway when its method carries state between queries that would change its
   /// rows (RunPlan::serial_reason says why).
   std::int32_t threads = 1;
   /// Samples per block a worker checks in a row (0: chosen from the clip length and threads).
   std::int32_t block_samples = 0;
-  /// With before_query set, a parallel run calls this once per extra worker for that worker's own
-  /// extension and hook; without it such a run is serial.
-  std::function<WorkerHooks()> make_worker_hooks;
   /// The factory's methods keep no state between queries that changes their findings or counters
   /// (methods of make_method are classified by name; a custom factory's only through this).
   bool factory_methods_stateless = false;
@@ -85,8 +76,8 @@ struct RunPlan {
 };
 
 /// Why method `name` must run serially under `options` (empty: parallel runs give the same rows):
-/// rvbc/dynamic carry which components were free of self-intersection from one query to the next,
-/// which changes their counters with --query ccd and can change them with --accuracy fast.
+/// what the method declares (culling::MethodInfo::serial_reason; rvbc/dynamic carry which
+/// components were free of self-intersection from one query to the next).
 [[nodiscard]] std::string serial_reason(std::string_view name, const RunOptions& options);
 
 /// The worker count `--threads N` means: N, or all cores for 0.
@@ -99,12 +90,6 @@ using MethodFactory = std::function<std::unique_ptr<culling::CullingMethod>(
 /// Called once per completed row (a DCD sample or a CCD interval), in order.
 using FrameCallback = std::function<void(const FrameReport&)>;
 
-/// Where `auto` sends each connected component of `topology` (the log's /routes rows); empty for
-/// any other method. `part_offset` is added to each route's part id (a scene's object offset).
-/// @throws InvalidInput as culling::route_components.
-[[nodiscard]] std::vector<LogRoute> method_routes(
-    const skinning::Topology& topology, const RunOptions& options, std::int32_t part_offset = 0);
-
 class ClipRunner {
  public:
   /// Builds the welded topology of motion.mesh() and the method; validates the options against the
@@ -115,6 +100,9 @@ class ClipRunner {
   [[nodiscard]] const RunPlan& plan() const { return plan_; }
   [[nodiscard]] const skinning::Topology& topology() const { return topology_; }
   [[nodiscard]] std::string_view method_name() const { return method_->name(); }
+  /// Under `auto`, where each connected component went (the log's /routes rows); empty for any
+  /// other method. `part_offset` is added to each route's part id (a scene's object offset).
+  [[nodiscard]] std::vector<LogRoute> routes(std::int32_t part_offset = 0) const;
 
   /// Runs every row of the plan, calling `on_frame` after each, in plan order (one call at a time;
   /// in a parallel run possibly from a worker thread).
@@ -134,6 +122,7 @@ class ClipRunner {
   RunPlan plan_;
   skinning::Topology topology_;
   std::unique_ptr<culling::CullingMethod> method_;
+  bool bones_ = false;  ///< the queries carry the bones' transforms (the method needs them)
 };
 
 /// Maps welded ids (culling's numbering) back to the file's own numbering (part, index).

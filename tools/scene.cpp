@@ -9,7 +9,7 @@
 #include <set>
 #include <sstream>
 
-#include "clustering/radial_view_extension.hpp"
+#include "culling/method_registry.hpp"
 #include "culling/method.hpp"
 #include "skinning/errors.hpp"
 #include "skinning/generators.hpp"
@@ -296,7 +296,7 @@ SceneObject parse_object(const Scene& scene, const std::string& name, const toml
   }
   o.accuracy = scene.accuracy;
   if (auto a = r.string("accuracy")) o.accuracy = parse_accuracy_at(r, "accuracy", *a);
-  if (clustering::is_radial_view_method(o.method) && (!o.parts.empty() || !o.offset.isZero())) {
+  if (culling::method_needs(o.method).bone_poses && (!o.parts.empty() || !o.offset.isZero())) {
     r.fail(
         o.method_line != 0 ? o.method_line : o.line,
         "method '" + o.method + "' needs the rig's own motion: not with 'parts' or 'offset'");
@@ -366,12 +366,7 @@ std::string Scene::where(int line, std::string_view message) const {
   return path.string() + ":" + std::to_string(line) + ": " + std::string(message);
 }
 
-std::vector<std::string> scene_method_names() {
-  auto names = culling::method_names();
-  names.push_back("rvbc");
-  names.push_back("dynamic");
-  return names;
-}
+std::vector<std::string> scene_method_names() { return culling::method_names(); }
 
 Scene parse_scene(const std::filesystem::path& path) {
   std::error_code ec;

@@ -99,7 +99,7 @@ struct Scene {
 /// As parse_scene, from text; `path` names the scene in messages and is the base of relative paths.
 [[nodiscard]] Scene parse_scene_text(std::string_view text, const std::filesystem::path& path);
 
-/// The method names a scene accepts (culling::method_names() and the radial-view methods).
+/// The method names a scene accepts: every registered method (culling/method_registry.hpp).
 [[nodiscard]] std::vector<std::string> scene_method_names();
 
 }  // namespace skelcd::tools

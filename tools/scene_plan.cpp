@@ -4,7 +4,7 @@
 #include <algorithm>
 #include <cstdio>
 
-#include "clustering/radial_view_extension.hpp"
+#include "culling/method_registry.hpp"
 #include "skinning/errors.hpp"
 
 namespace skelcd::tools {
@@ -33,7 +33,7 @@ void decide_stages(ObjectPlan& o) {
   o.topology = o.checked;
   o.bvh = pair || (self && o.method != "brute");
   o.swept_bounds = o.self_ccd || o.pair_ccd;
-  const bool radial = clustering::is_radial_view_method(o.method);
+  const bool radial = culling::method_needs(o.method).segmentation;
   if (self && is_cone_method(o.method)) {
     o.cones = true;
   } else if (self && o.method == "auto") {

@@ -12,7 +12,7 @@
 #include <memory>
 #include <sstream>
 
-#include "clustering/radial_view_extension.hpp"
+#include "culling/method_registry.hpp"
 #include "culling/pair_checker.hpp"
 #include "skelcd_version.hpp"
 #include "skinning/errors.hpp"
@@ -49,6 +49,11 @@ class SelectedMotion final : public skinning::Motion {
   int num_samples() const override { return base_.num_samples(); }
   double sample_time(int i) const override { return base_.sample_time(i); }
   std::string name() const override { return base_.name(); }
+  double rate_hz() const override { return base_.rate_hz(); }
+  std::int32_t num_bones() const override { return base_.num_bones(); }
+  void bone_transforms(int i, std::vector<skinning::BoneTransform>& out) const override {
+    base_.bone_transforms(i, out);
+  }
   // Thread-safe: each call poses into its own buffer (a parallel runner calls it from workers).
   void positions(int i, skinning::Positions& out) const override {
     skinning::Positions all;
@@ -202,14 +207,6 @@ skinning::Rig sheet_rig(
   return rig;
 }
 
-double motion_rate(const skinning::Motion& motion) {
-  if (const auto* rig = dynamic_cast<const skinning::RigMotion*>(&motion)) return rig->rate_hz();
-  const int n = motion.num_samples();
-  if (n < 2) return 0;
-  const double span = motion.sample_time(n - 1) - motion.sample_time(0);
-  return span > 0 ? (n - 1) / span : 0;
-}
-
 struct LoadedObject {
   std::optional<skinning::LoadedModel> model;
   std::unique_ptr<skinning::Motion> base;
@@ -288,13 +285,13 @@ ObjectFacts facts_of(const SceneObject& so, const LoadedObject& lo) {
   f.source = so.sheet ? "sheet on " + so.attach_to : so.model;
   f.motion = lo.motion->name();
   f.samples = lo.motion->num_samples();
-  f.rate_hz = motion_rate(*lo.motion);
+  f.rate_hz = lo.motion->rate_hz();
   f.vertices = lo.motion->mesh().num_vertices();
   f.triangles = lo.motion->mesh().num_triangles();
   f.parts = lo.motion->mesh().num_parts();
   for (const auto& c : lo.topology.components)
     (c.closed ? f.closed_components : f.open_components)++;
-  f.rig_motion = dynamic_cast<const skinning::RigMotion*>(lo.motion) != nullptr;
+  f.rig_motion = lo.motion->num_bones() > 0;
   return f;
 }
 
@@ -308,9 +305,9 @@ void check_time_bases(
         rates,
         sizeof rates,
         " (%.6g Hz) and %d (%.6g Hz)",
-        motion_rate(a),
+        a.rate_hz(),
         b.num_samples(),
-        motion_rate(b));
+        b.rate_hz());
     throw InvalidInput(scene.where(
         p.line,
         pair + "'" + p.a + "' has " + std::to_string(a.num_samples()) + " samples" + rates +
@@ -557,9 +554,8 @@ SceneRunResult run_scene(const Scene& scene, const SceneRunOptions& options) {
     ro.min_separation = scene.min_separation;
     ro.threads = options.threads;
     try {
-      // rvbc/dynamic need their extension even for DCD only (a DCD-only one, no segmentation).
-      if (plan.objects[at(c.object_a)].segmentation ||
-          clustering::is_radial_view_method(c.method)) {
+      // Methods that need a segmentation get one (none for DCD only: they answer as `bvh`).
+      if (plan.objects[at(c.object_a)].segmentation || culling::method_needs(c.method).segmentation) {
         const auto setup = setup_radial_view(RadialViewArguments{}, *lo.model, *lo.motion, ro);
         if (setup.gamma) gamma = setup.gamma;
         if (setup.seed) seed = setup.seed;
@@ -633,7 +629,7 @@ SceneRunResult run_scene(const Scene& scene, const SceneRunOptions& options) {
       const CheckPlan& c = plan.checks[k];
       if (c.kind != CheckKind::self || !runners[k]) continue;
       const auto routes =
-          method_routes(runners[k]->topology(), run_options[k], loaded[at(c.object_a)].part_offset);
+          runners[k]->routes(loaded[at(c.object_a)].part_offset);
       header.routes.insert(header.routes.end(), routes.begin(), routes.end());
     }
     writer = std::make_unique<LogWriter>(options.log, header);

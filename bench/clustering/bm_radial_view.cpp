@@ -199,7 +199,7 @@ int run_table(
       bare.guard = false;
       skelcd::clustering::RadialViewMethod method("dynamic", rig->mesh, scene.topology,
                                                   scene.segmentation, scene.poses,
-                                                  rig->skeleton.num_bones(), {}, bare);
+                                                  rig->skeleton.num_bones(), scene.options(), bare);
       const ClipRun run = skelcd::test::run_clip(scene, method, first, last);
       std::vector<skelcd::test::ContactKey> missed, extra;
       std::set_difference(reference.contacts.begin(), reference.contacts.end(),

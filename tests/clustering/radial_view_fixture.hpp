@@ -12,7 +12,7 @@
 #include <vector>
 
 #include "clustering/bone_poses.hpp"
-#include "clustering/radial_view_extension.hpp"
+#include "clustering/radial_view_methods.hpp"
 #include "clustering/radial_view_method.hpp"
 #include "culling/method.hpp"
 #include "segmentation/segmentation.hpp"
@@ -47,17 +47,23 @@ struct RadialViewScene {
   }
 
   [[nodiscard]] culling::MethodOptions options(
-      const clustering::RadialViewParameters& parameters = {},
+      const culling::MethodParameters& parameters = {},
       culling::MethodOptions base = {}) const {
-    base.extension = std::make_shared<clustering::RadialViewExtension>(
-        segmentation, poses, rig->skeleton.num_bones(), parameters);
+    base.segmentation = segmentation;
+    base.num_bones = rig->skeleton.num_bones();
+    base.parameters = parameters;
     return base;
   }
 
+  /// `rvbc`/`dynamic` pose their observers with the bone poses this fixture selects before each
+  /// query; every other method comes from the registry.
   [[nodiscard]] std::unique_ptr<culling::CullingMethod> method(
       const std::string& name,
-      const clustering::RadialViewParameters& parameters = {},
+      const culling::MethodParameters& parameters = {},
       culling::MethodOptions base = {}) const {
+    if (clustering::is_radial_view_method(name)) {
+      return clustering::make_radial_view_method(name, rig->mesh, topology, options(parameters, base), poses);
+    }
     return culling::make_method(name, rig->mesh, topology, options(parameters, base));
   }
 
@@ -114,7 +120,10 @@ inline ClipRun run_clip(
     }
     scene.poses->select_samples(i, i + 1);
     const auto start = std::chrono::steady_clock::now();
-    method.detect_ccd(x0, x1, out);
+    method.detect_ccd(
+        culling::Interval{.x_t0 = x0, .x_t1 = x1, .bones_t0 = scene.poses->t0(), .bones_t1 = scene.poses->t1(),
+                          .sample_t0 = i, .sample_t1 = i + 1},
+        out);
     run.ccd_ms.push_back(
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count());
     for (const auto& c : out.contacts) run.contacts.push_back({i, c.kind, c.a, c.b});

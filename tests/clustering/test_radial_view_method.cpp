@@ -1,14 +1,16 @@
 // `rvbc` and `dynamic` report exactly the contacts of `bvh` (and of `brute` on small meshes) on
 // generated clips that collide (coiling rope, touching tentacles and fingers) and on real
 // characters, BCN_Epileptic among them (its rest pose interpenetrates). Plus the interface:
-// names through the extension, errors, counters of paper Table 3.
+// names through the registry, errors, counters of paper Table 3.
 #include "clustering/radial_view_method.hpp"
 
 #include <algorithm>
 
 #include <gtest/gtest.h>
 
-#include "clustering/radial_view_extension.hpp"
+#include "clustering/radial_view_methods.hpp"
+#include "culling/method_registry.hpp"
+#include "culling/routed_method.hpp"
 #include "skinning/errors.hpp"
 #include "skinning/generators.hpp"
 #include "skinning/load.hpp"
@@ -213,15 +215,26 @@ TEST(RadialViewMethod, NamesErrorsAndCounters) {
   auto rig = generated("gen:hand?triangles=600&frames=8");
   RadialViewScene scene(rig);
   const auto options = scene.options();
-  EXPECT_EQ(culling::method_names(options).back(), "dynamic");
+  // Registered by this module itself: listed, with what they need, and `dynamic` is auto's choice
+  // for closed parts once a segmentation and bones are there.
+  const auto names = culling::method_names();
+  EXPECT_NE(std::find(names.begin(), names.end(), "rvbc"), names.end());
+  EXPECT_NE(std::find(names.begin(), names.end(), "dynamic"), names.end());
+  EXPECT_TRUE(culling::method_needs("dynamic").bone_poses);
+  EXPECT_TRUE(culling::method_needs("dynamic").segmentation);
+  EXPECT_EQ(culling::auto_group_methods(options).back(), "dynamic");
+  EXPECT_EQ(culling::auto_group_methods({}).back(), "bvh");
   EXPECT_EQ(scene.method("rvbc")->name(), "rvbc");
   EXPECT_EQ(scene.method("dynamic")->name(), "dynamic");
-  // Without the extension the names are unknown, and the message says which ones exist.
-  EXPECT_THROW_MESSAGE((void)culling::make_method("dynamic", rig->mesh, scene.topology),
-                       InvalidInput, "unknown method 'dynamic'");
+  // Through the registry without a segmentation: the DCD-only method, which refuses CCD.
+  auto dcd_only = culling::make_method("dynamic", rig->mesh, scene.topology);
+  skinning::Positions x0, x1;
+  scene.welded(0, x0);
+  scene.welded(1, x1);
+  culling::FrameResult out;
+  EXPECT_THROW_MESSAGE(dcd_only->detect_ccd(x0, x1, out), InvalidInput, "built for DCD only");
   EXPECT_THROW_MESSAGE((void)scene.method("octree"), InvalidInput, "rvbc, dynamic");
-  EXPECT_THROW_MESSAGE(RadialViewExtension(scene.segmentation, scene.poses, 3, {.gamma = 1.5}),
-                       InvalidInput, "gamma");
+  EXPECT_THROW_MESSAGE((void)scene.method("dynamic", {.gamma = 1.5}), InvalidInput, "gamma");
   // Bad method options are refused as for every method.
   culling::MethodOptions bad;
   bad.min_separation = -1;
@@ -229,28 +242,23 @@ TEST(RadialViewMethod, NamesErrorsAndCounters) {
   // A segmentation of another mesh.
   auto other = std::make_shared<segmentation::Segmentation>(*scene.segmentation);
   other->triangle_cluster.pop_back();
-  const auto ext = std::make_shared<RadialViewExtension>(other, scene.poses,
-                                                         rig->skeleton.num_bones());
-  culling::MethodOptions with_other;
-  with_other.extension = ext;
+  culling::MethodOptions with_other = options;
+  with_other.segmentation = other;
   EXPECT_THROW_MESSAGE((void)culling::make_method("rvbc", rig->mesh, scene.topology, with_other),
                        InvalidInput, "the segmentation has");
-  // No poses selected yet; wrong row counts.
-  auto fresh_poses = std::make_shared<BonePoses>(pose_at_sample(*scene.motion));
-  culling::MethodOptions unposed;
-  unposed.extension = std::make_shared<RadialViewExtension>(scene.segmentation, fresh_poses,
-                                                            rig->skeleton.num_bones());
-  auto m = culling::make_method("dynamic", rig->mesh, scene.topology, unposed);
-  skinning::Positions x0, x1;
-  scene.welded(0, x0);
-  scene.welded(1, x1);
-  culling::FrameResult out;
-  EXPECT_THROW_MESSAGE(m->detect_ccd(x0, x1, out), InvalidInput, "no bone poses");
-  fresh_poses->select_samples(0, 1);
+  // No bone transforms in the interval, none selected; wrong row counts.
+  auto m = culling::make_method("dynamic", rig->mesh, scene.topology, options);
+  EXPECT_THROW_MESSAGE(m->detect_ccd(x0, x1, out), InvalidInput, "carries no bone transforms");
+  std::vector<skinning::BoneTransform> t0, t1;
+  scene.motion->bone_transforms(0, t0);
+  scene.motion->bone_transforms(1, t1);
   const skinning::Positions few(3, 3);
-  EXPECT_THROW_MESSAGE(m->detect_ccd(x0, few, out), InvalidInput, "x_t1 has 3 rows");
+  EXPECT_THROW_MESSAGE(
+      m->detect_ccd(culling::Interval{.x_t0 = x0, .x_t1 = few, .bones_t0 = t0, .bones_t1 = t1}, out),
+      InvalidInput, "x_t1 has 3 rows");
+  const culling::Interval interval{.x_t0 = x0, .x_t1 = x1, .bones_t0 = t0, .bones_t1 = t1, .sample_t0 = 0, .sample_t1 = 1};
   // Table 3 counters of one interval.
-  m->detect_ccd(x0, x1, out);
+  m->detect_ccd(interval, out);
   EXPECT_EQ(out.counters.atomic_clusters,
             static_cast<std::int64_t>(scene.segmentation->clusters.size()));
   EXPECT_GE(out.counters.mega_clusters, 1);

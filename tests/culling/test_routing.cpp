@@ -1,5 +1,5 @@
-// `auto`: open components go to enhanced-dual-cone, closed ones to `dynamic` (through an
-// extension) or the `bvh` fallback, pairs across groups through a BVH pair traversal — and the
+// `auto`: open components go to enhanced-dual-cone, closed ones to the best registered closed-part
+// method whose needs are met (`dynamic` on a rig's clip) or the `bvh` fallback, pairs across groups through a BVH pair traversal — and the
 // answer is exactly `bvh`'s.
 #include <gtest/gtest.h>
 
@@ -9,7 +9,7 @@
 #include <vector>
 
 #include "culling/method.hpp"
-#include "culling/method_extension.hpp"
+#include "culling/method_registry.hpp"
 #include "culling/routed_method.hpp"
 #include "skinning/errors.hpp"
 #include "skinning/load.hpp"
@@ -39,24 +39,36 @@ FrameResult ccd(CullingMethod& m, const skinning::Positions& x0, const skinning:
   return out;
 }
 
-/// Stands in for clustering's extension: builds "dynamic" as a `bvh` over the mesh it is given
-/// (with that mesh's part exclusions), and counts how often it was asked.
-class FakeDynamic final : public MethodExtension {
+/// A closed-part method declared by this file alone (as a module above culling/ declares `dynamic`):
+/// a `bvh` over the mesh it is given (with that mesh's part exclusions), counting how often it was
+/// built. It needs bone poses, so `auto` chooses it only for options that announce bones — which
+/// no other test of this executable does.
+int fake_built = 0;
+
+class NamedAsTest final : public CullingMethod {
  public:
-  [[nodiscard]] std::vector<std::string> method_names() const override { return {"dynamic"}; }
-  [[nodiscard]] std::unique_ptr<CullingMethod> make_method(
-      std::string_view name,
-      const skinning::Mesh& mesh,
-      const skinning::Topology& topology,
-      const MethodOptions& options) const override {
-    if (name != "dynamic") return nullptr;
-    ++built;
-    MethodOptions plain = options;
-    plain.extension = nullptr;
-    return culling::make_method("bvh", mesh, topology, plain);
-  }
-  mutable int built = 0;
+  explicit NamedAsTest(std::unique_ptr<CullingMethod> bvh) : bvh_(std::move(bvh)) {}
+  [[nodiscard]] std::string_view name() const override { return "test-closed"; }
+
+ protected:
+  void dcd(const Instant& at, FrameResult& out) override { bvh_->detect_dcd(at, out); }
+  void ccd(const Interval& interval, FrameResult& out) override { bvh_->detect_ccd(interval, out); }
+
+ private:
+  std::unique_ptr<CullingMethod> bvh_;
 };
+
+[[maybe_unused]] const bool fake_registered = register_method({
+    .name = "test-closed",
+    .description = "a bvh declared by tests/culling/test_routing.cpp",
+    .needs = {.bone_poses = true},
+    .route = RouteKind::closed,
+    .route_priority = 100,
+    .order = 5000,
+    .make = [](const skinning::Mesh& mesh, const skinning::Topology& topology, const MethodOptions& options) {
+      ++fake_built;
+      return std::make_unique<NamedAsTest>(make_method("bvh", mesh, topology, options));
+    }});
 
 TEST(Routing, SkirtGoesToEnhancedDualConeAndTheBodyToTheFallback) {
   const OpenScene s = test::skirt_body_scene(9, 14, 16, 10, {0.3, 0.5});
@@ -148,23 +160,31 @@ TEST(Routing, RobotExpressiveCharacterRoutesItsOpenAndClosedPartsAndMatchesBvh) 
   EXPECT_EQ(keys(ccd(*a, x0, x1)), keys(ccd(*b, x0, x1)));
 }
 
-TEST(Routing, ClosedPartsGoToDynamicWhenTheExtensionBuildsIt) {
+TEST(Routing, ClosedPartsGoToTheRegisteredClosedPartMethodWhoseNeedsAreMet) {
   const OpenScene s = test::skirt_body_scene(9, 14, 16, 10, {0.3, 0.5});
-  auto ext = std::make_shared<FakeDynamic>();
+  // Without bones its needs are not met: the fallback.
+  EXPECT_EQ(route_components(s.topo)[0].method, std::string(kClosedFallbackMethod));
   MethodOptions options;
-  options.extension = ext;
+  options.num_bones = 1;
+  const int before = fake_built;
   auto a = make_method("auto", s.mesh, s.topo, options);
-  EXPECT_EQ(ext->built, 1);
+  EXPECT_EQ(fake_built, before + 1);
   const auto routes = routes_of(*a);
-  EXPECT_EQ(routes[0].method, "dynamic");
+  EXPECT_EQ(routes[0].method, "test-closed");
   EXPECT_EQ(routes[1].method, "enhanced-dual-cone");
-  // The whole-mesh `dynamic` is told to skip every pair with an open triangle: the merged
-  // answer is still bvh's, each contact once.
+  EXPECT_EQ(auto_group_methods(options), (std::vector<std::string>{"enhanced-dual-cone", "test-closed"}));
+  // The whole-mesh method is told to skip every pair with an open triangle: the merged answer is
+  // still bvh's, each contact once.
   auto b = make_method("bvh", s.mesh, s.topo);
   EXPECT_EQ(dcd(*a, s.frames[1]).dcd_pairs, dcd(*b, s.frames[1]).dcd_pairs);
   const FrameResult got = ccd(*a, s.frames[0], s.frames[1]);
   EXPECT_EQ(keys(got), keys(ccd(*b, s.frames[0], s.frames[1])));
   EXPECT_EQ(keys(got).size(), got.contacts.size());
+  // Registered once: a second registration of the name is refused; it is listed by name.
+  EXPECT_THROW_MESSAGE((void)register_method({.name = "test-closed", .make = find_method("bvh")->make}), InvalidInput,
+                       "registered twice");
+  const auto names = method_names();
+  EXPECT_NE(std::find(names.begin(), names.end(), "test-closed"), names.end());
 }
 
 TEST(Routing, OptionsChooseOtherGroupMethodsAndRejectUnknownOnes) {

@@ -17,7 +17,6 @@
 #include <tbb/info.h>
 
 #include "clustering/bone_poses.hpp"
-#include "clustering/radial_view_extension.hpp"
 #include "segmentation/segmentation.hpp"
 #include "skinning/errors.hpp"
 #include "skinning/load.hpp"
@@ -172,11 +171,14 @@ class ProbeMethod : public culling::CullingMethod {
   using Hook = std::function<void(int sample)>;
   explicit ProbeMethod(Hook hook) : hook_(std::move(hook)) {}
   std::string_view name() const override { return "probe"; }
-  void detect_dcd(const Positions& x, culling::FrameResult& out) override {
+  void dcd(const culling::Instant& at, culling::FrameResult& out) override {
+    const skinning::Positions& x = at.x;
     hook_(sample_of(x));
     out.counters.tt_tests = sample_of(x);
   }
-  void detect_ccd(const Positions& x_t0, const Positions& x_t1, culling::FrameResult& out) override {
+  void ccd(const culling::Interval& interval, culling::FrameResult& out) override {
+    const skinning::Positions& x_t0 = interval.x_t0;
+    const skinning::Positions& x_t1 = interval.x_t1;
     hook_(sample_of(x_t0));
     out.counters.vf_tests = 1000 * sample_of(x_t0) + sample_of(x_t1);
   }
@@ -273,9 +275,6 @@ TEST(ParallelRunner, ThreadsResolveAndStatefulRunsStaySerial) {
   o.min_separation = 0.01;  // nothing is skipped: the carried state is unused
   EXPECT_EQ(serial_reason("dynamic", o), "");
   EXPECT_NE(serial_reason("someone-elses", RunOptions{}).find("not known"), std::string::npos);
-  RunOptions hooked;
-  hooked.before_query = [](std::int32_t, std::int32_t) {};
-  EXPECT_NE(serial_reason("bvh", hooked).find("hook"), std::string::npos);
 
   // Through the runner: a custom factory's methods are serial unless declared stateless, and
   // dynamic on --query ccd is serial with the reason in the plan.
@@ -298,6 +297,26 @@ TEST(ParallelRunner, ThreadsResolveAndStatefulRunsStaySerial) {
   EXPECT_NE(dynamic.plan().serial_reason.find("--query ccd"), std::string::npos);
 }
 
+/// A method that takes 10 ms more per query than the one it wraps.
+class SlowMethod final : public culling::CullingMethod {
+ public:
+  explicit SlowMethod(std::unique_ptr<culling::CullingMethod> inner) : inner_(std::move(inner)) {}
+  [[nodiscard]] std::string_view name() const override { return inner_->name(); }
+
+ protected:
+  void dcd(const culling::Instant& at, culling::FrameResult& out) override {
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    inner_->detect_dcd(at, out);
+  }
+  void ccd(const culling::Interval& interval, culling::FrameResult& out) override {
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    inner_->detect_ccd(interval, out);
+  }
+
+ private:
+  std::unique_ptr<culling::CullingMethod> inner_;
+};
+
 /// Why dynamic with --query ccd stays serial: forced into blocks anyway (a factory declared
 /// stateless), each block's first interval starts without the state the previous interval left,
 /// and its counters differ from the serial run's (the contacts do not).
@@ -315,22 +334,10 @@ TEST(ParallelRunner, DynamicWithoutDcdCarriesStateSoBlocksWouldChangeItsCounters
     options.factory_methods_stateless = true;  // the lie under test
     // Slow queries, so that every worker takes blocks (a worker that happened to take all blocks
     // in order would carry the state like a serial run).
-    const auto slow = [](std::function<void(std::int32_t, std::int32_t)> select) {
-      return [select](std::int32_t s0, std::int32_t s1) {
-        select(s0, s1);
-        std::this_thread::sleep_for(std::chrono::milliseconds(10));
-      };
-    };
-    options.before_query = slow(options.before_query);
-    options.make_worker_hooks = [make = options.make_worker_hooks, slow] {
-      auto hooks = make();
-      hooks.before_query = slow(hooks.before_query);
-      return hooks;
-    };
     ClipRunner runner(*l.motion, options, [](const skinning::Mesh& mesh,
                                              const skinning::Topology& topology,
-                                             const culling::MethodOptions& mo) {
-      return culling::make_method("dynamic", mesh, topology, mo);
+                                             const culling::MethodOptions& mo) -> std::unique_ptr<culling::CullingMethod> {
+      return std::make_unique<SlowMethod>(culling::make_method("dynamic", mesh, topology, mo));
     });
     ASSERT_EQ(runner.plan().threads, k == 0 ? 1 : 3);
     out[k] = collect(runner);

@@ -75,14 +75,17 @@ class FakeMethod : public culling::CullingMethod {
              std::vector<culling::TrianglePair> pairs)
       : record_(record), contacts_(std::move(contacts)), pairs_(std::move(pairs)) {}
   std::string_view name() const override { return "fake"; }
-  void detect_dcd(const Positions& x, culling::FrameResult& out) override {
+  void dcd(const culling::Instant& at, culling::FrameResult& out) override {
+    const skinning::Positions& x = at.x;
     record_.dcd_inputs.push_back(x);
     out.dcd_pairs = pairs_;
     out.counters.tt_tests = 7;
     out.counters.dcd_pairs = 999;  // wrong on purpose: the runner counts the findings itself
     out.times.traverse_us = 1.5;
   }
-  void detect_ccd(const Positions& x_t0, const Positions& x_t1, culling::FrameResult& out) override {
+  void ccd(const culling::Interval& interval, culling::FrameResult& out) override {
+    const skinning::Positions& x_t0 = interval.x_t0;
+    const skinning::Positions& x_t1 = interval.x_t1;
     record_.ccd_inputs.emplace_back(x_t0, x_t1);
     out.contacts = contacts_;
     out.counters.vf_tests = 11;
