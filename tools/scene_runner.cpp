@@ -23,6 +23,7 @@
 #include "tools/file_hash.hpp"
 #include "tools/log/log_writer.hpp"
 #include "tools/radial_view_setup.hpp"
+#include "tools/sample_sequencer.hpp"
 
 namespace skelcd::tools {
 namespace {
@@ -371,16 +372,11 @@ void run_pair(
   const bool ccd = c.query != QuerySet::dcd;
   const std::string name_a = plan.objects[at(c.object_a)].name;
   const std::string name_b = plan.objects[at(c.object_b)].name;
-  skinning::Positions file, a0, a1, b0, b1;
+  skinning::Positions file;
+  skinning::Positions xa[2], xb[2];  // both objects at the two samples the sequencer holds
   culling::PairFrameResult result;
   FrameReport report;
 
-  const auto pose_both = [&](int sample, skinning::Positions& xa, skinning::Positions& xb) {
-    const auto start = Clock::now();
-    pose(*a.motion, a.topology, sample, file, xa, "object '" + name_a + "'");
-    pose(*b.motion, b.topology, sample, file, xb, "object '" + name_b + "'");
-    return micros(start, Clock::now());
-  };
   const auto emit = [&](QueryKind kind, int sample, double skin_us, Clock::time_point start) {
     report.row = FrameRow{};
     report.row.sample = sample;
@@ -419,27 +415,33 @@ void run_pair(
     report.row.total_us = micros(start, Clock::now()) + skin_us;
     on_frame(report);
   };
-  const auto run_dcd = [&](int sample, double skin_us) {
-    const auto start = Clock::now();
-    result.clear();
-    checker.detect_dcd(a1, b1, result);
-    emit(QueryKind::dcd, sample, skin_us, start);
-  };
 
-  double pending_skin_us = pose_both(c.first_sample, a1, b1);
-  if (dcd) run_dcd(c.first_sample, std::exchange(pending_skin_us, 0.0));
-  for (int i = c.first_sample; i < c.last_sample; ++i) {
-    std::swap(a0, a1);
-    std::swap(b0, b1);
-    pending_skin_us += pose_both(i + 1, a1, b1);
-    if (ccd) {
-      const auto start = Clock::now();
-      result.clear();
-      checker.detect_ccd(a0, a1, b0, b1, result);
-      emit(QueryKind::ccd, i, std::exchange(pending_skin_us, 0.0), start);
-    }
-    if (dcd) run_dcd(i + 1, std::exchange(pending_skin_us, 0.0));
-  }
+  // The row order of every check (tools/sample_sequencer.hpp): dcd A, ccd A, dcd A+1, …, dcd B.
+  const SampleSequence sequence{.first = c.first_sample,
+                                .end = dcd ? c.last_sample + 1 : c.last_sample,
+                                .last = c.last_sample,
+                                .dcd = dcd,
+                                .ccd = ccd};
+  run_sequence(
+      sequence,
+      [&](std::int32_t k, int slot) {
+        const auto start = Clock::now();
+        pose(*a.motion, a.topology, k, file, xa[slot], "object '" + name_a + "'");
+        pose(*b.motion, b.topology, k, file, xb[slot], "object '" + name_b + "'");
+        return micros(start, Clock::now());
+      },
+      [&](std::int32_t k, int slot, double skin_us) {
+        const auto start = Clock::now();
+        result.clear();
+        checker.detect_dcd(xa[slot], xb[slot], result);
+        emit(QueryKind::dcd, k, skin_us, start);
+      },
+      [&](std::int32_t k, int s0, int s1, double skin_us) {
+        const auto start = Clock::now();
+        result.clear();
+        checker.detect_ccd(xa[s0], xa[s1], xb[s0], xb[s1], result);
+        emit(QueryKind::ccd, k, skin_us, start);
+      });
 }
 
 std::string own_command_line() {
