@@ -75,7 +75,6 @@ bool apart_beyond_shared(
   return false;
 }
 
-
 }  // namespace
 
 RadialViewMethod::RadialViewMethod(
@@ -377,11 +376,13 @@ void RadialViewMethod::ccd(const culling::Interval& interval, culling::FrameResu
   // them itself) the BonePoses given at construction.
   std::span<const skinning::BoneTransform> bones_t0 = interval.bones_t0;
   std::span<const skinning::BoneTransform> bones_t1 = interval.bones_t1;
-  if (static_cast<std::int32_t>(bones_t0.size()) < num_bones_ || static_cast<std::int32_t>(bones_t1.size()) < num_bones_) {
+  if (static_cast<std::int32_t>(bones_t0.size()) < num_bones_ ||
+      static_cast<std::int32_t>(bones_t1.size()) < num_bones_) {
     if (!poses_ || !poses_->ready()) {
-      throw InvalidInput("clustering::" + name_ + "::detect_ccd: the interval carries no bone transforms (" +
-                         std::to_string(bones_t0.size()) + " for " + std::to_string(num_bones_) +
-                         " bones) and no bone poses were selected");
+      throw InvalidInput(
+          "clustering::" + name_ + "::detect_ccd: the interval carries no bone transforms (" +
+          std::to_string(bones_t0.size()) + " for " + std::to_string(num_bones_) +
+          " bones) and no bone poses were selected");
     }
     bones_t0 = poses_->t0();
     bones_t1 = poses_->t1();

@@ -26,7 +26,9 @@ class DcdOnlyRadialViewMethod final : public culling::CullingMethod {
   [[nodiscard]] std::string_view name() const override { return name_; }
 
  protected:
-  void dcd(const culling::Instant& at, culling::FrameResult& out) override { bvh_->detect_dcd(at, out); }
+  void dcd(const culling::Instant& at, culling::FrameResult& out) override {
+    bvh_->detect_dcd(at, out);
+  }
 
   void ccd(const culling::Interval&, culling::FrameResult&) override {
     throw InvalidInput(
@@ -42,7 +44,8 @@ class DcdOnlyRadialViewMethod final : public culling::CullingMethod {
 // What the radial-view methods carry between queries (docs/check.md, "Threads"): which components
 // were free of self-intersection at the last interval's end. With a DCD before every interval that
 // knowledge is re-established at each start, and the rows do not depend on it.
-std::string carried_state(std::string_view name, const culling::MethodOptions& options, bool dcd_before_each_ccd) {
+std::string carried_state(
+    std::string_view name, const culling::MethodOptions& options, bool dcd_before_each_ccd) {
   if (options.min_separation != 0.0) return {};
   if (!dcd_before_each_ccd) {
     return "method " + std::string(name) +
@@ -57,7 +60,8 @@ std::string carried_state(std::string_view name, const culling::MethodOptions& o
   return {};
 }
 
-culling::MethodInfo radial_view_info(std::string name, std::string description, int order, culling::RouteKind route) {
+culling::MethodInfo radial_view_info(
+    std::string name, std::string description, int order, culling::RouteKind route) {
   const std::string n = name;
   return culling::MethodInfo{
       .name = std::move(name),
@@ -70,16 +74,24 @@ culling::MethodInfo radial_view_info(std::string name, std::string description, 
       .route = route,
       .route_priority = route == culling::RouteKind::closed ? 10 : 0,
       .order = order,
-      .make = [n](const skinning::Mesh& mesh, const skinning::Topology& topology, const culling::MethodOptions& options) {
-        return make_radial_view_method(n, mesh, topology, options);
-      }};
+      .make =
+          [n](const skinning::Mesh& mesh,
+              const skinning::Topology& topology,
+              const culling::MethodOptions& options) {
+            return make_radial_view_method(n, mesh, topology, options);
+          }};
 }
 
 [[maybe_unused]] const bool registered =
-    culling::register_method(radial_view_info("rvbc", "radial-view culling with fixed atomic clusters (paper 002)", 70,
-                                              culling::RouteKind::none)) &&
     culling::register_method(radial_view_info(
-        "dynamic", "radial-view culling with mega clusters merged each interval (paper 002 §5)", 80,
+        "rvbc",
+        "radial-view culling with fixed atomic clusters (paper 002)",
+        70,
+        culling::RouteKind::none)) &&
+    culling::register_method(radial_view_info(
+        "dynamic",
+        "radial-view culling with mega clusters merged each interval (paper 002 §5)",
+        80,
         culling::RouteKind::closed));
 
 }  // namespace
@@ -93,19 +105,28 @@ std::unique_ptr<culling::CullingMethod> make_radial_view_method(
     const culling::MethodOptions& options,
     std::shared_ptr<const BonePoses> poses) {
   if (!is_radial_view_method(name)) {
-    throw InvalidInput("clustering::make_radial_view_method: '" + std::string(name) + "' is not rvbc or dynamic");
+    throw InvalidInput(
+        "clustering::make_radial_view_method: '" + std::string(name) + "' is not rvbc or dynamic");
   }
   const double gamma = options.parameters.gamma;
   if (!(std::isfinite(gamma) && gamma >= 0.0 && gamma <= 1.0)) {
     throw InvalidInput("clustering: gamma must be in [0, 1], got " + std::to_string(gamma));
   }
-  if (!options.segmentation) return std::make_unique<DcdOnlyRadialViewMethod>(std::string(name), mesh, topology, options);
+  if (!options.segmentation)
+    return std::make_unique<DcdOnlyRadialViewMethod>(std::string(name), mesh, topology, options);
   RadialViewOptions rv;
   rv.clusters.merge = name == "dynamic";
   rv.clusters.gamma = gamma;
   rv.clusters.seed = options.parameters.seed;
-  return std::make_unique<RadialViewMethod>(std::string(name), mesh, topology, options.segmentation, std::move(poses),
-                                            options.num_bones, options, rv);
+  return std::make_unique<RadialViewMethod>(
+      std::string(name),
+      mesh,
+      topology,
+      options.segmentation,
+      std::move(poses),
+      options.num_bones,
+      options,
+      rv);
 }
 
 }  // namespace skelcd::clustering

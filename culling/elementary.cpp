@@ -72,7 +72,8 @@ std::span<Outcome> evaluate(std::size_t n, const ElementaryTests& tests, const T
   if (tl_outcomes.size() < n) tl_outcomes.resize(n);
   const std::span<Outcome> outcomes(tl_outcomes.data(), n);
   const auto report = [&](std::size_t done) {
-    if (tests.tests_done != nullptr) tests.tests_done->fetch_add(static_cast<std::int64_t>(done), std::memory_order_relaxed);
+    if (tests.tests_done != nullptr)
+      tests.tests_done->fetch_add(static_cast<std::int64_t>(done), std::memory_order_relaxed);
   };
   if (tests.threads > 1 && n >= kParallelElementaryThreshold) {
     tbb::this_task_arena::isolate([&] {

@@ -92,7 +92,8 @@ class CullingMethod {
   /// @throws InvalidInput when x_t0 or x_t1 does not have #W rows, or the method needs bone
   ///         transforms (MethodInfo::needs) and the interval carries none.
   void detect_ccd(const Interval& interval, FrameResult& out) { ccd(interval, out); }
-  void detect_ccd(const skinning::Positions& x_t0, const skinning::Positions& x_t1, FrameResult& out) {
+  void detect_ccd(
+      const skinning::Positions& x_t0, const skinning::Positions& x_t1, FrameResult& out) {
     ccd(Interval{.x_t0 = x_t0, .x_t1 = x_t1}, out);
   }
 

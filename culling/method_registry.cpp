@@ -20,74 +20,100 @@ struct Registry {
 
 void add(Registry& r, MethodInfo info) {
   if (info.name.empty()) throw InvalidInput("culling::register_method: a method needs a name");
-  if (!info.make) throw InvalidInput("culling::register_method: method '" + info.name + "' has no factory");
+  if (!info.make)
+    throw InvalidInput("culling::register_method: method '" + info.name + "' has no factory");
   const std::lock_guard lock(r.mutex);
   for (const auto& m : r.methods) {
-    if (m->name == info.name) throw InvalidInput("culling::register_method: method '" + info.name + "' is registered twice");
+    if (m->name == info.name)
+      throw InvalidInput(
+          "culling::register_method: method '" + info.name + "' is registered twice");
   }
   r.methods.push_back(std::make_unique<MethodInfo>(std::move(info)));
 }
 
 // culling/'s own methods. Those of modules above register themselves from their own files.
 void add_culling_methods(Registry& r) {
-  add(r, {.name = "brute",
-          .description = "every feature pair (volume-filtered), the reference on small meshes",
-          .order = 10,
-          .make = [](const skinning::Mesh& mesh, const skinning::Topology& topology, const MethodOptions& options) {
-            return detail::make_brute_method(mesh, topology, options);
-          }});
-  add(r, {.name = "bvh",
-          .description = "AABB hierarchy (the papers' 'AABB only')",
-          .order = 20,
-          .make = [](const skinning::Mesh& mesh, const skinning::Topology& topology, const MethodOptions& options) {
-            return detail::make_bvh_method<3>("bvh", mesh, topology, options);
-          }});
-  add(r, {.name = "kdop",
-          .description = "16-DOP hierarchy",
-          .order = 30,
-          .make = [](const skinning::Mesh& mesh, const skinning::Topology& topology, const MethodOptions& options) {
-            return detail::make_bvh_method<8>("kdop", mesh, topology, options);
-          }});
-  add(r, {.name = "normal-cone",
-          .description = "continuous normal cones and contour tests (ICCD/CBC; NCT for DCD)",
-          .order = 40,
-          .make = [](const skinning::Mesh& mesh, const skinning::Topology& topology, const MethodOptions& options) {
-            return make_normal_cone_method(mesh, topology, options);
-          }});
-  add(r, {.name = "dual-cone",
-          .description = "the original dual-cone method (FASTCD), kept to show what it misses",
-          .may_miss = true,
-          .order = 50,
-          .make = [](const skinning::Mesh& mesh, const skinning::Topology& topology, const MethodOptions& options) {
-            return make_dual_cone_method(mesh, topology, options);
-          }});
-  add(r, {.name = "enhanced-dual-cone",
-          .description = "enhanced dual cones for meshes with open boundaries (paper 000)",
-          .route = RouteKind::open,
-          .route_priority = 10,
-          .order = 60,
-          .make = [](const skinning::Mesh& mesh, const skinning::Topology& topology, const MethodOptions& options) {
-            return make_enhanced_dual_cone_method(mesh, topology, options);
-          }});
-  add(r, {.name = "auto",
-          .description = "per connected part: closed parts to the best closed-part method whose needs are met "
-                         "(dynamic on a rig), open parts to enhanced-dual-cone, else bvh",
-          // `auto` carries what the methods it routes to carry.
-          .serial_reason =
-              [](const MethodOptions& options, bool dcd_before_each_ccd) {
-                for (const auto& route : auto_group_methods(options)) {
-                  const MethodInfo* m = find_method(route);
-                  if (m != nullptr && m->serial_reason) {
-                    auto why = m->serial_reason(options, dcd_before_each_ccd);
-                    if (!why.empty()) return why;
-                  }
-                }
-                return std::string();
-              },
-          .order = 65,
-          .make = [](const skinning::Mesh& mesh, const skinning::Topology& topology, const MethodOptions& options) {
-            return make_routed_method(mesh, topology, options);
-          }});
+  add(r,
+      {.name = "brute",
+       .description = "every feature pair (volume-filtered), the reference on small meshes",
+       .order = 10,
+       .make = [](const skinning::Mesh& mesh,
+                  const skinning::Topology& topology,
+                  const MethodOptions& options) {
+         return detail::make_brute_method(mesh, topology, options);
+       }});
+  add(r,
+      {.name = "bvh",
+       .description = "AABB hierarchy (the papers' 'AABB only')",
+       .order = 20,
+       .make = [](const skinning::Mesh& mesh,
+                  const skinning::Topology& topology,
+                  const MethodOptions& options) {
+         return detail::make_bvh_method<3>("bvh", mesh, topology, options);
+       }});
+  add(r,
+      {.name = "kdop",
+       .description = "16-DOP hierarchy",
+       .order = 30,
+       .make = [](const skinning::Mesh& mesh,
+                  const skinning::Topology& topology,
+                  const MethodOptions& options) {
+         return detail::make_bvh_method<8>("kdop", mesh, topology, options);
+       }});
+  add(r,
+      {.name = "normal-cone",
+       .description = "continuous normal cones and contour tests (ICCD/CBC; NCT for DCD)",
+       .order = 40,
+       .make = [](const skinning::Mesh& mesh,
+                  const skinning::Topology& topology,
+                  const MethodOptions& options) {
+         return make_normal_cone_method(mesh, topology, options);
+       }});
+  add(r,
+      {.name = "dual-cone",
+       .description = "the original dual-cone method (FASTCD), kept to show what it misses",
+       .may_miss = true,
+       .order = 50,
+       .make = [](const skinning::Mesh& mesh,
+                  const skinning::Topology& topology,
+                  const MethodOptions& options) {
+         return make_dual_cone_method(mesh, topology, options);
+       }});
+  add(r,
+      {.name = "enhanced-dual-cone",
+       .description = "enhanced dual cones for meshes with open boundaries (paper 000)",
+       .route = RouteKind::open,
+       .route_priority = 10,
+       .order = 60,
+       .make = [](const skinning::Mesh& mesh,
+                  const skinning::Topology& topology,
+                  const MethodOptions& options) {
+         return make_enhanced_dual_cone_method(mesh, topology, options);
+       }});
+  add(r,
+      {.name = "auto",
+       .description =
+           "per connected part: closed parts to the best closed-part method whose needs are met "
+           "(dynamic on a rig), open parts to enhanced-dual-cone, else bvh",
+       // `auto` carries what the methods it routes to carry.
+       .serial_reason =
+           [](const MethodOptions& options, bool dcd_before_each_ccd) {
+             for (const auto& route : auto_group_methods(options)) {
+               const MethodInfo* m = find_method(route);
+               if (m != nullptr && m->serial_reason) {
+                 auto why = m->serial_reason(options, dcd_before_each_ccd);
+                 if (!why.empty()) return why;
+               }
+             }
+             return std::string();
+           },
+       .order = 65,
+       .make =
+           [](const skinning::Mesh& mesh,
+              const skinning::Topology& topology,
+              const MethodOptions& options) {
+             return make_routed_method(mesh, topology, options);
+           }});
 }
 
 Registry& registry() {
@@ -136,7 +162,8 @@ std::vector<const MethodInfo*> registered_methods() {
 }
 
 bool needs_met(const MethodNeeds& needs, const MethodOptions& options) {
-  return (!needs.segmentation || options.segmentation != nullptr) && (!needs.bone_poses || options.num_bones > 0);
+  return (!needs.segmentation || options.segmentation != nullptr) &&
+         (!needs.bone_poses || options.num_bones > 0);
 }
 
 }  // namespace skelcd::culling

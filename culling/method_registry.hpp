@@ -35,9 +35,7 @@ enum class RouteKind : std::uint8_t {
 };
 
 using MethodFactory = std::function<std::unique_ptr<CullingMethod>(
-    const skinning::Mesh& mesh,
-    const skinning::Topology& topology,
-    const MethodOptions& options)>;
+    const skinning::Mesh& mesh, const skinning::Topology& topology, const MethodOptions& options)>;
 
 struct MethodInfo {
   std::string name{};
@@ -50,7 +48,8 @@ struct MethodInfo {
   /// (its state between queries changes its rows), given whether a DCD query precedes every
   /// CCD interval; empty or unset: blocks of samples may go to several workers with the rows of a
   /// serial run.
-  std::function<std::string(const MethodOptions& options, bool dcd_before_each_ccd)> serial_reason{};
+  std::function<std::string(const MethodOptions& options, bool dcd_before_each_ccd)>
+      serial_reason{};
   /// Where `auto` may route components, and its preference among the methods of that kind whose
   /// needs are met (highest first).
   RouteKind route = RouteKind::none;

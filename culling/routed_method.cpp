@@ -378,7 +378,8 @@ std::vector<ComponentRoute> route_components(
   return routes;
 }
 
-std::vector<std::string> auto_group_methods(const MethodOptions& options, const RoutingOptions& routing) {
+std::vector<std::string> auto_group_methods(
+    const MethodOptions& options, const RoutingOptions& routing) {
   return {routing.open_method, closed_method_name(options, routing)};
 }
 

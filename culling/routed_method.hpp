@@ -3,11 +3,11 @@
 // "Routing"). Components with an open boundary go to `enhanced-dual-cone` (radial-view culling
 // needs a closed surface); closed components go to the registered closed-part method with the
 // highest priority whose needs are met (culling/method_registry.hpp: `dynamic` on a rig's clip),
-// else to kClosedFallbackMethod (`bvh`). Pairs of triangles in different groups go through a BVH pair traversal between the
-// groups' hierarchies. Everything ends in the shared feature and elementary stages over the whole
-// mesh, so contacts are reported in the mesh's own welded numbering, canonical and sorted, as by
-// any other method. To force one method for a whole object, call make_method with its name
-// instead of "auto".
+// else to kClosedFallbackMethod (`bvh`). Pairs of triangles in different groups go through a BVH
+// pair traversal between the groups' hierarchies. Everything ends in the shared feature and
+// elementary stages over the whole mesh, so contacts are reported in the mesh's own welded
+// numbering, canonical and sorted, as by any other method. To force one method for a whole object,
+// call make_method with its name instead of "auto".
 
 #include <cstdint>
 #include <memory>

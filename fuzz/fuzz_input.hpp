@@ -15,9 +15,7 @@ namespace skelcd::fuzz {
 
 /// Writes `size` bytes to `<tmp>/skelcd-fuzz-<pid>/input<extension>` and returns that path.
 inline std::filesystem::path write_input(
-    const std::uint8_t* data,
-    std::size_t size,
-    std::string_view extension) {
+    const std::uint8_t* data, std::size_t size, std::string_view extension) {
   static const std::filesystem::path dir = [] {
     auto d = std::filesystem::temp_directory_path() / ("skelcd-fuzz-" + std::to_string(getpid()));
     std::filesystem::create_directories(d);

@@ -15,7 +15,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   static const std::filesystem::path scene_path =
       std::filesystem::path(SKELCD_SOURCE_DIR) / "assets" / "scenes" / "fuzz.toml";
   try {
-    const auto scene = skelcd::tools::parse_scene_text(skelcd::fuzz::as_text(data, size), scene_path);
+    const auto scene =
+        skelcd::tools::parse_scene_text(skelcd::fuzz::as_text(data, size), scene_path);
     // Touch what a caller reads next, so a half-built scene would show up here.
     for (const auto& o : scene.objects) (void)scene.is_checked(o.name);
     for (const auto& p : scene.pairs) (void)scene.find(p.a);

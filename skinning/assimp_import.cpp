@@ -1,9 +1,14 @@
 #include "skinning/assimp_import.hpp"
 
+#include <assimp/postprocess.h>
+#include <assimp/scene.h>
 #include <unistd.h>
 
 #include <algorithm>
 #include <array>
+#include <assimp/DefaultLogger.hpp>
+#include <assimp/Importer.hpp>
+#include <assimp/LogStream.hpp>
 #include <cctype>
 #include <cmath>
 #include <cstdint>
@@ -18,12 +23,6 @@
 #include <unordered_set>
 #include <utility>
 #include <vector>
-
-#include <assimp/DefaultLogger.hpp>
-#include <assimp/Importer.hpp>
-#include <assimp/LogStream.hpp>
-#include <assimp/postprocess.h>
-#include <assimp/scene.h>
 
 #include "skinning/detail/collada_bind_shape.hpp"
 #include "skinning/detail/import_guard.hpp"
@@ -222,13 +221,15 @@ double file_unit_scale(const aiScene* scene, Context& ctx) {
 
 // The bind shape of a mesh named after its geometry; assimp appends "_<n>" to the meshes it
 // splits one geometry into (one per material).
-std::map<std::string, Eigen::Affine3d>::const_iterator find_bind_shape(const std::map<std::string, Eigen::Affine3d>& shapes,
-                                                                     const std::string& mesh_name) {
+std::map<std::string, Eigen::Affine3d>::const_iterator find_bind_shape(
+    const std::map<std::string, Eigen::Affine3d>& shapes, const std::string& mesh_name) {
   if (const auto it = shapes.find(mesh_name); it != shapes.end()) return it;
   const auto underscore = mesh_name.rfind('_');
   if (underscore == std::string::npos || underscore + 1 == mesh_name.size()) return shapes.end();
   const auto suffix = mesh_name.substr(underscore + 1);
-  if (!std::all_of(suffix.begin(), suffix.end(), [](unsigned char c) { return std::isdigit(c) != 0; })) return shapes.end();
+  if (!std::all_of(
+          suffix.begin(), suffix.end(), [](unsigned char c) { return std::isdigit(c) != 0; }))
+    return shapes.end();
   return shapes.find(mesh_name.substr(0, underscore));
 }
 
@@ -396,7 +397,8 @@ void add_part(
   // rest mesh lay in another frame than every posed one (the stormtrooper lay along -Z).
   Eigen::Affine3d shape = Eigen::Affine3d::Identity();
   if (am->mNumBones > 0) {
-    if (const auto it = find_bind_shape(ctx.bind_shapes, mesh_name); it != ctx.bind_shapes.end()) shape = it->second;
+    if (const auto it = find_bind_shape(ctx.bind_shapes, mesh_name); it != ctx.bind_shapes.end())
+      shape = it->second;
   }
   std::vector<Eigen::Vector3d> local(am->mNumVertices);
   for (unsigned v = 0; v < am->mNumVertices; ++v) local[v] = shape * to_vector(am->mVertices[v]);
@@ -426,7 +428,9 @@ void add_part(
       bone_node[b] = resolve_node(h, bone_name, nullptr, ctx, "bone '" + bone_name + "'");
       // assimp folds the bind shape into every offset matrix (offset = inverse bind · shape); the
       // vertices above carry the shape now, so the offsets get it back out.
-      offset[b] = to_affine(bone->mOffsetMatrix, ctx, label + ", bone '" + bone_name + "' offset matrix") * shape.inverse();
+      offset[b] =
+          to_affine(bone->mOffsetMatrix, ctx, label + ", bone '" + bone_name + "' offset matrix") *
+          shape.inverse();
       if (bone->mNumWeights > 0 && bone->mWeights == nullptr) ctx.invalid(label + ", bone '" + bone_name + "' has no weight array");
       const bool placed = bone_node[b] >= 0;  // a bone without a node says nothing about B
       const Eigen::Affine3d at_rest = placed ? Eigen::Affine3d(h.scene_global[static_cast<std::size_t>(bone_node[b])] * offset[b]) : Eigen::Affine3d::Identity();
@@ -660,25 +664,35 @@ struct ClipRefusal {
 
 // One animation as a clip (channels resolved to nodes, keys in seconds, strictly increasing).
 // @throws ClipRefusal when its data are unusable.
-Clip read_clip(const aiAnimation* anim, const std::string& name, const Hierarchy& h, const std::vector<bool>& hosts_bone, Rig& rig,
-               Context& ctx) {
+Clip read_clip(
+    const aiAnimation* anim,
+    const std::string& name,
+    const Hierarchy& h,
+    const std::vector<bool>& hosts_bone,
+    Rig& rig,
+    Context& ctx) {
   Clip clip;
   clip.name = name;
   const std::string label = "clip '" + clip.name + "'";
   double ticks = anim->mTicksPerSecond;
   if (!std::isfinite(ticks) || ticks <= 0) {
     ticks = kDefaultTicksPerSecond;
-    ctx.problems.push_back(label + " does not give ticks per second; assumed " + std::to_string(static_cast<int>(ticks)));
+    ctx.problems.push_back(
+        label + " does not give ticks per second; assumed " +
+        std::to_string(static_cast<int>(ticks)));
   }
-  if (!std::isfinite(anim->mDuration) || anim->mDuration < 0) refuse_clip("its duration is " + std::to_string(anim->mDuration) + " ticks");
+  if (!std::isfinite(anim->mDuration) || anim->mDuration < 0)
+    refuse_clip("its duration is " + std::to_string(anim->mDuration) + " ticks");
   clip.duration_s = anim->mDuration / ticks;
-  if (anim->mNumChannels > 0 && anim->mChannels == nullptr) refuse_clip("it lists channels it does not have");
+  if (anim->mNumChannels > 0 && anim->mChannels == nullptr)
+    refuse_clip("it lists channels it does not have");
   std::vector<bool> animated(rig.skeleton.nodes.size(), false);
   for (unsigned c = 0; c < anim->mNumChannels; ++c) {
     const aiNodeAnim* na = anim->mChannels[c];
     if (na == nullptr) refuse_clip("channel " + std::to_string(c) + " is null");
     const std::string node_name = na->mNodeName.C_Str();
-    const auto node = resolve_node(h, node_name, &hosts_bone, ctx, label + " channel for '" + node_name + "'");
+    const auto node =
+        resolve_node(h, node_name, &hosts_bone, ctx, label + " channel for '" + node_name + "'");
     if (node < 0) {
       ctx.problems.push_back(label + ": channel for unknown node '" + node_name + "' ignored");
       continue;
@@ -693,40 +707,55 @@ Clip read_clip(const aiAnimation* anim, const std::string& name, const Hierarchy
     const std::string where = "node '" + node_name + "'";
     // Keys in seconds, strictly increasing: a key at the same time as the one before it is
     // dropped (reported); a key earlier than the one before it refuses the clip.
-    auto add_time = [&](std::vector<double>& times, double t_ticks, const char* kind, unsigned k) -> bool {
-      if (!std::isfinite(t_ticks)) refuse_clip(where + ", " + kind + " key " + std::to_string(k) + " has a non-finite time");
+    auto add_time =
+        [&](std::vector<double>& times, double t_ticks, const char* kind, unsigned k) -> bool {
+      if (!std::isfinite(t_ticks))
+        refuse_clip(where + ", " + kind + " key " + std::to_string(k) + " has a non-finite time");
       const double t = t_ticks / ticks;
       if (!times.empty() && t <= times.back()) {
         if (t < times.back()) {
-          refuse_clip(where + ", " + kind + " key " + std::to_string(k) + " (t = " + std::to_string(t) +
-                      " s) is earlier than the key before it (t = " + std::to_string(times.back()) + " s)");
+          refuse_clip(
+              where + ", " + kind + " key " + std::to_string(k) + " (t = " + std::to_string(t) +
+              " s) is earlier than the key before it (t = " + std::to_string(times.back()) + " s)");
         }
-        ctx.problems.push_back(label + ", " + where + ": " + kind + " key " + std::to_string(k) + " repeats a time; dropped");
+        ctx.problems.push_back(
+            label + ", " + where + ": " + kind + " key " + std::to_string(k) +
+            " repeats a time; dropped");
         return false;
       }
       times.push_back(t);
       return true;
     };
-    if ((na->mNumPositionKeys > 0 && na->mPositionKeys == nullptr) || (na->mNumRotationKeys > 0 && na->mRotationKeys == nullptr) ||
+    if ((na->mNumPositionKeys > 0 && na->mPositionKeys == nullptr) ||
+        (na->mNumRotationKeys > 0 && na->mRotationKeys == nullptr) ||
         (na->mNumScalingKeys > 0 && na->mScalingKeys == nullptr)) {
       refuse_clip(where + " lists keys it does not have");
     }
     for (unsigned k = 0; k < na->mNumPositionKeys; ++k) {
       const Eigen::Vector3d v = to_vector(na->mPositionKeys[k].mValue);
-      if (!v.allFinite()) refuse_clip(where + ", translation key " + std::to_string(k) + " is not finite");
-      if (add_time(ch.translation_times, na->mPositionKeys[k].mTime, "translation", k)) ch.translations.push_back(v);
+      if (!v.allFinite())
+        refuse_clip(where + ", translation key " + std::to_string(k) + " is not finite");
+      if (add_time(ch.translation_times, na->mPositionKeys[k].mTime, "translation", k))
+        ch.translations.push_back(v);
     }
     for (unsigned k = 0; k < na->mNumRotationKeys; ++k) {
       const aiQuaternion& q = na->mRotationKeys[k].mValue;
-      Eigen::Quaterniond e(static_cast<double>(q.w), static_cast<double>(q.x), static_cast<double>(q.y), static_cast<double>(q.z));
+      Eigen::Quaterniond e(
+          static_cast<double>(q.w),
+          static_cast<double>(q.x),
+          static_cast<double>(q.y),
+          static_cast<double>(q.z));
       const double norm = e.norm();
-      if (!e.coeffs().allFinite() || !(norm > 0)) refuse_clip(where + ", rotation key " + std::to_string(k) + " is not a rotation");
+      if (!e.coeffs().allFinite() || !(norm > 0))
+        refuse_clip(where + ", rotation key " + std::to_string(k) + " is not a rotation");
       e.coeffs() /= norm;
-      if (add_time(ch.rotation_times, na->mRotationKeys[k].mTime, "rotation", k)) ch.rotations.push_back(e);
+      if (add_time(ch.rotation_times, na->mRotationKeys[k].mTime, "rotation", k))
+        ch.rotations.push_back(e);
     }
     for (unsigned k = 0; k < na->mNumScalingKeys; ++k) {
       const Eigen::Vector3d v = to_vector(na->mScalingKeys[k].mValue);
-      if (!v.allFinite()) refuse_clip(where + ", scale key " + std::to_string(k) + " is not finite");
+      if (!v.allFinite())
+        refuse_clip(where + ", scale key " + std::to_string(k) + " is not finite");
       if (add_time(ch.scale_times, na->mScalingKeys[k].mTime, "scale", k)) ch.scales.push_back(v);
     }
     for (const auto* times : {&ch.translation_times, &ch.rotation_times, &ch.scale_times}) {
@@ -735,25 +764,35 @@ Clip read_clip(const aiAnimation* anim, const std::string& name, const Hierarchy
     clip.channels.push_back(std::move(ch));
   }
   std::sort(clip.key_times.begin(), clip.key_times.end());
-  clip.key_times.erase(std::unique(clip.key_times.begin(), clip.key_times.end()), clip.key_times.end());
+  clip.key_times.erase(
+      std::unique(clip.key_times.begin(), clip.key_times.end()), clip.key_times.end());
   return clip;
 }
 
-void read_clips(const aiScene* scene, const Hierarchy& h, Rig& rig, std::vector<RefusedClip>& refused, Context& ctx) {
+void read_clips(
+    const aiScene* scene,
+    const Hierarchy& h,
+    Rig& rig,
+    std::vector<RefusedClip>& refused,
+    Context& ctx) {
   std::vector<bool> hosts_bone(rig.skeleton.nodes.size(), false);
   for (const auto& b : rig.skeleton.bones) hosts_bone[static_cast<std::size_t>(b.node)] = true;
-  if (scene->mNumAnimations > 0 && scene->mAnimations == nullptr) ctx.invalid("the scene lists animations it does not have");
+  if (scene->mNumAnimations > 0 && scene->mAnimations == nullptr)
+    ctx.invalid("the scene lists animations it does not have");
   std::map<std::string, int> used_names;
   for (unsigned a = 0; a < scene->mNumAnimations; ++a) {
     const aiAnimation* anim = scene->mAnimations[a];
     std::string name = anim != nullptr ? anim->mName.C_Str() : "";
     if (name.empty()) {
       name = "clip_" + std::to_string(a);
-      ctx.problems.push_back("animation " + std::to_string(a) + " has no name; called '" + name + "'");
+      ctx.problems.push_back(
+          "animation " + std::to_string(a) + " has no name; called '" + name + "'");
     }
     if (used_names[name]++ > 0) {
       const auto renamed = name + "#" + std::to_string(a);
-      ctx.problems.push_back("animation " + std::to_string(a) + " repeats the name '" + name + "'; called '" + renamed + "'");
+      ctx.problems.push_back(
+          "animation " + std::to_string(a) + " repeats the name '" + name + "'; called '" +
+          renamed + "'");
       name = renamed;
     }
     try {
@@ -762,14 +801,16 @@ void read_clips(const aiScene* scene, const Hierarchy& h, Rig& rig, std::vector<
       const auto problems_before = ctx.problems.size();
       try {
         Clip clip = read_clip(anim, name, h, hosts_bone, rig, ctx);
-        if (anim->mNumMorphMeshChannels > 0 || anim->mNumMeshChannels > 0) ctx.clips_with_mesh_channels.push_back(name);
+        if (anim->mNumMorphMeshChannels > 0 || anim->mNumMeshChannels > 0)
+          ctx.clips_with_mesh_channels.push_back(name);
         rig.clips.push_back(std::move(clip));
       } catch (const ClipRefusal&) {
         ctx.problems.resize(problems_before);
         throw;
       }
     } catch (const ClipRefusal& refusal) {
-      ctx.problems.push_back("clip '" + name + "' refused: " + refusal.reason + "; the other clips are usable");
+      ctx.problems.push_back(
+          "clip '" + name + "' refused: " + refusal.reason + "; the other clips are usable");
       refused.push_back({name, refusal.reason});
     }
   }
@@ -799,7 +840,6 @@ void check_raw_numbers(const aiScene* scene, const Context& ctx) {
     }
   }
 }
-
 
 // The import proper; the caller holds import_mutex().
 ImportedRig import_locked(const std::filesystem::path& file, const ImportOptions& options) {
@@ -932,14 +972,16 @@ ImportedRig import_rig(const std::filesystem::path& file, const ImportOptions& o
   const std::string name = file.string();
   std::error_code ec;
   if (!std::filesystem::exists(file, ec)) throw IoError(name + ": no such file");
-  if (std::filesystem::is_directory(file, ec)) throw IoError(name + ": is a directory, not a model file");
+  if (std::filesystem::is_directory(file, ec))
+    throw IoError(name + ": is a directory, not a model file");
   if (std::filesystem::file_size(file, ec) == 0 && !ec) throw IoError(name + ": empty file");
   detail::check_declared_counts(file);
 
   std::lock_guard lock(import_mutex());
   if (options.isolate) {
     // A crash, a loop or a runaway allocation inside assimp ends the child, not this process.
-    const detail::ImportLimits limits{.memory_bytes = options.memory_limit_bytes, .time_s = options.time_limit_s};
+    const detail::ImportLimits limits{
+        .memory_bytes = options.memory_limit_bytes, .time_s = options.time_limit_s};
     detail::run_isolated(file, limits, [&] { (void)import_locked(file, options); });
   }
   try {

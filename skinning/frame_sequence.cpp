@@ -330,9 +330,10 @@ FrameMesh read_ply(const fs::path& file, const std::string& bytes) {
     // for it (found by fuzz/fuzz_frame_mesh). Items without properties hold nothing to read.
     if (e.properties.empty()) continue;
     if (e.count > bytes.size() - pos) {
-      throw IoError(file.string() + ": PLY element '" + e.name + "' declares " + std::to_string(e.count) +
-                    " items, more than the " + std::to_string(bytes.size() - pos) +
-                    " bytes after the header hold (truncated or damaged file)");
+      throw IoError(
+          file.string() + ": PLY element '" + e.name + "' declares " + std::to_string(e.count) +
+          " items, more than the " + std::to_string(bytes.size() - pos) +
+          " bytes after the header hold (truncated or damaged file)");
     }
     if (e.name == "vertex") xyz.reserve(3 * e.count);
     for (std::size_t item = 0; item < e.count; ++item) {
@@ -352,9 +353,11 @@ FrameMesh read_ply(const fs::path& file, const std::string& bytes) {
             const double index = reader.read(p.type);
             if (kk == ilist) {
               if (index != std::floor(index)) throw IoError(file.string() + ": PLY face index is not an integer");
-              // Beyond int64 the conversion is undefined; finish() reports the index as out of range.
+              // Beyond int64 the conversion is undefined; finish() reports the index as out of
+              // range.
               if (!(std::abs(index) < 0x1p62)) {
-                throw InvalidInput(file.string() + ": PLY face index " + std::to_string(index) + " out of range");
+                throw InvalidInput(
+                    file.string() + ": PLY face index " + std::to_string(index) + " out of range");
               }
               corners.push_back(static_cast<std::int64_t>(index));
             }

@@ -95,8 +95,11 @@ LoadedModel model_from_rig(
         return r.name == request.clip;
       });
       if (options.clip < 0 && refusal != refused.end()) {
-        throw InvalidInput(shared->source + ": clip '" + request.clip + "' was refused: " + refusal->reason +
-                           " (" + (clips.empty() ? std::string("no clip is usable") : "usable " + clip_list(clips)) + ")");
+        throw InvalidInput(
+            shared->source + ": clip '" + request.clip + "' was refused: " + refusal->reason +
+            " (" +
+            (clips.empty() ? std::string("no clip is usable") : "usable " + clip_list(clips)) +
+            ")");
       }
       if (options.clip < 0) {
         throw InvalidInput(shared->source + ": no clip named '" + request.clip + "' (" + clip_list(clips) + ")");

@@ -13,8 +13,8 @@
 #include <system_error>
 #include <utility>
 
-#include "culling/method_registry.hpp"
 #include "culling/method.hpp"
+#include "culling/method_registry.hpp"
 #include "skinning/errors.hpp"
 #include "tools/cli_util.hpp"
 

@@ -18,7 +18,8 @@ RunOptions run_options(const CheckRequest& r) {
     throw InvalidInput("rate " + std::to_string(r.fps) + ": expected a rate > 0 (samples/s)");
   }
   if (!(std::isfinite(r.min_separation) && r.min_separation >= 0)) {
-    throw InvalidInput("min_separation " + std::to_string(r.min_separation) + ": expected a finite distance >= 0");
+    throw InvalidInput(
+        "min_separation " + std::to_string(r.min_separation) + ": expected a finite distance >= 0");
   }
   const auto known = check_method_names();
   if (std::find(known.begin(), known.end(), r.method) == known.end()) {
@@ -43,9 +44,11 @@ RunOptions run_options(const CheckRequest& r) {
 
 std::vector<std::string> check_method_names() { return scene_method_names(); }
 
-CheckOutcome check_model(const skinning::LoadedModel& model, const CheckRequest& request, const FrameCallback& on_row) {
+CheckOutcome check_model(
+    const skinning::LoadedModel& model, const CheckRequest& request, const FrameCallback& on_row) {
   RunOptions options = run_options(request);
-  const auto motion = model.motion(skinning::MotionRequest{.clip = request.clip, .rate_hz = request.fps});
+  const auto motion =
+      model.motion(skinning::MotionRequest{.clip = request.clip, .rate_hz = request.fps});
   CheckOutcome outcome;
   outcome.radial_view = setup_radial_view(request.radial_view, model, *motion, options);
   ClipRunner runner(*motion, options);

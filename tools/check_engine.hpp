@@ -21,14 +21,14 @@ namespace skelcd::tools {
 /// What to check, and how. The defaults are `skelcd check`'s, but for `threads` (1 here, all
 /// cores on the command line).
 struct CheckRequest {
-  std::string clip;    ///< empty: the model's first clip (its bind pose when it has none)
-  double fps = 0;      ///< samples per second; 0: the clip's key rate, else 30
-  FrameRange frames;   ///< samples first … last
+  std::string clip;   ///< empty: the model's first clip (its bind pose when it has none)
+  double fps = 0;     ///< samples per second; 0: the clip's key rate, else 30
+  FrameRange frames;  ///< samples first … last
   std::string method = "bvh";
   ccd::Accuracy accuracy = ccd::Accuracy::conservative;
   QuerySet query = QuerySet::both;
-  double min_separation = 0;  ///< contact distance, model units
-  std::int32_t threads = 1;   ///< 0: all cores
+  double min_separation = 0;        ///< contact distance, model units
+  std::int32_t threads = 1;         ///< 0: all cores
   RadialViewArguments radial_view;  ///< γ, seed, segmentation file of rvbc/dynamic/auto
   /// Where to write the HDF5 log (docs/log-format.md); empty: no log.
   std::string log_path;
@@ -45,9 +45,9 @@ struct CheckRequest {
 
 /// What a check found and how it ran.
 struct CheckOutcome {
-  std::string clip;        ///< the motion's name
-  double fps = 0;          ///< samples per second it was sampled at
-  std::string method;      ///< the method that ran
+  std::string clip;    ///< the motion's name
+  double fps = 0;      ///< samples per second it was sampled at
+  std::string method;  ///< the method that ran
   RunPlan plan;
   RadialViewSetup radial_view;
   std::vector<FrameRow> rows;  ///< every row, in order

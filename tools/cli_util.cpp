@@ -14,8 +14,12 @@ void print_json(const nlohmann::json& object) { std::cout << object.dump(2) << '
 
 bool stderr_is_terminal() { return ::isatty(STDERR_FILENO) == 1; }
 
-Progress::Progress(std::string label, std::int64_t total, const std::atomic<std::int64_t>* tests_done)
-    : label_(std::move(label)), total_(total), enabled_(stderr_is_terminal()), tests_done_(tests_done) {
+Progress::Progress(
+    std::string label, std::int64_t total, const std::atomic<std::int64_t>* tests_done)
+    : label_(std::move(label)),
+      total_(total),
+      enabled_(stderr_is_terminal()),
+      tests_done_(tests_done) {
   if (!enabled_ || tests_done_ == nullptr) return;
   ticker_ = std::thread([this] {
     std::unique_lock lock(mutex_);
@@ -44,7 +48,10 @@ void Progress::draw(std::int64_t done) {
   std::fprintf(stderr, "\r%s %lld/%lld (%.0f%%)", label_.c_str(), static_cast<long long>(done),
                static_cast<long long>(total_), percent);
   if (tests_done_ != nullptr) {
-    std::fprintf(stderr, ", %lld elementary tests", static_cast<long long>(tests_done_->load(std::memory_order_relaxed)));
+    std::fprintf(
+        stderr,
+        ", %lld elementary tests",
+        static_cast<long long>(tests_done_->load(std::memory_order_relaxed)));
   }
   std::fprintf(stderr, "\033[K");
   std::fflush(stderr);
@@ -63,7 +70,8 @@ void Progress::finish() {
   if (ticker_.joinable()) ticker_.join();
 }
 
-CLI::Option* add_rate_option(CLI::App& command, const std::string& names, double& rate, const std::string& help) {
+CLI::Option* add_rate_option(
+    CLI::App& command, const std::string& names, double& rate, const std::string& help) {
   const std::string flag = names.substr(0, names.find(','));
   return command
       .add_option_function<double>(

@@ -1,18 +1,17 @@
 #pragma once
 // Small pieces every command uses: JSON output, a progress line on a terminal, path checks.
 
+#include <CLI/CLI.hpp>
 #include <atomic>
 #include <chrono>
 #include <condition_variable>
 #include <cstdint>
 #include <filesystem>
+#include <mutex>
+#include <nlohmann/json.hpp>
 #include <string>
 #include <string_view>
 #include <thread>
-#include <mutex>
-
-#include <CLI/CLI.hpp>
-#include <nlohmann/json.hpp>
 
 namespace skelcd::tools {
 
@@ -28,7 +27,8 @@ class Progress {
  public:
   /// @param tests_done when set, also shown (and redrawn every 0.25 s by a thread of its own
   ///   while the line is up), so that one long row still shows work going on.
-  Progress(std::string label, std::int64_t total, const std::atomic<std::int64_t>* tests_done = nullptr);
+  Progress(
+      std::string label, std::int64_t total, const std::atomic<std::int64_t>* tests_done = nullptr);
   ~Progress();
   Progress(const Progress&) = delete;
   Progress& operator=(const Progress&) = delete;
@@ -54,7 +54,8 @@ class Progress {
 /// samples/s into `rate`. Leaving it out keeps `rate` as it is (0: the model's default); giving a
 /// value that is not finite and > 0 (0 included) is refused: InvalidInput "--fps 0: expected a
 /// rate > 0 (samples/s)".
-CLI::Option* add_rate_option(CLI::App& command, const std::string& names, double& rate, const std::string& help);
+CLI::Option* add_rate_option(
+    CLI::App& command, const std::string& names, double& rate, const std::string& help);
 
 /// Throws IoError "<path>: no such file" unless `path` exists.
 void require_exists(const std::filesystem::path& path);

@@ -9,12 +9,12 @@
 #include <string>
 #include <vector>
 
+#include "culling/method_registry.hpp"
 #include "skinning/errors.hpp"
 #include "skinning/generators.hpp"
 #include "skinning/load.hpp"
 #include "skinning/rig_motion.hpp"
 #include "tools/bench_report.hpp"
-#include "culling/method_registry.hpp"
 #include "tools/cli_util.hpp"
 #include "tools/commands.hpp"
 #include "tools/model_options.hpp"
@@ -112,7 +112,8 @@ BenchReport bench_target(
 
   // rvbc and dynamic need a rig's clip: they are in the default list only then, and refused by
   // name otherwise. Their segmentation is made once, at the first radial-view run, and shared.
-  options.radial_view = model.rig != nullptr && model.kind == skinning::ModelKind::rig && motion.num_bones() > 0;
+  options.radial_view =
+      model.rig != nullptr && model.kind == skinning::ModelKind::rig && motion.num_bones() > 0;
   validate_methods(options.methods, options.radial_view);
   struct RadialViewCache {
     bool ready = false;
@@ -301,7 +302,8 @@ void add_bench_command(CLI::App& app) {
   cmd->add_option(
          "--methods",
          args->methods,
-         method_option_help("methods to run, comma-separated (default: all; brute only when it fits):"))
+         method_option_help(
+             "methods to run, comma-separated (default: all; brute only when it fits):"))
       ->delimiter(',');
   cmd->add_option(
          "--accuracies",
@@ -309,7 +311,8 @@ void add_bench_command(CLI::App& app) {
          "accuracies, comma-separated (default: exact,conservative,fast)")
       ->delimiter(',');
   cmd->add_option("--clip", args->clip, "clip to run (default: the first)");
-  add_rate_option(*cmd, "--fps", args->fps, "samples per second (default: the clip's key rate, else 30)");
+  add_rate_option(
+      *cmd, "--fps", args->fps, "samples per second (default: the clip's key rate, else 30)");
   cmd->add_option("--frames", args->frames, "samples A:B, both included (A:, :B, A)");
   cmd->add_option("--query", args->query, "ccd, dcd or both")->capture_default_str();
   cmd->add_option(

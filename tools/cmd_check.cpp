@@ -5,6 +5,7 @@
 
 #include <fnmatch.h>
 
+#include <CLI/CLI.hpp>
 #include <algorithm>
 #include <atomic>
 #include <cctype>
@@ -20,8 +21,6 @@
 #include <string>
 #include <vector>
 
-#include <CLI/CLI.hpp>
-
 #include "culling/routed_method.hpp"
 #include "skelcd_version.hpp"
 #include "skinning/errors.hpp"
@@ -32,9 +31,9 @@
 #include "tools/cli_util.hpp"
 #include "tools/commands.hpp"
 #include "tools/file_hash.hpp"
+#include "tools/log/log_writer.hpp"
 #include "tools/model_options.hpp"
 #include "tools/radial_view_setup.hpp"
-#include "tools/log/log_writer.hpp"
 #include "tools/run_summary.hpp"
 #include "tools/runner.hpp"
 #include "tools/scene.hpp"
@@ -93,7 +92,8 @@ RunOptions to_run_options(const CheckArguments& a) {
   if (!a.frames.empty()) o.frames = parse_frame_range(a.frames);
   o.method = a.method;
   // Every method the check knows, radial view's included, whether or not this run would build them.
-  if (const auto known = scene_method_names(); std::find(known.begin(), known.end(), a.method) == known.end()) {
+  if (const auto known = scene_method_names();
+      std::find(known.begin(), known.end(), a.method) == known.end()) {
     std::string list;
     for (const auto& k : known) list += (list.empty() ? "" : ", ") + k;
     throw InvalidInput("--method '" + a.method + "': unknown method (known: " + list + ")");
@@ -259,21 +259,24 @@ CheckedClip check_clip(const CheckArguments& args, RunOptions options, const std
   std::unique_ptr<Progress> progress;
   std::int64_t rows = 0;
   request.on_plan = [&](const RunPlan& plan) {
-    progress = std::make_unique<Progress>("check " + (clip.empty() ? model.path.filename().string() : clip), plan.rows,
-                                          &tests_done);
+    progress = std::make_unique<Progress>(
+        "check " + (clip.empty() ? model.path.filename().string() : clip), plan.rows, &tests_done);
   };
-  const auto outcome = check_model(model, request, [&](const FrameReport&) { progress->update(++rows); });
+  const auto outcome =
+      check_model(model, request, [&](const FrameReport&) { progress->update(++rows); });
   progress.reset();
   const auto motion = model.motion(skinning::MotionRequest{.clip = clip, .rate_hz = args.fps});
   options.clip = clip;
   CheckedClip checked;
   std::ostringstream text;
-  print_text_summary(text, model, *motion, options, outcome.plan, outcome.fps, outcome.summary, log_path);
+  print_text_summary(
+      text, model, *motion, options, outcome.plan, outcome.fps, outcome.summary, log_path);
   if (!outcome.radial_view.segmentation_source.empty()) {
     text << "segmentation: " << outcome.radial_view.segmentation_source << "\n";
   }
   checked.text = text.str();
-  checked.json = json_summary(model, *motion, options, outcome.plan, outcome.fps, outcome.summary, log_path);
+  checked.json =
+      json_summary(model, *motion, options, outcome.plan, outcome.fps, outcome.summary, log_path);
   if (!outcome.radial_view.segmentation_source.empty()) {
     checked.json["segmentation"] = outcome.radial_view.segmentation_source;
   }
@@ -463,8 +466,9 @@ void run_batch(const CheckArguments& args, const std::vector<std::string>& model
     for (const auto& f : failures) std::cout << "FAILED    " << describe(f) << '\n';
   }
   if (!failures.empty()) {
-    throw InvalidInput(std::to_string(failures.size()) + " of " + std::to_string(checks) +
-                       " checks failed, first " + describe(failures.front()));
+    throw InvalidInput(
+        std::to_string(failures.size()) + " of " + std::to_string(checks) +
+        " checks failed, first " + describe(failures.front()));
   }
 }
 
@@ -495,17 +499,17 @@ void add_check_command(CLI::App& app) {
                   "or a quoted glob ('dir/*.glb'), make a batch")
       ->required();
   cmd->add_option("--clip", args->clip, "clip to check (default: the first)");
-  add_rate_option(*cmd, "--fps", args->fps, "samples per second (default: the clip's key rate, else 30)");
+  add_rate_option(
+      *cmd, "--fps", args->fps, "samples per second (default: the clip's key rate, else 30)");
   cmd->add_option("--frames", args->frames, "samples A:B to check, both included (A:, :B, A)");
-  cmd->add_option(
-         "--method",
-         args->method,
-         method_option_help("culling method, one of:"))
+  cmd->add_option("--method", args->method, method_option_help("culling method, one of:"))
       ->capture_default_str();
-  cmd->add_option("--accuracy", args->accuracy,
-                  "elementary tests: conservative (never misses), fast (no guarantee), or exact (GMP "
-                  "rationals, the judge: 10-30x the time of conservative per test; a 92k-triangle cloth "
-                  "step takes minutes)")
+  cmd->add_option(
+         "--accuracy",
+         args->accuracy,
+         "elementary tests: conservative (never misses), fast (no guarantee), or exact (GMP "
+         "rationals, the judge: 10-30x the time of conservative per test; a 92k-triangle cloth "
+         "step takes minutes)")
       ->capture_default_str();
   cmd->add_option("--query", args->query, "ccd, dcd or both")->capture_default_str();
   cmd->add_option("--min-separation", args->min_separation,

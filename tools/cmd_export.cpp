@@ -1,14 +1,13 @@
 // skelcd export MODEL [--clip NAME] [--frame K | --time S] [--rate HZ] -o OUT.{obj,ply,glb}:
 // the mesh posed at one sample (or time) of a clip, written through assimp's exporter.
 
+#include <CLI/CLI.hpp>
 #include <algorithm>
 #include <cmath>
 #include <iostream>
 #include <memory>
 #include <optional>
 #include <string>
-
-#include <CLI/CLI.hpp>
 
 #include "skinning/errors.hpp"
 #include "skinning/load.hpp"
@@ -17,12 +16,11 @@
 #include "tools/commands.hpp"
 #include "tools/export_mesh.hpp"
 #include "tools/highlight.hpp"
-#include "tools/segmentation_colors.hpp"
 #include "tools/model_options.hpp"
+#include "tools/segmentation_colors.hpp"
 
 namespace skelcd::tools {
 namespace {
-
 
 struct ExportArgs {
   std::string model;
@@ -56,7 +54,8 @@ void run_export(const ExportArgs& args) {
     } else {
       int found = -1;
       for (int i = 0; i < motion->num_samples() && found < 0; ++i) {
-        if (std::abs(motion->sample_time(i) - t) <= kSampleTimeTolerance * std::max(1.0, t)) found = i;
+        if (std::abs(motion->sample_time(i) - t) <= kSampleTimeTolerance * std::max(1.0, t))
+          found = i;
       }
       if (found < 0) fail("time " + std::to_string(t) + " s is not a sample time of '" + motion->name() + "'; use --frame");
       motion->positions(found, positions);
@@ -109,7 +108,11 @@ void add_export_command(CLI::App& app) {
   auto* time = cmd->add_option("--time", args->time, "time in seconds from the start of the clip");
   frame->excludes(time);
   time->excludes(frame);
-  add_rate_option(*cmd, "--rate,--fps", args->rate, "samples per second (default: the clip's key rate, else 30)");
+  add_rate_option(
+      *cmd,
+      "--rate,--fps",
+      args->rate,
+      "samples per second (default: the clip's key rate, else 30)");
   cmd->add_option("-o,--output", args->output, "OUT.obj, OUT.ply or OUT.glb; '-' or /dev/stdout for standard output")
       ->required();
   cmd->add_option("--format", args->format, "obj, ply or glb (default: from OUT's extension; obj on standard output)");

@@ -140,8 +140,8 @@ std::string model_name(const LogHeader& h) {
 
 std::string completeness(const LogData& log) {
   if (!log.damage.empty()) {
-    return "damaged (" + std::to_string(log.frames.size()) + "/" + std::to_string(log.header.planned_rows) +
-           " rows readable)";
+    return "damaged (" + std::to_string(log.frames.size()) + "/" +
+           std::to_string(log.header.planned_rows) + " rows readable)";
   }
   if (log.header.complete) return "yes";
   return "no (" + std::to_string(log.frames.size()) + "/" + std::to_string(log.header.planned_rows) +
@@ -208,8 +208,8 @@ void run_inspect(const InspectOptions& o) {
       auto log = read_log(path, ReadLogOptions{.findings = false});
       if (!log.damage.empty()) {
         // Summarised from the rows before the damage; the exit status still says it.
-        std::cerr << "skelcd: " << path << ": " << log.damage.front() << "; the " << log.frames.size()
-                  << " rows written before it are read\n";
+        std::cerr << "skelcd: " << path << ": " << log.damage.front() << "; the "
+                  << log.frames.size() << " rows written before it are read\n";
         ++damaged;
       }
       logs.emplace_back(path, std::move(log));
@@ -280,8 +280,9 @@ void run_inspect(const InspectOptions& o) {
         " files skipped: not readable skelcd logs (named above)");
   }
   if (damaged > 0) {
-    throw IoError(std::to_string(damaged) + " of " + std::to_string(o.logs.size()) +
-                  " logs are damaged (named above); their rows before the damage are summarised");
+    throw IoError(
+        std::to_string(damaged) + " of " + std::to_string(o.logs.size()) +
+        " logs are damaged (named above); their rows before the damage are summarised");
   }
 }
 

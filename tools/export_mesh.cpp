@@ -94,8 +94,8 @@ std::string write_ply(const aiScene& scene) {
   return out;
 }
 
-// Builds an aiScene with one aiMesh per non-empty part, each in a node of its own. aiScene's destructor
-// frees everything allocated here with new/new[], as assimp expects.
+// Builds an aiScene with one aiMesh per non-empty part, each in a node of its own. aiScene's
+// destructor frees everything allocated here with new/new[], as assimp expects.
 std::unique_ptr<aiScene> build_scene(
     const skinning::Mesh& mesh,
     const skinning::Positions& positions,

@@ -125,11 +125,17 @@ std::vector<std::array<float, 4>> highlight_face_colors(
   }
   if (std::abs(row->t0 - frame_time_s) > kSampleTimeTolerance * std::max(1.0, std::abs(frame_time_s))) {
     char text[320];
-    std::snprintf(text, sizeof text,
-                  "frame %d is at t = %.9g s in the log (written at %.9g samples/s) but at t = %.9g s here, "
-                  "%.3g s apart (more than the %.0e s allowed): pose it at the log's rate",
-                  frame, row->t0, log.header.fps, frame_time_s, std::abs(row->t0 - frame_time_s),
-                  kSampleTimeTolerance * std::max(1.0, std::abs(frame_time_s)));
+    std::snprintf(
+        text,
+        sizeof text,
+        "frame %d is at t = %.9g s in the log (written at %.9g samples/s) but at t = %.9g s here, "
+        "%.3g s apart (more than the %.0e s allowed): pose it at the log's rate",
+        frame,
+        row->t0,
+        log.header.fps,
+        frame_time_s,
+        std::abs(row->t0 - frame_time_s),
+        kSampleTimeTolerance * std::max(1.0, std::abs(frame_time_s)));
     std::string message = text;
     if (log.header.fps > 0) {
       std::snprintf(text, sizeof text, " (--rate %.9g)", log.header.fps);

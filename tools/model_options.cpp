@@ -22,7 +22,8 @@ void add_model_options(CLI::App& command, skinning::LoadOptions& options) {
             if (!(std::isfinite(mib) && mib >= 64 && mib <= 1024.0 * 1024.0)) {
               char text[64];
               std::snprintf(text, sizeof text, "%g", mib);
-              throw InvalidInput(std::string("--import-memory ") + text + ": expected MiB between 64 and 1048576");
+              throw InvalidInput(
+                  std::string("--import-memory ") + text + ": expected MiB between 64 and 1048576");
             }
             options.import.memory_limit_bytes = static_cast<std::size_t>(mib * 1024.0 * 1024.0);
           },
@@ -46,9 +47,11 @@ void add_radial_view_options(CLI::App& command, RadialViewArguments& args) {
       ->capture_default_str();
   command.add_option("--seed", args.seed, "dynamic: seed of the seed-cluster draws")
       ->capture_default_str();
-  command.add_option("--segmentation", args.segmentation,
-                     "rvbc/dynamic: SEG.h5 from `skelcd preprocess`, used when made from this model "
-                     "(else, and by default, segment here with the rig's weights)");
+  command.add_option(
+      "--segmentation",
+      args.segmentation,
+      "rvbc/dynamic: SEG.h5 from `skelcd preprocess`, used when made from this model "
+      "(else, and by default, segment here with the rig's weights)");
 }
 
 }  // namespace skelcd::tools

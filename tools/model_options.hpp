@@ -2,9 +2,8 @@
 // The options every command that reads a MODEL shares (how to load it), so that `info`,
 // `export` and the others accept the same spellings.
 
-#include <string>
-
 #include <CLI/CLI.hpp>
+#include <string>
 
 #include "skinning/load.hpp"
 #include "tools/radial_view_setup.hpp"

@@ -17,8 +17,8 @@
 
 #include "culling/method_registry.hpp"
 #include "culling/routed_method.hpp"
-#include "tools/sample_sequencer.hpp"
 #include "skinning/errors.hpp"
+#include "tools/sample_sequencer.hpp"
 
 namespace skelcd::tools {
 namespace {
@@ -60,7 +60,6 @@ RunPlan make_plan(const skinning::Motion& motion, const RunOptions& options) {
   return plan;
 }
 
-
 /// What one row needs from the run: the motion, the welded topology and the file numbering, and
 /// whether the method needs the bones' transforms.
 struct RowContext {
@@ -78,7 +77,8 @@ struct PosedSample {
 
 /// Poses sample i into `out` (`posed`: scratch); returns the microseconds it took.
 /// Finiteness is checked once per sample, here, where positions enter.
-double pose_sample(const RowContext& c, std::int32_t i, skinning::Positions& posed, PosedSample& out) {
+double pose_sample(
+    const RowContext& c, std::int32_t i, skinning::Positions& posed, PosedSample& out) {
   const auto start = Clock::now();
   skinning::Positions& welded = out.welded;
   if (c.bones) c.motion.bone_transforms(i, out.bones);
@@ -144,7 +144,8 @@ void make_report(const RowContext& c, QueryKind kind, std::int32_t sample,
 }
 
 /// The options the method is built with.
-culling::MethodOptions method_options_of(const RunOptions& options, const skinning::Motion& motion) {
+culling::MethodOptions method_options_of(
+    const RunOptions& options, const skinning::Motion& motion) {
   culling::MethodOptions o;
   o.accuracy = options.accuracy;
   o.min_separation = options.min_separation;
@@ -176,7 +177,8 @@ struct Worker {
 
 /// Runs the rows of `sequence` with `w`, passing each completed row to `emit`, in order.
 template <class Emit>
-void check_samples(const RowContext& context, const SampleSequence& sequence, Worker& w, Emit&& emit) {
+void check_samples(
+    const RowContext& context, const SampleSequence& sequence, Worker& w, Emit&& emit) {
   FrameReport report;
   run_sequence(
       sequence,
@@ -185,7 +187,8 @@ void check_samples(const RowContext& context, const SampleSequence& sequence, Wo
         const auto start = Clock::now();
         w.result.clear();
         const PosedSample& x = w.samples[slot];
-        w.method->detect_dcd(culling::Instant{.x = x.welded, .bones = x.bones, .sample = k}, w.result);
+        w.method->detect_dcd(
+            culling::Instant{.x = x.welded, .bones = x.bones, .sample = k}, w.result);
         make_report(context, QueryKind::dcd, k, w.result, skin_us, start, report);
         emit(report);
       },
@@ -195,8 +198,13 @@ void check_samples(const RowContext& context, const SampleSequence& sequence, Wo
         const PosedSample& a = w.samples[slot_t0];
         const PosedSample& b = w.samples[slot_t1];
         w.method->detect_ccd(
-            culling::Interval{.x_t0 = a.welded, .x_t1 = b.welded, .bones_t0 = a.bones, .bones_t1 = b.bones,
-                              .sample_t0 = k, .sample_t1 = k + 1},
+            culling::Interval{
+                .x_t0 = a.welded,
+                .x_t1 = b.welded,
+                .bones_t0 = a.bones,
+                .bones_t1 = b.bones,
+                .sample_t0 = k,
+                .sample_t1 = k + 1},
             w.result);
         make_report(context, QueryKind::ccd, k, w.result, skin_us, start, report);
         emit(report);
@@ -332,9 +340,7 @@ std::string serial_reason(std::string_view name, const RunOptions& options) {
 }
 
 ClipRunner::ClipRunner(
-    const skinning::Motion& motion,
-    const RunOptions& options,
-    MethodFactory factory)
+    const skinning::Motion& motion, const RunOptions& options, MethodFactory factory)
     : motion_(motion),
       options_(options),
       factory_(std::move(factory)),
@@ -403,11 +409,12 @@ void ClipRunner::run_queries_in_order(const FrameCallback& on_frame) {
   const FeatureNumbering numbering(motion_.mesh(), topology_);
   const RowContext context{motion_, topology_, numbering, bones_};
   const bool dcd = options_.query != QuerySet::ccd;
-  const SampleSequence all{.first = plan_.first_sample,
-                           .end = dcd ? plan_.last_sample + 1 : plan_.last_sample,
-                           .last = plan_.last_sample,
-                           .dcd = dcd,
-                           .ccd = options_.query != QuerySet::dcd};
+  const SampleSequence all{
+      .first = plan_.first_sample,
+      .end = dcd ? plan_.last_sample + 1 : plan_.last_sample,
+      .last = plan_.last_sample,
+      .dcd = dcd,
+      .ccd = options_.query != QuerySet::dcd};
   Worker w;
   w.method = method_.get();
   check_samples(context, all, w, on_frame);
@@ -428,7 +435,8 @@ void ClipRunner::run_parallel(const FrameCallback& on_frame) {
   WorkerPool pool([&] {
     auto w = std::make_unique<Worker>();
     w->owned = factory_ ? factory_(motion_.mesh(), topology_, method_options_)
-                        : culling::make_method(options_.method, motion_.mesh(), topology_, method_options_);
+                        : culling::make_method(
+                              options_.method, motion_.mesh(), topology_, method_options_);
     if (!w->owned) throw InvalidInput("method '" + options_.method + "' could not be built");
     w->method = w->owned.get();
     return w;
@@ -443,8 +451,10 @@ void ClipRunner::run_parallel(const FrameCallback& on_frame) {
     Worker* acquired = nullptr;
     try {
       acquired = &pool.acquire();
-      const SampleSequence part{.first = block.first, .end = block.end, .last = last, .dcd = dcd, .ccd = ccd};
-      check_samples(context, part, *acquired, [&](const FrameReport& r) { block.reports.push_back(r); });
+      const SampleSequence part{
+          .first = block.first, .end = block.end, .last = last, .dcd = dcd, .ccd = ccd};
+      check_samples(
+          context, part, *acquired, [&](const FrameReport& r) { block.reports.push_back(r); });
     } catch (...) {
       // Reported after the rows before it, in order: as a serial run would.
       block.error = std::current_exception();

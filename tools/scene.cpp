@@ -9,8 +9,8 @@
 #include <set>
 #include <sstream>
 
-#include "culling/method_registry.hpp"
 #include "culling/method.hpp"
+#include "culling/method_registry.hpp"
 #include "skinning/errors.hpp"
 #include "skinning/generators.hpp"
 

@@ -417,11 +417,12 @@ void run_pair(
   };
 
   // The row order of every check (tools/sample_sequencer.hpp): dcd A, ccd A, dcd A+1, …, dcd B.
-  const SampleSequence sequence{.first = c.first_sample,
-                                .end = dcd ? c.last_sample + 1 : c.last_sample,
-                                .last = c.last_sample,
-                                .dcd = dcd,
-                                .ccd = ccd};
+  const SampleSequence sequence{
+      .first = c.first_sample,
+      .end = dcd ? c.last_sample + 1 : c.last_sample,
+      .last = c.last_sample,
+      .dcd = dcd,
+      .ccd = ccd};
   run_sequence(
       sequence,
       [&](std::int32_t k, int slot) {
@@ -557,7 +558,8 @@ SceneRunResult run_scene(const Scene& scene, const SceneRunOptions& options) {
     ro.threads = options.threads;
     try {
       // Methods that need a segmentation get one (none for DCD only: they answer as `bvh`).
-      if (plan.objects[at(c.object_a)].segmentation || culling::method_needs(c.method).segmentation) {
+      if (plan.objects[at(c.object_a)].segmentation ||
+          culling::method_needs(c.method).segmentation) {
         const auto setup = setup_radial_view(RadialViewArguments{}, *lo.model, *lo.motion, ro);
         if (setup.gamma) gamma = setup.gamma;
         if (setup.seed) seed = setup.seed;
@@ -630,8 +632,7 @@ SceneRunResult run_scene(const Scene& scene, const SceneRunOptions& options) {
     for (std::size_t k = 0; k < plan.checks.size(); ++k) {
       const CheckPlan& c = plan.checks[k];
       if (c.kind != CheckKind::self || !runners[k]) continue;
-      const auto routes =
-          runners[k]->routes(loaded[at(c.object_a)].part_offset);
+      const auto routes = runners[k]->routes(loaded[at(c.object_a)].part_offset);
       header.routes.insert(header.routes.end(), routes.begin(), routes.end());
     }
     writer = std::make_unique<LogWriter>(options.log, header);

@@ -197,9 +197,15 @@ int run_table(
       // should use; the measurement behind docs/radial-view.md ("Preconditions").
       skelcd::clustering::RadialViewOptions bare;
       bare.guard = false;
-      skelcd::clustering::RadialViewMethod method("dynamic", rig->mesh, scene.topology,
-                                                  scene.segmentation, scene.poses,
-                                                  rig->skeleton.num_bones(), scene.options(), bare);
+      skelcd::clustering::RadialViewMethod method(
+          "dynamic",
+          rig->mesh,
+          scene.topology,
+          scene.segmentation,
+          scene.poses,
+          rig->skeleton.num_bones(),
+          scene.options(),
+          bare);
       const ClipRun run = skelcd::test::run_clip(scene, method, first, last);
       std::vector<skelcd::test::ContactKey> missed, extra;
       std::set_difference(reference.contacts.begin(), reference.contacts.end(),

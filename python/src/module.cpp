@@ -48,7 +48,8 @@ class Model {
 
   /// The motion of (clip, fps). Called with the GIL held, which also guards the cache.
   /// @throws InvalidInput for an unknown clip or a bad rate.
-  [[nodiscard]] std::shared_ptr<const skinning::Motion> motion(const std::string& clip, double fps) {
+  [[nodiscard]] std::shared_ptr<const skinning::Motion> motion(
+      const std::string& clip, double fps) {
     const auto key = std::make_pair(clip, fps);
     if (const auto found = motions_.find(key); found != motions_.end()) return found->second;
     std::shared_ptr<const skinning::Motion> made = model_.motion({.clip = clip, .rate_hz = fps});
@@ -72,7 +73,8 @@ template <class T, class Row, class Get>
 py::array_t<T> column(const std::vector<Row>& rows, Get get) {
   py::array_t<T> out(static_cast<py::ssize_t>(rows.size()));
   auto view = out.template mutable_unchecked<1>();
-  for (std::size_t i = 0; i < rows.size(); ++i) view(static_cast<py::ssize_t>(i)) = static_cast<T>(get(rows[i]));
+  for (std::size_t i = 0; i < rows.size(); ++i)
+    view(static_cast<py::ssize_t>(i)) = static_cast<T>(get(rows[i]));
   return out;
 }
 
@@ -84,19 +86,23 @@ py::dict frame_columns(const std::vector<tools::FrameRow>& rows) {
   c["t0"] = column<double>(rows, [](const R& r) { return r.t0; });
   c["t1"] = column<double>(rows, [](const R& r) { return r.t1; });
   c["kind"] = column<std::uint8_t>(rows, [](const R& r) { return r.kind; });
-  c["atomic_clusters"] = column<std::int64_t>(rows, [](const R& r) { return r.counters.atomic_clusters; });
-  c["mega_clusters"] = column<std::int64_t>(rows, [](const R& r) { return r.counters.mega_clusters; });
+  c["atomic_clusters"] =
+      column<std::int64_t>(rows, [](const R& r) { return r.counters.atomic_clusters; });
+  c["mega_clusters"] =
+      column<std::int64_t>(rows, [](const R& r) { return r.counters.mega_clusters; });
   c["h_minus"] = column<std::int64_t>(rows, [](const R& r) { return r.counters.h_minus; });
   c["h_uncertain"] = column<std::int64_t>(rows, [](const R& r) { return r.counters.h_uncertain; });
   c["bv_tests"] = column<std::int64_t>(rows, [](const R& r) { return r.counters.bv_tests; });
-  c["candidate_pairs"] = column<std::int64_t>(rows, [](const R& r) { return r.counters.candidate_pairs; });
+  c["candidate_pairs"] =
+      column<std::int64_t>(rows, [](const R& r) { return r.counters.candidate_pairs; });
   c["vf_tests"] = column<std::int64_t>(rows, [](const R& r) { return r.counters.vf_tests; });
   c["ee_tests"] = column<std::int64_t>(rows, [](const R& r) { return r.counters.ee_tests; });
   c["vf_contacts"] = column<std::int64_t>(rows, [](const R& r) { return r.counters.vf_contacts; });
   c["ee_contacts"] = column<std::int64_t>(rows, [](const R& r) { return r.counters.ee_contacts; });
   c["tt_tests"] = column<std::int64_t>(rows, [](const R& r) { return r.counters.tt_tests; });
   c["dcd_pairs"] = column<std::int64_t>(rows, [](const R& r) { return r.counters.dcd_pairs; });
-  c["feature_bv_tests"] = column<std::int64_t>(rows, [](const R& r) { return r.counters.feature_bv_tests; });
+  c["feature_bv_tests"] =
+      column<std::int64_t>(rows, [](const R& r) { return r.counters.feature_bv_tests; });
   c["skin_us"] = column<double>(rows, [](const R& r) { return r.times.skin_us; });
   c["refit_us"] = column<double>(rows, [](const R& r) { return r.times.refit_us; });
   c["classify_us"] = column<double>(rows, [](const R& r) { return r.times.classify_us; });
@@ -247,10 +253,11 @@ py::dict header_dict(const tools::LogHeader& h) {
 
 // --- the functions the module exports ------------------------------------------------------------
 
-std::shared_ptr<Model> load(const std::string& path,
-                            const std::string& trajectory,
-                            const std::string& srdf,
-                            const std::vector<std::string>& package_path) {
+std::shared_ptr<Model> load(
+    const std::string& path,
+    const std::string& trajectory,
+    const std::string& srdf,
+    const std::vector<std::string>& package_path) {
   skinning::LoadOptions options;
   options.trajectory = trajectory;
   options.srdf = srdf;
@@ -282,7 +289,8 @@ py::list clips(const Model& model) {
 py::array_t<std::int32_t> triangles(const Model& model) {
   const auto& F = model.model().mesh->triangles;
   py::array_t<std::int32_t> out({static_cast<py::ssize_t>(F.rows()), py::ssize_t{3}});
-  std::memcpy(out.mutable_data(), F.data(), static_cast<std::size_t>(F.size()) * sizeof(std::int32_t));
+  std::memcpy(
+      out.mutable_data(), F.data(), static_cast<std::size_t>(F.size()) * sizeof(std::int32_t));
   return out;
 }
 
@@ -305,13 +313,15 @@ py::array_t<double> sample_times(Model& model, const std::optional<std::string>&
 }
 
 /// The posed positions at `sample`, refused like `skelcd export --frame K`.
-py::array_t<double> positions(Model& model, int sample, const std::optional<std::string>& clip, double fps) {
+py::array_t<double> positions(
+    Model& model, int sample, const std::optional<std::string>& clip, double fps) {
   const auto motion = model.motion(clip.value_or(""), fps);
   const int n = motion->num_samples();
   if (sample < 0 || sample >= n) {
-    throw InvalidInput(model.argument() + ": frame " + std::to_string(sample) + " out of range: '" +
-                       motion->name() + "' has " + std::to_string(n) + " samples (0 to " +
-                       std::to_string(n - 1) + ")");
+    throw InvalidInput(
+        model.argument() + ": frame " + std::to_string(sample) + " out of range: '" +
+        motion->name() + "' has " + std::to_string(n) + " samples (0 to " + std::to_string(n - 1) +
+        ")");
   }
   skinning::Positions V;
   {
@@ -324,27 +334,30 @@ py::array_t<double> positions(Model& model, int sample, const std::optional<std:
 /// Thrown out of a row callback when Python has a pending signal (Ctrl-C): stops the check.
 struct Interrupted {};
 
-py::dict check(const std::shared_ptr<Model>& model,
-               const std::string& clip,
-               double fps,
-               const std::string& frames,
-               const std::string& method,
-               const std::string& accuracy,
-               const std::string& query,
-               double min_separation,
-               std::int32_t threads,
-               const std::string& log,
-               double gamma,
-               std::uint64_t seed,
-               const std::string& segmentation,
-               const std::string& command_line) {
+py::dict check(
+    const std::shared_ptr<Model>& model,
+    const std::string& clip,
+    double fps,
+    const std::string& frames,
+    const std::string& method,
+    const std::string& accuracy,
+    const std::string& query,
+    double min_separation,
+    std::int32_t threads,
+    const std::string& log,
+    double gamma,
+    std::uint64_t seed,
+    const std::string& segmentation,
+    const std::string& command_line) {
   // Options refused with the CLI's own messages (tools/cmd_check.cpp).
   const auto parsed_accuracy = ccd::parse_accuracy(accuracy);
-  if (!parsed_accuracy) throw InvalidInput("--accuracy '" + accuracy + "': expected exact, conservative or fast");
+  if (!parsed_accuracy)
+    throw InvalidInput("--accuracy '" + accuracy + "': expected exact, conservative or fast");
   const auto parsed_query = tools::parse_query_set(query);
   if (!parsed_query) throw InvalidInput("--query '" + query + "': expected ccd, dcd or both");
   if (threads < 0) {
-    throw InvalidInput("--threads " + std::to_string(threads) + ": expected a worker count >= 1 (0: all cores)");
+    throw InvalidInput(
+        "--threads " + std::to_string(threads) + ": expected a worker count >= 1 (0: all cores)");
   }
   tools::CheckRequest request;
   request.clip = clip;
@@ -355,7 +368,8 @@ py::dict check(const std::shared_ptr<Model>& model,
   request.query = *parsed_query;
   request.min_separation = min_separation;
   request.threads = threads;
-  request.radial_view = tools::RadialViewArguments{.gamma = gamma, .seed = seed, .segmentation = segmentation};
+  request.radial_view =
+      tools::RadialViewArguments{.gamma = gamma, .seed = seed, .segmentation = segmentation};
   request.log_path = log;
   request.input_path = model->argument();
   request.command_line = command_line;
@@ -370,14 +384,15 @@ py::dict check(const std::shared_ptr<Model>& model,
   {
     py::gil_scoped_release release;
     try {
-      outcome.emplace(tools::check_model(model->model(), request, [&](const tools::FrameReport& report) {
-        contacts.insert(contacts.end(), report.contacts.begin(), report.contacts.end());
-        dcd_pairs.insert(dcd_pairs.end(), report.dcd_pairs.begin(), report.dcd_pairs.end());
-        if (std::this_thread::get_id() == caller) {
-          py::gil_scoped_acquire acquire;
-          if (PyErr_CheckSignals() != 0) throw Interrupted{};
-        }
-      }));
+      outcome.emplace(
+          tools::check_model(model->model(), request, [&](const tools::FrameReport& report) {
+            contacts.insert(contacts.end(), report.contacts.begin(), report.contacts.end());
+            dcd_pairs.insert(dcd_pairs.end(), report.dcd_pairs.begin(), report.dcd_pairs.end());
+            if (std::this_thread::get_id() == caller) {
+              py::gil_scoped_acquire acquire;
+              if (PyErr_CheckSignals() != 0) throw Interrupted{};
+            }
+          }));
     } catch (const Interrupted&) {
       interrupted = true;
     }
@@ -444,7 +459,8 @@ py::dict read_log(const std::string& path) {
   result["rows"] = frame_columns(data->frames);
   result["contacts"] = contact_columns(data->contacts);
   result["dcd_pairs"] = dcd_pair_columns(data->dcd_pairs);
-  result["frame_checks"] = column<std::int32_t>(data->frame_checks, [](std::int32_t k) { return k; });
+  result["frame_checks"] =
+      column<std::int32_t>(data->frame_checks, [](std::int32_t k) { return k; });
   result["verified"] = data->verified;
   result["damage"] = data->damage;
   return result;
@@ -463,16 +479,21 @@ PYBIND11_MODULE(_skelcd, m) {
   py::register_exception<skelcd::IoError>(m, "IoError", PyExc_OSError);
 
   py::class_<Model, std::shared_ptr<Model>>(m, "Model", "A loaded model; made by skelcd.load().")
-      .def_property_readonly("argument", &Model::argument, "the path (or spec) it was loaded from, as given")
+      .def_property_readonly(
+          "argument", &Model::argument, "the path (or spec) it was loaded from, as given")
       .def_property_readonly("path", [](const Model& model) { return model.model().path.string(); })
       .def_property_readonly(
-          "kind", [](const Model& model) { return std::string(skelcd::skinning::to_string(model.model().kind)); })
+          "kind",
+          [](const Model& model) {
+            return std::string(skelcd::skinning::to_string(model.model().kind));
+          })
       .def_property_readonly("clips", &clips, "names of the usable clips, in file order")
       .def_property_readonly(
           "refused_clips",
           [](const Model& model) {
             py::list out;
-            for (const auto& r : model.model().refused_clips) out.append(py::make_tuple(r.name, r.reason));
+            for (const auto& r : model.model().refused_clips)
+              out.append(py::make_tuple(r.name, r.reason));
             return out;
           },
           "(name, reason) of each clip of the file that cannot be used")
@@ -482,25 +503,60 @@ PYBIND11_MODULE(_skelcd, m) {
           "rest_positions",
           [](const Model& model) { return to_array(model.model().mesh->rest_positions); },
           "#V x 3 float64 rest positions")
-      .def_property_readonly("part_names", [](const Model& model) { return model.model().mesh->part_names; })
+      .def_property_readonly(
+          "part_names", [](const Model& model) { return model.model().mesh->part_names; })
       .def("info", &info, "the report of `skelcd info --json`, as a dict")
-      .def("num_samples", &num_samples, py::arg("clip") = py::none(), py::arg("fps") = 0.0,
-           "samples of `clip` (None: the first clip, else the bind pose) at `fps` (0: its key rate, else 30)")
-      .def("sample_times", &sample_times, py::arg("clip") = py::none(), py::arg("fps") = 0.0,
-           "seconds of each sample, a float64 array")
-      .def("positions", &positions, py::arg("sample"), py::arg("clip") = py::none(), py::arg("fps") = 0.0,
-           "#V x 3 float64 posed positions at `sample`")
+      .def(
+          "num_samples",
+          &num_samples,
+          py::arg("clip") = py::none(),
+          py::arg("fps") = 0.0,
+          "samples of `clip` (None: the first clip, else the bind pose) at `fps` (0: its key rate, "
+          "else 30)")
+      .def(
+          "sample_times",
+          &sample_times,
+          py::arg("clip") = py::none(),
+          py::arg("fps") = 0.0,
+          "seconds of each sample, a float64 array")
+      .def(
+          "positions",
+          &positions,
+          py::arg("sample"),
+          py::arg("clip") = py::none(),
+          py::arg("fps") = 0.0,
+          "#V x 3 float64 posed positions at `sample`")
       .def("__repr__", [](const Model& model) {
-        return "<skelcd.Model " + model.argument() + " (" + skelcd::skinning::to_string(model.model().kind) + ", " +
+        return "<skelcd.Model " + model.argument() + " (" +
+               skelcd::skinning::to_string(model.model().kind) + ", " +
                std::to_string(model.model().mesh->num_triangles()) + " triangles, " +
                std::to_string(model.model().clips.size()) + " clips)>";
       });
 
-  m.def("load", &load, py::arg("path"), py::arg("trajectory") = "", py::arg("srdf") = "",
-        py::arg("package_path") = std::vector<std::string>{});
-  m.def("check", &check, py::arg("model"), py::arg("clip"), py::arg("fps"), py::arg("frames"),
-        py::arg("method"), py::arg("accuracy"), py::arg("query"), py::arg("min_separation"), py::arg("threads"),
-        py::arg("log"), py::arg("gamma"), py::arg("seed"), py::arg("segmentation"), py::arg("command_line"));
+  m.def(
+      "load",
+      &load,
+      py::arg("path"),
+      py::arg("trajectory") = "",
+      py::arg("srdf") = "",
+      py::arg("package_path") = std::vector<std::string>{});
+  m.def(
+      "check",
+      &check,
+      py::arg("model"),
+      py::arg("clip"),
+      py::arg("fps"),
+      py::arg("frames"),
+      py::arg("method"),
+      py::arg("accuracy"),
+      py::arg("query"),
+      py::arg("min_separation"),
+      py::arg("threads"),
+      py::arg("log"),
+      py::arg("gamma"),
+      py::arg("seed"),
+      py::arg("segmentation"),
+      py::arg("command_line"));
   m.def("read_log", &read_log, py::arg("path"));
   m.def("method_names", &skelcd::tools::check_method_names);
 }

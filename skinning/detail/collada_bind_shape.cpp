@@ -1,13 +1,13 @@
 #include "skinning/detail/collada_bind_shape.hpp"
 
+#include <tinyxml.h>
+
 #include <algorithm>
 #include <cctype>
 #include <cmath>
 #include <cstdlib>
 #include <string>
 #include <vector>
-
-#include <tinyxml.h>
 
 #include "skinning/errors.hpp"
 
@@ -20,10 +20,13 @@ const TiXmlElement* child(const TiXmlNode* parent, const char* name) {
 
 }  // namespace
 
-std::map<std::string, Eigen::Affine3d> collada_bind_shape_matrices(const std::filesystem::path& file) {
+std::map<std::string, Eigen::Affine3d> collada_bind_shape_matrices(
+    const std::filesystem::path& file) {
   std::map<std::string, Eigen::Affine3d> out;
   std::string ext = file.extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) {
+    return static_cast<char>(std::tolower(c));
+  });
   if (ext != ".dae") return out;
   TiXmlDocument doc;
   if (!doc.LoadFile(file.string().c_str())) return out;  // assimp says what is wrong with it
@@ -32,7 +35,8 @@ std::map<std::string, Eigen::Affine3d> collada_bind_shape_matrices(const std::fi
 
   // Geometry id → name, so that a skin can be found by either.
   std::map<std::string, std::string> geometry_name;
-  for (const auto* g = child(child(root, "library_geometries"), "geometry"); g != nullptr; g = g->NextSiblingElement("geometry")) {
+  for (const auto* g = child(child(root, "library_geometries"), "geometry"); g != nullptr;
+       g = g->NextSiblingElement("geometry")) {
     const char* id = g->Attribute("id");
     const char* name = g->Attribute("name");
     if (id != nullptr && name != nullptr) geometry_name[id] = name;
@@ -46,7 +50,8 @@ std::map<std::string, Eigen::Affine3d> collada_bind_shape_matrices(const std::fi
       const char* source = skin != nullptr ? skin->Attribute("source") : nullptr;
       if (matrix == nullptr || source == nullptr || matrix->GetText() == nullptr) continue;
       const char* cid = controller->Attribute("id");
-      const std::string where = file.string() + ": controller '" + (cid != nullptr ? cid : "?") + "'";
+      const std::string where =
+          file.string() + ": controller '" + (cid != nullptr ? cid : "?") + "'";
       // Sixteen numbers, row by row (COLLADA stores matrices in row-major order).
       std::vector<double> values;
       const char* p = matrix->GetText();
@@ -55,7 +60,8 @@ std::map<std::string, Eigen::Affine3d> collada_bind_shape_matrices(const std::fi
         if (end == p) break;
         values.push_back(v);
       }
-      if (values.size() != 16 || !std::all_of(values.begin(), values.end(), [](double v) { return std::isfinite(v); })) {
+      if (values.size() != 16 ||
+          !std::all_of(values.begin(), values.end(), [](double v) { return std::isfinite(v); })) {
         throw InvalidInput(where + ": bind_shape_matrix is not 16 finite numbers");
       }
       Eigen::Matrix4d m;
@@ -68,7 +74,8 @@ std::map<std::string, Eigen::Affine3d> collada_bind_shape_matrices(const std::fi
       std::string geometry = source;
       if (!geometry.empty() && geometry.front() == '#') geometry.erase(0, 1);
       out[geometry] = a;
-      if (const auto it = geometry_name.find(geometry); it != geometry_name.end()) out[it->second] = a;
+      if (const auto it = geometry_name.find(geometry); it != geometry_name.end())
+        out[it->second] = a;
     }
   }
   return out;

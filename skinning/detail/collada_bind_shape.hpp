@@ -2,11 +2,10 @@
 // Internal to skinning/: the Collada <bind_shape_matrix> of each skin, which Debian's assimp 5.2
 // reads but never applies (its skinned vertices stay in the geometry's own frame).
 
+#include <Eigen/Geometry>
 #include <filesystem>
 #include <map>
 #include <string>
-
-#include <Eigen/Geometry>
 
 namespace skelcd::skinning::detail {
 
@@ -17,6 +16,7 @@ namespace skelcd::skinning::detail {
 /// expect (COLLADA 1.4.1, skin/bind_shape_matrix: "provides extra information about the position
 /// and orientation of the base mesh before binding").
 /// @throws InvalidInput naming the file and controller for a matrix that is not 16 finite numbers.
-[[nodiscard]] std::map<std::string, Eigen::Affine3d> collada_bind_shape_matrices(const std::filesystem::path& file);
+[[nodiscard]] std::map<std::string, Eigen::Affine3d> collada_bind_shape_matrices(
+    const std::filesystem::path& file);
 
 }  // namespace skelcd::skinning::detail

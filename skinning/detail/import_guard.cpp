@@ -55,7 +55,8 @@ std::atomic<long long> asan_live_bytes{0};
 long long asan_limit_bytes = 0;
 
 void asan_on_malloc(const volatile void*, std::size_t size) {
-  if (asan_live_bytes.fetch_add(static_cast<long long>(size)) + static_cast<long long>(size) > asan_limit_bytes) {
+  if (asan_live_bytes.fetch_add(static_cast<long long>(size)) + static_cast<long long>(size) >
+      asan_limit_bytes) {
     _exit(kOverMemoryExit);
   }
 }
@@ -66,7 +67,9 @@ void asan_on_free(const volatile void* p) {
 #endif
 
 std::string lower(std::string s) {
-  std::transform(s.begin(), s.end(), s.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  std::transform(s.begin(), s.end(), s.begin(), [](unsigned char c) {
+    return static_cast<char>(std::tolower(c));
+  });
   return s;
 }
 
@@ -76,15 +79,17 @@ std::string mib(double bytes) {
   return text;
 }
 
-[[noreturn]] void too_many(const std::string& file, const std::string& declared, long double need, std::uintmax_t size) {
+[[noreturn]] void too_many(
+    const std::string& file, const std::string& declared, long double need, std::uintmax_t size) {
   char text[64];
   std::snprintf(text, sizeof text, "%.0Lf", need);
-  throw InvalidInput(file + ": declares " + declared + ", which needs at least " + text + " bytes, but the file has " +
-                     std::to_string(size));
+  throw InvalidInput(
+      file + ": declares " + declared + ", which needs at least " + text +
+      " bytes, but the file has " + std::to_string(size));
 }
 
-// OFF: an optional magic ("OFF", "COFF", "NOFF", "STOFF", "4OFF", …), then "#vertices #faces #edges".
-// A vertex takes at least 6 bytes ("0 0 0\n"), a face at least 4 ("1 0\n").
+// OFF: an optional magic ("OFF", "COFF", "NOFF", "STOFF", "4OFF", …), then "#vertices #faces
+// #edges". A vertex takes at least 6 bytes ("0 0 0\n"), a face at least 4 ("1 0\n").
 void check_off(const std::filesystem::path& file, std::uintmax_t size) {
   std::ifstream in(file);
   std::string line;
@@ -104,7 +109,9 @@ void check_off(const std::filesystem::path& file, std::uintmax_t size) {
   }
   if (tokens.size() < 2) return;  // the importer says what is wrong
   const auto count = [](const std::string& t) -> long double {
-    if (t.empty() || !std::all_of(t.begin(), t.end(), [](unsigned char c) { return std::isdigit(c) != 0; })) return -1;
+    if (t.empty() ||
+        !std::all_of(t.begin(), t.end(), [](unsigned char c) { return std::isdigit(c) != 0; }))
+      return -1;
     return std::strtold(t.c_str(), nullptr);
   };
   const long double vertices = count(tokens[0]);
@@ -126,7 +133,9 @@ void check_ply(const std::filesystem::path& file, std::uintmax_t size) {
   const auto type_size = [](const std::string& t) -> int {
     if (t == "char" || t == "uchar" || t == "int8" || t == "uint8") return 1;
     if (t == "short" || t == "ushort" || t == "int16" || t == "uint16") return 2;
-    if (t == "int" || t == "uint" || t == "int32" || t == "uint32" || t == "float" || t == "float32") return 4;
+    if (t == "int" || t == "uint" || t == "int32" || t == "uint32" || t == "float" ||
+        t == "float32")
+      return 4;
     if (t == "double" || t == "float64") return 8;
     return 1;  // unknown: the importer says what is wrong; count it as small as can be
   };
@@ -152,7 +161,9 @@ void check_ply(const std::filesystem::path& file, std::uintmax_t size) {
       Element e;
       words >> e.name >> e.count_text;
       if (e.count_text.empty() ||
-          !std::all_of(e.count_text.begin(), e.count_text.end(), [](unsigned char c) { return std::isdigit(c) != 0; })) {
+          !std::all_of(e.count_text.begin(), e.count_text.end(), [](unsigned char c) {
+            return std::isdigit(c) != 0;
+          })) {
         return;
       }
       e.count = std::strtold(e.count_text.c_str(), nullptr);
@@ -164,12 +175,14 @@ void check_ply(const std::filesystem::path& file, std::uintmax_t size) {
       elements.back().min_bytes += binary ? type_size(type) : 2;
     }
   }
-  const auto header = static_cast<long double>(std::max<std::streamoff>(0, static_cast<std::streamoff>(in.tellg())));
+  const auto header = static_cast<long double>(
+      std::max<std::streamoff>(0, static_cast<std::streamoff>(in.tellg())));
   long double need = header;
   std::string declared;
   for (const auto& e : elements) {
     need += e.count * e.min_bytes;
-    if (e.count > 0) declared += (declared.empty() ? "" : " and ") + e.count_text + " " + e.name + " elements";
+    if (e.count > 0)
+      declared += (declared.empty() ? "" : " and ") + e.count_text + " " + e.name + " elements";
   }
   if (need > static_cast<long double>(size)) too_many(file.string(), declared, need, size);
 }
@@ -266,10 +279,14 @@ void check_declared_counts(const std::filesystem::path& file) {
   if (ext == ".ply") check_ply(file, size);
 }
 
-void run_isolated(const std::filesystem::path& file, const ImportLimits& limits, const std::function<void()>& probe) {
+void run_isolated(
+    const std::filesystem::path& file,
+    const ImportLimits& limits,
+    const std::function<void()>& probe) {
   const std::string name = file.string();
   int fds[2];
-  if (::pipe(fds) != 0) throw IoError(name + ": cannot start the import (pipe: " + std::strerror(errno) + ")");
+  if (::pipe(fds) != 0)
+    throw IoError(name + ": cannot start the import (pipe: " + std::strerror(errno) + ")");
   std::fflush(nullptr);  // nothing buffered is written twice
   const pid_t pid = ::fork();
   if (pid < 0) {
@@ -291,7 +308,9 @@ void run_isolated(const std::filesystem::path& file, const ImportLimits& limits,
   for (;;) {
     int wait_ms = -1;
     if (limits.time_s > 0) {
-      const double left = limits.time_s - std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+      const double left =
+          limits.time_s -
+          std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
       if (left <= 0) {
         timed_out = true;
         break;
@@ -318,17 +337,23 @@ void run_isolated(const std::filesystem::path& file, const ImportLimits& limits,
     std::snprintf(text, sizeof text, "%g", limits.time_s);
     throw IoError(name + ": importing it took longer than " + text + " s; gave up");
   }
-  const std::string limit_text = "the import memory limit of " + mib(static_cast<double>(limits.memory_bytes));
+  const std::string limit_text =
+      "the import memory limit of " + mib(static_cast<double>(limits.memory_bytes));
   if (WIFSIGNALED(status)) {
     const int sig = WTERMSIG(status);
-    if (sig == SIGKILL) throw InvalidInput(name + ": the import was killed, most likely for memory (" + limit_text + ")");
-    throw IoError(name + ": the importer (assimp) crashed reading it (" + signal_name(sig) +
-                  "); the file is damaged or uses a feature this assimp cannot read");
+    if (sig == SIGKILL)
+      throw InvalidInput(
+          name + ": the import was killed, most likely for memory (" + limit_text + ")");
+    throw IoError(
+        name + ": the importer (assimp) crashed reading it (" + signal_name(sig) +
+        "); the file is damaged or uses a feature this assimp cannot read");
   }
-  if (report.empty() && WIFEXITED(status) && WEXITSTATUS(status) == kOverMemoryExit) report = kOutOfMemory;
+  if (report.empty() && WIFEXITED(status) && WEXITSTATUS(status) == kOverMemoryExit)
+    report = kOutOfMemory;
   if (report.empty()) {
-    throw IoError(name + ": the importer (assimp) ended without an answer (exit status " +
-                  std::to_string(WIFEXITED(status) ? WEXITSTATUS(status) : -1) + ")");
+    throw IoError(
+        name + ": the importer (assimp) ended without an answer (exit status " +
+        std::to_string(WIFEXITED(status) ? WEXITSTATUS(status) : -1) + ")");
   }
   const std::string message = report.substr(1);
   switch (report.front()) {
@@ -339,8 +364,9 @@ void run_isolated(const std::filesystem::path& file, const ImportLimits& limits,
     case kIoError:
       throw IoError(message);
     case kOutOfMemory:
-      throw InvalidInput(name + ": importing it needs more memory than " + limit_text +
-                         " (--import-memory raises it)");
+      throw InvalidInput(
+          name + ": importing it needs more memory than " + limit_text +
+          " (--import-memory raises it)");
     default:
       throw IoError(name + ": " + message);
   }

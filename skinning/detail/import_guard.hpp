@@ -29,6 +29,9 @@ void check_declared_counts(const std::filesystem::path& file);
 /// - it ran out of memory (std::bad_alloc, or killed for it): InvalidInput naming the limit;
 /// - it crashed (a signal) or exceeded the time: IoError naming the signal or the time.
 /// Every message starts with `file`. The caller holds whatever lock `probe` would take.
-void run_isolated(const std::filesystem::path& file, const ImportLimits& limits, const std::function<void()>& probe);
+void run_isolated(
+    const std::filesystem::path& file,
+    const ImportLimits& limits,
+    const std::function<void()>& probe);
 
 }  // namespace skelcd::skinning::detail

@@ -12,8 +12,8 @@
 #include <vector>
 
 #include "clustering/bone_poses.hpp"
-#include "clustering/radial_view_methods.hpp"
 #include "clustering/radial_view_method.hpp"
+#include "clustering/radial_view_methods.hpp"
 #include "culling/method.hpp"
 #include "segmentation/segmentation.hpp"
 #include "skinning/rig_motion.hpp"
@@ -47,8 +47,7 @@ struct RadialViewScene {
   }
 
   [[nodiscard]] culling::MethodOptions options(
-      const culling::MethodParameters& parameters = {},
-      culling::MethodOptions base = {}) const {
+      const culling::MethodParameters& parameters = {}, culling::MethodOptions base = {}) const {
     base.segmentation = segmentation;
     base.num_bones = rig->skeleton.num_bones();
     base.parameters = parameters;
@@ -62,7 +61,8 @@ struct RadialViewScene {
       const culling::MethodParameters& parameters = {},
       culling::MethodOptions base = {}) const {
     if (clustering::is_radial_view_method(name)) {
-      return clustering::make_radial_view_method(name, rig->mesh, topology, options(parameters, base), poses);
+      return clustering::make_radial_view_method(
+          name, rig->mesh, topology, options(parameters, base), poses);
     }
     return culling::make_method(name, rig->mesh, topology, options(parameters, base));
   }
@@ -121,8 +121,13 @@ inline ClipRun run_clip(
     scene.poses->select_samples(i, i + 1);
     const auto start = std::chrono::steady_clock::now();
     method.detect_ccd(
-        culling::Interval{.x_t0 = x0, .x_t1 = x1, .bones_t0 = scene.poses->t0(), .bones_t1 = scene.poses->t1(),
-                          .sample_t0 = i, .sample_t1 = i + 1},
+        culling::Interval{
+            .x_t0 = x0,
+            .x_t1 = x1,
+            .bones_t0 = scene.poses->t0(),
+            .bones_t1 = scene.poses->t1(),
+            .sample_t0 = i,
+            .sample_t1 = i + 1},
         out);
     run.ccd_ms.push_back(
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count());

@@ -2,12 +2,11 @@
 // generated clips that collide (coiling rope, touching tentacles and fingers) and on real
 // characters, BCN_Epileptic among them (its rest pose interpenetrates). Plus the interface:
 // names through the registry, errors, counters of paper Table 3.
-#include "clustering/radial_view_method.hpp"
+#include <gtest/gtest.h>
 
 #include <algorithm>
 
-#include <gtest/gtest.h>
-
+#include "clustering/radial_view_method.hpp"
 #include "clustering/radial_view_methods.hpp"
 #include "culling/method_registry.hpp"
 #include "culling/routed_method.hpp"
@@ -254,9 +253,12 @@ TEST(RadialViewMethod, NamesErrorsAndCounters) {
   scene.motion->bone_transforms(1, t1);
   const skinning::Positions few(3, 3);
   EXPECT_THROW_MESSAGE(
-      m->detect_ccd(culling::Interval{.x_t0 = x0, .x_t1 = few, .bones_t0 = t0, .bones_t1 = t1}, out),
-      InvalidInput, "x_t1 has 3 rows");
-  const culling::Interval interval{.x_t0 = x0, .x_t1 = x1, .bones_t0 = t0, .bones_t1 = t1, .sample_t0 = 0, .sample_t1 = 1};
+      m->detect_ccd(
+          culling::Interval{.x_t0 = x0, .x_t1 = few, .bones_t0 = t0, .bones_t1 = t1}, out),
+      InvalidInput,
+      "x_t1 has 3 rows");
+  const culling::Interval interval{
+      .x_t0 = x0, .x_t1 = x1, .bones_t0 = t0, .bones_t1 = t1, .sample_t0 = 0, .sample_t1 = 1};
   // Table 3 counters of one interval.
   m->detect_ccd(interval, out);
   EXPECT_EQ(out.counters.atomic_clusters,

@@ -1,6 +1,6 @@
 // `auto`: open components go to enhanced-dual-cone, closed ones to the best registered closed-part
-// method whose needs are met (`dynamic` on a rig's clip) or the `bvh` fallback, pairs across groups through a BVH pair traversal — and the
-// answer is exactly `bvh`'s.
+// method whose needs are met (`dynamic` on a rig's clip) or the `bvh` fallback, pairs across groups
+// through a BVH pair traversal — and the answer is exactly `bvh`'s.
 #include <gtest/gtest.h>
 
 #include <set>
@@ -39,10 +39,10 @@ FrameResult ccd(CullingMethod& m, const skinning::Positions& x0, const skinning:
   return out;
 }
 
-/// A closed-part method declared by this file alone (as a module above culling/ declares `dynamic`):
-/// a `bvh` over the mesh it is given (with that mesh's part exclusions), counting how often it was
-/// built. It needs bone poses, so `auto` chooses it only for options that announce bones — which
-/// no other test of this executable does.
+/// A closed-part method declared by this file alone (as a module above culling/ declares
+/// `dynamic`): a `bvh` over the mesh it is given (with that mesh's part exclusions), counting how
+/// often it was built. It needs bone poses, so `auto` chooses it only for options that announce
+/// bones — which no other test of this executable does.
 int fake_built = 0;
 
 class NamedAsTest final : public CullingMethod {
@@ -58,17 +58,19 @@ class NamedAsTest final : public CullingMethod {
   std::unique_ptr<CullingMethod> bvh_;
 };
 
-[[maybe_unused]] const bool fake_registered = register_method({
-    .name = "test-closed",
-    .description = "a bvh declared by tests/culling/test_routing.cpp",
-    .needs = {.bone_poses = true},
-    .route = RouteKind::closed,
-    .route_priority = 100,
-    .order = 5000,
-    .make = [](const skinning::Mesh& mesh, const skinning::Topology& topology, const MethodOptions& options) {
-      ++fake_built;
-      return std::make_unique<NamedAsTest>(make_method("bvh", mesh, topology, options));
-    }});
+[[maybe_unused]] const bool fake_registered = register_method(
+    {.name = "test-closed",
+     .description = "a bvh declared by tests/culling/test_routing.cpp",
+     .needs = {.bone_poses = true},
+     .route = RouteKind::closed,
+     .route_priority = 100,
+     .order = 5000,
+     .make = [](const skinning::Mesh& mesh,
+                const skinning::Topology& topology,
+                const MethodOptions& options) {
+       ++fake_built;
+       return std::make_unique<NamedAsTest>(make_method("bvh", mesh, topology, options));
+     }});
 
 TEST(Routing, SkirtGoesToEnhancedDualConeAndTheBodyToTheFallback) {
   const OpenScene s = test::skirt_body_scene(9, 14, 16, 10, {0.3, 0.5});
@@ -172,7 +174,8 @@ TEST(Routing, ClosedPartsGoToTheRegisteredClosedPartMethodWhoseNeedsAreMet) {
   const auto routes = routes_of(*a);
   EXPECT_EQ(routes[0].method, "test-closed");
   EXPECT_EQ(routes[1].method, "enhanced-dual-cone");
-  EXPECT_EQ(auto_group_methods(options), (std::vector<std::string>{"enhanced-dual-cone", "test-closed"}));
+  EXPECT_EQ(
+      auto_group_methods(options), (std::vector<std::string>{"enhanced-dual-cone", "test-closed"}));
   // The whole-mesh method is told to skip every pair with an open triangle: the merged answer is
   // still bvh's, each contact once.
   auto b = make_method("bvh", s.mesh, s.topo);
@@ -181,8 +184,10 @@ TEST(Routing, ClosedPartsGoToTheRegisteredClosedPartMethodWhoseNeedsAreMet) {
   EXPECT_EQ(keys(got), keys(ccd(*b, s.frames[0], s.frames[1])));
   EXPECT_EQ(keys(got).size(), got.contacts.size());
   // Registered once: a second registration of the name is refused; it is listed by name.
-  EXPECT_THROW_MESSAGE((void)register_method({.name = "test-closed", .make = find_method("bvh")->make}), InvalidInput,
-                       "registered twice");
+  EXPECT_THROW_MESSAGE(
+      (void)register_method({.name = "test-closed", .make = find_method("bvh")->make}),
+      InvalidInput,
+      "registered twice");
   const auto names = method_names();
   EXPECT_NE(std::find(names.begin(), names.end(), "test-closed"), names.end());
 }

@@ -228,25 +228,33 @@ TEST(FrameSequence, BadCoordinatesAndIndicesAreRefused) {
 TEST(FrameSequence, DamagedPlyHeadersAreRefusedNotTrusted) {
   const fs::path dir = test::temp_dir("frames_fuzz");
   const std::string head =
-      "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n";
+      "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float "
+      "z\n";
   const std::string body = "end_header\n0 0 0\n1 0 0\n0 1 0\n";
   // 4294967295 vertices in a 150-byte file: was a 96 GB reserve.
-  write_file(dir / "count.ply",
-             "ply\nformat ascii 1.0\nelement vertex 4294967295\nproperty float x\nproperty float y\n"
-             "property float z\nend_header\n0 0 0\n");
+  write_file(
+      dir / "count.ply",
+      "ply\nformat ascii 1.0\nelement vertex 4294967295\nproperty float x\nproperty float y\n"
+      "property float z\nend_header\n0 0 0\n");
   EXPECT_THROW_MESSAGE(
-      (void)read_frame_mesh(dir / "count.ply"), IoError,
-      "count.ply: PLY element 'vertex' declares 4294967295 items, more than the 6 bytes after the header hold");
+      (void)read_frame_mesh(dir / "count.ply"),
+      IoError,
+      "count.ply: PLY element 'vertex' declares 4294967295 items, more than the 6 bytes after the "
+      "header hold");
   // An element without properties and 10^14 items: was a loop of 10^14 empty iterations.
   write_file(dir / "empty_element.ply", head + "element junk 100000000000000\n" + body);
   EXPECT_EQ(read_frame_mesh(dir / "empty_element.ply").positions.rows(), 3);
   // A list length and a face index of 1e300: were undefined conversions to integers.
-  write_file(dir / "list.ply", head + "element face 1\nproperty list float int vertex_indices\n" + body +
-                                   "1e300 0 1 2\n");
-  EXPECT_THROW_MESSAGE((void)read_frame_mesh(dir / "list.ply"), IoError, "list.ply: malformed PLY list length");
-  write_file(dir / "index.ply", head + "element face 1\nproperty list uchar int vertex_indices\n" + body +
-                                    "3 0 1 1e300\n");
-  EXPECT_THROW_MESSAGE((void)read_frame_mesh(dir / "index.ply"), InvalidInput, "index.ply: PLY face index");
+  write_file(
+      dir / "list.ply",
+      head + "element face 1\nproperty list float int vertex_indices\n" + body + "1e300 0 1 2\n");
+  EXPECT_THROW_MESSAGE(
+      (void)read_frame_mesh(dir / "list.ply"), IoError, "list.ply: malformed PLY list length");
+  write_file(
+      dir / "index.ply",
+      head + "element face 1\nproperty list uchar int vertex_indices\n" + body + "3 0 1 1e300\n");
+  EXPECT_THROW_MESSAGE(
+      (void)read_frame_mesh(dir / "index.ply"), InvalidInput, "index.ply: PLY face index");
 }
 
 TEST(FrameSequence, LoadModelEntryPoint) {

@@ -2,6 +2,7 @@
 // transforms, one bad clip among good ones, files that lie about their size, crashes and runaway
 // allocations kept in a child process, OBJ vertex numbering, Collada bind shape matrices.
 
+#include <gtest/gtest.h>
 #include <unistd.h>
 
 #include <chrono>
@@ -11,8 +12,6 @@
 #include <string>
 #include <thread>
 #include <vector>
-
-#include <gtest/gtest.h>
 
 #include "skinning/assimp_import.hpp"
 #include "skinning/detail/import_guard.hpp"
@@ -28,7 +27,9 @@ using skelcd::test::asset;
 using skelcd::test::assimp_model;
 using skelcd::test::temp_dir;
 
-Eigen::Vector3d extent(const Positions& x) { return x.colwise().maxCoeff() - x.colwise().minCoeff(); }
+Eigen::Vector3d extent(const Positions& x) {
+  return x.colwise().maxCoeff() - x.colwise().minCoeff();
+}
 
 bool any_problem_contains(const std::vector<std::string>& problems, const std::string& text) {
   for (const auto& p : problems) {
@@ -75,7 +76,8 @@ TEST(ImportRobustness, ARealProjectiveTransformIsStillRefused) {
   <scene><instance_visual_scene url="#scene"/></scene>
 </COLLADA>
 )";
-  EXPECT_THROW_MESSAGE((void)import_rig(file), InvalidInput, "projective transform (last row 0 0 0.5 1");
+  EXPECT_THROW_MESSAGE(
+      (void)import_rig(file), InvalidInput, "projective transform (last row 0 0 0.5 1");
 }
 
 // --- 2. one bad clip does not block the file --------------------------------------------------
@@ -88,7 +90,8 @@ TEST(ImportRobustness, TheNinjasBrokenClipsAreRefusedAloneAndTheOthersLoad) {
   ASSERT_EQ(imported.refused_clips.size(), 2u);
   EXPECT_EQ(imported.refused_clips[0].name, "HighJump");
   EXPECT_EQ(imported.refused_clips[1].name, "JumpNoHeight");
-  EXPECT_NE(imported.refused_clips[0].reason.find("earlier than the key before it"), std::string::npos);
+  EXPECT_NE(
+      imported.refused_clips[0].reason.find("earlier than the key before it"), std::string::npos);
   EXPECT_EQ(imported.rig.clips.size(), 18u);
   EXPECT_TRUE(any_problem_contains(imported.problems, "clip 'HighJump' refused"));
   for (const auto& clip : imported.rig.clips) {
@@ -103,8 +106,12 @@ TEST(ImportRobustness, TheNinjasBrokenClipsAreRefusedAloneAndTheOthersLoad) {
     const auto motion = model.motion({.clip = clip.name});
     EXPECT_GT(motion->num_samples(), 0) << clip.name;
   }
-  EXPECT_THROW_MESSAGE((void)model.motion({.clip = "HighJump"}), InvalidInput, "clip 'HighJump' was refused: node 'Joint1'");
-  EXPECT_THROW_MESSAGE((void)model.motion({.clip = "NoSuchClip"}), InvalidInput, "no clip named 'NoSuchClip'");
+  EXPECT_THROW_MESSAGE(
+      (void)model.motion({.clip = "HighJump"}),
+      InvalidInput,
+      "clip 'HighJump' was refused: node 'Joint1'");
+  EXPECT_THROW_MESSAGE(
+      (void)model.motion({.clip = "NoSuchClip"}), InvalidInput, "no clip named 'NoSuchClip'");
 }
 
 TEST(ImportRobustness, AnLwsFileWhoseOnlyClipIsBrokenStillLoadsItsMesh) {
@@ -112,7 +119,8 @@ TEST(ImportRobustness, AnLwsFileWhoseOnlyClipIsBrokenStillLoadsItsMesh) {
   EXPECT_GT(imported.rig.mesh.num_triangles(), 0);
   EXPECT_TRUE(imported.rig.clips.empty());
   ASSERT_EQ(imported.refused_clips.size(), 1u);
-  EXPECT_NE(imported.refused_clips[0].reason.find("earlier than the key before it"), std::string::npos);
+  EXPECT_NE(
+      imported.refused_clips[0].reason.find("earlier than the key before it"), std::string::npos);
 }
 
 // --- 3. files that lie about their size; crashes and memory kept in a child ---------------------
@@ -120,15 +128,20 @@ TEST(ImportRobustness, AnLwsFileWhoseOnlyClipIsBrokenStillLoadsItsMesh) {
 TEST(ImportRobustness, DeclaredCountsBeyondTheFileSizeAreRefusedBeforeImporting) {
   // 309 bytes declaring 353,535,235,358 vertices: assimp itself grows to 15.8 GB on it.
   EXPECT_THROW_MESSAGE(
-      (void)import_rig(assimp_model("invalid/OutOfMemory.off")), InvalidInput,
+      (void)import_rig(assimp_model("invalid/OutOfMemory.off")),
+      InvalidInput,
       "declares 353535235358 vertices and 6 faces");
   const auto dir = temp_dir("declared");
   const auto ply = dir / "huge.ply";
-  std::ofstream(ply, std::ios::binary) << "ply\nformat binary_little_endian 1.0\nelement vertex 1000000000\n"
-                                          "property float x\nproperty float y\nproperty float z\n"
-                                          "element face 1\nproperty list uchar int vertex_indices\nend_header\n"
-                                       << std::string(64, '\0');
-  EXPECT_THROW_MESSAGE((void)import_rig(ply), InvalidInput, "declares 1000000000 vertex elements and 1 face elements");
+  std::ofstream(ply, std::ios::binary)
+      << "ply\nformat binary_little_endian 1.0\nelement vertex 1000000000\n"
+         "property float x\nproperty float y\nproperty float z\n"
+         "element face 1\nproperty list uchar int vertex_indices\nend_header\n"
+      << std::string(64, '\0');
+  EXPECT_THROW_MESSAGE(
+      (void)import_rig(ply),
+      InvalidInput,
+      "declares 1000000000 vertex elements and 1 face elements");
   // A sound file of each format passes the check (and imports).
   EXPECT_GT(import_rig(assimp_model("OFF/Cube.off")).rig.mesh.num_triangles(), 0);
   EXPECT_GT(import_rig(assimp_model("PLY/cube_binary.ply")).rig.mesh.num_triangles(), 0);
@@ -138,17 +151,23 @@ TEST(ImportRobustness, DeclaredCountsBeyondTheFileSizeAreRefusedBeforeImporting)
 TEST(ImportGuard, AnExceptionInTheChildIsRethrownWithItsMessage) {
   const detail::ImportLimits limits{.memory_bytes = std::size_t{1} << 30, .time_s = 60};
   EXPECT_THROW_MESSAGE(
-      detail::run_isolated("model.glb", limits, [] { throw InvalidInput("model.glb: vertex 3 is bad"); }), InvalidInput,
+      detail::run_isolated(
+          "model.glb", limits, [] { throw InvalidInput("model.glb: vertex 3 is bad"); }),
+      InvalidInput,
       "model.glb: vertex 3 is bad");
-  EXPECT_THROW_MESSAGE(detail::run_isolated("model.glb", limits, [] { throw IoError("model.glb: cannot read"); }), IoError,
-                       "model.glb: cannot read");
+  EXPECT_THROW_MESSAGE(
+      detail::run_isolated("model.glb", limits, [] { throw IoError("model.glb: cannot read"); }),
+      IoError,
+      "model.glb: cannot read");
   EXPECT_NO_THROW(detail::run_isolated("model.glb", limits, [] {}));
 }
 
 TEST(ImportGuard, ACrashInTheChildIsOneLineAndThisProcessGoesOn) {
   const detail::ImportLimits limits{.memory_bytes = std::size_t{1} << 30, .time_s = 60};
-  EXPECT_THROW_MESSAGE(detail::run_isolated("model.glb", limits, [] { std::abort(); }), IoError,
-                       "model.glb: the importer (assimp) crashed reading it (SIGABRT)");
+  EXPECT_THROW_MESSAGE(
+      detail::run_isolated("model.glb", limits, [] { std::abort(); }),
+      IoError,
+      "model.glb: the importer (assimp) crashed reading it (SIGABRT)");
 }
 
 TEST(ImportGuard, ARunawayAllocationInTheChildIsRefusedWithTheLimit) {
@@ -158,15 +177,19 @@ TEST(ImportGuard, ARunawayAllocationInTheChildIsRefusedWithTheLimit) {
     std::vector<std::vector<char>> blocks;
     for (int i = 0; i < 64; ++i) blocks.emplace_back(std::size_t{64} << 20, 'x');
   };
-  EXPECT_THROW_MESSAGE(detail::run_isolated("model.glb", limits, grow), InvalidInput,
-                       "model.glb: importing it needs more memory than the import memory limit of 256 MiB");
+  EXPECT_THROW_MESSAGE(
+      detail::run_isolated("model.glb", limits, grow),
+      InvalidInput,
+      "model.glb: importing it needs more memory than the import memory limit of 256 MiB");
 }
 
 TEST(ImportGuard, AChildThatTakesTooLongIsStopped) {
   const detail::ImportLimits limits{.memory_bytes = std::size_t{1} << 30, .time_s = 0.3};
   const auto start = std::chrono::steady_clock::now();
   EXPECT_THROW_MESSAGE(
-      detail::run_isolated("model.glb", limits, [] { std::this_thread::sleep_for(std::chrono::seconds(30)); }), IoError,
+      detail::run_isolated(
+          "model.glb", limits, [] { std::this_thread::sleep_for(std::chrono::seconds(30)); }),
+      IoError,
       "model.glb: importing it took longer than 0.3 s");
   EXPECT_LT(std::chrono::steady_clock::now() - start, std::chrono::seconds(10));
 }
@@ -174,8 +197,10 @@ TEST(ImportGuard, AChildThatTakesTooLongIsStopped) {
 TEST(ImportRobustness, ATinyImportMemoryLimitRefusesARealCharacter) {
   ImportOptions options;
   options.memory_limit_bytes = std::size_t{1} << 20;  // 1 MiB: CesiumMan needs more
-  EXPECT_THROW_MESSAGE((void)import_rig(asset("characters/CesiumMan.glb"), options), InvalidInput,
-                       "importing it needs more memory than the import memory limit of 1 MiB");
+  EXPECT_THROW_MESSAGE(
+      (void)import_rig(asset("characters/CesiumMan.glb"), options),
+      InvalidInput,
+      "importing it needs more memory than the import memory limit of 1 MiB");
 }
 
 // --- 8. a NaN in an OBJ is named by the file's own vertex number ------------------------------
@@ -187,7 +212,10 @@ TEST(ImportRobustness, ANanInAnObjNamesTheFilesVertexNotAssimpsCorner) {
   // unindexed list (faces 1 2 3, 4 5 6, then 2 4 7).
   std::ofstream(file) << "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 2 0 0\nv 3 0 0\nv 2 1 0\nv 5 nan 0\n"
                          "f 1 2 3\nf 4 5 6\nf 2 4 7\n";
-  EXPECT_THROW_MESSAGE((void)import_rig(file), InvalidInput, file.string() + ": vertex 6 has a non-finite coordinate");
+  EXPECT_THROW_MESSAGE(
+      (void)import_rig(file),
+      InvalidInput,
+      file.string() + ": vertex 6 has a non-finite coordinate");
 }
 
 // --- 10. the Collada bind shape matrix ------------------------------------------------------

@@ -388,12 +388,17 @@ TEST(Urdf, BadInput) {
 // the buffer. Cut short by the end, or by a NUL (past which it used to read on and accept the
 // unterminated attribute as link2 "b\xdb"), the SRDF is refused.
 TEST(Urdf, SrdfWithATruncatedUtf8SequenceIsRefused) {
-  const std::string head = R"(<?xml version="1.0"?><robot name="r"><disable_collisions link1="a" link2="b)";
+  const std::string head =
+      R"(<?xml version="1.0"?><robot name="r"><disable_collisions link1="a" link2="b)";
   EXPECT_THROW_MESSAGE(
-      (void)parse_srdf_disabled_collisions(head + "\xdb", "cut.srdf"), IoError, "cut.srdf: not well-formed XML");
+      (void)parse_srdf_disabled_collisions(head + "\xdb", "cut.srdf"),
+      IoError,
+      "cut.srdf: not well-formed XML");
   EXPECT_THROW_MESSAGE(
-      (void)parse_srdf_disabled_collisions(head + "\xdb" + std::string(1, '\0') + "c\"/></robot>", "nul.srdf"),
-      IoError, "nul.srdf: not well-formed XML: a NUL byte at offset 76");
+      (void)parse_srdf_disabled_collisions(
+          head + "\xdb" + std::string(1, '\0') + "c\"/></robot>", "nul.srdf"),
+      IoError,
+      "nul.srdf: not well-formed XML: a NUL byte at offset 76");
   // UTF-8 that is whole still reads as before.
   const auto pairs = parse_srdf_disabled_collisions(head + "\xc3\xa9\"/></robot>", "ok.srdf");
   ASSERT_EQ(pairs.size(), 1U);

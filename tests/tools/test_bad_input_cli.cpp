@@ -2,14 +2,14 @@
 // naming the file and the fault, a non-zero exit, nothing half-written (issue "Real files and bad
 // files", items 4, 6, 7, 11, 12, 13).
 
+#include <gtest/gtest.h>
+
 #include <cstdlib>
 #include <fstream>
 #include <set>
 #include <sstream>
 #include <string>
 #include <vector>
-
-#include <gtest/gtest.h>
 
 #include "skinning/assimp_import.hpp"
 #include "tests/support/test_support.hpp"
@@ -26,7 +26,8 @@ using skelcd::test::temp_dir;
 std::size_t count_lines(const std::string& text) {
   std::size_t n = 0;
   std::istringstream in(text);
-  for (std::string line; std::getline(in, line);) if (!line.empty()) ++n;
+  for (std::string line; std::getline(in, line);)
+    if (!line.empty()) ++n;
   return n;
 }
 
@@ -49,7 +50,9 @@ TEST(BadInputCli, ZeroAndNegativeRatesAreRefusedAlikeByEveryCommand) {
   const auto model = asset("characters/RiggedFigure.glb").string();
   const auto out = (temp_dir("rates") / "out.obj").string();
   const std::vector<std::vector<std::string>> commands = {
-      {"check", model, "--fps"}, {"bench", model, "--fps"}, {"preprocess", model, "--clip", "clip_0", "--fps"},
+      {"check", model, "--fps"},
+      {"bench", model, "--fps"},
+      {"preprocess", model, "--clip", "clip_0", "--fps"},
       {"export", model, "-o", out, "--rate"}};
   for (const auto& base : commands) {
     for (const std::string value : {"0", "-5", "nan"}) {
@@ -59,7 +62,9 @@ TEST(BadInputCli, ZeroAndNegativeRatesAreRefusedAlikeByEveryCommand) {
       const std::string flag = base.back();
       EXPECT_EQ(r.exit_code, 1) << base.front() << " " << flag << " " << value << ": " << r.err;
       EXPECT_EQ(count_lines(r.err), 1u) << r.err;
-      EXPECT_NE(r.err.find(flag + " " + value + ": expected a rate > 0 (samples/s)"), std::string::npos) << r.err;
+      EXPECT_NE(
+          r.err.find(flag + " " + value + ": expected a rate > 0 (samples/s)"), std::string::npos)
+          << r.err;
     }
   }
 }
@@ -68,11 +73,25 @@ TEST(BadInputCli, ZeroAndNegativeRatesAreRefusedAlikeByEveryCommand) {
 
 TEST(BadInputCli, AnUnknownMethodListsEveryMethodRadialViewIncluded) {
   for (const std::string query : {"both", "dcd"}) {
-    const auto r = run_skelcd({"check", asset("characters/RiggedFigure.glb").string(), "--method", "octree", "--query", query});
+    const auto r = run_skelcd(
+        {"check",
+         asset("characters/RiggedFigure.glb").string(),
+         "--method",
+         "octree",
+         "--query",
+         query});
     EXPECT_EQ(r.exit_code, 1);
     EXPECT_EQ(count_lines(r.err), 1u) << r.err;
-    for (const std::string m : {"brute", "bvh", "kdop", "normal-cone", "dual-cone", "enhanced-dual-cone", "rvbc",
-                                "dynamic", "auto"}) {
+    for (const std::string m :
+         {"brute",
+          "bvh",
+          "kdop",
+          "normal-cone",
+          "dual-cone",
+          "enhanced-dual-cone",
+          "rvbc",
+          "dynamic",
+          "auto"}) {
       EXPECT_NE(r.err.find(m), std::string::npos) << m << " missing from: " << r.err;
     }
   }
@@ -83,7 +102,12 @@ TEST(BadInputCli, AnUnknownMethodListsEveryMethodRadialViewIncluded) {
 TEST(BadInputCli, BatchFailuresNameTheFileOnce) {
   const auto dir = temp_dir("batch-names");
   const auto missing = (dir / "missing.glb").string();
-  const auto r = run_skelcd({"check", asset("characters/RiggedFigure.glb").string(), missing, "-o", (dir / "logs").string()});
+  const auto r = run_skelcd(
+      {"check",
+       asset("characters/RiggedFigure.glb").string(),
+       missing,
+       "-o",
+       (dir / "logs").string()});
   EXPECT_EQ(r.exit_code, 1);
   EXPECT_EQ(count_lines(r.err), 1u) << r.err;
   EXPECT_EQ(occurrences(r.err, "missing.glb"), 1u) << r.err;
@@ -125,12 +149,15 @@ TEST(BadInputCli, TheNinjaLoadsAndEverySoundClipCanBeChecked) {
   EXPECT_EQ(info.exit_code, 0) << info.err;
   EXPECT_NE(info.out.find("clips:    18"), std::string::npos) << info.out;
   EXPECT_NE(info.out.find("clip 'HighJump' refused"), std::string::npos) << info.out;
-  const auto walk = run_skelcd({"check", ninja, "--clip", "Walk", "--frames", "0:2", "--query", "dcd"});
+  const auto walk =
+      run_skelcd({"check", ninja, "--clip", "Walk", "--frames", "0:2", "--query", "dcd"});
   EXPECT_EQ(walk.exit_code, 0) << walk.err;
   const auto broken = run_skelcd({"check", ninja, "--clip", "HighJump"});
   EXPECT_EQ(broken.exit_code, 1);
   EXPECT_EQ(count_lines(broken.err), 1u) << broken.err;
-  EXPECT_NE(broken.err.find("clip 'HighJump' was refused: node 'Joint1', translation key 1"), std::string::npos)
+  EXPECT_NE(
+      broken.err.find("clip 'HighJump' was refused: node 'Joint1', translation key 1"),
+      std::string::npos)
       << broken.err;
 }
 
@@ -146,8 +173,9 @@ TEST(BadInputCli, GlbExportHasOneMeshPerPartNamedAsThePart) {
   // meshes all named after it; one glTF mesh per part comes back named as the parts.
   const auto exported = skelcd::skinning::import_rig(out).rig.mesh.part_names;
   EXPECT_EQ(exported.size(), original.size());
-  EXPECT_EQ(std::multiset<std::string>(exported.begin(), exported.end()),
-            std::multiset<std::string>(original.begin(), original.end()));
+  EXPECT_EQ(
+      std::multiset<std::string>(exported.begin(), exported.end()),
+      std::multiset<std::string>(original.begin(), original.end()));
   // The glTF JSON chunk names each mesh once.
   const std::string bytes = read_text(out);
   EXPECT_EQ(occurrences(bytes, "\"primitives\""), original.size());
@@ -163,16 +191,22 @@ TEST(BadInputCli, AFullDiskIsOneLineAndTheRowsWrittenStayReadable) {
   const auto log = mount_point / "run.h5";
   const auto err = dir / "err.txt";
   const auto readable = dir / "readable.txt";
-  const std::string script = "mount -t tmpfs -o size=60k none '" + mount_point.string() + "' && '" + SKELCD_EXE +
-                             "' check '" + asset("characters/CesiumMan.glb").string() + "' --threads 1 -o '" + log.string() +
-                             "' > /dev/null 2> '" + err.string() + "'; echo \\$? > '" + dir.string() + "/rc'; '" +
-                             SKELCD_EXE + "' inspect --csv '" + log.string() + "' > '" + readable.string() + "' 2>&1";
+  const std::string script = "mount -t tmpfs -o size=60k none '" + mount_point.string() + "' && '" +
+                             SKELCD_EXE + "' check '" + asset("characters/CesiumMan.glb").string() +
+                             "' --threads 1 -o '" + log.string() + "' > /dev/null 2> '" +
+                             err.string() + "'; echo \\$? > '" + dir.string() + "/rc'; '" +
+                             SKELCD_EXE + "' inspect --csv '" + log.string() + "' > '" +
+                             readable.string() + "' 2>&1";
   const std::string command = "unshare -rm sh -c \"" + script + "\"";
   ASSERT_EQ(std::system(command.c_str()), 0) << command;
   EXPECT_EQ(read_text(dir / "rc"), "1\n");
   const std::string message = read_text(err);
   EXPECT_EQ(count_lines(message), 1u) << message;
-  EXPECT_EQ(message.rfind("skelcd: " + log.string() + ": the disk is full (No space left on device); its first ", 0), 0u)
+  EXPECT_EQ(
+      message.rfind(
+          "skelcd: " + log.string() + ": the disk is full (No space left on device); its first ",
+          0),
+      0u)
       << message;
   EXPECT_NE(message.find("were written and are readable"), std::string::npos) << message;
   EXPECT_EQ(message.find("18446744073709551615"), std::string::npos);
@@ -181,7 +215,8 @@ TEST(BadInputCli, AFullDiskIsOneLineAndTheRowsWrittenStayReadable) {
   EXPECT_NE(csv.find(log.string() + ","), std::string::npos) << csv;
   const auto rows_at = message.find("its first ") + 10;
   const std::string rows = message.substr(rows_at, message.find(' ', rows_at) - rows_at);
-  EXPECT_NE(csv.find("no (" + rows + "/"), std::string::npos) << "message: " << message << "\ncsv: " << csv;
+  EXPECT_NE(csv.find("no (" + rows + "/"), std::string::npos)
+      << "message: " << message << "\ncsv: " << csv;
 }
 
 // --- 13. a long exact query shows progress on a terminal ------------------------------------
@@ -192,14 +227,16 @@ TEST(BadInputCli, ALongExactQueryShowsElementaryTestsOnATerminal) {
   const auto out = dir / "tty.txt";
   const std::string command = "script -qfec \"'" + std::string(SKELCD_EXE) + "' check '" +
                               asset("cloth-funnel/frames").string() +
-                              "' --accuracy exact --threads 1 --query ccd\" /dev/null > '" + out.string() + "'";
+                              "' --accuracy exact --threads 1 --query ccd\" /dev/null > '" +
+                              out.string() + "'";
   ASSERT_EQ(std::system(command.c_str()), 0) << command;
   const std::string tty = read_text(out);
   // At least one redraw while the one row was not done yet, with tests counted.
   EXPECT_NE(tty.find("0/1 (0%), "), std::string::npos) << tty.substr(0, 400);
   EXPECT_NE(tty.find(" elementary tests"), std::string::npos) << tty.substr(0, 400);
   // Without a terminal, nothing of it.
-  const auto plain = run_skelcd({"check", asset("cloth-funnel/frames").string(), "--query", "ccd", "--threads", "1"});
+  const auto plain = run_skelcd(
+      {"check", asset("cloth-funnel/frames").string(), "--query", "ccd", "--threads", "1"});
   EXPECT_EQ(plain.exit_code, 0) << plain.err;
   EXPECT_EQ(plain.err, "");
 }

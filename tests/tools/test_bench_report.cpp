@@ -6,14 +6,13 @@
 
 #include <gtest/gtest.h>
 
-#include "culling/method_registry.hpp"
-
 #include <algorithm>
 #include <memory>
 #include <set>
 #include <sstream>
 
 #include "culling/method.hpp"
+#include "culling/method_registry.hpp"
 #include "skinning/errors.hpp"
 #include "skinning/generators.hpp"
 #include "skinning/load.hpp"

@@ -99,10 +99,14 @@ TEST(Highlight, ALogWrittenAtAFloatNoisyRateMatchesTheRoundRate) {
   // A real difference of rate is still refused, and the message shows the two times apart and
   // the rate to export at.
   EXPECT_THROW_MESSAGE(
-      (void)highlight_face_colors(path, mesh, 12, 12 / 25.0, "walk"), InvalidInput,
-      "frame 12 is at t = 0.500000012 s in the log (written at 23.9999994 samples/s) but at t = 0.48 s here");
-  EXPECT_THROW_MESSAGE((void)highlight_face_colors(path, mesh, 12, 12 / 25.0, "walk"), InvalidInput,
-                       "pose it at the log's rate (--rate 23.9999994)");
+      (void)highlight_face_colors(path, mesh, 12, 12 / 25.0, "walk"),
+      InvalidInput,
+      "frame 12 is at t = 0.500000012 s in the log (written at 23.9999994 samples/s) but at t = "
+      "0.48 s here");
+  EXPECT_THROW_MESSAGE(
+      (void)highlight_face_colors(path, mesh, 12, 12 / 25.0, "walk"),
+      InvalidInput,
+      "pose it at the log's rate (--rate 23.9999994)");
 }
 
 TEST(Highlight, FaceColoursFromALogFile) {

@@ -1,13 +1,13 @@
 // The HDF5 log: round trip of every field, partial logs, refusing to clobber, bad files reported by
 // name, and the h5py example of docs/log-format.md run on a real log.
 
+#include <gtest/gtest.h>
+#include <hdf5.h>
+
 #include <cstdlib>
 #include <fstream>
 #include <sstream>
 #include <string>
-
-#include <gtest/gtest.h>
-#include <hdf5.h>
 
 #include "skinning/errors.hpp"
 #include "tests/support/test_support.hpp"
@@ -352,14 +352,17 @@ TEST(Log, GarbageInsideATableIsFoundByItsChecksumAndTheRowsBeforeItStayReadable)
   ASSERT_NE(address, HADDR_UNDEF);
   std::string bytes = read_text(path);
   ASSERT_LT(address + 4096, bytes.size());
-  for (std::size_t i = 0; i < 4096; ++i) bytes[address + i] = static_cast<char>((i * 131 + 7) & 0xff);
+  for (std::size_t i = 0; i < 4096; ++i)
+    bytes[address + i] = static_cast<char>((i * 131 + 7) & 0xff);
   write_text(path, bytes);
 
   const auto damaged = read_log(path);
   EXPECT_FALSE(damaged.verified);
   ASSERT_FALSE(damaged.damage.empty());
   // The frame whose pairs start at row 2000 spans the damage: its block, rows 2000 to 2099, fails.
-  EXPECT_EQ(damaged.damage.front(), "/dcd_pairs rows 2000 to 2099 are damaged (they fail their checksum)");
+  EXPECT_EQ(
+      damaged.damage.front(),
+      "/dcd_pairs rows 2000 to 2099 are damaged (they fail their checksum)");
   // Everything written before it reads back exactly.
   ASSERT_EQ(damaged.frames.size(), 20u);
   ASSERT_EQ(damaged.dcd_pairs.size(), 2000u);
@@ -368,7 +371,8 @@ TEST(Log, GarbageInsideATableIsFoundByItsChecksumAndTheRowsBeforeItStayReadable)
     EXPECT_EQ(damaged.dcd_pairs[i].a.index, clean.dcd_pairs[i].a.index);
     EXPECT_EQ(damaged.dcd_pairs[i].b.index, clean.dcd_pairs[i].b.index);
   }
-  for (std::size_t i = 0; i < damaged.frames.size(); ++i) expect_rows_equal(damaged.frames[i], clean.frames[i]);
+  for (std::size_t i = 0; i < damaged.frames.size(); ++i)
+    expect_rows_equal(damaged.frames[i], clean.frames[i]);
   // Summaries that do not ask for the findings still verify them.
   const auto summary = read_log(path, ReadLogOptions{.findings = false});
   EXPECT_EQ(summary.frames.size(), 20u);
@@ -376,7 +380,9 @@ TEST(Log, GarbageInsideATableIsFoundByItsChecksumAndTheRowsBeforeItStayReadable)
   // inspect summarises the rows before the damage, names it, and exits 1.
   const auto r = skelcd::test::run_skelcd({"inspect", path.string()});
   EXPECT_EQ(r.exit_code, 1);
-  EXPECT_NE(r.err.find(path.string() + ": /dcd_pairs rows 2000 to 2099 are damaged"), std::string::npos) << r.err;
+  EXPECT_NE(
+      r.err.find(path.string() + ": /dcd_pairs rows 2000 to 2099 are damaged"), std::string::npos)
+      << r.err;
   EXPECT_NE(r.out.find("damaged (20/"), std::string::npos) << r.out;
 }
 

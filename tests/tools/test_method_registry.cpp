@@ -4,12 +4,12 @@
 // methods a scene accepts, among `auto`'s choices, and run through `check` like any method.
 // Its own test executable (tools/CMakeLists.txt), so the registration reaches no other test.
 
+#include <gtest/gtest.h>
+
+#include <CLI/CLI.hpp>
 #include <algorithm>
 #include <memory>
 #include <string>
-
-#include <CLI/CLI.hpp>
-#include <gtest/gtest.h>
 
 #include "culling/method_registry.hpp"
 #include "culling/routed_method.hpp"
@@ -30,7 +30,9 @@ class WrappedBvh final : public culling::CullingMethod {
   [[nodiscard]] std::string_view name() const override { return "test-wrapped-bvh"; }
 
  protected:
-  void dcd(const culling::Instant& at, culling::FrameResult& out) override { bvh_->detect_dcd(at, out); }
+  void dcd(const culling::Instant& at, culling::FrameResult& out) override {
+    bvh_->detect_dcd(at, out);
+  }
   void ccd(const culling::Interval& interval, culling::FrameResult& out) override {
     ++intervals_with_bones;
     if (interval.bones_t0.empty() || interval.bones_t1.empty()) ++intervals_without_bones;
@@ -45,17 +47,19 @@ class WrappedBvh final : public culling::CullingMethod {
   std::unique_ptr<culling::CullingMethod> bvh_;
 };
 
-[[maybe_unused]] const bool registered = culling::register_method({
-    .name = "test-wrapped-bvh",
-    .description = "a bvh registered by tests/tools/test_method_registry.cpp",
-    .needs = {.bone_poses = true},
-    // Above `dynamic` (10): on a rig's clip `auto` sends closed parts here.
-    .route = culling::RouteKind::closed,
-    .route_priority = 20,
-    .order = 90,
-    .make = [](const skinning::Mesh& mesh, const skinning::Topology& topology, const culling::MethodOptions& options) {
-      return std::make_unique<WrappedBvh>(culling::make_method("bvh", mesh, topology, options));
-    }});
+[[maybe_unused]] const bool registered = culling::register_method(
+    {.name = "test-wrapped-bvh",
+     .description = "a bvh registered by tests/tools/test_method_registry.cpp",
+     .needs = {.bone_poses = true},
+     // Above `dynamic` (10): on a rig's clip `auto` sends closed parts here.
+     .route = culling::RouteKind::closed,
+     .route_priority = 20,
+     .order = 90,
+     .make = [](const skinning::Mesh& mesh,
+                const skinning::Topology& topology,
+                const culling::MethodOptions& options) {
+       return std::make_unique<WrappedBvh>(culling::make_method("bvh", mesh, topology, options));
+     }});
 
 constexpr const char* kName = "test-wrapped-bvh";
 
@@ -63,7 +67,9 @@ TEST(MethodRegistry, AMethodOfItsOwnFileAppearsInHelp) {
   CLI::App app{"skelcd", "skelcd"};
   tools::add_check_command(app);
   tools::add_bench_command(app);
-  EXPECT_NE(app.get_subcommand("check")->help().find(std::string(kName) + ": a bvh registered by"), std::string::npos);
+  EXPECT_NE(
+      app.get_subcommand("check")->help().find(std::string(kName) + ": a bvh registered by"),
+      std::string::npos);
   EXPECT_NE(app.get_subcommand("bench")->help().find(kName), std::string::npos);
 }
 
@@ -71,7 +77,8 @@ TEST(MethodRegistry, AMethodOfItsOwnFileIsAcceptedByScenesAndChecks) {
   const auto names = tools::scene_method_names();
   EXPECT_NE(std::find(names.begin(), names.end(), kName), names.end());
   const auto scene = tools::parse_scene_text(
-      "[objects.man]\nmodel = \"../characters/CesiumMan.glb\"\nchecks = [\"self-ccd\"]\nmethod = \"test-wrapped-bvh\"\n",
+      "[objects.man]\nmodel = \"../characters/CesiumMan.glb\"\nchecks = [\"self-ccd\"]\nmethod = "
+      "\"test-wrapped-bvh\"\n",
       test::asset("scenes/registry.toml"));
   ASSERT_EQ(scene.objects.size(), 1u);
   EXPECT_EQ(scene.objects[0].method, kName);
@@ -120,11 +127,14 @@ TEST(MethodRegistry, AMethodOfItsOwnFileIsAmongAutosChoicesAndInBench) {
   options.radial_view = true;
   const auto motion = model.motion();
   // As `skelcd bench` does: the methods that need a segmentation get one.
-  options.prepare = [&](tools::RunOptions& run) { (void)tools::setup_radial_view({}, model, *motion, run); };
+  options.prepare = [&](tools::RunOptions& run) {
+    (void)tools::setup_radial_view({}, model, *motion, run);
+  };
   const auto report = tools::run_bench(*motion, options);
-  const bool listed = std::any_of(report.rows.begin(), report.rows.end(), [](const tools::BenchRow& r) {
-    return r.method == kName;
-  });
+  const bool listed =
+      std::any_of(report.rows.begin(), report.rows.end(), [](const tools::BenchRow& r) {
+        return r.method == kName;
+      });
   EXPECT_TRUE(listed);
 }
 

@@ -65,7 +65,8 @@ class Reader {
           const std::string member(name);
           H5free_memory(name);
           // /checksums' CRC of the /frames rows (and its own CRC) covers their timings too.
-          if (is_timing(member) || (where == "/checksums" && (member == "frames_crc" || member == "self_crc"))) {
+          if (is_timing(member) ||
+              (where == "/checksums" && (member == "frames_crc" || member == "self_crc"))) {
             skipped.push_back(where + "." + member);
             continue;
           }

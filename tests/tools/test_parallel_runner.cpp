@@ -4,6 +4,9 @@
 // rows waiting to be reported; an error reported after exactly the rows a serial run reports; and
 // the methods that carry state between queries kept serial — with a run that shows why.
 
+#include <gtest/gtest.h>
+#include <tbb/info.h>
+
 #include <algorithm>
 #include <atomic>
 #include <chrono>
@@ -12,9 +15,6 @@
 #include <mutex>
 #include <thread>
 #include <vector>
-
-#include <gtest/gtest.h>
-#include <tbb/info.h>
 
 #include "clustering/bone_poses.hpp"
 #include "segmentation/segmentation.hpp"
@@ -334,11 +334,14 @@ TEST(ParallelRunner, DynamicWithoutDcdCarriesStateSoBlocksWouldChangeItsCounters
     options.factory_methods_stateless = true;  // the lie under test
     // Slow queries, so that every worker takes blocks (a worker that happened to take all blocks
     // in order would carry the state like a serial run).
-    ClipRunner runner(*l.motion, options, [](const skinning::Mesh& mesh,
-                                             const skinning::Topology& topology,
-                                             const culling::MethodOptions& mo) -> std::unique_ptr<culling::CullingMethod> {
-      return std::make_unique<SlowMethod>(culling::make_method("dynamic", mesh, topology, mo));
-    });
+    ClipRunner runner(
+        *l.motion,
+        options,
+        [](const skinning::Mesh& mesh,
+           const skinning::Topology& topology,
+           const culling::MethodOptions& mo) -> std::unique_ptr<culling::CullingMethod> {
+          return std::make_unique<SlowMethod>(culling::make_method("dynamic", mesh, topology, mo));
+        });
     ASSERT_EQ(runner.plan().threads, k == 0 ? 1 : 3);
     out[k] = collect(runner);
   }

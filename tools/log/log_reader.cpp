@@ -278,7 +278,6 @@ FrameRow from_disk(const detail::FrameDisk& d) {
   return row;
 }
 
-
 /// The rows of every table that a log's /checksums cover, and what failed.
 struct Verified {
   std::int64_t frames = 0, contacts = 0, dcd_pairs = 0, frame_checks = 0;
@@ -286,28 +285,40 @@ struct Verified {
 };
 
 template <class Row>
-bool table_block_matches(const std::vector<Row>& rows, hid_t memory_type, const char* name, std::int64_t begin,
-                         std::int64_t end, std::uint32_t expected, std::vector<std::string>& damage) {
+bool table_block_matches(
+    const std::vector<Row>& rows,
+    hid_t memory_type,
+    const char* name,
+    std::int64_t begin,
+    std::int64_t end,
+    std::uint32_t expected,
+    std::vector<std::string>& damage) {
   const auto count = static_cast<std::int64_t>(rows.size());
   const std::string table = std::string("/") + name;
   if (end < begin || end > count) {
-    damage.push_back(table + " has " + std::to_string(count) + " rows, but its checksums cover rows " +
-                     std::to_string(begin) + " to " + std::to_string(end - 1));
+    damage.push_back(
+        table + " has " + std::to_string(count) + " rows, but its checksums cover rows " +
+        std::to_string(begin) + " to " + std::to_string(end - 1));
     return false;
   }
-  const auto crc = detail::rows_crc(0, memory_type, rows.data() + begin, static_cast<std::size_t>(end - begin), sizeof(Row));
+  const auto crc = detail::rows_crc(
+      0, memory_type, rows.data() + begin, static_cast<std::size_t>(end - begin), sizeof(Row));
   if (crc != expected) {
-    damage.push_back(table + " rows " + std::to_string(begin) + " to " + std::to_string(end - 1) +
-                     " are damaged (they fail their checksum)");
+    damage.push_back(
+        table + " rows " + std::to_string(begin) + " to " + std::to_string(end - 1) +
+        " are damaged (they fail their checksum)");
     return false;
   }
   return true;
 }
 
 /// Walks /checksums in order and stops at the first row whose blocks do not match.
-Verified verify_rows(const std::vector<detail::ChecksumDisk>& checksums, const std::vector<detail::FrameDisk>& frames,
-                     const std::vector<detail::ContactDisk>& contacts, const std::vector<detail::DcdPairDisk>& pairs,
-                     const std::vector<std::int32_t>& frame_checks) {
+Verified verify_rows(
+    const std::vector<detail::ChecksumDisk>& checksums,
+    const std::vector<detail::FrameDisk>& frames,
+    const std::vector<detail::ContactDisk>& contacts,
+    const std::vector<detail::DcdPairDisk>& pairs,
+    const std::vector<std::int32_t>& frame_checks) {
   Verified v;
   const auto frame_type = detail::frame_memory_type();
   const auto contact_type = detail::contact_memory_type();
@@ -322,13 +333,41 @@ Verified verify_rows(const std::vector<detail::ChecksumDisk>& checksums, const s
       v.damage.push_back(std::move(what));
       break;
     }
-    bool ok = table_block_matches(frames, frame_type.get(), detail::kFramesPath, v.frames, c.frames_end, c.frames_crc, v.damage);
-    ok = table_block_matches(contacts, contact_type.get(), detail::kContactsPath, v.contacts, c.contacts_end, c.contacts_crc,
-                             v.damage) && ok;
-    ok = table_block_matches(pairs, pair_type.get(), detail::kDcdPairsPath, v.dcd_pairs, c.dcd_pairs_end, c.dcd_pairs_crc,
-                             v.damage) && ok;
-    ok = table_block_matches(frame_checks, check_type.get(), detail::kFrameCheckPath, v.frame_checks, c.frame_check_end,
-                             c.frame_check_crc, v.damage) && ok;
+    bool ok = table_block_matches(
+        frames,
+        frame_type.get(),
+        detail::kFramesPath,
+        v.frames,
+        c.frames_end,
+        c.frames_crc,
+        v.damage);
+    ok = table_block_matches(
+             contacts,
+             contact_type.get(),
+             detail::kContactsPath,
+             v.contacts,
+             c.contacts_end,
+             c.contacts_crc,
+             v.damage) &&
+         ok;
+    ok = table_block_matches(
+             pairs,
+             pair_type.get(),
+             detail::kDcdPairsPath,
+             v.dcd_pairs,
+             c.dcd_pairs_end,
+             c.dcd_pairs_crc,
+             v.damage) &&
+         ok;
+    ok = table_block_matches(
+             frame_checks,
+             check_type.get(),
+             detail::kFrameCheckPath,
+             v.frame_checks,
+             c.frame_check_end,
+             c.frame_check_crc,
+             v.damage) &&
+         ok;
     if (!ok) break;
     v.frames = c.frames_end;
     v.contacts = c.contacts_end;

@@ -223,9 +223,16 @@ Table create_frame_check_table(hid_t file, const std::string& where) {
   const std::int32_t fill = -1;  // as create_table: an unwritten row reads as -1
   if (space.valid() && properties.valid() && H5Pset_chunk(properties.get(), 1, &chunk) >= 0 &&
       H5Pset_fill_value(properties.get(), H5T_NATIVE_INT32, &fill) >= 0) {
-    table.dataset = H5Handle(H5Dcreate2(file, detail::kFrameCheckPath, H5T_STD_I32LE, space.get(),
-                                        H5P_DEFAULT, properties.get(), H5P_DEFAULT),
-                             H5Dclose);
+    table.dataset = H5Handle(
+        H5Dcreate2(
+            file,
+            detail::kFrameCheckPath,
+            H5T_STD_I32LE,
+            space.get(),
+            H5P_DEFAULT,
+            properties.get(),
+            H5P_DEFAULT),
+        H5Dclose);
   }
   if (!table.dataset.valid()) {
     throw IoError(where + ": cannot create /frame_check (" + detail::take_hdf5_error() + ")");
@@ -301,17 +308,30 @@ struct LogWriter::Impl {
     row.dcd_pairs_end = static_cast<std::int64_t>(dcd_pairs.rows);
     row.frame_check_end = static_cast<std::int64_t>(frame_checks.rows);
     row.frames_crc = detail::rows_crc(0, frames.memory_type.get(), &frame, 1, sizeof frame);
-    row.contacts_crc = detail::rows_crc(0, contacts.memory_type.get(), contact_rows.data(), contact_rows.size(),
-                                        sizeof(detail::ContactDisk));
-    row.dcd_pairs_crc = detail::rows_crc(0, dcd_pairs.memory_type.get(), pair_rows.data(), pair_rows.size(),
-                                         sizeof(detail::DcdPairDisk));
+    row.contacts_crc = detail::rows_crc(
+        0,
+        contacts.memory_type.get(),
+        contact_rows.data(),
+        contact_rows.size(),
+        sizeof(detail::ContactDisk));
+    row.dcd_pairs_crc = detail::rows_crc(
+        0,
+        dcd_pairs.memory_type.get(),
+        pair_rows.data(),
+        pair_rows.size(),
+        sizeof(detail::DcdPairDisk));
     if (frame_checks.dataset.valid()) {
-      row.frame_check_crc = detail::rows_crc(0, frame_checks.memory_type.get(), pending_checks.data(),
-                                             pending_checks.size(), sizeof(std::int32_t));
+      row.frame_check_crc = detail::rows_crc(
+          0,
+          frame_checks.memory_type.get(),
+          pending_checks.data(),
+          pending_checks.size(),
+          sizeof(std::int32_t));
     }
     pending_checks.clear();
     row.self_crc = detail::checksum_row_crc(row);
-    append_rows(checksums, std::span<const detail::ChecksumDisk>(&row, 1), detail::kChecksumsPath, where);
+    append_rows(
+        checksums, std::span<const detail::ChecksumDisk>(&row, 1), detail::kChecksumsPath, where);
     flush();
   }
 
@@ -343,13 +363,12 @@ struct LogWriter::Impl {
           .b_index = p.b.index,
       });
     }
-    append_rows(contacts, std::span<const detail::ContactDisk>(contact_rows),
-                detail::kContactsPath, where);
-    append_rows(dcd_pairs, std::span<const detail::DcdPairDisk>(pair_rows),
-                detail::kDcdPairsPath, where);
+    append_rows(
+        contacts, std::span<const detail::ContactDisk>(contact_rows), detail::kContactsPath, where);
+    append_rows(
+        dcd_pairs, std::span<const detail::DcdPairDisk>(pair_rows), detail::kDcdPairsPath, where);
     const detail::FrameDisk row = to_disk(report.row);
-    append_rows(frames, std::span<const detail::FrameDisk>(&row, 1), detail::kFramesPath,
-                where);
+    append_rows(frames, std::span<const detail::FrameDisk>(&row, 1), detail::kFramesPath, where);
     flush_with_checksums(row);
   }
 
@@ -362,9 +381,11 @@ struct LogWriter::Impl {
     const int err = detail::hdf5_errno(error);
     std::string message = where + ": ";
     if (err == ENOSPC || err == EDQUOT) {
-      message += std::string(err == ENOSPC ? "the disk is full" : "the disk quota is exceeded") + " (" + std::strerror(err) + ")";
+      message += std::string(err == ENOSPC ? "the disk is full" : "the disk quota is exceeded") +
+                 " (" + std::strerror(err) + ")";
     } else {
-      message += "cannot write the log (" + (error.rfind(where + ": ", 0) == 0 ? error.substr(where.size() + 2) : error) + ")";
+      message += "cannot write the log (" +
+                 (error.rfind(where + ": ", 0) == 0 ? error.substr(where.size() + 2) : error) + ")";
     }
     try {
       const auto log = read_log(path, ReadLogOptions{.findings = false});
@@ -372,8 +393,8 @@ struct LogWriter::Impl {
         message += "; no row was written";
       } else {
         message += "; its first " + std::to_string(log.frames.size()) + " rows (samples " +
-                   std::to_string(log.frames.front().sample) + " to " + std::to_string(log.frames.back().sample) +
-                   ") were written and are readable";
+                   std::to_string(log.frames.front().sample) + " to " +
+                   std::to_string(log.frames.back().sample) + ") were written and are readable";
       }
     } catch (const std::exception&) {
       message += "; what was written cannot be read back";
@@ -434,8 +455,13 @@ LogWriter::LogWriter(const std::filesystem::path& path, const LogHeader& header)
                                    kPairChunkRows, unwritten<detail::ContactDisk>(), impl_->where);
     impl_->dcd_pairs = create_table(file, detail::kDcdPairsPath, detail::dcd_pair_memory_type(),
                                     kPairChunkRows, unwritten<detail::DcdPairDisk>(), impl_->where);
-    impl_->checksums = create_table(file, detail::kChecksumsPath, detail::checksum_memory_type(),
-                                    kFrameChunkRows, unwritten<detail::ChecksumDisk>(), impl_->where);
+    impl_->checksums = create_table(
+        file,
+        detail::kChecksumsPath,
+        detail::checksum_memory_type(),
+        kFrameChunkRows,
+        unwritten<detail::ChecksumDisk>(),
+        impl_->where);
     if (H5Fflush(file, H5F_SCOPE_LOCAL) < 0) {
       throw IoError(impl_->where + ": cannot flush (" + detail::take_hdf5_error() + ")");
     }
@@ -467,8 +493,11 @@ void LogWriter::append(const FrameReport& report, std::int32_t check) {
   }
   // The row's check first: a /frames row on disk implies its /frame_check entry is too.
   try {
-    append_rows(impl_->frame_checks, std::span<const std::int32_t>(&check, 1), detail::kFrameCheckPath,
-                impl_->where);
+    append_rows(
+        impl_->frame_checks,
+        std::span<const std::int32_t>(&check, 1),
+        detail::kFrameCheckPath,
+        impl_->where);
     impl_->pending_checks.push_back(check);
     impl_->write(report);
   } catch (const IoError& e) {

@@ -3,9 +3,9 @@
 #include <zlib.h>
 
 #include <algorithm>
+#include <cstddef>
 #include <cstdlib>
 #include <cstring>
-#include <cstddef>
 #include <mutex>
 #include <vector>
 
@@ -146,7 +146,6 @@ H5Handle dcd_pair_memory_type() {
   return type;
 }
 
-
 H5Handle checksum_memory_type() {
   auto type = compound(sizeof(ChecksumDisk));
   SKELCD_FIELD(type, ChecksumDisk, frames_end, H5T_NATIVE_INT64);
@@ -163,14 +162,20 @@ H5Handle checksum_memory_type() {
 
 #undef SKELCD_FIELD
 
-std::uint32_t rows_crc(std::uint32_t crc, hid_t memory_type, const void* rows, std::size_t count, std::size_t row_size) {
+std::uint32_t rows_crc(
+    std::uint32_t crc,
+    hid_t memory_type,
+    const void* rows,
+    std::size_t count,
+    std::size_t row_size) {
   // (offset, size) of every field; a scalar type is one field of its own size.
   std::vector<std::pair<std::size_t, std::size_t>> fields;
   if (H5Tget_class(memory_type) == H5T_COMPOUND) {
     const int members = H5Tget_nmembers(memory_type);
     for (int m = 0; m < members; ++m) {
       H5Handle member(H5Tget_member_type(memory_type, static_cast<unsigned>(m)), H5Tclose);
-      fields.emplace_back(H5Tget_member_offset(memory_type, static_cast<unsigned>(m)), H5Tget_size(member.get()));
+      fields.emplace_back(
+          H5Tget_member_offset(memory_type, static_cast<unsigned>(m)), H5Tget_size(member.get()));
     }
   } else {
     fields.emplace_back(0, H5Tget_size(memory_type));
@@ -181,7 +186,8 @@ std::uint32_t rows_crc(std::uint32_t crc, hid_t memory_type, const void* rows, s
   const auto* bytes = static_cast<const unsigned char*>(rows);
   uLong value = crc;
   for (std::size_t r = 0; r < count; ++r) {
-    for (const auto& [offset, size] : fields) value = crc32(value, bytes + r * row_size + offset, static_cast<uInt>(size));
+    for (const auto& [offset, size] : fields)
+      value = crc32(value, bytes + r * row_size + offset, static_cast<uInt>(size));
   }
   return static_cast<std::uint32_t>(value);
 }

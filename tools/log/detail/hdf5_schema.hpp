@@ -124,7 +124,12 @@ struct ChecksumDisk {
 /// CRC-32 of `count` rows at `rows` (laid out as `memory_type` says, `row_size` bytes apart),
 /// continuing from `crc`. Only the bytes of the type's fields count, never the padding between
 /// them, so the writer's rows and the reader's (read through the same memory type) agree.
-[[nodiscard]] std::uint32_t rows_crc(std::uint32_t crc, hid_t memory_type, const void* rows, std::size_t count, std::size_t row_size);
+[[nodiscard]] std::uint32_t rows_crc(
+    std::uint32_t crc,
+    hid_t memory_type,
+    const void* rows,
+    std::size_t count,
+    std::size_t row_size);
 /// `self_crc` of a checksum row: the CRC of its other fields.
 [[nodiscard]] std::uint32_t checksum_row_crc(const ChecksumDisk& row);
 
