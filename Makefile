@@ -12,7 +12,7 @@ FUZZ_SECONDS ?= 600
 FUZZERS      ?= scene ccd_queries frame_mesh trajectory srdf log_reader assimp_import
 FUZZ_BUILD   ?= build-fuzz
 
-.PHONY: all deps configure build demo test sanitize bench fuzz clean
+.PHONY: all deps configure build demo test sanitize sanitize-ci format-check bench fuzz sweep clean
 
 all: build
 
@@ -37,6 +37,24 @@ sanitize: deps
 	cmake -S . -B $(SAN_BUILD) -G Ninja -DCMAKE_BUILD_TYPE=Debug -DSKELCD_SANITIZE=ON -DSKELCD_WERROR=$(WERROR) $(CMAKE_ARGS)
 	cmake --build $(SAN_BUILD) -j $(JOBS)
 	cd $(SAN_BUILD) && ctest --output-on-failure -j $(JOBS) -LE bench
+
+# CI's sanitizer lane (.ci/run): ASan + UBSan over the tests of what reads files and guards
+# processes — import (the forked child, memory limits), frame sequences, the CCD kernels, the log
+# (checksums, a full disk), bad input at the command line — within CI's time.
+SAN_CI_TARGETS ?= skelcd skelcd_ccd_tests skelcd_skinning_tests skelcd_tools_tests
+SAN_CI_TESTS   ?= ImportRobustness|ImportGuard|AssimpImport|FrameSequence|Log\.|BadInputCli|CmdInspect|Vertex|Edge|TriangleTriangle
+sanitize-ci: deps
+	cmake -S . -B $(SAN_BUILD) -G Ninja -DCMAKE_BUILD_TYPE=Debug -DSKELCD_SANITIZE=ON -DSKELCD_WERROR=$(WERROR) $(CMAKE_ARGS)
+	cmake --build $(SAN_BUILD) -j $(JOBS) --target $(SAN_CI_TARGETS)
+	cd $(SAN_BUILD) && ctest --output-on-failure -j $(JOBS) -LE bench -R '$(SAN_CI_TESTS)'
+
+# Every C++ line changed since .ci/format-base must be as clang-format makes it.
+format-check:
+	bash scripts/check_format.sh
+
+# scripts/sweep_models.py: `info` on every file of Debian's assimp test models (docs/bad-input.md).
+sweep: build
+	/usr/bin/python3 scripts/sweep_models.py $(BUILD)/tools/skelcd
 
 bench: build
 	bash scripts/bench.sh $(BUILD)
