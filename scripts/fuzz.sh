@@ -77,6 +77,9 @@ for name in "${harnesses[@]}"; do
     args+=(-fork=1 -ignore_crashes=1 -ignore_ooms=1 -ignore_timeouts=1)
   fi
   echo "fuzz: $name for ${seconds}s (log $log)" >&2
+  # Only the artifacts of this run count (older ones stay in the folder for reference).
+  stamp="$out/logs/$name.start"
+  touch "$stamp"
   start=$(date +%s)
   # New entries go to the first corpus folder (scratch); the committed seeds are only read.
   nice -n 19 "$exe" "${args[@]}" "$scratch" "$seeds" >"$log" 2>&1
@@ -88,19 +91,35 @@ for name in "${harnesses[@]}"; do
   [[ -z "$execs" ]] && execs=$(grep -oE '^#[0-9]+' "$log" | tail -n 1 | tr -d '#')
   corpus="$(find "$seeds" -type f | wc -l) + $(find "$scratch" -type f | wc -l)"
 
-  # Sort every crashing input by the owner of its stack (re-run alone, at most 60 s).
+  # Sort every crashing input by the owner of its stack (re-run alone, at most 60 s). The
+  # sanitizers also write to a log file and ASan, not libFuzzer, handles abort(): import_rig
+  # points stderr at a temporary file while assimp reads, which would swallow the report.
   crashes=""
   ours=0
-  for a in "$artifacts"/crash-* "$artifacts"/oom-* "$artifacts"/timeout-* "$artifacts"/leak-*; do
-    [[ -f "$a" ]] || continue
+  while IFS= read -r a; do
     report="$a.report"
-    [[ -f "$report" ]] || timeout 90 nice -n 19 "$exe" -rss_limit_mb=2048 -malloc_limit_mb=2048 \
-      -timeout=60 "$a" >"$report" 2>&1
+    if [[ ! -f "$report" ]]; then
+      ASAN_OPTIONS="handle_abort=1:log_path=$a.san${ASAN_OPTIONS:+:$ASAN_OPTIONS}" \
+        UBSAN_OPTIONS="$UBSAN_OPTIONS:log_path=$a.san" \
+        timeout 90 nice -n 19 "$exe" -handle_abrt=0 -rss_limit_mb=2048 -malloc_limit_mb=2048 \
+        -timeout=60 "$a" >"$report" 2>&1
+      cat "$a".san.* >>"$report" 2>/dev/null
+      rm -f "$a".san.*
+    fi
     owner=$(crash_owner "$report")
+    # No report at all but no clean finish either: it died while stderr was captured, i.e.
+    # inside assimp's ReadFile/ApplyPostProcessing (skinning/assimp_import.cpp).
+    if [[ -z "$owner" && "$name" == assimp_import ]] && ! grep -q '^Executed ' "$report"; then
+      owner=assimp
+    fi
+    # A clean re-run: not reproducible alone (state built up over a fork job) or a suppressed leak.
+    [[ -z "$owner" ]] && grep -q '^Executed ' "$report" && owner=not-reproduced
     owner=${owner:-unknown}
     crashes+="$(basename "$a") ($owner); "
-    [[ -n "$library" && "$owner" == "$library" ]] || ours=$((ours + 1))
-  done
+    [[ -n "$library" && ("$owner" == "$library" || "$owner" == not-reproduced) ]] || ours=$((ours + 1))
+  done < <(find "$artifacts" -maxdepth 1 -type f -newer "$stamp" \
+             \( -name 'crash-*' -o -name 'oom-*' -o -name 'timeout-*' -o -name 'leak-*' \) \
+             ! -name '*.report' | sort)
   if [[ -z "$library" && $rc -ne 0 && $ours -eq 0 ]]; then
     ours=1  # a failure that left no artifact (e.g. the harness did not start)
     crashes+="exit status $rc without an artifact; "
