@@ -44,6 +44,13 @@ crash_owner() {
   awk '
     /^ *#[0-9]+ / {
       line = $0
+      # An unsymbolized frame: a library by its name, else sanitizer runtime internals.
+      if (line !~ / in /) {
+        if (line ~ /libassimp/) { print "assimp"; exit }
+        if (line ~ /libhdf5/) { print "hdf5"; exit }
+        next
+      }
+      if (line ~ / in (main|fuzzer::)[ (]/) next
       if (line ~ / in (__interceptor_|__asan|__sanitizer|__ubsan|__lsan|fuzzer::|__libc_|_start|abort|raise|malloc|calloc|realloc|free|operator new|operator delete|__cxa_|__gxx_|_Unwind)/) next
       if (line ~ /libc\.so|libstdc\+\+\.so|libm\.so|libgcc_s\.so|ld-linux/) next
       if (line ~ /libassimp/) { print "assimp"; exit }
