@@ -8,33 +8,60 @@
 
 namespace skelcd::culling {
 
+/// The work counters of one row, one entry each: every place that stores, sums, logs, reads or
+/// shows them is generated from this list (X(name, meaning)) — the struct below, `+=`, the log's
+/// /frames columns (tools/log/detail/hdf5_schema.hpp), the log reader, `inspect --frames` and the
+/// Python module's arrays. Add a counter here and everywhere follows (docs/architecture.md).
+#define SKELCD_COUNTERS(X)                                                  \
+  X(atomic_clusters, "atomic clusters (radial-view methods)")               \
+  X(mega_clusters, "mega clusters after merging (dynamic)")                 \
+  X(h_minus, "triangles in H- (radial-view methods)")                       \
+  X(h_uncertain, "triangles in Hu (radial-view methods)")                   \
+  X(bv_tests, "bounding-volume overlap tests")                              \
+  X(candidate_pairs, "candidate triangle pairs reaching the feature stage") \
+  X(vf_tests, "vertex-face elementary tests")                               \
+  X(ee_tests, "edge-edge elementary tests")                                 \
+  X(vf_contacts, "vertex-face contacts")                                    \
+  X(ee_contacts, "edge-edge contacts")                                      \
+  X(tt_tests, "triangle-triangle DCD tests")                                \
+  X(dcd_pairs, "intersecting triangle pairs found by DCD")                  \
+  X(feature_bv_tests, "feature-pair volume tests before the elementary tests (VF, EE)")
+
+/// Microseconds per stage of one row, likewise (X(name, meaning)).
+#define SKELCD_STAGE_TIMES(X)                       \
+  X(skin_us, "posing the sample(s)")                \
+  X(refit_us, "refitting bounding volumes")         \
+  X(classify_us, "orientation classes")             \
+  X(merge_us, "mega-cluster merging")               \
+  X(traverse_us, "hierarchy traversal and filters") \
+  X(elementary_us, "elementary tests")
+
 /// Work counters of one interval; every method fills the ones it uses and leaves the rest 0.
 struct Counters {
-  std::int64_t atomic_clusters = 0;
-  std::int64_t mega_clusters = 0;
-  std::int64_t h_minus = 0;      ///< triangles in H⁻ (radial-view methods)
-  std::int64_t h_uncertain = 0;  ///< triangles in Hᵘ (radial-view methods)
-  std::int64_t bv_tests = 0;     ///< bounding-volume overlap tests
-  std::int64_t candidate_pairs = 0;  ///< candidate triangle pairs reaching the feature stage
-  std::int64_t vf_tests = 0;     ///< vertex-face elementary tests
-  std::int64_t ee_tests = 0;     ///< edge-edge elementary tests
-  std::int64_t vf_contacts = 0;
-  std::int64_t ee_contacts = 0;
-  std::int64_t tt_tests = 0;     ///< triangle-triangle DCD tests
-  std::int64_t dcd_pairs = 0;    ///< intersecting triangle pairs found by DCD
-  /// Feature-pair volume tests (VF: vertex vs face, EE: edge vs edge) before the elementary
-  /// tests; a cheap filter, counted apart from the hierarchy's bv_tests.
-  std::int64_t feature_bv_tests = 0;
+#define SKELCD_COUNTER_MEMBER(name, meaning) std::int64_t name = 0;
+  SKELCD_COUNTERS(SKELCD_COUNTER_MEMBER)
+#undef SKELCD_COUNTER_MEMBER
+
+  Counters& operator+=(const Counters& other) {
+#define SKELCD_COUNTER_ADD(name, meaning) name += other.name;
+    SKELCD_COUNTERS(SKELCD_COUNTER_ADD)
+#undef SKELCD_COUNTER_ADD
+    return *this;
+  }
 };
 
 /// Microseconds spent per stage in one interval.
 struct StageTimes {
-  double skin_us = 0;
-  double refit_us = 0;
-  double classify_us = 0;
-  double merge_us = 0;
-  double traverse_us = 0;
-  double elementary_us = 0;
+#define SKELCD_STAGE_MEMBER(name, meaning) double name = 0;
+  SKELCD_STAGE_TIMES(SKELCD_STAGE_MEMBER)
+#undef SKELCD_STAGE_MEMBER
+
+  StageTimes& operator+=(const StageTimes& other) {
+#define SKELCD_STAGE_ADD(name, meaning) name += other.name;
+    SKELCD_STAGE_TIMES(SKELCD_STAGE_ADD)
+#undef SKELCD_STAGE_ADD
+    return *this;
+  }
 };
 
 /// A CCD contact in welded numbering. VF: `a` is a welded vertex, `b` a triangle. EE: `a` and `b`

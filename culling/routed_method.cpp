@@ -97,31 +97,6 @@ std::vector<skinning::Component> components_of(const skinning::Topology& topolog
   return out;
 }
 
-void add(Counters& a, const Counters& b) {
-  a.atomic_clusters += b.atomic_clusters;
-  a.mega_clusters += b.mega_clusters;
-  a.h_minus += b.h_minus;
-  a.h_uncertain += b.h_uncertain;
-  a.bv_tests += b.bv_tests;
-  a.candidate_pairs += b.candidate_pairs;
-  a.vf_tests += b.vf_tests;
-  a.ee_tests += b.ee_tests;
-  a.vf_contacts += b.vf_contacts;
-  a.ee_contacts += b.ee_contacts;
-  a.tt_tests += b.tt_tests;
-  a.dcd_pairs += b.dcd_pairs;
-  a.feature_bv_tests += b.feature_bv_tests;
-}
-
-void add(StageTimes& a, const StageTimes& b) {
-  a.skin_us += b.skin_us;
-  a.refit_us += b.refit_us;
-  a.classify_us += b.classify_us;
-  a.merge_us += b.merge_us;
-  a.traverse_us += b.traverse_us;
-  a.elementary_us += b.elementary_us;
-}
-
 /// A copy of `mesh` whose parts are split into (part, open) and (part, closed), with every pair
 /// that involves an open triangle excluded on top of the mesh's own exclusions: what a whole-mesh
 /// method (an extension's `dynamic`) is given so that it tests only closed-closed pairs.
@@ -314,8 +289,8 @@ class AutoMethod final : public detail::MethodBase, public RoutedMethod {
       if (m == nullptr) continue;
       sub_.clear();
       call(*m, sub_);
-      add(out.counters, sub_.counters);
-      add(out.times, sub_.times);
+      out.counters += sub_.counters;
+      out.times += sub_.times;
       out.contacts.insert(out.contacts.end(), sub_.contacts.begin(), sub_.contacts.end());
       out.dcd_pairs.insert(out.dcd_pairs.end(), sub_.dcd_pairs.begin(), sub_.dcd_pairs.end());
     }

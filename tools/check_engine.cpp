@@ -1,11 +1,14 @@
 #include "tools/check_engine.hpp"
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
+#include <filesystem>
 #include <memory>
 
 #include "skelcd_version.hpp"
 #include "skinning/errors.hpp"
+#include "skinning/generators.hpp"
 #include "tools/file_hash.hpp"
 #include "tools/log/log_writer.hpp"
 #include "tools/scene.hpp"
@@ -41,6 +44,35 @@ RunOptions run_options(const CheckRequest& r) {
 }
 
 }  // namespace
+
+std::string file_name_part(const std::string& text) {
+  std::string out;
+  for (const char c : text) {
+    const bool keep =
+        std::isalnum(static_cast<unsigned char>(c)) != 0 || c == '-' || c == '_' || c == '.';
+    out += keep ? c : '_';
+  }
+  while (!out.empty() && out.front() == '.') out.erase(out.begin());
+  return out.empty() ? std::string("model") : out;
+}
+
+std::string batch_log_name(const std::string& model_arg, const std::string& clip) {
+  std::string stem;
+  if (skinning::is_generator_spec(model_arg)) {
+    stem = model_arg;
+  } else {
+    auto path = std::filesystem::path(model_arg).lexically_normal();
+    if (path.filename().empty()) path = path.parent_path();
+    const bool glob = model_arg.find_first_of("*?[") != std::string::npos;
+    stem = glob ? path.parent_path().filename().string() : path.stem().string();
+  }
+  std::string name = file_name_part(stem);
+  if (!clip.empty()) {
+    name += '-';  // (not "-" + …: GCC 12 warns -Wrestrict on that, wrongly)
+    name += file_name_part(clip);
+  }
+  return name;
+}
 
 std::vector<std::string> check_method_names() { return scene_method_names(); }
 

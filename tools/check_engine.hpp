@@ -64,6 +64,15 @@ struct CheckOutcome {
     const CheckRequest& request,
     const FrameCallback& on_row = {});
 
+/// `text` as part of a file name: letters, digits, '-', '_' and '.' kept, anything else '_', no
+/// leading dot; "model" when nothing is left.
+[[nodiscard]] std::string file_name_part(const std::string& text);
+
+/// The name (without ".h5") of a batch's log of `clip` of `model_arg`: the model file's stem (a
+/// frame sequence's folder, a generator spec as written), then "-CLIP" when there is one. The
+/// command line's batch and `skelcd.batch` name logs so.
+[[nodiscard]] std::string batch_log_name(const std::string& model_arg, const std::string& clip);
+
 /// Every method name a check accepts (culling's and radial view's), in `bench` order.
 [[nodiscard]] std::vector<std::string> check_method_names();
 

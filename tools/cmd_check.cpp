@@ -353,32 +353,6 @@ std::vector<std::string> expand_models(const std::vector<std::string>& args, boo
   return models;
 }
 
-std::string file_name_part(const std::string& text) {
-  std::string out;
-  for (const char c : text) {
-    const bool keep = std::isalnum(static_cast<unsigned char>(c)) != 0 || c == '-' || c == '_' ||
-                      c == '.';
-    out += keep ? c : '_';
-  }
-  while (!out.empty() && out.front() == '.') out.erase(out.begin());
-  return out.empty() ? std::string("model") : out;
-}
-
-/// MODEL-CLIP.h5 for a batch log: the model file's stem (a generator spec as written), the clip.
-std::string log_name(const std::string& model_arg, const std::string& clip) {
-  std::string stem;
-  if (skinning::is_generator_spec(model_arg)) {
-    stem = model_arg;
-  } else {
-    auto path = std::filesystem::path(model_arg).lexically_normal();
-    if (path.filename().empty()) path = path.parent_path();
-    stem = has_glob(model_arg) ? path.parent_path().filename().string() : path.stem().string();
-  }
-  std::string name = file_name_part(stem);
-  if (!clip.empty()) name += "-" + file_name_part(clip);
-  return name;
-}
-
 struct Failure {
   std::string model;
   std::string clip;
@@ -437,7 +411,7 @@ void run_batch(const CheckArguments& args, const std::vector<std::string>& model
           !clip.empty() ? clip : (model->clips.empty() ? std::string() : model->clips.front().name);
       std::string log_path;
       if (!dir.empty()) {
-        const std::string base = log_name(model_arg, clip_name);
+        const std::string base = batch_log_name(model_arg, clip_name);
         std::string name = base;
         for (int k = 2; names.count(name) != 0; ++k) name = base + "-" + std::to_string(k);
         names.insert(name);

@@ -167,18 +167,30 @@ Table summary_table(const std::vector<std::pair<std::string, LogData>>& logs) {
 }
 
 Table frames_table(const LogData& log) {
+  // Every counter and stage of the log's one table of them (culling/frame_result.hpp), the stages
+  // in milliseconds.
   Table t;
-  t.columns = {"sample",   "kind",     "t0",          "t1",          "bv_tests",
-               "candidate_pairs",      "feature_bv_tests",    "vf_tests",    "ee_tests",    "tt_tests",
-               "vf_contacts",          "ee_contacts", "dcd_pairs",   "skin_ms",
-               "refit_ms", "traverse_ms",             "elementary_ms", "total_ms"};
+  t.columns = {"sample", "kind", "t0", "t1"};
+#define SKELCD_COUNTER_COLUMN(name, meaning) t.columns.push_back(#name);
+  SKELCD_COUNTERS(SKELCD_COUNTER_COLUMN)
+#undef SKELCD_COUNTER_COLUMN
+  for (const std::string stage : {
+#define SKELCD_STAGE_NAME(name, meaning) #name,
+           SKELCD_STAGE_TIMES(SKELCD_STAGE_NAME)
+#undef SKELCD_STAGE_NAME
+               "total_us"}) {
+    t.columns.push_back(stage.substr(0, stage.size() - 3) + "_ms");
+  }
   for (const auto& r : log.frames) {
-    const auto& c = r.counters;
-    t.rows.push_back({r.sample, std::string(to_string(r.kind)), r.t0, r.t1, c.bv_tests,
-                      c.candidate_pairs, c.feature_bv_tests, c.vf_tests, c.ee_tests, c.tt_tests, c.vf_contacts,
-                      c.ee_contacts, c.dcd_pairs, r.times.skin_us / 1000.0,
-                      r.times.refit_us / 1000.0, r.times.traverse_us / 1000.0,
-                      r.times.elementary_us / 1000.0, r.total_us / 1000.0});
+    auto& row = t.rows.emplace_back();
+    row = {r.sample, std::string(to_string(r.kind)), r.t0, r.t1};
+#define SKELCD_COUNTER_CELL(name, meaning) row.push_back(r.counters.name);
+    SKELCD_COUNTERS(SKELCD_COUNTER_CELL)
+#undef SKELCD_COUNTER_CELL
+#define SKELCD_STAGE_CELL(name, meaning) row.push_back(r.times.name / 1000.0);
+    SKELCD_STAGE_TIMES(SKELCD_STAGE_CELL)
+#undef SKELCD_STAGE_CELL
+    row.push_back(r.total_us / 1000.0);
   }
   return t;
 }

@@ -78,20 +78,8 @@ void report(benchmark::State& state, const culling::FrameResult& sum, std::int64
 }
 
 void accumulate(culling::FrameResult& sum, const culling::FrameResult& r) {
-  auto& s = sum.counters;
-  const auto& c = r.counters;
-  s.bv_tests += c.bv_tests;
-  s.candidate_pairs += c.candidate_pairs;
-  s.feature_bv_tests += c.feature_bv_tests;
-  s.vf_tests += c.vf_tests;
-  s.ee_tests += c.ee_tests;
-  s.tt_tests += c.tt_tests;
-  s.vf_contacts += c.vf_contacts;
-  s.ee_contacts += c.ee_contacts;
-  s.dcd_pairs += c.dcd_pairs;
-  sum.times.refit_us += r.times.refit_us;
-  sum.times.traverse_us += r.times.traverse_us;
-  sum.times.elementary_us += r.times.elementary_us;
+  sum.counters += r.counters;
+  sum.times += r.times;
 }
 
 void bm_ccd(benchmark::State& state, const std::string& name) {

@@ -51,13 +51,9 @@ Model.__module__ = __name__
 #: One row of /frames: a DCD sample (kind 0) or a CCD interval (kind 1); docs/log-format.md.
 FRAME_DTYPE = np.dtype(
     [("sample", "<i4"), ("t0", "<f8"), ("t1", "<f8"), ("kind", "u1")]
-    + [(name, "<i8") for name in (
-        "atomic_clusters", "mega_clusters", "h_minus", "h_uncertain", "bv_tests", "candidate_pairs",
-        "vf_tests", "ee_tests", "vf_contacts", "ee_contacts", "tt_tests", "dcd_pairs",
-        "feature_bv_tests")]
-    + [(name, "<f8") for name in (
-        "skin_us", "refit_us", "classify_us", "merge_us", "traverse_us", "elementary_us",
-        "total_us")])
+    + [(name, "<i8") for name in _skelcd.counter_names()]
+    + [(name, "<f8") for name in _skelcd.stage_names()]
+    + [("total_us", "<f8")])
 
 #: One row of /contacts: a CCD contact, VF (kind 0: vertex a, triangle b) or EE (kind 1: edges),
 #: features in the file's numbering (part, index within the part, side of an edge or -1).

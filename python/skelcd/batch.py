@@ -28,10 +28,12 @@ import sys
 from dataclasses import dataclass, field
 from typing import Iterable, Optional, Sequence
 
+from . import _skelcd
+
 __all__ = ["BatchResult", "log_name", "run", "main"]
 
 
-# --- naming: the command line's (tools/cmd_check.cpp, log_name) -----------------------------------
+# --- naming: the command line's own (tools/check_engine.hpp, batch_log_name) ----------------------
 
 def _is_generator_spec(model: str) -> bool:
     return model.startswith("gen:")
@@ -41,25 +43,13 @@ def _has_glob(model: str) -> bool:
     return not _is_generator_spec(model) and re.search(r"[*?\[]", model) is not None
 
 
-def _file_name_part(text: str) -> str:
-    out = "".join(c if (c.isascii() and c.isalnum()) or c in "-_." else "_" for c in text)
-    out = out.lstrip(".")
-    return out or "model"
+_file_name_part = _skelcd.file_name_part
 
 
 def log_name(model: str, clip: str) -> str:
     """MODEL-CLIP (without .h5), as ``skelcd check``'s batch names a log: the model file's stem
     (a frame sequence's folder, a generator spec as written), then the clip when there is one."""
-    if _is_generator_spec(model):
-        stem = model
-    else:
-        path = os.path.normpath(model)
-        stem = os.path.basename(os.path.dirname(path)) if _has_glob(model) else \
-            os.path.splitext(os.path.basename(path))[0]
-    name = _file_name_part(stem)
-    if clip:
-        name += "-" + _file_name_part(clip)
-    return name
+    return _skelcd.log_name(os.fspath(model), clip or "")
 
 
 def _expand_models(models: Iterable[str]) -> list:

@@ -86,29 +86,15 @@ py::dict frame_columns(const std::vector<tools::FrameRow>& rows) {
   c["t0"] = column<double>(rows, [](const R& r) { return r.t0; });
   c["t1"] = column<double>(rows, [](const R& r) { return r.t1; });
   c["kind"] = column<std::uint8_t>(rows, [](const R& r) { return r.kind; });
-  c["atomic_clusters"] =
-      column<std::int64_t>(rows, [](const R& r) { return r.counters.atomic_clusters; });
-  c["mega_clusters"] =
-      column<std::int64_t>(rows, [](const R& r) { return r.counters.mega_clusters; });
-  c["h_minus"] = column<std::int64_t>(rows, [](const R& r) { return r.counters.h_minus; });
-  c["h_uncertain"] = column<std::int64_t>(rows, [](const R& r) { return r.counters.h_uncertain; });
-  c["bv_tests"] = column<std::int64_t>(rows, [](const R& r) { return r.counters.bv_tests; });
-  c["candidate_pairs"] =
-      column<std::int64_t>(rows, [](const R& r) { return r.counters.candidate_pairs; });
-  c["vf_tests"] = column<std::int64_t>(rows, [](const R& r) { return r.counters.vf_tests; });
-  c["ee_tests"] = column<std::int64_t>(rows, [](const R& r) { return r.counters.ee_tests; });
-  c["vf_contacts"] = column<std::int64_t>(rows, [](const R& r) { return r.counters.vf_contacts; });
-  c["ee_contacts"] = column<std::int64_t>(rows, [](const R& r) { return r.counters.ee_contacts; });
-  c["tt_tests"] = column<std::int64_t>(rows, [](const R& r) { return r.counters.tt_tests; });
-  c["dcd_pairs"] = column<std::int64_t>(rows, [](const R& r) { return r.counters.dcd_pairs; });
-  c["feature_bv_tests"] =
-      column<std::int64_t>(rows, [](const R& r) { return r.counters.feature_bv_tests; });
-  c["skin_us"] = column<double>(rows, [](const R& r) { return r.times.skin_us; });
-  c["refit_us"] = column<double>(rows, [](const R& r) { return r.times.refit_us; });
-  c["classify_us"] = column<double>(rows, [](const R& r) { return r.times.classify_us; });
-  c["merge_us"] = column<double>(rows, [](const R& r) { return r.times.merge_us; });
-  c["traverse_us"] = column<double>(rows, [](const R& r) { return r.times.traverse_us; });
-  c["elementary_us"] = column<double>(rows, [](const R& r) { return r.times.elementary_us; });
+  // Every counter and stage of the one table of them (culling/frame_result.hpp).
+#define SKELCD_COUNTER_COLUMN(name, meaning) \
+  c[#name] = column<std::int64_t>(rows, [](const R& r) { return r.counters.name; });
+  SKELCD_COUNTERS(SKELCD_COUNTER_COLUMN)
+#undef SKELCD_COUNTER_COLUMN
+#define SKELCD_STAGE_COLUMN(name, meaning) \
+  c[#name] = column<double>(rows, [](const R& r) { return r.times.name; });
+  SKELCD_STAGE_TIMES(SKELCD_STAGE_COLUMN)
+#undef SKELCD_STAGE_COLUMN
   c["total_us"] = column<double>(rows, [](const R& r) { return r.total_us; });
   return c;
 }
@@ -559,4 +545,21 @@ PYBIND11_MODULE(_skelcd, m) {
       py::arg("command_line"));
   m.def("read_log", &read_log, py::arg("path"));
   m.def("method_names", &skelcd::tools::check_method_names);
+  // The /frames columns' counters and stages, in the log's order (FRAME_DTYPE is built from them).
+  m.def("counter_names", [] {
+    return std::vector<std::string>{
+#define SKELCD_NAME(name, meaning) #name,
+        SKELCD_COUNTERS(SKELCD_NAME)
+#undef SKELCD_NAME
+    };
+  });
+  m.def("stage_names", [] {
+    return std::vector<std::string>{
+#define SKELCD_NAME(name, meaning) #name,
+        SKELCD_STAGE_TIMES(SKELCD_NAME)
+#undef SKELCD_NAME
+    };
+  });
+  m.def("log_name", &skelcd::tools::batch_log_name, py::arg("model"), py::arg("clip"));
+  m.def("file_name_part", &skelcd::tools::file_name_part, py::arg("text"));
 }

@@ -96,34 +96,19 @@ void append_rows(Table& table, std::span<const Row> rows, const char* name, cons
 }
 
 detail::FrameDisk to_disk(const FrameRow& row) {
-  const auto& c = row.counters;
-  const auto& t = row.times;
-  return detail::FrameDisk{
-      .sample = row.sample,
-      .kind = static_cast<std::uint8_t>(row.kind),
-      .t0 = row.t0,
-      .t1 = row.t1,
-      .atomic_clusters = c.atomic_clusters,
-      .mega_clusters = c.mega_clusters,
-      .h_minus = c.h_minus,
-      .h_uncertain = c.h_uncertain,
-      .bv_tests = c.bv_tests,
-      .candidate_pairs = c.candidate_pairs,
-      .vf_tests = c.vf_tests,
-      .ee_tests = c.ee_tests,
-      .vf_contacts = c.vf_contacts,
-      .ee_contacts = c.ee_contacts,
-      .tt_tests = c.tt_tests,
-      .dcd_pairs = c.dcd_pairs,
-      .feature_bv_tests = c.feature_bv_tests,
-      .skin_us = t.skin_us,
-      .refit_us = t.refit_us,
-      .classify_us = t.classify_us,
-      .merge_us = t.merge_us,
-      .traverse_us = t.traverse_us,
-      .elementary_us = t.elementary_us,
-      .total_us = row.total_us,
-  };
+  detail::FrameDisk d{};
+  d.sample = row.sample;
+  d.kind = static_cast<std::uint8_t>(row.kind);
+  d.t0 = row.t0;
+  d.t1 = row.t1;
+#define SKELCD_COPY_COUNTER(name, meaning) d.name = row.counters.name;
+  SKELCD_COUNTERS(SKELCD_COPY_COUNTER)
+#undef SKELCD_COPY_COUNTER
+#define SKELCD_COPY_STAGE(name, meaning) d.name = row.times.name;
+  SKELCD_STAGE_TIMES(SKELCD_COPY_STAGE)
+#undef SKELCD_COPY_STAGE
+  d.total_us = row.total_us;
+  return d;
 }
 
 void write_parts(hid_t file, const std::vector<std::string>& names, const std::string& where) {

@@ -97,25 +97,12 @@ H5Handle frame_memory_type() {
   SKELCD_FIELD(type, FrameDisk, t0, H5T_NATIVE_DOUBLE);
   SKELCD_FIELD(type, FrameDisk, t1, H5T_NATIVE_DOUBLE);
   SKELCD_FIELD(type, FrameDisk, kind, kind.get());
-  SKELCD_FIELD(type, FrameDisk, atomic_clusters, H5T_NATIVE_INT64);
-  SKELCD_FIELD(type, FrameDisk, mega_clusters, H5T_NATIVE_INT64);
-  SKELCD_FIELD(type, FrameDisk, h_minus, H5T_NATIVE_INT64);
-  SKELCD_FIELD(type, FrameDisk, h_uncertain, H5T_NATIVE_INT64);
-  SKELCD_FIELD(type, FrameDisk, bv_tests, H5T_NATIVE_INT64);
-  SKELCD_FIELD(type, FrameDisk, candidate_pairs, H5T_NATIVE_INT64);
-  SKELCD_FIELD(type, FrameDisk, vf_tests, H5T_NATIVE_INT64);
-  SKELCD_FIELD(type, FrameDisk, ee_tests, H5T_NATIVE_INT64);
-  SKELCD_FIELD(type, FrameDisk, vf_contacts, H5T_NATIVE_INT64);
-  SKELCD_FIELD(type, FrameDisk, ee_contacts, H5T_NATIVE_INT64);
-  SKELCD_FIELD(type, FrameDisk, tt_tests, H5T_NATIVE_INT64);
-  SKELCD_FIELD(type, FrameDisk, dcd_pairs, H5T_NATIVE_INT64);
-  SKELCD_FIELD(type, FrameDisk, feature_bv_tests, H5T_NATIVE_INT64);
-  SKELCD_FIELD(type, FrameDisk, skin_us, H5T_NATIVE_DOUBLE);
-  SKELCD_FIELD(type, FrameDisk, refit_us, H5T_NATIVE_DOUBLE);
-  SKELCD_FIELD(type, FrameDisk, classify_us, H5T_NATIVE_DOUBLE);
-  SKELCD_FIELD(type, FrameDisk, merge_us, H5T_NATIVE_DOUBLE);
-  SKELCD_FIELD(type, FrameDisk, traverse_us, H5T_NATIVE_DOUBLE);
-  SKELCD_FIELD(type, FrameDisk, elementary_us, H5T_NATIVE_DOUBLE);
+#define SKELCD_COUNTER_FIELD(name, meaning) SKELCD_FIELD(type, FrameDisk, name, H5T_NATIVE_INT64);
+  SKELCD_COUNTERS(SKELCD_COUNTER_FIELD)
+#undef SKELCD_COUNTER_FIELD
+#define SKELCD_STAGE_FIELD(name, meaning) SKELCD_FIELD(type, FrameDisk, name, H5T_NATIVE_DOUBLE);
+  SKELCD_STAGE_TIMES(SKELCD_STAGE_FIELD)
+#undef SKELCD_STAGE_FIELD
   SKELCD_FIELD(type, FrameDisk, total_us, H5T_NATIVE_DOUBLE);
   return type;
 }

@@ -9,6 +9,8 @@
 #include <string>
 #include <utility>
 
+#include "culling/frame_result.hpp"  // SKELCD_COUNTERS, SKELCD_STAGE_TIMES
+
 namespace skelcd::tools::detail {
 
 /// Owns one HDF5 identifier and closes it with the matching H5?close.
@@ -63,25 +65,12 @@ struct FrameDisk {
   std::uint8_t kind;  // QueryKind
   double t0;
   double t1;
-  std::int64_t atomic_clusters;
-  std::int64_t mega_clusters;
-  std::int64_t h_minus;
-  std::int64_t h_uncertain;
-  std::int64_t bv_tests;
-  std::int64_t candidate_pairs;
-  std::int64_t vf_tests;
-  std::int64_t ee_tests;
-  std::int64_t vf_contacts;
-  std::int64_t ee_contacts;
-  std::int64_t tt_tests;
-  std::int64_t dcd_pairs;
-  std::int64_t feature_bv_tests;
-  double skin_us;
-  double refit_us;
-  double classify_us;
-  double merge_us;
-  double traverse_us;
-  double elementary_us;
+#define SKELCD_DISK_COUNTER(name, meaning) std::int64_t name;
+  SKELCD_COUNTERS(SKELCD_DISK_COUNTER)
+#undef SKELCD_DISK_COUNTER
+#define SKELCD_DISK_STAGE(name, meaning) double name;
+  SKELCD_STAGE_TIMES(SKELCD_DISK_STAGE)
+#undef SKELCD_DISK_STAGE
   double total_us;
 };
 
