@@ -405,7 +405,9 @@ void add_part(
 
   const auto part = static_cast<std::int32_t>(rig.mesh.part_names.size());
   const auto base = static_cast<std::int32_t>(build.positions.size());
-  const Eigen::Affine3d& mesh_global = h.scene_global[static_cast<std::size_t>(node)];
+  // A copy: add_static_node below grows h.scene_global, which would leave a reference dangling
+  // (a use after free that fuzz_assimp_import found).
+  const Eigen::Affine3d mesh_global = h.scene_global[static_cast<std::size_t>(node)];
 
   // Skin: which bind frame B places the mesh? assimp's offset matrices map mesh space to bone
   // space, and a skinned vertex poses as G_bone · offset · v whatever the mesh node says. Files

@@ -31,7 +31,7 @@ struct ImportOptions {
   /// Address space that importing one file may use, bytes (checked in the child process).
   std::size_t memory_limit_bytes = kDefaultImportMemoryLimit;
   /// Time that importing one file may take in the child process, seconds.
-  double time_limit_s = 600.0;
+  double time_limit_s = 120.0;
 };
 
 /// A clip of the file that could not be used (keys out of order, non-finite keys, …). The rest

@@ -305,9 +305,7 @@ class RealCharacters : public ::testing::TestWithParam<const char*> {};
 
 std::filesystem::path character_path(const std::string& name) {
   if (name.ends_with(".X")) return skelcd::test::assimp_model("X/" + name);
-  const auto bundled = skelcd::test::asset("characters/" + name);
-  if (std::filesystem::exists(bundled)) return bundled;
-  return std::filesystem::path(SKELCD_SHARED_DIR) / "assets/characters" / name;
+  return skelcd::test::asset("characters/" + name);
 }
 
 TEST_P(RealCharacters, HeatAndRigWeightsBothPartitionTheMesh) {

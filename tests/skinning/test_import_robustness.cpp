@@ -203,6 +203,52 @@ TEST(ImportRobustness, ATinyImportMemoryLimitRefusesARealCharacter) {
       "importing it needs more memory than the import memory limit of 1 MiB");
 }
 
+// --- what fuzzing found (fuzz/crashes/, docs/fuzzing.md) ------------------------------------
+
+std::filesystem::path fuzz_input(const std::string& relative) {
+  return std::filesystem::path(SKELCD_SOURCE_DIR) / "fuzz/crashes" / relative;
+}
+
+// One line naming the file, whatever the exception's type (an assimp crash is IoError, a memory
+// blow-up InvalidInput; under AddressSanitizer a crash ends the child differently).
+void expect_one_line_refusal(const std::filesystem::path& file, const ImportOptions& options = {}) {
+  bool refused = false;
+  try {
+    (void)import_rig(file, options);
+  } catch (const std::exception& e) {
+    refused = true;
+    const std::string message = e.what();
+    EXPECT_EQ(message.rfind(file.string() + ": ", 0), 0u) << message;
+    EXPECT_EQ(message.find('\n'), std::string::npos) << message;
+  }
+  EXPECT_TRUE(refused) << file;
+}
+
+TEST(ImportRobustness, AFileThatMadeUsUseFreedMemoryImportsCleanly) {
+  // A bone naming no node grew the hierarchy's transforms while a reference into them was held.
+  const auto imported = import_rig(fuzz_input("ours/add_part_use_after_free.md5mesh"));
+  EXPECT_GT(imported.rig.mesh.num_triangles(), 0);
+}
+
+TEST(ImportRobustness, FilesOnWhichAssimpCrashesOrRunsAwayAreOneLineEach) {
+  for (const char* f :
+       {"assimp/md5mesh_null_deref.md5mesh",
+        "assimp/triangulate_assert_abort.ply",
+        "assimp/x_25gb_allocation.x",
+        "assimp/x_runaway_allocation.x",
+        "assimp/x_compressed_zlib_leak.x"}) {
+    SCOPED_TRACE(f);
+    expect_one_line_refusal(fuzz_input(f));
+  }
+  // The PLY reader loops for ever at the end of this file: the child is stopped at the limit.
+  ImportOptions quick;
+  quick.time_limit_s = 2.0;
+  EXPECT_THROW_MESSAGE(
+      (void)import_rig(fuzz_input("assimp/ply_reader_endless_loop.ply"), quick),
+      IoError,
+      "importing it took longer than 2 s");
+}
+
 // --- 8. a NaN in an OBJ is named by the file's own vertex number ------------------------------
 
 TEST(ImportRobustness, ANanInAnObjNamesTheFilesVertexNotAssimpsCorner) {

@@ -26,11 +26,7 @@ namespace fs = std::filesystem;
 
 const fs::path kBcn = skelcd::test::assimp_model("X/BCN_Epileptic.X");
 
-fs::path character(const std::string& name) {
-  const auto bundled = skelcd::test::asset("characters/" + name);
-  if (fs::exists(bundled)) return bundled;
-  return fs::path(SKELCD_SHARED_DIR) / "assets/characters" / name;
-}
+fs::path character(const std::string& name) { return skelcd::test::asset("characters/" + name); }
 
 // Runs a shell command, returns its exit status and standard output.
 std::pair<int, std::string> shell(const std::string& command) {

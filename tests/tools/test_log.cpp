@@ -386,6 +386,14 @@ TEST(Log, GarbageInsideATableIsFoundByItsChecksumAndTheRowsBeforeItStayReadable)
   EXPECT_NE(r.out.find("damaged (20/"), std::string::npos) << r.out;
 }
 
+TEST(Log, ADamagedExtentIsRefusedNotAllocated) {
+  // Found by fuzz_log_reader: /parts claiming 2^53 rows in a 26 KB file (a std::bad_alloc before).
+  const auto file = std::filesystem::path(skelcd::test::asset("..")) /
+                    "fuzz/crashes/ours/read_parts_huge_extent.hdf5";
+  EXPECT_THROW_MESSAGE(
+      (void)read_log(file), IoError, "/parts claims 14636698788954113 rows, more than the file's");
+}
+
 TEST(Log, ReaderRejectsForeignHdf5ByName) {
   const auto dir = skelcd::test::temp_dir("log-foreign");
   const auto foreign = dir / "foreign.h5";

@@ -1,5 +1,6 @@
 #include "tools/log/log_reader.hpp"
 
+#include <algorithm>
 #include <string>
 #include <type_traits>
 #include <vector>
@@ -32,6 +33,19 @@ void drop_unwritten(std::vector<Row>& rows) {
   while (!rows.empty() && first(rows.back()) == -1) rows.pop_back();
 }
 
+/// Bytes of the log file being read: no table can hold more rows than its bytes (plus one chunk
+/// of unwritten rows, which take no space), so a damaged extent is refused instead of allocated.
+thread_local std::uintmax_t tl_file_bytes = 0;
+
+void check_extent(const std::string& where, hsize_t count, std::size_t min_row_bytes) {
+  const std::uintmax_t most = tl_file_bytes / std::max<std::size_t>(min_row_bytes, 1) + 1024;
+  if (count > most) {
+    throw IoError(
+        where + " claims " + std::to_string(count) + " rows, more than the file's " +
+        std::to_string(tl_file_bytes) + " bytes can hold (damaged)");
+  }
+}
+
 /// Reads the whole 1-D compound dataset `name` into `rows` through `memory_type` (fields matched
 /// by name).
 template <class Row>
@@ -50,6 +64,7 @@ void read_table(hid_t file, const char* name, const H5Handle& memory_type, std::
   }
   hsize_t count = 0;
   H5Sget_simple_extent_dims(space.get(), &count, nullptr);
+  check_extent(where, count, H5Tget_size(type.get()));
   rows.resize(count);
   if (count == 0) return;
   if (H5Dread(dataset.get(), memory_type.get(), H5S_ALL, H5S_ALL, H5P_DEFAULT, rows.data()) < 0) {
@@ -75,6 +90,7 @@ std::vector<std::string> read_parts(hid_t file) {
   }
   hsize_t count = 0;
   H5Sget_simple_extent_dims(space.get(), &count, nullptr);
+  check_extent("/parts", count, 16);  // a variable-length string takes a 16-byte reference
   if (count == 0) return names;
   const auto type = detail::vlen_string_type();
   std::vector<char*> pointers(count, nullptr);
@@ -99,6 +115,7 @@ std::vector<T> read_route_column(hid_t group, const char* name, hid_t type, hsiz
     throw IoError(std::string("/routes/") + name + " is missing or not " + std::to_string(count) +
                   " rows");
   }
+  check_extent(std::string("/routes/") + name, rows, 1);
   std::vector<T> values(rows);
   if (rows > 0 && H5Dread(dataset.get(), type, H5S_ALL, H5S_ALL, H5P_DEFAULT, values.data()) < 0) {
     throw IoError(std::string("cannot read /routes/") + name + " (" + detail::take_hdf5_error() + ")");
@@ -156,6 +173,7 @@ std::vector<LogCheck> read_checks(hid_t file) {
       detail::clear_hdf5_error();
       throw IoError(std::string("/checks/") + name + " is missing");
     }
+    check_extent(std::string("/checks/") + name, rows, 16);
     std::vector<char*> raw(rows, nullptr);
     if (rows > 0 && H5Dread(dataset.get(), type.get(), H5S_ALL, H5S_ALL, H5P_DEFAULT, raw.data()) < 0) {
       throw IoError(std::string("cannot read /checks/") + name + " (" + detail::take_hdf5_error() + ")");
@@ -194,6 +212,7 @@ std::vector<std::int32_t> read_frame_checks(hid_t file) {
     detail::clear_hdf5_error();
     throw IoError("/frame_check is not readable");
   }
+  check_extent("/frame_check", rows, 4);
   values.resize(rows);
   if (rows > 0 && H5Dread(dataset.get(), H5T_NATIVE_INT32, H5S_ALL, H5S_ALL, H5P_DEFAULT,
                           values.data()) < 0) {
@@ -253,27 +272,12 @@ FrameRow from_disk(const detail::FrameDisk& d) {
   row.t0 = d.t0;
   row.t1 = d.t1;
   row.kind = d.kind == static_cast<std::uint8_t>(QueryKind::ccd) ? QueryKind::ccd : QueryKind::dcd;
-  auto& c = row.counters;
-  c.atomic_clusters = d.atomic_clusters;
-  c.mega_clusters = d.mega_clusters;
-  c.h_minus = d.h_minus;
-  c.h_uncertain = d.h_uncertain;
-  c.bv_tests = d.bv_tests;
-  c.candidate_pairs = d.candidate_pairs;
-  c.vf_tests = d.vf_tests;
-  c.ee_tests = d.ee_tests;
-  c.vf_contacts = d.vf_contacts;
-  c.ee_contacts = d.ee_contacts;
-  c.tt_tests = d.tt_tests;
-  c.dcd_pairs = d.dcd_pairs;
-  c.feature_bv_tests = d.feature_bv_tests;
-  auto& t = row.times;
-  t.skin_us = d.skin_us;
-  t.refit_us = d.refit_us;
-  t.classify_us = d.classify_us;
-  t.merge_us = d.merge_us;
-  t.traverse_us = d.traverse_us;
-  t.elementary_us = d.elementary_us;
+#define SKELCD_COPY_COUNTER(name, meaning) row.counters.name = d.name;
+  SKELCD_COUNTERS(SKELCD_COPY_COUNTER)
+#undef SKELCD_COPY_COUNTER
+#define SKELCD_COPY_STAGE(name, meaning) row.times.name = d.name;
+  SKELCD_STAGE_TIMES(SKELCD_COPY_STAGE)
+#undef SKELCD_COPY_STAGE
   row.total_us = d.total_us;
   return row;
 }
@@ -399,6 +403,7 @@ LogData read_log(const std::filesystem::path& path, const ReadLogOptions& option
   if (!file.valid()) {
     throw IoError(name + ": cannot open HDF5 file (" + detail::take_hdf5_error() + ")");
   }
+  tl_file_bytes = std::filesystem::file_size(path, ec);
   LogData data;
   try {
     data.header = read_header(file.get());
