@@ -14,7 +14,7 @@
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   const auto path = skelcd::fuzz::write_input(data, size, ".h5");
   try {
-    (void)skelcd::tools::read_log(path, {.findings = true});
+    (void)skelcd::tools::read_log(path, {.findings = true, .isolate = false});
   } catch (const std::exception&) {
   }
   return 0;

@@ -345,14 +345,14 @@ void run_isolated(
       throw InvalidInput(
           name + ": the import was killed, most likely for memory (" + limit_text + ")");
     throw IoError(
-        name + ": the importer (assimp) crashed reading it (" + signal_name(sig) +
-        "); the file is damaged or uses a feature this assimp cannot read");
+        name + ": " + limits.reader + " crashed reading it (" + signal_name(sig) +
+        "); the file is damaged or uses a feature it cannot read");
   }
   if (report.empty() && WIFEXITED(status) && WEXITSTATUS(status) == kOverMemoryExit)
     report = kOutOfMemory;
   if (report.empty()) {
     throw IoError(
-        name + ": the importer (assimp) ended without an answer (exit status " +
+        name + ": " + limits.reader + " ended without an answer (exit status " +
         std::to_string(WIFEXITED(status) ? WEXITSTATUS(status) : -1) + ")");
   }
   const std::string message = report.substr(1);

@@ -1,5 +1,6 @@
 #pragma once
-// Internal to skinning/: keeps a broken model file from taking skelcd down with it. assimp trusts
+// Keeps a broken file from taking skelcd down with it (internal; skinning/ for model files, and
+// tools/log/ for logs, whose HDF5 library crashes on some malformed files). assimp trusts
 // the counts a file declares (a 300-byte OFF file asks for 15 GB) and crashes on some malformed
 // files; skelcd must answer every input with a result or one line.
 
@@ -14,6 +15,8 @@ struct ImportLimits {
   std::size_t memory_bytes = 0;
   /// Wall-clock time the probe may take, seconds (<= 0: no limit).
   double time_s = 0.0;
+  /// Who reads the file, for the messages ("the importer (assimp)", "HDF5").
+  const char* reader = "the importer (assimp)";
 };
 
 /// Refuses a file whose header declares more elements than its size can hold, before any

@@ -5,6 +5,7 @@
 #include <type_traits>
 #include <vector>
 
+#include "skinning/detail/import_guard.hpp"
 #include "skinning/errors.hpp"
 #include "tools/log/detail/hdf5_schema.hpp"
 
@@ -389,6 +390,16 @@ void cut(std::vector<Row>& rows, std::int64_t end) {
 }  // namespace
 
 LogData read_log(const std::filesystem::path& path, const ReadLogOptions& options) {
+  if (options.isolate) {
+    std::error_code exists_ec;
+    if (std::filesystem::is_regular_file(path, exists_ec)) {
+      ReadLogOptions inside = options;
+      inside.isolate = false;
+      const skinning::detail::ImportLimits limits{
+          .memory_bytes = std::size_t{4} << 30, .time_s = 120.0, .reader = "HDF5"};
+      skinning::detail::run_isolated(path, limits, [&] { (void)read_log(path, inside); });
+    }
+  }
   detail::silence_hdf5_errors();
   const std::string name = path.string();
   std::error_code ec;
