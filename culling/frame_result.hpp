@@ -25,7 +25,13 @@ namespace skelcd::culling {
   X(ee_contacts, "edge-edge contacts")                                      \
   X(tt_tests, "triangle-triangle DCD tests")                                \
   X(dcd_pairs, "intersecting triangle pairs found by DCD")                  \
-  X(feature_bv_tests, "feature-pair volume tests before the elementary tests (VF, EE)")
+  X(feature_bv_tests, "feature-pair volume tests before the elementary tests (VF, EE)") \
+  X(new_dcd_pairs, "DCD pairs neither in the baseline nor allowed (events)")         \
+  X(new_ccd_contacts, "CCD contacts neither in the baseline nor allowed (events)")   \
+  X(baseline_dcd_pairs, "DCD pairs the baseline already had")                       \
+  X(baseline_ccd_contacts, "CCD contacts within the baseline's regions")            \
+  X(allowed_dcd_pairs, "DCD pairs between allowed parts or bones")                  \
+  X(allowed_ccd_contacts, "CCD contacts between allowed parts or bones")
 
 /// Microseconds per stage of one row, likewise (X(name, meaning)).
 #define SKELCD_STAGE_TIMES(X)                       \

@@ -50,6 +50,13 @@ struct FrameRow {
   double total_us = 0;  ///< wall time of the whole row, skinning included
 };
 
+/// What a finding is against the check's baseline and the user's allowances (docs/events.md):
+/// a value >= 0 is the id of the new event it belongs to (the log's /events row).
+inline constexpr std::int32_t kLabelBaseline = -1;  ///< the rig already had it (the baseline)
+inline constexpr std::int32_t kLabelAllowed = -2;   ///< between parts or bones the user allowed
+/// Not labelled: a log written before events existed (its rows read so), or a runner's raw rows.
+inline constexpr std::int32_t kLabelNone = -3;
+
 /// One row of /contacts: a CCD contact. VF: `a` is a vertex, `b` a triangle. EE: both are edges.
 struct ContactRow {
   std::int32_t frame = 0;  ///< first sample of the interval
@@ -58,6 +65,7 @@ struct ContactRow {
   FeatureId b;
   double toi_lower = 1;  ///< fraction of the interval, in [0, 1]
   double toi_upper = 1;
+  std::int32_t label = kLabelNone;  ///< event id, kLabelBaseline, kLabelAllowed or kLabelNone
   friend bool operator==(const ContactRow&, const ContactRow&) = default;
 };
 
@@ -66,6 +74,7 @@ struct DcdPairRow {
   std::int32_t frame = 0;
   FeatureId a;  ///< a triangle (side -1)
   FeatureId b;
+  std::int32_t label = kLabelNone;  ///< event id, kLabelBaseline, kLabelAllowed or kLabelNone
   friend bool operator==(const DcdPairRow&, const DcdPairRow&) = default;
 };
 

@@ -62,6 +62,12 @@ struct LogHeader {
   std::vector<LogRoute> routes;  ///< the /routes group; empty (and absent) unless method is auto
   /// The /checks group and /frame_check dataset; empty (and absent) unless the log is a scene's.
   std::vector<LogCheck> checks;
+  /// What the findings were compared with (docs/events.md): "rest pose", "sample 12", "none",
+  /// "log PATH"; empty in a log written before events existed (its findings are unlabelled).
+  std::string baseline;
+  std::int32_t baseline_slack = 0;  ///< rings of triangles a baseline region may slide by
+  std::vector<std::string> allow;   ///< `--allow` rules as given ("PART_A:PART_B")
+  bool allow_adjacent_bones = false;  ///< `--allow-adjacent-bones`
   bool complete = false;  ///< set when the run finished; false in a log of a killed run
 };
 
