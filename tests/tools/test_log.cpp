@@ -46,7 +46,48 @@ LogHeader sample_header() {
   h.num_vertices = 1234;
   h.num_triangles = 2345;
   h.part_names = {"Body", "Hat", ""};
+  h.baseline = "sample 12";
+  h.baseline_slack = 3;
+  h.allow = {"Body:Hat", "Händ:Händ"};
+  h.allow_adjacent_bones = true;
   return h;
+}
+
+/// Events with every field distinct: a missing t_first_contact, no bones, a merge, a negative
+/// peak_sample, names with spaces and accents.
+std::vector<EventRecord> sample_events() {
+  EventRecord a;
+  a.id = 0;
+  a.first_sample = 3;
+  a.last_sample = 5;
+  a.t_first = 0.1;
+  a.t_last = 5 / 30.0;
+  a.t_first_contact = 0.0875;
+  a.parts = {0, 2};
+  a.bones = {"mixamorig:LeftForeArm", "Spine 1", "Hüfte"};
+  a.peak_pairs = 1500;
+  a.peak_sample = 5;
+  a.dcd_pairs = 1502;
+  a.ccd_contacts = (std::int64_t{1} << 33) + 7;
+  a.depth = 0.03125;
+  a.merged_into = -1;
+  EventRecord b;
+  b.id = 1;
+  b.first_sample = 3;
+  b.last_sample = 4;
+  b.t_first = 0.1;
+  b.t_last = 4 / 30.0;
+  b.parts = {1};
+  b.peak_pairs = 0;
+  b.peak_sample = -1;
+  b.ccd_contacts = 2;
+  b.merged_into = 0;
+  EventRecord c;  // neither parts nor bones
+  c.id = 2;
+  c.first_sample = c.last_sample = 5;
+  c.t_first = c.t_last = 5 / 30.0;
+  c.t_first_contact = 0.0;
+  return {a, b, c};
 }
 
 /// Report with every counter and time distinct so a swapped column shows.
@@ -71,6 +112,12 @@ FrameReport sample_report(int sample, QueryKind kind, int contacts, int pairs) {
   c.tt_tests = base + 11;
   c.dcd_pairs = (std::int64_t{1} << 40) + base;  // beyond 32 bits
   c.feature_bv_tests = base + 12;
+  c.new_dcd_pairs = base + 13;
+  c.new_ccd_contacts = base + 14;
+  c.baseline_dcd_pairs = base + 15;
+  c.baseline_ccd_contacts = base + 16;
+  c.allowed_dcd_pairs = base + 17;
+  c.allowed_ccd_contacts = base + 18;
   auto& t = r.row.times;
   t.skin_us = 0.5 + sample;
   t.refit_us = 1.25 + sample;
@@ -87,11 +134,15 @@ FrameReport sample_report(int sample, QueryKind kind, int contacts, int pairs) {
         .b = FeatureId{(i + 1) % 3, 10 * i + 1, static_cast<std::int8_t>(i % 2 == 0 ? -1 : 2)},
         .toi_lower = 0.125 * i / (contacts + 1.0),
         .toi_upper = 0.125 * (i + 1) / (contacts + 1.0),
+        .label = i % 4 - 2,  // allowed, baseline, event 0, event 1
     });
   }
   for (int i = 0; i < pairs; ++i) {
     r.dcd_pairs.push_back(DcdPairRow{
-        .frame = sample, .a = FeatureId{0, 7 * i, -1}, .b = FeatureId{2, 7 * i + 3, -1}});
+        .frame = sample,
+        .a = FeatureId{0, 7 * i, -1},
+        .b = FeatureId{2, 7 * i + 3, -1},
+        .label = i % 5 - 2});
   }
   return r;
 }
@@ -116,6 +167,12 @@ void expect_rows_equal(const FrameRow& a, const FrameRow& b) {
   EXPECT_EQ(x.tt_tests, y.tt_tests);
   EXPECT_EQ(x.dcd_pairs, y.dcd_pairs);
   EXPECT_EQ(x.feature_bv_tests, y.feature_bv_tests);
+  EXPECT_EQ(x.new_dcd_pairs, y.new_dcd_pairs);
+  EXPECT_EQ(x.new_ccd_contacts, y.new_ccd_contacts);
+  EXPECT_EQ(x.baseline_dcd_pairs, y.baseline_dcd_pairs);
+  EXPECT_EQ(x.baseline_ccd_contacts, y.baseline_ccd_contacts);
+  EXPECT_EQ(x.allowed_dcd_pairs, y.allowed_dcd_pairs);
+  EXPECT_EQ(x.allowed_ccd_contacts, y.allowed_ccd_contacts);
   EXPECT_EQ(a.times.skin_us, b.times.skin_us);
   EXPECT_EQ(a.times.refit_us, b.times.refit_us);
   EXPECT_EQ(a.times.classify_us, b.times.classify_us);
@@ -146,6 +203,10 @@ void expect_headers_equal(const LogHeader& a, const LogHeader& b) {
   EXPECT_EQ(a.num_vertices, b.num_vertices);
   EXPECT_EQ(a.num_triangles, b.num_triangles);
   EXPECT_EQ(a.part_names, b.part_names);
+  EXPECT_EQ(a.baseline, b.baseline);
+  EXPECT_EQ(a.baseline_slack, b.baseline_slack);
+  EXPECT_EQ(a.allow, b.allow);
+  EXPECT_EQ(a.allow_adjacent_bones, b.allow_adjacent_bones);
 }
 
 std::vector<FrameReport> sample_reports() {
@@ -173,11 +234,16 @@ TEST(Log, RoundTripsEveryField) {
     LogWriter writer(path, header);
     for (const auto& r : reports) writer.append(r);
     EXPECT_EQ(writer.rows_written(), 5);
+    writer.write_events(sample_events());
     writer.finish();
   }
   const auto data = read_log(path);
   expect_headers_equal(data.header, header);
   EXPECT_TRUE(data.header.complete);
+  EXPECT_TRUE(data.verified);
+  EXPECT_TRUE(data.damage.empty());
+  EXPECT_TRUE(data.events_recorded);
+  EXPECT_EQ(data.events, sample_events());
 
   std::vector<ContactRow> contacts;
   std::vector<DcdPairRow> pairs;
@@ -196,6 +262,131 @@ TEST(Log, RoundTripsEveryField) {
   const auto summary_only = read_log(path, ReadLogOptions{.findings = false});
   EXPECT_EQ(summary_only.frames.size(), 5u);
   EXPECT_TRUE(summary_only.contacts.empty());
+  EXPECT_EQ(summary_only.events, sample_events());  // events are read either way
+}
+
+TEST(Log, EventsAreWrittenOnceBeforeFinishAndAbsentEventsAreNotNoEvents) {
+  const auto dir = skelcd::test::temp_dir("log-events");
+  {
+    LogWriter writer(dir / "none.h5", sample_header());
+    writer.append(sample_report(3, QueryKind::dcd, 0, 1));
+    writer.write_events({});
+    EXPECT_THROW_MESSAGE(writer.write_events({}), IoError, "events already written");
+    writer.finish();
+    EXPECT_THROW_MESSAGE(writer.write_events({}), IoError, "log already finished");
+  }
+  const auto none = read_log(dir / "none.h5");
+  EXPECT_TRUE(none.events_recorded);  // a run with no events
+  EXPECT_TRUE(none.events.empty());
+  EXPECT_TRUE(none.verified);
+  {
+    LogWriter writer(dir / "cut.h5", sample_header());
+    writer.append(sample_report(3, QueryKind::dcd, 0, 1));
+  }  // cut short: no events written
+  const auto cut = read_log(dir / "cut.h5");
+  EXPECT_FALSE(cut.events_recorded);
+  EXPECT_EQ(cut.header.baseline, "sample 12");  // labelled, but the events never came
+  EXPECT_EQ(cut.dcd_pairs.at(0).label, -2);
+}
+
+TEST(Log, ALogWithoutBaselineWritesNoEventAttributes) {
+  const auto path = skelcd::test::temp_dir("log-no-baseline") / "run.h5";
+  auto header = sample_header();
+  header.baseline.clear();
+  {
+    LogWriter writer(path, header);
+    writer.finish();
+  }
+  const std::string script =
+      "import h5py, sys\n"
+      "with h5py.File('" +
+      path.string() +
+      "', 'r') as f:\n"
+      "    names = ('baseline', 'baseline_slack', 'allow', 'allow_adjacent_bones')\n"
+      "    sys.exit(3 if any(n in f.attrs for n in names) else 0)\n";
+  const auto py = path.parent_path() / "attrs.py";
+  write_text(py, script);
+  EXPECT_EQ(std::system((std::string(kPython) + " " + py.string()).c_str()), 0);
+  const auto data = read_log(path);
+  EXPECT_TRUE(data.header.baseline.empty());
+  EXPECT_TRUE(data.header.allow.empty());
+  EXPECT_FALSE(data.header.allow_adjacent_bones);
+}
+
+/// tests/tools/data/log_before_events.hdf5: written by the log writer of commit 139b64c (format 1,
+/// before labels and events, with /checksums) for the seam mesh of test_highlight.cpp: rows dcd 3
+/// (one pair), ccd 3 (a VF and an EE contact), dcd 4.
+std::filesystem::path log_before_events() {
+  return std::filesystem::path(SKELCD_SOURCE_DIR) / "tests/tools/data/log_before_events.hdf5";
+}
+
+TEST(Log, ALogWrittenBeforeEventsReadsUnlabelledAndVerified) {
+  const auto data = read_log(log_before_events());
+  EXPECT_EQ(data.header.format_version, 1);
+  EXPECT_TRUE(data.header.complete);
+  // Its checksums cover the columns it has: still verified with the columns added since.
+  EXPECT_TRUE(data.verified);
+  EXPECT_TRUE(data.damage.empty());
+  EXPECT_TRUE(data.header.baseline.empty());
+  EXPECT_FALSE(data.events_recorded);
+  EXPECT_TRUE(data.events.empty());
+  ASSERT_EQ(data.frames.size(), 3u);
+  EXPECT_EQ(data.frames[0].counters.dcd_pairs, 1);
+  EXPECT_EQ(data.frames[0].counters.tt_tests, 3);
+  EXPECT_EQ(data.frames[1].counters.ee_contacts, 1);
+  for (const auto& f : data.frames) {  // counters the log has no column for read 0
+    EXPECT_EQ(f.counters.new_dcd_pairs, 0);
+    EXPECT_EQ(f.counters.baseline_ccd_contacts, 0);
+    EXPECT_EQ(f.counters.allowed_dcd_pairs, 0);
+  }
+  ASSERT_EQ(data.dcd_pairs.size(), 1u);
+  EXPECT_EQ(data.dcd_pairs[0], (DcdPairRow{3, {0, 0, -1}, {1, 1, -1}, kLabelNone}));
+  ASSERT_EQ(data.contacts.size(), 2u);
+  EXPECT_EQ(data.contacts[1].toi_upper, 0.75);
+  EXPECT_EQ(data.contacts[0].label, kLabelNone);
+  EXPECT_EQ(data.contacts[1].label, kLabelNone);
+}
+
+TEST(Log, ANewerFormatIsRefusedByItsVersion) {
+  // What a version-1 reader does with the logs this build writes (it could not checksum them).
+  const auto path = skelcd::test::temp_dir("log-version") / "run.h5";
+  auto header = sample_header();
+  header.format_version = kLogFormatVersion + 1;
+  {
+    LogWriter writer(path, header);
+    writer.finish();
+  }
+  EXPECT_THROW_MESSAGE((void)read_log(path), IoError, "is not supported (this build reads 1..");
+}
+
+TEST(Log, DamagedEventsAreDroppedAndNamed) {
+  const auto dir = skelcd::test::temp_dir("log-events-damage");
+  const auto path = dir / "run.h5";
+  {
+    LogWriter writer(path, sample_header());
+    for (const auto& r : sample_reports()) writer.append(r);
+    writer.write_events(sample_events());
+    writer.finish();
+  }
+  // One bone renamed behind the writer's back: the events fail their checksum.
+  const std::string script =
+      "import h5py, numpy\n"
+      "with h5py.File('" +
+      path.string() +
+      "', 'r+') as f:\n"
+      "    d = f['event_bones']; row = d[1]; row['bone'] = 'Spine 2'; d[1] = row\n";
+  write_text(dir / "edit.py", script);
+  ASSERT_EQ(std::system((std::string(kPython) + " " + (dir / "edit.py").string()).c_str()), 0);
+  const auto data = read_log(path);
+  EXPECT_FALSE(data.verified);
+  ASSERT_EQ(data.damage.size(), 1u);
+  EXPECT_EQ(
+      data.damage[0],
+      "/events (with /event_parts and /event_bones) is damaged (it fails its checksum)");
+  EXPECT_FALSE(data.events_recorded);
+  EXPECT_TRUE(data.events.empty());
+  EXPECT_EQ(data.frames.size(), 5u);  // the rows before the events are whole
+  EXPECT_EQ(data.dcd_pairs.size(), 1502u);
 }
 
 TEST(Log, OptionalParametersStayAbsent) {

@@ -11,7 +11,10 @@ namespace skelcd::tools {
 /// Value of the root attribute `format` that marks a file as a skelcd log.
 inline constexpr const char* kLogFormatName = "skelcd-log";
 /// Version of the schema written by this build; readers accept versions <= this.
-inline constexpr std::int32_t kLogFormatVersion = 1;
+/// 2: finding labels, /events, the baseline attributes and /checksums over every stored column
+/// (a version-1 reader checksums only the columns it knows and would call a version-2 log
+/// damaged, so it refuses it by its version instead).
+inline constexpr std::int32_t kLogFormatVersion = 2;
 
 /// Where one connected component of the mesh went under `auto` (culling::ComponentRoute): stored
 /// as the /routes group, one row per component.
@@ -65,8 +68,8 @@ struct LogHeader {
   /// What the findings were compared with (docs/events.md): "rest pose", "sample 12", "none",
   /// "log PATH"; empty in a log written before events existed (its findings are unlabelled).
   std::string baseline;
-  std::int32_t baseline_slack = 0;  ///< rings of triangles a baseline region may slide by
-  std::vector<std::string> allow;   ///< `--allow` rules as given ("PART_A:PART_B")
+  std::int32_t baseline_slack = 0;    ///< rings of triangles a baseline region may slide by
+  std::vector<std::string> allow;     ///< `--allow` rules as given ("PART_A:PART_B")
   bool allow_adjacent_bones = false;  ///< `--allow-adjacent-bones`
   bool complete = false;  ///< set when the run finished; false in a log of a killed run
 };

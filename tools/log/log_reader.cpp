@@ -1,6 +1,10 @@
 #include "tools/log/log_reader.hpp"
 
 #include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <limits>
+#include <map>
 #include <string>
 #include <type_traits>
 #include <vector>
@@ -27,8 +31,10 @@ void drop_unwritten(std::vector<Row>& rows) {
       return r.sample;
     } else if constexpr (requires { r.frames_end; }) {
       return r.frames_end;
-    } else {
+    } else if constexpr (requires { r.frame; }) {
       return r.frame;
+    } else {
+      return 0;  // a table written once, in full (/events …): nothing to drop
     }
   };
   while (!rows.empty() && first(rows.back()) == -1) rows.pop_back();
@@ -47,13 +53,46 @@ void check_extent(const std::string& where, hsize_t count, std::size_t min_row_b
   }
 }
 
-/// Reads the whole 1-D compound dataset `name` into `rows` through `memory_type` (fields matched
-/// by name).
+/// A compound table as read: its rows in memory, and the same rows as stored (every column the
+/// file has, known to this build or not), which the checksums cover.
 template <class Row>
-void read_table(hid_t file, const char* name, const H5Handle& memory_type, std::vector<Row>& rows) {
+struct StoredTable {
+  std::vector<Row> rows;
+  std::vector<unsigned char> bytes;  ///< rows as stored, row_size bytes each
+  std::size_t row_size = 0;
+  H5Handle file_type;  ///< the stored row type (native copy of the file's, same layout)
+  bool present = false;
+
+  [[nodiscard]] std::uint32_t crc(std::uint32_t from, std::size_t begin, std::size_t end) const {
+    if (end <= begin) return from;
+    return detail::rows_crc(
+        from, file_type.get(), bytes.data() + begin * row_size, end - begin, row_size);
+  }
+  void cut(std::size_t end) {
+    if (rows.size() > end) rows.resize(end);
+    if (bytes.size() > end * row_size) bytes.resize(end * row_size);
+  }
+};
+
+/// Reads the whole 1-D compound dataset `name` through `memory_type` (fields matched by name).
+/// Each row starts as `defaults`, which a column the file lacks (a log written before it existed)
+/// keeps. `optional`: a missing table reads as empty (present = false) instead of failing.
+template <class Row>
+StoredTable<Row> read_table(
+    hid_t file,
+    const char* name,
+    const H5Handle& memory_type,
+    const Row& defaults,
+    bool optional = false) {
   const std::string where = std::string("/") + name;
+  StoredTable<Row> table;
   const htri_t exists = H5Lexists(file, name, H5P_DEFAULT);
-  if (exists <= 0) throw IoError("missing table " + where);
+  if (exists <= 0) {
+    detail::clear_hdf5_error();
+    if (optional) return table;
+    throw IoError("missing table " + where);
+  }
+  table.present = true;
   H5Handle dataset(H5Dopen2(file, name, H5P_DEFAULT), H5Dclose);
   if (!dataset.valid()) throw IoError("cannot open " + where + " (" + detail::take_hdf5_error() + ")");
   H5Handle type(H5Dget_type(dataset.get()), H5Tclose);
@@ -66,12 +105,51 @@ void read_table(hid_t file, const char* name, const H5Handle& memory_type, std::
   hsize_t count = 0;
   H5Sget_simple_extent_dims(space.get(), &count, nullptr);
   check_extent(where, count, H5Tget_size(type.get()));
-  rows.resize(count);
-  if (count == 0) return;
-  if (H5Dread(dataset.get(), memory_type.get(), H5S_ALL, H5S_ALL, H5P_DEFAULT, rows.data()) < 0) {
+  std::vector<std::string> missing;
+  const auto common = detail::common_members(memory_type.get(), type.get(), &missing);
+  table.rows.assign(count, defaults);
+  if (count == 0) return table;
+  if (H5Dread(dataset.get(), common.get(), H5S_ALL, H5S_ALL, H5P_DEFAULT, table.rows.data()) < 0) {
     throw IoError("cannot read " + where + " (" + detail::take_hdf5_error() + ")");
   }
-  drop_unwritten(rows);
+  // A column the file lacks: back to its default, whatever the conversion left there.
+  for (const auto& column : missing) {
+    const int index = H5Tget_member_index(memory_type.get(), column.c_str());
+    H5Handle member(H5Tget_member_type(memory_type.get(), static_cast<unsigned>(index)), H5Tclose);
+    const std::size_t offset =
+        H5Tget_member_offset(memory_type.get(), static_cast<unsigned>(index));
+    const std::size_t size = H5Tget_size(member.get());
+    for (auto& row : table.rows) {
+      std::memcpy(
+          reinterpret_cast<unsigned char*>(&row) + offset,
+          reinterpret_cast<const unsigned char*>(&defaults) + offset,
+          size);
+    }
+  }
+  drop_unwritten(table.rows);
+  // The stored bytes, for the checksums: a type holding no variable-length data reads as is.
+  if (H5Tdetect_class(type.get(), H5T_VLEN) <= 0 && H5Tdetect_class(type.get(), H5T_STRING) <= 0) {
+    table.file_type = H5Handle(H5Tget_native_type(type.get(), H5T_DIR_ASCEND), H5Tclose);
+    // A native type may align its members; the stored layout is the file's own, packed.
+    if (table.file_type.valid() && H5Tpack(table.file_type.get()) < 0) table.file_type.reset();
+    if (!table.file_type.valid()) {
+      throw IoError("cannot read " + where + " (" + detail::take_hdf5_error() + ")");
+    }
+    table.row_size = H5Tget_size(table.file_type.get());
+    table.bytes.resize(count * table.row_size);
+    if (H5Dread(
+            dataset.get(),
+            table.file_type.get(),
+            H5S_ALL,
+            H5S_ALL,
+            H5P_DEFAULT,
+            table.bytes.data()) < 0) {
+      throw IoError("cannot read " + where + " (" + detail::take_hdf5_error() + ")");
+    }
+    table.bytes.resize(table.rows.size() * table.row_size);
+  }
+  detail::clear_hdf5_error();
+  return table;
 }
 
 std::vector<std::string> read_parts(hid_t file) {
@@ -261,6 +339,11 @@ LogHeader read_header(hid_t file) {
   h.num_vertices = read_int_attribute(file, "num_vertices").value_or(0);
   h.num_triangles = read_int_attribute(file, "num_triangles").value_or(0);
   h.complete = read_int_attribute(file, "complete").value_or(0) != 0;
+  h.baseline = text("baseline");
+  h.baseline_slack =
+      static_cast<std::int32_t>(read_int_attribute(file, "baseline_slack").value_or(0));
+  h.allow = detail::read_string_list_attribute(file, "allow").value_or(std::vector<std::string>{});
+  h.allow_adjacent_bones = read_int_attribute(file, "allow_adjacent_bones").value_or(0) != 0;
   h.part_names = read_parts(file);
   h.routes = read_routes(file);
   h.checks = read_checks(file);
@@ -285,53 +368,148 @@ FrameRow from_disk(const detail::FrameDisk& d) {
 
 /// The rows of every table that a log's /checksums cover, and what failed.
 struct Verified {
-  std::int64_t frames = 0, contacts = 0, dcd_pairs = 0, frame_checks = 0;
+  std::int64_t frames = 0, contacts = 0, dcd_pairs = 0, frame_checks = 0, events = 0;
   std::vector<std::string> damage;
 };
 
-template <class Row>
-bool table_block_matches(
-    const std::vector<Row>& rows,
-    hid_t memory_type,
+void damaged_block(
+    std::vector<std::string>& damage, const char* name, std::int64_t begin, std::int64_t end) {
+  damage.push_back(
+      std::string("/") + name + " rows " + std::to_string(begin) + " to " +
+      std::to_string(end - 1) + " are damaged (they fail their checksum)");
+}
+
+bool covers(
+    std::vector<std::string>& damage,
     const char* name,
+    std::int64_t count,
     std::int64_t begin,
-    std::int64_t end,
-    std::uint32_t expected,
-    std::vector<std::string>& damage) {
-  const auto count = static_cast<std::int64_t>(rows.size());
-  const std::string table = std::string("/") + name;
+    std::int64_t end) {
   if (end < begin || end > count) {
     damage.push_back(
-        table + " has " + std::to_string(count) + " rows, but its checksums cover rows " +
-        std::to_string(begin) + " to " + std::to_string(end - 1));
-    return false;
-  }
-  const auto crc = detail::rows_crc(
-      0, memory_type, rows.data() + begin, static_cast<std::size_t>(end - begin), sizeof(Row));
-  if (crc != expected) {
-    damage.push_back(
-        table + " rows " + std::to_string(begin) + " to " + std::to_string(end - 1) +
-        " are damaged (they fail their checksum)");
+        std::string("/") + name + " has " + std::to_string(count) +
+        " rows, but its checksums cover rows " + std::to_string(begin) + " to " +
+        std::to_string(end - 1));
     return false;
   }
   return true;
 }
 
+template <class Row>
+bool table_block_matches(
+    const StoredTable<Row>& table,
+    const char* name,
+    std::int64_t begin,
+    std::int64_t end,
+    std::uint32_t expected,
+    std::vector<std::string>& damage) {
+  if (!covers(damage, name, static_cast<std::int64_t>(table.rows.size()), begin, end)) return false;
+  if (table.crc(0, static_cast<std::size_t>(begin), static_cast<std::size_t>(end)) != expected) {
+    damaged_block(damage, name, begin, end);
+    return false;
+  }
+  return true;
+}
+
+bool frame_check_block_matches(
+    const std::vector<std::int32_t>& values,
+    std::int64_t begin,
+    std::int64_t end,
+    std::uint32_t expected,
+    std::vector<std::string>& damage) {
+  if (!covers(
+          damage, detail::kFrameCheckPath, static_cast<std::int64_t>(values.size()), begin, end))
+    return false;
+  const H5Handle type(H5Tcopy(H5T_NATIVE_INT32), H5Tclose);
+  const auto crc = detail::rows_crc(
+      0,
+      type.get(),
+      values.data() + begin,
+      static_cast<std::size_t>(end - begin),
+      sizeof(std::int32_t));
+  if (crc != expected) {
+    damaged_block(damage, detail::kFrameCheckPath, begin, end);
+    return false;
+  }
+  return true;
+}
+
+/// The events as read: /events, /event_parts, /event_bones.
+struct EventTables {
+  StoredTable<detail::EventDisk> events;
+  StoredTable<detail::EventPartDisk> parts;
+  StoredTable<detail::EventBoneDisk> bones;
+  hid_t bone_type = H5I_INVALID_HID;  // memory type of `bones` (for reclaiming its strings)
+  ~EventTables() {
+    if (bones.rows.empty()) return;
+    const auto type = detail::event_bone_memory_type();
+    const hsize_t count = bones.rows.size();
+    H5Handle space(H5Screate_simple(1, &count, nullptr), H5Sclose);
+    H5Dvlen_reclaim(type.get(), space.get(), H5P_DEFAULT, bones.rows.data());
+  }
+};
+
+/// Events are written once, at the end: a checksum row covers none of them or all of them.
+bool events_block_matches(
+    const EventTables& e,
+    std::int64_t begin,
+    std::int64_t end,
+    std::uint32_t expected,
+    std::vector<std::string>& damage) {
+  const auto count = static_cast<std::int64_t>(e.events.rows.size());
+  if (end == begin) {
+    if (expected == 0) return true;
+    damaged_block(damage, detail::kEventsPath, begin, begin + 1);
+    return false;
+  }
+  if (begin != 0 || end != count) {
+    damage.push_back(
+        std::string("/") + detail::kEventsPath + " has " + std::to_string(count) +
+        " rows, but its checksums cover rows " + std::to_string(begin) + " to " +
+        std::to_string(end - 1));
+    return false;
+  }
+  std::uint32_t crc = e.events.crc(0, 0, e.events.rows.size());
+  crc = e.parts.crc(crc, 0, e.parts.rows.size());
+  crc = detail::bone_rows_crc(crc, e.bones.rows);
+  if (crc != expected) {
+    damage.push_back(
+        std::string("/") + detail::kEventsPath + " (with /" + detail::kEventPartsPath + " and /" +
+        detail::kEventBonesPath + ") is damaged (it fails its checksum)");
+    return false;
+  }
+  return true;
+}
+
+/// `self_crc` of a checksum row as stored: the CRC of its bytes with `self_crc` zeroed.
+bool checksum_row_matches(const StoredTable<detail::ChecksumDisk>& checksums, std::size_t i) {
+  const hid_t type = checksums.file_type.get();
+  const int index = H5Tget_member_index(type, "self_crc");
+  if (index < 0) {
+    detail::clear_hdf5_error();
+    return false;
+  }
+  const std::size_t offset = H5Tget_member_offset(type, static_cast<unsigned>(index));
+  std::vector<unsigned char> row(
+      checksums.bytes.begin() + static_cast<std::ptrdiff_t>(i * checksums.row_size),
+      checksums.bytes.begin() + static_cast<std::ptrdiff_t>((i + 1) * checksums.row_size));
+  if (offset + 4 > row.size()) return false;
+  std::memset(row.data() + offset, 0, 4);
+  return detail::rows_crc(0, type, row.data(), 1, row.size()) == checksums.rows[i].self_crc;
+}
+
 /// Walks /checksums in order and stops at the first row whose blocks do not match.
 Verified verify_rows(
-    const std::vector<detail::ChecksumDisk>& checksums,
-    const std::vector<detail::FrameDisk>& frames,
-    const std::vector<detail::ContactDisk>& contacts,
-    const std::vector<detail::DcdPairDisk>& pairs,
-    const std::vector<std::int32_t>& frame_checks) {
+    const StoredTable<detail::ChecksumDisk>& checksums,
+    const StoredTable<detail::FrameDisk>& frames,
+    const StoredTable<detail::ContactDisk>& contacts,
+    const StoredTable<detail::DcdPairDisk>& pairs,
+    const std::vector<std::int32_t>& frame_checks,
+    const EventTables& events) {
   Verified v;
-  const auto frame_type = detail::frame_memory_type();
-  const auto contact_type = detail::contact_memory_type();
-  const auto pair_type = detail::dcd_pair_memory_type();
-  const H5Handle check_type(H5Tcopy(H5T_NATIVE_INT32), H5Tclose);
-  for (std::size_t i = 0; i < checksums.size(); ++i) {
-    const auto& c = checksums[i];
-    if (detail::checksum_row_crc(c) != c.self_crc) {
+  for (std::size_t i = 0; i < checksums.rows.size(); ++i) {
+    const auto& c = checksums.rows[i];
+    if (!checksum_row_matches(checksums, i)) {
       std::string what = "/";
       what += detail::kChecksumsPath;
       what += " row " + std::to_string(i) + " is damaged";
@@ -339,16 +517,9 @@ Verified verify_rows(
       break;
     }
     bool ok = table_block_matches(
-        frames,
-        frame_type.get(),
-        detail::kFramesPath,
-        v.frames,
-        c.frames_end,
-        c.frames_crc,
-        v.damage);
+        frames, detail::kFramesPath, v.frames, c.frames_end, c.frames_crc, v.damage);
     ok = table_block_matches(
              contacts,
-             contact_type.get(),
              detail::kContactsPath,
              v.contacts,
              c.contacts_end,
@@ -357,27 +528,22 @@ Verified verify_rows(
          ok;
     ok = table_block_matches(
              pairs,
-             pair_type.get(),
              detail::kDcdPairsPath,
              v.dcd_pairs,
              c.dcd_pairs_end,
              c.dcd_pairs_crc,
              v.damage) &&
          ok;
-    ok = table_block_matches(
-             frame_checks,
-             check_type.get(),
-             detail::kFrameCheckPath,
-             v.frame_checks,
-             c.frame_check_end,
-             c.frame_check_crc,
-             v.damage) &&
+    ok = frame_check_block_matches(
+             frame_checks, v.frame_checks, c.frame_check_end, c.frame_check_crc, v.damage) &&
          ok;
+    ok = events_block_matches(events, v.events, c.events_end, c.events_crc, v.damage) && ok;
     if (!ok) break;
     v.frames = c.frames_end;
     v.contacts = c.contacts_end;
     v.dcd_pairs = c.dcd_pairs_end;
     v.frame_checks = c.frame_check_end;
+    v.events = c.events_end;
   }
   return v;
 }
@@ -385,6 +551,66 @@ Verified verify_rows(
 template <class Row>
 void cut(std::vector<Row>& rows, std::int64_t end) {
   if (static_cast<std::int64_t>(rows.size()) > end) rows.resize(static_cast<std::size_t>(end));
+}
+
+/// What a finding row reads as where the file has no such column: a log written before labels
+/// has kLabelNone in every row.
+detail::ContactDisk contact_defaults() {
+  detail::ContactDisk d{};
+  d.label = kLabelNone;
+  return d;
+}
+
+detail::DcdPairDisk pair_defaults() {
+  detail::DcdPairDisk d{};
+  d.label = kLabelNone;
+  return d;
+}
+
+detail::EventDisk event_defaults() {
+  detail::EventDisk d{};
+  d.t_first_contact = std::numeric_limits<double>::quiet_NaN();
+  d.peak_sample = -1;
+  d.merged_into = -1;
+  return d;
+}
+
+/// EventRecords from the three tables; parts and bones attach to the event of their `event` id.
+std::vector<EventRecord> assemble_events(const EventTables& t) {
+  std::vector<EventRecord> events;
+  std::map<std::int32_t, std::size_t> by_id;
+  for (const auto& d : t.events.rows) {
+    EventRecord e;
+    e.id = d.id;
+    e.first_sample = d.first_sample;
+    e.last_sample = d.last_sample;
+    e.t_first = d.t_first;
+    e.t_last = d.t_last;
+    if (!std::isnan(d.t_first_contact)) e.t_first_contact = d.t_first_contact;
+    e.peak_pairs = d.peak_pairs;
+    e.peak_sample = d.peak_sample;
+    e.dcd_pairs = d.dcd_pairs;
+    e.ccd_contacts = d.ccd_contacts;
+    e.depth = d.depth;
+    e.merged_into = d.merged_into;
+    by_id.emplace(e.id, events.size());
+    events.push_back(std::move(e));
+  }
+  const auto event_of = [&](std::int32_t id, const char* table) -> EventRecord& {
+    const auto it = by_id.find(id);
+    if (it == by_id.end()) {
+      throw IoError(
+          std::string("/") + table + " names event " + std::to_string(id) +
+          ", which /events does not have");
+    }
+    return events[it->second];
+  };
+  for (const auto& p : t.parts.rows)
+    event_of(p.event, detail::kEventPartsPath).parts.push_back(p.part);
+  for (const auto& b : t.bones.rows) {
+    event_of(b.event, detail::kEventBonesPath).bones.emplace_back(b.bone != nullptr ? b.bone : "");
+  }
+  return events;
 }
 
 }  // namespace
@@ -418,36 +644,63 @@ LogData read_log(const std::filesystem::path& path, const ReadLogOptions& option
   LogData data;
   try {
     data.header = read_header(file.get());
-    std::vector<detail::FrameDisk> frames;
-    read_table(file.get(), detail::kFramesPath, detail::frame_memory_type(), frames);
+    auto frames = read_table(
+        file.get(), detail::kFramesPath, detail::frame_memory_type(), detail::FrameDisk{});
     data.frame_checks = read_frame_checks(file.get());
     // Findings are read when asked for, or when the checksums need them.
     const bool has_checksums = H5Lexists(file.get(), detail::kChecksumsPath, H5P_DEFAULT) > 0;
     detail::clear_hdf5_error();
-    std::vector<detail::ContactDisk> contacts;
-    std::vector<detail::DcdPairDisk> pairs;
+    StoredTable<detail::ContactDisk> contacts;
+    StoredTable<detail::DcdPairDisk> pairs;
     if (options.findings || has_checksums) {
-      read_table(file.get(), detail::kContactsPath, detail::contact_memory_type(), contacts);
-      read_table(file.get(), detail::kDcdPairsPath, detail::dcd_pair_memory_type(), pairs);
+      contacts = read_table(
+          file.get(), detail::kContactsPath, detail::contact_memory_type(), contact_defaults());
+      pairs = read_table(
+          file.get(), detail::kDcdPairsPath, detail::dcd_pair_memory_type(), pair_defaults());
+    }
+    // Events (optional: written at the end of a run, since events exist).
+    EventTables events;
+    events.events = read_table(
+        file.get(),
+        detail::kEventsPath,
+        detail::event_memory_type(),
+        event_defaults(),
+        /*optional=*/true);
+    if (events.events.present) {
+      events.parts = read_table(
+          file.get(),
+          detail::kEventPartsPath,
+          detail::event_part_memory_type(),
+          detail::EventPartDisk{},
+          true);
+      events.bones = read_table(
+          file.get(),
+          detail::kEventBonesPath,
+          detail::event_bone_memory_type(),
+          detail::EventBoneDisk{.event = 0, .bone = nullptr},
+          true);
     }
     if (has_checksums) {
-      std::vector<detail::ChecksumDisk> checksums;
-      read_table(file.get(), detail::kChecksumsPath, detail::checksum_memory_type(), checksums);
-      auto verified = verify_rows(checksums, frames, contacts, pairs, data.frame_checks);
+      detail::ChecksumDisk checksum_defaults{};
+      const auto checksums = read_table(
+          file.get(), detail::kChecksumsPath, detail::checksum_memory_type(), checksum_defaults);
+      auto verified = verify_rows(checksums, frames, contacts, pairs, data.frame_checks, events);
       data.verified = verified.damage.empty();
       if (!verified.damage.empty()) {
-        cut(frames, verified.frames);
-        cut(contacts, verified.contacts);
-        cut(pairs, verified.dcd_pairs);
+        frames.cut(static_cast<std::size_t>(verified.frames));
+        contacts.cut(static_cast<std::size_t>(verified.contacts));
+        pairs.cut(static_cast<std::size_t>(verified.dcd_pairs));
         cut(data.frame_checks, verified.frame_checks);
+        // The events are written last, covered by the last checksum row: past the damage.
+        events.events.present = false;
         data.damage = std::move(verified.damage);
       }
     }
-    data.frames.reserve(frames.size());
-    for (const auto& f : frames) data.frames.push_back(from_disk(f));
+    data.frames.reserve(frames.rows.size());
+    for (const auto& f : frames.rows) data.frames.push_back(from_disk(f));
     if (options.findings) {
-      data.contacts.reserve(contacts.size());
-      for (const auto& c : contacts) {
+      data.contacts.reserve(contacts.rows.size());
+      for (const auto& c : contacts.rows) {
         data.contacts.push_back(ContactRow{
             .frame = c.frame,
             .kind = c.kind == static_cast<std::uint8_t>(culling::CcdContact::Kind::ee)
@@ -457,16 +710,22 @@ LogData read_log(const std::filesystem::path& path, const ReadLogOptions& option
             .b = FeatureId{c.b_part, c.b_index, c.b_side},
             .toi_lower = c.toi_lower,
             .toi_upper = c.toi_upper,
+            .label = c.label,
         });
       }
-      data.dcd_pairs.reserve(pairs.size());
-      for (const auto& p : pairs) {
+      data.dcd_pairs.reserve(pairs.rows.size());
+      for (const auto& p : pairs.rows) {
         data.dcd_pairs.push_back(DcdPairRow{
             .frame = p.frame,
             .a = FeatureId{p.a_part, p.a_index, -1},
             .b = FeatureId{p.b_part, p.b_index, -1},
+            .label = p.label,
         });
       }
+    }
+    if (events.events.present) {
+      data.events = assemble_events(events);
+      data.events_recorded = true;
     }
   } catch (const IoError& e) {
     throw IoError(name + ": " + e.what());

@@ -5,6 +5,7 @@
 #include <string>
 #include <vector>
 
+#include "tools/events.hpp"
 #include "tools/frame_report.hpp"
 #include "tools/log/log_header.hpp"
 
@@ -18,6 +19,13 @@ struct LogData {
   /// /frame_check of a scene log: the check (index into header.checks) of each /frames row, in
   /// file order (empty for other logs).
   std::vector<std::int32_t> frame_checks;
+  /// /events with their parts and bones (docs/events.md), by id. Empty unless events_recorded.
+  std::vector<EventRecord> events;
+  /// True when the log holds its events: written at the end of a run by a skelcd that labels
+  /// findings. False for a log written before events existed (header.baseline empty, findings
+  /// labelled kLabelNone), for a run cut short before its end, and for a damaged log (its events
+  /// come after the damage): `events` then says nothing, not "no events".
+  bool events_recorded = false;
   /// True when the log carries /checksums (logs written since checksums were added) and every
   /// row it covers matched. Rows after the last checksum row (a run killed mid-flush) are read
   /// unverified either way.

@@ -2,6 +2,7 @@
 
 #include <cerrno>
 #include <cstring>
+#include <limits>
 #include <span>
 #include <system_error>
 #include <vector>
@@ -250,6 +251,14 @@ void write_header(hid_t file, const LogHeader& h) {
   write_attribute(file, "planned_rows", h.planned_rows);
   write_attribute(file, "num_vertices", h.num_vertices);
   write_attribute(file, "num_triangles", h.num_triangles);
+  // Events (docs/events.md): present exactly when the findings are labelled.
+  if (!h.baseline.empty()) {
+    write_attribute(file, "baseline", h.baseline);
+    write_attribute(file, "baseline_slack", static_cast<std::int64_t>(h.baseline_slack));
+    if (!h.allow.empty()) write_attribute(file, "allow", h.allow);
+    write_attribute(
+        file, "allow_adjacent_bones", static_cast<std::int64_t>(h.allow_adjacent_bones));
+  }
   write_attribute(file, "complete", static_cast<std::int64_t>(0));
 }
 
@@ -280,6 +289,8 @@ struct LogWriter::Impl {
   std::vector<detail::ContactDisk> contact_rows;
   std::vector<detail::DcdPairDisk> pair_rows;
   std::vector<std::int32_t> pending_checks;  // /frame_check rows since the last checksum row
+  std::int64_t events_rows = 0;              // rows of /events (written once, at the end)
+  bool events_written = false;
   bool finished = false;
 
   /// Flushes the rows appended so far, then records their checksums in /checksums and flushes
@@ -287,11 +298,7 @@ struct LogWriter::Impl {
   /// the two flushes leaves unchecked rows, never a false mismatch.
   void flush_with_checksums(const detail::FrameDisk& frame) {
     flush();
-    detail::ChecksumDisk row{};
-    row.frames_end = static_cast<std::int64_t>(frames.rows);
-    row.contacts_end = static_cast<std::int64_t>(contacts.rows);
-    row.dcd_pairs_end = static_cast<std::int64_t>(dcd_pairs.rows);
-    row.frame_check_end = static_cast<std::int64_t>(frame_checks.rows);
+    detail::ChecksumDisk row = checksum_row();
     row.frames_crc = detail::rows_crc(0, frames.memory_type.get(), &frame, 1, sizeof frame);
     row.contacts_crc = detail::rows_crc(
         0,
@@ -314,10 +321,85 @@ struct LogWriter::Impl {
           sizeof(std::int32_t));
     }
     pending_checks.clear();
+    append_checksum_row(row);
+  }
+
+  /// A checksum row at the tables' current ends, every CRC 0 (no rows since the previous one).
+  detail::ChecksumDisk checksum_row() const {
+    detail::ChecksumDisk row{};
+    row.frames_end = static_cast<std::int64_t>(frames.rows);
+    row.contacts_end = static_cast<std::int64_t>(contacts.rows);
+    row.dcd_pairs_end = static_cast<std::int64_t>(dcd_pairs.rows);
+    row.frame_check_end = static_cast<std::int64_t>(frame_checks.rows);
+    row.events_end = events_rows;
+    return row;
+  }
+
+  void append_checksum_row(detail::ChecksumDisk& row) {
     row.self_crc = detail::checksum_row_crc(row);
     append_rows(
         checksums, std::span<const detail::ChecksumDisk>(&row, 1), detail::kChecksumsPath, where);
     flush();
+  }
+
+  /// /events, /event_parts and /event_bones, written once, then their checksum row.
+  void write_events(const std::vector<EventRecord>& records) {
+    std::vector<detail::EventDisk> events;
+    std::vector<detail::EventPartDisk> parts;
+    std::vector<detail::EventBoneDisk> bones;
+    for (const auto& e : records) {
+      events.push_back(detail::EventDisk{
+          .id = e.id,
+          .first_sample = e.first_sample,
+          .last_sample = e.last_sample,
+          .t_first = e.t_first,
+          .t_last = e.t_last,
+          .t_first_contact = e.t_first_contact.value_or(std::numeric_limits<double>::quiet_NaN()),
+          .peak_pairs = e.peak_pairs,
+          .peak_sample = e.peak_sample,
+          .dcd_pairs = e.dcd_pairs,
+          .ccd_contacts = e.ccd_contacts,
+          .depth = e.depth,
+          .merged_into = e.merged_into,
+      });
+      for (const auto part : e.parts) parts.push_back({e.id, part});
+      // The names stay owned by `records`; HDF5 only reads them.
+      for (const auto& bone : e.bones) bones.push_back({e.id, const_cast<char*>(bone.c_str())});
+    }
+    write_fixed_table(detail::kEventsPath, detail::event_memory_type(), events);
+    write_fixed_table(detail::kEventPartsPath, detail::event_part_memory_type(), parts);
+    write_fixed_table(detail::kEventBonesPath, detail::event_bone_memory_type(), bones);
+    flush();
+    events_rows = static_cast<std::int64_t>(events.size());
+    detail::ChecksumDisk row = checksum_row();
+    row.events_crc = detail::events_crc(events, parts, bones);
+    append_checksum_row(row);
+  }
+
+  /// A table of fixed length (not extendible): written once.
+  template <class Row>
+  void write_fixed_table(
+      const char* name, const H5Handle& memory_type, const std::vector<Row>& rows) {
+    const auto file_type = detail::packed_copy(memory_type.get());
+    const hsize_t count = rows.size();
+    H5Handle space(H5Screate_simple(1, &count, nullptr), H5Sclose);
+    H5Handle dataset(
+        space.valid() ? H5Dcreate2(
+                            file.get(),
+                            name,
+                            file_type.get(),
+                            space.get(),
+                            H5P_DEFAULT,
+                            H5P_DEFAULT,
+                            H5P_DEFAULT)
+                      : H5I_INVALID_HID,
+        H5Dclose);
+    if (!dataset.valid() ||
+        (count > 0 &&
+         H5Dwrite(dataset.get(), memory_type.get(), H5S_ALL, H5S_ALL, H5P_DEFAULT, rows.data()) <
+             0)) {
+      throw IoError(where + ": cannot write /" + name + " (" + detail::take_hdf5_error() + ")");
+    }
   }
 
   /// Appends the report's contacts, DCD pairs and /frames row, then flushes with checksums.
@@ -336,6 +418,7 @@ struct LogWriter::Impl {
           .b_side = c.b.side,
           .toi_lower = c.toi_lower,
           .toi_upper = c.toi_upper,
+          .label = c.label,
       });
     }
     pair_rows.clear();
@@ -346,6 +429,7 @@ struct LogWriter::Impl {
           .a_index = p.a.index,
           .b_part = p.b.part,
           .b_index = p.b.index,
+          .label = p.label,
       });
     }
     append_rows(
@@ -485,6 +569,17 @@ void LogWriter::append(const FrameReport& report, std::int32_t check) {
         impl_->where);
     impl_->pending_checks.push_back(check);
     impl_->write(report);
+  } catch (const IoError& e) {
+    impl_->fail(e.what());
+  }
+}
+
+void LogWriter::write_events(const std::vector<EventRecord>& events) {
+  if (impl_->finished) throw IoError(impl_->where + ": log already finished");
+  if (impl_->events_written) throw IoError(impl_->where + ": events already written");
+  impl_->events_written = true;
+  try {
+    impl_->write_events(events);
   } catch (const IoError& e) {
     impl_->fail(e.what());
   }

@@ -4,7 +4,9 @@
 
 #include <filesystem>
 #include <memory>
+#include <vector>
 
+#include "tools/events.hpp"
 #include "tools/frame_report.hpp"
 #include "tools/log/log_header.hpp"
 
@@ -29,6 +31,12 @@ class LogWriter {
   /// header.checks) in /frame_check, then appends as above.
   /// @throws IoError naming the file when HDF5 fails or the log has no checks.
   void append(const FrameReport& report, std::int32_t check);
+
+  /// Writes the run's events (/events, /event_parts, /event_bones, and their /checksums row), once,
+  /// after the last append and before finish(). A log without them (a run cut short, or written
+  /// before events) reads with LogData::events_recorded false.
+  /// @throws IoError naming the file when HDF5 fails, the log is finished or already has events.
+  void write_events(const std::vector<EventRecord>& events);
 
   /// Sets the root attribute `complete` to 1 and closes the file. Further calls do nothing.
   void finish();

@@ -7,6 +7,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <mutex>
+#include <string>
 #include <vector>
 
 #include "culling/frame_result.hpp"
@@ -120,6 +121,7 @@ H5Handle contact_memory_type() {
   SKELCD_FIELD(type, ContactDisk, b_side, H5T_NATIVE_INT8);
   SKELCD_FIELD(type, ContactDisk, toi_lower, H5T_NATIVE_DOUBLE);
   SKELCD_FIELD(type, ContactDisk, toi_upper, H5T_NATIVE_DOUBLE);
+  SKELCD_FIELD(type, ContactDisk, label, H5T_NATIVE_INT32);
   return type;
 }
 
@@ -130,6 +132,7 @@ H5Handle dcd_pair_memory_type() {
   SKELCD_FIELD(type, DcdPairDisk, a_index, H5T_NATIVE_INT32);
   SKELCD_FIELD(type, DcdPairDisk, b_part, H5T_NATIVE_INT32);
   SKELCD_FIELD(type, DcdPairDisk, b_index, H5T_NATIVE_INT32);
+  SKELCD_FIELD(type, DcdPairDisk, label, H5T_NATIVE_INT32);
   return type;
 }
 
@@ -139,11 +142,45 @@ H5Handle checksum_memory_type() {
   SKELCD_FIELD(type, ChecksumDisk, contacts_end, H5T_NATIVE_INT64);
   SKELCD_FIELD(type, ChecksumDisk, dcd_pairs_end, H5T_NATIVE_INT64);
   SKELCD_FIELD(type, ChecksumDisk, frame_check_end, H5T_NATIVE_INT64);
+  SKELCD_FIELD(type, ChecksumDisk, events_end, H5T_NATIVE_INT64);
   SKELCD_FIELD(type, ChecksumDisk, frames_crc, H5T_NATIVE_UINT32);
   SKELCD_FIELD(type, ChecksumDisk, contacts_crc, H5T_NATIVE_UINT32);
   SKELCD_FIELD(type, ChecksumDisk, dcd_pairs_crc, H5T_NATIVE_UINT32);
   SKELCD_FIELD(type, ChecksumDisk, frame_check_crc, H5T_NATIVE_UINT32);
+  SKELCD_FIELD(type, ChecksumDisk, events_crc, H5T_NATIVE_UINT32);
   SKELCD_FIELD(type, ChecksumDisk, self_crc, H5T_NATIVE_UINT32);
+  return type;
+}
+
+H5Handle event_memory_type() {
+  auto type = compound(sizeof(EventDisk));
+  SKELCD_FIELD(type, EventDisk, id, H5T_NATIVE_INT32);
+  SKELCD_FIELD(type, EventDisk, first_sample, H5T_NATIVE_INT32);
+  SKELCD_FIELD(type, EventDisk, last_sample, H5T_NATIVE_INT32);
+  SKELCD_FIELD(type, EventDisk, t_first, H5T_NATIVE_DOUBLE);
+  SKELCD_FIELD(type, EventDisk, t_last, H5T_NATIVE_DOUBLE);
+  SKELCD_FIELD(type, EventDisk, t_first_contact, H5T_NATIVE_DOUBLE);
+  SKELCD_FIELD(type, EventDisk, peak_pairs, H5T_NATIVE_INT64);
+  SKELCD_FIELD(type, EventDisk, peak_sample, H5T_NATIVE_INT32);
+  SKELCD_FIELD(type, EventDisk, dcd_pairs, H5T_NATIVE_INT64);
+  SKELCD_FIELD(type, EventDisk, ccd_contacts, H5T_NATIVE_INT64);
+  SKELCD_FIELD(type, EventDisk, depth, H5T_NATIVE_DOUBLE);
+  SKELCD_FIELD(type, EventDisk, merged_into, H5T_NATIVE_INT32);
+  return type;
+}
+
+H5Handle event_part_memory_type() {
+  auto type = compound(sizeof(EventPartDisk));
+  SKELCD_FIELD(type, EventPartDisk, event, H5T_NATIVE_INT32);
+  SKELCD_FIELD(type, EventPartDisk, part, H5T_NATIVE_INT32);
+  return type;
+}
+
+H5Handle event_bone_memory_type() {
+  auto type = compound(sizeof(EventBoneDisk));
+  const auto text = vlen_string_type();
+  SKELCD_FIELD(type, EventBoneDisk, event, H5T_NATIVE_INT32);
+  SKELCD_FIELD(type, EventBoneDisk, bone, text.get());
   return type;
 }
 
@@ -177,6 +214,57 @@ std::uint32_t rows_crc(
       value = crc32(value, bytes + r * row_size + offset, static_cast<uInt>(size));
   }
   return static_cast<std::uint32_t>(value);
+}
+
+std::uint32_t bytes_crc(std::uint32_t crc, const void* bytes, std::size_t size) {
+  return static_cast<std::uint32_t>(
+      crc32(crc, static_cast<const unsigned char*>(bytes), static_cast<uInt>(size)));
+}
+
+std::uint32_t events_crc(
+    const std::vector<EventDisk>& events,
+    const std::vector<EventPartDisk>& parts,
+    const std::vector<EventBoneDisk>& bones) {
+  const auto event_type = event_memory_type();
+  const auto part_type = event_part_memory_type();
+  std::uint32_t crc =
+      rows_crc(0, event_type.get(), events.data(), events.size(), sizeof(EventDisk));
+  crc = rows_crc(crc, part_type.get(), parts.data(), parts.size(), sizeof(EventPartDisk));
+  return bone_rows_crc(crc, bones);
+}
+
+std::uint32_t bone_rows_crc(std::uint32_t crc, const std::vector<EventBoneDisk>& bones) {
+  for (const auto& b : bones) {
+    const std::uint32_t v = static_cast<std::uint32_t>(b.event);
+    const unsigned char le[4] = {
+        static_cast<unsigned char>(v),
+        static_cast<unsigned char>(v >> 8),
+        static_cast<unsigned char>(v >> 16),
+        static_cast<unsigned char>(v >> 24)};
+    crc = bytes_crc(crc, le, sizeof le);
+    if (b.bone != nullptr) crc = bytes_crc(crc, b.bone, std::strlen(b.bone));
+  }
+  return crc;
+}
+
+H5Handle common_members(hid_t memory_type, hid_t file_type, std::vector<std::string>* missing) {
+  auto type = compound(H5Tget_size(memory_type));
+  const int members = H5Tget_nmembers(memory_type);
+  for (int m = 0; m < members; ++m) {
+    const auto index = static_cast<unsigned>(m);
+    char* name = H5Tget_member_name(memory_type, index);
+    if (name == nullptr) throw IoError("HDF5: cannot read a member name");
+    const std::string text = name;
+    H5free_memory(name);
+    if (H5Tget_member_index(file_type, text.c_str()) < 0) {
+      clear_hdf5_error();  // an absent name pushes an error
+      if (missing != nullptr) missing->push_back(text);
+      continue;
+    }
+    H5Handle member(H5Tget_member_type(memory_type, index), H5Tclose);
+    insert(type, text.c_str(), H5Tget_member_offset(memory_type, index), member.get());
+  }
+  return type;
 }
 
 std::uint32_t checksum_row_crc(const ChecksumDisk& row) {
@@ -257,6 +345,62 @@ void write_attribute(hid_t location, const char* name, double value) {
 
 void write_attribute(hid_t location, const char* name, std::int64_t value) {
   write_scalar(location, name, H5T_STD_I64LE, H5T_NATIVE_INT64, &value);
+}
+
+void write_attribute(hid_t location, const char* name, const std::vector<std::string>& values) {
+  const auto type = vlen_string_type();
+  const hsize_t count = values.size();
+  H5Handle space(H5Screate_simple(1, &count, nullptr), H5Sclose);
+  std::vector<const char*> pointers;
+  pointers.reserve(values.size());
+  for (const auto& v : values) pointers.push_back(v.c_str());
+  H5Handle attribute(
+      space.valid() ? H5Acreate2(location, name, type.get(), space.get(), H5P_DEFAULT, H5P_DEFAULT)
+                    : H5I_INVALID_HID,
+      H5Aclose);
+  if (!attribute.valid() || H5Awrite(attribute.get(), type.get(), pointers.data()) < 0) {
+    throw IoError(std::string("cannot write attribute '") + name + "' (" + take_hdf5_error() + ")");
+  }
+}
+
+std::optional<std::vector<std::string>> read_string_list_attribute(
+    hid_t location, const char* name) {
+  const htri_t exists = H5Aexists(location, name);
+  if (exists < 0) {
+    throw IoError(
+        std::string("cannot look up attribute '") + name + "' (" + take_hdf5_error() + ")");
+  }
+  if (exists == 0) return std::nullopt;
+  H5Handle attribute(H5Aopen(location, name, H5P_DEFAULT), H5Aclose);
+  H5Handle space(attribute.valid() ? H5Aget_space(attribute.get()) : H5I_INVALID_HID, H5Sclose);
+  H5Handle stored(attribute.valid() ? H5Aget_type(attribute.get()) : H5I_INVALID_HID, H5Tclose);
+  if (!space.valid() || !stored.valid() || H5Tget_class(stored.get()) != H5T_STRING ||
+      H5Sget_simple_extent_ndims(space.get()) > 1) {
+    clear_hdf5_error();
+    throw IoError(std::string("attribute '") + name + "' is not a list of strings");
+  }
+  if (H5Tis_variable_str(stored.get()) <= 0 || H5Sget_simple_extent_ndims(space.get()) == 0) {
+    clear_hdf5_error();
+    // A single (or fixed-length) string: read as one.
+    if (H5Sget_simple_extent_ndims(space.get()) == 0) {
+      return std::vector<std::string>{read_string_attribute(location, name).value_or("")};
+    }
+    throw IoError(std::string("attribute '") + name + "' is not a list of variable-length strings");
+  }
+  const hssize_t count = H5Sget_simple_extent_npoints(space.get());
+  if (count < 0 || count > (1 << 20)) {
+    throw IoError(std::string("attribute '") + name + "' has an unexpected shape");
+  }
+  const auto type = vlen_string_type();
+  std::vector<char*> pointers(static_cast<std::size_t>(count), nullptr);
+  if (count > 0 && H5Aread(attribute.get(), type.get(), pointers.data()) < 0) {
+    throw IoError(std::string("cannot read attribute '") + name + "' (" + take_hdf5_error() + ")");
+  }
+  std::vector<std::string> values;
+  values.reserve(pointers.size());
+  for (const char* p : pointers) values.emplace_back(p != nullptr ? p : "");
+  if (count > 0) H5Dvlen_reclaim(type.get(), space.get(), H5P_DEFAULT, pointers.data());
+  return values;
 }
 
 std::optional<std::string> read_string_attribute(hid_t location, const char* name) {
