@@ -87,8 +87,10 @@ void run_export(const ExportArgs& args) {
   }
   if (!args.highlight.empty()) {
     const auto frame = args.frame.value_or(0);
-    options.face_colors = highlight_face_colors(
+    auto highlight = highlight_frame(
         args.highlight, motion->mesh(), frame, motion->sample_time(frame), motion->name());
+    options.face_colors = std::move(highlight.face_colors);
+    marked = "; " + legend(highlight);
   }
   const auto result = export_mesh(motion->mesh(), positions, args.output, options);
   // Standard output may be carrying the mesh: the summary goes to stderr then.
@@ -116,7 +118,12 @@ void add_export_command(CLI::App& app) {
   cmd->add_option("-o,--output", args->output, "OUT.obj, OUT.ply or OUT.glb; '-' or /dev/stdout for standard output")
       ->required();
   cmd->add_option("--format", args->format, "obj, ply or glb (default: from OUT's extension; obj on standard output)");
-  cmd->add_option("--highlight", args->highlight, "colour the triangles the log LOG.h5 found colliding at --frame")->excludes(time);
+  cmd->add_option(
+         "--highlight",
+         args->highlight,
+         "colour the triangles the log LOG.h5 found colliding at --frame: a colour per collision "
+         "event, slate for the baseline's findings, khaki for allowed ones")
+      ->excludes(time);
   cmd->add_option("--segmentation", args->segmentation, "colour each atomic cluster of the segmentation SEG.h5 (from skelcd preprocess); triangles not positively oriented to their observer in the rest pose are drawn dark")
       ->excludes("--highlight");
   add_model_options(*cmd, args->load);

@@ -1,6 +1,7 @@
 // skelcd inspect LOG.h5… — batch summary of many logs (table, CSV, JSON), the per-frame table of
-// one log, and per-log PNG plots. Files that are not readable skelcd logs are reported by name on
-// stderr and skipped; the command fails only when no file could be read (docs/check.md).
+// one log, the collision events of every log (docs/events.md), and PNG plots. Files that are not
+// readable skelcd logs are reported by name on stderr and skipped; the command fails only when no
+// file could be read (docs/check.md).
 
 #include <algorithm>
 #include <cstdio>
@@ -31,6 +32,7 @@ struct InspectOptions {
   bool csv = false;
   bool json = false;
   bool frames = false;
+  bool events = false;
   std::string plot_dir;
 };
 
@@ -49,7 +51,12 @@ std::string cell_text(const nlohmann::json& v) {
     return text;
   }
   if (v.is_boolean()) return v.get<bool>() ? "yes" : "no";
-  if (v.is_null()) return "";
+  if (v.is_null()) return "–";
+  if (v.is_array()) {  // names: one field, "; " between them
+    std::string text;
+    for (const auto& item : v) text += (text.empty() ? "" : "; ") + cell_text(item);
+    return text;
+  }
   return v.dump();
 }
 
@@ -99,7 +106,7 @@ void print_text(const Table& table) {
                               const std::vector<nlohmann::json>* values) {
     std::string out;
     for (std::size_t c = 0; c < cells.size(); ++c) {
-      const bool number = values != nullptr && (*values)[c].is_number();
+      const bool number = values != nullptr && ((*values)[c].is_number() || (*values)[c].is_null());
       const std::string pad(width[c] - display_width(cells[c]), ' ');
       out += (c == 0 ? "" : "  ") + (number ? pad + cells[c] : cells[c] + pad);
     }
@@ -117,7 +124,9 @@ void print_csv(const Table& table) {
   std::cout << '\n';
   for (const auto& row : table.rows) {
     for (std::size_t c = 0; c < row.size(); ++c) {
-      const std::string text = row[c].is_number_float() ? row[c].dump() : cell_text(row[c]);
+      const std::string text = row[c].is_null()           ? std::string()
+                               : row[c].is_number_float() ? row[c].dump()
+                                                          : cell_text(row[c]);
       std::cout << (c == 0 ? "" : ",") << csv_field(text);
     }
     std::cout << '\n';
@@ -148,13 +157,50 @@ std::string completeness(const LogData& log) {
          " rows)";
 }
 
+/// The labelled findings of a log, summed from its /frames counters.
+struct LabelTotals {
+  std::int64_t new_dcd_pairs = 0, new_ccd_contacts = 0;
+  std::int64_t baseline_dcd_pairs = 0, baseline_ccd_contacts = 0;
+  std::int64_t allowed_dcd_pairs = 0, allowed_ccd_contacts = 0;
+};
+
+LabelTotals label_totals(const LogData& log) {
+  LabelTotals t;
+  for (const auto& r : log.frames) {
+    const auto& c = r.counters;
+    t.new_dcd_pairs += c.new_dcd_pairs;
+    t.new_ccd_contacts += c.new_ccd_contacts;
+    t.baseline_dcd_pairs += c.baseline_dcd_pairs;
+    t.baseline_ccd_contacts += c.baseline_ccd_contacts;
+    t.allowed_dcd_pairs += c.allowed_dcd_pairs;
+    t.allowed_ccd_contacts += c.allowed_ccd_contacts;
+  }
+  return t;
+}
+
 Table summary_table(const std::vector<std::pair<std::string, LogData>>& logs) {
   Table t;
-  t.columns = {"log",       "model",        "clip",        "method",
-               "accuracy",  "query",        "frames",      "intervals",
-               "frames_with_contacts",      "dcd_pairs",   "ccd_contacts",
-               "contacts",  "max_candidate_pairs",         "ms_per_interval",
-               "complete"};
+  t.columns = {
+      "log",
+      "model",
+      "clip",
+      "method",
+      "accuracy",
+      "query",
+      "frames",
+      "intervals",
+      "frames_with_contacts",
+      "dcd_pairs",
+      "ccd_contacts",
+      "contacts",
+      "max_candidate_pairs",
+      "ms_per_interval",
+      "complete",
+      "events",
+      "new_findings",
+      "baseline_findings",
+      "allowed_findings",
+      "baseline"};
   for (const auto& [path, log] : logs) {
     const auto s = summarize(log.frames);
     const auto& h = log.header;
@@ -162,8 +208,210 @@ Table summary_table(const std::vector<std::pair<std::string, LogData>>& logs) {
                       s.intervals, s.frames_with_contacts, s.dcd_pairs, s.ccd_vf + s.ccd_ee,
                       s.dcd_pairs + s.ccd_vf + s.ccd_ee, s.max_candidate_pairs, s.ms_per_interval,
                       completeness(log)});
+    // Labelled logs only: an older log's findings are neither new nor baseline (null, "–").
+    auto& row = t.rows.back();
+    if (h.baseline.empty()) {
+      row.insert(row.end(), {nullptr, nullptr, nullptr, nullptr, ""});
+      continue;
+    }
+    const auto totals = label_totals(log);
+    row.push_back(log.events_recorded ? nlohmann::json(log.events.size()) : nlohmann::json());
+    row.push_back(totals.new_dcd_pairs + totals.new_ccd_contacts);
+    row.push_back(totals.baseline_dcd_pairs + totals.baseline_ccd_contacts);
+    row.push_back(totals.allowed_dcd_pairs + totals.allowed_ccd_contacts);
+    row.push_back(h.baseline);
   }
   return t;
+}
+
+/// Why a log has no events to list ("" when it has them, possibly none).
+std::string missing_events(const LogData& log) {
+  if (log.events_recorded) return "";
+  if (log.header.baseline.empty()) return "no event data (log written before events)";
+  if (!log.damage.empty()) return "no event data (the log is damaged before them)";
+  return "no event data (the run did not finish)";
+}
+
+/// One row per event of every log, every field (--events, --csv, --json): bones and parts as
+/// lists of names, t_first_contact and merged_into null when absent.
+Table events_table(const std::vector<std::pair<std::string, LogData>>& logs) {
+  Table t;
+  t.columns = {
+      "log",
+      "clip",
+      "event",
+      "first_sample",
+      "last_sample",
+      "t_first",
+      "t_last",
+      "t_first_contact",
+      "bones",
+      "parts",
+      "peak_pairs",
+      "peak_sample",
+      "dcd_pairs",
+      "ccd_contacts",
+      "depth",
+      "merged_into"};
+  for (const auto& [path, log] : logs) {
+    for (const auto& e : log.events) {
+      auto parts = nlohmann::json::array();
+      for (const auto p : e.parts) {
+        const auto k = static_cast<std::size_t>(p);
+        parts.push_back(
+            p >= 0 && k < log.header.part_names.size() ? log.header.part_names[k]
+                                                       : "part " + std::to_string(p));
+      }
+      t.rows.push_back(
+          {path,
+           log.header.clip,
+           e.id,
+           e.first_sample,
+           e.last_sample,
+           e.t_first,
+           e.t_last,
+           e.t_first_contact ? nlohmann::json(*e.t_first_contact) : nlohmann::json(),
+           e.bones,
+           parts,
+           e.peak_pairs,
+           e.peak_sample >= 0 ? nlohmann::json(e.peak_sample) : nlohmann::json(),
+           e.dcd_pairs,
+           e.ccd_contacts,
+           e.depth,
+           e.merged_into >= 0 ? nlohmann::json(e.merged_into) : nlohmann::json()});
+    }
+  }
+  return t;
+}
+
+/// "A, B, C +2": the first three names of a list and how many more.
+std::string top_names(const nlohmann::json& names) {
+  std::string text;
+  std::size_t shown = 0;
+  for (const auto& n : names) {
+    if (shown == 3) break;
+    text += (shown++ == 0 ? "" : ", ") + n.get<std::string>();
+  }
+  if (names.size() > shown) text += " +" + std::to_string(names.size() - shown);
+  return text;
+}
+
+std::string number_text(const char* format, double value) {
+  char text[64];
+  std::snprintf(text, sizeof text, format, value);
+  return text;
+}
+
+/// The events for a terminal: event, samples a–b, time range, bones (top 3), parts, peak pairs,
+/// depth, merged into; `with_log` keeps the log and clip columns (several logs).
+Table events_text(const Table& full, bool with_log) {
+  const auto at = [&](const char* name) {
+    return static_cast<std::size_t>(
+        std::find(full.columns.begin(), full.columns.end(), name) - full.columns.begin());
+  };
+  Table t;
+  if (with_log) t.columns = {"log", "clip"};
+  for (const char* c :
+       {"event", "samples", "time_s", "bones", "parts", "peak_pairs", "depth", "merged_into"}) {
+    t.columns.emplace_back(c);
+  }
+  for (const auto& r : full.rows) {
+    auto& row = t.rows.emplace_back();
+    if (with_log) row = {r[at("log")], r[at("clip")]};
+    const auto first = r[at("first_sample")].get<std::int64_t>();
+    const auto last = r[at("last_sample")].get<std::int64_t>();
+    std::string time = number_text("%.3f", r[at("t_first")].get<double>()) + "–" +
+                       number_text("%.3f", r[at("t_last")].get<double>());
+    if (!r[at("t_first_contact")].is_null()) {
+      time += " (contact " + number_text("%.3f", r[at("t_first_contact")].get<double>()) + ")";
+    }
+    std::string peak = std::to_string(r[at("peak_pairs")].get<std::int64_t>());
+    if (!r[at("peak_sample")].is_null()) peak += " @ " + r[at("peak_sample")].dump();
+    row.insert(
+        row.end(),
+        {r[at("event")],
+         first == last ? std::to_string(first) : std::to_string(first) + "–" + std::to_string(last),
+         time,
+         top_names(r[at("bones")]),
+         top_names(r[at("parts")]),
+         peak,
+         number_text("%.4g", r[at("depth")].get<double>()),
+         r[at("merged_into")]});
+  }
+  return t;
+}
+
+/// "Hat:Body, adjacent bones" or "none".
+std::string allowances(const LogHeader& h) {
+  std::string text;
+  for (const auto& rule : h.allow) text += (text.empty() ? "" : ", ") + rule;
+  if (h.allow_adjacent_bones) text += std::string(text.empty() ? "" : ", ") + "adjacent bones";
+  return text.empty() ? "none" : text;
+}
+
+/// The events section of the text output, before the summary (or the per-frame table): `full`
+/// is events_table(logs), sorted as asked.
+void print_events_text(
+    const std::vector<std::pair<std::string, LogData>>& logs, const Table& full) {
+  if (logs.size() == 1) {
+    const auto& log = logs.front().second;
+    const auto& h = log.header;
+    const std::string missing = missing_events(log);
+    if (!missing.empty()) {
+      std::cout << "events: " << missing << '\n';
+    } else if (full.rows.empty()) {
+      std::cout << "events: none\n";
+    } else {
+      std::cout << "events: " << full.rows.size() << '\n';
+      print_text(events_text(full, false));
+    }
+    if (!h.baseline.empty()) {
+      const auto totals = label_totals(log);
+      std::cout << "baseline: " << totals.baseline_dcd_pairs << " DCD pairs, "
+                << totals.baseline_ccd_contacts << " CCD contacts (" << h.baseline << ", slack "
+                << h.baseline_slack << ")\n";
+      std::cout << "allowed: " << totals.allowed_dcd_pairs << " DCD pairs, "
+                << totals.allowed_ccd_contacts << " CCD contacts (" << allowances(h) << ")\n";
+    }
+    return;
+  }
+  std::cout << "events: " << full.rows.size() << " in " << logs.size() << " logs\n";
+  if (!full.rows.empty()) print_text(events_text(full, true));
+  for (const auto& [path, log] : logs) {
+    const std::string missing = missing_events(log);
+    if (!missing.empty()) {
+      std::cout << path << ": " << missing << '\n';
+    } else if (log.events.empty()) {
+      std::cout << path << ": no events\n";
+    }
+  }
+}
+
+/// Lanes of the events timeline: one per log, a bar per event from t_first to t_last.
+std::vector<PlotLane> event_lanes(const std::vector<std::pair<std::string, LogData>>& logs) {
+  // Lanes are named by clip, or by log file when two logs share a clip name.
+  std::map<std::string, int> clips;
+  for (const auto& entry : logs) ++clips[entry.second.header.clip];
+  std::vector<PlotLane> lanes;
+  for (const auto& [path, log] : logs) {
+    auto& lane = lanes.emplace_back();
+    const auto& h = log.header;
+    lane.label = clips[h.clip] > 1 || h.clip.empty()
+                     ? std::filesystem::path(path).stem().string() + " (" + h.clip + ")"
+                     : h.clip;
+    if (!log.events_recorded) {
+      lane.label += " (no event data)";
+      continue;
+    }
+    if (!log.frames.empty()) {
+      lane.span_begin = log.frames.front().t0;
+      lane.span_end = log.frames.back().t1;
+    }
+    for (const auto& e : log.events) {
+      lane.bars.push_back(PlotBar{e.t_first, e.t_last, e.id, std::to_string(e.id)});
+    }
+  }
+  return lanes;
 }
 
 Table frames_table(const LogData& log) {
@@ -207,6 +455,7 @@ std::filesystem::path plot_path(const std::filesystem::path& dir, const std::str
 
 void run_inspect(const InspectOptions& o) {
   if (o.csv && o.json) throw InvalidInput("inspect: --csv and --json exclude each other");
+  if (o.frames && o.events) throw InvalidInput("inspect: --frames and --events exclude each other");
   if (o.frames && o.logs.size() != 1) {
     throw InvalidInput("inspect --frames: give exactly one log (got " +
                        std::to_string(o.logs.size()) + ")");
@@ -236,11 +485,16 @@ void run_inspect(const InspectOptions& o) {
                                            " files is a readable skelcd log");
   }
 
-  Table table = o.frames ? frames_table(logs.front().second) : summary_table(logs);
+  Table events = events_table(logs);
+  Table table = o.frames   ? frames_table(logs.front().second)
+                : o.events ? events
+                           : summary_table(logs);
   sort_table(table, o.sort, o.descending);
+  if (o.events) events = table;
 
-  // Plots, one PNG per log.
+  // Plots, one PNG per log, and the events of every log on one timeline.
   std::vector<std::string> plots(logs.size());
+  std::string timeline;
   if (!o.plot_dir.empty()) {
     const std::filesystem::path dir(o.plot_dir);
     std::error_code ec;
@@ -248,7 +502,12 @@ void run_inspect(const InspectOptions& o) {
     if (ec || !std::filesystem::is_directory(dir)) {
       throw IoError(o.plot_dir + ": cannot create plot folder");
     }
-    std::set<std::string> used;
+    std::set<std::string> used{"events.png"};
+    if (std::any_of(
+            logs.begin(), logs.end(), [](const auto& l) { return l.second.events_recorded; })) {
+      timeline = (dir / "events.png").string();
+      write_events_timeline(timeline, event_lanes(logs), "collision events");
+    }
     for (std::size_t i = 0; i < logs.size(); ++i) {
       const auto& [path, log] = logs[i];
       const auto png = plot_path(dir, path, used);
@@ -259,6 +518,14 @@ void run_inspect(const InspectOptions& o) {
     }
   }
 
+  // --events with --csv/--json: a log that has no events to list is named on stderr.
+  if (o.events && (o.csv || o.json)) {
+    for (const auto& [path, log] : logs) {
+      if (const auto missing = missing_events(log); !missing.empty()) {
+        std::cerr << path << ": " << missing << '\n';
+      }
+    }
+  }
   if (o.json) {
     nlohmann::json out;
     if (o.frames) {
@@ -270,6 +537,7 @@ void run_inspect(const InspectOptions& o) {
         for (std::size_t i = 0; i < logs.size(); ++i) {
           if (entry["log"] == logs[i].first && !plots[i].empty()) entry["plot"] = plots[i];
         }
+        if (!timeline.empty()) entry["events_plot"] = timeline;
       }
     }
     print_json(out);
@@ -277,12 +545,19 @@ void run_inspect(const InspectOptions& o) {
     if (o.csv) {
       print_csv(table);
     } else {
-      print_text(table);
+      // The events first: for one log its table and what its findings were compared with; over
+      // many, every log's events.
+      print_events_text(logs, events);
+      if (!o.events) {
+        std::cout << '\n';
+        print_text(table);
+      }
     }
     for (const auto& p : plots) {
       if (p.empty()) continue;
       (o.csv ? std::cerr : std::cout) << "plot: " << p << '\n';
     }
+    if (!timeline.empty()) (o.csv ? std::cerr : std::cout) << "plot: " << timeline << '\n';
   }
   // The readable logs are summarised above; a script still learns that some were not (as a
   // batch `check` that had failures).
@@ -303,14 +578,24 @@ void run_inspect(const InspectOptions& o) {
 void add_inspect_command(CLI::App& app) {
   auto options = std::make_shared<InspectOptions>();
   auto* cmd = app.add_subcommand(
-      "inspect", "Summarise skelcd logs: one row per log, or per frame of one log; plots");
+      "inspect",
+      "Summarise skelcd logs: their collision events, one row per log (or per event, or per frame "
+      "of one log); plots");
   cmd->add_option("logs", options->logs, "LOG.h5 files written by `skelcd check`")->required();
   cmd->add_option("--sort", options->sort, "sort rows by this column (ascending)");
   cmd->add_flag("--desc", options->descending, "sort descending");
   cmd->add_flag("--csv", options->csv, "print CSV instead of a table");
   cmd->add_flag("--json", options->json, "print JSON instead of a table");
   cmd->add_flag("--frames", options->frames, "per-frame table of one log");
-  cmd->add_option("--plot", options->plot_dir, "write one PNG plot per log into this folder");
+  cmd->add_flag(
+      "--events",
+      options->events,
+      "one row per collision event of every log (with --csv/--json: every field)");
+  cmd->add_option(
+      "--plot",
+      options->plot_dir,
+      "write one PNG plot per log, and the events of every log on a timeline "
+      "(events.png), into this folder");
   cmd->callback([options] { run_inspect(*options); });
 }
 

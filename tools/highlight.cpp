@@ -30,6 +30,25 @@ std::vector<std::int32_t> highlighted_triangles(
     const LogData& log,
     const skinning::Mesh& mesh,
     std::int32_t frame) {
+  std::vector<std::int32_t> out;
+  for (const auto& [f, label] : labelled_triangles(log, mesh, frame)) out.push_back(f);
+  return out;
+}
+
+namespace {
+
+/// Order of precedence of labels on one triangle: events by id, then baseline, allowed, none.
+std::pair<int, std::int32_t> precedence(std::int32_t label) {
+  if (label >= 0) return {0, label};
+  if (label == kLabelBaseline) return {1, 0};
+  if (label == kLabelAllowed) return {2, 0};
+  return {3, 0};
+}
+
+}  // namespace
+
+std::vector<std::pair<std::int32_t, std::int32_t>> labelled_triangles(
+    const LogData& log, const skinning::Mesh& mesh, std::int32_t frame) {
   const auto& h = log.header;
   if (h.num_vertices != mesh.num_vertices() || h.num_triangles != mesh.num_triangles()) {
     throw InvalidInput("the log was written for a mesh of " + std::to_string(h.num_vertices) +
@@ -62,17 +81,21 @@ std::vector<std::int32_t> highlighted_triangles(
     return static_cast<std::size_t>(topology.welded_of_vertex[static_cast<std::size_t>(file_vertex)]);
   };
 
-  std::vector<std::int32_t> out;
+  std::vector<std::pair<std::int32_t, std::int32_t>> out;  // (triangle, label)
+  std::int32_t label = kLabelNone;                         // of the finding being added
+  const auto add = [&](std::int32_t f) { out.emplace_back(f, label); };
   const auto add_around = [&](std::size_t w) {
-    out.insert(out.end(), around[w].begin(), around[w].end());
+    for (const auto f : around[w]) add(f);
   };
   for (const auto& p : log.dcd_pairs) {
     if (p.frame != frame) continue;
-    out.push_back(face_of(p.a));
-    out.push_back(face_of(p.b));
+    label = p.label;
+    add(face_of(p.a));
+    add(face_of(p.b));
   }
   for (const auto& c : log.contacts) {
     if (c.frame != frame) continue;
+    label = c.label;
     if (c.kind == culling::CcdContact::Kind::vf) {
       const auto it = vertices.find({c.a.part, c.a.index});
       if (it == vertices.end()) {
@@ -80,7 +103,7 @@ std::vector<std::int32_t> highlighted_triangles(
                            std::to_string(c.a.part) + ", which this mesh does not have");
       }
       add_around(welded(it->second));
-      out.push_back(face_of(c.b));
+      add(face_of(c.b));
       continue;
     }
     // EE: an edge is side `side` of a triangle; mark the triangles sharing both its ends.
@@ -92,16 +115,73 @@ std::vector<std::int32_t> highlighted_triangles(
       const auto w1 = welded(mesh.triangles(f, (e.side + 1) % 3));
       for (const auto t : around[w0]) {
         const auto& tri = around[w1];
-        if (std::find(tri.begin(), tri.end(), t) != tri.end()) out.push_back(t);
+        if (std::find(tri.begin(), tri.end(), t) != tri.end()) add(t);
       }
     }
   }
-  std::sort(out.begin(), out.end());
-  out.erase(std::unique(out.begin(), out.end()), out.end());
+  // By triangle, the label of highest precedence first; then one entry per triangle.
+  std::sort(out.begin(), out.end(), [](const auto& a, const auto& b) {
+    return a.first != b.first ? a.first < b.first : precedence(a.second) < precedence(b.second);
+  });
+  out.erase(
+      std::unique(
+          out.begin(), out.end(), [](const auto& a, const auto& b) { return a.first == b.first; }),
+      out.end());
   return out;
 }
 
+const PaletteColour& event_palette(std::int32_t event) {
+  const auto n = static_cast<std::int32_t>(kEventPalette.size());
+  return kEventPalette[static_cast<std::size_t>(((event % n) + n) % n)];
+}
+
+std::array<float, 4> label_colour(std::int32_t label) {
+  if (label >= 0) {
+    const auto& c = event_palette(label);
+    return {c.r / 255.0f, c.g / 255.0f, c.b / 255.0f, 1.0f};
+  }
+  if (label == kLabelBaseline) return kBaselineColour;
+  if (label == kLabelAllowed) return kAllowedColour;
+  return kHighlightColour;
+}
+
+std::string legend(const Highlight& highlight) {
+  if (highlight.triangles_per_label.empty()) return "no finding at this frame";
+  std::string text;
+  const auto add = [&](const std::string& item) { text += (text.empty() ? "" : ", ") + item; };
+  const auto count = [](std::int64_t n) {
+    return std::to_string(n) + (n == 1 ? " triangle" : " triangles");
+  };
+  // Events by id, then baseline, allowed, unlabelled.
+  std::vector<std::pair<std::int32_t, std::int64_t>> entries(
+      highlight.triangles_per_label.begin(), highlight.triangles_per_label.end());
+  std::sort(entries.begin(), entries.end(), [](const auto& a, const auto& b) {
+    return precedence(a.first) < precedence(b.first);
+  });
+  for (const auto& [label, n] : entries) {
+    if (label >= 0) {
+      add("event " + std::to_string(label) + " " + event_palette(label).name + ": " + count(n));
+    } else if (label == kLabelBaseline) {
+      add("baseline (slate): " + count(n));
+    } else if (label == kLabelAllowed) {
+      add("allowed (khaki): " + count(n));
+    } else {
+      add(count(n) + " in red");
+    }
+  }
+  return text;
+}
+
 std::vector<std::array<float, 4>> highlight_face_colors(
+    const std::filesystem::path& log_path,
+    const skinning::Mesh& mesh,
+    std::int32_t frame,
+    double frame_time_s,
+    std::string_view clip) {
+  return highlight_frame(log_path, mesh, frame, frame_time_s, clip).face_colors;
+}
+
+Highlight highlight_frame(
     const std::filesystem::path& log_path,
     const skinning::Mesh& mesh,
     std::int32_t frame,
@@ -143,16 +223,22 @@ std::vector<std::array<float, 4>> highlight_face_colors(
     }
     throw InvalidInput(where + message);
   }
-  std::vector<std::int32_t> hits;
+  std::vector<std::pair<std::int32_t, std::int32_t>> hits;
   try {
-    hits = highlighted_triangles(log, mesh, frame);
+    hits = labelled_triangles(log, mesh, frame);
   } catch (const InvalidInput& e) {
     throw InvalidInput(where + e.what());
   }
-  std::vector<std::array<float, 4>> colours(static_cast<std::size_t>(mesh.num_triangles()),
-                                            kPlainColour);
-  for (const auto f : hits) colours[static_cast<std::size_t>(f)] = kHighlightColour;
-  return colours;
+  Highlight out;
+  // A log written before events has no labels: one colour, as it always had.
+  out.labelled = !log.header.baseline.empty();
+  out.face_colors.assign(static_cast<std::size_t>(mesh.num_triangles()), kPlainColour);
+  for (const auto& [f, label] : hits) {
+    const std::int32_t shown = out.labelled ? label : kLabelNone;
+    out.face_colors[static_cast<std::size_t>(f)] = label_colour(shown);
+    ++out.triangles_per_label[shown];
+  }
+  return out;
 }
 
 }  // namespace skelcd::tools

@@ -1,5 +1,6 @@
 // skelcd inspect as a user runs it: several logs with known contents plus files that are not
-// readable logs (truncated, foreign HDF5, plain text), sorting, CSV/JSON, the per-frame table, plots.
+// readable logs (truncated, foreign HDF5, plain text), sorting, CSV/JSON, the per-frame table,
+// plots, and the collision events of labelled logs next to logs written before events.
 
 #include <array>
 #include <cstdlib>
@@ -28,9 +29,23 @@ struct RowSpec {
   double total_us = 1000;
 };
 
+/// What makes a log labelled (docs/events.md): its header and its events. No baseline: a log as
+/// written before events.
+struct EventSpec {
+  std::string baseline;
+  std::vector<EventRecord> events;
+  bool write_events = true;  ///< false: a run cut short before its events
+};
+
 /// Writes a log whose rows have the given findings (with matching /contacts and /dcd_pairs rows).
-void write_log(const std::filesystem::path& path, const std::string& method,
-               const std::vector<RowSpec>& rows, bool finish = true) {
+/// Labelled (events.baseline set): every DCD row's first pair is new (event 0), the second in the
+/// baseline and the rest allowed; every contact is in the baseline.
+void write_log(
+    const std::filesystem::path& path,
+    const std::string& method,
+    const std::vector<RowSpec>& rows,
+    bool finish = true,
+    const EventSpec& events = {}) {
   LogHeader h;
   h.skelcd_version = "test";
   h.input_path = "/models/" + method + "-model.x";
@@ -40,7 +55,14 @@ void write_log(const std::filesystem::path& path, const std::string& method,
   h.query = "both";
   h.fps = 30;
   h.planned_rows = static_cast<std::int64_t>(rows.size()) + (finish ? 0 : 3);
-  h.part_names = {"body"};
+  h.part_names = {"body", "cape"};
+  h.baseline = events.baseline;
+  if (!h.baseline.empty()) {
+    h.baseline_slack = 2;
+    h.allow = {"body:cape"};
+    h.allow_adjacent_bones = true;
+  }
+  const bool labelled = !h.baseline.empty();
   LogWriter writer(path, h);
   for (const auto& spec : rows) {
     FrameReport r;
@@ -54,16 +76,75 @@ void write_log(const std::filesystem::path& path, const std::string& method,
     r.row.counters.candidate_pairs = spec.candidates;
     r.row.total_us = spec.total_us;
     for (int i = 0; i < spec.dcd_pairs; ++i) {
-      r.dcd_pairs.push_back({spec.sample, {0, i, -1}, {0, 100 + i, -1}});
+      const std::int32_t label = !labelled ? kLabelNone
+                                 : i == 0  ? 0
+                                 : i == 1  ? kLabelBaseline
+                                           : kLabelAllowed;
+      r.dcd_pairs.push_back({spec.sample, {0, i, -1}, {0, 100 + i, -1}, label});
+      auto& c = r.row.counters;
+      (label == 0                ? c.new_dcd_pairs
+       : label == kLabelBaseline ? c.baseline_dcd_pairs
+                                 : c.allowed_dcd_pairs) += labelled;
     }
     for (int i = 0; i < spec.vf + spec.ee; ++i) {
       const auto kind = i < spec.vf ? skelcd::culling::CcdContact::Kind::vf
                                     : skelcd::culling::CcdContact::Kind::ee;
-      r.contacts.push_back({spec.sample, kind, {0, i, -1}, {0, 50 + i, -1}, 0.5, 0.5});
+      r.contacts.push_back(
+          {spec.sample,
+           kind,
+           {0, i, -1},
+           {0, 50 + i, -1},
+           0.5,
+           0.5,
+           labelled ? kLabelBaseline : kLabelNone});
+      r.row.counters.baseline_ccd_contacts += labelled;
     }
     writer.append(r);
   }
+  if (labelled && events.write_events) writer.write_events(events.events);
   if (finish) writer.finish();
+}
+
+EventRecord event(
+    std::int32_t id,
+    std::int32_t first,
+    std::int32_t last,
+    std::vector<std::string> bones,
+    std::vector<std::int32_t> parts,
+    double depth) {
+  EventRecord e;
+  e.id = id;
+  e.first_sample = first;
+  e.last_sample = last;
+  e.t_first = first / 30.0;
+  e.t_last = last / 30.0;
+  e.bones = std::move(bones);
+  e.parts = std::move(parts);
+  e.peak_pairs = 1;
+  e.peak_sample = first;
+  e.dcd_pairs = last - first + 1;
+  e.depth = depth;
+  return e;
+}
+
+/// A labelled log of two events: 0 (samples 0–2, five bones, body and cape) and 1 (sample 2,
+/// first contact during the interval before it, merged into 0).
+void write_labelled_log(const std::filesystem::path& path, const std::string& method) {
+  auto e1 = event(1, 2, 2, {"LeftHand"}, {1}, 0.5);
+  e1.t_first_contact = 1.5 / 30.0;
+  e1.merged_into = 0;
+  write_log(
+      path,
+      method,
+      {{QueryKind::dcd, 0, 3, 0, 0, 10},
+       {QueryKind::ccd, 0, 0, 1, 0, 40},
+       {QueryKind::dcd, 1, 1, 0, 0, 12},
+       {QueryKind::ccd, 1, 0, 0, 0, 30},
+       {QueryKind::dcd, 2, 1, 0, 0, 11}},
+      true,
+      {.baseline = "rest pose",
+       .events = {
+           event(0, 0, 2, {"Hips", "Spine", "LeftArm", "RightArm", "Head"}, {0, 1}, 0.0123), e1}});
 }
 
 /// Three logs: bvh (findings in frames 0 and 2), kdop (none), brute (slow, one CCD contact).
@@ -153,13 +234,20 @@ TEST(CmdInspect, TableSortsByAnyColumn) {
   sorted.insert(sorted.end(), {"--sort", "ms_per_interval", "--desc"});
   const auto r = run_skelcd(sorted);
   ASSERT_EQ(r.exit_code, 0) << r.err;
-  ASSERT_EQ(count_lines(r.out), 4u) << r.out;  // header + 3 logs
-  const auto brute = r.out.find("brute.h5");
-  const auto bvh = r.out.find("bvh.h5");
-  const auto kdop = r.out.find("kdop.h5");
+  // The events section (none of these logs has event data), a blank line, then the table.
+  const auto blank = r.out.find("\n\n");
+  ASSERT_NE(blank, std::string::npos) << r.out;
+  const std::string events = r.out.substr(0, blank + 1);
+  const std::string summary = r.out.substr(blank + 2);
+  EXPECT_EQ(events.rfind("events: 0 in 3 logs\n", 0), 0u) << events;
+  EXPECT_NE(events.find("kdop.h5: no event data (log written before events)"), std::string::npos);
+  ASSERT_EQ(count_lines(summary), 4u) << summary;  // header + 3 logs
+  const auto brute = summary.find("brute.h5");
+  const auto bvh = summary.find("bvh.h5");
+  const auto kdop = summary.find("kdop.h5");
   EXPECT_LT(brute, bvh);
   EXPECT_LT(bvh, kdop);
-  EXPECT_EQ(r.out.rfind("log", 0), 0u);  // header first
+  EXPECT_EQ(summary.rfind("log", 0), 0u);  // header first
 
   auto by_method = args;
   by_method.insert(by_method.end(), {"--sort", "method", "--json"});
@@ -240,6 +328,179 @@ TEST(CmdInspect, WritesOnePngPerLog) {
     EXPECT_EQ(be32(20), 900u) << name;
     EXPECT_NE(r.out.find((plots / name).string()), std::string::npos) << r.out;
   }
+}
+
+TEST(CmdInspect, TheEventsOfOneLogComeFirstWithItsBaselineAndAllowances) {
+  const auto dir = skelcd::test::temp_dir("inspect-events-one");
+  write_labelled_log(dir / "walk.h5", "bvh");
+  const auto r = run_skelcd({"inspect", (dir / "walk.h5").string()});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  std::istringstream lines(r.out);
+  std::vector<std::string> line;
+  for (std::string l; std::getline(lines, l);) line.push_back(l);
+  ASSERT_GE(line.size(), 9u) << r.out;
+  EXPECT_EQ(line[0], "events: 2");
+  EXPECT_EQ(line[1].rfind("event  samples  time_s", 0), 0u) << line[1];
+  EXPECT_NE(line[1].find("bones"), std::string::npos);
+  // Event 0: samples 0–2, the first three bones and how many more, both parts.
+  EXPECT_NE(line[2].find("0–2"), std::string::npos) << line[2];
+  EXPECT_NE(line[2].find("0.000–0.067"), std::string::npos) << line[2];
+  EXPECT_NE(line[2].find("Hips, Spine, LeftArm +2"), std::string::npos) << line[2];
+  EXPECT_NE(line[2].find("body, cape"), std::string::npos) << line[2];
+  EXPECT_NE(line[2].find("0.0123"), std::string::npos) << line[2];
+  // Event 1: one sample, its first contact, merged into 0.
+  EXPECT_NE(line[3].find("0.067–0.067 (contact 0.050)"), std::string::npos) << line[3];
+  EXPECT_NE(line[3].find("LeftHand"), std::string::npos) << line[3];
+  EXPECT_EQ(line[3].back(), '0') << line[3];
+  // Rows 0, 1, 2 have 3 + 1 + 1 DCD pairs: 3 new, 1 baseline, 1 allowed; the contact is baseline.
+  EXPECT_EQ(line[4], "baseline: 1 DCD pairs, 1 CCD contacts (rest pose, slack 2)");
+  EXPECT_EQ(line[5], "allowed: 1 DCD pairs, 0 CCD contacts (body:cape, adjacent bones)");
+  EXPECT_EQ(line[6], "");
+  EXPECT_EQ(line[7].rfind("log ", 0), 0u);  // then the summary, as before
+  EXPECT_NE(
+      line[7].find("events  new_findings  baseline_findings  allowed_findings  baseline"),
+      std::string::npos)
+      << line[7];
+
+  const auto j =
+      nlohmann::json::parse(run_skelcd({"inspect", (dir / "walk.h5").string(), "--json"}).out);
+  EXPECT_EQ(j[0]["events"], 2);
+  EXPECT_EQ(j[0]["new_findings"], 3);
+  EXPECT_EQ(j[0]["baseline_findings"], 2);
+  EXPECT_EQ(j[0]["allowed_findings"], 1);
+  EXPECT_EQ(j[0]["baseline"], "rest pose");
+}
+
+TEST(CmdInspect, ALogWrittenBeforeEventsSaysSo) {
+  const auto old =
+      (std::filesystem::path(SKELCD_SOURCE_DIR) / "tests/tools/data/log_before_events.hdf5")
+          .string();
+  const auto r = run_skelcd({"inspect", old});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(r.out.rfind("events: no event data (log written before events)\n\nlog ", 0), 0u)
+      << r.out;
+  EXPECT_EQ(r.out.find("baseline:"), std::string::npos) << r.out;
+  const auto j = nlohmann::json::parse(run_skelcd({"inspect", old, "--json"}).out);
+  EXPECT_TRUE(j[0]["events"].is_null());
+  EXPECT_TRUE(j[0]["new_findings"].is_null());
+  EXPECT_EQ(j[0]["dcd_pairs"], 1);
+  EXPECT_EQ(j[0]["complete"], "yes");
+  const auto events = run_skelcd({"inspect", old, "--events", "--json"});
+  ASSERT_EQ(events.exit_code, 0) << events.err;
+  EXPECT_TRUE(nlohmann::json::parse(events.out).empty());
+  EXPECT_EQ(events.err, old + ": no event data (log written before events)\n");
+  // Its frames table has the columns added since, at 0.
+  const auto frames = nlohmann::json::parse(run_skelcd({"inspect", old, "--frames", "--json"}).out);
+  EXPECT_EQ(frames["rows"][0]["dcd_pairs"], 1);
+  EXPECT_EQ(frames["rows"][0]["new_dcd_pairs"], 0);
+}
+
+TEST(CmdInspect, OneRowPerEventOfEveryLogInCsvAndJson) {
+  const auto dir = skelcd::test::temp_dir("inspect-events-many");
+  write_labelled_log(dir / "a.h5", "bvh");
+  write_labelled_log(dir / "b.h5", "kdop");
+  write_log(dir / "none.h5", "brute", {{QueryKind::dcd, 0, 0}}, true, {.baseline = "sample 0"});
+  write_log(
+      dir / "cut.h5",
+      "brute",
+      {{QueryKind::dcd, 0, 2}},
+      false,
+      {.baseline = "rest pose", .write_events = false});
+  write_log(dir / "old.h5", "brute", {{QueryKind::dcd, 0, 1}});
+  std::vector<std::string> args{"inspect"};
+  for (const char* name : {"a.h5", "none.h5", "b.h5", "cut.h5", "old.h5"}) {
+    args.push_back((dir / name).string());
+  }
+  auto json_args = args;
+  json_args.insert(json_args.end(), {"--events", "--json", "--sort", "depth", "--desc"});
+  const auto r = run_skelcd(json_args);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  ASSERT_EQ(j.size(), 4u);                             // two events in each of a.h5 and b.h5
+  EXPECT_DOUBLE_EQ(j[0]["depth"].get<double>(), 0.5);  // sorted by depth, deepest first
+  EXPECT_EQ(j[0]["event"], 1);
+  EXPECT_EQ(j[0]["clip"], "clip-bvh");
+  EXPECT_EQ(j[0]["log"], (dir / "a.h5").string());
+  EXPECT_EQ(j[0]["merged_into"], 0);
+  EXPECT_DOUBLE_EQ(j[0]["t_first_contact"].get<double>(), 0.05);
+  EXPECT_EQ(j[1]["clip"], "clip-kdop");
+  const auto& e0 = j[2];
+  EXPECT_EQ(e0["event"], 0);
+  EXPECT_EQ(e0["bones"], (nlohmann::json{"Hips", "Spine", "LeftArm", "RightArm", "Head"}));
+  EXPECT_EQ(e0["parts"], (nlohmann::json{"body", "cape"}));
+  EXPECT_TRUE(e0["t_first_contact"].is_null());
+  EXPECT_TRUE(e0["merged_into"].is_null());
+  EXPECT_EQ(e0["first_sample"], 0);
+  EXPECT_EQ(e0["last_sample"], 2);
+  // Logs with nothing to list are named on stderr, each with its reason; a run without events
+  // is not among them.
+  EXPECT_NE(r.err.find("cut.h5: no event data (the run did not finish)"), std::string::npos)
+      << r.err;
+  EXPECT_NE(r.err.find("old.h5: no event data (log written before events)"), std::string::npos);
+  EXPECT_EQ(r.err.find("none.h5"), std::string::npos) << r.err;
+
+  auto csv_args = args;
+  csv_args.insert(csv_args.end(), {"--events", "--csv"});
+  const auto csv = run_skelcd(csv_args);
+  ASSERT_EQ(csv.exit_code, 0) << csv.err;
+  std::istringstream lines(csv.out);
+  std::string header, first;
+  std::getline(lines, header);
+  std::getline(lines, first);
+  EXPECT_EQ(
+      header,
+      "log,clip,event,first_sample,last_sample,t_first,t_last,t_first_contact,bones,parts,"
+      "peak_pairs,peak_sample,dcd_pairs,ccd_contacts,depth,merged_into");
+  EXPECT_NE(first.find(",clip-bvh,0,0,2,0.0,"), std::string::npos) << first;
+  EXPECT_NE(first.find(",Hips; Spine; LeftArm; RightArm; Head,body; cape,"), std::string::npos)
+      << first;
+  EXPECT_EQ(count_lines(csv.out), 5u);
+
+  // The text: every log's events, then the logs without any, then the summary.
+  const auto text = run_skelcd(args);
+  ASSERT_EQ(text.exit_code, 0) << text.err;
+  EXPECT_EQ(text.out.rfind("events: 4 in 5 logs\nlog ", 0), 0u) << text.out;
+  EXPECT_NE(text.out.find("none.h5: no events\n"), std::string::npos) << text.out;
+  EXPECT_NE(text.out.find("cut.h5: no event data (the run did not finish)\n"), std::string::npos);
+  const auto summary = nlohmann::json::parse(
+      run_skelcd({"inspect", (dir / "none.h5").string(), (dir / "cut.h5").string(), "--json"}).out);
+  EXPECT_EQ(summary[0]["events"], 0);
+  EXPECT_TRUE(summary[1]["events"].is_null());  // unknown, not 0
+  EXPECT_EQ(summary[1]["new_findings"], 1);
+}
+
+TEST(CmdInspect, PlotsTheEventsOfEveryLogOnATimeline) {
+  const auto dir = skelcd::test::temp_dir("inspect-events-plot");
+  write_labelled_log(dir / "a.h5", "bvh");
+  write_log(dir / "old.h5", "brute", {{QueryKind::dcd, 0, 1}});
+  const auto plots = dir / "plots";
+  const auto r = run_skelcd(
+      {"inspect",
+       (dir / "a.h5").string(),
+       (dir / "old.h5").string(),
+       "--plot",
+       plots.string(),
+       "--json"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(j[0]["events_plot"], (plots / "events.png").string());
+  EXPECT_EQ(j[1]["plot"], (plots / "old.png").string());
+  const auto size = [](const std::filesystem::path& png) {
+    const std::string bytes = read_text(png);
+    EXPECT_EQ(bytes.substr(0, 8), std::string("\x89PNG\r\n\x1a\n", 8)) << png;
+    const auto be32 = [&](std::size_t at) {
+      unsigned v = 0;
+      for (std::size_t k = 0; k < 4; ++k)
+        v = (v << 8) | static_cast<unsigned char>(bytes.at(at + k));
+      return v;
+    };
+    return std::pair{be32(16), be32(20)};
+  };
+  // The labelled log's page has a fourth panel, its events; the old log's has the three.
+  EXPECT_EQ(size(plots / "a.png"), (std::pair{1000u, 1200u}));
+  EXPECT_EQ(size(plots / "old.png"), (std::pair{1000u, 900u}));
+  // The timeline: one lane per log, at least 300 px.
+  EXPECT_EQ(size(plots / "events.png"), (std::pair{1000u, 300u}));
 }
 
 TEST(CmdInspect, FailsOnlyWhenNoFileIsReadable) {

@@ -1,16 +1,18 @@
 // export --highlight: which triangles are coloured for a frame of a log, worked out by hand on a
-// mesh with a welded seam.
+// mesh with a welded seam; a colour per event in a labelled log, one colour in a log written before
+// events.
+
+#include <gtest/gtest.h>
 
 #include <cstring>
 #include <fstream>
 #include <sstream>
 
-#include <gtest/gtest.h>
-
 #include "skinning/errors.hpp"
 #include "tests/support/test_support.hpp"
 #include "tests/tools/cli_runner.hpp"
 #include "tools/highlight.hpp"
+#include "tools/log/log_reader.hpp"
 #include "tools/log/log_writer.hpp"
 
 namespace {
@@ -150,6 +152,95 @@ TEST(Highlight, FaceColoursFromALogFile) {
       "checked clip 'walk', not 'run'");
 }
 
+TEST(Highlight, ATriangleInSeveralFindingsTakesTheEventBeforeTheBaselineBeforeAllowed) {
+  const auto mesh = seam_mesh();
+  LogData log;
+  log.header.num_vertices = 9;
+  log.header.num_triangles = 3;
+  log.dcd_pairs.push_back({3, {0, 0, -1}, {1, 1, -1}, kLabelBaseline});  // triangles 0, 2
+  log.dcd_pairs.push_back({3, {0, 0, -1}, {1, 0, -1}, kLabelAllowed});   // 0, 1
+  log.dcd_pairs.push_back({3, {1, 0, -1}, {1, 1, -1}, 4});               // 1, 2
+  log.dcd_pairs.push_back({3, {0, 0, -1}, {1, 1, -1}, 2});               // 0, 2
+  using V = std::vector<std::pair<std::int32_t, std::int32_t>>;
+  EXPECT_EQ(labelled_triangles(log, mesh, 3), (V{{0, 2}, {1, 4}, {2, 2}}));
+  log.dcd_pairs.resize(2);
+  EXPECT_EQ(
+      labelled_triangles(log, mesh, 3),
+      (V{{0, kLabelBaseline}, {1, kLabelAllowed}, {2, kLabelBaseline}}));
+  // A CCD contact of the interval [3, 4] carries its label to every triangle it marks.
+  log.contacts.push_back({3, Kind::vf, {1, 3, -1}, {0, 0, -1}, 0.5, 0.5, 0});
+  EXPECT_EQ(labelled_triangles(log, mesh, 3), (V{{0, 0}, {1, 0}, {2, 0}}));
+  EXPECT_EQ(highlighted_triangles(log, mesh, 3), (std::vector<std::int32_t>{0, 1, 2}));
+}
+
+TEST(Highlight, EachEventHasItsColourAndBaselineAndAllowedTheirNeutralOnes) {
+  // Two parts of the seam mesh plus a fourth, far triangle.
+  auto mesh = seam_mesh();
+  mesh.triangles.conservativeResize(5, 3);
+  mesh.triangles.row(3) << 0, 2, 1;
+  mesh.triangles.row(4) << 3, 5, 4;
+  mesh.face_part = {0, 1, 1, 0, 1};
+  mesh.face_index_in_part = {0, 0, 1, 1, 2};
+  const auto path = test::temp_dir("highlight-events") / "run.h5";
+  LogHeader header;
+  header.num_vertices = 9;
+  header.num_triangles = 5;
+  header.clip = "walk";
+  header.baseline = "rest pose";
+  {
+    LogWriter writer(path, header);
+    FrameReport report;
+    report.row.sample = 3;
+    report.row.t0 = report.row.t1 = 0.125;
+    report.dcd_pairs.push_back({3, {0, 0, -1}, {1, 1, -1}, 0});               // 0, 2: event 0
+    report.dcd_pairs.push_back({3, {0, 1, -1}, {1, 2, -1}, 13});              // 3, 4: event 13
+    report.dcd_pairs.push_back({3, {1, 0, -1}, {1, 1, -1}, kLabelBaseline});  // 1 (2 is event 0)
+    writer.append(report);
+    writer.write_events({});
+    writer.finish();
+  }
+  const auto h = highlight_frame(path, mesh, 3, 0.125, "walk");
+  EXPECT_TRUE(h.labelled);
+  ASSERT_EQ(h.face_colors.size(), 5u);
+  EXPECT_EQ(h.face_colors[0], label_colour(0));
+  EXPECT_EQ(h.face_colors[2], label_colour(0));
+  EXPECT_EQ(h.face_colors[3], label_colour(13));
+  EXPECT_EQ(h.face_colors[4], label_colour(13));
+  EXPECT_EQ(h.face_colors[1], kBaselineColour);
+  // The palette: event 0 red, 13 = 1 + 12 the second colour, blue; every event colour differs from
+  // the neutral ones.
+  EXPECT_EQ(label_colour(0), (std::array<float, 4>{228 / 255.0f, 26 / 255.0f, 28 / 255.0f, 1.0f}));
+  EXPECT_EQ(label_colour(13), label_colour(1));
+  EXPECT_EQ(label_colour(kLabelAllowed), kAllowedColour);
+  for (std::int32_t e = 0; e < 12; ++e) {
+    for (const auto& neutral : {kBaselineColour, kAllowedColour, kPlainColour, kHighlightColour}) {
+      EXPECT_NE(label_colour(e), neutral) << e;
+    }
+    for (std::int32_t other = 0; other < e; ++other)
+      EXPECT_NE(label_colour(e), label_colour(other));
+  }
+  EXPECT_EQ(
+      legend(h),
+      "event 0 red: 2 triangles, event 13 blue: 2 triangles, baseline (slate): 1 triangle");
+  EXPECT_EQ(legend(highlight_frame(path, mesh, 3, 0.125, "walk")), legend(h));
+}
+
+TEST(Highlight, ALogWrittenBeforeEventsKeepsOneColour) {
+  // tests/tools/data/log_before_events.hdf5 (the version-1 writer, no labels) for the seam mesh:
+  // at frame 3 a DCD pair (triangles 0 and 2), a VF contact (vertex 4: triangles 1 and 0) and an
+  // EE contact (the diagonal against triangle 0's side 0): every triangle, all in one colour.
+  const auto old =
+      std::filesystem::path(SKELCD_SOURCE_DIR) / "tests/tools/data/log_before_events.hdf5";
+  const auto mesh = seam_mesh();
+  const auto h = highlight_frame(old, mesh, 3, 3 / 8.0, "walk");
+  EXPECT_FALSE(h.labelled);
+  for (const auto& c : h.face_colors) EXPECT_EQ(c, kHighlightColour);
+  EXPECT_EQ(legend(h), "3 triangles in red");
+  const auto quiet = highlight_frame(old, mesh, 4, 4 / 8.0, "walk");
+  for (const auto& c : quiet.face_colors) EXPECT_EQ(c, kPlainColour);
+  EXPECT_EQ(legend(quiet), "no finding at this frame");
+}
+
 TEST(Highlight, ExportColoursTheCollidingTrianglesOfAFrame) {
   // Frames: a large triangle in z = 0 (0), a small one piercing it at frame 2 (1), and a third
   // far away that nothing touches (2). check, then export frame 2 with --highlight to PLY.
@@ -217,6 +308,71 @@ TEST(Highlight, ExportColoursTheCollidingTrianglesOfAFrame) {
   EXPECT_EQ(bad.exit_code, 1);
   EXPECT_NE(bad.err.find("log's rate"), std::string::npos) << bad.err;
   EXPECT_FALSE(std::filesystem::exists(dir / "x.ply"));
+}
+
+TEST(Highlight, ExportNamesTheColoursOfALabelledLog) {
+  // The frames of the test above, checked; the log then rewritten with labels as an events run
+  // writes them: the piercing pair at frame 2 is event 5.
+  const auto dir = test::temp_dir("highlight-export-events");
+  std::filesystem::create_directories(dir / "frames");
+  const char* small[3] = {
+      "1 1 1\nv 2 1 1\nv 1 2 1", "1 1 -1\nv 2 1 -1\nv 1 2 -1", "1 1 -1\nv 1.5 1 1\nv 2 2 1"};
+  for (int i = 0; i < 3; ++i) {
+    std::string name = "f";
+    name += std::to_string(i);
+    name += ".obj";
+    std::ofstream(dir / "frames" / name)
+        << "v 0 0 0\nv 4 0 0\nv 0 4 0\nv " << small[i]
+        << "\nv 10 10 10\nv 11 10 10\nv 10 11 10\nf 1 2 3\nf 4 5 6\nf 7 8 9\n";
+  }
+  const auto plain = (dir / "plain.h5").string();
+  const auto check = test::run_skelcd({"check", (dir / "frames").string(), "-o", plain});
+  ASSERT_EQ(check.exit_code, 0) << check.err;
+  const auto log = read_log(plain);
+  auto header = log.header;
+  header.baseline = "sample 0";
+  header.format_version = kLogFormatVersion;
+  const auto labelled = (dir / "labelled.h5").string();
+  {
+    LogWriter writer(labelled, header);
+    for (const auto& row : log.frames) {
+      FrameReport report;
+      report.row = row;
+      for (auto p : log.dcd_pairs) {
+        if (p.frame != row.sample || row.kind != QueryKind::dcd) continue;
+        p.label = 5;
+        report.dcd_pairs.push_back(p);
+      }
+      writer.append(report);
+    }
+    writer.write_events({});
+    writer.finish();
+  }
+  const auto r = test::run_skelcd(
+      {"export",
+       (dir / "frames").string(),
+       "--frame",
+       "2",
+       "--highlight",
+       labelled,
+       "-o",
+       (dir / "f2.ply").string()});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find("; event 5 brown: 2 triangles\n"), std::string::npos) << r.out;
+  // The same log unlabelled: red, as before events.
+  const auto old = test::run_skelcd(
+      {"export",
+       (dir / "frames").string(),
+       "--frame",
+       "2",
+       "--highlight",
+       plain,
+       "-o",
+       (dir / "f2-plain.ply").string()});
+  ASSERT_EQ(old.exit_code, 0) << old.err;
+  if (log.header.baseline.empty()) {
+    EXPECT_NE(old.out.find("; 2 triangles in red\n"), std::string::npos) << old.out;
+  }
 }
 
 }  // namespace
