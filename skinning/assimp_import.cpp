@@ -48,6 +48,8 @@ constexpr std::size_t kMaxForwardedWarnings = 8;
 constexpr double kAffineRowTolerance = 64.0 * 0x1p-24;
 // Ticks per second assimp's loaders assume when a file does not say (aiAnimation docs).
 constexpr double kDefaultTicksPerSecond = 25.0;
+// A frame rate the file declares above this is ignored (FBX's highest time mode is 1000 fps).
+constexpr double kMaxFileFrameRateHz = 1000.0;
 
 // ---------------------------------------------------------------------------------------------
 // assimp's logger is a process-wide singleton: imports are serialised, and each one listens to
@@ -168,6 +170,8 @@ struct Context {
   std::vector<std::string> clips_with_mesh_channels;
   /// Collada bind shape matrices by geometry id and name (detail/collada_bind_shape.hpp).
   std::map<std::string, Eigen::Affine3d> bind_shapes;
+  /// Frames per second the file declares for its clips (file_frame_rate), 0 when it declares none.
+  double frame_rate_hz = 0.0;
   [[noreturn]] void invalid(const std::string& fault) const { throw InvalidInput(file + ": " + fault); }
 };
 
@@ -217,6 +221,79 @@ double file_unit_scale(const aiScene* scene, Context& ctx) {
     return 1.0;
   }
   return factor / 100.0;  // FBX units are centimetres times UnitScaleFactor
+}
+
+// The frames per second of an FBX time mode (GlobalSettings TimeMode, which assimp's FBX
+// converter hands over as the scene metadata "FrameRate"): the table of assimp 5.2's
+// FBXConverter::FrameRateToDouble, which also sets every aiAnimation::mTicksPerSecond from it.
+// 0 for the default mode (0: no rate chosen, and assimp then counts ticks in seconds) and for
+// modes assimp does not know; `custom` for the custom mode (14, CustomFrameRate).
+double fbx_time_mode_rate(std::int32_t mode, double custom) {
+  switch (mode) {
+    case 1:
+      return 120.0;
+    case 2:
+      return 100.0;
+    case 3:
+      return 60.0;
+    case 4:
+      return 50.0;
+    case 5:
+      return 48.0;
+    case 6:  // 30
+    case 7:  // 30, drop frame
+      return 30.0;
+    case 8:  // NTSC, drop frame
+    case 9:  // NTSC, full frame
+      return 29.9700262;
+    case 10:  // PAL
+      return 25.0;
+    case 11:  // cinema
+      return 24.0;
+    case 12:
+      return 1000.0;
+    case 13:  // cinema NTSC
+      return 23.976;
+    case 14:
+      return custom;
+    default:
+      return 0.0;
+  }
+}
+
+// Frames per second the file declares for its animations, 0 when it declares none. FBX: the time
+// mode (fbx_time_mode_rate). Collada: 3ds Max's <frame_rate> extra (detail::read_collada_extras,
+// read by the caller into `collada_rate`). Every other format assimp reads (glTF, .X, Ogre, …)
+// declares none, or assimp does not hand it over.
+double file_frame_rate(const aiScene* scene, double collada_rate, Context& ctx) {
+  if (scene->mNumAnimations == 0) return 0.0;
+  double rate = collada_rate;
+  std::string what = "Collada <frame_rate>";
+  const aiMetadata* meta = scene->mMetaData;
+  aiString format;
+  if (meta != nullptr && meta->Get("SourceAsset_Format", format) &&
+      lower(format.C_Str()).find("fbx") != std::string::npos) {
+    std::int32_t mode = 0;
+    if (!meta->Get("FrameRate", mode)) return 0.0;
+    float custom = 0.0f;
+    if (!meta->Get("CustomFrameRate", custom)) custom = 0.0f;
+    rate = fbx_time_mode_rate(mode, static_cast<double>(custom));
+    what = "FBX time mode " + std::to_string(mode);
+    if (mode == 14) what += " (custom, CustomFrameRate " + std::to_string(custom) + ")";
+    if (mode == 0) return 0.0;
+    if (rate == 0.0 && mode != 14) {
+      ctx.problems.push_back(what + " is not one assimp knows; the clips' frame rate is not known");
+      return 0.0;
+    }
+  }
+  if (rate == 0.0) return 0.0;
+  if (!std::isfinite(rate) || rate < 0 || rate > kMaxFileFrameRateHz) {
+    ctx.problems.push_back(
+        what + " gives " + std::to_string(rate) + " frames per second, not in (0, " +
+        std::to_string(static_cast<int>(kMaxFileFrameRateHz)) + "]; ignored");
+    return 0.0;
+  }
+  return rate;
 }
 
 // The bind shape of a mesh named after its geometry; assimp appends "_<n>" to the meshes it
@@ -768,6 +845,14 @@ Clip read_clip(
   std::sort(clip.key_times.begin(), clip.key_times.end());
   clip.key_times.erase(
       std::unique(clip.key_times.begin(), clip.key_times.end()), clip.key_times.end());
+  // The frame rate: the file's, else the standard rate its keys lie evenly on, else unknown.
+  if (ctx.frame_rate_hz > 0) {
+    clip.frame_rate_hz = ctx.frame_rate_hz;
+    clip.frame_rate_source = FrameRateSource::file;
+  } else if (const double grid = key_grid_frame_rate(clip.key_times); grid > 0) {
+    clip.frame_rate_hz = grid;
+    clip.frame_rate_source = FrameRateSource::key_grid;
+  }
   return clip;
 }
 
@@ -889,7 +974,13 @@ ImportedRig import_locked(const std::filesystem::path& file, const ImportOptions
   rig.skeleton.root_transform = unit;
 
   Hierarchy h = read_hierarchy(scene, rig.skeleton, ctx);
-  ctx.bind_shapes = detail::collada_bind_shape_matrices(file);
+  auto collada = detail::read_collada_extras(file);
+  ctx.bind_shapes = std::move(collada.bind_shapes);
+  if (!collada.bad_frame_rate.empty() && scene->mNumAnimations > 0) {
+    ctx.problems.push_back(
+        "Collada <frame_rate> '" + collada.bad_frame_rate + "' is not a positive number; ignored");
+  }
+  ctx.frame_rate_hz = file_frame_rate(scene, collada.frame_rate_hz, ctx);
 
   // Meshes in hierarchy order; a mesh instanced by several nodes becomes several parts.
   MeshBuild build;

@@ -538,7 +538,12 @@ LoadedModel load_frame_sequence_model(const fs::path& spec, const LoadOptions& o
   model.kind = ModelKind::frame_sequence;
   model.mesh = std::shared_ptr<const Mesh>(motion, &motion->mesh());
   const double duration = (motion->num_samples() - 1) / kDefaultFrameRateHz;
-  model.clips.push_back({motion->name(), duration, motion->num_samples() > 1 ? kDefaultFrameRateHz : 0.0});
+  model.clips.push_back(
+      {motion->name(),
+       duration,
+       motion->num_samples() > 1 ? kDefaultFrameRateHz : 0.0,
+       kDefaultFrameRateHz,
+       FrameRateSource::frame_sequence});
   model.motion_factory = [motion](const MotionRequest& request) -> std::unique_ptr<Motion> {
     if (!request.clip.empty() && request.clip != motion->name()) {
       throw InvalidInput(motion->frame_file(0).parent_path().string() + ": a frame sequence has one clip, '" +

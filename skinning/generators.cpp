@@ -282,6 +282,8 @@ Clip rotation_clip(
   clip.name = name;
   clip.duration_s = (frames - 1) / kGeneratorFrameRateHz;
   for (int i = 0; i < frames; ++i) clip.key_times.push_back(i / kGeneratorFrameRateHz);
+  clip.frame_rate_hz = kGeneratorFrameRateHz;
+  clip.frame_rate_source = FrameRateSource::generator;
   for (std::size_t k = 0; k < nodes.size(); ++k) {
     const SkeletonNode& node = builder.skeleton().nodes[static_cast<std::size_t>(nodes[k])];
     Channel c;

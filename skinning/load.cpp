@@ -82,7 +82,10 @@ LoadedModel model_from_rig(
   auto shared = std::make_shared<const Rig>(std::move(rig));
   model.rig = shared;
   model.mesh = std::shared_ptr<const Mesh>(shared, &shared->mesh);  // shares the rig's lifetime
-  for (const auto& c : shared->clips) model.clips.push_back({c.name, c.duration_s, c.keys_per_s()});
+  for (const auto& c : shared->clips) {
+    const auto source = c.frame_rate_hz > 0 ? c.frame_rate_source : FrameRateSource::none;
+    model.clips.push_back({c.name, c.duration_s, c.keys_per_s(), c.sample_rate_hz(), source});
+  }
   model.problems = std::move(problems);
   model.refused_clips = std::move(refused_clips);
   model.motion_factory = [shared, clips = model.clips, refused = model.refused_clips](

@@ -39,18 +39,26 @@ struct LoadOptions {
   std::vector<std::filesystem::path> package_path;
 };
 
-/// Name, duration and key rate of one clip (or trajectory, or frame sequence).
+/// Name, duration, key rate and default sampling rate of one clip (or trajectory, or frame
+/// sequence).
 struct ClipSummary {
   std::string name;
   double duration_s = 0.0;
-  double keys_per_s = 0.0;  ///< 0 when the clip has fewer than two keys
+  double keys_per_s = 0.0;  ///< 0 when the clip has fewer than two keys; informative only
+  /// Samples per second of a motion that asks for no rate (MotionRequest::rate_hz == 0): the
+  /// clip's frame rate (Clip::sample_rate_hz), else kDefaultSampleRateHz.
+  double rate_hz = kDefaultSampleRateHz;
+  /// Where rate_hz comes from; FrameRateSource::none: the default.
+  FrameRateSource rate_source = FrameRateSource::none;
 };
 
 /// Which motion to make.
 struct MotionRequest {
   /// Clip name; empty picks the first clip (the bind pose when there is none).
   std::string clip;
-  /// Samples per second; 0 picks the clip's key rate, else 30 Hz.
+  /// Samples per second; 0 picks the clip's frame rate (ClipSummary::rate_hz): the file's, the
+  /// grid of its evenly spaced keys, a trajectory's rows, else 30 Hz. A frame sequence has one
+  /// sample per frame whatever the rate (it only sets their times).
   double rate_hz = 0.0;
 };
 

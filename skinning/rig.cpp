@@ -35,7 +35,85 @@ void check_keys(
   }
 }
 
+// Frame rates of film, video and game animation (FBX SDK time modes, 12 and 15 fps), in Hz.
+constexpr double kStandardFrameRates[] = {
+    12.0,
+    15.0,
+    24000.0 / 1001.0,
+    24.0,
+    25.0,
+    30000.0 / 1001.0,
+    30.0,
+    48.0,
+    50.0,
+    60000.0 / 1001.0,
+    60.0,
+    72.0,
+    96.0,
+    100.0,
+    120000.0 / 1001.0,
+    120.0};
+// Every gap within this of the mean gap (relative): float32 key times (glTF) near t = 100 s are
+// 8e-6 s apart, 1e-3 of a 1/120 s gap; a near-duplicate key or a missing frame is off by 50 % or
+// more.
+constexpr double kGridGapTolerance = 1e-2;
+// The mean gap's rate within this of a standard rate (relative): 23.976 and 24 differ by 1e-3; the
+// mean over the whole span is exact to float32 rounding of its two ends.
+constexpr double kGridRateTolerance = 2e-4;
+
 }  // namespace
+
+const char* to_string(FrameRateSource source) {
+  switch (source) {
+    case FrameRateSource::none:
+      return "default";
+    case FrameRateSource::file:
+      return "file";
+    case FrameRateSource::key_grid:
+      return "key_grid";
+    case FrameRateSource::trajectory_rows:
+      return "trajectory_rows";
+    case FrameRateSource::frame_sequence:
+      return "frame_sequence";
+    case FrameRateSource::generator:
+      return "generator";
+  }
+  return "?";
+}
+
+const char* describe(FrameRateSource source) {
+  switch (source) {
+    case FrameRateSource::none:
+      return "default: no frame rate in the file";
+    case FrameRateSource::file:
+      return "the file's frame rate";
+    case FrameRateSource::key_grid:
+      return "evenly spaced keys at a standard frame rate";
+    case FrameRateSource::trajectory_rows:
+      return "the trajectory's rows per second";
+    case FrameRateSource::frame_sequence:
+      return "one sample per frame";
+    case FrameRateSource::generator:
+      return "the generator's frames";
+  }
+  return "?";
+}
+
+double key_grid_frame_rate(const std::vector<double>& key_times) {
+  const std::size_t n = key_times.size();
+  if (n < 3) return 0.0;
+  const double span = key_times.back() - key_times.front();
+  if (!(span > 0) || !std::isfinite(span)) return 0.0;
+  const double gap = span / static_cast<double>(n - 1);
+  for (std::size_t k = 1; k < n; ++k) {
+    if (!(std::abs(key_times[k] - key_times[k - 1] - gap) <= kGridGapTolerance * gap)) return 0.0;
+  }
+  const double rate = 1.0 / gap;
+  for (const double standard : kStandardFrameRates) {
+    if (std::abs(rate - standard) <= kGridRateTolerance * standard) return standard;
+  }
+  return 0.0;
+}
 
 void validate_rig(const Rig& rig) {
   const auto src = where(rig);
@@ -108,6 +186,10 @@ void validate_rig(const Rig& rig) {
   for (const auto& clip : rig.clips) {
     if (!(clip.duration_s >= 0) || !std::isfinite(clip.duration_s)) {
       throw InvalidInput(src + ": clip '" + clip.name + "' has duration " + std::to_string(clip.duration_s));
+    }
+    if (!(clip.frame_rate_hz >= 0) || !std::isfinite(clip.frame_rate_hz)) {
+      throw InvalidInput(
+          src + ": clip '" + clip.name + "' has frame rate " + std::to_string(clip.frame_rate_hz));
     }
     for (const auto& ch : clip.channels) {
       if (ch.node < 0 || ch.node >= nn) {

@@ -57,15 +57,49 @@ struct Channel {
   std::vector<Eigen::Vector3d> scales;
 };
 
+/// Samples per second of a clip whose frame rate is not known (and of the bind pose) (Hz).
+inline constexpr double kDefaultSampleRateHz = 30.0;
+
+/// Where a clip's frame rate (Clip::frame_rate_hz) comes from.
+enum class FrameRateSource : std::uint8_t {
+  none,             ///< not known: the clip is sampled at kDefaultSampleRateHz
+  file,             ///< the file declares it (FBX time mode, Collada 3ds Max <frame_rate>)
+  key_grid,         ///< the file declares none; its keys are evenly spaced at a standard frame rate
+  trajectory_rows,  ///< a robot's joint trajectory: its rows per second
+  frame_sequence,   ///< a sequence of mesh frames: one sample per frame (times at 30 Hz)
+  generator,        ///< a generated rig: one key per frame
+};
+
+/// "default", "file", "key_grid", "trajectory_rows", "frame_sequence", "generator" (for JSON).
+[[nodiscard]] const char* to_string(FrameRateSource source);
+/// One phrase for people: "the file's frame rate", "default: no frame rate in the file", ….
+[[nodiscard]] const char* describe(FrameRateSource source);
+
+/// The standard frame rate (12, 15, 23.976, 24, 25, 29.97, 30, 48, 50, 59.94, 60, 72, 96, 100,
+/// 119.88, 120) on which `key_times` (sorted, seconds) lie evenly spaced: at least three keys,
+/// every gap within 1 % of the mean gap, and the mean gap's rate within 0.02 % of that
+/// standard rate; 0 otherwise. Near-duplicate keys, sparse keys (two keys 1.25 s apart, keys
+/// every 0.5 s) and keys on a grid with holes give 0.
+[[nodiscard]] double key_grid_frame_rate(const std::vector<double>& key_times);
+
 struct Clip {
   std::string name;
   double duration_s = 0.0;
   std::vector<Channel> channels;
   /// Sorted union of every channel's key times (seconds).
   std::vector<double> key_times;
+  /// Frames per second of the clip as made (see FrameRateSource), 0 when not known. The default
+  /// sampling rate of a check (sample_rate_hz), not the key rate: keys may be sparser or denser.
+  double frame_rate_hz = 0.0;
+  FrameRateSource frame_rate_source = FrameRateSource::none;
+  /// Samples per second when none is asked for: the frame rate, else kDefaultSampleRateHz.
+  [[nodiscard]] double sample_rate_hz() const {
+    return frame_rate_hz > 0 ? frame_rate_hz : kDefaultSampleRateHz;
+  }
   /// Keys per second: (#key_times - 1) / (last key time - first key time), or 0 when it cannot
   /// be told (fewer than two distinct key times). Measured over the keys' own span, so a clip
-  /// whose first key is at 1/24 s still reports 24 keys/s.
+  /// whose first key is at 1/24 s still reports 24 keys/s. Informative only: sampling uses
+  /// sample_rate_hz (near-duplicate keys would double this rate, sparse keys shrink it).
   [[nodiscard]] double keys_per_s() const {
     if (key_times.size() < 2) return 0.0;
     const double span = key_times.back() - key_times.front();
@@ -110,7 +144,7 @@ struct Rig {
 /// non-finite keys or transforms.
 /// Also refused: bone or attachment nodes out of range, a weight row that does not sum to 1
 /// (relative 1e-9: rows are normalised at import), key times not increasing, quaternions that are
-/// not unit (relative 1e-9), negative durations.
+/// not unit (relative 1e-9), negative durations, a frame rate that is negative or not finite.
 void validate_rig(const Rig& rig);
 
 }  // namespace skelcd::skinning

@@ -11,7 +11,10 @@
 namespace skelcd::skinning {
 namespace {
 
-constexpr double kWholeIntervalTolerance = 1e-9;
+// A product duration × rate this close (relative) to an integer is that many intervals: durations
+// read in float32 (glTF seconds, Collada and FBX ticks) are off by up to 6e-8 relative, so 24 Hz
+// times a 3.4166667 s clip is 82.000002, 82 intervals, not 83 with a last one of 1e-7 s.
+constexpr double kWholeIntervalTolerance = 1e-6;
 
 const Rig& checked(const std::shared_ptr<const Rig>& rig) {
   if (!rig) throw InvalidInput("RigMotion: no rig");
@@ -45,8 +48,7 @@ RigMotion::RigMotion(std::shared_ptr<const Rig> rig, const RigMotionOptions& opt
   if (clip_ >= 0) {
     const auto& c = rig_->clips[static_cast<std::size_t>(clip_)];
     duration_s_ = c.duration_s;
-    const double keys = c.keys_per_s();
-    rate_hz_ = options.rate_hz > 0 ? options.rate_hz : (keys > 0 ? keys : kDefaultSampleRateHz);
+    rate_hz_ = options.rate_hz > 0 ? options.rate_hz : c.sample_rate_hz();
     num_samples_ = sample_count(duration_s_, rate_hz_);
   } else {
     rate_hz_ = options.rate_hz > 0 ? options.rate_hz : kDefaultSampleRateHz;
@@ -56,6 +58,7 @@ RigMotion::RigMotion(std::shared_ptr<const Rig> rig, const RigMotionOptions& opt
 
 double RigMotion::sample_time(int i) const {
   assert(i >= 0 && i < num_samples_);
+  if (i == num_samples_ - 1) return duration_s_;  // the last sample is the clip's end
   return std::min(static_cast<double>(i) / rate_hz_, duration_s_);
 }
 

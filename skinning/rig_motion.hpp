@@ -12,21 +12,19 @@
 
 namespace skelcd::skinning {
 
-/// Sample rate used when a clip has no key rate of its own (Hz).
-inline constexpr double kDefaultSampleRateHz = 30.0;
-
 struct RigMotionOptions {
   /// Index into Rig::clips, or -1 for the bind pose alone (one sample at t = 0).
   std::int32_t clip = -1;
-  /// Samples per second; 0 picks the clip's key rate (Clip::keys_per_s), else
-  /// kDefaultSampleRateHz.
+  /// Samples per second; 0 picks the clip's frame rate (Clip::sample_rate_hz: the frame rate
+  /// when known, else kDefaultSampleRateHz), and kDefaultSampleRateHz for the bind pose.
   double rate_hz = 0.0;
 };
 
 /// Number of samples covering [0, duration_s] at `rate_hz`, both ends included: the intervals
 /// are 1/rate long except possibly the last, which ends exactly at duration_s. A product
-/// duration × rate within relative 1e-9 of an integer counts as that integer (key times and
-/// durations come from files in float or as ticks / ticks-per-second).
+/// duration × rate within relative 1e-6 of an integer counts as that integer (key times and
+/// durations come from files in float32 or as ticks / ticks-per-second: a float32 duration is
+/// off by up to 6e-8 relative, which must not add a last interval of a fraction of a microsecond).
 /// @pre duration_s >= 0, rate_hz > 0
 [[nodiscard]] int sample_count(double duration_s, double rate_hz);
 
@@ -38,7 +36,7 @@ class RigMotion final : public Motion {
 
   [[nodiscard]] const Mesh& mesh() const override { return rig_->mesh; }
   [[nodiscard]] int num_samples() const override { return num_samples_; }
-  /// i / rate, the last sample at the clip's duration.
+  /// i / rate; the last sample at the clip's duration exactly.
   [[nodiscard]] double sample_time(int i) const override;
   /// The clip's name, or "bind pose".
   [[nodiscard]] std::string name() const override;

@@ -117,7 +117,7 @@ struct UrdfOptions {
 /// The load_model() entry point for robots (ModelKind::robot): load_urdf with
 /// LoadOptions::package_path and srdf, plus, when LoadOptions::trajectory is given, its clip
 /// (read_joint_trajectory + trajectory_clip, named after the CSV file's stem). Motions sample the
-/// clip at its key rate (the CSV rows when they are evenly spaced) unless asked otherwise.
+/// clip at its rows' rate (every row when they are evenly spaced) unless asked otherwise.
 /// Without a trajectory the robot has no clip and its one motion is the rest pose.
 /// LoadedModel::problems lists links without geometry and the absence of a trajectory.
 /// @throws as load_urdf and read_joint_trajectory.

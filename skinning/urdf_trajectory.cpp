@@ -177,6 +177,12 @@ Clip trajectory_clip(const Robot& robot, const JointTrajectory& trajectory, cons
   const std::size_t rows = trajectory.times.size();
   const double t0 = trajectory.times.front();
   clip.duration_s = trajectory.times.back() - t0;
+  // The rows are the trajectory's frames: sampled at their mean rate, which is every row when
+  // they are evenly spaced (keys added between rows below do not count).
+  if (rows > 1 && clip.duration_s > 0) {
+    clip.frame_rate_hz = static_cast<double>(rows - 1) / clip.duration_s;
+    clip.frame_rate_source = FrameRateSource::trajectory_rows;
+  }
 
   // Which joints move: the listed ones and the mimic joints whose master chain ends at one.
   std::vector<bool> listed(robot.joints.size(), false);

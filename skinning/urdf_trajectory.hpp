@@ -63,6 +63,8 @@ void write_joint_trajectory(
 /// is exactly the rotation by the linearly interpolated angle when the step is below pi, so a
 /// step larger than pi/2 is split into equal sub-steps by extra keys on that channel (also added
 /// to Clip::key_times). Prismatic joints key translations (lerp is exact).
+/// Its frame rate is the rows' (rows - 1) / duration (FrameRateSource::trajectory_rows), so the
+/// default motion samples every row when the rows are evenly spaced; extra keys do not count.
 /// @pre trajectory was read for `robot`.
 [[nodiscard]] Clip trajectory_clip(
     const Robot& robot,

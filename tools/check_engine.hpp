@@ -22,7 +22,7 @@ namespace skelcd::tools {
 /// cores on the command line).
 struct CheckRequest {
   std::string clip;   ///< empty: the model's first clip (its bind pose when it has none)
-  double fps = 0;     ///< samples per second; 0: the clip's key rate, else 30
+  double fps = 0;     ///< samples per second; 0: the clip's frame rate, else 30
   FrameRange frames;  ///< samples first … last
   std::string method = "bvh";
   ccd::Accuracy accuracy = ccd::Accuracy::conservative;

@@ -57,6 +57,11 @@ class Progress {
 CLI::Option* add_rate_option(
     CLI::App& command, const std::string& names, double& rate, const std::string& help);
 
+/// The help of a rate option that samples a clip, saying its default: the clip's frame rate
+/// (skinning::ClipSummary::rate_hz), else 30.
+inline constexpr const char* kClipRateHelp =
+    "samples per second (default: the clip's frame rate, else 30; `skelcd info` shows it)";
+
 /// Throws IoError "<path>: no such file" unless `path` exists.
 void require_exists(const std::filesystem::path& path);
 

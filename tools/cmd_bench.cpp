@@ -311,8 +311,7 @@ void add_bench_command(CLI::App& app) {
          "accuracies, comma-separated (default: exact,conservative,fast)")
       ->delimiter(',');
   cmd->add_option("--clip", args->clip, "clip to run (default: the first)");
-  add_rate_option(
-      *cmd, "--fps", args->fps, "samples per second (default: the clip's key rate, else 30)");
+  add_rate_option(*cmd, "--fps", args->fps, kClipRateHelp);
   cmd->add_option("--frames", args->frames, "samples A:B, both included (A:, :B, A)");
   cmd->add_option("--query", args->query, "ccd, dcd or both")->capture_default_str();
   cmd->add_option(

@@ -38,7 +38,10 @@ void run_info(const InfoArgs& args) {
 
 void add_info_command(CLI::App& app) {
   auto args = std::make_shared<InfoArgs>();
-  auto* cmd = app.add_subcommand("info", "meshes, triangles, vertices, bones, clips, open/closed parts, problems found");
+  auto* cmd = app.add_subcommand(
+      "info",
+      "meshes, triangles, vertices, bones, clips (and the rate a check samples each at), "
+      "open/closed parts, problems found");
   cmd->add_option("model", args->model, "model file (glTF, FBX, Collada, .X, OBJ, PLY, …), URDF, or frames (folder or glob)")
       ->required();
   cmd->add_flag("--json", args->json, "print one JSON object instead of the summary");

@@ -257,7 +257,7 @@ void add_preprocess_command(CLI::App& app) {
   cmd->add_option("--theta", args->theta, "observer test rotation, degrees")->capture_default_str();
   cmd->add_option("--clip", args->clip, "also average |H-| and |Hu| over this clip's intervals");
   add_rate_option(
-      *cmd, "--fps", args->fps, "samples per second for --clip (default: its key rate)");
+      *cmd, "--fps", args->fps, "samples per second for --clip (default: its frame rate, else 30)");
   cmd->add_option("--grid", args->grid, "coarse distance: voxels along the longest side")
       ->capture_default_str();
   cmd->add_flag("--no-refine", args->no_refine, "skip the cluster refinement (RVBC's plain split)");

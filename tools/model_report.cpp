@@ -14,6 +14,28 @@ std::string fixed(double value, int digits) {
   return buffer;
 }
 
+// A rate as people write it: 24, 29.97, 23.976, 0.8.
+std::string rate(double hz) {
+  char buffer[64];
+  std::snprintf(buffer, sizeof buffer, "%.6g", hz);
+  return buffer;
+}
+
+// The phrase of a report's rate_source (skinning::to_string of a FrameRateSource).
+std::string rate_source_phrase(const std::string& source) {
+  using skinning::FrameRateSource;
+  for (const auto s :
+       {FrameRateSource::none,
+        FrameRateSource::file,
+        FrameRateSource::key_grid,
+        FrameRateSource::trajectory_rows,
+        FrameRateSource::frame_sequence,
+        FrameRateSource::generator}) {
+    if (source == skinning::to_string(s)) return skinning::describe(s);
+  }
+  return source;
+}
+
 // "triangle 12 (part 'Head', its triangle 3)": file numbering for the user.
 std::string triangle_label(const skinning::Mesh& mesh, std::int32_t f) {
   const auto part = mesh.face_part[static_cast<std::size_t>(f)];
@@ -36,7 +58,12 @@ nlohmann::json model_report(const skinning::LoadedModel& model, const skinning::
   j["nodes"] = model.rig ? model.rig->skeleton.nodes.size() : 0;
   j["clips"] = nlohmann::json::array();
   for (const auto& c : model.clips) {
-    j["clips"].push_back({{"name", c.name}, {"duration_s", c.duration_s}, {"keys_per_s", c.keys_per_s}});
+    j["clips"].push_back(
+        {{"name", c.name},
+         {"duration_s", c.duration_s},
+         {"keys_per_s", c.keys_per_s},
+         {"rate_hz", c.rate_hz},
+         {"rate_source", skinning::to_string(c.rate_source)}});
   }
 
   // Parts: a part is closed when every component its triangles belong to is closed.
@@ -116,8 +143,10 @@ std::string format_model_report(const nlohmann::json& r) {
   os << "  skeleton: " << r["bones"] << " bones, " << r["nodes"] << " nodes\n";
   os << "  clips:    " << r["clips"].size() << "\n";
   for (const auto& c : r["clips"]) {
-    os << "    " << c["name"].get<std::string>() << "  " << fixed(c["duration_s"].get<double>(), 3) << " s  "
-       << fixed(c["keys_per_s"].get<double>(), 2) << " keys/s\n";
+    os << "    " << c["name"].get<std::string>() << "  " << fixed(c["duration_s"].get<double>(), 3)
+       << " s  " << fixed(c["keys_per_s"].get<double>(), 2) << " keys/s  sampled at "
+       << rate(c["rate_hz"].get<double>()) << " Hz ("
+       << rate_source_phrase(c["rate_source"].get<std::string>()) << ")\n";
   }
   std::size_t closed_parts = 0;
   for (const auto& p : r["parts"]) {

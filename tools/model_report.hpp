@@ -11,7 +11,9 @@ namespace skelcd::tools {
 
 /// The report of `model` whose mesh has topology `topology`:
 /// {file, kind, triangles, vertices, welded_vertices, edges, bones, nodes,
-///  clips: [{name, duration_s, keys_per_s}],
+///  clips: [{name, duration_s, keys_per_s, rate_hz, rate_source}] — rate_hz: what a check samples
+///    at without --fps, rate_source: where it comes from (skinning::to_string(FrameRateSource):
+///    default, file, key_grid, trajectory_rows, frame_sequence, generator),
 ///  parts: [{name, triangles, vertices, closed, components}],
 ///  components, closed_components, boundary_edges, boundary_loops, non_manifold_edges,
 ///  degenerate_triangles, unit_scale, rest_pose_deviation, bounding_box: {min, max},

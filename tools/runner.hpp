@@ -37,7 +37,7 @@ struct FrameRange {
 
 struct RunOptions {
   std::string clip;    ///< clip to check (empty: the model's first clip) — used by the loader
-  double fps = 0;      ///< sampling rate in samples/s (0: the clip's own key rate) — used by the loader
+  double fps = 0;      ///< samples/s (0: the clip's frame rate, else 30) — used by the loader
   FrameRange frames;
   std::string method = "bvh";
   ccd::Accuracy accuracy = ccd::Accuracy::conservative;

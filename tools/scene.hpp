@@ -41,7 +41,7 @@ struct SceneObject {
   std::string attach_to;
   int attach_line = 0;
   std::string clip;    ///< empty: the model's first clip
-  double rate_hz = 0;  ///< 0: the clip's key rate
+  double rate_hz = 0;  ///< 0: the clip's frame rate, else 30 (skinning::ClipSummary::rate_hz)
   /// Trajectory, SRDF and package path of a URDF (resolved).
   skinning::LoadOptions load;
   /// Mesh parts kept (by name); empty: every part.

@@ -159,7 +159,7 @@ def check(model_or_path: Union[Model, str, os.PathLike], clip: Optional[str] = N
 
     model_or_path: a Model from ``load``, or a path loaded with default options.
     clip: clip name (None: the first clip, the bind pose when there is none).
-    fps: samples per second (0: the clip's key rate, else 30).
+    fps: samples per second (0: the clip's frame rate, else 30; ``skelcd info`` shows it).
     frames: samples to check — None (all), K, (A, B) (both included; B None: to the end) or "A:B".
     method: one of ``methods()``; accuracy: conservative, exact or fast; query: dcd, ccd or both.
     min_separation: contact distance in model units. threads: workers (1: serial; 0: all cores);

@@ -497,8 +497,8 @@ PYBIND11_MODULE(_skelcd, m) {
           &num_samples,
           py::arg("clip") = py::none(),
           py::arg("fps") = 0.0,
-          "samples of `clip` (None: the first clip, else the bind pose) at `fps` (0: its key rate, "
-          "else 30)")
+          "samples of `clip` (None: the first clip, else the bind pose) at `fps` (0: its frame "
+          "rate, else 30)")
       .def(
           "sample_times",
           &sample_times,

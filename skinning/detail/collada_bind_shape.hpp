@@ -1,6 +1,8 @@
 #pragma once
-// Internal to skinning/: the Collada <bind_shape_matrix> of each skin, which Debian's assimp 5.2
-// reads but never applies (its skinned vertices stay in the geometry's own frame).
+// Internal to skinning/: what Debian's assimp 5.2 reads from a Collada file but does not hand
+// over — the <bind_shape_matrix> of each skin, which it reads but never applies (its skinned
+// vertices stay in the geometry's own frame), and the frame rate 3ds Max exporters write in an
+// <extra>, which it ignores.
 
 #include <Eigen/Geometry>
 #include <filesystem>
@@ -9,14 +11,27 @@
 
 namespace skelcd::skinning::detail {
 
-/// For a Collada file: the bind shape matrix of every <controller><skin source="#GEOMETRY">,
-/// keyed by the geometry's id and, when it has one, its name (assimp names meshes by one of the
-/// two). Empty for any other file, or when the file has no skin with a non-identity matrix.
-/// The matrix maps the geometry's vertices into the space the skin's inverse bind matrices
-/// expect (COLLADA 1.4.1, skin/bind_shape_matrix: "provides extra information about the position
-/// and orientation of the base mesh before binding").
-/// @throws InvalidInput naming the file and controller for a matrix that is not 16 finite numbers.
-[[nodiscard]] std::map<std::string, Eigen::Affine3d> collada_bind_shape_matrices(
-    const std::filesystem::path& file);
+struct ColladaExtras {
+  /// The bind shape matrix of every <controller><skin source="#GEOMETRY">, keyed by the
+  /// geometry's id and, when it has one, its name (assimp names meshes by one of the two); only
+  /// non-identity matrices. The matrix maps the geometry's vertices into the space the skin's
+  /// inverse bind matrices expect (COLLADA 1.4.1, skin/bind_shape_matrix: "provides extra
+  /// information about the position and orientation of the base mesh before binding").
+  std::map<std::string, Eigen::Affine3d> bind_shapes;
+  /// Frames per second from <visual_scene><extra><technique profile="MAX3D"><frame_rate> (3ds
+  /// Max's exporters: ColladaMax, OpenCOLLADA, Autodesk Collada) of the scene <scene> instances,
+  /// else of the first visual scene that has one; 0 when there is none. COLLADA itself has no
+  /// frame rate (its times are seconds).
+  double frame_rate_hz = 0.0;
+  /// The <frame_rate> as written when it is not a positive finite number (frame_rate_hz is then
+  /// 0); empty otherwise (and for an empty <frame_rate/>).
+  std::string bad_frame_rate;
+};
+
+/// The extras of a Collada file (`.dae`); empty for any other file, or a file TinyXML cannot
+/// parse (assimp then says what is wrong with it).
+/// @throws InvalidInput naming the file and controller for a bind shape matrix that is not 16
+///   finite numbers.
+[[nodiscard]] ColladaExtras read_collada_extras(const std::filesystem::path& file);
 
 }  // namespace skelcd::skinning::detail

@@ -21,7 +21,7 @@ using agreement::same_pairs_subset;
 struct Character {
   std::string file;
   std::string clip;
-  double rate_hz;  // 0: the clip's key rate
+  double rate_hz;  // 0: the clip's frame rate, else 30
   bool exact_too;  // also compare under the (slow, GMP) exact accuracy
 };
 

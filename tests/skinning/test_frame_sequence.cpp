@@ -266,6 +266,8 @@ TEST(FrameSequence, LoadModelEntryPoint) {
   EXPECT_EQ(model.clips[0].name, "frames");
   EXPECT_DOUBLE_EQ(model.clips[0].duration_s, 1.0 / 30.0);
   EXPECT_DOUBLE_EQ(model.clips[0].keys_per_s, 30.0);
+  EXPECT_DOUBLE_EQ(model.clips[0].rate_hz, kDefaultFrameRateHz);
+  EXPECT_EQ(model.clips[0].rate_source, FrameRateSource::frame_sequence);
   const auto motion = model.motion({});
   EXPECT_EQ(motion->num_samples(), 2);
   EXPECT_DOUBLE_EQ(motion->sample_time(1), 1.0 / 30.0);

@@ -139,6 +139,8 @@ TEST(Generators, RigsAreValidAndStartAtRest) {
     EXPECT_EQ(g.rig.source, "gen:" + name + "?triangles=1000&frames=4");
     ASSERT_EQ(g.rig.clips.size(), 1U);
     EXPECT_DOUBLE_EQ(g.rig.clips[0].keys_per_s(), kGeneratorFrameRateHz);
+    EXPECT_EQ(g.rig.clips[0].frame_rate_hz, kGeneratorFrameRateHz);
+    EXPECT_EQ(g.rig.clips[0].frame_rate_source, FrameRateSource::generator);
     EXPECT_NEAR(g.rig.clips[0].duration_s, 3.0 / 30.0, 1e-15);
     // Frame 0 is the rest pose: every joint angle is 0 at tau = 0.
     auto rig = std::make_shared<Rig>(g.rig);

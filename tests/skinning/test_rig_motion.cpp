@@ -1,13 +1,13 @@
 // RigMotion: sample counts and times, default rates, names, and positions at samples.
 
-#include "skinning/rig_motion.hpp"
+#include <gtest/gtest.h>
 
 #include <cmath>
 #include <memory>
-
-#include <gtest/gtest.h>
+#include <vector>
 
 #include "skinning/errors.hpp"
+#include "skinning/rig_motion.hpp"
 #include "tests/skinning/mini_rigs.hpp"
 #include "tests/support/test_support.hpp"
 
@@ -21,20 +21,70 @@ TEST(SampleCount, CoversTheClipWithBothEnds) {
   EXPECT_EQ(sample_count(2.0, 24.0), 49);
   EXPECT_EQ(sample_count(1.0, 2.5), 4);       // 0, 0.4, 0.8, then 1.0 (a shorter last interval)
   EXPECT_EQ(sample_count(0.7083333333333334, 24.0), 18);
+  // Durations read in float32: 3.4166667 s (Fox's Survey) at 24 Hz is 82.000002 intervals.
+  EXPECT_EQ(sample_count(static_cast<double>(3.41666667f), 24.0), 83);
+  EXPECT_EQ(sample_count(static_cast<double>(3.8666667f), 30.0), 117);
+  EXPECT_EQ(sample_count(1.0 + 2e-6, 30.0), 32);  // a real extra 2 µs is still an interval
 }
 
-TEST(RigMotion, DefaultRateIsTheKeyRateAndTimesEndAtTheDuration) {
+TEST(RigMotion, DefaultRateIsTheFrameRateAndTimesEndAtTheDuration) {
   auto rig = test::two_bone_rig();
   rig.clips[0].duration_s = 1.0;
-  rig.clips[0].channels[0].rotation_times = {0.0, 0.25, 0.5, 0.75, 1.0};
-  rig.clips[0].channels[0].rotations.assign(5, Eigen::Quaterniond::Identity());
-  rig.clips[0].key_times = {0.0, 0.25, 0.5, 0.75, 1.0};
+  rig.clips[0].channels[0].rotation_times = {0.0, 0.5, 1.0};
+  rig.clips[0].channels[0].rotations.assign(3, Eigen::Quaterniond::Identity());
+  rig.clips[0].key_times = {0.0, 0.5, 1.0};  // 2 keys/s: not what is sampled
+  rig.clips[0].frame_rate_hz = 4.0;
+  rig.clips[0].frame_rate_source = FrameRateSource::file;
   const RigMotion motion(std::make_shared<const Rig>(rig), RigMotionOptions{.clip = 0});
   EXPECT_DOUBLE_EQ(motion.rate_hz(), 4.0);
   EXPECT_EQ(motion.num_samples(), 5);
   EXPECT_DOUBLE_EQ(motion.sample_time(0), 0.0);
   EXPECT_DOUBLE_EQ(motion.sample_time(4), 1.0);
   EXPECT_EQ(motion.name(), "bend");
+}
+
+TEST(RigMotion, KeysDoNotSetTheRateOfAClipWithoutFrameRate) {
+  // Near-duplicate key pairs (t and t + 5e-8 s, as some FBX exports have) made the key rate twice
+  // the frame rate; sparse keys made it tiny. Without a frame rate the clip is sampled at 30 Hz.
+  for (const std::vector<double>& keys :
+       {std::vector<double>{0.0, 5e-8, 0.5, 0.5 + 5e-8, 1.0}, std::vector<double>{0.0, 1.0}}) {
+    auto rig = test::two_bone_rig();
+    rig.clips[0].duration_s = 1.0;
+    rig.clips[0].channels[0].rotation_times = keys;
+    rig.clips[0].channels[0].rotations.assign(keys.size(), Eigen::Quaterniond::Identity());
+    rig.clips[0].key_times = keys;
+    ASSERT_GT(rig.clips[0].keys_per_s(), 0.0);
+    const RigMotion motion(std::make_shared<const Rig>(rig), RigMotionOptions{.clip = 0});
+    EXPECT_EQ(motion.rate_hz(), kDefaultSampleRateHz);
+    EXPECT_EQ(motion.num_samples(), 31);
+  }
+}
+
+TEST(KeyGridFrameRate, EvenlySpacedKeysAtAStandardRateGiveThatRate) {
+  std::vector<double> at24;
+  for (int k = 1; k <= 48; ++k)
+    at24.push_back(static_cast<double>(static_cast<float>(k / 24.0)));  // float times, as glTF
+  EXPECT_EQ(key_grid_frame_rate(at24), 24.0);
+  std::vector<double> ntsc;
+  for (int k = 0; k < 100; ++k) ntsc.push_back(k * 1001.0 / 30000.0);
+  EXPECT_DOUBLE_EQ(key_grid_frame_rate(ntsc), 30000.0 / 1001.0);
+  EXPECT_EQ(key_grid_frame_rate({0.0, 1.0 / 30, 2.0 / 30}), 30.0);
+}
+
+TEST(KeyGridFrameRate, OtherKeysGiveNone) {
+  EXPECT_EQ(key_grid_frame_rate({}), 0.0);
+  EXPECT_EQ(key_grid_frame_rate({0.0, 1.0 / 24}), 0.0);            // two keys: no evidence
+  EXPECT_EQ(key_grid_frame_rate({0.0, 0.5, 1.0, 1.5, 2.0}), 0.0);  // 2 Hz: keys, not frames
+  EXPECT_EQ(key_grid_frame_rate({0.0, 1.0 / 24, 3.0 / 24, 4.0 / 24}), 0.0);  // a hole in the grid
+  std::vector<double> pairs;  // frames at 30 Hz, each key doubled 5e-8 s later
+  for (int k = 0; k < 30; ++k) {
+    pairs.push_back(k / 30.0);
+    pairs.push_back(k / 30.0 + 5e-8);
+  }
+  EXPECT_EQ(key_grid_frame_rate(pairs), 0.0);
+  std::vector<double> odd;  // evenly spaced at 27 Hz: not a standard frame rate
+  for (int k = 0; k < 27; ++k) odd.push_back(k / 27.0);
+  EXPECT_EQ(key_grid_frame_rate(odd), 0.0);
 }
 
 TEST(RigMotion, RateFallsBackToThirtyHertzAndCanBeChosen) {

@@ -135,6 +135,12 @@ TEST(UrdfTrajectory, LargeStepsAreSplitSoSlerpStaysExact) {
   ASSERT_EQ(clip.key_times.size(), 5U);
   EXPECT_NEAR(clip.key_times[1], 1.0 / 3.0, 1e-15);
   EXPECT_NEAR(clip.key_times[2], 2.0 / 3.0, 1e-15);
+  // The extra keys raise the key rate, not the frame rate: the rows (3 over 2 s) are the frames.
+  EXPECT_DOUBLE_EQ(clip.keys_per_s(), 2.0);
+  EXPECT_DOUBLE_EQ(
+      clip.frame_rate_hz,
+      static_cast<double>(t.num_rows() - 1) / (t.times.back() - t.times.front()));
+  EXPECT_EQ(clip.frame_rate_source, FrameRateSource::trajectory_rows);
   for (const double time : {0.1, 0.5, 0.9, 1.0, 1.4, 2.0}) {
     const double angle = time <= 1.0 ? 3.5 * time : 3.5 - 0.2 * (time - 1.0);
     expect_same_poses(clip_globals(robot, clip, time), forward_kinematics(robot, std::vector<double>{angle}), 1e-12);
@@ -205,6 +211,8 @@ TEST(UrdfTrajectory, LoadModelMotionFollowsForwardKinematics) {
   EXPECT_EQ(model.clips[0].name, "wave");
   EXPECT_NEAR(model.clips[0].duration_s, 0.3, 1e-15);
   EXPECT_NEAR(model.clips[0].keys_per_s, 10.0, 1e-9);
+  EXPECT_NEAR(model.clips[0].rate_hz, 10.0, 1e-9);  // 4 rows over 0.3 s
+  EXPECT_EQ(model.clips[0].rate_source, FrameRateSource::trajectory_rows);
   EXPECT_EQ(model.mesh->excluded_part_pairs.size(), 46U);
   ASSERT_FALSE(model.problems.empty());
   EXPECT_NE(model.problems[0].find("panda_link8, panda_hand_tcp"), std::string::npos);

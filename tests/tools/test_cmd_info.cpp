@@ -3,8 +3,10 @@
 #include <gtest/gtest.h>
 
 #include <cstdint>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <nlohmann/json.hpp>
 #include <string>
 #include <utility>
@@ -113,9 +115,78 @@ TEST(CmdInfo, UrdfRobotReportsItsCollisionGeometryAndTrajectory) {
   EXPECT_EQ(j["clips"][0]["name"], "panda_reach");
   EXPECT_DOUBLE_EQ(j["clips"][0]["duration_s"].get<double>(), duration);
   EXPECT_NEAR(j["clips"][0]["keys_per_s"].get<double>(), (rows - 1) / duration, 1e-9);
+  EXPECT_NEAR(j["clips"][0]["rate_hz"].get<double>(), (rows - 1) / duration, 1e-9);  // every row
+  EXPECT_EQ(j["clips"][0]["rate_source"], "trajectory_rows");
   const std::string problems = j["problems"].dump();
   EXPECT_NE(problems.find("panda_link8"), std::string::npos) << problems;
   EXPECT_NE(problems.find("panda_hand_tcp"), std::string::npos) << problems;
+}
+
+// The 3ds Max <frame_rate> a Collada file carries, read from its text (0 when it has none).
+double collada_frame_rate(const std::filesystem::path& file) {
+  std::ifstream in(file, std::ios::binary);
+  const std::string text{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+  const std::string tag = "<technique profile=\"MAX3D\"><frame_rate>";
+  const auto at = text.find(tag);
+  return at == std::string::npos ? 0.0 : std::stod(text.substr(at + tag.size()));
+}
+
+// The rate `check --json` reports for the first samples of `model` (and `extra` arguments).
+double check_rate(const std::string& model, const std::vector<std::string>& extra = {}) {
+  std::vector<std::string> args = {
+      "check",
+      model,
+      "--frames",
+      "0:1",
+      "--json",
+      "--threads",
+      "1",
+      "-o",
+      (skelcd::test::temp_dir("cmd_info_rate") / "log.h5").string()};
+  args.insert(args.end(), extra.begin(), extra.end());
+  const auto r = run_skelcd(args);
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  return nlohmann::json::parse(r.out)["fps"].get<double>();
+}
+
+std::string rate_text(double hz) {
+  char text[64];
+  std::snprintf(text, sizeof text, "%.6g", hz);
+  return text;
+}
+
+TEST(CmdInfo, EachClipSaysTheRateACheckSamplesItAtAndWhy) {
+  // A Collada file from 3ds Max declares its frame rate; its keys (about 3 s apart) do not set it.
+  const auto dae = assimp_model("Collada/anims_with_full_rotations_between_keys.DAE").string();
+  const double declared = collada_frame_rate(dae);
+  ASSERT_GT(declared, 0.0);
+  const auto j = info_json(dae);
+  ASSERT_FALSE(j["clips"].empty());
+  EXPECT_EQ(j["clips"][0]["rate_hz"].get<double>(), declared);
+  EXPECT_EQ(j["clips"][0]["rate_source"], "file");
+  EXPECT_LT(j["clips"][0]["keys_per_s"].get<double>(), 0.5 * declared);
+  EXPECT_EQ(check_rate(dae), declared);
+  const auto text = run_skelcd({"info", dae});
+  ASSERT_EQ(text.exit_code, 0) << text.err;
+  EXPECT_NE(
+      text.out.find("sampled at " + rate_text(declared) + " Hz (the file's frame rate)"),
+      std::string::npos)
+      << text.out;
+
+  // A glTF declares none, and two keys 1.25 s apart are no frame grid: 30 Hz by default, and
+  // --fps still decides.
+  const auto figure = asset("characters/RiggedFigure.glb").string();
+  const auto g = info_json(figure);
+  ASSERT_EQ(g["clips"].size(), 1u);
+  EXPECT_EQ(g["clips"][0]["rate_hz"].get<double>(), 30.0);
+  EXPECT_EQ(g["clips"][0]["rate_source"], "default");
+  EXPECT_EQ(check_rate(figure), 30.0);
+  EXPECT_EQ(check_rate(figure, {"--fps", "12"}), 12.0);
+  const auto figure_text = run_skelcd({"info", figure});
+  EXPECT_NE(
+      figure_text.out.find("sampled at 30 Hz (default: no frame rate in the file)"),
+      std::string::npos)
+      << figure_text.out;
 }
 
 TEST(CmdInfo, ClosedCharacterAndOpenParts) {
