@@ -34,6 +34,9 @@ __all__ = [
     "FRAME_DTYPE",
     "InvalidInput",
     "IoError",
+    "LABEL_ALLOWED",
+    "LABEL_BASELINE",
+    "LABEL_NONE",
     "Model",
     "check",
     "load",
@@ -56,16 +59,25 @@ FRAME_DTYPE = np.dtype(
     + [("total_us", "<f8")])
 
 #: One row of /contacts: a CCD contact, VF (kind 0: vertex a, triangle b) or EE (kind 1: edges),
-#: features in the file's numbering (part, index within the part, side of an edge or -1).
+#: features in the file's numbering (part, index within the part, side of an edge or -1), and its
+#: label: an event id (>= 0), LABEL_BASELINE, LABEL_ALLOWED or LABEL_NONE (docs/log-format.md).
 CONTACT_DTYPE = np.dtype([
     ("frame", "<i4"), ("kind", "u1"),
     ("a_part", "<i4"), ("a_index", "<i4"), ("a_side", "i1"),
     ("b_part", "<i4"), ("b_index", "<i4"), ("b_side", "i1"),
-    ("toi_lower", "<f8"), ("toi_upper", "<f8")])
+    ("toi_lower", "<f8"), ("toi_upper", "<f8"), ("label", "<i4")])
 
-#: One row of /dcd_pairs: triangles (a_part, a_index) and (b_part, b_index) intersect at `frame`.
+#: One row of /dcd_pairs: triangles (a_part, a_index) and (b_part, b_index) intersect at `frame`;
+#: `label` as in CONTACT_DTYPE.
 DCD_PAIR_DTYPE = np.dtype([
-    ("frame", "<i4"), ("a_part", "<i4"), ("a_index", "<i4"), ("b_part", "<i4"), ("b_index", "<i4")])
+    ("frame", "<i4"), ("a_part", "<i4"), ("a_index", "<i4"), ("b_part", "<i4"), ("b_index", "<i4"),
+    ("label", "<i4")])
+
+#: Labels of findings that belong to no event: the baseline had it, it is between allowed parts or
+#: bones, or the log was written before labels existed (docs/events.md).
+LABEL_BASELINE = -1
+LABEL_ALLOWED = -2
+LABEL_NONE = -3
 
 
 @dataclass
@@ -81,6 +93,11 @@ class CheckResult:
     header: the log's root attributes (``read_log``; None from ``check``).
     verified: the log's rows all matched /checksums (``read_log``; None from ``check``).
     damage: what failed verification, one sentence each (``read_log``).
+    events: the log's collision events (``read_log``), one dict each: id, first_sample,
+        last_sample, t_first, t_last, t_first_contact (None when absent), parts (part ids), bones
+        (names), peak_pairs, peak_sample, dcd_pairs, ccd_contacts, depth, merged_into (-1: none).
+        None when the log holds no event data (written before events, or cut short); [] when the
+        run had no event. None from ``check``.
     """
 
     summary: dict
@@ -91,6 +108,7 @@ class CheckResult:
     header: Optional[dict] = None
     verified: Optional[bool] = None
     damage: list = field(default_factory=list)
+    events: Optional[list] = None
 
 
 def _table(columns: dict, dtype: np.dtype) -> np.ndarray:
@@ -112,6 +130,7 @@ def _result(raw: dict) -> CheckResult:
         header=raw.get("header"),
         verified=raw.get("verified"),
         damage=list(raw.get("damage", [])),
+        events=raw.get("events"),
     )
 
 

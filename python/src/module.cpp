@@ -113,6 +113,7 @@ py::dict contact_columns(const std::vector<tools::ContactRow>& rows) {
   c["b_side"] = column<std::int8_t>(rows, [](const R& r) { return r.b.side; });
   c["toi_lower"] = column<double>(rows, [](const R& r) { return r.toi_lower; });
   c["toi_upper"] = column<double>(rows, [](const R& r) { return r.toi_upper; });
+  c["label"] = column<std::int32_t>(rows, [](const R& r) { return r.label; });
   return c;
 }
 
@@ -125,7 +126,33 @@ py::dict dcd_pair_columns(const std::vector<tools::DcdPairRow>& rows) {
   c["a_index"] = column<std::int32_t>(rows, [](const R& r) { return r.a.index; });
   c["b_part"] = column<std::int32_t>(rows, [](const R& r) { return r.b.part; });
   c["b_index"] = column<std::int32_t>(rows, [](const R& r) { return r.b.index; });
+  c["label"] = column<std::int32_t>(rows, [](const R& r) { return r.label; });
   return c;
+}
+
+/// /events with their parts and bones: one dict per event, keys as the log's columns.
+py::list event_dicts(const std::vector<tools::EventRecord>& events) {
+  py::list out;
+  for (const auto& e : events) {
+    py::dict d;
+    d["id"] = e.id;
+    d["first_sample"] = e.first_sample;
+    d["last_sample"] = e.last_sample;
+    d["t_first"] = e.t_first;
+    d["t_last"] = e.t_last;
+    d["t_first_contact"] =
+        e.t_first_contact ? py::object(py::float_(*e.t_first_contact)) : py::object(py::none());
+    d["parts"] = e.parts;
+    d["bones"] = e.bones;
+    d["peak_pairs"] = e.peak_pairs;
+    d["peak_sample"] = e.peak_sample;
+    d["dcd_pairs"] = e.dcd_pairs;
+    d["ccd_contacts"] = e.ccd_contacts;
+    d["depth"] = e.depth;
+    d["merged_into"] = e.merged_into;
+    out.append(d);
+  }
+  return out;
 }
 
 /// What a run was, for the summary: the fields `skelcd check --json` prints besides the counts.
@@ -233,6 +260,10 @@ py::dict header_dict(const tools::LogHeader& h) {
   d["parts"] = h.part_names;
   d["routes"] = routes;
   d["checks"] = checks;
+  d["baseline"] = h.baseline;
+  d["baseline_slack"] = h.baseline_slack;
+  d["allow"] = h.allow;
+  d["allow_adjacent_bones"] = h.allow_adjacent_bones;
   d["complete"] = h.complete;
   return d;
 }
@@ -449,6 +480,9 @@ py::dict read_log(const std::string& path) {
       column<std::int32_t>(data->frame_checks, [](std::int32_t k) { return k; });
   result["verified"] = data->verified;
   result["damage"] = data->damage;
+  // None, not [], when the log holds no events (written before events, or cut short).
+  result["events"] =
+      data->events_recorded ? py::object(event_dicts(data->events)) : py::object(py::none());
   return result;
 }
 

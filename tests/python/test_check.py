@@ -1,6 +1,7 @@
 """skelcd.check and skelcd.read_log against `skelcd check … -o LOG.h5 --json` on bundled clips:
 the same findings, rows, summary and log."""
 
+import h5py
 import numpy as np
 import pytest
 
@@ -90,3 +91,59 @@ def test_one_sample_is_dcd_only():
     result = skelcd.check("assets/characters/Fox.glb", clip="Walk", frames=4)
     assert list(result.rows["sample"]) == [4] and list(result.rows["kind"]) == [0]
     assert result.summary["intervals"] == 0 and len(result.contacts) == 0
+
+
+def test_read_log_of_a_log_written_before_events():
+    """The version-1 log of the C++ tests: unlabelled findings, no event data (None, not [])."""
+    old = skelcd.read_log("tests/tools/data/log_before_events.hdf5")
+    assert old.verified and old.damage == []
+    assert old.events is None
+    assert old.header["format_version"] == 1 and old.header["baseline"] == ""
+    assert old.header["allow"] == [] and not old.header["allow_adjacent_bones"]
+    assert old.dcd_pairs.dtype == skelcd.DCD_PAIR_DTYPE and len(old.dcd_pairs) == 1
+    assert list(old.dcd_pairs["label"]) == [skelcd.LABEL_NONE]
+    assert list(old.contacts["label"]) == [skelcd.LABEL_NONE] * 2
+    assert list(old.rows["new_dcd_pairs"]) == [0, 0, 0] and old.rows["dcd_pairs"][0] == 1
+
+
+def test_read_log_returns_the_events_and_the_labels(tmp_path):
+    """A labelled log made with h5py (so without /checksums: read unverified): its events as dicts,
+    the labels of its findings, the baseline attributes."""
+    path = tmp_path / "events.h5"
+    text = h5py.string_dtype()
+    with h5py.File(path, "w") as f:
+        f.attrs.update({"format": "skelcd-log", "format_version": 2, "clip": "Walk",
+                        "baseline": "rest pose", "baseline_slack": 2, "allow_adjacent_bones": 1})
+        f.attrs["allow"] = np.array(["body:cape", "Hips:Hips"], dtype=text)
+        f["parts"] = np.array(["body", "cape"], dtype=text)
+        f["frames"] = np.array([(0, 0.0, 0.0, 2, 1)], dtype=[
+            ("sample", "<i4"), ("t0", "<f8"), ("t1", "<f8"), ("dcd_pairs", "<i8"),
+            ("new_dcd_pairs", "<i8")])
+        f["contacts"] = np.zeros(0, dtype=skelcd.CONTACT_DTYPE)
+        f["dcd_pairs"] = np.array([(0, 0, 1, 1, 2, 0), (0, 0, 3, 1, 4, skelcd.LABEL_BASELINE)],
+                                  dtype=skelcd.DCD_PAIR_DTYPE)
+        f["events"] = np.array(
+            [(0, 0, 4, 0.0, 0.125, np.nan, 1, 0, 3, 0, 0.25, -1),
+             (1, 2, 2, 0.0625, 0.0625, 0.05, 0, -1, 0, 2, 0.0, 0)],
+            dtype=[("id", "<i4"), ("first_sample", "<i4"), ("last_sample", "<i4"),
+                   ("t_first", "<f8"), ("t_last", "<f8"), ("t_first_contact", "<f8"),
+                   ("peak_pairs", "<i8"), ("peak_sample", "<i4"), ("dcd_pairs", "<i8"),
+                   ("ccd_contacts", "<i8"), ("depth", "<f8"), ("merged_into", "<i4")])
+        f["event_parts"] = np.array([(0, 0), (0, 1), (1, 1)],
+                                    dtype=[("event", "<i4"), ("part", "<i4")])
+        f["event_bones"] = np.array([(0, "Hips"), (0, "Spine 1"), (1, "Händ")],
+                                    dtype=[("event", "<i4"), ("bone", text)])
+    log = skelcd.read_log(path)
+    assert not log.verified  # no /checksums
+    assert log.header["baseline"] == "rest pose" and log.header["baseline_slack"] == 2
+    assert log.header["allow"] == ["body:cape", "Hips:Hips"] and log.header["allow_adjacent_bones"]
+    assert list(log.dcd_pairs["label"]) == [0, skelcd.LABEL_BASELINE]
+    assert log.rows["new_dcd_pairs"][0] == 1 and log.rows["baseline_dcd_pairs"][0] == 0
+    assert len(log.events) == 2
+    first, second = log.events
+    assert first == {"id": 0, "first_sample": 0, "last_sample": 4, "t_first": 0.0,
+                     "t_last": 0.125, "t_first_contact": None, "parts": [0, 1],
+                     "bones": ["Hips", "Spine 1"], "peak_pairs": 1, "peak_sample": 0,
+                     "dcd_pairs": 3, "ccd_contacts": 0, "depth": 0.25, "merged_into": -1}
+    assert second["t_first_contact"] == 0.05 and second["bones"] == ["Händ"]
+    assert second["parts"] == [1] and second["merged_into"] == 0
