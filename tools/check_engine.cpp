@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <memory>
 
+#include "culling/method.hpp"
 #include "skelcd_version.hpp"
 #include "skinning/errors.hpp"
 #include "skinning/generators.hpp"
@@ -74,6 +75,34 @@ std::string batch_log_name(const std::string& model_arg, const std::string& clip
   return name;
 }
 
+RunIdentity check_identity(
+    const skinning::LoadedModel& model, const CheckRequest& request, const CheckOutcome& outcome) {
+  return RunIdentity{
+      .model = model.path.string(),
+      .clip = outcome.clip,
+      .fps = outcome.fps,
+      .first_sample = outcome.plan.first_sample,
+      .last_sample = outcome.plan.last_sample,
+      .method = request.method,
+      .accuracy = std::string(ccd::to_string(request.accuracy)),
+      .query = std::string(to_string(request.query)),
+      .log = request.log_path,
+  };
+}
+
+RunLabels check_labels(
+    const skinning::LoadedModel& model, const CheckRequest& request, const CheckOutcome& outcome) {
+  return RunLabels{
+      .baseline = outcome.baseline,
+      .baseline_slack = request.baseline_slack,
+      .allow = request.allow.rules,
+      .allow_adjacent_bones = request.allow.adjacent_bones,
+      .events = outcome.events,
+      .events_recorded = true,
+      .part_names = model.mesh->part_names,
+  };
+}
+
 std::vector<std::string> check_method_names() { return scene_method_names(); }
 
 CheckOutcome check_model(
@@ -88,6 +117,33 @@ CheckOutcome check_model(
   outcome.clip = motion->name();
   outcome.fps = motion->rate_hz();
   outcome.method = std::string(runner.method_name());
+
+  // The baseline and the allowances, refused (a bad sample, a log of another model, an unknown
+  // part) before the log is created.
+  const skinning::Mesh& mesh = motion->mesh();
+  const auto positions_at = [&motion](std::int32_t sample, skinning::Positions& out) {
+    motion->positions(sample, out);
+  };
+  const auto dcd = [&](const skinning::Positions& x) {
+    const auto method = culling::make_method("bvh", mesh, runner.topology());
+    skinning::Positions welded;
+    skinning::gather_welded(runner.topology(), x, welded);
+    culling::FrameResult found;
+    method->detect_dcd(welded, found);
+    std::vector<std::pair<std::int32_t, std::int32_t>> pairs;
+    pairs.reserve(found.dcd_pairs.size());
+    for (const auto& p : found.dcd_pairs) pairs.emplace_back(p.a, p.b);
+    return pairs;
+  };
+  const auto baseline =
+      baseline_findings(request.baseline, mesh, motion->num_samples(), positions_at, dcd);
+  outcome.baseline = describe(request.baseline);
+  outcome.baseline_pairs = static_cast<std::int64_t>(baseline.pairs.size());
+  const skinning::Rig* rig = model.rig && model.rig->mesh.num_vertices() == mesh.num_vertices()
+                                 ? model.rig.get()
+                                 : nullptr;
+  EventTracker tracker(
+      mesh, runner.topology(), rig, baseline, request.allow, request.baseline_slack, positions_at);
 
   std::unique_ptr<LogWriter> writer;
   if (!request.log_path.empty()) {
@@ -114,17 +170,30 @@ CheckOutcome check_model(
     header.num_triangles = motion->mesh().num_triangles();
     header.part_names = motion->mesh().part_names;
     header.routes = runner.routes();
+    header.baseline = outcome.baseline;
+    header.baseline_slack = request.baseline_slack;
+    header.allow = request.allow.rules;
+    header.allow_adjacent_bones = request.allow.adjacent_bones;
     writer = std::make_unique<LogWriter>(request.log_path, header);
   }
 
   outcome.rows.reserve(static_cast<std::size_t>(outcome.plan.rows));
   if (request.on_plan) request.on_plan(outcome.plan);
-  runner.run([&](const FrameReport& report) {
-    if (writer) writer->append(report);
-    outcome.rows.push_back(report.row);
-    if (on_row) on_row(report);
-  });
-  if (writer) writer->finish();
+  const auto emit = [&](std::vector<FrameReport> ready) {
+    for (const auto& report : ready) {
+      if (writer) writer->append(report);
+      outcome.rows.push_back(report.row);
+      if (on_row) on_row(report);
+    }
+  };
+  runner.run([&](const FrameReport& report) { emit(tracker.push(report)); });
+  emit(tracker.flush());
+  outcome.events = tracker.events();
+  outcome.totals = tracker.totals();
+  if (writer) {
+    writer->write_events(outcome.events);
+    writer->finish();
+  }
   outcome.summary = summarize(outcome.rows);
   return outcome;
 }

@@ -11,6 +11,7 @@
 
 #include "ccd/accuracy.hpp"
 #include "skinning/load.hpp"
+#include "tools/events.hpp"
 #include "tools/frame_report.hpp"
 #include "tools/radial_view_setup.hpp"
 #include "tools/run_summary.hpp"
@@ -30,6 +31,12 @@ struct CheckRequest {
   double min_separation = 0;        ///< contact distance, model units
   std::int32_t threads = 1;         ///< 0: all cores
   RadialViewArguments radial_view;  ///< γ, seed, segmentation file of rvbc/dynamic/auto
+  /// What findings are compared with (docs/events.md): the rig's rest pose by default.
+  BaselineSpec baseline;
+  /// Rings of triangles a baseline region may slide by and still be the baseline's.
+  std::int32_t baseline_slack = kDefaultBaselineSlack;
+  /// Pairs of parts or bones whose findings are allowed (counted apart).
+  Allowances allow;
   /// Where to write the HDF5 log (docs/log-format.md); empty: no log.
   std::string log_path;
   /// For the log header: the MODEL argument as the user wrote it (empty: the model's path) and
@@ -52,6 +59,10 @@ struct CheckOutcome {
   RadialViewSetup radial_view;
   std::vector<FrameRow> rows;  ///< every row, in order
   RunSummary summary;
+  std::string baseline;             ///< describe(request.baseline)
+  std::int64_t baseline_pairs = 0;  ///< intersecting pairs (and contacts) of the baseline
+  std::vector<EventRecord> events;  ///< the new findings' events, by id
+  EventTotals totals;
 };
 
 /// Checks one clip of `model`: one FrameReport per DCD sample and CCD interval, in order, passed
@@ -63,6 +74,14 @@ struct CheckOutcome {
     const skinning::LoadedModel& model,
     const CheckRequest& request,
     const FrameCallback& on_row = {});
+
+/// The identity fields of the check's summary (summary_json): the model's path, the clip, rate,
+/// samples, method, accuracy, query and the log.
+[[nodiscard]] RunIdentity check_identity(
+    const skinning::LoadedModel& model, const CheckRequest& request, const CheckOutcome& outcome);
+/// The baseline, allowances and events of the check, for summary_json.
+[[nodiscard]] RunLabels check_labels(
+    const skinning::LoadedModel& model, const CheckRequest& request, const CheckOutcome& outcome);
 
 /// `text` as part of a file name: letters, digits, '-', '_' and '.' kept, anything else '_', no
 /// leading dot; "model" when nothing is left.

@@ -19,6 +19,7 @@
 #include <set>
 #include <sstream>
 #include <string>
+#include <tuple>
 #include <vector>
 
 #include "culling/routed_method.hpp"
@@ -56,6 +57,9 @@ struct CheckArguments {
   bool all_clips = false;
   bool json = false;
   std::int32_t threads = 0;
+  std::string baseline = "rest";
+  std::int32_t baseline_slack = kDefaultBaselineSlack;
+  Allowances allow;
   RadialViewArguments radial_view;
   skinning::LoadOptions load;
 };
@@ -121,17 +125,113 @@ RunOptions to_run_options(const CheckArguments& a) {
 std::string describe(const FrameRow& row) {
   std::ostringstream s;
   char time[32];
+  std::snprintf(time, sizeof time, "%.3f", row.t0);
   if (row.kind == QueryKind::dcd) {
-    std::snprintf(time, sizeof time, "%.3f", row.t0);
-    s << "sample " << row.sample << " (t = " << time << " s): " << row.counters.dcd_pairs
-      << " intersecting triangle pairs";
+    s << "sample " << row.sample << " (t = " << time << " s): " << new_dcd_pairs(row)
+      << " new intersecting triangle pairs";
+    if (new_dcd_pairs(row) != row.counters.dcd_pairs) s << " of " << row.counters.dcd_pairs;
   } else {
-    std::snprintf(time, sizeof time, "%.3f", row.t0);
     s << "interval " << row.sample << "-" << row.sample + 1 << " (t = " << time
-      << " s): " << row.counters.vf_contacts << " VF + " << row.counters.ee_contacts
-      << " EE contacts";
+      << " s): " << new_ccd_contacts(row) << " new contacts";
+    s << " of " << row.counters.vf_contacts << " VF + " << row.counters.ee_contacts << " EE";
   }
   return s.str();
+}
+
+/// "a, b, c +2": as many names as fit in `width` characters, then how many more.
+std::string name_list(const std::vector<std::string>& names, std::size_t width) {
+  std::string text;
+  std::size_t shown = 0;
+  for (; shown < names.size(); ++shown) {
+    const std::string more = " +" + std::to_string(names.size() - shown - 1);
+    const std::size_t extra =
+        (shown > 0 ? 2 : 0) + names[shown].size() + (shown + 1 < names.size() ? more.size() : 0);
+    if (shown > 0 && text.size() + extra > width) break;
+    if (shown > 0) text += ", ";
+    text += names[shown];
+  }
+  if (shown < names.size()) text += " +" + std::to_string(names.size() - shown);
+  return text.empty() ? std::string("-") : text;
+}
+
+std::vector<std::string> part_list(const skinning::Mesh& mesh, const EventRecord& e) {
+  std::vector<std::string> parts;
+  for (const auto p : e.parts) parts.push_back(mesh.part_names[static_cast<std::size_t>(p)]);
+  return parts;
+}
+
+/// Most events the text summary lists; the log and --json have every one.
+constexpr std::size_t kEventsShown = 20;
+
+/// The events table, then the baseline's and the allowed counts: what the clip causes first.
+/// With more than kEventsShown events, the largest (peak pairs, then contacts) are listed.
+void print_events(
+    std::ostream& out,
+    const skinning::Mesh& mesh,
+    const CheckOutcome& o,
+    const RunOptions& options) {
+  const auto& s = o.summary;
+  char line[512];
+  auto roots = root_events(o.events);
+  out << "events    " << roots.size() << " new collision event" << (roots.size() == 1 ? "" : "s")
+      << " against the baseline (" << o.baseline << "): " << s.new_dcd_pairs << " new DCD pairs, "
+      << s.new_ccd_contacts << " new CCD contacts\n";
+  const std::size_t total = roots.size();
+  if (roots.size() > kEventsShown) {
+    std::stable_sort(roots.begin(), roots.end(), [](const EventRecord* a, const EventRecord* b) {
+      return std::tie(a->peak_pairs, a->ccd_contacts) > std::tie(b->peak_pairs, b->ccd_contacts);
+    });
+    roots.resize(kEventsShown);
+    std::sort(roots.begin(), roots.end(), [](const EventRecord* a, const EventRecord* b) {
+      return a->id < b->id;
+    });
+  }
+  if (!roots.empty()) {
+    std::snprintf(
+        line,
+        sizeof line,
+        "  %4s  %-9s  %-13s  %-8s  %-34s  %-20s  %5s  %8s\n",
+        "#",
+        "samples",
+        "time (s)",
+        "contact",
+        "bones",
+        "parts",
+        "peak",
+        "depth");
+    out << line;
+  }
+  for (const auto* e : roots) {
+    const std::string samples =
+        std::to_string(e->first_sample) + "-" + std::to_string(e->last_sample);
+    char times[64];
+    std::snprintf(times, sizeof times, "%.3f-%.3f", e->t_first, e->t_last);
+    char contact[32] = "-";
+    if (e->t_first_contact) std::snprintf(contact, sizeof contact, "%.4f", *e->t_first_contact);
+    std::snprintf(
+        line,
+        sizeof line,
+        "  %4d  %-9s  %-13s  %-8s  %-34s  %-20s  %5lld  %8.3g\n",
+        e->id,
+        samples.c_str(),
+        times,
+        contact,
+        name_list(e->bones, 34).c_str(),
+        name_list(part_list(mesh, *e), 20).c_str(),
+        static_cast<long long>(e->peak_pairs),
+        e->depth);
+    out << line;
+  }
+  if (total > roots.size()) {
+    out << "  … " << total - roots.size()
+        << " smaller events not listed (--json and the log have all: skelcd inspect LOG)\n";
+  }
+  out << "baseline  " << o.baseline << ": " << s.baseline_dcd_pairs << " DCD pairs";
+  if (options.query != QuerySet::dcd) out << ", " << s.baseline_ccd_contacts << " CCD contacts";
+  out << " the rig already had (" << o.baseline_pairs << " pairs at the baseline)\n";
+  out << "allowed   " << s.allowed_dcd_pairs << " DCD pairs";
+  if (options.query != QuerySet::dcd) out << ", " << s.allowed_ccd_contacts << " CCD contacts";
+  out << '\n';
 }
 
 void print_text_summary(std::ostream& out, const skinning::LoadedModel& model,
@@ -150,12 +250,13 @@ void print_text_summary(std::ostream& out, const skinning::LoadedModel& model,
   out << "frames    " << s.samples << " samples, " << s.intervals << " intervals\n";
   if (options.query != QuerySet::ccd) {
     out << "DCD       " << s.frames_with_interpenetration << " of " << s.samples
-              << " samples interpenetrate; " << s.dcd_pairs << " intersecting triangle pairs\n";
+        << " samples have new intersections; " << s.dcd_pairs
+        << " intersecting triangle pairs in all\n";
   }
   if (options.query != QuerySet::dcd) {
     out << "CCD       " << s.intervals_with_contacts << " of " << s.intervals
-              << " intervals have contacts; " << s.ccd_vf << " VF + " << s.ccd_ee
-              << " EE contacts\n";
+        << " intervals have new contacts; " << s.ccd_vf << " VF + " << s.ccd_ee
+        << " EE contacts in all\n";
   }
   if (!s.worst.empty()) {
     out << "worst\n";
@@ -168,47 +269,6 @@ void print_text_summary(std::ostream& out, const skinning::LoadedModel& model,
                 s.classify_ms, s.merge_ms, s.traverse_ms, s.elementary_ms, s.other_ms);
   out << line;
   if (!log_path.empty()) out << "log       " << log_path << '\n';
-}
-
-nlohmann::json json_summary(const skinning::LoadedModel& model, const skinning::Motion& motion,
-                            const RunOptions& options, const RunPlan& plan, double fps,
-                            const RunSummary& s, const std::string& log_path) {
-  auto worst = nlohmann::json::array();
-  for (const auto& row : s.worst) {
-    worst.push_back({{"sample", row.sample},
-                     {"kind", std::string(to_string(row.kind))},
-                     {"t0", row.t0},
-                     {"t1", row.t1},
-                     {"dcd_pairs", row.counters.dcd_pairs},
-                     {"vf_contacts", row.counters.vf_contacts},
-                     {"ee_contacts", row.counters.ee_contacts}});
-  }
-  return nlohmann::json{
-      {"model", model.path.string()},
-      {"clip", motion.name()},
-      {"fps", fps},
-      {"first_sample", plan.first_sample},
-      {"last_sample", plan.last_sample},
-      {"method", options.method},
-      {"accuracy", std::string(ccd::to_string(options.accuracy))},
-      {"query", std::string(to_string(options.query))},
-      {"frames", s.samples},
-      {"intervals", s.intervals},
-      {"dcd_pairs", s.dcd_pairs},
-      {"ccd_vf", s.ccd_vf},
-      {"ccd_ee", s.ccd_ee},
-      {"frames_with_contacts", s.frames_with_contacts},
-      {"frames_with_interpenetration", s.frames_with_interpenetration},
-      {"intervals_with_contacts", s.intervals_with_contacts},
-      {"max_candidate_pairs", s.max_candidate_pairs},
-      {"bv_tests", s.bv_tests},
-      {"candidate_pairs", s.candidate_pairs},
-      {"ms_per_interval", s.ms_per_interval},
-      {"total_ms", s.total_ms},
-      {"stages_ms", stages_json(s)},
-      {"worst", worst},
-      {"log", log_path.empty() ? nlohmann::json(nullptr) : nlohmann::json(log_path)},
-  };
 }
 
 /// Under `auto`, where each connected component went (the plan make_method("auto") follows, with
@@ -247,6 +307,9 @@ CheckedClip check_clip(const CheckArguments& args, RunOptions options, const std
       .min_separation = options.min_separation,
       .threads = options.threads,
       .radial_view = args.radial_view,
+      .baseline = parse_baseline(args.baseline),
+      .baseline_slack = args.baseline_slack,
+      .allow = args.allow,
       .log_path = log_path,
       .input_path = model_arg,
       .command_line = command_line(),
@@ -269,14 +332,17 @@ CheckedClip check_clip(const CheckArguments& args, RunOptions options, const std
   options.clip = clip;
   CheckedClip checked;
   std::ostringstream text;
+  print_events(text, motion->mesh(), outcome, options);
   print_text_summary(
       text, model, *motion, options, outcome.plan, outcome.fps, outcome.summary, log_path);
   if (!outcome.radial_view.segmentation_source.empty()) {
     text << "segmentation: " << outcome.radial_view.segmentation_source << "\n";
   }
   checked.text = text.str();
-  checked.json =
-      json_summary(model, *motion, options, outcome.plan, outcome.fps, outcome.summary, log_path);
+  checked.json = summary_json(
+      check_identity(model, request, outcome),
+      outcome.summary,
+      check_labels(model, request, outcome));
   if (!outcome.radial_view.segmentation_source.empty()) {
     checked.json["segmentation"] = outcome.radial_view.segmentation_source;
   }
@@ -473,8 +539,7 @@ void add_check_command(CLI::App& app) {
                   "or a quoted glob ('dir/*.glb'), make a batch")
       ->required();
   cmd->add_option("--clip", args->clip, "clip to check (default: the first)");
-  add_rate_option(
-      *cmd, "--fps", args->fps, "samples per second (default: the clip's key rate, else 30)");
+  add_rate_option(*cmd, "--fps", args->fps, kClipRateHelp);
   cmd->add_option("--frames", args->frames, "samples A:B to check, both included (A:, :B, A)");
   cmd->add_option("--method", args->method, method_option_help("culling method, one of:"))
       ->capture_default_str();
@@ -496,6 +561,26 @@ void add_check_command(CLI::App& app) {
   cmd->add_option("--threads", args->threads,
                   "worker threads (default 0: all cores; 1: serial); results do not depend on it");
   cmd->add_flag("--json", args->json, "print the summary as one JSON object");
+  cmd->add_option(
+         "--baseline",
+         args->baseline,
+         "what the rig already had, never reported as new (docs/events.md): rest (its "
+         "rest pose), sample:K, none, or LOG.h5 (every finding of a log of this model)")
+      ->capture_default_str();
+  cmd->add_option(
+         "--baseline-slack",
+         args->baseline_slack,
+         "rings of triangles a baseline intersection may slide by and stay the rig's")
+      ->capture_default_str();
+  cmd->add_option(
+      "--allow",
+      args->allow.rules,
+      "PART_A:PART_B: parts or bones allowed to touch; their findings are counted "
+      "apart (repeatable)");
+  cmd->add_flag(
+      "--allow-adjacent-bones",
+      args->allow.adjacent_bones,
+      "allow findings between triangles driven by the same bone or a bone and its parent");
   add_radial_view_options(*cmd, args->radial_view);
   add_model_options(*cmd, args->load);
   cmd->callback([args] { run_check_command(*args); });

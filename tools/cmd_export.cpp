@@ -110,11 +110,7 @@ void add_export_command(CLI::App& app) {
   auto* time = cmd->add_option("--time", args->time, "time in seconds from the start of the clip");
   frame->excludes(time);
   time->excludes(frame);
-  add_rate_option(
-      *cmd,
-      "--rate,--fps",
-      args->rate,
-      "samples per second (default: the clip's key rate, else 30)");
+  add_rate_option(*cmd, "--rate,--fps", args->rate, kClipRateHelp);
   cmd->add_option("-o,--output", args->output, "OUT.obj, OUT.ply or OUT.glb; '-' or /dev/stdout for standard output")
       ->required();
   cmd->add_option("--format", args->format, "obj, ply or glb (default: from OUT's extension; obj on standard output)");

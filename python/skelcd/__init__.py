@@ -97,7 +97,8 @@ class CheckResult:
         last_sample, t_first, t_last, t_first_contact (None when absent), parts (part ids), bones
         (names), peak_pairs, peak_sample, dcd_pairs, ccd_contacts, depth, merged_into (-1: none).
         None when the log holds no event data (written before events, or cut short); [] when the
-        run had no event. None from ``check``.
+        run had no event. From ``check``: its events, likewise. ``summary["events"]`` lists the
+        events that did not merge into an older one, as ``check --json`` does.
     """
 
     summary: dict
@@ -173,7 +174,8 @@ def check(model_or_path: Union[Model, str, os.PathLike], clip: Optional[str] = N
           fps: float = 0, frames=None, method: str = "bvh", accuracy: str = "conservative",
           query: str = "both", min_separation: float = 0.0, threads: int = 1,
           log: Union[str, os.PathLike, None] = None, gamma: float = 0.05, seed: int = 1,
-          segmentation: Union[str, os.PathLike, None] = None) -> CheckResult:
+          segmentation: Union[str, os.PathLike, None] = None, baseline: str = "rest",
+          baseline_slack: int = 2, allow=(), allow_adjacent_bones: bool = False) -> CheckResult:
     """Checks one clip for self-collision, as ``skelcd check MODEL -o LOG`` does.
 
     model_or_path: a Model from ``load``, or a path loaded with default options.
@@ -186,6 +188,9 @@ def check(model_or_path: Union[Model, str, os.PathLike], clip: Optional[str] = N
     log: write the HDF5 log here (docs/log-format.md); None: no log.
     gamma, seed, segmentation: the radial-view options of rvbc/dynamic/auto (``--gamma``,
         ``--seed``, ``--segmentation SEG.h5``).
+    baseline, baseline_slack, allow, allow_adjacent_bones: what findings are compared with and
+        which pairs are allowed (``--baseline rest|sample:K|none|LOG.h5``, ``--baseline-slack``,
+        ``--allow A:B`` per item of ``allow``, ``--allow-adjacent-bones``; docs/events.md).
     The GIL is released while checking; Ctrl-C stops a serial check between rows.
     Raises InvalidInput (bad option, clip, frame range, method) or IoError (unreadable file, a
     log that cannot be written), with the command line's messages.
@@ -193,7 +198,14 @@ def check(model_or_path: Union[Model, str, os.PathLike], clip: Optional[str] = N
     model = model_or_path if isinstance(model_or_path, Model) else load(model_or_path)
     arguments = {"clip": clip, "fps": fps, "frames": frames, "method": method,
                  "accuracy": accuracy, "query": query, "min_separation": min_separation,
-                 "threads": threads, "log": None if log is None else os.fspath(log)}
+                 "threads": threads, "log": None if log is None else os.fspath(log),
+                 "baseline": baseline}
+    if baseline_slack != 2:
+        arguments["baseline_slack"] = baseline_slack
+    if allow:
+        arguments["allow"] = list(allow)
+    if allow_adjacent_bones:
+        arguments["allow_adjacent_bones"] = True
     if method in ("rvbc", "dynamic", "auto"):
         arguments.update(gamma=gamma, seed=seed, segmentation=segmentation)
     command_line = _call_text("check", {"model": model.argument,
@@ -201,7 +213,9 @@ def check(model_or_path: Union[Model, str, os.PathLike], clip: Optional[str] = N
     raw = _skelcd.check(
         model, clip or "", float(fps), _frames_text(frames), method, accuracy, query,
         float(min_separation), int(threads), "" if log is None else os.fspath(log), float(gamma),
-        int(seed), "" if segmentation is None else os.fspath(segmentation), command_line)
+        int(seed), "" if segmentation is None else os.fspath(segmentation), command_line,
+        os.fspath(baseline) if isinstance(baseline, os.PathLike) else str(baseline),
+        int(baseline_slack), [str(a) for a in allow], bool(allow_adjacent_bones))
     return _result(raw)
 
 

@@ -155,59 +155,10 @@ py::list event_dicts(const std::vector<tools::EventRecord>& events) {
   return out;
 }
 
-/// What a run was, for the summary: the fields `skelcd check --json` prints besides the counts.
-struct RunIdentity {
-  std::string model;
-  std::string clip;
-  double fps = 0;
-  std::int32_t first_sample = 0;
-  std::int32_t last_sample = 0;
-  std::string method;
-  std::string accuracy;
-  std::string query;
-  std::string log;
-};
-
-/// The object `skelcd check --json` prints (tools/cmd_check.cpp, json_summary), same keys.
-py::dict summary_dict(const RunIdentity& id, const tools::RunSummary& s) {
-  py::list worst;
-  for (const auto& row : s.worst) {
-    py::dict w;
-    w["sample"] = row.sample;
-    w["kind"] = std::string(tools::to_string(row.kind));
-    w["t0"] = row.t0;
-    w["t1"] = row.t1;
-    w["dcd_pairs"] = row.counters.dcd_pairs;
-    w["vf_contacts"] = row.counters.vf_contacts;
-    w["ee_contacts"] = row.counters.ee_contacts;
-    worst.append(w);
-  }
-  py::dict d;
-  d["model"] = id.model;
-  d["clip"] = id.clip;
-  d["fps"] = id.fps;
-  d["first_sample"] = id.first_sample;
-  d["last_sample"] = id.last_sample;
-  d["method"] = id.method;
-  d["accuracy"] = id.accuracy;
-  d["query"] = id.query;
-  d["frames"] = s.samples;
-  d["intervals"] = s.intervals;
-  d["dcd_pairs"] = s.dcd_pairs;
-  d["ccd_vf"] = s.ccd_vf;
-  d["ccd_ee"] = s.ccd_ee;
-  d["frames_with_contacts"] = s.frames_with_contacts;
-  d["frames_with_interpenetration"] = s.frames_with_interpenetration;
-  d["intervals_with_contacts"] = s.intervals_with_contacts;
-  d["max_candidate_pairs"] = s.max_candidate_pairs;
-  d["bv_tests"] = s.bv_tests;
-  d["candidate_pairs"] = s.candidate_pairs;
-  d["ms_per_interval"] = s.ms_per_interval;
-  d["total_ms"] = s.total_ms;
-  d["stages_ms"] = to_python(tools::stages_json(s));
-  d["worst"] = worst;
-  d["log"] = id.log.empty() ? py::object(py::none()) : py::object(py::str(id.log));
-  return d;
+/// The object `skelcd check --json` prints (tools/run_summary.hpp, summary_json), same keys.
+py::dict summary_dict(
+    const tools::RunIdentity& id, const tools::RunSummary& s, const tools::RunLabels& labels) {
+  return to_python(tools::summary_json(id, s, labels));
 }
 
 py::dict header_dict(const tools::LogHeader& h) {
@@ -365,7 +316,11 @@ py::dict check(
     double gamma,
     std::uint64_t seed,
     const std::string& segmentation,
-    const std::string& command_line) {
+    const std::string& command_line,
+    const std::string& baseline,
+    std::int32_t baseline_slack,
+    const std::vector<std::string>& allow,
+    bool allow_adjacent_bones) {
   // Options refused with the CLI's own messages (tools/cmd_check.cpp).
   const auto parsed_accuracy = ccd::parse_accuracy(accuracy);
   if (!parsed_accuracy)
@@ -387,6 +342,9 @@ py::dict check(
   request.threads = threads;
   request.radial_view =
       tools::RadialViewArguments{.gamma = gamma, .seed = seed, .segmentation = segmentation};
+  request.baseline = tools::parse_baseline(baseline);
+  request.baseline_slack = baseline_slack;
+  request.allow = tools::Allowances{.rules = allow, .adjacent_bones = allow_adjacent_bones};
   request.log_path = log;
   request.input_path = model->argument();
   request.command_line = command_line;
@@ -416,18 +374,10 @@ py::dict check(
   }
   if (interrupted) throw py::error_already_set();  // the KeyboardInterrupt PyErr_CheckSignals set
 
-  const RunIdentity id{
-      .model = model->model().path.string(),
-      .clip = outcome->clip,
-      .fps = outcome->fps,
-      .first_sample = outcome->plan.first_sample,
-      .last_sample = outcome->plan.last_sample,
-      .method = request.method,
-      .accuracy = std::string(ccd::to_string(request.accuracy)),
-      .query = std::string(tools::to_string(request.query)),
-      .log = log,
-  };
-  py::dict summary = summary_dict(id, outcome->summary);
+  py::dict summary = summary_dict(
+      tools::check_identity(model->model(), request, *outcome),
+      outcome->summary,
+      tools::check_labels(model->model(), request, *outcome));
   if (!outcome->radial_view.segmentation_source.empty()) {
     summary["segmentation"] = outcome->radial_view.segmentation_source;
   }
@@ -446,6 +396,7 @@ py::dict check(
   result["rows"] = frame_columns(outcome->rows);
   result["contacts"] = contact_columns(contacts);
   result["dcd_pairs"] = dcd_pair_columns(dcd_pairs);
+  result["events"] = event_dicts(outcome->events);
   return result;
 }
 
@@ -456,7 +407,7 @@ py::dict read_log(const std::string& path) {
     data.emplace(tools::read_log(path));
   }
   const auto& h = data->header;
-  const RunIdentity id{
+  const tools::RunIdentity id{
       .model = h.input_path,
       .clip = h.clip,
       .fps = h.fps,
@@ -467,7 +418,16 @@ py::dict read_log(const std::string& path) {
       .query = h.query,
       .log = path,
   };
-  py::dict summary = summary_dict(id, tools::summarize(data->frames));
+  const tools::RunLabels labels{
+      .baseline = h.baseline,
+      .baseline_slack = h.baseline_slack,
+      .allow = h.allow,
+      .allow_adjacent_bones = h.allow_adjacent_bones,
+      .events = data->events,
+      .events_recorded = data->events_recorded,
+      .part_names = h.part_names,
+  };
+  py::dict summary = summary_dict(id, tools::summarize(data->frames), labels);
   if (!h.segmentation.empty()) summary["segmentation"] = h.segmentation;
 
   py::dict result;
@@ -576,7 +536,11 @@ PYBIND11_MODULE(_skelcd, m) {
       py::arg("gamma"),
       py::arg("seed"),
       py::arg("segmentation"),
-      py::arg("command_line"));
+      py::arg("command_line"),
+      py::arg("baseline"),
+      py::arg("baseline_slack"),
+      py::arg("allow"),
+      py::arg("allow_adjacent_bones"));
   m.def("read_log", &read_log, py::arg("path"));
   m.def("method_names", &skelcd::tools::check_method_names);
   // The /frames columns' counters and stages, in the log's order (FRAME_DTYPE is built from them).

@@ -56,6 +56,7 @@ class Reader {
       H5Tclose(mem);
     } else {
       hid_t mem = -1;
+      std::vector<std::string> string_members;
       if (cls == H5T_COMPOUND) {
         // Same members minus the timings, each in its native type, packed.
         std::vector<std::pair<std::string, hid_t>> members;
@@ -71,7 +72,11 @@ class Reader {
             continue;
           }
           const hid_t member_type = H5Tget_member_type(file_type, static_cast<unsigned>(i));
-          EXPECT_NE(H5Tget_class(member_type), H5T_STRING) << where << "." << member;
+          if (H5Tget_class(member_type) == H5T_STRING) {  // e.g. /event_bones' names
+            string_members.push_back(member);
+            H5Tclose(member_type);
+            continue;
+          }
           const hid_t native = H5Tget_native_type(member_type, H5T_DIR_ASCEND);
           H5Tclose(member_type);
           size += H5Tget_size(native);
@@ -97,6 +102,22 @@ class Reader {
       EXPECT_GE(ok, 0) << where;
       out.append(bytes.begin(), bytes.end());
       H5Tclose(mem);
+      // String members of a compound table, read one member at a time as variable-length text.
+      for (const auto& member : string_members) {
+        const hid_t text = H5Tcopy(H5T_C_S1);
+        H5Tset_size(text, H5T_VARIABLE);
+        H5Tset_cset(text, H5T_CSET_UTF8);
+        const hid_t one = H5Tcreate(H5T_COMPOUND, sizeof(char*));
+        H5Tinsert(one, member.c_str(), 0, text);
+        std::vector<char*> strings(static_cast<std::size_t>(n));
+        const herr_t read = H5Dread(object, one, H5S_ALL, H5S_ALL, H5P_DEFAULT, strings.data());
+        EXPECT_GE(read, 0) << where << "." << member;
+        out += member + ":";
+        for (char* str : strings) out += (str != nullptr ? std::string(str) : "<null>") + '\n';
+        if (read >= 0) H5Dvlen_reclaim(one, space, H5P_DEFAULT, strings.data());
+        H5Tclose(one);
+        H5Tclose(text);
+      }
     }
     H5Sclose(space);
     H5Tclose(file_type);
