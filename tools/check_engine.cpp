@@ -124,19 +124,7 @@ CheckOutcome check_model(
   const auto positions_at = [&motion](std::int32_t sample, skinning::Positions& out) {
     motion->positions(sample, out);
   };
-  const auto dcd = [&](const skinning::Positions& x) {
-    const auto method = culling::make_method("bvh", mesh, runner.topology());
-    skinning::Positions welded;
-    skinning::gather_welded(runner.topology(), x, welded);
-    culling::FrameResult found;
-    method->detect_dcd(welded, found);
-    std::vector<std::pair<std::int32_t, std::int32_t>> pairs;
-    pairs.reserve(found.dcd_pairs.size());
-    for (const auto& p : found.dcd_pairs) pairs.emplace_back(p.a, p.b);
-    return pairs;
-  };
-  const auto baseline =
-      baseline_findings(request.baseline, mesh, motion->num_samples(), positions_at, dcd);
+  const auto baseline = baseline_findings(request.baseline, *motion, runner.topology());
   outcome.baseline = describe(request.baseline);
   outcome.baseline_pairs = static_cast<std::int64_t>(baseline.pairs.size());
   const skinning::Rig* rig = model.rig && model.rig->mesh.num_vertices() == mesh.num_vertices()

@@ -10,6 +10,7 @@
 #include <unordered_map>
 #include <utility>
 
+#include "culling/method.hpp"
 #include "skinning/errors.hpp"
 #include "tools/log/log_reader.hpp"
 
@@ -872,6 +873,26 @@ BaselineFindings baseline_findings(
   std::sort(out.pairs.begin(), out.pairs.end());
   out.pairs.erase(std::unique(out.pairs.begin(), out.pairs.end()), out.pairs.end());
   return out;
+}
+
+BaselineFindings baseline_findings(
+    const BaselineSpec& spec, const skinning::Motion& motion, const skinning::Topology& topology) {
+  const skinning::Mesh& mesh = motion.mesh();
+  const auto positions_at = [&motion](std::int32_t sample, skinning::Positions& out) {
+    motion.positions(sample, out);
+  };
+  const auto dcd = [&](const skinning::Positions& x) {
+    const auto method = culling::make_method("bvh", mesh, topology);
+    skinning::Positions welded;
+    skinning::gather_welded(topology, x, welded);
+    culling::FrameResult found;
+    method->detect_dcd(welded, found);
+    std::vector<Pair> pairs;
+    pairs.reserve(found.dcd_pairs.size());
+    for (const auto& p : found.dcd_pairs) pairs.emplace_back(p.a, p.b);
+    return pairs;
+  };
+  return baseline_findings(spec, mesh, motion.num_samples(), positions_at, dcd);
 }
 
 }  // namespace skelcd::tools

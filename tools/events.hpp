@@ -44,6 +44,7 @@ struct EventRecord {
 #include <memory>
 
 #include "skinning/mesh.hpp"
+#include "skinning/motion.hpp"
 #include "skinning/rig.hpp"
 #include "skinning/topology.hpp"
 #include "tools/frame_report.hpp"
@@ -148,6 +149,12 @@ class EventTracker {
     const EventTracker::PositionsAt& positions_at,
     const std::function<
         std::vector<std::pair<std::int32_t, std::int32_t>>(const skinning::Positions&)>& dcd);
+
+/// The baseline findings of `spec` for `motion`: DCD (`bvh`, exact) at the rest pose or at a
+/// sample of the motion, nothing for none, a log's findings. `topology` is the motion mesh's.
+/// @throws as above.
+[[nodiscard]] BaselineFindings baseline_findings(
+    const BaselineSpec& spec, const skinning::Motion& motion, const skinning::Topology& topology);
 
 /// Length of the segment along which triangles (p0, p1, p2) and (q0, q1, q2) intersect (0 when
 /// they do not, or are coplanar): the depth measure of an event.

@@ -176,6 +176,18 @@ SceneSheet parse_sheet(const Scene& scene, const toml::node& node, const std::st
   return sheet;
 }
 
+/// `baseline = "…"`: rest, sample:K, none or a log (resolved against the scene's folder).
+BaselineSpec parse_baseline_at(const Scene& scene, const Reader& r, const std::string& text) {
+  try {
+    auto spec = parse_baseline(text);
+    if (spec.kind == BaselineSpec::Kind::log)
+      spec.log_path = resolve(scene, spec.log_path).string();
+    return spec;
+  } catch (const std::exception& e) {
+    r.fail(r.line("baseline"), e.what());
+  }
+}
+
 SceneObject parse_object(const Scene& scene, const std::string& name, const toml::node& node) {
   const auto* table = node.as_table();
   const std::string context = "object '" + name + "'";
@@ -199,7 +211,11 @@ SceneObject parse_object(const Scene& scene, const std::string& name, const toml
        "offset",
        "checks",
        "method",
-       "accuracy"});
+       "accuracy",
+       "baseline",
+       "baseline_slack",
+       "allow",
+       "allow_adjacent_bones"});
   SceneObject o;
   o.name = name;
   o.line = line_of(*table);
@@ -296,6 +312,35 @@ SceneObject parse_object(const Scene& scene, const std::string& name, const toml
   }
   o.accuracy = scene.accuracy;
   if (auto a = r.string("accuracy")) o.accuracy = parse_accuracy_at(r, "accuracy", *a);
+  o.baseline = scene.baseline;
+  if (auto b = r.string("baseline")) {
+    o.baseline = parse_baseline_at(scene, r, *b);
+    o.baseline_line = r.line("baseline");
+  }
+  if (auto slack = r.number("baseline_slack")) {
+    if (*slack < 0 || *slack != std::floor(*slack) || *slack > 1000) {
+      r.fail(r.line("baseline_slack"), "'baseline_slack' must be a whole number of rings >= 0");
+    }
+    o.baseline_slack = static_cast<std::int32_t>(*slack);
+  }
+  if (auto allow = r.strings("allow")) {
+    o.allow.rules = *allow;
+    o.allow_line = r.line("allow");
+    for (const auto& rule : o.allow.rules) {
+      const auto colon = rule.find(':');
+      if (colon == std::string::npos || colon == 0 || colon + 1 == rule.size()) {
+        r.fail(
+            o.allow_line,
+            "'allow' entry '" + rule + "': expected \"PART_A:PART_B\" (part or bone names)");
+      }
+    }
+  }
+  if (const auto* adjacent = r.get("allow_adjacent_bones")) {
+    if (!adjacent->is_boolean()) {
+      r.fail(line_of(*adjacent), "'allow_adjacent_bones' must be true or false");
+    }
+    o.allow.adjacent_bones = *adjacent->value<bool>();
+  }
   if (culling::method_needs(o.method).bone_poses && (!o.parts.empty() || !o.offset.isZero())) {
     r.fail(
         o.method_line != 0 ? o.method_line : o.line,
@@ -394,7 +439,7 @@ Scene parse_scene_text(std::string_view text, const std::filesystem::path& path)
       scene,
       root,
       "",
-      {"output", "frames", "min_separation", "method", "accuracy", "objects", "pairs"});
+      {"output", "frames", "min_separation", "method", "accuracy", "baseline", "objects", "pairs"});
   if (auto output = r.string("output")) {
     if (output->empty()) r.fail(r.line("output"), "'output' is empty");
     scene.output = resolve(scene, *output);
@@ -413,6 +458,7 @@ Scene parse_scene_text(std::string_view text, const std::filesystem::path& path)
   }
   if (auto m = r.string("method")) scene.method = parse_method_at(r, "method", *m);
   if (auto a = r.string("accuracy")) scene.accuracy = parse_accuracy_at(r, "accuracy", *a);
+  if (auto b = r.string("baseline")) scene.baseline = parse_baseline_at(scene, r, *b);
   if (scene.min_separation > 0 && scene.accuracy == ccd::Accuracy::exact) {
     r.fail(r.line("min_separation"), "the exact accuracy supports only min_separation = 0");
   }

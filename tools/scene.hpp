@@ -14,6 +14,7 @@
 
 #include "ccd/accuracy.hpp"
 #include "skinning/load.hpp"
+#include "tools/events.hpp"
 #include "tools/runner.hpp"
 
 namespace skelcd::tools {
@@ -55,6 +56,15 @@ struct SceneObject {
   std::string method;  ///< resolved: the object's own, else the scene's
   int method_line = 0;
   ccd::Accuracy accuracy = ccd::Accuracy::conservative;  ///< resolved likewise
+  /// What its self checks' findings are compared with (resolved: its own `baseline`, else the
+  /// scene's; a log path resolved against the scene's folder) — docs/events.md.
+  BaselineSpec baseline;
+  int baseline_line = 0;
+  std::int32_t baseline_slack = kDefaultBaselineSlack;
+  /// Parts or bones of this object allowed to touch (`allow = ["A:B", …]`) and
+  /// `allow_adjacent_bones`.
+  Allowances allow;
+  int allow_line = 0;
 
   [[nodiscard]] bool has_self_check() const { return self_dcd || self_ccd; }
 };
@@ -81,6 +91,7 @@ struct Scene {
   double min_separation = 0;
   std::string method = "bvh";
   ccd::Accuracy accuracy = ccd::Accuracy::conservative;
+  BaselineSpec baseline;  ///< the objects' default baseline (`baseline`)
 
   /// The object named `name`, or null.
   [[nodiscard]] const SceneObject* find(std::string_view name) const;

@@ -20,6 +20,7 @@
 #include "skinning/rig_motion.hpp"
 #include "skinning/topology.hpp"
 #include "tools/cli_util.hpp"
+#include "tools/events.hpp"
 #include "tools/file_hash.hpp"
 #include "tools/log/log_writer.hpp"
 #include "tools/radial_view_setup.hpp"
@@ -538,6 +539,8 @@ SceneRunResult run_scene(const Scene& scene, const SceneRunOptions& options) {
   // 5. Self-check runners, built now so that everything they refuse is refused before the log
   //    exists. Segmentation only where the plan says so.
   std::vector<std::unique_ptr<ClipRunner>> runners(plan.checks.size());
+  std::vector<std::unique_ptr<EventTracker>> trackers(plan.checks.size());
+  std::string baselines;  // "object: baseline; …" for the log header
   std::vector<RunOptions> run_options(plan.checks.size());
   std::optional<double> gamma;
   std::optional<std::int64_t> seed;
@@ -569,6 +572,24 @@ SceneRunResult run_scene(const Scene& scene, const SceneRunOptions& options) {
         }
       }
       runners[k] = std::make_unique<ClipRunner>(*lo.motion, ro);
+      // The labels and events of this self check (docs/events.md).
+      const auto& mesh = lo.motion->mesh();
+      const skinning::Rig* rig =
+          lo.model && lo.model->rig && lo.model->rig->mesh.num_vertices() == mesh.num_vertices()
+              ? lo.model->rig.get()
+              : nullptr;
+      const skinning::Motion* motion = lo.motion;
+      trackers[k] = std::make_unique<EventTracker>(
+          mesh,
+          runners[k]->topology(),
+          rig,
+          baseline_findings(so.baseline, *motion, runners[k]->topology()),
+          so.allow,
+          so.baseline_slack,
+          [motion](std::int32_t sample, skinning::Positions& out) {
+            motion->positions(sample, out);
+          });
+      baselines += (baselines.empty() ? "" : "; ") + so.name + ": " + describe(so.baseline);
     } catch (const std::exception& e) {
       throw InvalidInput(scene.where(c.line, "object '" + so.name + "': " + e.what()));
     }
@@ -627,6 +648,9 @@ SceneRunResult run_scene(const Scene& scene, const SceneRunOptions& options) {
     header.num_vertices = vertices;
     header.num_triangles = triangles;
     header.part_names = result.part_names;
+    // Self checks are labelled against their objects' baselines; pair checks are not (yet).
+    header.baseline =
+        baselines.empty() ? std::string("none (pair checks are not labelled)") : baselines;
     // Where `auto` sent each component of each object it checks (parts numbered as in /parts,
     // so a route's part says which object it belongs to; components count within an object).
     for (std::size_t k = 0; k < plan.checks.size(); ++k) {
@@ -639,6 +663,7 @@ SceneRunResult run_scene(const Scene& scene, const SceneRunOptions& options) {
   }
 
   // 7. Run the checks in plan order.
+  std::vector<EventRecord> all_events;
   for (std::size_t k = 0; k < plan.checks.size(); ++k) {
     const CheckPlan& c = plan.checks[k];
     SceneCheckResult check;
@@ -654,21 +679,36 @@ SceneRunResult run_scene(const Scene& scene, const SceneRunOptions& options) {
     Progress progress("check " + check.name, c.rows);
     if (c.kind == CheckKind::self) {
       const std::int32_t offset = loaded[at(c.object_a)].part_offset;
-      FrameReport shifted_report;
-      runners[k]->run([&](const FrameReport& report) {
-        shifted_report = report;
-        for (auto& r : shifted_report.contacts) {
+      const auto first_event = static_cast<std::int32_t>(all_events.size());
+      // Parts and event ids numbered as in the log (object offsets; events of earlier checks).
+      const auto shifted = [&](FrameReport& report) {
+        for (auto& r : report.contacts) {
           r.a.part += offset;
           r.b.part += offset;
+          if (r.label >= 0) r.label += first_event;
         }
-        for (auto& r : shifted_report.dcd_pairs) {
+        for (auto& r : report.dcd_pairs) {
           r.a.part += offset;
           r.b.part += offset;
+          if (r.label >= 0) r.label += first_event;
         }
-        record(shifted_report);
+        record(report);
         progress.update(static_cast<std::int64_t>(check.rows.size()));
+      };
+      runners[k]->run([&](const FrameReport& report) {
+        for (auto& labelled : trackers[k]->push(report)) shifted(labelled);
       });
+      for (auto& labelled : trackers[k]->flush()) shifted(labelled);
+      for (auto e : trackers[k]->events()) {
+        e.id += first_event;
+        if (e.merged_into >= 0) e.merged_into += first_event;
+        for (auto& part : e.parts) part += offset;
+        check.events.push_back(e);
+        all_events.push_back(std::move(e));
+      }
+      check.baseline = describe(scene.objects[at(c.object_a)].baseline);
       runners[k].reset();  // frees the method's buffers before the next check
+      trackers[k].reset();
     } else {
       run_pair(
           c,
@@ -685,7 +725,10 @@ SceneRunResult run_scene(const Scene& scene, const SceneRunOptions& options) {
     check.summary = summarize(check.rows);
     result.checks.push_back(std::move(check));
   }
-  if (writer) writer->finish();
+  if (writer) {
+    writer->write_events(all_events);
+    writer->finish();
+  }
   result.total_ms = micros(started, Clock::now()) / 1000.0;
   return result;
 }
@@ -728,7 +771,17 @@ void run_scene_check(const std::filesystem::path& scene_path, const SceneCheckAr
            {"candidate_pairs", s.candidate_pairs},
            {"ms_per_interval", s.ms_per_interval},
            {"total_ms", s.total_ms},
-           {"stages_ms", stages_json(s)}});
+           {"stages_ms", stages_json(s)},
+           {"baseline", c.baseline.empty() ? nlohmann::json(nullptr) : nlohmann::json(c.baseline)},
+           {"events",
+            c.baseline.empty() ? nlohmann::json(nullptr)
+                               : events_json(c.events, result.part_names)},
+           {"new_dcd_pairs", s.new_dcd_pairs},
+           {"new_ccd_contacts", s.new_ccd_contacts},
+           {"baseline_dcd_pairs", s.baseline_dcd_pairs},
+           {"baseline_ccd_contacts", s.baseline_ccd_contacts},
+           {"allowed_dcd_pairs", s.allowed_dcd_pairs},
+           {"allowed_ccd_contacts", s.allowed_ccd_contacts}});
     }
     print_json(
         {{"scene", scene_path.string()},
@@ -747,14 +800,19 @@ void run_scene_check(const std::filesystem::path& scene_path, const SceneCheckAr
     const auto& s = c.summary;
     const auto& p = result.plan.checks[k];
     std::cout << "result    " << c.name << std::string(width - c.name.size(), ' ') << "  ";
+    if (!c.baseline.empty()) {
+      std::cout << root_events(c.events).size() << " events against " << c.baseline << " ("
+                << s.baseline_dcd_pairs + s.baseline_ccd_contacts << " baseline, "
+                << s.allowed_dcd_pairs + s.allowed_ccd_contacts << " allowed findings); ";
+    }
     if (p.query != QuerySet::ccd) {
       std::cout << "DCD " << s.frames_with_interpenetration << "/" << s.samples
-                << " samples interpenetrate (" << s.dcd_pairs << " pairs)";
+                << " samples with new intersections (" << s.dcd_pairs << " pairs)";
       if (p.query == QuerySet::both) std::cout << "; ";
     }
     if (p.query != QuerySet::dcd) {
       std::cout << "CCD " << s.intervals_with_contacts << "/" << s.intervals
-                << " intervals with contacts (" << s.ccd_vf << " VF + " << s.ccd_ee << " EE)";
+                << " intervals with new contacts (" << s.ccd_vf << " VF + " << s.ccd_ee << " EE)";
     }
     std::snprintf(
         line,

@@ -56,6 +56,10 @@ struct SceneCheckResult {
   std::vector<ContactRow> contacts;  ///< parts numbered as in the log (object offsets applied)
   std::vector<DcdPairRow> dcd_pairs;
   RunSummary summary;
+  /// A self check's baseline (describe()) and events, ids and parts numbered as in the log;
+  /// empty for a pair check (not labelled).
+  std::string baseline;
+  std::vector<EventRecord> events;
 };
 
 struct SceneRunResult {

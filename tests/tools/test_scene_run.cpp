@@ -564,3 +564,91 @@ TEST(SceneCli, ABadSceneIsOneLineExitOneAndNothingWritten) {
 
 }  // namespace
 }  // namespace skelcd::tools
+
+namespace skelcd::tools {
+namespace {
+
+// Scenes label their self checks against each object's baseline and allowances (docs/events.md):
+// a baseline at a sample where the limbs touch leaves nothing new there; allowing every part with
+// itself leaves nothing new at all; the log holds every check's events with ids and parts as in
+// the log, and a bad baseline or allow entry is refused with its line.
+TEST(SceneEvents, ObjectsAreLabelledAgainstTheirBaselineAndAllowances) {
+  const std::string octopus = "gen:octopus?triangles=2000&frames=30";
+  const auto path = write_scene(
+      "baseline = \"sample:0\"\nframes = \"17:29\"\n"
+      "[objects.free]\nmodel = \"" +
+          octopus +
+          "\"\nchecks = [\"self-dcd\"]\n"
+          "[objects.touching]\nmodel = \"" +
+          octopus +
+          "\"\nchecks = [\"self-dcd\"]\n"
+          "baseline = \"sample:29\"\n"
+          "[objects.allowed]\nmodel = \"" +
+          octopus +
+          "\"\nchecks = [\"self-dcd\"]\n"
+          "allow = [\"octopus:octopus\"]\n",
+      "scene_events");
+  const Scene scene = parse_scene(path);
+  EXPECT_EQ(scene.objects[1].baseline.kind, BaselineSpec::Kind::sample);
+  EXPECT_EQ(scene.objects[0].baseline.sample, 0);
+  SceneRunOptions options;
+  options.log = path.parent_path() / "log.h5";
+  const auto result = run_scene(scene, options);
+  const auto& free = check_named(result, "self free");
+  const auto& touching = check_named(result, "self touching");
+  const auto& allowed = check_named(result, "self allowed");
+  ASSERT_FALSE(free.events.empty());
+  EXPECT_GT(free.summary.new_dcd_pairs, 0);
+  EXPECT_EQ(free.summary.new_dcd_pairs, free.summary.dcd_pairs);
+  // The last sample is the touching object's baseline: nothing new there.
+  EXPECT_EQ(touching.rows.back().counters.new_dcd_pairs, 0);
+  EXPECT_EQ(
+      touching.rows.back().counters.baseline_dcd_pairs, touching.rows.back().counters.dcd_pairs);
+  EXPECT_GT(touching.rows.back().counters.dcd_pairs, 0);
+  EXPECT_EQ(allowed.summary.new_dcd_pairs, 0);
+  EXPECT_EQ(allowed.summary.allowed_dcd_pairs, free.summary.dcd_pairs);
+  EXPECT_TRUE(allowed.events.empty());
+
+  const auto log = read_log(options.log);
+  ASSERT_TRUE(log.events_recorded);
+  ASSERT_EQ(log.events.size(), free.events.size() + touching.events.size());
+  for (std::size_t i = 0; i < log.events.size(); ++i) {
+    EXPECT_EQ(log.events[i].id, static_cast<std::int32_t>(i));
+  }
+  // The touching object's events come after the free one's, with its parts.
+  const auto touching_part = static_cast<std::int32_t>(
+      std::find(log.header.part_names.begin(), log.header.part_names.end(), "touching/octopus") -
+      log.header.part_names.begin());
+  for (std::size_t i = free.events.size(); i < log.events.size(); ++i) {
+    EXPECT_EQ(log.events[i].parts, (std::vector<std::int32_t>{touching_part}));
+  }
+  std::set<std::int32_t> labels;
+  for (const auto& p : log.dcd_pairs) labels.insert(p.label);
+  EXPECT_TRUE(labels.contains(kLabelAllowed));
+  EXPECT_TRUE(labels.contains(kLabelBaseline));
+  EXPECT_TRUE(labels.contains(0));
+
+  EXPECT_THROW_MESSAGE(
+      (void)parse_scene(write_scene(
+          "[objects.a]\nmodel = \"" + octopus +
+              "\"\nchecks = [\"self-dcd\"]\nbaseline = \"sample:x\"\n",
+          "scene_events_bad")),
+      InvalidInput,
+      "scene.toml:4:");
+  EXPECT_THROW_MESSAGE(
+      (void)parse_scene(write_scene(
+          "[objects.a]\nmodel = \"" + octopus +
+              "\"\nchecks = [\"self-dcd\"]\nallow = [\"octopus\"]\n",
+          "scene_events_bad2")),
+      InvalidInput,
+      "scene.toml:4:");
+  // A name that is neither a part nor a bone is refused before any work, naming the object.
+  const auto unknown = write_scene(
+      "[objects.a]\nmodel = \"" + octopus +
+          "\"\nchecks = [\"self-dcd\"]\nallow = [\"octopus:fin\"]\n",
+      "scene_events_bad3");
+  EXPECT_THROW_MESSAGE((void)run_scene(parse_scene(unknown)), InvalidInput, "'fin'");
+}
+
+}  // namespace
+}  // namespace skelcd::tools
