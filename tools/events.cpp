@@ -169,7 +169,8 @@ struct EventTracker::Impl {
   // Drivers (skeleton nodes) of triangles and file vertices, and each driver's parent driver.
   std::vector<std::int32_t> face_driver;
   std::vector<std::int32_t> vertex_driver;
-  std::vector<std::int32_t> driver_parent;  ///< per skeleton node
+  std::vector<std::int32_t> driver_bone;    ///< per skeleton node: its bone (node), or itself
+  std::vector<std::int32_t> driver_parent;  ///< per skeleton node: its bone's parent bone
   std::vector<std::string> node_names;
   std::string no_name;
   // Allowances: per rule, the parts and drivers each side names.
@@ -322,13 +323,26 @@ struct EventTracker::Impl {
       }
       face_driver[static_cast<std::size_t>(f)] = best;
     }
+    // For adjacency, a node that is no bone (a rigid part's attachment node) counts as the bone
+    // it hangs from: RobotExpressive's arm mesh hangs beside the lower arm bone, under the upper
+    // arm's. Each node's bone, and that bone's parent bone.
+    std::vector<bool> is_bone(nodes.size(), false);
+    for (const auto& b : bones) {
+      if (b.node >= 0) is_bone[static_cast<std::size_t>(b.node)] = true;
+    }
+    const auto bone_at_or_above = [&](std::int32_t n) {
+      while (n >= 0 && !is_bone[static_cast<std::size_t>(n)])
+        n = nodes[static_cast<std::size_t>(n)].parent;
+      return n;
+    };
+    driver_bone.assign(nodes.size(), -1);
     driver_parent.assign(nodes.size(), -1);
     for (std::size_t n = 0; n < nodes.size(); ++n) {
-      std::int32_t p = nodes[n].parent;
-      while (p >= 0 && !is_driver[static_cast<std::size_t>(p)])
-        p = nodes[static_cast<std::size_t>(p)].parent;
-      driver_parent[n] = p;
+      const auto b = bone_at_or_above(static_cast<std::int32_t>(n));
+      driver_bone[n] = b >= 0 ? b : static_cast<std::int32_t>(n);
+      driver_parent[n] = b >= 0 ? bone_at_or_above(nodes[static_cast<std::size_t>(b)].parent) : -1;
     }
+    (void)is_driver;
   }
 
   void build_allowances(const Allowances& allowances) {
@@ -369,9 +383,10 @@ struct EventTracker::Impl {
       if ((x.matches(a) && y.matches(b)) || (x.matches(b) && y.matches(a))) return true;
     }
     if (adjacent_bones && a.driver >= 0 && b.driver >= 0) {
-      if (a.driver == b.driver) return true;
-      if (driver_parent[static_cast<std::size_t>(a.driver)] == b.driver) return true;
-      if (driver_parent[static_cast<std::size_t>(b.driver)] == a.driver) return true;
+      const auto ua = static_cast<std::size_t>(a.driver);
+      const auto ub = static_cast<std::size_t>(b.driver);
+      if (driver_bone[ua] == driver_bone[ub]) return true;
+      if (driver_parent[ua] == driver_bone[ub] || driver_parent[ub] == driver_bone[ua]) return true;
     }
     return false;
   }

@@ -415,3 +415,44 @@ TEST(RealCharacterBaselines, ABaselineAtSampleKLeavesNothingNewAtK) {
 
 }  // namespace
 }  // namespace skelcd::tools
+
+namespace skelcd::tools {
+namespace {
+
+// RobotExpressive's rigid arm meshes hang from nodes beside the lower-arm bones (both under the
+// upper arm): with --allow-adjacent-bones their contact with the hands is allowed, not an event.
+TEST(RealCharacterAllowances, AdjacentBonesIncludeRigidPartsHangingFromABone) {
+  const auto model = skinning::load_model(test::asset("characters/RobotExpressive.glb"));
+  const auto arm_and_hand = [](const CheckOutcome& o) {
+    for (const auto* e : roots(o)) {
+      const auto has = [&](const char* bone) {
+        return std::find(e->bones.begin(), e->bones.end(), bone) != e->bones.end();
+      };
+      if (has("Arm.L") && has("LowerArm.L") && e->bones.size() == 2) return true;
+    }
+    return false;
+  };
+  const FrameRange frames{.first = 0, .last = 2};
+  const auto plain = check(model, BaselineSpec{}, QuerySet::dcd, frames);
+  ASSERT_TRUE(arm_and_hand(plain.outcome));
+  const auto allowed = check(
+      model,
+      BaselineSpec{},
+      QuerySet::dcd,
+      frames,
+      Allowances{.rules = {}, .adjacent_bones = true});
+  expect_rows_account_for_every_finding(allowed);
+  EXPECT_FALSE(arm_and_hand(allowed.outcome));
+  EXPECT_GT(allowed.outcome.totals.allowed_dcd_pairs, 0);
+  // Allowing is decided first: it takes from the new pairs and from the baseline's.
+  const auto& a = allowed.outcome.totals;
+  const auto& p = plain.outcome.totals;
+  EXPECT_LT(a.new_dcd_pairs, p.new_dcd_pairs);
+  EXPECT_LE(a.baseline_dcd_pairs, p.baseline_dcd_pairs);
+  EXPECT_EQ(
+      a.new_dcd_pairs + a.baseline_dcd_pairs + a.allowed_dcd_pairs,
+      p.new_dcd_pairs + p.baseline_dcd_pairs);
+}
+
+}  // namespace
+}  // namespace skelcd::tools
