@@ -19,6 +19,12 @@ CASES = {
                          ["--clip", "Run", "--method", "kdop", "--query", "ccd"]),
     "Fox-Survey-dynamic": ("Fox", {"clip": "Survey", "method": "dynamic", "frames": "0:20"},
                            ["--clip", "Survey", "--method", "dynamic", "--frames", "0:20"]),
+    # Events against another baseline, with allowances (docs/events.md).
+    "CesiumMan-baseline-allow": ("CesiumMan",
+                                 {"baseline": "sample:3", "frames": "0:8",
+                                  "allow_adjacent_bones": True, "baseline_slack": 3},
+                                 ["--baseline", "sample:3", "--frames", "0:8",
+                                  "--allow-adjacent-bones", "--baseline-slack", "3"]),
 }
 
 # Summary keys that are wall times (or the log's path); every other key must be equal.
