@@ -215,7 +215,8 @@ Table summary_table(const std::vector<std::pair<std::string, LogData>>& logs) {
       continue;
     }
     const auto totals = label_totals(log);
-    row.push_back(log.events_recorded ? nlohmann::json(log.events.size()) : nlohmann::json());
+    row.push_back(
+        log.events_recorded ? nlohmann::json(root_events(log.events).size()) : nlohmann::json());
     row.push_back(totals.new_dcd_pairs + totals.new_ccd_contacts);
     row.push_back(totals.baseline_dcd_pairs + totals.baseline_ccd_contacts);
     row.push_back(totals.allowed_dcd_pairs + totals.allowed_ccd_contacts);
@@ -362,7 +363,13 @@ void print_events_text(
     } else if (full.rows.empty()) {
       std::cout << "events: none\n";
     } else {
-      std::cout << "events: " << full.rows.size() << '\n';
+      // As check counts them: events that ran into an older one are listed, not counted.
+      const auto roots = root_events(log.events).size();
+      std::cout << "events: " << roots;
+      if (roots < log.events.size()) {
+        std::cout << " (+" << log.events.size() - roots << " merged into an older one)";
+      }
+      std::cout << '\n';
       print_text(events_text(full, false));
     }
     if (!h.baseline.empty()) {
