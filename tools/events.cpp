@@ -845,7 +845,12 @@ BaselineFindings baseline_findings(
     case BaselineSpec::Kind::log:
       break;
   }
-  const LogData log = read_log(spec.log_path);
+  LogData log;
+  try {
+    log = read_log(spec.log_path);
+  } catch (const IoError& e) {
+    throw IoError(std::string(e.what()) + " (the --baseline log)");
+  }
   if (log.header.num_triangles != mesh.num_triangles() ||
       log.header.part_names != mesh.part_names) {
     throw InvalidInput(

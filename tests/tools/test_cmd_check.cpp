@@ -148,6 +148,14 @@ TEST(CmdCheck, BadInputsFailWithOneLineAndLeaveNoLog) {
       {{"check", kModel, "--query", "all", "-o", log}, "--query"},
       {{"check", kModel, "--fps", "-3", "-o", log}, "--fps"},
       {{"check", kModel, "--clip", "NoSuchClip", "-o", log}, "NoSuchClip"},
+      // The baseline and the allowances (docs/events.md) are refused before the log too.
+      {{"check", kModel, "--baseline", "sample:100", "-o", log}, "--baseline sample:100"},
+      {{"check", kModel, "--baseline", "bogus", "-o", log}, "--baseline 'bogus'"},
+      {{"check", kModel, "--baseline", (dir / "none.h5").string(), "-o", log},
+       "none.h5: no such file (the --baseline log)"},
+      {{"check", kModel, "--baseline-slack", "-1", "-o", log}, "--baseline-slack"},
+      {{"check", kModel, "--allow", "a-b", "-o", log}, "--allow 'a-b'"},
+      {{"check", kModel, "--allow", "fin:fin", "-o", log}, "'fin' names neither a part nor a bone"},
   };
   for (const auto& [args, message] : cases) {
     const auto r = run_skelcd(args);
