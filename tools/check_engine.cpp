@@ -7,7 +7,6 @@
 #include <memory>
 
 #include "culling/method.hpp"
-#include "skelcd_version.hpp"
 #include "skinning/errors.hpp"
 #include "skinning/generators.hpp"
 #include "tools/file_hash.hpp"
@@ -136,11 +135,17 @@ CheckOutcome check_model(
   std::unique_ptr<LogWriter> writer;
   if (!request.log_path.empty()) {
     const std::string input = request.input_path.empty() ? model.path.string() : request.input_path;
-    LogHeader header;
-    header.skelcd_version = kVersion;
-    header.command_line = request.command_line;
-    header.input_path = input;
-    header.input_hash = model_identity(input);
+    LogHeader header = log_header_base({
+        .input_path = input,
+        .input_hash = model_identity(input),
+        .command_line = request.command_line,
+        .first_sample = outcome.plan.first_sample,
+        .last_sample = outcome.plan.last_sample,
+        .planned_rows = outcome.plan.rows,
+        .num_vertices = mesh.num_vertices(),
+        .num_triangles = mesh.num_triangles(),
+        .part_names = mesh.part_names,
+    });
     header.clip = outcome.clip;
     header.method = outcome.method;
     header.accuracy = std::string(ccd::to_string(options.accuracy));
@@ -150,13 +155,6 @@ CheckOutcome check_model(
     header.gamma = outcome.radial_view.gamma;
     header.seed = outcome.radial_view.seed;
     header.segmentation = outcome.radial_view.segmentation_source;
-    header.start_time = iso8601_utc_now();
-    header.first_sample = outcome.plan.first_sample;
-    header.last_sample = outcome.plan.last_sample;
-    header.planned_rows = outcome.plan.rows;
-    header.num_vertices = motion->mesh().num_vertices();
-    header.num_triangles = motion->mesh().num_triangles();
-    header.part_names = motion->mesh().part_names;
     header.routes = runner.routes();
     header.baseline = outcome.baseline;
     header.baseline_slack = request.baseline_slack;
@@ -177,7 +175,6 @@ CheckOutcome check_model(
   runner.run([&](const FrameReport& report) { emit(tracker.push(report)); });
   emit(tracker.flush());
   outcome.events = tracker.events();
-  outcome.totals = tracker.totals();
   if (writer) {
     writer->write_events(outcome.events);
     writer->finish();

@@ -14,7 +14,6 @@
 
 #include "culling/method_registry.hpp"
 #include "culling/pair_checker.hpp"
-#include "skelcd_version.hpp"
 #include "skinning/errors.hpp"
 #include "skinning/generators.hpp"
 #include "skinning/rig_motion.hpp"
@@ -599,15 +598,26 @@ SceneRunResult run_scene(const Scene& scene, const SceneRunOptions& options) {
   // 6. The log, once nothing more can be refused.
   std::unique_ptr<LogWriter> writer;
   if (!options.log.empty()) {
-    LogHeader header;
-    header.skelcd_version = kVersion;
-    header.command_line = options.command_line;
-    header.input_path = scene.path.string();
-    header.input_hash = file_content_hash(scene.path);
+    std::int32_t first_sample = std::numeric_limits<std::int32_t>::max();
+    std::int32_t last_sample = 0;
+    for (const auto& c : plan.checks) {
+      first_sample = std::min(first_sample, c.first_sample);
+      last_sample = std::max(last_sample, c.last_sample);
+    }
+    if (plan.checks.empty()) first_sample = 0;
+    LogHeader header = log_header_base({
+        .input_path = scene.path.string(),
+        .input_hash = file_content_hash(scene.path),
+        .command_line = options.command_line,
+        .first_sample = first_sample,
+        .last_sample = last_sample,
+        .planned_rows = plan.rows,
+        .num_vertices = vertices,
+        .num_triangles = triangles,
+        .part_names = result.part_names,
+    });
     std::vector<std::string> clips, methods, accuracies;
     bool dcd = false, ccd = false;
-    header.first_sample = std::numeric_limits<std::int32_t>::max();
-    header.last_sample = 0;
     for (const auto& c : plan.checks) {
       header.checks.push_back(LogCheck{
           .name = c.name(plan.objects),
@@ -620,10 +630,7 @@ SceneRunResult run_scene(const Scene& scene, const SceneRunOptions& options) {
       accuracies.push_back(std::string(ccd::to_string(c.accuracy)));
       dcd = dcd || c.query != QuerySet::ccd;
       ccd = ccd || c.query != QuerySet::dcd;
-      header.first_sample = std::min(header.first_sample, c.first_sample);
-      header.last_sample = std::max(header.last_sample, c.last_sample);
     }
-    if (plan.checks.empty()) header.first_sample = 0;
     for (std::size_t i = 0; i < scene.objects.size(); ++i) {
       if (plan.objects[i].checked) clips.push_back(scene.objects[i].name + ": " + facts[i].motion);
     }
@@ -643,11 +650,6 @@ SceneRunResult run_scene(const Scene& scene, const SceneRunOptions& options) {
     header.gamma = gamma;
     header.seed = seed;
     header.segmentation = segmentation_sources;
-    header.start_time = iso8601_utc_now();
-    header.planned_rows = plan.rows;
-    header.num_vertices = vertices;
-    header.num_triangles = triangles;
-    header.part_names = result.part_names;
     // Self checks are labelled against their objects' baselines; pair checks are not (yet).
     header.baseline =
         baselines.empty() ? std::string("none (pair checks are not labelled)") : baselines;

@@ -77,4 +77,22 @@ struct LogHeader {
 /// The current time as ISO 8601 UTC with seconds ("2026-01-31T12:00:00Z").
 [[nodiscard]] std::string iso8601_utc_now();
 
+/// What every log says of its run, whoever writes it (a clip's check or a scene): the input, the
+/// command, the samples asked for, the planned rows and the mesh checked.
+struct LogRunFacts {
+  std::string input_path;
+  std::string input_hash;  ///< "fnv1a64:<16 hex digits>" (file_hash.hpp)
+  std::string command_line;
+  std::int32_t first_sample = 0;
+  std::int32_t last_sample = 0;
+  std::int64_t planned_rows = 0;
+  std::int64_t num_vertices = 0;
+  std::int64_t num_triangles = 0;
+  std::vector<std::string> part_names;
+};
+
+/// The one place a log header starts: this build's version, the start time (now) and `facts`;
+/// the caller fills what its kind of run adds (clip, method, accuracy, query, routes, baseline…).
+[[nodiscard]] LogHeader log_header_base(LogRunFacts facts);
+
 }  // namespace skelcd::tools
