@@ -157,27 +157,6 @@ std::string completeness(const LogData& log) {
          " rows)";
 }
 
-/// The labelled findings of a log, summed from its /frames counters.
-struct LabelTotals {
-  std::int64_t new_dcd_pairs = 0, new_ccd_contacts = 0;
-  std::int64_t baseline_dcd_pairs = 0, baseline_ccd_contacts = 0;
-  std::int64_t allowed_dcd_pairs = 0, allowed_ccd_contacts = 0;
-};
-
-LabelTotals label_totals(const LogData& log) {
-  LabelTotals t;
-  for (const auto& r : log.frames) {
-    const auto& c = r.counters;
-    t.new_dcd_pairs += c.new_dcd_pairs;
-    t.new_ccd_contacts += c.new_ccd_contacts;
-    t.baseline_dcd_pairs += c.baseline_dcd_pairs;
-    t.baseline_ccd_contacts += c.baseline_ccd_contacts;
-    t.allowed_dcd_pairs += c.allowed_dcd_pairs;
-    t.allowed_ccd_contacts += c.allowed_ccd_contacts;
-  }
-  return t;
-}
-
 Table summary_table(const std::vector<std::pair<std::string, LogData>>& logs) {
   Table t;
   t.columns = {
@@ -214,7 +193,7 @@ Table summary_table(const std::vector<std::pair<std::string, LogData>>& logs) {
       row.insert(row.end(), {nullptr, nullptr, nullptr, nullptr, ""});
       continue;
     }
-    const auto totals = label_totals(log);
+    const auto totals = summarize(log.frames, 0);
     row.push_back(
         log.events_recorded ? nlohmann::json(root_events(log.events).size()) : nlohmann::json());
     row.push_back(totals.new_dcd_pairs + totals.new_ccd_contacts);
@@ -373,7 +352,7 @@ void print_events_text(
       print_text(events_text(full, false));
     }
     if (!h.baseline.empty()) {
-      const auto totals = label_totals(log);
+      const auto totals = summarize(log.frames, 0);
       std::cout << "baseline: " << totals.baseline_dcd_pairs << " DCD pairs, "
                 << totals.baseline_ccd_contacts << " CCD contacts (" << h.baseline << ", slack "
                 << h.baseline_slack << ")\n";
@@ -482,6 +461,8 @@ void run_inspect(const InspectOptions& o) {
       }
       logs.emplace_back(path, std::move(log));
     } catch (const std::exception& e) {
+      // One file given: its reason, naming it, is the whole answer (one line, exit status 1).
+      if (o.logs.size() == 1) throw;
       std::cerr << "skelcd: " << e.what() << " (skipped)\n";
       ++skipped;
     }

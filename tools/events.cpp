@@ -56,6 +56,18 @@ struct Owner {
   std::int32_t driver = -1;  ///< skeleton node, -1 when none
 };
 
+/// Per part, the mesh triangle of each of its triangles in the file's numbering (-1: none).
+std::vector<std::vector<std::int32_t>> faces_by_part(const skinning::Mesh& mesh) {
+  std::vector<std::vector<std::int32_t>> table(static_cast<std::size_t>(mesh.num_parts()));
+  for (std::int32_t f = 0; f < static_cast<std::int32_t>(mesh.num_triangles()); ++f) {
+    auto& list = table[static_cast<std::size_t>(mesh.face_part[static_cast<std::size_t>(f)])];
+    const auto i = static_cast<std::size_t>(mesh.face_index_in_part[static_cast<std::size_t>(f)]);
+    if (list.size() <= i) list.resize(i + 1, -1);
+    list[i] = f;
+  }
+  return table;
+}
+
 }  // namespace
 
 BaselineSpec parse_baseline(std::string_view text) {
@@ -199,7 +211,6 @@ struct EventTracker::Impl {
     std::vector<std::int32_t> faces;
   };
   std::map<std::int32_t, Footprint> recent;
-  EventTotals totals;
   skinning::Positions posed;
 
   Impl(const skinning::Mesh& m, const skinning::Topology& t, const skinning::Rig* r, PositionsAt p)
@@ -220,15 +231,8 @@ struct EventTracker::Impl {
   }
 
   void build_numbering() {
-    face_of_part.assign(static_cast<std::size_t>(mesh.num_parts()), {});
+    face_of_part = faces_by_part(mesh);
     vertex_of_part.assign(static_cast<std::size_t>(mesh.num_parts()), {});
-    for (std::int32_t f = 0; f < static_cast<std::int32_t>(mesh.num_triangles()); ++f) {
-      auto& list =
-          face_of_part[static_cast<std::size_t>(mesh.face_part[static_cast<std::size_t>(f)])];
-      const auto i = static_cast<std::size_t>(mesh.face_index_in_part[static_cast<std::size_t>(f)]);
-      if (list.size() <= i) list.resize(i + 1, -1);
-      list[i] = f;
-    }
     for (std::int32_t v = 0; v < static_cast<std::int32_t>(mesh.num_vertices()); ++v) {
       auto& list =
           vertex_of_part[static_cast<std::size_t>(mesh.vertex_part[static_cast<std::size_t>(v)])];
@@ -504,9 +508,6 @@ struct EventTracker::Impl {
               NewFinding{.a = a, .b = b, .dcd = true, .label = &p.label, .faces = {a, b}});
         }
       }
-      totals.new_dcd_pairs += c.new_dcd_pairs;
-      totals.baseline_dcd_pairs += c.baseline_dcd_pairs;
-      totals.allowed_dcd_pairs += c.allowed_dcd_pairs;
     }
     if (ccd != nullptr) {
       auto& c = ccd->row.counters;
@@ -536,9 +537,6 @@ struct EventTracker::Impl {
           fresh.push_back(std::move(n));
         }
       }
-      totals.new_ccd_contacts += c.new_ccd_contacts;
-      totals.baseline_ccd_contacts += c.baseline_ccd_contacts;
-      totals.allowed_ccd_contacts += c.allowed_ccd_contacts;
     }
     const std::int32_t sample = dcd != nullptr ? dcd->row.sample : ccd->row.sample + 1;
     const double t_sample = dcd != nullptr ? dcd->row.t0 : ccd->row.t1;
@@ -811,7 +809,6 @@ std::vector<FrameReport> EventTracker::flush() {
 }
 
 const std::vector<EventRecord>& EventTracker::events() const { return impl_->events; }
-const EventTotals& EventTracker::totals() const { return impl_->totals; }
 
 const std::string& EventTracker::triangle_bone(std::int32_t f) const {
   const auto d = impl_->face_driver[static_cast<std::size_t>(f)];
@@ -859,14 +856,10 @@ BaselineFindings baseline_findings(
         std::to_string(log.header.part_names.size()) + " parts; this model has " +
         std::to_string(mesh.num_triangles()) + " in " + std::to_string(mesh.num_parts()) + ")");
   }
-  std::vector<std::vector<std::int32_t>> face_of_part(static_cast<std::size_t>(mesh.num_parts()));
+  const auto face_of_part = faces_by_part(mesh);
+  // A vertex's first triangle, per part in the file's numbering (a VF contact's vertex side).
   std::vector<std::vector<std::int32_t>> vertex_face(static_cast<std::size_t>(mesh.num_parts()));
   for (std::int32_t f = 0; f < static_cast<std::int32_t>(mesh.num_triangles()); ++f) {
-    auto& list =
-        face_of_part[static_cast<std::size_t>(mesh.face_part[static_cast<std::size_t>(f)])];
-    const auto i = static_cast<std::size_t>(mesh.face_index_in_part[static_cast<std::size_t>(f)]);
-    if (list.size() <= i) list.resize(i + 1, -1);
-    list[i] = f;
     for (int k = 0; k < 3; ++k) {
       const auto v = static_cast<std::size_t>(mesh.triangles(f, k));
       auto& vl = vertex_face[static_cast<std::size_t>(mesh.vertex_part[v])];

@@ -88,16 +88,6 @@ struct BaselineFindings {
   std::vector<std::pair<std::int32_t, std::int32_t>> pairs;
 };
 
-/// Totals of the labelled findings of a run.
-struct EventTotals {
-  std::int64_t new_dcd_pairs = 0;
-  std::int64_t new_ccd_contacts = 0;
-  std::int64_t baseline_dcd_pairs = 0;
-  std::int64_t baseline_ccd_contacts = 0;
-  std::int64_t allowed_dcd_pairs = 0;
-  std::int64_t allowed_ccd_contacts = 0;
-};
-
 /// Labels every finding of a run (FrameReport rows in run order) against the baseline and the
 /// allowances and groups the new ones into events (docs/events.md). Rows go in through push()
 /// and come out labelled, in the same order; a CCD row is held until the DCD row of the sample
@@ -128,7 +118,6 @@ class EventTracker {
 
   /// The events so far (complete after flush()), by id.
   [[nodiscard]] const std::vector<EventRecord>& events() const;
-  [[nodiscard]] const EventTotals& totals() const;
   /// The name of the bone (node, link) driving triangle f, "" when none.
   [[nodiscard]] const std::string& triangle_bone(std::int32_t f) const;
 

@@ -242,9 +242,9 @@ TEST(BaselineEvents, AClipCheckedAgainstALogOfItselfHasNoNewEvent) {
       QuerySet::both,
       window);
   EXPECT_TRUE(again.outcome.events.empty());
-  EXPECT_EQ(again.outcome.totals.new_dcd_pairs, 0);
-  EXPECT_EQ(again.outcome.totals.new_ccd_contacts, 0);
-  EXPECT_EQ(again.outcome.totals.baseline_dcd_pairs, first.outcome.summary.dcd_pairs);
+  EXPECT_EQ(again.outcome.summary.new_dcd_pairs, 0);
+  EXPECT_EQ(again.outcome.summary.new_ccd_contacts, 0);
+  EXPECT_EQ(again.outcome.summary.baseline_dcd_pairs, first.outcome.summary.dcd_pairs);
   // A log of another model is refused, naming the log.
   try {
     (void)check(
@@ -261,7 +261,7 @@ TEST(BaselineEvents, AClipCheckedAgainstALogOfItselfHasNoNewEvent) {
 TEST(AllowedEvents, AllowingThePartsOfEveryEventLeavesNothingNew) {
   const auto model = skinning::load_model("gen:panda");
   const auto run = check(model, at_sample(0), QuerySet::dcd);
-  ASSERT_GT(run.outcome.totals.new_dcd_pairs, 0);
+  ASSERT_GT(run.outcome.summary.new_dcd_pairs, 0);
   std::set<std::string> rules;
   const auto& m = *model.mesh;
   for (const auto& r : run.reports) {
@@ -277,8 +277,8 @@ TEST(AllowedEvents, AllowingThePartsOfEveryEventLeavesNothingNew) {
   const auto allowed = check(model, at_sample(0), QuerySet::dcd, {}, allow);
   expect_rows_account_for_every_finding(allowed);
   EXPECT_TRUE(allowed.outcome.events.empty());
-  EXPECT_EQ(allowed.outcome.totals.new_dcd_pairs, 0);
-  EXPECT_EQ(allowed.outcome.totals.allowed_dcd_pairs, run.outcome.totals.new_dcd_pairs);
+  EXPECT_EQ(allowed.outcome.summary.new_dcd_pairs, 0);
+  EXPECT_EQ(allowed.outcome.summary.allowed_dcd_pairs, run.outcome.summary.new_dcd_pairs);
   // A name that is neither a part nor a bone is refused.
   allow.rules = {"panda_link1:no_such_part"};
   EXPECT_THROW((void)check(model, at_sample(0), QuerySet::dcd, {}, allow), InvalidInput);
@@ -443,10 +443,10 @@ TEST(RealCharacterAllowances, AdjacentBonesIncludeRigidPartsHangingFromABone) {
       Allowances{.rules = {}, .adjacent_bones = true});
   expect_rows_account_for_every_finding(allowed);
   EXPECT_FALSE(arm_and_hand(allowed.outcome));
-  EXPECT_GT(allowed.outcome.totals.allowed_dcd_pairs, 0);
+  EXPECT_GT(allowed.outcome.summary.allowed_dcd_pairs, 0);
   // Allowing is decided first: it takes from the new pairs and from the baseline's.
-  const auto& a = allowed.outcome.totals;
-  const auto& p = plain.outcome.totals;
+  const auto& a = allowed.outcome.summary;
+  const auto& p = plain.outcome.summary;
   EXPECT_LT(a.new_dcd_pairs, p.new_dcd_pairs);
   EXPECT_LE(a.baseline_dcd_pairs, p.baseline_dcd_pairs);
   EXPECT_EQ(

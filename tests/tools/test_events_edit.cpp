@@ -337,7 +337,7 @@ TEST_P(EditedClip, ReportsANewEventOfTheLimbInTheWindowAndNothingElseChanges) {
     EXPECT_GE(e.first_sample, edit.ramp_start) << "event " << e.id << " of the limb";
     EXPECT_LE(e.last_sample, edit.ramp_end) << "event " << e.id << " of the limb";
   }
-  EXPECT_GT(after.outcome.totals.new_dcd_pairs, before.outcome.totals.new_dcd_pairs);
+  EXPECT_GT(after.outcome.summary.new_dcd_pairs, before.outcome.summary.new_dcd_pairs);
 
   // The unedited clip: no event of the limb there.
   for (const auto& e : before.outcome.events) {
