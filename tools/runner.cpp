@@ -326,19 +326,6 @@ std::int32_t resolve_threads(std::int32_t threads) {
   return threads;
 }
 
-std::string serial_reason(std::string_view name, const RunOptions& options) {
-  const culling::MethodInfo* m = culling::find_method(name);
-  if (m == nullptr) return "method " + std::string(name) + " is not known (not registered)";
-  if (!m->serial_reason) return {};
-  culling::MethodOptions o;
-  o.accuracy = options.accuracy;
-  o.min_separation = options.min_separation;
-  o.segmentation = options.segmentation;
-  o.parameters = options.method_parameters;
-  o.num_bones = options.segmentation ? 1 : 0;  // bone poses come with a segmentation (a rig's clip)
-  return m->serial_reason(o, options.query != QuerySet::ccd);
-}
-
 ClipRunner::ClipRunner(
     const skinning::Motion& motion, const RunOptions& options, MethodFactory factory)
     : motion_(motion),

@@ -75,11 +75,6 @@ struct RunPlan {
   std::string serial_reason;
 };
 
-/// Why method `name` must run serially under `options` (empty: parallel runs give the same rows):
-/// what the method declares (culling::MethodInfo::serial_reason; rvbc/dynamic carry which
-/// components were free of self-intersection from one query to the next).
-[[nodiscard]] std::string serial_reason(std::string_view name, const RunOptions& options);
-
 /// The worker count `--threads N` means: N, or all cores for 0.
 [[nodiscard]] std::int32_t resolve_threads(std::int32_t threads);
 

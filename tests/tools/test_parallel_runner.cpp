@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "clustering/bone_poses.hpp"
+#include "culling/method_registry.hpp"
 #include "segmentation/segmentation.hpp"
 #include "skinning/errors.hpp"
 #include "skinning/load.hpp"
@@ -262,19 +263,24 @@ TEST(ParallelRunner, ThreadsResolveAndStatefulRunsStaySerial) {
   EXPECT_EQ(resolve_threads(3), 3);
   EXPECT_THROW_MESSAGE((void)resolve_threads(-1), InvalidInput, "--threads -1");
 
-  RunOptions o;
-  EXPECT_EQ(serial_reason("bvh", o), "");
-  EXPECT_EQ(serial_reason("dynamic", o), "");
-  o.query = QuerySet::ccd;
-  EXPECT_NE(serial_reason("dynamic", o).find("--query ccd"), std::string::npos);
-  EXPECT_NE(serial_reason("rvbc", o).find("--query ccd"), std::string::npos);
-  EXPECT_EQ(serial_reason("bvh", o), "");
-  o.query = QuerySet::both;
+  // The registry is the one source of why a method runs serially (MethodInfo::serial_reason),
+  // given its options and whether a DCD precedes every CCD interval (not under --query ccd).
+  const auto serial_reason = [](std::string_view name, const culling::MethodOptions& o, bool dcd) {
+    const culling::MethodInfo* m = culling::find_method(name);
+    EXPECT_NE(m, nullptr) << name;
+    return m != nullptr && m->serial_reason ? m->serial_reason(o, dcd) : std::string();
+  };
+  culling::MethodOptions o;
+  EXPECT_EQ(serial_reason("bvh", o, true), "");
+  EXPECT_EQ(serial_reason("dynamic", o, true), "");
+  EXPECT_NE(serial_reason("dynamic", o, false).find("--query ccd"), std::string::npos);
+  EXPECT_NE(serial_reason("rvbc", o, false).find("--query ccd"), std::string::npos);
+  EXPECT_EQ(serial_reason("bvh", o, false), "");
   o.accuracy = ccd::Accuracy::fast;
-  EXPECT_NE(serial_reason("dynamic", o).find("--accuracy fast"), std::string::npos);
+  EXPECT_NE(serial_reason("dynamic", o, true).find("--accuracy fast"), std::string::npos);
   o.min_separation = 0.01;  // nothing is skipped: the carried state is unused
-  EXPECT_EQ(serial_reason("dynamic", o), "");
-  EXPECT_NE(serial_reason("someone-elses", RunOptions{}).find("not known"), std::string::npos);
+  EXPECT_EQ(serial_reason("dynamic", o, true), "");
+  EXPECT_EQ(culling::find_method("someone-elses"), nullptr);
 
   // Through the runner: a custom factory's methods are serial unless declared stateless, and
   // dynamic on --query ccd is serial with the reason in the plan.
