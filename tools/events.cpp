@@ -165,6 +165,9 @@ double intersection_length(
 
 /// Samples an event may go unseen and still continue when a region touches its last triangles.
 constexpr std::int32_t kEventGap = 2;
+/// … or within this many seconds, whichever is longer: at 120 Hz two samples are 17 ms, and a
+/// contact that flickers for a tenth of a second is still the same contact.
+constexpr double kEventGapSeconds = 0.1;
 
 struct EventTracker::Impl {
   const skinning::Mesh& mesh;
@@ -208,6 +211,7 @@ struct EventTracker::Impl {
   /// step's sample. A region links to an event seen within kEventGap samples before it.
   struct Footprint {
     std::int32_t sample = 0;
+    double time = 0;
     std::vector<std::int32_t> faces;
   };
   std::map<std::int32_t, Footprint> recent;
@@ -540,8 +544,10 @@ struct EventTracker::Impl {
     }
     const std::int32_t sample = dcd != nullptr ? dcd->row.sample : ccd->row.sample + 1;
     const double t_sample = dcd != nullptr ? dcd->row.t0 : ccd->row.t1;
-    std::erase_if(
-        recent, [&](const auto& entry) { return sample - entry.second.sample > kEventGap + 1; });
+    std::erase_if(recent, [&](const auto& entry) {
+      return sample - entry.second.sample > kEventGap + 1 &&
+             t_sample - entry.second.time > kEventGapSeconds;
+    });
     if (fresh.empty()) return;
     std::unordered_map<std::int32_t, std::int32_t> previous_owner;  // triangle → linkable event
     for (const auto& [e, footprint] : recent) {
@@ -686,7 +692,7 @@ struct EventTracker::Impl {
     for (auto& [e, list] : footprints) {
       std::sort(list.begin(), list.end());
       list.erase(std::unique(list.begin(), list.end()), list.end());
-      recent[e] = Footprint{sample, std::move(list)};
+      recent[e] = Footprint{sample, t_sample, std::move(list)};
     }
     std::erase_if(recent, [&](const auto& entry) {
       return events[static_cast<std::size_t>(entry.first)].merged_into >= 0;
