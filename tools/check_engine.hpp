@@ -25,7 +25,7 @@ struct CheckRequest {
   std::string clip;   ///< empty: the model's first clip (its bind pose when it has none)
   double fps = 0;     ///< samples per second; 0: the clip's frame rate, else 30
   FrameRange frames;  ///< samples first … last
-  std::string method = "bvh";
+  std::string method = "auto";
   ccd::Accuracy accuracy = ccd::Accuracy::conservative;
   QuerySet query = QuerySet::both;
   double min_separation = 0;        ///< contact distance, model units

@@ -48,7 +48,7 @@ struct CheckArguments {
   std::string clip;
   double fps = 0;
   std::string frames;
-  std::string method = "bvh";
+  std::string method = "auto";  // docs/benchmarks.md, "auto against bvh: the default method"
   std::string accuracy = "conservative";
   std::string query = "both";
   double min_separation = 0;

@@ -171,7 +171,7 @@ def _call_text(name: str, arguments: dict) -> str:
 
 
 def check(model_or_path: Union[Model, str, os.PathLike], clip: Optional[str] = None,
-          fps: float = 0, frames=None, method: str = "bvh", accuracy: str = "conservative",
+          fps: float = 0, frames=None, method: str = "auto", accuracy: str = "conservative",
           query: str = "both", min_separation: float = 0.0, threads: int = 1,
           log: Union[str, os.PathLike, None] = None, gamma: float = 0.05, seed: int = 1,
           segmentation: Union[str, os.PathLike, None] = None, baseline: str = "rest",
