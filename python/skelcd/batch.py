@@ -174,7 +174,7 @@ def _client(scheduler, n_workers: Optional[int]):
 
 
 def run(models: Sequence, out_dir, *, clips: Optional[Sequence[str]] = None, all_clips: bool = False,
-        methods: Sequence[str] = ("bvh",), scheduler=None, n_workers: Optional[int] = None,
+        methods: Sequence[str] = ("auto",), scheduler=None, n_workers: Optional[int] = None,
         progress: Optional[bool] = None, trajectory=None, srdf=None, package_path=(),
         **check_options) -> BatchResult:
     """Checks models × clips × methods on a Dask cluster, one log per clip in `out_dir`.
@@ -269,7 +269,7 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
     parser.add_argument("-o", "--output-dir", required=True, help="folder for the logs (MODEL-CLIP.h5)")
     parser.add_argument("--clip", action="append", help="clip to check (repeatable; default: the first)")
     parser.add_argument("--all-clips", action="store_true", help="every usable clip of each model")
-    parser.add_argument("--method", action="append", help="culling method (repeatable; default bvh)")
+    parser.add_argument("--method", action="append", help="culling method (repeatable; default auto, as skelcd check)")
     parser.add_argument("--accuracy", default="conservative")
     parser.add_argument("--query", default="both")
     parser.add_argument("--fps", type=float, default=0.0)
@@ -277,7 +277,7 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
     parser.add_argument("--workers", type=int, help="local worker processes (default: one per core)")
     args = parser.parse_args(argv)
     result = run(args.models, args.output_dir, clips=args.clip, all_clips=args.all_clips,
-                 methods=args.method or ["bvh"], scheduler=args.scheduler, n_workers=args.workers,
+                 methods=args.method or ["auto"], scheduler=args.scheduler, n_workers=args.workers,
                  accuracy=args.accuracy, query=args.query, fps=args.fps)
     checks = len(result.done) + len(result.skipped) + len(result.failures)
     print(f"batch     {checks} checks: {len(result.done)} done, {len(result.skipped)} skipped "

@@ -193,12 +193,13 @@ TEST(BadInputCli, AFullDiskIsOneLineAndTheRowsWrittenStayReadable) {
   const auto readable = dir / "readable.txt";
   // Under AddressSanitizer the check runs without leak detection: libhdf5 keeps the buffer of
   // the write that failed (40 KB, allocated and lost inside the library), which is not ours.
-  const std::string script =
-      "mount -t tmpfs -o size=60k none '" + mount_point.string() +
-      "' && ASAN_OPTIONS=detect_leaks=0 '" + SKELCD_EXE + "' check '" +
-      asset("characters/CesiumMan.glb").string() + "' --threads 1 -o '" + log.string() +
-      "' > /dev/null 2> '" + err.string() + "'; echo \\$? > '" + dir.string() + "/rc'; '" +
-      SKELCD_EXE + "' inspect --csv '" + log.string() + "' > '" + readable.string() + "' 2>&1";
+  const std::string script = "mount -t tmpfs -o size=60k none '" + mount_point.string() +
+                             "' && ASAN_OPTIONS=detect_leaks=0 '" + SKELCD_EXE + "' check '" +
+                             asset("characters/CesiumMan.glb").string() +
+                             "' --method bvh --threads 1 -o '" + log.string() +
+                             "' > /dev/null 2> '" + err.string() + "'; echo \\$? > '" +
+                             dir.string() + "/rc'; '" + SKELCD_EXE + "' inspect --csv '" +
+                             log.string() + "' > '" + readable.string() + "' 2>&1";
   const std::string command = "unshare -rm sh -c \"" + script + "\"";
   ASSERT_EQ(std::system(command.c_str()), 0) << command;
   EXPECT_EQ(read_text(dir / "rc"), "1\n");

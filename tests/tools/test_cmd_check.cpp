@@ -77,7 +77,7 @@ TEST(CmdCheck, JsonSummaryMatchesTheLogItWrote) {
 
   const auto log = read_log(log_path);
   EXPECT_TRUE(log.header.complete);
-  EXPECT_EQ(log.header.method, "bvh");
+  EXPECT_EQ(log.header.method, "auto");
   EXPECT_EQ(log.header.input_path, kModel);
   EXPECT_EQ(log.header.input_hash.rfind("fnv1a64:", 0), 0u);
   EXPECT_EQ(log.header.first_sample, 10);

@@ -419,6 +419,27 @@ TEST(RealCharacterBaselines, ABaselineAtSampleKLeavesNothingNewAtK) {
 namespace skelcd::tools {
 namespace {
 
+// A real character's clip checked against a log of itself has nothing new: CesiumMan's walk has
+// events against its rest pose, none against its own log (DCD pairs and CCD contacts both).
+TEST(RealCharacterBaselines, AClipAgainstALogOfItselfHasNoNewEvent) {
+  const auto model = skinning::load_model(test::asset("characters/CesiumMan.glb"));
+  const auto dir = test::temp_dir("events-self-log");
+  const auto log = (dir / "walk.h5").string();
+  const FrameRange frames{.first = 8, .last = 16};
+  const auto first = check(model, BaselineSpec{}, QuerySet::both, frames, {}, log);
+  ASSERT_FALSE(roots(first.outcome).empty());
+  const auto again = check(
+      model,
+      BaselineSpec{.kind = BaselineSpec::Kind::log, .sample = 0, .log_path = log},
+      QuerySet::both,
+      frames);
+  expect_rows_account_for_every_finding(again);
+  EXPECT_TRUE(again.outcome.events.empty());
+  EXPECT_EQ(again.outcome.summary.new_dcd_pairs, 0);
+  EXPECT_EQ(again.outcome.summary.new_ccd_contacts, 0);
+  EXPECT_EQ(again.outcome.summary.dcd_pairs, first.outcome.summary.dcd_pairs);
+}
+
 // RobotExpressive's rigid arm meshes hang from nodes beside the lower-arm bones (both under the
 // upper arm): with --allow-adjacent-bones their contact with the hands is allowed, not an event.
 TEST(RealCharacterAllowances, AdjacentBonesIncludeRigidPartsHangingFromABone) {
