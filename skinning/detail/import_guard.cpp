@@ -6,6 +6,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <array>
 #include <cctype>
 #include <cerrno>
 #include <chrono>
@@ -14,9 +15,13 @@
 #include <cstdio>
 #include <cstring>
 #include <fstream>
+#include <limits>
+#include <map>
 #include <new>
 #include <sstream>
 #include <string>
+#include <string_view>
+#include <utility>
 #include <vector>
 
 #include "skinning/errors.hpp"
@@ -187,6 +192,427 @@ void check_ply(const std::filesystem::path& file, std::uintmax_t size) {
   if (need > static_cast<long double>(size)) too_many(file.string(), declared, need, size);
 }
 
+// MD5 mesh (.md5mesh, assimp 5.2's MD5 loader). The loader indexes its arrays with the file's
+// numbers unchecked: a vertex's weights (`vert I ( U V ) FIRST COUNT`) beyond the mesh's weights,
+// a weight's joint beyond the joints, a triangle's corner beyond the vertices, a triangle that
+// `numtris` declares but no `tri` line gives (a null index array) — it reads, and for a joint
+// writes, outside its buffers (found by fuzz_assimp_import: fuzz/crashes/assimp/md5mesh_*). Its
+// parser also reads past the end of the text when the file stops where a value or a quoted name
+// is expected. This walks the text as that parser does (the same section and element splits),
+// reads the elements the loader indexes with in their strict form — one assimp would only warn
+// about, and read on from wherever it stopped, is refused — and refuses what would send the
+// loader outside its arrays. A valid file passes untouched.
+class Md5MeshCheck {
+ public:
+  Md5MeshCheck(std::string file, std::string text)
+      : file_(std::move(file)), text_(std::move(text)), b_(text_ + '\0'), n_(text_.size()) {}
+
+  void run() {
+    remove_line_comments();
+    if (!header()) return;  // not MD5 version 10: assimp refuses it itself
+    std::vector<Section> sections;
+    while (true) {
+      const std::size_t start = pos_;
+      sections.emplace_back();
+      if (!section(sections.back())) break;
+      // A form feed where a section starts: assimp's parser neither reads it nor steps over it,
+      // and adds empty sections for ever (until memory runs out).
+      if (pos_ == start)
+        refuse(
+            "MD5 line " + std::to_string(line_of(start)) +
+            ": a form feed where a section starts (assimp's MD5 reader would loop for ever)");
+    }
+    std::uint64_t joints = 0;
+    std::vector<Mesh> meshes;
+    for (const auto& s : sections) {
+      if (s.name == "joints") {
+        for (const auto e : s.elements) {
+          joint(e);
+          ++joints;
+        }
+      } else if (s.name == "mesh") {
+        meshes.push_back(mesh(s));
+      }
+    }
+    for (std::size_t m = 0; m < meshes.size(); ++m) indices(meshes[m], m + 1, joints);
+  }
+
+ private:
+  struct Section {
+    std::string name;
+    std::size_t at = 0;
+    std::vector<std::size_t> elements;  // offsets of the element texts (ended by '\0' in b_)
+  };
+  struct Mesh {
+    std::size_t line = 0;
+    // The array sizes as the parser resizes them, and what the lines give (by index).
+    std::uint64_t vertices = 0, triangles = 0, weights = 0;
+    std::map<std::uint32_t, std::pair<std::uint32_t, std::uint32_t>> vertex_weights;
+    std::map<std::uint32_t, std::array<std::uint32_t, 3>> corners;
+    std::map<std::uint32_t, std::uint32_t> weight_joint;
+  };
+
+  static bool space(char c) { return c == ' ' || c == '\t'; }
+  static bool line_end(char c) { return c == '\r' || c == '\n' || c == '\0' || c == '\f'; }
+  static bool space_or_line_end(char c) { return space(c) || line_end(c); }
+
+  std::size_t line_of(std::size_t offset) const {
+    return 1 + static_cast<std::size_t>(std::count(
+                   text_.begin(),
+                   text_.begin() + static_cast<std::ptrdiff_t>(std::min(offset, n_)),
+                   '\n'));
+  }
+
+  [[noreturn]] void refuse(const std::string& what) const {
+    throw InvalidInput(file_ + ": " + what);
+  }
+
+  // The character at `p`; the parser reading beyond the text's terminating NUL is a refusal.
+  char at(std::size_t p) const {
+    if (p > n_)
+      refuse(
+          "the MD5 text ends where assimp's MD5 reader expects more (it would read past the end of "
+          "the file)");
+    return b_[p];
+  }
+
+  void skip_spaces(std::size_t& p) const {
+    while (space(at(p))) ++p;
+  }
+  bool skip_spaces_and_line_ends(std::size_t& p) const {
+    while (space(at(p)) || at(p) == '\r' || at(p) == '\n') ++p;
+    return at(p) != '\0';
+  }
+  // assimp's TokenMatch: the word, then a space or line end (stepped over unless the NUL).
+  bool token(std::size_t& p, std::string_view word) const {
+    for (std::size_t i = 0; i < word.size(); ++i) {
+      if (at(p + i) != word[i]) return false;
+    }
+    const char next = at(p + word.size());
+    if (!space_or_line_end(next)) return false;
+    p += word.size() + (next != '\0' ? 1 : 0);
+    return true;
+  }
+  // After a number: what may follow it for assimp to stop where this reading stops.
+  bool number_end(std::size_t p) const {
+    const char c = at(p);
+    return space(c) || c == '\0' || c == '(' || c == ')';
+  }
+
+  // CommentRemover::RemoveLineComments("//", …, ' '), which assimp runs over the text first. It
+  // steps over quotes ('"' or '\'') to the next quote character, and past the end of the text when
+  // there is none.
+  void remove_line_comments() {
+    std::size_t p = 0;
+    while (at(p) != '\0') {
+      if (at(p) == '"' || at(p) == '\'') {
+        while (true) {
+          const char c = at(p++);
+          if (c == '\0' || at(p) == '"' || at(p) == '\'') break;
+        }
+      }
+      if (at(p) == '/' && at(p + 1) == '/') {
+        while (!line_end(at(p))) b_[p++] = ' ';
+        if (at(p) == '\0') break;
+      }
+      ++p;
+    }
+  }
+
+  bool header() {
+    std::size_t p = 0;
+    skip_spaces(p);
+    if (!token(p, "MD5Version")) return false;
+    skip_spaces(p);
+    std::uint32_t version = 0;
+    while (at(p) >= '0' && at(p) <= '9')
+      version = version * 10 + static_cast<std::uint32_t>(at(p++) - '0');
+    if (version != 10) return false;
+    while (at(p) != '\r' && at(p) != '\n' && at(p) != '\0') ++p;  // the rest of the line
+    while (at(p) == '\r' || at(p) == '\n') ++p;
+    while (!line_end(at(p++))) {
+    }  // the command line, through its line end
+    skip_spaces_and_line_ends(p);
+    pos_ = p;
+    return true;
+  }
+
+  // MD5Parser::ParseSection: "name [value…] { element lines }" or "name value".
+  bool section(Section& s) {
+    std::size_t& p = pos_;
+    s.at = p;
+    const std::size_t start = p;
+    while (!space_or_line_end(at(p))) ++p;
+    s.name = b_.substr(start, p - start);
+    skip_spaces(p);
+    while (true) {
+      if (at(p) == '{') {
+        ++p;
+        while (true) {
+          if (!skip_spaces_and_line_ends(p)) return false;
+          if (at(p) == '}') {
+            ++p;
+            break;
+          }
+          s.elements.push_back(p);
+          while (!line_end(at(p))) ++p;
+          if (at(p) != '\0') b_[p++] = '\0';
+        }
+        break;
+      }
+      if (!space_or_line_end(at(p))) {
+        while (!space_or_line_end(at(p++))) {
+        }  // a value at global scope, through the character after it
+        continue;
+      }
+      break;
+    }
+    return skip_spaces_and_line_ends(p);
+  }
+
+  bool read_uint(std::size_t& p, std::uint32_t& value) const {
+    if (at(p) < '0' || at(p) > '9') return false;
+    std::uint64_t v = 0;
+    while (at(p) >= '0' && at(p) <= '9') {
+      v = v * 10 + static_cast<std::uint64_t>(at(p++) - '0');
+      if (v > std::numeric_limits<std::uint32_t>::max()) return false;
+    }
+    value = static_cast<std::uint32_t>(v);
+    return number_end(p);
+  }
+
+  bool read_int(std::size_t& p) const {
+    if (at(p) == '-' || at(p) == '+') ++p;
+    std::uint32_t ignored = 0;
+    return read_uint(p, ignored);
+  }
+
+  // A decimal number as assimp's fast_atoreal_move reads it whole (nan, inf, infinity too).
+  bool read_float(std::size_t& p) const {
+    if (at(p) == '-' || at(p) == '+') ++p;
+    for (const std::string_view word : {"infinity", "inf", "nan"}) {
+      bool match = true;
+      for (std::size_t i = 0; i < word.size() && match; ++i) {
+        match = std::tolower(static_cast<unsigned char>(at(p + i))) == word[i];
+      }
+      if (match) {
+        p += word.size();
+        return number_end(p);
+      }
+    }
+    const auto digits = [&] {
+      std::size_t count = 0;
+      while (at(p) >= '0' && at(p) <= '9') ++p, ++count;
+      return count;
+    };
+    std::size_t mantissa = digits();
+    if (at(p) == '.') {
+      ++p;
+      mantissa += digits();
+    }
+    if (mantissa == 0) return false;
+    if (at(p) == 'e' || at(p) == 'E') {
+      ++p;
+      if (at(p) == '-' || at(p) == '+') ++p;
+      if (digits() == 0) return false;
+    }
+    return number_end(p);
+  }
+
+  bool expect(std::size_t& p, char c) const {
+    skip_spaces(p);
+    if (at(p) != c) return false;
+    ++p;
+    return true;
+  }
+  bool uint_field(std::size_t& p, std::uint32_t& value) const {
+    skip_spaces(p);
+    return read_uint(p, value);
+  }
+  bool int_field(std::size_t& p) const {
+    skip_spaces(p);
+    return read_int(p);
+  }
+  bool float_field(std::size_t& p) const {
+    skip_spaces(p);
+    return read_float(p);
+  }
+
+  // A name in quotes within the element (assimp scans to the next quote wherever it is, and
+  // copies the name into a 1024-byte string).
+  bool quoted(std::size_t& p) const {
+    std::size_t q = p;
+    while (at(q) != '"' && at(q) != '\0') ++q;
+    if (at(q) != '"') return false;
+    const std::size_t begin = ++q;
+    while (at(q) != '"' && at(q) != '\0') ++q;
+    if (at(q) != '"' || q - begin >= 1024) return false;
+    p = q + 1;
+    return true;
+  }
+
+  [[noreturn]] void unreadable(std::size_t element, const char* form) const {
+    refuse(
+        "MD5 line " + std::to_string(line_of(element)) + " is not `" + form +
+        "` (assimp's MD5 reader would read on from wherever it stopped)");
+  }
+
+  // "name" PARENT ( X Y Z ) ( QX QY QZ )
+  void joint(std::size_t e) const {
+    std::size_t p = e;
+    const bool ok = at(p) == '"' && quoted(p) && int_field(p) && expect(p, '(') && float_field(p) &&
+                    float_field(p) && float_field(p) && expect(p, ')') && expect(p, '(') &&
+                    float_field(p) && float_field(p) && float_field(p) && expect(p, ')');
+    if (!ok) unreadable(e, "\"NAME\" PARENT ( X Y Z ) ( QX QY QZ )");
+  }
+
+  static void resize(std::uint64_t& size, std::uint32_t count, auto& given) {
+    size = count;
+    given.erase(given.lower_bound(count), given.end());
+  }
+  void grow(std::uint64_t& size, std::uint32_t index, std::size_t e) const {
+    // idx + 1 wraps to 0 in assimp's unsigned int: the array shrinks to nothing, then is indexed.
+    if (index == std::numeric_limits<std::uint32_t>::max())
+      refuse("MD5 line " + std::to_string(line_of(e)) + ": index 4294967295 is out of range");
+    if (index >= size) size = std::uint64_t{index} + 1;
+  }
+
+  Mesh mesh(const Section& s) const {
+    Mesh m;
+    m.line = line_of(s.at);
+    for (const auto e : s.elements) {
+      std::size_t p = e;
+      std::uint32_t index = 0;
+      std::uint32_t count = 0;
+      if (token(p, "shader")) {
+        skip_spaces(p);
+        if (!quoted(p)) unreadable(e, "shader \"NAME\"");
+      } else if (token(p, "numverts")) {
+        if (!uint_field(p, count)) unreadable(e, "numverts COUNT");
+        resize(m.vertices, count, m.vertex_weights);
+      } else if (token(p, "numtris")) {
+        if (!uint_field(p, count)) unreadable(e, "numtris COUNT");
+        resize(m.triangles, count, m.corners);
+      } else if (token(p, "numweights")) {
+        if (!uint_field(p, count)) unreadable(e, "numweights COUNT");
+        resize(m.weights, count, m.weight_joint);
+      } else if (token(p, "vert")) {
+        std::uint32_t first = 0;
+        if (!(uint_field(p, index) && expect(p, '(') && float_field(p) && float_field(p) &&
+              expect(p, ')') && uint_field(p, first) && uint_field(p, count)))
+          unreadable(e, "vert INDEX ( U V ) FIRST_WEIGHT WEIGHT_COUNT");
+        grow(m.vertices, index, e);
+        m.vertex_weights[index] = {first, count};
+      } else if (token(p, "tri")) {
+        std::array<std::uint32_t, 3> c{};
+        if (!(uint_field(p, index) && uint_field(p, c[0]) && uint_field(p, c[1]) &&
+              uint_field(p, c[2])))
+          unreadable(e, "tri INDEX VERTEX VERTEX VERTEX");
+        grow(m.triangles, index, e);
+        m.corners[index] = c;
+      } else if (token(p, "weight")) {
+        std::uint32_t joint = 0;
+        if (!(uint_field(p, index) && uint_field(p, joint) && float_field(p) && expect(p, '(') &&
+              float_field(p) && float_field(p) && float_field(p) && expect(p, ')')))
+          unreadable(e, "weight INDEX JOINT BIAS ( X Y Z )");
+        grow(m.weights, index, e);
+        m.weight_joint[index] = joint;
+      }
+    }
+    return m;
+  }
+
+  // What MD5Importer::MakeDataUnique and LoadMD5MeshFile index with.
+  void indices(const Mesh& m, std::size_t number, std::uint64_t joints) const {
+    if (m.triangles == 0 || m.vertices == 0) return;  // skipped by the loader
+    const std::string name =
+        "MD5 mesh " + std::to_string(number) + " (line " + std::to_string(m.line) + ")";
+    if (3 * m.triangles > std::numeric_limits<std::uint32_t>::max())
+      refuse(
+          name + " declares " + std::to_string(m.triangles) +
+          " triangles, more than assimp's MD5 reader can count");
+    if (m.corners.size() < m.triangles) {
+      std::uint64_t missing = 0;
+      for (const auto& [index, corners] : m.corners) {
+        if (index != missing) break;
+        ++missing;
+      }
+      refuse(
+          name + " declares " + std::to_string(m.triangles) +
+          " triangles but gives no `tri` line for triangle " + std::to_string(missing));
+    }
+    // MakeDataUnique gives every repeated corner a new vertex after the old ones, in an array of
+    // 3 x triangles: a vertex no triangle uses leaves one slot too few (it writes past the array).
+    if (m.vertices > 3 * m.triangles)
+      refuse(
+          name + " has " + std::to_string(m.vertices) + " vertices, more than its " +
+          std::to_string(m.triangles) +
+          " triangles can use (assimp's MD5 reader would write past its vertex array)");
+    std::vector<bool> used(static_cast<std::size_t>(m.vertices));
+    for (const auto& [index, corners] : m.corners) {
+      for (const auto v : corners) {
+        if (v >= m.vertices)
+          refuse(
+              name + ": triangle " + std::to_string(index) + " uses vertex " + std::to_string(v) +
+              ", but the mesh has " + std::to_string(m.vertices) + " vertices");
+        used[v] = true;
+      }
+    }
+    if (const auto unused = std::find(used.begin(), used.end(), false); unused != used.end())
+      refuse(
+          name + ": vertex " + std::to_string(unused - used.begin()) +
+          " is in no triangle (assimp's MD5 reader would write past its vertex array)");
+    // The given weights whose joint does not exist, and all given weights, by index.
+    std::vector<std::uint32_t> bad;
+    std::vector<std::uint32_t> given;
+    for (const auto& [index, joint] : m.weight_joint) {
+      given.push_back(index);
+      if (joint >= joints) bad.push_back(index);
+    }
+    for (const auto& [vertex, range] : m.vertex_weights) {
+      const auto [first, count] = range;
+      if (count == 0) continue;
+      const std::uint64_t end = std::uint64_t{first} + count;
+      if (end > m.weights)
+        refuse(
+            name + ": vertex " + std::to_string(vertex) + " uses weights " + std::to_string(first) +
+            " to " + std::to_string(end - 1) + ", but the mesh has " + std::to_string(m.weights) +
+            " weights");
+      const auto b = std::lower_bound(bad.begin(), bad.end(), first);
+      if (b != bad.end() && *b < end)
+        refuse(
+            name + ": weight " + std::to_string(*b) + " names joint " +
+            std::to_string(m.weight_joint.at(*b)) + ", but the file has " + std::to_string(joints) +
+            " joints");
+      const auto listed = std::lower_bound(given.begin(), given.end(), end) -
+                          std::lower_bound(given.begin(), given.end(), first);
+      if (joints == 0 && static_cast<std::uint64_t>(listed) < count)
+        refuse(
+            name + ": vertex " + std::to_string(vertex) +
+            " uses a weight without a `weight` line (joint 0), but the file has no joints");
+    }
+  }
+
+  std::string file_;
+  std::string text_;  // the file
+  std::string b_;     // the file and a NUL, split into elements as assimp's parser does
+  std::size_t n_;     // offset of that NUL
+  std::size_t pos_ = 0;
+};
+
+void check_md5mesh(const std::filesystem::path& file) {
+  std::string text;
+  try {
+    std::ifstream in(file, std::ios::binary);
+    std::ostringstream bytes;
+    bytes << in.rdbuf();
+    text = std::move(bytes).str();
+  } catch (const std::bad_alloc&) {
+    return;  // too large to look at here; the import's child process still contains assimp
+  }
+  Md5MeshCheck(file.string(), std::move(text)).run();
+}
+
 #if !defined(SKELCD_UNDER_ASAN)
 // The process's current address space, bytes (/proc/self/statm: pages).
 std::size_t mapped_bytes() {
@@ -277,6 +703,7 @@ void check_declared_counts(const std::filesystem::path& file) {
   const auto ext = lower(file.extension().string());
   if (ext == ".off") check_off(file, size);
   if (ext == ".ply") check_ply(file, size);
+  if (ext == ".md5mesh") check_md5mesh(file);
 }
 
 void run_isolated(

@@ -8,7 +8,9 @@
 #include <chrono>
 #include <csignal>
 #include <cstdlib>
+#include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <string>
 #include <thread>
 #include <vector>
@@ -148,6 +150,69 @@ TEST(ImportRobustness, DeclaredCountsBeyondTheFileSizeAreRefusedBeforeImporting)
   EXPECT_GT(import_rig(assimp_model("PLY/cube.ply")).rig.mesh.num_triangles(), 0);
 }
 
+// assimp's MD5 loader indexes its arrays with the file's numbers unchecked (found by
+// fuzz_assimp_import); the check before importing refuses what would send it outside them.
+TEST(ImportRobustness, Md5MeshesThatSendAssimpOutsideItsArraysAreRefusedBeforeImporting) {
+  const auto cube = assimp_model("MD5/SimpleCube.md5mesh");
+  std::string text;
+  {
+    std::ifstream in(cube, std::ios::binary);
+    text.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+  }
+  ASSERT_NE(text.find("vert 16 ( -0.25 -0.5 ) 14 2"), std::string::npos);
+  const auto dir = temp_dir("md5");
+  int n = 0;
+  const auto damaged = [&](const std::string& from, const std::string& to) {
+    std::string t = text;
+    const auto at = t.find(from);
+    EXPECT_NE(at, std::string::npos) << from;
+    if (at != std::string::npos) t.replace(at, from.size(), to);
+    const auto file = dir / ("damaged" + std::to_string(++n) + ".md5mesh");
+    std::ofstream(file, std::ios::binary) << t;
+    return file;
+  };
+  const auto refused = [](const std::filesystem::path& file, const std::string& message) {
+    EXPECT_THROW_MESSAGE(
+        detail::check_declared_counts(file), InvalidInput, file.string() + ": " + message);
+  };
+  // The sound file passes the check and imports.
+  detail::check_declared_counts(cube);
+  EXPECT_GT(import_rig(cube).rig.mesh.num_triangles(), 0);
+
+  refused(
+      damaged("vert 16 ( -0.25 -0.5 ) 14 2", "vert 16 ( -0.25 -0.5 ) 76 2"),
+      "MD5 mesh 1 (line 13): vertex 16 uses weights 76 to 77, but the mesh has 16 weights");
+  refused(
+      damaged("weight 3 2 ", "weight 3 7 "),
+      "MD5 mesh 1 (line 13): weight 3 names joint 7, but the file has 3 joints");
+  refused(
+      damaged("tri 11 22 20 23\n", ""),
+      "MD5 mesh 1 (line 13) declares 12 triangles but gives no `tri` line for triangle 11");
+  refused(
+      damaged("tri 9 18 16 19", "tri 9 18 16 24"),
+      "MD5 mesh 1 (line 13): triangle 9 uses vertex 24, but the mesh has 24 vertices");
+  refused(
+      damaged("numverts 24", "numverts 25"), "MD5 mesh 1 (line 13): vertex 24 is in no triangle");
+  // A NUL ends assimp's reading of the mesh (the triangles after it are never given).
+  refused(
+      damaged("tri 10 22 21 20", std::string("tri 10 22 21 20\0", 16)),
+      "MD5 mesh 1 (line 13) declares 12 triangles but gives no `tri` line for triangle 11");
+  refused(
+      damaged("vert 3 ( 0.1875 0.25 ) 6 2", "vert 3 ( 0.1875 0.25 6 2"),
+      "MD5 line 21 is not `vert");
+  // A quote with no partner: assimp's comment remover reads on past the end of the text.
+  refused(
+      damaged("weight 15 2 0.5 ( 31.9750270844 0.0196647644 -32 )\n}", "weight 15 2 \""),
+      "the MD5 text ends where assimp's MD5 reader expects more");
+  // A form feed where a section starts: assimp adds empty sections until memory runs out.
+  refused(damaged("\nmesh {", "\n\fmesh {"), "MD5 line 13: a form feed where a section starts");
+  // The joints a section swallows: "numMeshes 1" directly followed by "joints {" makes the
+  // joints the elements of a section named numMeshes, so the file has none.
+  refused(
+      damaged("numMeshes 1\n\njoints {", "numMeshes 1\njoints {"),
+      "MD5 mesh 1 (line 12): weight 0 names joint 1, but the file has 0 joints");
+}
+
 TEST(ImportGuard, AnExceptionInTheChildIsRethrownWithItsMessage) {
   const detail::ImportLimits limits{.memory_bytes = std::size_t{1} << 30, .time_s = 60};
   EXPECT_THROW_MESSAGE(
@@ -233,6 +298,9 @@ TEST(ImportRobustness, AFileThatMadeUsUseFreedMemoryImportsCleanly) {
 TEST(ImportRobustness, FilesOnWhichAssimpCrashesOrRunsAwayAreOneLineEach) {
   for (const char* f :
        {"assimp/md5mesh_null_deref.md5mesh",
+        "assimp/md5mesh_weight_out_of_range.md5mesh",
+        "assimp/collada_assert_abort.dae",
+        "assimp/ply_no_vertex_element_segv.ply",
         "assimp/triangulate_assert_abort.ply",
         "assimp/x_25gb_allocation.x",
         "assimp/x_runaway_allocation.x",
