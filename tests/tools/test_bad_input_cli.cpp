@@ -220,6 +220,18 @@ TEST(BadInputCli, AFullDiskIsOneLineAndTheRowsWrittenStayReadable) {
   const std::string rows = message.substr(rows_at, message.find(' ', rows_at) - rows_at);
   EXPECT_NE(csv.find("no (" + rows + "/"), std::string::npos)
       << "message: " << message << "\ncsv: " << csv;
+
+  // With the default method the disk fills while the first rows are set up: still one line and
+  // exit 1 — libhdf5's exit handler used to crash on the file whose close had failed (SIGSEGV).
+  const auto small_rc = dir / "rc-default";
+  const std::string again = "unshare -rm sh -c \"mount -t tmpfs -o size=60k none '" +
+                            mount_point.string() + "' && ASAN_OPTIONS=detect_leaks=0 '" +
+                            SKELCD_EXE + "' check '" + asset("characters/CesiumMan.glb").string() +
+                            "' --threads 1 -o '" + log.string() + "' > /dev/null 2> '" +
+                            err.string() + "'; echo \\$? > '" + small_rc.string() + "'\"";
+  ASSERT_EQ(std::system(again.c_str()), 0) << again;
+  EXPECT_EQ(read_text(small_rc), "1\n");
+  EXPECT_EQ(count_lines(read_text(err)), 1u) << read_text(err);
 }
 
 // --- 13. a long exact query shows progress on a terminal ------------------------------------

@@ -17,6 +17,13 @@
 namespace skelcd::tools::detail {
 namespace {
 
+// libhdf5 closes whatever is still open from an atexit handler. After a close that failed on a
+// full disk (the file's metadata could not be flushed), that handler dereferences the half-closed
+// file and the process dies with SIGSEGV after printing its one-line error. Every file we open
+// is closed explicitly, so the handler is not installed: this runs before main, before the
+// library is initialised (H5dont_atexit has no effect later).
+[[maybe_unused]] const herr_t kNoHdf5Atexit = H5dont_atexit();
+
 herr_t keep_innermost(unsigned n, const H5E_error2_t* error, void* client) {
   // Walked upward: entry 0 is the innermost (most specific) error.
   if (n == 0 && error != nullptr && error->desc != nullptr) {
