@@ -12,25 +12,25 @@ namespace skelcd::culling {
 /// shows them is generated from this list (X(name, meaning)) — the struct below, `+=`, the log's
 /// /frames columns (tools/log/detail/hdf5_schema.hpp), the log reader, `inspect --frames` and the
 /// Python module's arrays. Add a counter here and everywhere follows (docs/architecture.md).
-#define SKELCD_COUNTERS(X)                                                  \
-  X(atomic_clusters, "atomic clusters (radial-view methods)")               \
-  X(mega_clusters, "mega clusters after merging (dynamic)")                 \
-  X(h_minus, "triangles in H- (radial-view methods)")                       \
-  X(h_uncertain, "triangles in Hu (radial-view methods)")                   \
-  X(bv_tests, "bounding-volume overlap tests")                              \
-  X(candidate_pairs, "candidate triangle pairs reaching the feature stage") \
-  X(vf_tests, "vertex-face elementary tests")                               \
-  X(ee_tests, "edge-edge elementary tests")                                 \
-  X(vf_contacts, "vertex-face contacts")                                    \
-  X(ee_contacts, "edge-edge contacts")                                      \
-  X(tt_tests, "triangle-triangle DCD tests")                                \
-  X(dcd_pairs, "intersecting triangle pairs found by DCD")                  \
+#define SKELCD_COUNTERS(X)                                                              \
+  X(atomic_clusters, "atomic clusters (radial-view methods)")                           \
+  X(mega_clusters, "mega clusters after merging (dynamic)")                             \
+  X(h_minus, "triangles in H- (radial-view methods)")                                   \
+  X(h_uncertain, "triangles in Hu (radial-view methods)")                               \
+  X(bv_tests, "bounding-volume overlap tests")                                          \
+  X(candidate_pairs, "candidate triangle pairs reaching the feature stage")             \
+  X(vf_tests, "vertex-face elementary tests")                                           \
+  X(ee_tests, "edge-edge elementary tests")                                             \
+  X(vf_contacts, "vertex-face contacts")                                                \
+  X(ee_contacts, "edge-edge contacts")                                                  \
+  X(tt_tests, "triangle-triangle DCD tests")                                            \
+  X(dcd_pairs, "intersecting triangle pairs found by DCD")                              \
   X(feature_bv_tests, "feature-pair volume tests before the elementary tests (VF, EE)") \
-  X(new_dcd_pairs, "DCD pairs neither in the baseline nor allowed (events)")         \
-  X(new_ccd_contacts, "CCD contacts neither in the baseline nor allowed (events)")   \
-  X(baseline_dcd_pairs, "DCD pairs the baseline already had")                       \
-  X(baseline_ccd_contacts, "CCD contacts within the baseline's regions")            \
-  X(allowed_dcd_pairs, "DCD pairs between allowed parts or bones")                  \
+  X(new_dcd_pairs, "DCD pairs neither in the baseline nor allowed (events)")            \
+  X(new_ccd_contacts, "CCD contacts neither in the baseline nor allowed (events)")      \
+  X(baseline_dcd_pairs, "DCD pairs the baseline already had")                           \
+  X(baseline_ccd_contacts, "CCD contacts within the baseline's regions")                \
+  X(allowed_dcd_pairs, "DCD pairs between allowed parts or bones")                      \
   X(allowed_ccd_contacts, "CCD contacts between allowed parts or bones")
 
 /// Microseconds per stage of one row, likewise (X(name, meaning)).
