@@ -32,8 +32,8 @@ struct RowSpec {
 /// What makes a log labelled (docs/events.md): its header and its events. No baseline: a log as
 /// written before events.
 struct EventSpec {
-  std::string baseline;
-  std::vector<EventRecord> events;
+  std::string baseline{};
+  std::vector<EventRecord> events{};
   bool write_events = true;  ///< false: a run cut short before its events
 };
 
