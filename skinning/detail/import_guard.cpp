@@ -3,6 +3,7 @@
 #include <poll.h>
 #include <sys/resource.h>
 #include <sys/wait.h>
+#include <fcntl.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -643,6 +644,15 @@ void write_all(int fd, const std::string& data) {
 }
 
 [[noreturn]] void child(int fd, const ImportLimits& limits, const std::function<void()>& probe) {
+#if defined(SKELCD_UNDER_ASAN)
+  // Under the sanitizers a library's memory error in the child is caught by ASan, which prints a
+  // report of dozens of lines and exits 1 instead of dying by a signal: the user's stderr keeps
+  // the parent's one line only (the child answers through the pipe; no answer is the crash).
+  if (const int null = ::open("/dev/null", O_WRONLY); null >= 0) {
+    ::dup2(null, STDERR_FILENO);
+    ::close(null);
+  }
+#endif
   if (limits.memory_bytes > 0) {
 #if defined(SKELCD_UNDER_ASAN)
     asan_limit_bytes = static_cast<long long>(limits.memory_bytes);
