@@ -4,10 +4,11 @@
 
 namespace skelcd::ccd {
 
-int orient3d(const Eigen::Vector3d& a,
-             const Eigen::Vector3d& b,
-             const Eigen::Vector3d& c,
-             const Eigen::Vector3d& d) {
+int orient3d_exact(
+    const Eigen::Vector3d& a,
+    const Eigen::Vector3d& b,
+    const Eigen::Vector3d& c,
+    const Eigen::Vector3d& d) {
   using detail::lift;
   return detail::exact_sign([&]<typename T>() -> T {
     const auto pa = lift<T>(a);

@@ -1,18 +1,94 @@
 #pragma once
-// Exact orientation of four points: filtered double with a proven dynamic error bound, GMP rational
-// fallback when the filter cannot decide (ccd/detail/filtered.hpp, docs/ccd.md).
+// Exact orientation of four points: Shewchuk's static floating-point filter first (inline, decides
+// almost every call), then a filtered double with a proven dynamic error bound and a GMP rational
+// fallback when neither can decide (ccd/detail/filtered.hpp, docs/ccd.md).
 
 #include <Eigen/Core>
+#include <cmath>
+#include <limits>
 
 namespace skelcd::ccd {
 
-/// Sign of det(b - a, c - a, d - a): +1 when d is on the side of the plane (a, b, c) its normal
-/// (b - a) x (c - a) points to, -1 on the other side, 0 when the four points are coplanar (or a, b, c
-/// are collinear). Exact for every finite input.
-[[nodiscard]] int orient3d(
+/// The exact predicate behind orient3d (filtered double, then GMP): use orient3d, which screens
+/// with a cheaper filter first.
+[[nodiscard]] int orient3d_exact(
     const Eigen::Vector3d& a,
     const Eigen::Vector3d& b,
     const Eigen::Vector3d& c,
     const Eigen::Vector3d& d);
+
+namespace detail {
+
+/// Value returned by the static filters below when they cannot decide.
+inline constexpr int kUndecided = 2;
+
+/// Shewchuk's static orient3d filter ("Adaptive precision floating-point arithmetic and fast
+/// robust geometric predicates", 1997): D = det[a − d; b − d; c − d], evaluated in double on the
+/// rounded differences, is within (7 + 56ε) ε · permanent of the exact value (ε = 2⁻⁵³) when no
+/// product underflows. Returns the sign of −D = (d − a) · ((b − a) × (c − a)) when |D| exceeds
+/// the bound, kUndecided otherwise (also when the permanent is too small to rule out underflow,
+/// or not finite).
+inline int orient3d_static(
+    const Eigen::Vector3d& a,
+    const Eigen::Vector3d& b,
+    const Eigen::Vector3d& c,
+    const Eigen::Vector3d& d) {
+  constexpr double kHalfUlp = std::numeric_limits<double>::epsilon() / 2.0;
+  constexpr double kErrBound = (7.0 + 56.0 * kHalfUlp) * kHalfUlp;
+  const double adx = a.x() - d.x(), ady = a.y() - d.y(), adz = a.z() - d.z();
+  const double bdx = b.x() - d.x(), bdy = b.y() - d.y(), bdz = b.z() - d.z();
+  const double cdx = c.x() - d.x(), cdy = c.y() - d.y(), cdz = c.z() - d.z();
+  const double bdxcdy = bdx * cdy, cdxbdy = cdx * bdy;
+  const double cdxady = cdx * ady, adxcdy = adx * cdy;
+  const double adxbdy = adx * bdy, bdxady = bdx * ady;
+  const double det = adz * (bdxcdy - cdxbdy) + bdz * (cdxady - adxcdy) + cdz * (adxbdy - bdxady);
+  const double permanent = (std::abs(bdxcdy) + std::abs(cdxbdy)) * std::abs(adz) +
+                           (std::abs(cdxady) + std::abs(adxcdy)) * std::abs(bdz) +
+                           (std::abs(adxbdy) + std::abs(bdxady)) * std::abs(cdz);
+  // The bound assumes no underflow (and finite values): otherwise leave it to the exact path.
+  if (!(permanent > std::numeric_limits<double>::min() * 0x1p64) ||
+      !(permanent < std::numeric_limits<double>::infinity())) {
+    return kUndecided;
+  }
+  const double bound = kErrBound * permanent;
+  if (det > bound) return -1;
+  if (-det > bound) return 1;
+  return kUndecided;
+}
+
+/// Shewchuk's static orient2d filter applied to coordinates (i, j) of (b − a) × (c − a): the sign
+/// of (b − a)_i (c − a)_j − (b − a)_j (c − a)_i when it exceeds (3 + 16ε) ε · permanent,
+/// kUndecided otherwise (as orient3d_static).
+inline int cross_component_static(
+    const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::Vector3d& c, int i, int j) {
+  constexpr double kHalfUlp = std::numeric_limits<double>::epsilon() / 2.0;
+  constexpr double kErrBound = (3.0 + 16.0 * kHalfUlp) * kHalfUlp;
+  const double left = (b[i] - a[i]) * (c[j] - a[j]);
+  const double right = (b[j] - a[j]) * (c[i] - a[i]);
+  const double det = left - right;
+  const double permanent = std::abs(left) + std::abs(right);
+  if (!(permanent > std::numeric_limits<double>::min() * 0x1p64) ||
+      !(permanent < std::numeric_limits<double>::infinity())) {
+    return kUndecided;
+  }
+  const double bound = kErrBound * permanent;
+  if (det > bound) return 1;
+  if (-det > bound) return -1;
+  return kUndecided;
+}
+
+}  // namespace detail
+
+/// Sign of det(b - a, c - a, d - a): +1 when d is on the side of the plane (a, b, c) its normal
+/// (b - a) x (c - a) points to, -1 on the other side, 0 when the four points are coplanar (or a, b,
+/// c are collinear). Exact for every finite input.
+[[nodiscard]] inline int orient3d(
+    const Eigen::Vector3d& a,
+    const Eigen::Vector3d& b,
+    const Eigen::Vector3d& c,
+    const Eigen::Vector3d& d) {
+  const int s = detail::orient3d_static(a, b, c, d);
+  return s != detail::kUndecided ? s : orient3d_exact(a, b, c, d);
+}
 
 }  // namespace skelcd::ccd

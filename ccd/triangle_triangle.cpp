@@ -35,8 +35,16 @@ int cross_sign(const Vector3d& a, const Vector3d& b, const Vector3d& c, int k) {
   });
 }
 
-// (b - a) x (c - a) == 0: the three points are collinear (or coincide).
+// (b - a) x (c - a) == 0: the three points are collinear (or coincide). One component that the
+// static filter finds nonzero settles it (almost every triangle); the exact signs otherwise.
 bool collinear(const Vector3d& a, const Vector3d& b, const Vector3d& c) {
+  constexpr int kAxes[3][2] = {{1, 2}, {2, 0}, {0, 1}};  // components x, y, z of the cross product
+  for (const auto& axes : kAxes) {
+    // The static filter returns ±1 (certain) or kUndecided, never 0.
+    if (detail::cross_component_static(a, b, c, axes[0], axes[1]) != detail::kUndecided) {
+      return false;
+    }
+  }
   return cross_sign(a, b, c, 0) == 0 && cross_sign(a, b, c, 1) == 0 && cross_sign(a, b, c, 2) == 0;
 }
 
@@ -301,12 +309,15 @@ bool triangles_intersect(const TriangleTriangleQuery& q, const SharedCorners& sh
   const Vector3d& s1 = *a[s[1]];
   const Vector3d& fa = *a[a_free[0]];
   const Vector3d& fb = *b[b_free[0]];
-  if (orient3d(s0, s1, fa, fb) != 0) return false;
-  return exact_sign([&]<typename T>() -> T {
-           const auto p0 = lift<T>(s0);
-           const auto e = lift<T>(s1) - p0;
-           return dot(cross(e, lift<T>(fa) - p0), cross(e, lift<T>(fb) - p0));
-         }) > 0;
+  // Both conditions must hold; the side test comes first because it is the cheap one on a
+  // surface: neighbours fold away from each other (free corners on opposite sides, a robust
+  // negative sign), while their orientation is near zero wherever the surface is nearly flat.
+  const bool same_side = exact_sign([&]<typename T>() -> T {
+                           const auto p0 = lift<T>(s0);
+                           const auto e = lift<T>(s1) - p0;
+                           return dot(cross(e, lift<T>(fa) - p0), cross(e, lift<T>(fb) - p0));
+                         }) > 0;
+  return same_side && orient3d(s0, s1, fa, fb) == 0;
 }
 
 }  // namespace skelcd::ccd

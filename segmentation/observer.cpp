@@ -16,43 +16,12 @@ std::string_view to_string(ObserverKind kind) {
   return kind == ObserverKind::point ? "point" : "line";
 }
 
-namespace {
-
-// Shewchuk's static orient3d filter ("Adaptive precision floating-point arithmetic and fast robust
-// geometric predicates", 1997): the sign of det[a − d; b − d; c − d] = (a − d) · ((b − a) × (c − a))
-// when |det| exceeds (7 + 56ε) ε · permanent (ε = 2⁻⁵³), else 0 for "undecided". Decides almost
-// every call at a fraction of the cost of the exact predicate it screens for.
-int static_filter_orient3d(const Eigen::Vector3d& a, const Eigen::Vector3d& b,
-                           const Eigen::Vector3d& c, const Eigen::Vector3d& d) {
-  constexpr double kHalfUlp = std::numeric_limits<double>::epsilon() / 2.0;
-  constexpr double kErrBound = (7.0 + 56.0 * kHalfUlp) * kHalfUlp;
-  const double adx = a.x() - d.x(), ady = a.y() - d.y(), adz = a.z() - d.z();
-  const double bdx = b.x() - d.x(), bdy = b.y() - d.y(), bdz = b.z() - d.z();
-  const double cdx = c.x() - d.x(), cdy = c.y() - d.y(), cdz = c.z() - d.z();
-  const double bdxcdy = bdx * cdy, cdxbdy = cdx * bdy;
-  const double cdxady = cdx * ady, adxcdy = adx * cdy;
-  const double adxbdy = adx * bdy, bdxady = bdx * ady;
-  const double det = adz * (bdxcdy - cdxbdy) + bdz * (cdxady - adxcdy) + cdz * (adxbdy - bdxady);
-  const double permanent = (std::abs(bdxcdy) + std::abs(cdxbdy)) * std::abs(adz) +
-                           (std::abs(cdxady) + std::abs(adxcdy)) * std::abs(bdz) +
-                           (std::abs(adxbdy) + std::abs(bdxady)) * std::abs(cdz);
-  // The bound assumes no underflow: below a safe magnitude leave it to the exact predicate.
-  if (!(permanent > std::numeric_limits<double>::min() * 0x1p64)) return 0;
-  const double bound = kErrBound * permanent;
-  if (det > bound) return 1;
-  if (-det > bound) return -1;
-  return 0;
-}
-
-}  // namespace
-
 Orientation orientation(const Observer& observer, const Eigen::Vector3d& a,
                         const Eigen::Vector3d& b, const Eigen::Vector3d& c) {
   const Eigen::Vector3d q = observer.viewing_position(a);
-  int s = static_filter_orient3d(a, b, c, q);
-  // Undecided: the exact predicate (ccd::orient3d(a, b, c, q) is the sign of (q − a) · n, the
-  // opposite of ours).
-  if (s == 0) s = -ccd::orient3d(a, b, c, q);
+  // ccd::orient3d (Shewchuk's static filter, then the exact predicate) is the sign of (q − a) · n,
+  // the opposite of ours.
+  const int s = -ccd::orient3d(a, b, c, q);
   return s > 0 ? Orientation::positive : (s < 0 ? Orientation::negative : Orientation::uncertain);
 }
 

@@ -4,15 +4,15 @@
 // exactly (GMP) gives every extreme point of A n B; the triangles meet beyond their shared part
 // iff one of those points is outside it.
 
-#include "ccd/triangle_triangle.hpp"
-
-#include <random>
-#include <vector>
-
 #include <gmpxx.h>
 #include <gtest/gtest.h>
 
+#include <Eigen/Geometry>
+#include <random>
+#include <vector>
+
 #include "ccd/orientation.hpp"
+#include "ccd/triangle_triangle.hpp"
 
 namespace skelcd::ccd {
 namespace {
@@ -224,6 +224,112 @@ TEST(Orientation, ExactOnNearlyCoplanarPoints) {
   // Scaled to the underflow range: the filter hands over to the exact path.
   const double s = 1e-300;
   EXPECT_EQ(orient3d(a * s, b * s, c * s, V(5, 7, 0.4) * s), 1);
+}
+
+// The exact sign of (d − a) · ((b − a) × (c − a)), in rationals (the reference for the filters).
+int rational_orient3d(const V& a, const V& b, const V& c, const V& d) {
+  const Q3 qa = rational(a), qb = rational(b), qc = rational(c), qd = rational(d);
+  Q3 u, v, w;
+  for (std::size_t k = 0; k < 3; ++k) {
+    u[k] = qb[k] - qa[k];
+    v[k] = qc[k] - qa[k];
+    w[k] = qd[k] - qa[k];
+  }
+  const mpq_class det = w[0] * (u[1] * v[2] - u[2] * v[1]) + w[1] * (u[2] * v[0] - u[0] * v[2]) +
+                        w[2] * (u[0] * v[1] - u[1] * v[0]);
+  return (det > 0) - (det < 0);
+}
+
+// The static filters in front of orient3d and of the degeneracy test: never a wrong sign (a sign
+// only where the exact value has it, undecided on exact zeros), on generic points, exactly
+// coplanar grid points, the same nudged by one ulp, rotated flat patches (coplanar up to
+// rounding) and scales down to the underflow range and up to 1e150.
+TEST(Orientation, StaticFiltersNeverContradictTheExactSign) {
+  std::mt19937_64 rng(2026);
+  std::uniform_real_distribution<double> unit(-1.0, 1.0);
+  std::uniform_int_distribution<int> small(-3, 3);
+  std::uniform_int_distribution<int> corner(0, 11);
+  const double scales[] = {1.0, 1e-3, 1e8, 1e-150, 1e150, 1e-160};
+  int decided = 0;
+  int generic = 0;
+  int zeros = 0;
+  for (int n = 0; n < 12000; ++n) {
+    std::array<V, 4> p;
+    const int kind = n % 4;
+    for (auto& q : p) {
+      if (kind == 0) {
+        q = V(unit(rng), unit(rng), unit(rng));
+      } else {
+        // On the plane z = x + 2y (exactly coplanar with small integers).
+        const double x = small(rng), y = small(rng);
+        q = V(x, y, x + 2 * y);
+      }
+    }
+    if (kind == 2) {
+      const int k = corner(rng);
+      double& c = p[static_cast<std::size_t>(k / 3)][k % 3];
+      c = std::nextafter(c, (n % 8 < 4) ? 10.0 : -10.0);
+    }
+    if (kind == 3) {
+      // A rotation in double: coplanar only up to rounding.
+      const Eigen::Matrix3d r =
+          Eigen::AngleAxisd(unit(rng) * 3.0, V(unit(rng), unit(rng), 1.0).normalized())
+              .toRotationMatrix();
+      for (auto& q : p) q = r * q;
+    }
+    const double s = scales[static_cast<std::size_t>(n / 4) % std::size(scales)];
+    for (auto& q : p) q *= s;
+    const int exact = rational_orient3d(p[0], p[1], p[2], p[3]);
+    const int fast = detail::orient3d_static(p[0], p[1], p[2], p[3]);
+    ASSERT_TRUE(fast == detail::kUndecided || fast == exact) << "case " << n;
+    ASSERT_EQ(orient3d(p[0], p[1], p[2], p[3]), exact) << "case " << n;
+    zeros += exact == 0 ? 1 : 0;
+    if (kind == 0 && s >= 1e-3 && s <= 1e8) {
+      ++generic;
+      decided += fast != detail::kUndecided ? 1 : 0;
+    }
+    for (int axis = 0; axis < 3; ++axis) {
+      const int i = (axis + 1) % 3, j = (axis + 2) % 3;
+      const Q3 qa = rational(p[0]), qb = rational(p[1]), qc = rational(p[2]);
+      const auto ui = static_cast<std::size_t>(i), uj = static_cast<std::size_t>(j);
+      const mpq_class value =
+          (qb[ui] - qa[ui]) * (qc[uj] - qa[uj]) - (qb[uj] - qa[uj]) * (qc[ui] - qa[ui]);
+      const int component = (value > 0) - (value < 0);
+      const int f = detail::cross_component_static(p[0], p[1], p[2], i, j);
+      ASSERT_TRUE(f == detail::kUndecided || f == component) << "case " << n << " axis " << axis;
+    }
+  }
+  EXPECT_GT(zeros, 2000) << "the exactly coplanar cases must be there";
+  // The filter is what makes orient3d cheap: it decides generic points.
+  EXPECT_GT(decided, generic * 99 / 100);
+}
+
+// Neighbours across an edge of a rotated, nearly flat or folded strip (the case the side-first
+// order of the shared-edge test is for) agree with the brute-force reference.
+TEST(TriangleTriangle, SharedEdgeNeighboursOfRotatedStrips) {
+  std::mt19937_64 rng(99);
+  std::uniform_real_distribution<double> unit(-1.0, 1.0);
+  int hits = 0;
+  for (int n = 0; n < 400; ++n) {
+    // Shared edge s0–s1, free corners fa and fb: flat (fb across the edge), folded onto fa's side
+    // (same side, in the plane), or bent by a small angle.
+    const V s0(0, 0, 0), s1(1, 0, 0);
+    const V fa(unit(rng), 1.0, 0.0);
+    const int kind = n % 3;
+    V fb(unit(rng), kind == 1 ? 0.5 : -1.0, 0.0);
+    if (kind == 2) fb.z() = 1e-9 * unit(rng);
+    // Every sixth case unrotated: exactly flat or exactly folded (then they overlap).
+    const Eigen::Matrix3d r =
+        n % 6 == 1 ? Eigen::Matrix3d::Identity()
+                   : Eigen::AngleAxisd(unit(rng) * 3.0, V(unit(rng), unit(rng), 1.0).normalized())
+                         .toRotationMatrix();
+    const TriangleTriangleQuery q{r * s0, r * s1, r * fa, r * s1, r * s0, r * fb};
+    const SharedCorners shared{1, 0, -1};
+    const bool expected = brute_intersect(q, shared);
+    ASSERT_EQ(triangles_intersect(q, shared), expected) << "case " << n;
+    hits += expected ? 1 : 0;
+  }
+  EXPECT_GT(hits, 0);
 }
 
 }  // namespace
