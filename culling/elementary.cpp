@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cassert>
+#include <cstdint>
 #include <vector>
 
 namespace skelcd::culling {
@@ -58,12 +59,15 @@ struct Outcome {
   bool hit = false;
   double toi_lower = 0;
   double toi_upper = 0;
+  bool tested = true;  ///< false: settled without a test (DCD, a certified vertex fan)
 };
 
 /// Per calling thread, reused across calls: grows to the largest candidate list it has seen.
 /// The parallel loops below run isolated, so a thread waiting for them never picks up another
 /// caller's work and re-enters this function with its buffer in use.
 thread_local std::vector<Outcome> tl_outcomes;
+/// Per calling thread, likewise: which welded vertices have a certified fan at the DCD instant.
+thread_local std::vector<std::uint8_t> tl_certified_fans;
 
 /// Calls `test(i, outcome)` for i in [0, n): on this thread, or split over oneTBB workers when
 /// `threads` > 1 and n is large enough. Every outcome goes to its own slot.
@@ -166,11 +170,29 @@ void run_dcd_tests(
     FrameResult& out) {
   assert(tests.triangles != nullptr);
   const std::size_t first = out.dcd_pairs.size();
+  // Certified vertex fans (culling/vertex_fans.hpp) settle pairs that share a corner without a
+  // test — only for the exact test they stand for (a test of another definition sees every pair).
+  const bool use_fans = tests.triangles == &ccd::triangles_intersect && !pairs.empty() &&
+                        topology.fans().num_fans() > 0;
+  if (use_fans) topology.fans().certify(x, tl_certified_fans);
+  // The calling thread's flags, read by the workers too (their own thread_local is another one).
+  const std::vector<std::uint8_t>& certified = tl_certified_fans;
   const auto outcomes = evaluate(pairs.size(), tests, [&](std::size_t i, Outcome& o) {
     const TrianglePair& p = pairs[i];
     assert(p.a < p.b);
     int count = 0;
     const ccd::SharedCorners shared = topology.shared_corners(p.a, p.b, count);
+    if (use_fans && count > 0) {
+      const auto& ta = topology.triangle(p.a);
+      for (std::size_t k = 0; k < 3; ++k) {
+        if (shared[k] >= 0 && certified[static_cast<std::size_t>(ta[k])] != 0) {
+          o.hit = false;
+          o.tested = false;
+          return;
+        }
+      }
+    }
+    o.tested = true;
     const auto& ta = topology.triangle(p.a);
     const auto& tb = topology.triangle(p.b);
     const ccd::TriangleTriangleQuery q{
@@ -178,7 +200,8 @@ void run_dcd_tests(
     o.hit = tests.triangles(q, shared);
   });
   for (std::size_t i = 0; i < outcomes.size(); ++i) {
-    ++out.counters.tt_tests;
+    // Pairs settled by a fan are candidates (candidate_pairs) but not tests.
+    if (outcomes[i].tested) ++out.counters.tt_tests;
     if (!outcomes[i].hit) continue;
     ++out.counters.dcd_pairs;
     out.dcd_pairs.push_back(pairs[i]);

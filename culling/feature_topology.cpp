@@ -176,6 +176,7 @@ FeatureTopology::FeatureTopology(const skinning::Mesh& mesh, const skinning::Top
       }
     }
   }
+  fans_ = VertexFans(triangles_, num_vertices_);
 }
 
 std::span<const std::int32_t> FeatureTopology::vertex_parts(std::int32_t v) const {

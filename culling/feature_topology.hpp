@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "ccd/triangle_triangle.hpp"
+#include "culling/vertex_fans.hpp"
 #include "skinning/mesh.hpp"
 #include "skinning/topology.hpp"
 
@@ -92,6 +93,9 @@ class FeatureTopology {
   /// welded vertices.
   [[nodiscard]] ccd::SharedCorners shared_corners(std::int32_t a, std::int32_t b, int& count) const;
 
+  /// The vertex fans (culling/vertex_fans.hpp), for the DCD tests of pairs sharing a corner.
+  [[nodiscard]] const VertexFans& fans() const { return fans_; }
+
   [[nodiscard]] std::int32_t face_part(std::int32_t f) const {
     return face_part_.empty() ? 0 : face_part_[static_cast<std::size_t>(f)];
   }
@@ -124,6 +128,7 @@ class FeatureTopology {
   std::size_t num_parts_ = 1;
   std::vector<std::uint8_t> excluded_ = std::vector<std::uint8_t>(1, 0);
   bool has_exclusions_ = false;
+  VertexFans fans_;
 };
 
 }  // namespace skelcd::culling

@@ -1,0 +1,151 @@
+#include "culling/vertex_fans.hpp"
+
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <utility>
+
+#include "ccd/orientation.hpp"
+
+namespace skelcd::culling {
+
+VertexFans::VertexFans(
+    std::span<const std::array<std::int32_t, 3>> triangles, std::int32_t num_vertices) {
+  const auto nv = static_cast<std::size_t>(std::max(num_vertices, 0));
+  // Per vertex, the oriented sides (a → b) of the triangles (v, a, b) around it (CSR).
+  std::vector<std::int32_t> count(nv + 1, 0);
+  std::vector<std::uint8_t> broken(nv, 0);
+  for (const auto& t : triangles) {
+    const bool degenerate = t[0] == t[1] || t[1] == t[2] || t[0] == t[2];
+    for (const auto v : t) {
+      if (v < 0 || static_cast<std::size_t>(v) >= nv) continue;
+      if (degenerate) broken[static_cast<std::size_t>(v)] = 1;
+      ++count[static_cast<std::size_t>(v) + 1];
+    }
+  }
+  for (std::size_t v = 0; v < nv; ++v) count[v + 1] += count[v];
+  std::vector<std::pair<std::int32_t, std::int32_t>> sides(static_cast<std::size_t>(count[nv]));
+  std::vector<std::int32_t> fill(count.begin(), count.end() - 1);
+  for (const auto& t : triangles) {
+    if (t[0] == t[1] || t[1] == t[2] || t[0] == t[2]) continue;
+    for (int k = 0; k < 3; ++k) {
+      const auto v = static_cast<std::size_t>(t[static_cast<std::size_t>(k)]);
+      if (v >= nv) continue;
+      sides[static_cast<std::size_t>(fill[v]++)] = {
+          t[static_cast<std::size_t>((k + 1) % 3)], t[static_cast<std::size_t>((k + 2) % 3)]};
+    }
+  }
+  offsets_.assign(nv + 1, 0);
+  closed_.assign(nv, 0);
+  for (std::size_t v = 0; v < nv; ++v) {
+    offsets_[v + 1] = offsets_[v];
+    if (broken[v]) continue;
+    const auto begin = sides.begin() + count[v];
+    const auto end = sides.begin() + count[v + 1];
+    const auto m = static_cast<std::size_t>(end - begin);
+    if (m < 1) continue;
+    std::sort(begin, end);
+    // One chain: every spoke starts at most one side and ends at most one. A cycle when every
+    // start is also an end (a closed vertex); else a path from the one start that is no end (a
+    // boundary vertex). The walk must visit every side.
+    bool ok = true;
+    for (auto it = begin; it + 1 != end && ok; ++it) ok = it->first != (it + 1)->first;
+    std::vector<std::int32_t> ends;
+    ends.reserve(m);
+    for (auto it = begin; it != end; ++it) ends.push_back(it->second);
+    std::sort(ends.begin(), ends.end());
+    for (std::size_t i = 0; i + 1 < m && ok; ++i) ok = ends[i] != ends[i + 1];
+    if (!ok) continue;
+    std::int32_t start = -1;
+    int starts_only = 0;
+    for (auto it = begin; it != end; ++it) {
+      if (!std::binary_search(ends.begin(), ends.end(), it->first)) {
+        start = it->first;
+        ++starts_only;
+      }
+    }
+    if (starts_only > 1) continue;
+    const bool closed = starts_only == 0;
+    if (closed && m < 3) continue;  // two triangles on the same three vertices, back to back
+    if (closed) start = begin->first;
+    const auto next = [&](std::int32_t a) -> std::int32_t {
+      const auto it = std::lower_bound(begin, end, std::pair{a, INT32_MIN});
+      return it != end && it->first == a ? it->second : -1;
+    };
+    const std::size_t first = spokes_.size();
+    std::int32_t a = start;
+    for (std::size_t i = 0; i < m && ok; ++i) {
+      spokes_.push_back(a);
+      a = next(a);
+      ok = a >= 0 && (i + 1 == m ? (closed ? a == start : true) : a != start);
+    }
+    if (ok && !closed) spokes_.push_back(a);  // the path's last spoke
+    if (!ok) {
+      spokes_.resize(first);
+      continue;
+    }
+    offsets_[v + 1] = static_cast<std::int32_t>(spokes_.size());
+    closed_[v] = closed ? 1 : 0;
+    ++num_fans_;
+  }
+}
+
+bool VertexFans::certified(const skinning::Positions& x, std::int32_t v) const {
+  const std::span<const std::int32_t> s = spokes(v);
+  const bool closed = closed_[static_cast<std::size_t>(v)] != 0;
+  // m triangles: (v, s[i], s[i + 1]), the last one wrapping around when the fan is closed.
+  const std::size_t m = closed ? s.size() : (s.empty() ? 0 : s.size() - 1);
+  if (m < (closed ? 3u : 1u)) return false;
+  const auto point = [&](std::int32_t i) { return Eigen::Vector3d(x(i, 0), x(i, 1), x(i, 2)); };
+  const auto spoke = [&](std::size_t i) { return point(s[i % s.size()]); };
+  const Eigen::Vector3d c = point(v);
+  // The projection: drop the axis where the fan's (approximate) normal is largest. Any choice is
+  // sound; this one makes the certificate likely.
+  Eigen::Vector3d n = Eigen::Vector3d::Zero();
+  for (std::size_t i = 0; i < m; ++i) n += (spoke(i) - c).cross(spoke(i + 1) - c);
+  int k = 0;
+  if (std::abs(n.y()) > std::abs(n[k])) k = 1;
+  if (std::abs(n.z()) > std::abs(n[k])) k = 2;
+  const int i_axis = (k + 1) % 3;
+  const int j_axis = (k + 2) % 3;
+  // orient(p, q) in the projection: the k-th component of (p − v) × (q − v), or kUndecided.
+  const auto orient = [&](const Eigen::Vector3d& p, const Eigen::Vector3d& q) {
+    return ccd::detail::cross_component_static(c, p, q, i_axis, j_axis);
+  };
+  const Eigen::Vector3d r = spoke(0);
+  int sign = 0;
+  int covering = 0;
+  for (std::size_t i = 0; i < m; ++i) {
+    const Eigen::Vector3d a = spoke(i);
+    const Eigen::Vector3d b = spoke(i + 1);
+    const int o = orient(a, b);
+    if (o == ccd::detail::kUndecided) return false;
+    if (sign == 0) sign = o;
+    if (o != sign) return false;
+    // Does the ray from v through spoke 0 lie in the half-open sector [a, b)? Sector 0 starts on
+    // it; a closed fan's last sector ends on it (excluded); the others need two decided signs
+    // (each sector is narrower than a half-turn, so both signs equal to the fan's mean inside).
+    if (i == 0) {
+      ++covering;
+    } else if (!closed || i + 1 < m) {
+      const int o1 = orient(a, r);
+      const int o2 = orient(r, b);
+      if (o1 == ccd::detail::kUndecided || o2 == ccd::detail::kUndecided) return false;
+      if (o1 == sign && o2 == sign) ++covering;
+    }
+  }
+  // Closed: the fan winds exactly once. Open: no sector after the first reaches the ray again
+  // (and the last spoke is off it: its sign was decided above), so the sectors do not overlap.
+  return covering == 1;
+}
+
+void VertexFans::certify(const skinning::Positions& x, std::vector<std::uint8_t>& out) const {
+  const std::size_t nv = closed_.size();
+  out.resize(nv);
+  for (std::size_t v = 0; v < nv; ++v) {
+    out[v] = certified(x, static_cast<std::int32_t>(v)) ? 1 : 0;
+  }
+}
+
+}  // namespace skelcd::culling

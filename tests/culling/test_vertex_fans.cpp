@@ -1,0 +1,219 @@
+// Vertex fans (culling/vertex_fans.hpp): which vertices have one, that a certified fan never has
+// two intersecting triangles (against the exact triangle test, on random and folded fans), and
+// that DCD with fans reports exactly the pairs it reports testing every pair, on real characters.
+#include <gtest/gtest.h>
+
+#include <array>
+#include <cmath>
+#include <numbers>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "ccd/triangle_triangle.hpp"
+#include "culling/method.hpp"
+#include "culling/vertex_fans.hpp"
+#include "skinning/load.hpp"
+#include "skinning/topology.hpp"
+#include "tests/support/test_support.hpp"
+
+namespace skelcd::culling {
+namespace {
+
+using Tri = std::array<std::int32_t, 3>;
+
+/// A fan around vertex 0 with spokes 1..m; closed joins spoke m back to spoke 1.
+std::vector<Tri> fan(int m, bool closed) {
+  std::vector<Tri> t;
+  for (int i = 1; i < m; ++i) t.push_back({0, i, i + 1});
+  if (closed) t.push_back({0, m, 1});
+  return t;
+}
+
+skinning::Positions positions(const std::vector<Eigen::Vector3d>& p) {
+  skinning::Positions x(static_cast<Eigen::Index>(p.size()), 3);
+  for (std::size_t i = 0; i < p.size(); ++i) x.row(static_cast<Eigen::Index>(i)) = p[i].transpose();
+  return x;
+}
+
+/// Spoke i at angle angles[i] (radians) around the z axis, height heights[i].
+std::vector<Eigen::Vector3d> star(
+    const std::vector<double>& angles, const std::vector<double>& heights) {
+  std::vector<Eigen::Vector3d> p{Eigen::Vector3d::Zero()};
+  for (std::size_t i = 0; i < angles.size(); ++i) {
+    p.emplace_back(std::cos(angles[i]), std::sin(angles[i]), heights[i]);
+  }
+  return p;
+}
+
+/// Does any pair of the triangles intersect beyond the corners they share (the exact test)?
+bool some_pair_intersects(const std::vector<Tri>& tris, const skinning::Positions& x) {
+  const auto row = [&](std::int32_t i) { return Eigen::Vector3d(x.row(i).transpose()); };
+  for (std::size_t a = 0; a < tris.size(); ++a) {
+    for (std::size_t b = a + 1; b < tris.size(); ++b) {
+      ccd::SharedCorners shared = ccd::kNoSharedCorners;
+      for (int i = 0; i < 3; ++i) {
+        for (int j = 0; j < 3; ++j) {
+          if (tris[a][static_cast<std::size_t>(i)] == tris[b][static_cast<std::size_t>(j)]) {
+            shared[static_cast<std::size_t>(i)] = static_cast<std::int8_t>(j);
+          }
+        }
+      }
+      const ccd::TriangleTriangleQuery q{
+          row(tris[a][0]),
+          row(tris[a][1]),
+          row(tris[a][2]),
+          row(tris[b][0]),
+          row(tris[b][1]),
+          row(tris[b][2])};
+      if (ccd::triangles_intersect(q, shared)) return true;
+    }
+  }
+  return false;
+}
+
+TEST(VertexFans, ClosedOpenAndNoFan) {
+  // A closed fan of 5 around vertex 0: spokes in order; each spoke an open fan of 2 triangles.
+  const VertexFans closed(fan(5, true), 6);
+  EXPECT_EQ(closed.num_fans(), 6);
+  ASSERT_EQ(closed.spokes(0).size(), 5u);
+  EXPECT_TRUE(closed.closed(0));
+  EXPECT_EQ(closed.spokes(0)[0], 1);
+  EXPECT_EQ(closed.spokes(0)[4], 5);
+  EXPECT_FALSE(closed.closed(1));
+  // The open fan 1..5 around vertex 0: a path of 5 spokes for 4 triangles.
+  const VertexFans open(fan(5, false), 6);
+  ASSERT_EQ(open.spokes(0).size(), 5u);
+  EXPECT_FALSE(open.closed(0));
+  // A flipped triangle (inconsistent orientation), a duplicate face, a degenerate triangle, and
+  // a bow tie (two fans through one vertex): no fan at vertex 0.
+  auto flipped = fan(5, true);
+  std::swap(flipped[2][1], flipped[2][2]);
+  EXPECT_TRUE(VertexFans(flipped, 6).spokes(0).empty());
+  auto duplicate = fan(5, true);
+  duplicate.push_back(duplicate[0]);
+  EXPECT_TRUE(VertexFans(duplicate, 6).spokes(0).empty());
+  auto degenerate = fan(5, true);
+  degenerate.push_back({0, 1, 1});
+  EXPECT_TRUE(VertexFans(degenerate, 6).spokes(0).empty());
+  std::vector<Tri> bow_tie{{0, 1, 2}, {0, 2, 3}, {0, 3, 1}, {0, 4, 5}, {0, 5, 6}, {0, 6, 4}};
+  EXPECT_TRUE(VertexFans(bow_tie, 7).spokes(0).empty());
+  EXPECT_FALSE(VertexFans(bow_tie, 7).spokes(4).empty());
+}
+
+TEST(VertexFans, CertifiesFlatAndBumpyFansAndRefusesOnesThatWindTwice) {
+  const auto tris = fan(5, true);
+  const VertexFans fans(tris, 6);
+  const double step = 2.0 * std::numbers::pi / 5.0;
+  // Flat (exactly coplanar in z = 0) and bumpy: certified, and indeed no pair meets.
+  for (const double h : {0.0, 0.3}) {
+    const auto x = positions(star({0, step, 2 * step, 3 * step, 4 * step}, {h, -h, h, -h, 0}));
+    EXPECT_TRUE(fans.certified(x, 0)) << h;
+    EXPECT_FALSE(some_pair_intersects(tris, x));
+  }
+  // Winding twice (each sector 144°): every projected triangle has the same orientation, yet the
+  // fan overlaps itself — not certified, and the exact test finds intersecting pairs.
+  const double twice = 2.0 * step;
+  const auto x = positions(star({0, twice, 2 * twice, 3 * twice, 4 * twice}, {0, 0, 0, 0, 0}));
+  EXPECT_FALSE(fans.certified(x, 0));
+  EXPECT_TRUE(some_pair_intersects(tris, x));
+  // An open fan sweeping more than a full turn (five sectors of 80°): not certified.
+  const auto open_tris = fan(6, false);
+  const VertexFans open(open_tris, 7);
+  const double s80 = 80.0 * std::numbers::pi / 180.0;
+  const auto xo =
+      positions(star({0, s80, 2 * s80, 3 * s80, 4 * s80, 5 * s80}, {0, 0.1, 0.2, 0.3, 0.4, 0.5}));
+  EXPECT_FALSE(open.certified(xo, 0));
+  // The same open fan over 4 sectors of 80° (320°): certified.
+  const auto open4 = fan(5, false);
+  const auto x4 = positions(star({0, s80, 2 * s80, 3 * s80, 4 * s80}, {0, 0.1, 0.2, 0.1, 0}));
+  EXPECT_TRUE(VertexFans(open4, 6).certified(x4, 0));
+}
+
+// Random fans, closed and open, from nearly flat to wildly folded: a certified one never has an
+// intersecting pair (the exact test decides), and both outcomes occur often.
+TEST(VertexFans, CertifiedFansNeverIntersectThemselves) {
+  std::mt19937_64 rng(1234);
+  std::uniform_real_distribution<double> unit(-1.0, 1.0);
+  std::uniform_int_distribution<int> spokes(3, 9);
+  int certified = 0, refused = 0, refused_and_intersecting = 0;
+  for (int n = 0; n < 3000; ++n) {
+    const int m = spokes(rng);
+    const bool closed = n % 2 == 0;
+    const auto tris = fan(m, closed);
+    // Angles increasing by random steps (sometimes exceeding a full turn), random heights and
+    // radii, and a random rotation: the projection axis differs from case to case.
+    const double spread = (n % 5 == 0) ? 4.0 : 2.0;
+    std::vector<Eigen::Vector3d> p{Eigen::Vector3d(unit(rng), unit(rng), unit(rng)) * 0.1};
+    double angle = 0;
+    const double bump = (n % 3 == 0) ? 0.0 : std::abs(unit(rng)) * 2.0;
+    const Eigen::Matrix3d r =
+        Eigen::AngleAxisd(
+            unit(rng) * 3.0, Eigen::Vector3d(unit(rng), unit(rng), unit(rng) + 2).normalized())
+            .toRotationMatrix();
+    for (int i = 0; i < m; ++i) {
+      const double radius = 0.2 + std::abs(unit(rng));
+      p.push_back(
+          r *
+          Eigen::Vector3d(radius * std::cos(angle), radius * std::sin(angle), bump * unit(rng)));
+      angle += spread * std::numbers::pi / m * (0.3 + std::abs(unit(rng)));
+    }
+    const auto x = positions(p);
+    const VertexFans fans(tris, m + 1);
+    ASSERT_FALSE(fans.spokes(0).empty());
+    if (fans.certified(x, 0)) {
+      ++certified;
+      ASSERT_FALSE(some_pair_intersects(tris, x)) << "case " << n;
+    } else {
+      ++refused;
+      refused_and_intersecting += some_pair_intersects(tris, x) ? 1 : 0;
+    }
+  }
+  EXPECT_GT(certified, 500);
+  EXPECT_GT(refused, 300);
+  EXPECT_GT(refused_and_intersecting, 100);
+}
+
+/// The exact triangle test under another name: run_dcd_tests settles pairs by fans only for
+/// ccd::triangles_intersect itself, so this one sees every pair (the reference).
+bool every_pair(const ccd::TriangleTriangleQuery& q, const ccd::SharedCorners& shared) {
+  return ccd::triangles_intersect(q, shared);
+}
+
+// On real characters, at rest and at posed samples: the same pairs with and without fans, and the
+// fans settle most of the pairs that share a corner.
+TEST(VertexFans, DcdOnRealCharactersIsUnchangedAndTestsFewerPairs) {
+  for (const std::string file :
+       {"CesiumMan.glb", "RobotExpressive.glb", "stormtrooper/stormtrooper.dae"}) {
+    const auto model = skinning::load_model(test::asset("characters/" + file));
+    const skinning::Mesh& mesh = *model.mesh;
+    const skinning::Topology topo = skinning::build_topology(mesh);
+    const auto motion = model.motion();
+    auto with_fans = make_method("bvh", mesh, topo);
+    auto without = make_method("bvh", mesh, topo, {.elementary = {.triangles = &every_pair}});
+    skinning::Positions posed, welded;
+    std::int64_t tests_with = 0, tests_without = 0, pairs = 0;
+    const int n = motion->num_samples();
+    for (const int k : {-1, 0, n / 2, n - 1}) {
+      if (k < 0) {
+        skinning::gather_welded(topo, mesh.rest_positions, welded);
+      } else {
+        motion->positions(k, posed);
+        skinning::gather_welded(topo, posed, welded);
+      }
+      FrameResult a, b;
+      with_fans->detect_dcd(welded, a);
+      without->detect_dcd(welded, b);
+      ASSERT_EQ(a.dcd_pairs, b.dcd_pairs) << file << " sample " << k;
+      EXPECT_EQ(a.counters.candidate_pairs, b.counters.candidate_pairs);
+      tests_with += a.counters.tt_tests;
+      tests_without += b.counters.tt_tests;
+      pairs += static_cast<std::int64_t>(a.dcd_pairs.size());
+    }
+    EXPECT_GT(pairs, 0) << file;
+    EXPECT_LT(tests_with * 2, tests_without) << file << ": fans settle most pairs";
+  }
+}
+
+}  // namespace
+}  // namespace skelcd::culling
