@@ -12,6 +12,7 @@
 
 #include "ccd/triangle_triangle.hpp"
 
+#include <algorithm>
 #include <cassert>
 #include <vector>
 
@@ -99,25 +100,90 @@ bool segments_intersect(const Vector3d& p, const Vector3d& q, const Vector3d& r,
   return coplanar_segments_intersect(p, q, r, s);
 }
 
-// p in the closed non-degenerate triangle (a, b, c), p known to be in its plane.
-bool in_coplanar_triangle(const Vector3d& p, const Vector3d& a, const Vector3d& b, const Vector3d& c) {
-  const auto side = [&](const Vector3d& e0, const Vector3d& e1) {
-    return exact_sign([&]<typename T>() -> T {
-      const auto pa = lift<T>(a);
-      const auto n = cross(lift<T>(b) - pa, lift<T>(c) - pa);
-      const auto pe0 = lift<T>(e0);
-      return dot(n, cross(lift<T>(e1) - pe0, lift<T>(p) - pe0));
-    });
-  };
-  return side(a, b) >= 0 && side(b, c) >= 0 && side(c, a) >= 0;
-}
-
 struct Triangle {
   const Vector3d& a;
   const Vector3d& b;
   const Vector3d& c;
   bool degenerate;
 };
+
+// --- the coplanar case in the plane of one coordinate projection ---------------------------------
+// Points known to lie in the plane of a non-degenerate triangle are compared in the projection
+// that drops a coordinate k along which the triangle's normal has a nonzero component: it is
+// injective on that plane, so every answer there is the answer in space, and 2D orientations do
+// not run into the exact zeros that a plane parallel to a coordinate plane gives 3D cross
+// products (which sent such pairs to rational arithmetic).
+
+// Sign of the 2D orientation of (a, b, c) in coordinates (i, j): static filter, then exact.
+int orient2d(const Vector3d& a, const Vector3d& b, const Vector3d& c, int i, int j) {
+  const int s = detail::cross_component_static(a, b, c, i, j);
+  if (s != detail::kUndecided) return s;
+  return exact_sign([&]<typename T>() -> T {
+    const T ai = lift<T>(a[i]), aj = lift<T>(a[j]);
+    return T(
+        (lift<T>(b[i]) - ai) * (lift<T>(c[j]) - aj) - (lift<T>(b[j]) - aj) * (lift<T>(c[i]) - ai));
+  });
+}
+
+struct Projection {
+  int i = 0;
+  int j = 1;
+  int sign = 0;  ///< the triangle's orientation in (i, j), never 0
+};
+
+// A coordinate projection in which the non-degenerate triangle t keeps a nonzero area.
+Projection projection_of(const Triangle& t) {
+  constexpr int kAxes[3][2] = {{1, 2}, {2, 0}, {0, 1}};
+  for (const auto& axes : kAxes) {  // the filter decides almost every triangle on one of them
+    const int s = detail::cross_component_static(t.a, t.b, t.c, axes[0], axes[1]);
+    if (s != detail::kUndecided) return {axes[0], axes[1], s};
+  }
+  for (const auto& axes : kAxes) {
+    const int s = orient2d(t.a, t.b, t.c, axes[0], axes[1]);
+    if (s != 0) return {axes[0], axes[1], s};
+  }
+  assert(false && "projection_of needs a non-degenerate triangle");
+  return {};
+}
+
+// p, collinear with a and b in the projection, lies on the closed segment [a, b] there.
+bool between_2d(const Vector3d& p, const Vector3d& a, const Vector3d& b, const Projection& pr) {
+  const auto within = [&](int k) {
+    return std::min(a[k], b[k]) <= p[k] && p[k] <= std::max(a[k], b[k]);
+  };
+  return within(pr.i) && within(pr.j);
+}
+
+// Closed segments [p, q] and [a, b] meet in the projection.
+bool segments_meet_2d(
+    const Vector3d& p,
+    const Vector3d& q,
+    const Vector3d& a,
+    const Vector3d& b,
+    const Projection& pr) {
+  const int o1 = orient2d(p, q, a, pr.i, pr.j);
+  const int o2 = orient2d(p, q, b, pr.i, pr.j);
+  const int o3 = orient2d(a, b, p, pr.i, pr.j);
+  const int o4 = orient2d(a, b, q, pr.i, pr.j);
+  if (o1 * o2 < 0 && o3 * o4 < 0) return true;
+  return (o1 == 0 && between_2d(a, p, q, pr)) || (o2 == 0 && between_2d(b, p, q, pr)) ||
+         (o3 == 0 && between_2d(p, a, b, pr)) || (o4 == 0 && between_2d(q, a, b, pr));
+}
+
+// p in the closed triangle t in the projection.
+bool in_triangle_2d(const Vector3d& p, const Triangle& t, const Projection& pr) {
+  return orient2d(t.a, t.b, p, pr.i, pr.j) * pr.sign >= 0 &&
+         orient2d(t.b, t.c, p, pr.i, pr.j) * pr.sign >= 0 &&
+         orient2d(t.c, t.a, p, pr.i, pr.j) * pr.sign >= 0;
+}
+
+// Closed segment [p, q], lying in the plane of the non-degenerate triangle t, meets t.
+bool coplanar_segment_triangle(const Vector3d& p, const Vector3d& q, const Triangle& t) {
+  const Projection pr = projection_of(t);
+  return in_triangle_2d(p, t, pr) || in_triangle_2d(q, t, pr) ||
+         segments_meet_2d(p, q, t.a, t.b, pr) || segments_meet_2d(p, q, t.b, t.c, pr) ||
+         segments_meet_2d(p, q, t.c, t.a, pr);
+}
 
 // Closed segment [p, q] meets the closed triangle t; o_p, o_q = orient3d(t.a, t.b, t.c, p / q).
 bool segment_triangle(const Vector3d& p, const Vector3d& q, const Triangle& t, int o_p, int o_q) {
@@ -127,12 +193,7 @@ bool segment_triangle(const Vector3d& p, const Vector3d& q, const Triangle& t, i
            segments_intersect(p, q, t.c, t.a);
   }
   if (o_p * o_q > 0) return false;  // both endpoints strictly on one side of the plane
-  if (o_p == 0 && o_q == 0) {
-    // The segment lies in the triangle's plane.
-    return in_coplanar_triangle(p, t.a, t.b, t.c) || in_coplanar_triangle(q, t.a, t.b, t.c) ||
-           coplanar_segments_intersect(p, q, t.a, t.b) || coplanar_segments_intersect(p, q, t.b, t.c) ||
-           coplanar_segments_intersect(p, q, t.c, t.a);
-  }
+  if (o_p == 0 && o_q == 0) return coplanar_segment_triangle(p, q, t);  // in the triangle's plane
   // The segment crosses (or touches) the plane at one point X; X is in the triangle iff it is not
   // strictly outside any edge: orient3d(p, q, e0, e1) has the sign of X's side of edge (e0, e1).
   const int s1 = orient3d(p, q, t.a, t.b);
@@ -266,6 +327,30 @@ bool triangles_intersect(const TriangleTriangleQuery& q, const SharedCorners& sh
   if (shared_count == 3) return false;  // the same triangle: nothing beyond the shared part
 
   if (ta.degenerate || tb.degenerate) {
+    // One degenerate, one not: the degenerate one is the hull of its corners, so when its free
+    // (unshared) corners lie strictly on one side of the other's plane, its only points in that
+    // plane are in the hull of the shared corners — nothing beyond the shared part. Settles most
+    // such pairs without rationals.
+    if (ta.degenerate != tb.degenerate) {
+      const bool a_flat = ta.degenerate;
+      const Triangle& solid = a_flat ? tb : ta;
+      int side = 0;
+      bool one_side = true;
+      for (int i = 0; i < 3 && one_side; ++i) {
+        bool is_shared = false;
+        if (a_flat) {
+          is_shared = shared_with_b[static_cast<std::size_t>(i)] >= 0;
+        } else {
+          for (int k = 0; k < 3; ++k)
+            is_shared = is_shared || shared_with_b[static_cast<std::size_t>(k)] == i;
+        }
+        if (is_shared) continue;
+        const int o = orient3d(solid.a, solid.b, solid.c, a_flat ? *a[i] : *b[i]);
+        one_side = o != 0 && (side == 0 || o == side);
+        side = o;
+      }
+      if (one_side && side != 0) return false;
+    }
     std::vector<Q3> shared;
     for (int i = 0; i < 3; ++i) {
       if (shared_with_b[static_cast<std::size_t>(i)] >= 0) shared.push_back(rational(*a[i]));
