@@ -12,7 +12,7 @@ FUZZ_SECONDS ?= 600
 FUZZERS      ?= scene ccd_queries frame_mesh trajectory srdf log_reader assimp_import
 FUZZ_BUILD   ?= build-fuzz
 
-.PHONY: all deps configure build demo test sanitize sanitize-ci format-check bench fuzz sweep clean
+.PHONY: all deps configure build demo test sanitize sanitize-ci format-check bench bench-real fuzz sweep clean
 
 all: build
 
@@ -58,6 +58,16 @@ sweep: build
 
 bench: build
 	bash scripts/bench.sh $(BUILD)
+
+# scripts/bench_real.sh (docs/benchmarks.md "Real assets"): DCD against CGAL (libcgal-dev, for this
+# benchmark only), CCD of every method, peak memory, on the bundled, Debian and cloth assets.
+# BENCH_REAL_ARGS passes options to scripts/bench_real.py (e.g. --no-debian --cap 20).
+BENCH_REAL_ARGS ?=
+bench-real: build
+	@bash scripts/install-deps.sh libcgal-dev
+	cmake -S . -B $(BUILD)
+	cmake --build $(BUILD) -j $(JOBS) --target dcd_vs_cgal
+	bash scripts/bench_real.sh $(BUILD) $(BENCH_REAL_ARGS)
 
 fuzz: deps
 	@bash scripts/install-deps.sh clang-14 libclang-rt-14-dev

@@ -1,0 +1,247 @@
+#!/usr/bin/python3
+"""Real assets in one run (issue 14, docs/benchmarks.md "Real assets"): for every bundled and
+Debian rigged character and every cloth step, the DCD of posed frames against CGAL's
+`self_intersections` and the CCD of the clip by `bvh`, `kdop`, `dynamic` and `auto`, with peak
+memory, and the findings compared between them.
+
+  scripts/bench_real.py [--skelcd build/tools/skelcd] [--dcd build/bench/real/dcd_vs_cgal]
+                        [--samples 4] [--repeat 3] [--cap 60] [--no-debian] [--models FILE…]
+                        [--cloth DIR…] [--json-out FILE]
+
+DCD: `dcd_vs_cgal MODEL --json` (bench/real/dcd_vs_cgal.cpp; built by `make bench-real` when
+libcgal-dev is installed) poses --samples frames spread over the first clip (each frame of a cloth
+step) and times skelcd's `bvh` DCD and CGAL 5.5's self_intersections, one thread each, fastest of
+--repeat runs, and compares the pairs (CGAL's extra pairs at vertices its soup-to-mesh conversion
+duplicated are counted apart, see the source).
+
+CCD: `skelcd check MODEL --query ccd --threads 1 --method M --json -o LOG` for each method, each in
+its own process so that its peak RSS (ru_maxrss from wait4) is its own. A clip whose bvh run takes
+longer than --cap seconds is cut to the samples that fit (--frames 0:K, from a probe), the same for
+every method. The contact sets are compared through the logs (every /contacts row's sample, kind
+and features); `dynamic` needs a skeleton and is "n/a" on frame sequences.
+
+Prints a Markdown table and summary lines: DCD speed-up over CGAL (geometric mean and minimum over
+the frames of models with at least --min-triangles triangles), CCD ms per interval ratios bvh/M,
+peak RSS per triangle. Exits 1 when any pair or contact set differs, 2 on a failed run.
+"""
+
+import argparse
+import glob
+import importlib.util
+import json
+import math
+import os
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+REPO = Path(__file__).resolve().parent.parent
+CCD_METHODS = ["bvh", "kdop", "dynamic", "auto"]
+
+
+def load_sibling(name):
+    spec = importlib.util.spec_from_file_location(name, REPO / "scripts" / f"{name}.py")
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+def run_measured(cmd, timeout):
+    """(returncode, stdout, stderr, seconds, peak RSS in MiB) of one process."""
+    start = time.monotonic()
+    with tempfile.TemporaryFile() as out, tempfile.TemporaryFile() as err:
+        p = subprocess.Popen(cmd, stdout=out, stderr=err, stdin=subprocess.DEVNULL)
+        deadline = start + timeout if timeout else None
+        while True:
+            pid, status, usage = os.wait4(p.pid, os.WNOHANG)
+            if pid:
+                break
+            if deadline and time.monotonic() > deadline:
+                p.kill()
+                os.wait4(p.pid, 0)
+                raise subprocess.TimeoutExpired(cmd, timeout)
+            time.sleep(0.02)
+        seconds = time.monotonic() - start
+        out.seek(0)
+        err.seek(0)
+        code = os.waitstatus_to_exitcode(status)
+        return (code, out.read().decode(errors="replace"), err.read().decode(errors="replace"),
+                seconds, usage.ru_maxrss / 1024.0)
+
+
+def contact_set(log):
+    import h5py
+    with h5py.File(log, "r") as f:
+        c = f["contacts"][()]
+    return set(zip(c["frame"].tolist(), c["kind"].tolist(), c["a_part"].tolist(),
+                   c["a_index"].tolist(), c["a_side"].tolist(), c["b_part"].tolist(),
+                   c["b_index"].tolist(), c["b_side"].tolist()))
+
+
+def dcd_rows(dcd, model, samples, repeat, timeout):
+    cmd = [dcd, model, "--json", "--samples", str(samples), "--repeat", str(repeat)]
+    code, out, err, _, _ = run_measured(cmd, timeout)
+    rows = [json.loads(line) for line in out.splitlines() if line.startswith("{")]
+    if code == 2 or not rows:
+        raise RuntimeError(f"{' '.join(cmd)}: exit {code}: {err.strip()[:300]}")
+    return rows
+
+
+def ccd_run(skelcd, model, method, frames, log, timeout):
+    cmd = [skelcd, "check", model, "--query", "ccd", "--threads", "1", "--method", method,
+           "--json", "-o", log]
+    if frames:
+        cmd += ["--frames", frames]
+    code, out, err, seconds, rss = run_measured(cmd, timeout)
+    if code != 0:
+        raise RuntimeError(f"{' '.join(cmd)}: exit {code}: {err.strip()[:300]}")
+    s = json.loads(out)
+    return {"ms_per_interval": s["ms_per_interval"], "intervals": s["intervals"],
+            "contacts": s["ccd_vf"] + s["ccd_ee"], "rss_mib": rss, "seconds": seconds}
+
+
+def geomean(values):
+    return math.exp(sum(map(math.log, values)) / len(values)) if values else math.nan
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("--skelcd", default=str(REPO / "build/tools/skelcd"))
+    ap.add_argument("--dcd", default=str(REPO / "build/bench/real/dcd_vs_cgal"))
+    ap.add_argument("--samples", type=int, default=4, help="posed frames per model for DCD")
+    ap.add_argument("--repeat", type=int, default=3, help="DCD runs per frame (fastest kept)")
+    ap.add_argument("--cap", type=float, default=60.0, help="seconds one CCD run may take")
+    ap.add_argument("--min-triangles", type=int, default=1000,
+                    help="models below this are listed but left out of the summary lines")
+    ap.add_argument("--models", nargs="+", help="these models instead of the characters")
+    ap.add_argument("--no-debian", action="store_true", help="bundled characters only")
+    ap.add_argument("--cloth", nargs="*",
+                    default=sorted(glob.glob(str(REPO.parent / "shared/assets/cloth/*/frames"))),
+                    help="frame-sequence folders (default: ../shared/assets/cloth/*/frames)")
+    ap.add_argument("--json-out", help="write every figure here")
+    args = ap.parse_args()
+
+    bdm = load_sibling("bench_default_method")
+    models = bdm.character_models(args.skelcd, args.models, not args.no_debian)
+    models += list(args.cloth or [])
+    have_cgal = os.access(args.dcd, os.X_OK)
+    if not have_cgal:
+        print(f"# {args.dcd} is missing (libcgal-dev not installed?): no DCD column",
+              file=sys.stderr)
+    load = os.getloadavg()
+    print(f"# {len(models)} models; load average {load[0]:.2f} at the start", file=sys.stderr)
+
+    results, differ, failed = [], [], []
+    tmp = tempfile.mkdtemp(prefix="bench_real_")
+    for model in models:
+        name = bdm.short_name(model)
+        if "shared/assets/cloth" in model:
+            name = Path(model).parent.name
+        r = {"model": name, "path": model}
+        print(f"# {name}", file=sys.stderr)
+        try:
+            if have_cgal:
+                rows = dcd_rows(args.dcd, model, args.samples, args.repeat, 20 * args.cap)
+                r["triangles"] = rows[0]["triangles"]
+                r["dcd"] = rows
+                for row in rows:
+                    if not row["identical"]:
+                        differ.append(f"{name} DCD sample {row['sample']}: skelcd-only "
+                                      f"{row['skelcd_only']}, CGAL-only {row['cgal_only']}")
+            # The cut, decided by bvh and shared by every method.
+            frames = None
+            log = os.path.join(tmp, "bvh.h5")
+            try:
+                first = ccd_run(args.skelcd, model, "bvh", None, log, args.cap)
+            except subprocess.TimeoutExpired:
+                probe = ccd_run(args.skelcd, model, "bvh", "0:5", log, None)
+                k = max(2, int(0.5 * args.cap * 1000.0 / max(probe["ms_per_interval"], 1e-3)))
+                frames = f"0:{k}"
+                first = ccd_run(args.skelcd, model, "bvh", frames, log, None)
+            r["frames"] = frames
+            r["ccd"] = {"bvh": first}
+            reference = contact_set(log)
+            for method in CCD_METHODS[1:]:
+                mlog = os.path.join(tmp, f"{method}.h5")
+                try:
+                    r["ccd"][method] = ccd_run(args.skelcd, model, method, frames, mlog, None)
+                except RuntimeError as e:
+                    if method == "dynamic" and ("skeleton" in str(e) or "bone" in str(e)):
+                        r["ccd"][method] = None
+                        continue
+                    raise
+                if contact_set(mlog) != reference:
+                    differ.append(f"{name} CCD {method}: contacts differ from bvh's")
+        except (RuntimeError, subprocess.TimeoutExpired) as e:
+            failed.append(f"{name}: {e}")
+            print(f"# FAILED {name}: {e}", file=sys.stderr)
+            continue
+        results.append(r)
+
+    # The table.
+    print("| model | triangles | DCD frames | skelcd DCD ms | CGAL ms | × CGAL (min) | pairs | "
+          "CCD intervals | bvh ms | kdop ms | dynamic ms | auto ms | bvh/dynamic | bvh/auto | "
+          "peak RSS MiB | contacts |")
+    print("|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|")
+    all_frames, per_model_tri = [], []
+    for r in results:
+        dcd = r.get("dcd", [])
+        tri = r.get("triangles", 0)
+        ccd = r["ccd"]
+        if dcd:
+            speed = [d["speedup"] for d in dcd]
+            dcd_cols = (f"{len(dcd)} | {sum(d['skelcd_ms'] for d in dcd) / len(dcd):.2f} | "
+                        f"{sum(d['cgal_ms'] for d in dcd) / len(dcd):.2f} | "
+                        f"{geomean(speed):.2f} ({min(speed):.2f}) | "
+                        f"{max(d['skelcd_pairs'] for d in dcd)}")
+            if tri >= args.min_triangles:
+                all_frames += speed
+        else:
+            dcd_cols = "– | – | – | – | –"
+
+        def ms(m):
+            return f"{ccd[m]['ms_per_interval']:.2f}" if ccd.get(m) else "n/a"
+
+        def ratio(m):
+            if not ccd.get(m) or ccd[m]["ms_per_interval"] <= 0:
+                return "n/a"
+            return f"{ccd['bvh']['ms_per_interval'] / ccd[m]['ms_per_interval']:.2f}"
+
+        rss = max(v["rss_mib"] for v in ccd.values() if v)
+        cut = f" (0:{r['frames'].split(':')[1]})" if r.get("frames") else ""
+        print(f"| {r['model']} | {tri} | {dcd_cols} | {ccd['bvh']['intervals']}{cut} | "
+              f"{ms('bvh')} | {ms('kdop')} | {ms('dynamic')} | {ms('auto')} | {ratio('dynamic')} | "
+              f"{ratio('auto')} | {rss:.0f} | {ccd['bvh']['contacts']} |")
+        if tri >= args.min_triangles:
+            per_model_tri.append((r["model"], rss * 1024.0 / tri))
+
+    print()
+    if all_frames:
+        print(f"DCD speed-up over CGAL (frames of models with >= {args.min_triangles} triangles, "
+              f"{len(all_frames)} frames): geometric mean {geomean(all_frames):.2f}, "
+              f"minimum {min(all_frames):.2f}")
+    big = [r for r in results if r.get("triangles", 0) >= args.min_triangles]
+    for m in CCD_METHODS[1:]:
+        vals = [r["ccd"]["bvh"]["ms_per_interval"] / r["ccd"][m]["ms_per_interval"]
+                for r in big if r["ccd"].get(m) and r["ccd"][m]["ms_per_interval"] > 0]
+        if vals:
+            print(f"CCD bvh/{m} per interval ({len(vals)} models): geometric mean "
+                  f"{geomean(vals):.2f}, min {min(vals):.2f}, max {max(vals):.2f}")
+    if per_model_tri:
+        worst = max(per_model_tri, key=lambda w: w[1])
+        print(f"peak RSS per triangle: worst {worst[1]:.1f} KiB ({worst[0]}), process included")
+    for d in differ:
+        print(f"DIFFERENT: {d}")
+    for f in failed:
+        print(f"FAILED: {f}")
+    if args.json_out:
+        Path(args.json_out).write_text(json.dumps(results, indent=1))
+    if failed:
+        return 2
+    return 1 if differ else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
