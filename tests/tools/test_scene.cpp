@@ -7,8 +7,8 @@
 
 #include "skinning/errors.hpp"
 #include "tests/support/test_support.hpp"
-#include "tools/scene.hpp"
-#include "tools/scene_plan.hpp"
+#include "tools/engine/scene.hpp"
+#include "tools/engine/scene_plan.hpp"
 
 namespace skelcd::tools {
 namespace {
