@@ -5,7 +5,7 @@
 #include <string>
 #include <vector>
 
-#include "tools/engine/events.hpp"
+#include "tools/io/event_record.hpp"
 #include "tools/io/frame_report.hpp"
 #include "tools/io/log/log_header.hpp"
 

@@ -6,7 +6,7 @@
 #include <memory>
 #include <vector>
 
-#include "tools/engine/events.hpp"
+#include "tools/io/event_record.hpp"
 #include "tools/io/frame_report.hpp"
 #include "tools/io/log/log_header.hpp"
 
