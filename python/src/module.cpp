@@ -30,6 +30,7 @@
 #include "tools/engine/run_summary.hpp"
 #include "tools/io/log/log_reader.hpp"
 #include "tools/report/model_report.hpp"
+#include "tools/report/summary_json.hpp"
 
 namespace py = pybind11;
 
@@ -156,7 +157,7 @@ py::list event_dicts(const std::vector<tools::EventRecord>& events) {
   return out;
 }
 
-/// The object `skelcd check --json` prints (tools/engine/run_summary.hpp, summary_json), same keys.
+/// The object `skelcd check --json` prints (tools/report/summary_json.hpp), same keys.
 py::dict summary_dict(
     const tools::RunIdentity& id, const tools::RunSummary& s, const tools::RunLabels& labels) {
   return to_python(tools::summary_json(id, s, labels));

@@ -9,6 +9,7 @@
 #include "tests/support/test_support.hpp"
 #include "tools/engine/scene.hpp"
 #include "tools/engine/scene_plan.hpp"
+#include "tools/report/scene_plan_report.hpp"
 
 namespace skelcd::tools {
 namespace {

@@ -31,6 +31,7 @@
 #include "tools/cli/cli_util.hpp"
 #include "tools/cli/commands.hpp"
 #include "tools/cli/model_options.hpp"
+#include "tools/cli/scene_check.hpp"
 #include "tools/engine/check_engine.hpp"
 #include "tools/engine/radial_view_setup.hpp"
 #include "tools/engine/run_summary.hpp"
@@ -39,6 +40,7 @@
 #include "tools/engine/scene_runner.hpp"
 #include "tools/io/file_hash.hpp"
 #include "tools/io/log/log_writer.hpp"
+#include "tools/report/summary_json.hpp"
 
 namespace skelcd::tools {
 namespace {

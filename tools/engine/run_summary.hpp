@@ -3,7 +3,6 @@
 // `inspect` (from a log, complete or partial).
 
 #include <cstdint>
-#include <nlohmann/json.hpp>
 #include <span>
 #include <vector>
 
@@ -57,9 +56,6 @@ struct RunSummary {
 [[nodiscard]] std::int64_t new_dcd_pairs(const FrameRow& row);
 [[nodiscard]] std::int64_t new_ccd_contacts(const FrameRow& row);
 
-/// {"ms_per_interval", "skin", "refit", …} → per-stage ms object used by `check --json`.
-[[nodiscard]] nlohmann::json stages_json(const RunSummary& summary);
-
 /// What a run was: the identity fields of `check --json` (and of skelcd.check / read_log).
 struct RunIdentity {
   std::string model;
@@ -88,14 +84,5 @@ struct RunLabels {
 /// The events a user reads: those that did not run into an older one (whose records the older
 /// one's include), by id.
 [[nodiscard]] std::vector<const EventRecord*> root_events(const std::vector<EventRecord>& events);
-
-/// The events of `check --json`: root events, each with the ids merged into it.
-[[nodiscard]] nlohmann::json events_json(
-    const std::vector<EventRecord>& events, const std::vector<std::string>& part_names);
-
-/// The object `skelcd check --json` prints for one clip; skelcd.check and skelcd.read_log return
-/// the same keys.
-[[nodiscard]] nlohmann::json summary_json(
-    const RunIdentity& id, const RunSummary& summary, const RunLabels& labels);
 
 }  // namespace skelcd::tools

@@ -4,8 +4,6 @@
 // Rule: nothing that no requested check needs is built or run.
 
 #include <cstdint>
-#include <nlohmann/json.hpp>
-#include <ostream>
 #include <string>
 #include <vector>
 
@@ -86,12 +84,5 @@ struct ScenePlan {
     const Scene& scene,
     const std::vector<ObjectFacts>& facts,
     const std::optional<FrameRange>& frames);
-
-/// The plan as text (a few lines per object and check).
-void print_plan(std::ostream& out, const ScenePlan& plan);
-
-/// The plan as JSON: {"scene", "objects": [{name, checked, stages: {…}, skipped: […], …}],
-/// "checks": […]}.
-[[nodiscard]] nlohmann::json plan_json(const ScenePlan& plan);
 
 }  // namespace skelcd::tools

@@ -1,7 +1,7 @@
 #pragma once
-// Runs a scene (docs/scenes.md): validates and loads what the checks need, plans, prints the plan,
-// then runs every check — self checks through ClipRunner, pair checks through
-// culling::PairChecker — writing all rows into one HDF5 log with the check of each row.
+// Runs a scene (docs/scenes.md): validates and loads what the checks need, plans, then runs every
+// check — self checks through ClipRunner, pair checks through culling::PairChecker — writing all
+// rows into one HDF5 log with the check of each row. What the command prints: cli/scene_check.hpp.
 
 #include <cstdint>
 #include <filesystem>
@@ -21,23 +21,8 @@
 
 namespace skelcd::tools {
 
-/// What `skelcd check SCENE.toml` passes on from its command line.
-struct SceneCheckArguments {
-  std::string output;  ///< -o: the log (overrides the scene's `output`); empty: the scene's
-  std::string frames;  ///< --frames A:B (overrides the scene's `frames`); empty: the scene's
-  std::int32_t threads =
-      1;  ///< self checks: worker threads (0: all cores); pair checks run serially
-  bool json = false;
-};
-
 /// True when a MODEL argument names a scene file (ends in `.toml`).
 [[nodiscard]] bool is_scene_path(std::string_view model_arg);
-
-/// `skelcd check SCENE.toml`: prints the plan, runs, prints a summary per check (or one JSON
-/// object with the plan and the summaries), writes the log.
-/// @throws InvalidInput "SCENE:LINE: …" for anything refused before work starts (nothing is
-///   written then); IoError when the log cannot be written.
-void run_scene_check(const std::filesystem::path& scene, const SceneCheckArguments& args);
 
 struct SceneRunOptions {
   std::filesystem::path log;         ///< empty: no log
@@ -48,6 +33,11 @@ struct SceneRunOptions {
   std::function<void(const ScenePlan&)> on_plan;
   /// Called with an object's name when it is loaded (tests count loads through it).
   std::function<void(std::string_view)> on_load;
+  /// Called when a check starts, with its label ("check NAME") and rows; what it returns is called
+  /// with the rows done after each row and destroyed when the check ends (the command line draws
+  /// its progress line with it). Empty: nothing is shown.
+  std::function<std::function<void(std::int64_t)>(const std::string& label, std::int64_t rows)>
+      on_check;
 };
 
 struct SceneCheckResult {

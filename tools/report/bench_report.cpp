@@ -16,7 +16,8 @@
 #include "culling/method.hpp"
 #include "culling/method_registry.hpp"
 #include "skinning/errors.hpp"
-#include "tools/cli/cli_util.hpp"
+#include "tools/report/progress.hpp"
+#include "tools/report/summary_json.hpp"
 
 namespace skelcd::tools {
 namespace {
