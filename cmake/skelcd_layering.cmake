@@ -5,20 +5,23 @@
 # it with FATAL_ERROR naming the path through which a forbidden library comes in. The sources'
 # includes are checked by the tests tools.layering.* (cmake/skelcd_check_includes.cmake).
 
-# The targets (real names, aliases resolved) that `item` names in a link list, or nothing.
-function(_skelcd_link_item_targets item out)
+# The names that link item `item` holds: itself, or the comma-separated targets inside a generator
+# expression such as $<LINK_ONLY:a> or $<LINK_LIBRARY:WHOLE_ARCHIVE,a>; an alias also gives the
+# target it stands for. Names need not be targets in the calling directory (an imported target is
+# visible only where it was found), so callers compare names too.
+function(_skelcd_link_item_names item out)
   set(result)
-  # $<LINK_LIBRARY:WHOLE_ARCHIVE,a,b> and similar: the targets are the comma-separated tail.
   string(REGEX REPLACE "^\\$<[A-Z_]+:([^>]*)>$" "\\1" inner "${item}")
   string(REPLACE "," ";" parts "${inner}")
   foreach(part IN LISTS parts)
-    string(REGEX REPLACE "^::@\\([^)]*\\)" "" part "${part}")  # a directory-scoped link item
+    if(part STREQUAL "" OR part MATCHES "^::@")  # ::@(dir) markers of a link from another folder
+      continue()
+    endif()
+    list(APPEND result "${part}")
     if(TARGET "${part}")
       get_target_property(aliased "${part}" ALIASED_TARGET)
       if(aliased)
         list(APPEND result "${aliased}")
-      else()
-        list(APPEND result "${part}")
       endif()
     endif()
   endforeach()
@@ -26,17 +29,12 @@ function(_skelcd_link_item_targets item out)
 endfunction()
 
 function(_skelcd_check_links target forbidden)
-  set(real_forbidden)
-  foreach(f IN LISTS forbidden)
-    _skelcd_link_item_targets("${f}" resolved)
-    list(APPEND real_forbidden ${f} ${resolved})
-  endforeach()
   set(queue "${target}")
   set(path_${target} "${target}")
   set(seen)
   while(queue)
     list(POP_FRONT queue current)
-    if(current IN_LIST seen)
+    if(current IN_LIST seen OR NOT TARGET "${current}")
       continue()
     endif()
     list(APPEND seen "${current}")
@@ -53,17 +51,17 @@ function(_skelcd_check_links target forbidden)
       list(APPEND links ${interface})
     endif()
     foreach(item IN LISTS links)
-      _skelcd_link_item_targets("${item}" targets)
-      foreach(t IN LISTS targets)
-        if(t IN_LIST real_forbidden)
+      _skelcd_link_item_names("${item}" names)
+      foreach(name IN LISTS names)
+        if(name IN_LIST forbidden)
           message(FATAL_ERROR
-            "${target} must not link ${t} (docs/architecture.md: no CLI11 and no JSON in tools/engine "
-            "and tools/io); it comes in through ${path_${current}} -> ${t}")
+            "${target} must not link ${name} (docs/architecture.md: no CLI11 and no JSON in "
+            "tools/engine and tools/io); it comes in through ${path_${current}} -> ${name}")
         endif()
-        if(NOT DEFINED path_${t})
-          set(path_${t} "${path_${current}} -> ${t}")
+        if(NOT DEFINED path_${name})
+          set(path_${name} "${path_${current}} -> ${name}")
         endif()
-        list(APPEND queue "${t}")
+        list(APPEND queue "${name}")
       endforeach()
     endforeach()
   endwhile()
@@ -71,9 +69,15 @@ endfunction()
 
 function(skelcd_forbid_links)
   cmake_parse_arguments(ARG "" "" "TARGETS;FORBID" ${ARGN})
+  # Resolved here, where the forbidden targets are found, with whatever they are aliases of.
+  set(forbidden)
+  foreach(f IN LISTS ARG_FORBID)
+    _skelcd_link_item_names("${f}" names)
+    list(APPEND forbidden ${names})
+  endforeach()
   foreach(target IN LISTS ARG_TARGETS)
     cmake_language(EVAL CODE "
       cmake_language(DEFER DIRECTORY \"${PROJECT_SOURCE_DIR}\" CALL
-        _skelcd_check_links \"${target}\" \"${ARG_FORBID}\")")
+        _skelcd_check_links \"${target}\" \"${forbidden}\")")
   endforeach()
 endfunction()
