@@ -1,9 +1,6 @@
 // The plan of a scene: which stages run for which object, and why the others do not.
 #include "tools/engine/scene_plan.hpp"
 
-#include <algorithm>
-#include <cstdio>
-
 #include "culling/method_registry.hpp"
 #include "skinning/errors.hpp"
 
