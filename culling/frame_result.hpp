@@ -10,8 +10,8 @@ namespace skelcd::culling {
 
 /// The work counters of one row, one entry each: every place that stores, sums, logs, reads or
 /// shows them is generated from this list (X(name, meaning)) — the struct below, `+=`, the log's
-/// /frames columns (tools/log/detail/hdf5_schema.hpp), the log reader, `inspect --frames` and the
-/// Python module's arrays. Add a counter here and everywhere follows (docs/architecture.md).
+/// /frames columns (tools/io/log/detail/hdf5_schema.hpp), the log reader, `inspect --frames` and
+/// the Python module's arrays. Add a counter here and everywhere follows (docs/architecture.md).
 #define SKELCD_COUNTERS(X)                                                              \
   X(atomic_clusters, "atomic clusters (radial-view methods)")                           \
   X(mega_clusters, "mega clusters after merging (dynamic)")                             \

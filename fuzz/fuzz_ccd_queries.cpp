@@ -1,4 +1,4 @@
-// libFuzzer harness: CCD query files (tools/ccd_query_file.hpp, parse_ccd_queries), with the
+// libFuzzer harness: CCD query files (tools/io/ccd_query_file.hpp, parse_ccd_queries), with the
 // exact rationals kept (the slower path, which also parses every p/q into GMP).
 // A thrown std::exception is the parser refusing the input (fine); crashes, sanitizer reports,
 // hangs and memory blow-ups are findings.
@@ -9,7 +9,7 @@
 #include <sstream>
 
 #include "fuzz/fuzz_input.hpp"
-#include "tools/ccd_query_file.hpp"
+#include "tools/io/ccd_query_file.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   std::istringstream in{std::string(skelcd::fuzz::as_text(data, size))};

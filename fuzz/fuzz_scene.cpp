@@ -1,4 +1,4 @@
-// libFuzzer harness: scene TOML (tools/scene.hpp, parse_scene_text). The scene is named
+// libFuzzer harness: scene TOML (tools/engine/scene.hpp, parse_scene_text). The scene is named
 // assets/scenes/fuzz.toml so that relative model paths in the seeds (../characters/...) resolve
 // to the bundled files; parsing only checks that they exist, nothing is loaded.
 // A thrown std::exception is the parser refusing the input (fine); crashes, sanitizer reports,
@@ -9,7 +9,7 @@
 #include <exception>
 
 #include "fuzz/fuzz_input.hpp"
-#include "tools/scene.hpp"
+#include "tools/engine/scene.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   static const std::filesystem::path scene_path =

@@ -33,7 +33,7 @@ from . import _skelcd
 __all__ = ["BatchResult", "log_name", "run", "main"]
 
 
-# --- naming: the command line's own (tools/check_engine.hpp, batch_log_name) ----------------------
+# --- naming: the command line's own (tools/engine/check_engine.hpp, batch_log_name) ----------------------
 
 def _is_generator_spec(model: str) -> bool:
     return model.startswith("gen:")

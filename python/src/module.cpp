@@ -1,9 +1,10 @@
 // skelcd._skelcd — the extension under the Python package `skelcd` (docs/python.md): loading a
 // model, posing it, checking a clip and reading a log, through the library's façade
-// (skinning/load.hpp, tools/check_engine.hpp, tools/model_report.hpp, tools/log/log_reader.hpp).
-// Tables leave as dicts of NumPy columns named like the HDF5 log's (docs/log-format.md);
-// skelcd/__init__.py assembles them into structured arrays. InvalidInput and IoError become the
-// Python exceptions skelcd.InvalidInput (a ValueError) and skelcd.IoError (an OSError), same text.
+// (skinning/load.hpp, tools/engine/check_engine.hpp, tools/report/model_report.hpp,
+// tools/io/log/log_reader.hpp). Tables leave as dicts of NumPy columns named like the HDF5 log's
+// (docs/log-format.md); skelcd/__init__.py assembles them into structured arrays. InvalidInput and
+// IoError become the Python exceptions skelcd.InvalidInput (a ValueError) and skelcd.IoError (an
+// OSError), same text.
 
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
@@ -25,10 +26,11 @@
 #include "skinning/errors.hpp"
 #include "skinning/load.hpp"
 #include "skinning/topology.hpp"
-#include "tools/check_engine.hpp"
-#include "tools/log/log_reader.hpp"
-#include "tools/model_report.hpp"
-#include "tools/run_summary.hpp"
+#include "tools/engine/check_engine.hpp"
+#include "tools/engine/run_summary.hpp"
+#include "tools/io/log/log_reader.hpp"
+#include "tools/report/model_report.hpp"
+#include "tools/report/summary_json.hpp"
 
 namespace py = pybind11;
 
@@ -155,7 +157,7 @@ py::list event_dicts(const std::vector<tools::EventRecord>& events) {
   return out;
 }
 
-/// The object `skelcd check --json` prints (tools/run_summary.hpp, summary_json), same keys.
+/// The object `skelcd check --json` prints (tools/report/summary_json.hpp), same keys.
 py::dict summary_dict(
     const tools::RunIdentity& id, const tools::RunSummary& s, const tools::RunLabels& labels) {
   return to_python(tools::summary_json(id, s, labels));
@@ -321,7 +323,7 @@ py::dict check(
     std::int32_t baseline_slack,
     const std::vector<std::string>& allow,
     bool allow_adjacent_bones) {
-  // Options refused with the CLI's own messages (tools/cmd_check.cpp).
+  // Options refused with the CLI's own messages (tools/cli/cmd_check.cpp).
   const auto parsed_accuracy = ccd::parse_accuracy(accuracy);
   if (!parsed_accuracy)
     throw InvalidInput("--accuracy '" + accuracy + "': expected exact, conservative or fast");

@@ -1,6 +1,6 @@
 #pragma once
 // Keeps a broken file from taking skelcd down with it (internal; skinning/ for model files, and
-// tools/log/ for logs, whose HDF5 library crashes on some malformed files). assimp trusts
+// tools/io/log/ for logs, whose HDF5 library crashes on some malformed files). assimp trusts
 // the counts a file declares (a 300-byte OFF file asks for 15 GB) and crashes on some malformed
 // files; skelcd must answer every input with a result or one line.
 

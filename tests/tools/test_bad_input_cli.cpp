@@ -14,7 +14,7 @@
 #include "skinning/assimp_import.hpp"
 #include "tests/support/test_support.hpp"
 #include "tests/tools/cli_runner.hpp"
-#include "tools/log/log_reader.hpp"
+#include "tools/io/log/log_reader.hpp"
 
 namespace {
 

@@ -1,8 +1,8 @@
-// The accuracy-versus-time report (tools/bench_report.hpp): set comparison on hand-made keys, the
-// reference choice, and whole reports on a generated rope with a known answer and on a real
-// character — the reference row is clean, exact and conservative hierarchies miss nothing, a method
-// that drops known contacts is charged exactly what it dropped, and `fast`'s misses are recounted
-// independently.
+// The accuracy-versus-time report (tools/report/bench_report.hpp): set comparison on hand-made
+// keys, the reference choice, and whole reports on a generated rope with a known answer and on a
+// real character — the reference row is clean, exact and conservative hierarchies miss nothing, a
+// method that drops known contacts is charged exactly what it dropped, and `fast`'s misses are
+// recounted independently.
 
 #include <gtest/gtest.h>
 
@@ -17,7 +17,7 @@
 #include "skinning/generators.hpp"
 #include "skinning/load.hpp"
 #include "tests/support/test_support.hpp"
-#include "tools/bench_report.hpp"
+#include "tools/report/bench_report.hpp"
 
 namespace {
 

@@ -2,17 +2,17 @@
 // results), stdin, results file, JSON summary, one-line errors naming the line, and the
 // cloth-funnel ground truth run through the real binary.
 
-#include <fstream>
-#include <sstream>
-
 #include <gtest/gtest.h>
+
+#include <fstream>
 #include <nlohmann/json.hpp>
+#include <sstream>
 
 #include "ccd/vertex_face.hpp"
 #include "tests/ccd/cloth_funnel.hpp"
 #include "tests/support/test_support.hpp"
 #include "tests/tools/cli_runner.hpp"
-#include "tools/ccd_query_file.hpp"
+#include "tools/io/ccd_query_file.hpp"
 
 namespace {
 

@@ -3,6 +3,7 @@
 // left behind, and a run killed with SIGKILL half-way leaving a log that our reader, h5dump and
 // skelcd inspect all read.
 
+#include <gtest/gtest.h>
 #include <signal.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -12,16 +13,14 @@
 #include <chrono>
 #include <cstdlib>
 #include <fstream>
+#include <nlohmann/json.hpp>
 #include <sstream>
 #include <thread>
 #include <tuple>
 
-#include <gtest/gtest.h>
-#include <nlohmann/json.hpp>
-
 #include "tests/support/test_support.hpp"
 #include "tests/tools/cli_runner.hpp"
-#include "tools/log/log_reader.hpp"
+#include "tools/io/log/log_reader.hpp"
 
 namespace {
 

@@ -2,17 +2,17 @@
 // readable logs (truncated, foreign HDF5, plain text), sorting, CSV/JSON, the per-frame table,
 // plots, and the collision events of labelled logs next to logs written before events.
 
+#include <gtest/gtest.h>
+
 #include <array>
 #include <cstdlib>
 #include <fstream>
-#include <sstream>
-
-#include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
+#include <sstream>
 
 #include "tests/support/test_support.hpp"
 #include "tests/tools/cli_runner.hpp"
-#include "tools/log/log_writer.hpp"
+#include "tools/io/log/log_writer.hpp"
 
 namespace {
 

@@ -2,22 +2,22 @@
 // (h5dump opens it; read back equal to what was computed; its input hash checked), clip averages,
 // and bad input refused with one line and nothing written.
 
+#include <gtest/gtest.h>
+
 #include <algorithm>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <memory>
-#include <string>
-
-#include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
+#include <string>
 
 #include "segmentation/segmentation.hpp"
 #include "skinning/errors.hpp"
 #include "skinning/load.hpp"
 #include "tests/support/test_support.hpp"
 #include "tests/tools/cli_runner.hpp"
-#include "tools/segmentation_file.hpp"
+#include "tools/io/segmentation_file.hpp"
 
 namespace {
 

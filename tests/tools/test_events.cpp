@@ -1,12 +1,12 @@
-// Baselines and collision events (tools/events.hpp, docs/events.md): the depth measure against
-// hand-computed segments, labels and events on generated rigs with known answers and on real
-// characters whose clips are edited in the test.
+// Baselines and collision events (tools/engine/events.hpp, docs/events.md): the depth measure
+// against hand-computed segments, labels and events on generated rigs with known answers and on
+// real characters whose clips are edited in the test.
 
 #include <gtest/gtest.h>
 
 #include <cmath>
 
-#include "tools/events.hpp"
+#include "tools/engine/events.hpp"
 
 namespace skelcd::tools {
 namespace {
@@ -39,8 +39,8 @@ TEST(IntersectionLength, SeparateOrCoplanarTrianglesGiveZero) {
 #include "skinning/errors.hpp"
 #include "skinning/generators.hpp"
 #include "skinning/load.hpp"
-#include "tools/check_engine.hpp"
-#include "tools/run_summary.hpp"
+#include "tools/engine/check_engine.hpp"
+#include "tools/engine/run_summary.hpp"
 
 namespace skelcd::tools {
 namespace {

@@ -32,8 +32,8 @@
 #include "skinning/pose.hpp"
 #include "skinning/rig.hpp"
 #include "tests/support/test_support.hpp"
-#include "tools/check_engine.hpp"
-#include "tools/events.hpp"
+#include "tools/engine/check_engine.hpp"
+#include "tools/engine/events.hpp"
 
 namespace skelcd::tools {
 namespace {

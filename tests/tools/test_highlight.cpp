@@ -11,9 +11,9 @@
 #include "skinning/errors.hpp"
 #include "tests/support/test_support.hpp"
 #include "tests/tools/cli_runner.hpp"
-#include "tools/highlight.hpp"
-#include "tools/log/log_reader.hpp"
-#include "tools/log/log_writer.hpp"
+#include "tools/io/log/log_reader.hpp"
+#include "tools/io/log/log_writer.hpp"
+#include "tools/report/highlight.hpp"
 
 namespace {
 

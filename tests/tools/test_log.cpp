@@ -13,9 +13,9 @@
 #include "skinning/errors.hpp"
 #include "tests/support/test_support.hpp"
 #include "tests/tools/cli_runner.hpp"
-#include "tools/file_hash.hpp"
-#include "tools/log/log_reader.hpp"
-#include "tools/log/log_writer.hpp"
+#include "tools/io/file_hash.hpp"
+#include "tools/io/log/log_reader.hpp"
+#include "tools/io/log/log_writer.hpp"
 
 namespace {
 

@@ -15,11 +15,11 @@
 #include "culling/routed_method.hpp"
 #include "skinning/load.hpp"
 #include "tests/support/test_support.hpp"
-#include "tools/bench_report.hpp"
-#include "tools/check_engine.hpp"
-#include "tools/commands.hpp"
-#include "tools/radial_view_setup.hpp"
-#include "tools/scene.hpp"
+#include "tools/cli/commands.hpp"
+#include "tools/engine/check_engine.hpp"
+#include "tools/engine/radial_view_setup.hpp"
+#include "tools/engine/scene.hpp"
+#include "tools/report/bench_report.hpp"
 
 namespace skelcd {
 namespace {

@@ -23,8 +23,8 @@
 #include "skinning/load.hpp"
 #include "skinning/rig_motion.hpp"
 #include "tests/support/test_support.hpp"
-#include "tools/radial_view_setup.hpp"
-#include "tools/runner.hpp"
+#include "tools/engine/radial_view_setup.hpp"
+#include "tools/engine/runner.hpp"
 
 namespace {
 

@@ -2,17 +2,16 @@
 // columns in the log (clusters, |H⁻|, |Hᵘ|, RV-update times), γ in the header, a segmentation
 // from `skelcd preprocess` reused, and bad input refused in one line.
 
-#include <algorithm>
-#include <tuple>
-
-#include <fstream>
-
 #include <gtest/gtest.h>
+
+#include <algorithm>
+#include <fstream>
 #include <nlohmann/json.hpp>
+#include <tuple>
 
 #include "tests/support/test_support.hpp"
 #include "tests/tools/cli_runner.hpp"
-#include "tools/log/log_reader.hpp"
+#include "tools/io/log/log_reader.hpp"
 
 namespace {
 

@@ -1,16 +1,16 @@
 // The per-interval runner: rows in order for each --query, positions handed to the method,
 // findings converted from welded ids to the file's own numbering, non-finite samples refused.
 
+#include <gtest/gtest.h>
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
 #include <vector>
 
-#include <gtest/gtest.h>
-
 #include "skinning/errors.hpp"
 #include "tests/support/test_support.hpp"
-#include "tools/runner.hpp"
+#include "tools/engine/runner.hpp"
 
 namespace {
 

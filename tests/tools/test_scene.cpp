@@ -7,8 +7,9 @@
 
 #include "skinning/errors.hpp"
 #include "tests/support/test_support.hpp"
-#include "tools/scene.hpp"
-#include "tools/scene_plan.hpp"
+#include "tools/engine/scene.hpp"
+#include "tools/engine/scene_plan.hpp"
+#include "tools/report/scene_plan_report.hpp"
 
 namespace skelcd::tools {
 namespace {

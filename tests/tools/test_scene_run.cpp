@@ -16,8 +16,8 @@
 #include "skinning/topology.hpp"
 #include "tests/support/test_support.hpp"
 #include "tests/tools/cli_runner.hpp"
-#include "tools/log/log_reader.hpp"
-#include "tools/scene_runner.hpp"
+#include "tools/engine/scene_runner.hpp"
+#include "tools/io/log/log_reader.hpp"
 
 namespace skelcd::tools {
 namespace {

@@ -1,6 +1,6 @@
 // export --segmentation: one colour per atomic cluster of a file written by `skelcd preprocess`.
 
-#include "tools/segmentation_colors.hpp"
+#include <gtest/gtest.h>
 
 #include <algorithm>
 #include <array>
@@ -8,13 +8,12 @@
 #include <map>
 #include <set>
 
-#include <gtest/gtest.h>
-
 #include "skinning/errors.hpp"
 #include "skinning/load.hpp"
 #include "tests/support/test_support.hpp"
 #include "tests/tools/cli_runner.hpp"
-#include "tools/segmentation_file.hpp"
+#include "tools/io/segmentation_file.hpp"
+#include "tools/report/segmentation_colors.hpp"
 
 namespace skelcd::tools {
 namespace {

@@ -1,0 +1,37 @@
+// skelcd: self-collision detection for skeleton-driven animation. Every error reaches the user as
+// one line on stderr and a non-zero exit status.
+
+#include <CLI/CLI.hpp>
+#include <cstdio>
+#include <exception>
+#include <iostream>
+
+#include "skelcd_version.hpp"
+#include "tools/cli/commands.hpp"
+
+int main(int argc, char** argv) {
+  CLI::App app{"skelcd — finds self-collisions in skeleton-driven animation", "skelcd"};
+  app.set_version_flag("--version", skelcd::kVersion);
+  app.require_subcommand(1);
+  app.fallthrough(false);
+
+  // Commands, in the order of DESIGN.md's table (one line each):
+  skelcd::tools::add_info_command(app);
+  skelcd::tools::add_preprocess_command(app);
+  skelcd::tools::add_check_command(app);
+  skelcd::tools::add_inspect_command(app);
+  skelcd::tools::add_export_command(app);
+  skelcd::tools::add_generate_command(app);
+  skelcd::tools::add_ccd_queries_command(app);
+  skelcd::tools::add_bench_command(app);
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e);
+  } catch (const std::exception& e) {
+    std::cerr << "skelcd: " << e.what() << '\n';
+    return 1;
+  }
+  return 0;
+}

@@ -1,0 +1,186 @@
+#include "tools/engine/check_engine.hpp"
+
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <filesystem>
+#include <memory>
+
+#include "culling/method.hpp"
+#include "skinning/errors.hpp"
+#include "skinning/generators.hpp"
+#include "tools/engine/scene.hpp"
+#include "tools/io/file_hash.hpp"
+#include "tools/io/log/log_writer.hpp"
+
+namespace skelcd::tools {
+namespace {
+
+RunOptions run_options(const CheckRequest& r) {
+  if (!(std::isfinite(r.fps) && r.fps >= 0)) {
+    throw InvalidInput("rate " + std::to_string(r.fps) + ": expected a rate > 0 (samples/s)");
+  }
+  if (!(std::isfinite(r.min_separation) && r.min_separation >= 0)) {
+    throw InvalidInput(
+        "min_separation " + std::to_string(r.min_separation) + ": expected a finite distance >= 0");
+  }
+  const auto known = check_method_names();
+  if (std::find(known.begin(), known.end(), r.method) == known.end()) {
+    std::string list;
+    for (const auto& k : known) list += (list.empty() ? "" : ", ") + k;
+    throw InvalidInput("--method '" + r.method + "': unknown method (known: " + list + ")");
+  }
+  RunOptions o;
+  o.clip = r.clip;
+  o.fps = r.fps;
+  o.frames = r.frames;
+  o.method = r.method;
+  o.accuracy = r.accuracy;
+  o.query = r.query;
+  o.min_separation = r.min_separation;
+  o.threads = r.threads;
+  o.elementary_tests_done = r.tests_done;
+  return o;
+}
+
+}  // namespace
+
+std::string file_name_part(const std::string& text) {
+  std::string out;
+  for (const char c : text) {
+    const bool keep =
+        std::isalnum(static_cast<unsigned char>(c)) != 0 || c == '-' || c == '_' || c == '.';
+    out += keep ? c : '_';
+  }
+  while (!out.empty() && out.front() == '.') out.erase(out.begin());
+  return out.empty() ? std::string("model") : out;
+}
+
+std::string batch_log_name(const std::string& model_arg, const std::string& clip) {
+  std::string stem;
+  if (skinning::is_generator_spec(model_arg)) {
+    stem = model_arg;
+  } else {
+    auto path = std::filesystem::path(model_arg).lexically_normal();
+    if (path.filename().empty()) path = path.parent_path();
+    const bool glob = model_arg.find_first_of("*?[") != std::string::npos;
+    stem = glob ? path.parent_path().filename().string() : path.stem().string();
+  }
+  std::string name = file_name_part(stem);
+  if (!clip.empty()) {
+    name += '-';  // (not "-" + …: GCC 12 warns -Wrestrict on that, wrongly)
+    name += file_name_part(clip);
+  }
+  return name;
+}
+
+RunIdentity check_identity(
+    const skinning::LoadedModel& model, const CheckRequest& request, const CheckOutcome& outcome) {
+  return RunIdentity{
+      .model = model.path.string(),
+      .clip = outcome.clip,
+      .fps = outcome.fps,
+      .first_sample = outcome.plan.first_sample,
+      .last_sample = outcome.plan.last_sample,
+      .method = request.method,
+      .accuracy = std::string(ccd::to_string(request.accuracy)),
+      .query = std::string(to_string(request.query)),
+      .log = request.log_path,
+  };
+}
+
+RunLabels check_labels(
+    const skinning::LoadedModel& model, const CheckRequest& request, const CheckOutcome& outcome) {
+  return RunLabels{
+      .baseline = outcome.baseline,
+      .baseline_slack = request.baseline_slack,
+      .allow = request.allow.rules,
+      .allow_adjacent_bones = request.allow.adjacent_bones,
+      .events = outcome.events,
+      .events_recorded = true,
+      .part_names = model.mesh->part_names,
+  };
+}
+
+std::vector<std::string> check_method_names() { return scene_method_names(); }
+
+CheckOutcome check_model(
+    const skinning::LoadedModel& model, const CheckRequest& request, const FrameCallback& on_row) {
+  RunOptions options = run_options(request);
+  const auto motion =
+      model.motion(skinning::MotionRequest{.clip = request.clip, .rate_hz = request.fps});
+  CheckOutcome outcome;
+  outcome.radial_view = setup_radial_view(request.radial_view, model, *motion, options);
+  ClipRunner runner(*motion, options);
+  outcome.plan = runner.plan();
+  outcome.clip = motion->name();
+  outcome.fps = motion->rate_hz();
+  outcome.method = std::string(runner.method_name());
+
+  // The baseline and the allowances, refused (a bad sample, a log of another model, an unknown
+  // part) before the log is created.
+  const skinning::Mesh& mesh = motion->mesh();
+  const auto positions_at = [&motion](std::int32_t sample, skinning::Positions& out) {
+    motion->positions(sample, out);
+  };
+  const auto baseline = baseline_findings(request.baseline, *motion, runner.topology());
+  outcome.baseline = describe(request.baseline);
+  outcome.baseline_pairs = static_cast<std::int64_t>(baseline.pairs.size());
+  const skinning::Rig* rig = model.rig && model.rig->mesh.num_vertices() == mesh.num_vertices()
+                                 ? model.rig.get()
+                                 : nullptr;
+  EventTracker tracker(
+      mesh, runner.topology(), rig, baseline, request.allow, request.baseline_slack, positions_at);
+
+  std::unique_ptr<LogWriter> writer;
+  if (!request.log_path.empty()) {
+    const std::string input = request.input_path.empty() ? model.path.string() : request.input_path;
+    LogHeader header = log_header_base({
+        .input_path = input,
+        .input_hash = model_identity(input),
+        .command_line = request.command_line,
+        .first_sample = outcome.plan.first_sample,
+        .last_sample = outcome.plan.last_sample,
+        .planned_rows = outcome.plan.rows,
+        .num_vertices = mesh.num_vertices(),
+        .num_triangles = mesh.num_triangles(),
+        .part_names = mesh.part_names,
+    });
+    header.clip = outcome.clip;
+    header.method = outcome.method;
+    header.accuracy = std::string(ccd::to_string(options.accuracy));
+    header.query = std::string(to_string(options.query));
+    header.fps = outcome.fps;
+    header.min_separation = options.min_separation;
+    header.gamma = outcome.radial_view.gamma;
+    header.seed = outcome.radial_view.seed;
+    header.segmentation = outcome.radial_view.segmentation_source;
+    header.routes = runner.routes();
+    header.baseline = outcome.baseline;
+    header.baseline_slack = request.baseline_slack;
+    header.allow = request.allow.rules;
+    header.allow_adjacent_bones = request.allow.adjacent_bones;
+    writer = std::make_unique<LogWriter>(request.log_path, header);
+  }
+
+  outcome.rows.reserve(static_cast<std::size_t>(outcome.plan.rows));
+  if (request.on_plan) request.on_plan(outcome.plan);
+  const auto emit = [&](std::vector<FrameReport> ready) {
+    for (const auto& report : ready) {
+      if (writer) writer->append(report);
+      outcome.rows.push_back(report.row);
+      if (on_row) on_row(report);
+    }
+  };
+  runner.run([&](const FrameReport& report) { emit(tracker.push(report)); });
+  emit(tracker.flush());
+  outcome.events = tracker.events();
+  if (writer) {
+    writer->write_events(outcome.events);
+    writer->finish();
+  }
+  outcome.summary = summarize(outcome.rows);
+  return outcome;
+}
+
+}  // namespace skelcd::tools

@@ -1,0 +1,49 @@
+#pragma once
+// What `check` (and any command built on ClipRunner) adds for the radial-view methods `rvbc` and
+// `dynamic`: the options --gamma, --seed, --segmentation, and the setup that gives the runner's
+// method what it needs beyond the mesh — a segmentation (read from a `preprocess` file made from
+// the same model, else computed from the rig); the bone poses of each interval travel with the
+// query (docs/radial-view.md, "Command line").
+
+#include <cstdint>
+#include <optional>
+#include <string>
+
+#include "skinning/load.hpp"
+#include "skinning/motion.hpp"
+#include "tools/engine/runner.hpp"
+
+namespace skelcd::tools {
+
+struct RadialViewArguments {
+  double gamma = 0.05;  ///< merge threshold γ of `dynamic` (§5)
+  std::uint64_t seed = 1;
+  std::string segmentation;  ///< SEG.h5 from `skelcd preprocess`; empty: computed here
+};
+
+struct RadialViewSetup {
+  /// Where the segmentation came from: the file, or "computed (rig weights)" / "(heat weights)".
+  std::string segmentation_source;
+  std::int32_t atomic_clusters = 0;
+  /// γ and the seed when the method uses them (`dynamic`), for the log header.
+  std::optional<double> gamma;
+  std::optional<std::int64_t> seed;
+};
+
+/// For a method that needs a segmentation (rvbc, dynamic; `auto` on a rig's clip): loads or
+/// computes it and sets options.segmentation and options.method_parameters; the bones'
+/// transforms then travel with every query (the runner asks the motion for them). With
+/// options.query == dcd nothing of the radial view is built: rvbc/dynamic answer DCD as `bvh`
+/// does and `auto`'s closed parts go to its `bvh` fallback. Does nothing and returns an empty
+/// setup for any other method.
+/// @param motion the motion the runner will check (a rig's clip: Motion::num_bones() > 0).
+/// @throws InvalidInput when the model has no rig, the motion is not a rig's, γ is outside
+///   [0, 1], or the segmentation file was made from another model (hash mismatch); IoError when
+///   the segmentation file cannot be read.
+[[nodiscard]] RadialViewSetup setup_radial_view(
+    const RadialViewArguments& args,
+    const skinning::LoadedModel& model,
+    const skinning::Motion& motion,
+    RunOptions& options);
+
+}  // namespace skelcd::tools

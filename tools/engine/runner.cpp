@@ -1,0 +1,528 @@
+#include "tools/engine/runner.hpp"
+
+#include <tbb/global_control.h>
+#include <tbb/info.h>
+#include <tbb/parallel_pipeline.h>
+#include <tbb/task_arena.h>
+
+#include <algorithm>
+#include <atomic>
+#include <charconv>
+#include <chrono>
+#include <cmath>
+#include <exception>
+#include <limits>
+#include <mutex>
+#include <utility>
+
+#include "culling/method_registry.hpp"
+#include "culling/routed_method.hpp"
+#include "skinning/errors.hpp"
+#include "tools/engine/sample_sequencer.hpp"
+
+namespace skelcd::tools {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double microseconds_since(Clock::time_point start) {
+  return std::chrono::duration<double, std::micro>(Clock::now() - start).count();
+}
+
+std::optional<std::int32_t> parse_index(std::string_view text) {
+  std::int32_t value = 0;
+  const auto [end, error] = std::from_chars(text.data(), text.data() + text.size(), value);
+  if (error != std::errc() || end != text.data() + text.size() || value < 0) return std::nullopt;
+  return value;
+}
+
+RunPlan make_plan(const skinning::Motion& motion, const RunOptions& options) {
+  const std::int32_t samples = motion.num_samples();
+  if (samples < 1) throw InvalidInput(motion.name() + ": the motion has no samples");
+  RunPlan plan;
+  plan.first_sample = options.frames.first;
+  plan.last_sample = options.frames.last.value_or(samples - 1);
+  if (plan.first_sample > plan.last_sample || plan.last_sample >= samples) {
+    throw InvalidInput(
+        "--frames " + std::to_string(plan.first_sample) + ":" + std::to_string(plan.last_sample) +
+        " is outside the " + std::to_string(samples) +
+        " samples (0:" + std::to_string(samples - 1) + ") of " + motion.name());
+  }
+  plan.samples = plan.last_sample - plan.first_sample + 1;
+  const bool dcd = options.query != QuerySet::ccd;
+  const bool ccd = options.query != QuerySet::dcd;
+  plan.intervals = ccd ? plan.samples - 1 : 0;
+  if (ccd && !dcd && plan.intervals == 0) {
+    throw InvalidInput(
+        "--query ccd needs at least two samples; --frames selects only sample " +
+        std::to_string(plan.first_sample));
+  }
+  plan.rows = (dcd ? plan.samples : 0) + plan.intervals;
+  return plan;
+}
+
+/// What one row needs from the run: the motion, the welded topology and the file numbering, and
+/// whether the method needs the bones' transforms.
+struct RowContext {
+  const skinning::Motion& motion;
+  const skinning::Topology& topology;
+  const FeatureNumbering& numbering;
+  bool bones;
+};
+
+/// One posed sample: welded positions and, when the method needs them, the bone transforms.
+struct PosedSample {
+  skinning::Positions welded;
+  std::vector<skinning::BoneTransform> bones;
+};
+
+/// Poses sample i into `out` (`posed`: scratch); returns the microseconds it took.
+/// Finiteness is checked once per sample, here, where positions enter.
+double pose_sample(
+    const RowContext& c, std::int32_t i, skinning::Positions& posed, PosedSample& out) {
+  const auto start = Clock::now();
+  skinning::Positions& welded = out.welded;
+  if (c.bones) c.motion.bone_transforms(i, out.bones);
+  const auto& mesh = c.motion.mesh();
+  c.motion.positions(i, posed);
+  if (posed.rows() != mesh.num_vertices()) {
+    throw InvalidInput(
+        c.motion.name() + ": sample " + std::to_string(i) + " has " + std::to_string(posed.rows()) +
+        " positions, expected " + std::to_string(mesh.num_vertices()));
+  }
+  if (!posed.allFinite()) {
+    Eigen::Index bad = 0;
+    while (bad < posed.rows() && posed.row(bad).allFinite()) ++bad;
+    throw InvalidInput(
+        c.motion.name() + ": sample " + std::to_string(i) +
+        " (t = " + std::to_string(c.motion.sample_time(i)) + " s): vertex " + std::to_string(bad) +
+        " has a non-finite position");
+  }
+  skinning::gather_welded(c.topology, posed, welded);
+  return microseconds_since(start);
+}
+
+/// Converts the method's findings (welded numbering) into a row in the file's numbering. The
+/// found-counters are taken from the findings themselves so that a row's counts always equal its
+/// rows in /contacts and /dcd_pairs.
+void make_report(
+    const RowContext& c,
+    QueryKind kind,
+    std::int32_t sample,
+    const culling::FrameResult& result,
+    double skin_us,
+    Clock::time_point start,
+    FrameReport& report) {
+  report.row = FrameRow{};
+  report.row.sample = sample;
+  report.row.kind = kind;
+  report.row.t0 = c.motion.sample_time(sample);
+  report.row.t1 = kind == QueryKind::ccd ? c.motion.sample_time(sample + 1) : report.row.t0;
+  report.row.counters = result.counters;
+  report.row.times = result.times;
+  report.row.times.skin_us = skin_us;
+  report.contacts.clear();
+  report.dcd_pairs.clear();
+  std::int64_t vf = 0;
+  std::int64_t ee = 0;
+  for (const auto& contact : result.contacts) {
+    const bool is_vf = contact.kind == culling::CcdContact::Kind::vf;
+    (is_vf ? vf : ee) += 1;
+    report.contacts.push_back(ContactRow{
+        .frame = sample,
+        .kind = contact.kind,
+        .a = is_vf ? c.numbering.vertex(contact.a) : c.numbering.edge(contact.a),
+        .b = is_vf ? c.numbering.triangle(contact.b) : c.numbering.edge(contact.b),
+        .toi_lower = contact.toi_lower,
+        .toi_upper = contact.toi_upper,
+    });
+  }
+  for (const auto& p : result.dcd_pairs) {
+    report.dcd_pairs.push_back(DcdPairRow{
+        .frame = sample, .a = c.numbering.triangle(p.a), .b = c.numbering.triangle(p.b)});
+  }
+  if (kind == QueryKind::ccd) {
+    report.row.counters.vf_contacts = vf;
+    report.row.counters.ee_contacts = ee;
+  } else {
+    report.row.counters.dcd_pairs = static_cast<std::int64_t>(result.dcd_pairs.size());
+  }
+  report.row.total_us = skin_us + microseconds_since(start);
+}
+
+/// The options the method is built with.
+culling::MethodOptions method_options_of(
+    const RunOptions& options, const skinning::Motion& motion) {
+  culling::MethodOptions o;
+  o.accuracy = options.accuracy;
+  o.min_separation = options.min_separation;
+  o.segmentation = options.segmentation;
+  o.num_bones = motion.num_bones();
+  o.parameters = options.method_parameters;
+  return o;
+}
+
+/// True when `name` (or, for `auto`, a method it routes to) needs the bones' transforms.
+bool needs_bone_poses(std::string_view name, const culling::MethodOptions& options) {
+  std::vector<std::string> names{std::string(name)};
+  if (name == "auto") names = culling::auto_group_methods(options);
+  for (const auto& n : names) {
+    const auto* m = culling::find_method(n);
+    if (m != nullptr && m->needs.bone_poses) return true;
+  }
+  return false;
+}
+
+/// One method and the buffers of the samples it checks: the serial run's, or a parallel worker's.
+struct Worker {
+  std::unique_ptr<culling::CullingMethod> owned;
+  culling::CullingMethod* method = nullptr;
+  skinning::Positions posed;
+  PosedSample samples[2];
+  culling::FrameResult result;
+};
+
+/// Runs the rows of `sequence` with `w`, passing each completed row to `emit`, in order.
+template <class Emit>
+void check_samples(
+    const RowContext& context, const SampleSequence& sequence, Worker& w, Emit&& emit) {
+  FrameReport report;
+  run_sequence(
+      sequence,
+      [&](std::int32_t k, int slot) { return pose_sample(context, k, w.posed, w.samples[slot]); },
+      [&](std::int32_t k, int slot, double skin_us) {
+        const auto start = Clock::now();
+        w.result.clear();
+        const PosedSample& x = w.samples[slot];
+        w.method->detect_dcd(
+            culling::Instant{.x = x.welded, .bones = x.bones, .sample = k}, w.result);
+        make_report(context, QueryKind::dcd, k, w.result, skin_us, start, report);
+        emit(report);
+      },
+      [&](std::int32_t k, int slot_t0, int slot_t1, double skin_us) {
+        const auto start = Clock::now();
+        w.result.clear();
+        const PosedSample& a = w.samples[slot_t0];
+        const PosedSample& b = w.samples[slot_t1];
+        w.method->detect_ccd(
+            culling::Interval{
+                .x_t0 = a.welded,
+                .x_t1 = b.welded,
+                .bones_t0 = a.bones,
+                .bones_t1 = b.bones,
+                .sample_t0 = k,
+                .sample_t1 = k + 1},
+            w.result);
+        make_report(context, QueryKind::ccd, k, w.result, skin_us, start, report);
+        emit(report);
+      });
+}
+
+/// Workers handed out to the pipeline's parallel stage: one per block being checked, built on
+/// first need (at most one per thread of the arena), returned after the block.
+class WorkerPool {
+ public:
+  explicit WorkerPool(std::function<std::unique_ptr<Worker>()> make) : make_(std::move(make)) {}
+  void add(std::unique_ptr<Worker> worker) {
+    free_.push_back(worker.get());
+    all_.push_back(std::move(worker));
+  }
+  Worker& acquire() {
+    const std::lock_guard lock(mutex_);
+    if (free_.empty()) {
+      all_.push_back(make_());  // rare: construction is serialized under the lock
+      return *all_.back();
+    }
+    Worker* w = free_.back();
+    free_.pop_back();
+    return *w;
+  }
+  void release(Worker& worker) {
+    const std::lock_guard lock(mutex_);
+    free_.push_back(&worker);
+  }
+
+ private:
+  std::function<std::unique_ptr<Worker>()> make_;
+  std::mutex mutex_;
+  std::vector<std::unique_ptr<Worker>> all_;
+  std::vector<Worker*> free_;
+};
+
+/// A block of consecutive samples [first, end) and the rows it produced (in order), followed by
+/// the error that stopped it, if any.
+struct Block {
+  std::int32_t first = 0;
+  std::int32_t end = 0;
+  std::vector<FrameReport> reports;
+  std::exception_ptr error;
+};
+
+}  // namespace
+
+FrameRange parse_frame_range(std::string_view text) {
+  const auto bad = [&](const char* why) {
+    return InvalidInput(
+        "--frames '" + std::string(text) + "': " + why +
+        " (expected A:B, A:, :B or A with sample indices >= 0)");
+  };
+  FrameRange range;
+  const auto colon = text.find(':');
+  if (colon == std::string_view::npos) {
+    const auto one = parse_index(text);
+    if (!one) throw bad("not a sample index");
+    range.first = *one;
+    range.last = *one;
+    return range;
+  }
+  const auto first = text.substr(0, colon);
+  const auto last = text.substr(colon + 1);
+  if (!first.empty()) {
+    const auto value = parse_index(first);
+    if (!value) throw bad("bad first sample");
+    range.first = *value;
+  }
+  if (!last.empty()) {
+    const auto value = parse_index(last);
+    if (!value) throw bad("bad last sample");
+    range.last = *value;
+  }
+  if (range.last && *range.last < range.first) throw bad("last sample before first");
+  return range;
+}
+
+FeatureNumbering::FeatureNumbering(const skinning::Mesh& mesh, const skinning::Topology& topology)
+    : mesh_(mesh), topology_(topology) {
+  // Name every edge through the first triangle incident to it (CSR edge → faces) and the side of
+  // that triangle it is.
+  const std::int32_t num_edges = topology.num_edges();
+  edges_.assign(static_cast<std::size_t>(num_edges), FeatureId{});
+  for (std::int32_t e = 0; e < num_edges; ++e) {
+    const auto begin = topology.edge_face_offsets[static_cast<std::size_t>(e)];
+    const auto end = topology.edge_face_offsets[static_cast<std::size_t>(e) + 1];
+    if (begin == end) continue;
+    const std::int32_t f = topology.edge_faces[static_cast<std::size_t>(begin)];
+    for (std::int8_t k = 0; k < 3; ++k) {
+      if (topology.face_edges(f, k) == e) {
+        auto& id = edges_[static_cast<std::size_t>(e)];
+        id = triangle(f);
+        id.side = k;
+        break;
+      }
+    }
+  }
+}
+
+FeatureId FeatureNumbering::vertex(std::int32_t welded_vertex) const {
+  const auto v = static_cast<std::size_t>(
+      topology_.representative_vertex[static_cast<std::size_t>(welded_vertex)]);
+  return FeatureId{mesh_.vertex_part[v], mesh_.vertex_index_in_part[v], -1};
+}
+
+FeatureId FeatureNumbering::triangle(std::int32_t triangle) const {
+  const auto f = static_cast<std::size_t>(triangle);
+  return FeatureId{mesh_.face_part[f], mesh_.face_index_in_part[f], -1};
+}
+
+FeatureId FeatureNumbering::edge(std::int32_t edge) const {
+  return edges_[static_cast<std::size_t>(edge)];
+}
+
+std::int32_t resolve_threads(std::int32_t threads) {
+  if (threads < 0) throw InvalidInput("--threads " + std::to_string(threads) + ": expected >= 0");
+  if (threads == 0) return std::max(1, tbb::info::default_concurrency());
+  return threads;
+}
+
+ClipRunner::ClipRunner(
+    const skinning::Motion& motion, const RunOptions& options, MethodFactory factory)
+    : motion_(motion),
+      options_(options),
+      factory_(std::move(factory)),
+      method_options_(method_options_of(options, motion)),
+      plan_(make_plan(motion, options)) {
+  // Within one query the elementary tests may split over the threads asked for (identical
+  // output); across queries, blocks of samples go to workers (below) when the method allows.
+  method_options_.elementary.threads = resolve_threads(options.threads);
+  method_options_.elementary.tests_done = options.elementary_tests_done;
+  topology_ = skinning::build_topology(motion.mesh());
+  if (factory_) {
+    method_ = factory_(motion.mesh(), topology_, method_options_);
+  } else {
+    method_ = culling::make_method(options.method, motion.mesh(), topology_, method_options_);
+  }
+  if (!method_) throw InvalidInput("method '" + options.method + "' could not be built");
+  bones_ = motion.num_bones() > 0 && needs_bone_poses(options.method, method_options_);
+
+  // Threads: blocks of consecutive samples (a DCD at k, then the CCD k → k+1) go to workers.
+  const std::int32_t wanted = resolve_threads(options.threads);
+  if (wanted > 1) {
+    if (!factory_) {
+      const culling::MethodInfo* m = culling::find_method(options.method);
+      if (m != nullptr && m->serial_reason) {
+        plan_.serial_reason = m->serial_reason(method_options_, options.query != QuerySet::ccd);
+      }
+    } else if (!options.factory_methods_stateless) {
+      plan_.serial_reason = "the method factory's methods are not known to be stateless";
+    }
+    const bool dcd = options.query != QuerySet::ccd;
+    const std::int32_t units = plan_.samples - (dcd ? 0 : 1);
+    const std::int32_t block =
+        options.block_samples > 0
+            ? options.block_samples
+            : std::clamp(units / (wanted * 8), std::int32_t{4}, std::int32_t{64});
+    const std::int32_t blocks = (units + block - 1) / block;
+    if (plan_.serial_reason.empty() && blocks > 1) {
+      plan_.threads = std::min(wanted, blocks);
+      plan_.block_samples = block;
+    }
+  }
+}
+
+void ClipRunner::run(const FrameCallback& on_frame) {
+  if (plan_.threads > 1) {
+    run_parallel(on_frame);
+  } else {
+    run_serial(on_frame);
+  }
+}
+
+void ClipRunner::run_serial(const FrameCallback& on_frame) {
+  // One query at a time; with more than one thread asked for, the elementary tests of a query
+  // split over an arena of that many (the parallel loops run in the caller's arena).
+  const std::int32_t threads = method_options_.elementary.threads;
+  if (threads > 1) {
+    const tbb::global_control allowed(
+        tbb::global_control::max_allowed_parallelism, static_cast<std::size_t>(threads));
+    tbb::task_arena arena(threads);
+    arena.execute([&] { run_queries_in_order(on_frame); });
+  } else {
+    run_queries_in_order(on_frame);
+  }
+}
+
+void ClipRunner::run_queries_in_order(const FrameCallback& on_frame) {
+  const FeatureNumbering numbering(motion_.mesh(), topology_);
+  const RowContext context{motion_, topology_, numbering, bones_};
+  const bool dcd = options_.query != QuerySet::ccd;
+  const SampleSequence all{
+      .first = plan_.first_sample,
+      .end = dcd ? plan_.last_sample + 1 : plan_.last_sample,
+      .last = plan_.last_sample,
+      .dcd = dcd,
+      .ccd = options_.query != QuerySet::dcd};
+  Worker w;
+  w.method = method_.get();
+  check_samples(context, all, w, on_frame);
+}
+
+void ClipRunner::run_parallel(const FrameCallback& on_frame) {
+  const FeatureNumbering numbering(motion_.mesh(), topology_);
+  const RowContext context{motion_, topology_, numbering, bones_};
+  const bool dcd = options_.query != QuerySet::ccd;
+  const bool ccd = options_.query != QuerySet::dcd;
+  const std::int32_t last = plan_.last_sample;
+  // Block "units" k: the DCD at k (if asked) then the CCD k → k+1 (if asked and k < last) — the
+  // serial row order, cut into runs of consecutive k.
+  const std::int32_t end = dcd ? last + 1 : last;
+
+  // Worker 0 is the method built by the constructor; the others are built on first need, each
+  // with the same options (what a query needs travels with the query).
+  WorkerPool pool([&] {
+    auto w = std::make_unique<Worker>();
+    w->owned = factory_ ? factory_(motion_.mesh(), topology_, method_options_)
+                        : culling::make_method(
+                              options_.method, motion_.mesh(), topology_, method_options_);
+    if (!w->owned) throw InvalidInput("method '" + options_.method + "' could not be built");
+    w->method = w->owned.get();
+    return w;
+  });
+  {
+    auto first = std::make_unique<Worker>();
+    first->method = method_.get();
+    pool.add(std::move(first));
+  }
+
+  const auto check_block = [&](Block& block) {
+    Worker* acquired = nullptr;
+    try {
+      acquired = &pool.acquire();
+      const SampleSequence part{
+          .first = block.first, .end = block.end, .last = last, .dcd = dcd, .ccd = ccd};
+      check_samples(
+          context, part, *acquired, [&](const FrameReport& r) { block.reports.push_back(r); });
+    } catch (...) {
+      // Reported after the rows before it, in order: as a serial run would.
+      block.error = std::current_exception();
+    }
+    if (acquired != nullptr) pool.release(*acquired);
+  };
+
+  const std::int32_t block_samples = plan_.block_samples;
+  std::int32_t next = plan_.first_sample;
+  const auto live_blocks =
+      static_cast<std::size_t>(2 * plan_.threads);  // bounds the reorder buffer
+  // As many threads as asked for, even beyond the cores (TBB caps its workers at the core count
+  // otherwise and warns on stderr).
+  const tbb::global_control allowed(
+      tbb::global_control::max_allowed_parallelism, static_cast<std::size_t>(plan_.threads));
+  tbb::task_arena arena(plan_.threads);
+  // The first failure in row order (a block's error, or on_frame's), rethrown once the pipeline
+  // has drained: an exception thrown through parallel_pipeline would leave the blocks in flight
+  // undestroyed (LeakSanitizer sees them). After it, no block is started or reported.
+  std::exception_ptr failure;
+  std::atomic<bool> failed{false};
+  arena.execute([&] {
+    tbb::parallel_pipeline(
+        live_blocks,
+        tbb::make_filter<void, std::shared_ptr<Block>>(
+            tbb::filter_mode::serial_in_order,
+            [&](tbb::flow_control& control) -> std::shared_ptr<Block> {
+              if (next >= end || failed.load()) {
+                control.stop();
+                return nullptr;
+              }
+              auto block = std::make_shared<Block>();
+              block->first = next;
+              block->end = std::min(end, next + block_samples);
+              block->reports.reserve(static_cast<std::size_t>(2 * (block->end - block->first)));
+              next = block->end;
+              return block;
+            }) &
+            tbb::make_filter<std::shared_ptr<Block>, std::shared_ptr<Block>>(
+                tbb::filter_mode::parallel,
+                [&](std::shared_ptr<Block> block) {
+                  // A block after a failure is never reported: no need to check it.
+                  if (!failed.load()) check_block(*block);
+                  return block;
+                }) &
+            tbb::make_filter<std::shared_ptr<Block>, void>(
+                tbb::filter_mode::serial_in_order, [&](const std::shared_ptr<Block>& block) {
+                  if (failure) return;  // rows after the first failure: a serial run has none
+                  try {
+                    for (const auto& report : block->reports) on_frame(report);
+                  } catch (...) {
+                    failure = std::current_exception();
+                  }
+                  if (!failure && block->error) failure = block->error;
+                  if (failure) failed.store(true);
+                }));
+  });
+  if (failure) std::rethrow_exception(failure);
+}
+
+std::vector<LogRoute> ClipRunner::routes(std::int32_t part_offset) const {
+  std::vector<LogRoute> routes;
+  if (options_.method != "auto") return routes;
+  for (const auto& r : culling::route_components(topology_, method_options_)) {
+    routes.push_back(LogRoute{
+        .component = r.component,
+        .part = r.part + part_offset,
+        .closed = r.closed,
+        .triangles = r.num_triangles,
+        .method = r.method});
+  }
+  return routes;
+}
+
+}  // namespace skelcd::tools

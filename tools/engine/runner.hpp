@@ -1,0 +1,140 @@
+#pragma once
+// The per-interval runner: poses a Motion sample by sample, welds, and asks a culling method for
+// DCD findings at each sample and CCD contacts over each interval between consecutive samples,
+// reporting every row in the file's own numbering as soon as it completes. With several threads
+// (RunOptions::threads) it checks blocks of consecutive samples in parallel, one method object
+// per worker, and still reports the rows strictly in order with the same contents as a serial run
+// (docs/check.md, "Threads").
+
+#include <atomic>
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "ccd/accuracy.hpp"
+#include "culling/method.hpp"
+#include "segmentation/segmentation.hpp"
+#include "skinning/motion.hpp"
+#include "skinning/topology.hpp"
+#include "tools/io/frame_report.hpp"
+#include "tools/io/log/log_header.hpp"
+
+namespace skelcd::tools {
+
+/// Samples first … last, both included (`--frames A:B`); last unset means the final sample.
+struct FrameRange {
+  std::int32_t first = 0;
+  std::optional<std::int32_t> last;
+};
+
+/// Parses `--frames`: "A:B", "A:" (to the end), ":B" (from 0) or "A" (one sample); A <= B, both >=
+/// 0.
+/// @throws InvalidInput quoting `text` when it is malformed.
+[[nodiscard]] FrameRange parse_frame_range(std::string_view text);
+
+struct RunOptions {
+  std::string clip;  ///< clip to check (empty: the model's first clip) — used by the loader
+  double fps = 0;    ///< samples/s (0: the clip's frame rate, else 30) — used by the loader
+  FrameRange frames;
+  std::string method = "bvh";
+  ccd::Accuracy accuracy = ccd::Accuracy::conservative;
+  QuerySet query = QuerySet::both;
+  double min_separation = 0;  ///< contact distance, model units
+  /// The mesh's segmentation for methods that need one (rvbc, dynamic, auto's closed parts:
+  /// tools/engine/radial_view_setup.hpp); null otherwise.
+  std::shared_ptr<const segmentation::Segmentation> segmentation;
+  /// Parameters of methods declared above culling/ (γ, seed).
+  culling::MethodParameters method_parameters;
+  /// Worker threads: 1 = serial (the default here), 0 = all cores (tbb::info::default_concurrency).
+  /// A run is serial anyway when its method carries state between queries that would change its
+  /// rows (RunPlan::serial_reason says why).
+  std::int32_t threads = 1;
+  /// Samples per block a worker checks in a row (0: chosen from the clip length and threads).
+  std::int32_t block_samples = 0;
+  /// The factory's methods keep no state between queries that changes their findings or counters
+  /// (methods of make_method are classified by name; a custom factory's only through this).
+  bool factory_methods_stateless = false;
+  /// When set, elementary tests add to it as they finish (culling::ElementaryTests::tests_done):
+  /// a progress line can move inside one long query.
+  std::atomic<std::int64_t>* elementary_tests_done = nullptr;
+};
+
+/// What a run will do, resolved against the motion's sample count.
+struct RunPlan {
+  std::int32_t first_sample = 0;
+  std::int32_t last_sample = 0;
+  std::int32_t samples = 0;        ///< last - first + 1
+  std::int32_t intervals = 0;      ///< CCD intervals checked (0 for --query dcd)
+  std::int64_t rows = 0;           ///< FrameReports the run produces
+  std::int32_t threads = 1;        ///< workers the run uses (1: serial)
+  std::int32_t block_samples = 0;  ///< samples per block of a parallel run (0 when serial)
+  /// Why a run asked for several threads is serial (empty when it is not).
+  std::string serial_reason;
+};
+
+/// The worker count `--threads N` means: N, or all cores for 0.
+[[nodiscard]] std::int32_t resolve_threads(std::int32_t threads);
+
+/// Builds the culling method for a mesh; the default calls culling::make_method(options.method…).
+using MethodFactory = std::function<std::unique_ptr<culling::CullingMethod>(
+    const skinning::Mesh&, const skinning::Topology&, const culling::MethodOptions&)>;
+
+/// Called once per completed row (a DCD sample or a CCD interval), in order.
+using FrameCallback = std::function<void(const FrameReport&)>;
+
+class ClipRunner {
+ public:
+  /// Builds the welded topology of motion.mesh() and the method; validates the options against the
+  /// motion (frame range inside [0, num_samples)).
+  /// @throws InvalidInput for a bad frame range, an unknown method or an unusable mesh.
+  ClipRunner(const skinning::Motion& motion, const RunOptions& options, MethodFactory factory = {});
+
+  [[nodiscard]] const RunPlan& plan() const { return plan_; }
+  [[nodiscard]] const skinning::Topology& topology() const { return topology_; }
+  [[nodiscard]] std::string_view method_name() const { return method_->name(); }
+  /// Under `auto`, where each connected component went (the log's /routes rows); empty for any
+  /// other method. `part_offset` is added to each route's part id (a scene's object offset).
+  [[nodiscard]] std::vector<LogRoute> routes(std::int32_t part_offset = 0) const;
+
+  /// Runs every row of the plan, calling `on_frame` after each, in plan order (one call at a time;
+  /// in a parallel run possibly from a worker thread).
+  /// @throws InvalidInput naming the motion and sample when a posed position is not finite;
+  /// rows completed before it have been reported (also in a parallel run).
+  void run(const FrameCallback& on_frame);
+
+ private:
+  void run_serial(const FrameCallback& on_frame);
+  void run_queries_in_order(const FrameCallback& on_frame);
+  void run_parallel(const FrameCallback& on_frame);
+
+  const skinning::Motion& motion_;
+  RunOptions options_;
+  MethodFactory factory_;
+  culling::MethodOptions method_options_;
+  RunPlan plan_;
+  skinning::Topology topology_;
+  std::unique_ptr<culling::CullingMethod> method_;
+  bool bones_ = false;  ///< the queries carry the bones' transforms (the method needs them)
+};
+
+/// Maps welded ids (culling's numbering) back to the file's own numbering (part, index).
+class FeatureNumbering {
+ public:
+  FeatureNumbering(const skinning::Mesh& mesh, const skinning::Topology& topology);
+  /// Welded vertex → its representative file vertex.
+  [[nodiscard]] FeatureId vertex(std::int32_t welded_vertex) const;
+  [[nodiscard]] FeatureId triangle(std::int32_t triangle) const;
+  /// Edge (Topology::edges row) → side of the first triangle incident to it.
+  [[nodiscard]] FeatureId edge(std::int32_t edge) const;
+
+ private:
+  const skinning::Mesh& mesh_;
+  const skinning::Topology& topology_;
+  std::vector<FeatureId> edges_;
+};
+
+}  // namespace skelcd::tools
