@@ -1,5 +1,7 @@
 // `bvh` and `kdop`: a hierarchy of AABBs or 16-DOPs over the welded triangles, built once at rest,
 // refit per interval, traversed against itself; then the shared feature and elementary stages.
+#include <algorithm>
+#include <cstddef>
 #include <string>
 
 #include "culling/bvh.hpp"
@@ -82,17 +84,29 @@ class BvhMethod final : public MethodBase {
     bounds_.derive(topology_);
     bvh_.refit(bounds_.triangles);
     const auto t1 = Clock::now();
-    // Self traversal → triangle pairs → de-duplicated feature pairs.
-    pairs_.clear();
-    features_.clear();
-    self_traverse<N>(bvh_, bounds_.triangles, scratch_, pairs_, out.counters.bv_tests);
-    ccd_candidates_from_triangle_pairs<N>(topology_, pairs_, bounds_, features_, out.counters);
-    const auto t2 = Clock::now();
-    run_ccd_tests(topology_, features_, x_t0, x_t1, tests_, options_.accuracy, ccd_options_, out);
-    const auto t3 = Clock::now();
     out.times.refit_us += micros(t0, t1);
-    out.times.traverse_us += micros(t1, t2);
-    out.times.elementary_us += micros(t2, t3);
+    // Self traversal → triangle pairs → de-duplicated feature pairs → tests, in blocks of
+    // kCcdBlockPairs triangle pairs: the candidates held at once stay bounded on any motion (the
+    // de-duplication is by ownership within each triangle pair, so blocks never repeat a test).
+    const std::size_t first = out.contacts.size();
+    start_self_traversal<N>(bvh_, scratch_);
+    for (bool done = false; !done;) {
+      const auto b0 = Clock::now();
+      pairs_.clear();
+      features_.clear();
+      done = self_traverse_some<N>(
+          bvh_, bounds_.triangles, scratch_, pairs_, out.counters.bv_tests, kCcdBlockPairs);
+      ccd_candidates_from_triangle_pairs<N>(topology_, pairs_, bounds_, features_, out.counters);
+      const auto b1 = Clock::now();
+      run_ccd_tests(topology_, features_, x_t0, x_t1, tests_, options_.accuracy, ccd_options_, out);
+      out.times.traverse_us += micros(b0, b1);
+      out.times.elementary_us += micros(b1, Clock::now());
+    }
+    // Each block's contacts are sorted; the interval's are sorted as one (in place).
+    std::sort(
+        out.contacts.begin() + static_cast<std::ptrdiff_t>(first),
+        out.contacts.end(),
+        [](const CcdContact& a, const CcdContact& b) { return a.before(b); });
   }
 
  private:

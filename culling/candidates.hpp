@@ -14,6 +14,7 @@
 // are therefore *not* skipped for CCD: only their feature pairs that share a vertex are.
 
 #include <compare>
+#include <cstddef>
 #include <cstdint>
 #include <span>
 #include <vector>
@@ -60,6 +61,13 @@ struct FeatureBounds {
   /// Allocation-free once the vectors have their sizes.
   void derive(const FeatureTopology& topology, bool with_edges = true);
 };
+
+/// Triangle pairs per CCD block: the hierarchy methods turn their traversal's pairs into feature
+/// candidates and test them a block at a time, so that what they hold at once (pairs, at most 15
+/// feature candidates each, the tests' outcomes: a few MB) is bounded whatever the motion, and a
+/// block is still long enough to be split over the threads. The feature de-duplication is by
+/// ownership within each triangle pair, so blocks never repeat a test.
+inline constexpr std::size_t kCcdBlockPairs = std::size_t{1} << 15;
 
 /// CCD feature stage of a hierarchy method: appends the feature pairs of each triangle pair in
 /// `pairs` (any order within a pair) to `out`.

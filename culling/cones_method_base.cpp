@@ -110,18 +110,43 @@ void ConeMethodBase::ccd(const culling::Interval& query, FrameResult& out) {
     refit_extra(interval);
   }
   const auto t1 = Clock::now();
-  // Cone-culled self traversal → triangle pairs → de-duplicated feature pairs. A culled node's
-  // triangle pairs produce only feature pairs inside a surface proven free of contact.
+  // Cone-culled self traversal → triangle pairs → de-duplicated feature pairs → tests, in blocks
+  // of kCcdBlockPairs pairs (bounded memory). A culled node's triangle pairs produce only feature
+  // pairs inside a surface proven free of contact.
+  const std::size_t first = out.contacts.size();
   pairs_.clear();
-  features_.clear();
+  block_ = {.x_t0 = &x_t0, .x_t1 = &x_t1, .out = &out, .elementary_us = 0.0};
   traverse(interval, out.counters.bv_tests);
-  ccd_candidates_from_triangle_pairs<3>(topology_, pairs_, bounds_, features_, out.counters);
+  flush_ccd_block();
+  const double elementary_us = block_.elementary_us;
+  block_ = {};
+  // Each block's contacts are sorted; the interval's are sorted as one (in place).
+  std::sort(
+      out.contacts.begin() + static_cast<std::ptrdiff_t>(first),
+      out.contacts.end(),
+      [](const CcdContact& a, const CcdContact& b) { return a.before(b); });
   const auto t2 = Clock::now();
-  run_ccd_tests(topology_, features_, x_t0, x_t1, tests_, options_.accuracy, ccd_options_, out);
-  const auto t3 = Clock::now();
   out.times.refit_us += micros(t0, t1);
-  out.times.traverse_us += micros(t1, t2);
-  out.times.elementary_us += micros(t2, t3);
+  out.times.traverse_us += micros(t1, t2) - elementary_us;
+  out.times.elementary_us += elementary_us;
+}
+
+void ConeMethodBase::flush_ccd_block() {
+  const auto t0 = Clock::now();
+  FrameResult& out = *block_.out;
+  features_.clear();
+  ccd_candidates_from_triangle_pairs<3>(topology_, pairs_, bounds_, features_, out.counters);
+  run_ccd_tests(
+      topology_,
+      features_,
+      *block_.x_t0,
+      *block_.x_t1,
+      tests_,
+      options_.accuracy,
+      ccd_options_,
+      out);
+  pairs_.clear();
+  block_.elementary_us += micros(t0, Clock::now());
 }
 
 bool ConeMethodBase::normal_test(std::int32_t n, Eigen::Vector3d& axis) {
@@ -199,6 +224,7 @@ void ConeMethodBase::collide(std::int32_t a, std::int32_t b, std::int64_t& bv_te
         const std::int32_t ta = order[sz(nx.begin)];
         const std::int32_t tb = order[sz(ny.begin)];
         pairs_.push_back({std::min(ta, tb), std::max(ta, tb)});
+        pair_added();
         continue;
       }
       for (std::int32_t i = nx.begin; i < nx.end; ++i) {
@@ -211,6 +237,7 @@ void ConeMethodBase::collide(std::int32_t a, std::int32_t b, std::int64_t& bv_te
           }
         }
       }
+      pair_added();
       continue;
     }
     // Split the node with more triangles (a leaf never).
@@ -237,6 +264,7 @@ void ConeMethodBase::leaf_self(std::int32_t leaf, std::int64_t& bv_tests) {
       if (tri[sz(ta)].overlaps(tri[sz(tb)])) pairs_.push_back({std::min(ta, tb), std::max(ta, tb)});
     }
   }
+  pair_added();
 }
 
 }  // namespace skelcd::culling::detail

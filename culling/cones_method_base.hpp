@@ -79,6 +79,21 @@ class ConeMethodBase : public MethodBase, public ConeStatistics {
   /// The triangle pairs inside one leaf (leaf_size > 1).
   void leaf_self(std::int32_t leaf, std::int64_t& bv_tests);
 
+  /// CCD: tests the pairs gathered so far (features, elementary tests into the interval's
+  /// result) and empties them — when kCcdBlockPairs are waiting, and at the end of the traversal.
+  void flush_ccd_block();
+  void pair_added() {
+    if (block_.out != nullptr && pairs_.size() >= kCcdBlockPairs) flush_ccd_block();
+  }
+
+  /// The interval being tested while a CCD traversal runs (out == nullptr otherwise: DCD).
+  struct CcdBlock {
+    const skinning::Positions* x_t0 = nullptr;
+    const skinning::Positions* x_t1 = nullptr;
+    FrameResult* out = nullptr;
+    double elementary_us = 0.0;  ///< µs spent in flushes (tests), apart from the traversal
+  };
+  CcdBlock block_{};
   Descent descent_;
   bool cull_enabled_;
   FeatureBounds<3> bounds_;

@@ -238,13 +238,33 @@ class AutoMethod final : public detail::MethodBase, public RoutedMethod {
     bounds_.derive(topology_);
     refit_groups();
     const auto t1 = Clock::now();
+    // The `bvh` groups' own pairs, tested in blocks of kCcdBlockPairs (bounded memory).
+    double elementary_us = 0.0;
+    const auto flush = [&] {
+      const auto f0 = Clock::now();
+      features_.clear();
+      ccd_candidates_from_triangle_pairs<3>(topology_, pairs_, bounds_, features_, out.counters);
+      run_ccd_tests(topology_, features_, x_t0, x_t1, tests_, options_.accuracy, ccd_options_, out);
+      pairs_.clear();
+      elementary_us += micros(f0, Clock::now());
+    };
     pairs_.clear();
-    features_.clear();
-    traverse_own(out.counters.bv_tests);
-    ccd_candidates_from_triangle_pairs<3>(topology_, pairs_, bounds_, features_, out.counters);
+    const std::span<const Aabb> tri(bounds_.triangles);
+    for (const AabbBvh* group : {&open_bvh_, &closed_bvh_}) {
+      const bool own = group == &open_bvh_ ? open_method_ == nullptr : closed_method_ == nullptr;
+      if (group->empty() || !own) continue;
+      start_self_traversal<3>(*group, scratch_);
+      for (bool done = false; !done;) {
+        done = self_traverse_some<3>(
+            *group, tri, scratch_, pairs_, out.counters.bv_tests, kCcdBlockPairs);
+        flush();
+      }
+    }
+    if (!open_bvh_.empty() && !closed_bvh_.empty()) {
+      pair_traverse<3>(open_bvh_, tri, closed_bvh_, tri, scratch_, pairs_, out.counters.bv_tests);
+      flush();
+    }
     const auto t2 = Clock::now();
-    run_ccd_tests(topology_, features_, x_t0, x_t1, tests_, options_.accuracy, ccd_options_, out);
-    const auto t3 = Clock::now();
     // Merge: canonical order, each pair once (a vertex shared by an open and a closed component
     // can reach one feature pair from two groups), earliest time of impact kept.
     auto& c = out.contacts;
@@ -261,8 +281,8 @@ class AutoMethod final : public detail::MethodBase, public RoutedMethod {
         c.begin(), c.end(), [](const CcdContact& x) { return x.kind == CcdContact::Kind::vf; });
     out.counters.ee_contacts = static_cast<std::int64_t>(c.size()) - out.counters.vf_contacts;
     out.times.refit_us += micros(t0, t1);
-    out.times.traverse_us += micros(t1, t2);
-    out.times.elementary_us += micros(t2, t3);
+    out.times.traverse_us += micros(t1, t2) - elementary_us;
+    out.times.elementary_us += elementary_us;
   }
 
  private:

@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cassert>
+#include <cstdint>
+#include <limits>
 #include <utility>
 
 namespace skelcd::culling {
@@ -84,22 +86,28 @@ inline void split_pair(
 }  // namespace
 
 template <int N>
-void self_traverse(
+void start_self_traversal(const Bvh<N>& bvh, TraversalScratch& scratch) {
+  scratch.reserve_self(bvh);
+  scratch.stack.clear();
+  if (!bvh.empty()) push(scratch.stack, 0, 0);
+}
+
+template <int N>
+bool self_traverse_some(
     const Bvh<N>& bvh,
     std::span<const Dop<N>> triangle_bounds,
     TraversalScratch& scratch,
     std::vector<TrianglePair>& out,
-    std::int64_t& bv_tests) {
-  if (bvh.empty()) return;
+    std::int64_t& bv_tests,
+    std::size_t max_pairs) {
+  if (bvh.empty()) return true;
   const auto nodes = bvh.nodes();
   const auto bounds = bvh.node_bounds();
   const auto order = bvh.triangle_order();
   const bool single = bvh.leaf_size() == 1;
-  scratch.reserve_self(bvh);
   auto& stack = scratch.stack;
-  stack.clear();
-  push(stack, 0, 0);
   while (!stack.empty()) {
+    if (out.size() >= max_pairs) return false;
     const Entry e = stack.back();
     stack.pop_back();
     const BvhNode& na = nodes[to_size(e.a)];
@@ -145,6 +153,19 @@ void self_traverse(
       split_pair(stack, e.a, na, e.b, nb);
     }
   }
+  return true;
+}
+
+template <int N>
+void self_traverse(
+    const Bvh<N>& bvh,
+    std::span<const Dop<N>> triangle_bounds,
+    TraversalScratch& scratch,
+    std::vector<TrianglePair>& out,
+    std::int64_t& bv_tests) {
+  start_self_traversal(bvh, scratch);
+  self_traverse_some(
+      bvh, triangle_bounds, scratch, out, bv_tests, std::numeric_limits<std::size_t>::max());
 }
 
 template <int N>
@@ -190,6 +211,22 @@ void pair_traverse(
   }
 }
 
+template void start_self_traversal<3>(const Bvh<3>&, TraversalScratch&);
+template void start_self_traversal<8>(const Bvh<8>&, TraversalScratch&);
+template bool self_traverse_some<3>(
+    const Bvh<3>&,
+    std::span<const Dop<3>>,
+    TraversalScratch&,
+    std::vector<TrianglePair>&,
+    std::int64_t&,
+    std::size_t);
+template bool self_traverse_some<8>(
+    const Bvh<8>&,
+    std::span<const Dop<8>>,
+    TraversalScratch&,
+    std::vector<TrianglePair>&,
+    std::int64_t&,
+    std::size_t);
 template void self_traverse<3>(
     const Bvh<3>&,
     std::span<const Dop<3>>,

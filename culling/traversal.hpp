@@ -54,6 +54,23 @@ void self_traverse(
     std::vector<TrianglePair>& out,
     std::int64_t& bv_tests);
 
+/// The self traversal in installments, so that its pairs can be tested in bounded blocks
+/// (bounded memory on any motion): start_self_traversal seeds `scratch`; each self_traverse_some
+/// appends pairs until `out` holds at least `max_pairs` (it may pass that by one leaf pair's
+/// pairs, at most leaf_size² − 1) and returns true once the traversal is finished. Over all
+/// installments the pairs are exactly self_traverse's, each once; `scratch` must not be used for
+/// anything else in between.
+template <int N>
+void start_self_traversal(const Bvh<N>& bvh, TraversalScratch& scratch);
+template <int N>
+bool self_traverse_some(
+    const Bvh<N>& bvh,
+    std::span<const Dop<N>> triangle_bounds,
+    TraversalScratch& scratch,
+    std::vector<TrianglePair>& out,
+    std::int64_t& bv_tests,
+    std::size_t max_pairs);
+
 /// Pair traversal: appends to `out` every (triangle of a, triangle of b) whose volumes overlap,
 /// each once; `TrianglePair::a` is a triangle id of `a`'s triangles, `TrianglePair::b` of `b`'s.
 template <int N>

@@ -11,6 +11,7 @@
 
 #include "ccd/edge_edge.hpp"
 #include "ccd/vertex_face.hpp"
+#include "culling/candidates.hpp"
 #include "culling/cones_method.hpp"
 #include "culling/enhanced_dual_cone.hpp"
 #include "culling/method.hpp"
@@ -331,6 +332,8 @@ TEST(ConeMethods, ClothFunnelMatchesBvh) {
   const FrameResult bvh = run_ccd("bvh", s, 0);
   EXPECT_EQ(bvh.counters.vf_contacts, 27);
   EXPECT_EQ(bvh.counters.ee_contacts, 107);
+  // Enough candidates for several CCD blocks (culling/candidates.hpp): the blocks lose nothing.
+  EXPECT_GT(bvh.counters.candidate_pairs, static_cast<std::int64_t>(3 * kCcdBlockPairs));
   for (const auto& name : kExactMethods) {
     EXPECT_TRUE(same_ccd_contacts(s, 0, run_ccd(name, s, 0), bvh)) << name;
   }

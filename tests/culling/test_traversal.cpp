@@ -92,6 +92,28 @@ void check_self(const Case& c, int leaf_size) {
   EXPECT_EQ(sorted, want);
   const auto nf = static_cast<std::int64_t>(ft.num_triangles());
   EXPECT_LT(bv_tests, nf * (nf - 1) / 8) << "the hierarchy culled almost nothing";
+
+  // In installments of at most `block` pairs (+ one leaf pair's), emptied in between as the CCD
+  // blocks do: the same pairs, each once, the same volume tests, and no installment too large.
+  for (const std::size_t block : {std::size_t{1}, std::size_t{7}, std::size_t{100}}) {
+    std::vector<TrianglePair> all, part;
+    std::int64_t tests = 0;
+    int installments = 0;
+    start_self_traversal<N>(bvh, scratch);
+    for (bool done = false; !done; ++installments) {
+      part.clear();
+      done = self_traverse_some<N>(bvh, bounds.triangles, scratch, part, tests, block);
+      ASSERT_LT(part.size(), block + static_cast<std::size_t>(leaf_size * leaf_size));
+      all.insert(all.end(), part.begin(), part.end());
+    }
+    std::sort(all.begin(), all.end());
+    EXPECT_EQ(all, want) << "block " << block;
+    EXPECT_EQ(tests, bv_tests) << "block " << block;
+    EXPECT_EQ(scratch.stack.capacity(), capacity);
+    if (want.size() > block) {
+      EXPECT_GT(installments, 1);
+    }
+  }
 }
 
 TEST(SelfTraverse, FindsExactlyTheOverlappingPairs) {
