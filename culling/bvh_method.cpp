@@ -61,16 +61,25 @@ class BvhMethod final : public MethodBase {
     bounds_.derive(topology_, /*with_edges=*/false);
     bvh_.refit(bounds_.triangles);
     const auto t1 = Clock::now();
-    // Self traversal → overlapping triangle pairs → the DCD rules.
-    pairs_.clear();
-    self_traverse<N>(bvh_, bounds_.triangles, scratch_, pairs_, out.counters.bv_tests);
-    dcd_filter_triangle_pairs(topology_, pairs_, out.counters);
-    const auto t2 = Clock::now();
-    run_dcd_tests(topology_, pairs_, x, tests_, out);
-    const auto t3 = Clock::now();
     out.times.refit_us += micros(t0, t1);
-    out.times.traverse_us += micros(t1, t2);
-    out.times.elementary_us += micros(t2, t3);
+    // Self traversal → overlapping triangle pairs → the DCD rules → tests, in blocks as the CCD
+    // (bounded memory), the vertex fans certified once for the instant.
+    const std::size_t first = out.dcd_pairs.size();
+    const std::span<const std::uint8_t> fans = certify_dcd_fans(topology_, x, tests_);
+    out.times.elementary_us += micros(t1, Clock::now());
+    start_self_traversal<N>(bvh_, scratch_);
+    for (bool done = false; !done;) {
+      const auto b0 = Clock::now();
+      pairs_.clear();
+      done = self_traverse_some<N>(
+          bvh_, bounds_.triangles, scratch_, pairs_, out.counters.bv_tests, kCcdBlockPairs);
+      dcd_filter_triangle_pairs(topology_, pairs_, out.counters);
+      const auto b1 = Clock::now();
+      run_dcd_tests(topology_, pairs_, x, tests_, fans, out);
+      out.times.traverse_us += micros(b0, b1);
+      out.times.elementary_us += micros(b1, Clock::now());
+    }
+    std::sort(out.dcd_pairs.begin() + static_cast<std::ptrdiff_t>(first), out.dcd_pairs.end());
   }
 
   void ccd(const Interval& interval, FrameResult& out) override {

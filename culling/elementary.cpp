@@ -168,15 +168,36 @@ void run_dcd_tests(
     const skinning::Positions& x,
     const ElementaryTests& tests,
     FrameResult& out) {
+  run_dcd_tests(
+      topology,
+      pairs,
+      x,
+      tests,
+      pairs.empty() ? std::span<const std::uint8_t>{} : certify_dcd_fans(topology, x, tests),
+      out);
+}
+
+std::span<const std::uint8_t> certify_dcd_fans(
+    const FeatureTopology& topology, const skinning::Positions& x, const ElementaryTests& tests) {
+  // Certified vertex fans settle pairs that share a corner without a test — only for the exact
+  // test they stand for (a test of another definition sees every pair).
+  if (tests.triangles != &ccd::triangles_intersect || topology.fans().num_fans() == 0) return {};
+  topology.fans().certify(x, tl_certified_fans);
+  return tl_certified_fans;
+}
+
+void run_dcd_tests(
+    const FeatureTopology& topology,
+    std::span<const TrianglePair> pairs,
+    const skinning::Positions& x,
+    const ElementaryTests& tests,
+    std::span<const std::uint8_t> certified,
+    FrameResult& out) {
   assert(tests.triangles != nullptr);
   const std::size_t first = out.dcd_pairs.size();
-  // Certified vertex fans (culling/vertex_fans.hpp) settle pairs that share a corner without a
-  // test — only for the exact test they stand for (a test of another definition sees every pair).
-  const bool use_fans = tests.triangles == &ccd::triangles_intersect && !pairs.empty() &&
-                        topology.fans().num_fans() > 0;
-  if (use_fans) topology.fans().certify(x, tl_certified_fans);
-  // The calling thread's flags, read by the workers too (their own thread_local is another one).
-  const std::vector<std::uint8_t>& certified = tl_certified_fans;
+  // The flags are read by the workers too: a span of the caller's, not their own thread_local.
+  const bool use_fans = !certified.empty();
+  assert(!use_fans || certified.size() == static_cast<std::size_t>(topology.num_vertices()));
   const auto outcomes = evaluate(pairs.size(), tests, [&](std::size_t i, Outcome& o) {
     const TrianglePair& p = pairs[i];
     assert(p.a < p.b);

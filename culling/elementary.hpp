@@ -96,4 +96,19 @@ void run_dcd_tests(
     const ElementaryTests& tests,
     FrameResult& out);
 
+/// The certified vertex fans at instant x (culling/vertex_fans.hpp), one flag per welded vertex,
+/// for run_dcd_tests calls on blocks of one instant's pairs; empty when `tests` is not the exact
+/// triangle test (fans stand for that test only). Valid until the calling thread's next call.
+[[nodiscard]] std::span<const std::uint8_t> certify_dcd_fans(
+    const FeatureTopology& topology, const skinning::Positions& x, const ElementaryTests& tests);
+
+/// run_dcd_tests with the fans of certify_dcd_fans(topology, x, tests) (empty: no fans).
+void run_dcd_tests(
+    const FeatureTopology& topology,
+    std::span<const TrianglePair> pairs,
+    const skinning::Positions& x,
+    const ElementaryTests& tests,
+    std::span<const std::uint8_t> certified_fans,
+    FrameResult& out);
+
 }  // namespace skelcd::culling
