@@ -1,7 +1,7 @@
 #pragma once
 // What the cone culling methods (`normal-cone`, `dual-cone`, `enhanced-dual-cone`) report beside
 // the shared Counters: how many hierarchy nodes their cone tests examined, culled, and why the
-// others failed. Read it through `dynamic_cast<const ConeStatistics*>(&method)`.
+// others failed. Read it through `method.cone_statistics()` (null for other methods).
 
 #include <array>
 #include <cstdint>
@@ -35,7 +35,8 @@ struct ConeCullingStats {
   bool culling_disabled = false;
 };
 
-/// Implemented by the cone methods beside CullingMethod.
+/// Implemented by the cone methods beside CullingMethod; CullingMethod::cone_statistics() returns
+/// it (null for other methods).
 class ConeStatistics {
  public:
   virtual ~ConeStatistics() = default;

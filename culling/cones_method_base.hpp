@@ -26,6 +26,7 @@ class ConeMethodBase : public MethodBase, public ConeStatistics {
   void ccd(const culling::Interval& interval, FrameResult& out) override;
 
   [[nodiscard]] const ConeCullingStats& cone_stats() const override { return stats_; }
+  [[nodiscard]] const ConeStatistics* cone_statistics() const override { return this; }
   [[nodiscard]] const NodeContours& contours() const override { return contours_; }
 
  protected:

@@ -49,6 +49,17 @@ struct MethodOptions {
   MethodParameters parameters{};
 };
 
+/// Where one connected component (Topology::components) goes under `auto` (routed_method.hpp).
+struct ComponentRoute {
+  std::int32_t component = -1;  ///< index into Topology::components
+  std::int32_t part = -1;       ///< Mesh part of its first triangle
+  bool closed = false;          ///< no boundary and no non-manifold edge
+  std::int32_t num_triangles = 0;
+  std::string method;  ///< the method testing its pairs within its group
+};
+
+class ConeStatistics;  // culling/cones_method.hpp
+
 /// One instant as a method sees it (a DCD query).
 struct Instant {
   /// #W × 3 welded positions (finite: the runner checks).
@@ -75,6 +86,12 @@ class CullingMethod {
  public:
   virtual ~CullingMethod() = default;
   [[nodiscard]] virtual std::string_view name() const = 0;
+
+  /// What some methods report beside their findings, asked of any method (no casts): which
+  /// method each component used (`auto`; empty for the others, see routes_of) and the cone
+  /// methods' culling statistics of the last query (null for the others).
+  [[nodiscard]] virtual std::span<const ComponentRoute> component_routes() const { return {}; }
+  [[nodiscard]] virtual const ConeStatistics* cone_statistics() const { return nullptr; }
 
   /// Intersecting triangle pairs at one instant: every pair of distinct triangles with a common
   /// point beyond the vertices or edge they share (exact), except part-excluded pairs and

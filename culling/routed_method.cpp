@@ -142,7 +142,7 @@ skinning::Mesh closed_only_mesh(
   return m;
 }
 
-class AutoMethod final : public detail::MethodBase, public RoutedMethod {
+class AutoMethod final : public detail::MethodBase {
  public:
   AutoMethod(
       const skinning::Mesh& mesh,
@@ -197,7 +197,9 @@ class AutoMethod final : public detail::MethodBase, public RoutedMethod {
     pairs_.reserve(num_faces);
   }
 
-  [[nodiscard]] std::span<const ComponentRoute> routes() const override { return routes_; }
+  [[nodiscard]] std::span<const ComponentRoute> component_routes() const override {
+    return routes_;
+  }
 
   void dcd(const Instant& at, FrameResult& out) override {
     const skinning::Positions& x = at.x;
@@ -387,8 +389,7 @@ std::unique_ptr<CullingMethod> make_routed_method(
 }
 
 std::span<const ComponentRoute> routes_of(const CullingMethod& method) {
-  if (const auto* r = dynamic_cast<const RoutedMethod*>(&method)) return r->routes();
-  return {};
+  return method.component_routes();
 }
 
 }  // namespace skelcd::culling

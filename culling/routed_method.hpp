@@ -32,15 +32,6 @@ struct RoutingOptions {
   std::string closed_method;
 };
 
-/// Where one connected component (Topology::components) goes.
-struct ComponentRoute {
-  std::int32_t component = -1;  ///< index into Topology::components
-  std::int32_t part = -1;       ///< Mesh part of its first triangle
-  bool closed = false;          ///< no boundary and no non-manifold edge
-  std::int32_t num_triangles = 0;
-  std::string method;  ///< the method testing its pairs within its group
-};
-
 /// The methods `auto` uses for the open and the closed components under `options`: {open, closed}.
 /// The closed one, unless `routing` names one, is the registered method of RouteKind::closed with
 /// the highest priority whose needs the options meet (`dynamic` with a segmentation and bone
@@ -56,14 +47,6 @@ struct ComponentRoute {
     const MethodOptions& options = {},
     const RoutingOptions& routing = {});
 
-/// Implemented by the `auto` method beside CullingMethod: routes() says which method each
-/// component used (for the log). Reach it with routes_of().
-class RoutedMethod {
- public:
-  virtual ~RoutedMethod() = default;
-  [[nodiscard]] virtual std::span<const ComponentRoute> routes() const = 0;
-};
-
 /// Builds the `auto` method (what make_method("auto", …) returns, with default RoutingOptions).
 /// @throws InvalidInput as make_method and route_components.
 [[nodiscard]] std::unique_ptr<CullingMethod> make_routed_method(
@@ -72,7 +55,8 @@ class RoutedMethod {
     const MethodOptions& options = {},
     const RoutingOptions& routing = {});
 
-/// The routes of `method` when it is a routed method, else empty.
+/// The routes of `method` (CullingMethod::component_routes): which method each component used
+/// under `auto` (for the log), empty for the other methods.
 [[nodiscard]] std::span<const ComponentRoute> routes_of(const CullingMethod& method);
 
 }  // namespace skelcd::culling

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <string>
+#include <vector>
 
 #include "ccd/polynomial_sign.hpp"
 #include "skinning/errors.hpp"
@@ -74,43 +75,45 @@ OrientationCounts count_orientations_interval(
   return counts;
 }
 
-ClipOrientationStats clip_orientation_stats(const Segmentation& segmentation,
-                                            const skinning::RigMotion& motion) {
+ClipOrientationStats clip_orientation_stats(
+    const Segmentation& segmentation, const skinning::Motion& motion) {
   const auto start = std::chrono::steady_clock::now();
-  const auto& rig = motion.rig();
-  if (static_cast<std::int64_t>(segmentation.triangle_cluster.size()) != rig.mesh.num_triangles()) {
-    throw InvalidInput(rig.source + ": the segmentation has " +
-                       std::to_string(segmentation.triangle_cluster.size()) +
-                       " triangles, the mesh " + std::to_string(rig.mesh.num_triangles()));
+  const skinning::Mesh& mesh = motion.mesh();
+  const std::string where = "clip '" + motion.name() + "'";
+  if (motion.num_bones() <= 0) {
+    throw InvalidInput(where + ": clip statistics need a motion with a skeleton");
+  }
+  if (static_cast<std::int64_t>(segmentation.triangle_cluster.size()) != mesh.num_triangles()) {
+    throw InvalidInput(
+        where + ": the segmentation has " + std::to_string(segmentation.triangle_cluster.size()) +
+        " triangles, the mesh " + std::to_string(mesh.num_triangles()));
   }
   for (const auto& c : segmentation.clusters) {
-    if (c.bone < 0 || c.bone >= rig.skeleton.num_bones()) {
-      throw InvalidInput(rig.source + ": the segmentation names bone " + std::to_string(c.bone) +
-                         ", the skeleton has " + std::to_string(rig.skeleton.num_bones()));
+    if (c.bone < 0 || c.bone >= motion.num_bones()) {
+      throw InvalidInput(
+          where + ": the segmentation names bone " + std::to_string(c.bone) +
+          ", the skeleton has " + std::to_string(motion.num_bones()));
     }
   }
-  const auto topology = skinning::build_topology(rig.mesh);
+  const auto topology = skinning::build_topology(mesh);
   ClipOrientationStats out;
   out.clip = motion.name();
   const int n = motion.num_samples();
   skinning::Positions file_x, x_t0, x_t1;
-  skinning::Pose pose_t0, pose_t1;
-  const auto sample = [&](int i, skinning::Positions& welded, skinning::Pose& pose) {
-    motion.positions(i, file_x);
-    skinning::gather_welded(topology, file_x, welded);
-    if (motion.clip() >= 0) {
-      motion.evaluator().clip_pose(motion.clip(), motion.sample_time(i), pose);
-    } else {
-      motion.evaluator().bind_pose(pose);
-    }
-  };
+  std::vector<skinning::BoneTransform> pose_t0, pose_t1;
+  // The pose's skinning transforms at sample i (Motion::bone_transforms: #B bones first).
+  const auto sample =
+      [&](int i, skinning::Positions& welded, std::vector<skinning::BoneTransform>& pose) {
+        motion.positions(i, file_x);
+        skinning::gather_welded(topology, file_x, welded);
+        motion.bone_transforms(i, pose);
+      };
   sample(0, x_t0, pose_t0);
   double sum_minus = 0.0, sum_uncertain = 0.0;
   for (int i = 0; i + 1 < n; ++i) {
     sample(i + 1, x_t1, pose_t1);
-    const auto counts = count_orientations_interval(segmentation, x_t0, x_t1,
-                                                    topology.welded_triangles, pose_t0.transforms,
-                                                    pose_t1.transforms);
+    const auto counts = count_orientations_interval(
+        segmentation, x_t0, x_t1, topology.welded_triangles, pose_t0, pose_t1);
     sum_minus += static_cast<double>(counts.h_minus);
     sum_uncertain += static_cast<double>(counts.h_uncertain);
     out.max_h_minus = std::max(out.max_h_minus, counts.h_minus);

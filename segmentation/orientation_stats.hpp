@@ -8,8 +8,8 @@
 #include <string>
 
 #include "segmentation/segmentation.hpp"
+#include "skinning/motion.hpp"
 #include "skinning/pose.hpp"
-#include "skinning/rig_motion.hpp"
 
 namespace skelcd::segmentation {
 
@@ -52,11 +52,12 @@ struct ClipOrientationStats {
   double seconds = 0.0;
 };
 
-/// Classifies every interval of `motion` (its samples i, i+1) against the segmentation of
-/// motion.rig(); the rig's mesh is welded as segment() welds it.
-/// @throws InvalidInput when the segmentation does not fit the rig (triangle or bone count).
+/// Classifies every interval of `motion` (its samples i, i+1; bone poses from
+/// Motion::bone_transforms) against the segmentation of its rig; the mesh is welded as segment()
+/// welds it.
+/// @throws InvalidInput when the motion has no skeleton or the segmentation does not fit it
+/// (triangle or bone count).
 [[nodiscard]] ClipOrientationStats clip_orientation_stats(
-    const Segmentation& segmentation,
-    const skinning::RigMotion& motion);
+    const Segmentation& segmentation, const skinning::Motion& motion);
 
 }  // namespace skelcd::segmentation

@@ -2,6 +2,8 @@
 // Motion: positions of a mesh at samples i = 0 … N-1 — the one interface every later stage reads
 // positions through, whatever moves the mesh (a skinned clip, a robot trajectory, a frame sequence).
 
+#include <algorithm>
+#include <cmath>
 #include <memory>
 #include <string>
 #include <vector>
@@ -26,6 +28,19 @@ class Motion {
   /// Writes the #V × 3 positions at sample i into `out` (resized if needed).
   /// @pre 0 <= i < num_samples()
   virtual void positions(int i, Positions& out) const = 0;
+
+  /// Positions at time t (seconds). A motion defined between its samples (a rig's clip)
+  /// evaluates it there (clamped to the clip); the others answer at a sample time only, within
+  /// tolerance_s × max(1, t). Returns false, `out` untouched, when t is not such a time.
+  [[nodiscard]] virtual bool positions_at(double t, Positions& out, double tolerance_s) const {
+    for (int i = 0; i < num_samples(); ++i) {
+      if (std::abs(sample_time(i) - t) <= tolerance_s * std::max(1.0, t)) {
+        positions(i, out);
+        return true;
+      }
+    }
+    return false;
+  }
 
   /// Samples per second. The default estimates it from the sample times ((N-1) / span; 0 for a
   /// single sample); motions that know their rate say it.

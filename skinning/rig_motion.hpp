@@ -46,6 +46,11 @@ class RigMotion final : public Motion {
 
   /// Skinned positions at any time in seconds (clamped to the clip's keys).
   void positions_at_time(double time_s, Positions& out) const;
+  /// Any time: positions_at_time (the tolerance is not needed).
+  [[nodiscard]] bool positions_at(double t, Positions& out, double /*tolerance_s*/) const override {
+    positions_at_time(t, out);
+    return true;
+  }
 
   [[nodiscard]] const Rig& rig() const { return *rig_; }
   [[nodiscard]] std::int32_t clip() const { return clip_; }

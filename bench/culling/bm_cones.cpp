@@ -124,7 +124,7 @@ void run(benchmark::State& state, std::size_t scene_index, const std::string& me
   o.pairs = static_cast<std::int64_t>(out.dcd_pairs.size());
   o.candidates = out.counters.candidate_pairs;
   o.tests = ccd ? out.counters.vf_tests + out.counters.ee_tests : out.counters.tt_tests;
-  if (const auto* cs = dynamic_cast<const skelcd::culling::ConeStatistics*>(m.get())) {
+  if (const auto* cs = m->cone_statistics()) {
     o.nodes_tested = cs->cone_stats().nodes_tested;
     o.nodes_culled = cs->cone_stats().nodes_culled;
   }

@@ -11,7 +11,6 @@
 
 #include "skinning/errors.hpp"
 #include "skinning/load.hpp"
-#include "skinning/rig_motion.hpp"
 #include "tools/cli/cli_util.hpp"
 #include "tools/cli/commands.hpp"
 #include "tools/cli/model_options.hpp"
@@ -53,19 +52,10 @@ void run_export(const ExportArgs& args) {
           "time " + std::to_string(t) + " s is outside '" + motion->name() + "' [0, " +
           std::to_string(end) + "] s");
     }
-    if (const auto* rig_motion = dynamic_cast<const skinning::RigMotion*>(motion.get())) {
-      rig_motion->positions_at_time(t, positions);
-    } else {
-      int found = -1;
-      for (int i = 0; i < motion->num_samples() && found < 0; ++i) {
-        if (std::abs(motion->sample_time(i) - t) <= kSampleTimeTolerance * std::max(1.0, t))
-          found = i;
-      }
-      if (found < 0)
-        fail(
-            "time " + std::to_string(t) + " s is not a sample time of '" + motion->name() +
-            "'; use --frame");
-      motion->positions(found, positions);
+    if (!motion->positions_at(t, positions, kSampleTimeTolerance)) {
+      fail(
+          "time " + std::to_string(t) + " s is not a sample time of '" + motion->name() +
+          "'; use --frame");
     }
     where = "t = " + std::to_string(t) + " s";
   } else {

@@ -16,7 +16,6 @@
 #include "skinning/errors.hpp"
 #include "skinning/generators.hpp"
 #include "skinning/load.hpp"
-#include "skinning/rig_motion.hpp"
 #include "tools/cli/cli_util.hpp"
 #include "tools/cli/commands.hpp"
 #include "tools/cli/model_options.hpp"
@@ -247,19 +246,20 @@ void run_preprocess(const PreprocessArguments& args) {
   }
   const skinning::Rig& rig = *model.rig;
   std::unique_ptr<skinning::Motion> motion;
-  const skinning::RigMotion* rig_motion = nullptr;
   if (!args.clip.empty()) {
     motion = model.motion(skinning::MotionRequest{.clip = args.clip, .rate_hz = args.fps});
-    rig_motion = dynamic_cast<const skinning::RigMotion*>(motion.get());
-    if (rig_motion == nullptr) {
-      throw InvalidInput(args.model + ": --clip: clip statistics need a skinned rig's clip");
-    }
   }
   const auto input_hash = model_identity(args.model);
 
   const auto s = seg::segment(rig, options);
   std::optional<seg::ClipOrientationStats> clip;
-  if (rig_motion != nullptr) clip = seg::clip_orientation_stats(s, *rig_motion);
+  if (motion) {
+    try {
+      clip = seg::clip_orientation_stats(s, *motion);
+    } catch (const InvalidInput& e) {
+      throw InvalidInput(args.model + ": --clip: " + e.what());
+    }
+  }
 
   if (!args.output.empty()) {
     SegmentationRecord record;
