@@ -586,6 +586,12 @@ TEST(Log, ADamagedExtentIsRefusedNotAllocated) {
       (void)read_log(file), IoError, "/parts claims 14636698788954113 rows, more than the file's");
 }
 
+#if defined(__SANITIZE_ADDRESS__)
+constexpr bool kUnderAddressSanitizer = true;
+#else
+constexpr bool kUnderAddressSanitizer = false;
+#endif
+
 TEST(Log, LogsOnWhichHdf5ItselfCrashesAreOneLineEach) {
   // Found by fuzz_log_reader: libhdf5 1.10.8 overflows its heap, or asks for terabytes, on these.
   // Logs are read in a child process first, so each is a line naming the file, never a crash.
@@ -600,6 +606,22 @@ TEST(Log, LogsOnWhichHdf5ItselfCrashesAreOneLineEach) {
     } catch (const IoError& e) {
       refused = true;
       EXPECT_EQ(std::string(e.what()).rfind(file + ": ", 0), 0u) << e.what();
+    }
+    if (kUnderAddressSanitizer &&
+        entry.path().filename().string().find("use_after_free") != std::string::npos) {
+      // Under ASan freed memory usually sits in its quarantine untouched, so libhdf5's read after
+      // free (in uninstrumented code) often reads intact data and the log is whole; sometimes
+      // ASan's allocator sees it and the reader child dies. Either way no crash reaches the user:
+      // a quiet read, or the one line.
+      const auto r = skelcd::test::run_skelcd({"inspect", file});
+      if (r.exit_code == 0) {
+        EXPECT_EQ(r.err, "") << file;
+      } else {
+        EXPECT_EQ(r.exit_code, 1) << file << ": " << r.err;
+        EXPECT_EQ(r.err.rfind("skelcd: " + file + ": ", 0), 0u) << r.err;
+        EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+      }
+      continue;
     }
     EXPECT_TRUE(refused) << file;
     const auto r = skelcd::test::run_skelcd({"inspect", file});
