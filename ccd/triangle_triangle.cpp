@@ -326,40 +326,8 @@ bool triangles_intersect(const TriangleTriangleQuery& q, const SharedCorners& sh
   if (shared_count == 0) return triangles_meet(ta, tb);
   if (shared_count == 3) return false;  // the same triangle: nothing beyond the shared part
 
-  if (ta.degenerate || tb.degenerate) {
-    // One degenerate, one not: the degenerate one is the hull of its corners, so when its free
-    // (unshared) corners lie strictly on one side of the other's plane, its only points in that
-    // plane are in the hull of the shared corners — nothing beyond the shared part. Settles most
-    // such pairs without rationals.
-    if (ta.degenerate != tb.degenerate) {
-      const bool a_flat = ta.degenerate;
-      const Triangle& solid = a_flat ? tb : ta;
-      int side = 0;
-      bool one_side = true;
-      for (int i = 0; i < 3 && one_side; ++i) {
-        bool is_shared = false;
-        if (a_flat) {
-          is_shared = shared_with_b[static_cast<std::size_t>(i)] >= 0;
-        } else {
-          for (int k = 0; k < 3; ++k)
-            is_shared = is_shared || shared_with_b[static_cast<std::size_t>(k)] == i;
-        }
-        if (is_shared) continue;
-        const int o = orient3d(solid.a, solid.b, solid.c, a_flat ? *a[i] : *b[i]);
-        one_side = o != 0 && (side == 0 || o == side);
-        side = o;
-      }
-      if (one_side && side != 0) return false;
-    }
-    std::vector<Q3> shared;
-    for (int i = 0; i < 3; ++i) {
-      if (shared_with_b[static_cast<std::size_t>(i)] >= 0) shared.push_back(rational(*a[i]));
-    }
-    return meet_beyond_shared_rational({rational(q.a0), rational(q.a1), rational(q.a2)},
-                                       {rational(q.b0), rational(q.b1), rational(q.b2)}, shared);
-  }
-
-  // Corners of a and b that are not shared.
+  // Corners of a and b that are not shared (a degenerate triangle may repeat a shared vertex, so
+  // only non-degenerate pairs have as many free corners on each side).
   int a_free[2] = {-1, -1};
   int na = 0;
   bool b_is_shared[3] = {false, false, false};
@@ -376,6 +344,36 @@ bool triangles_intersect(const TriangleTriangleQuery& q, const SharedCorners& sh
   for (int j = 0; j < 3; ++j) {
     if (!b_is_shared[j]) b_free[nb++] = j;
   }
+
+  if (ta.degenerate || tb.degenerate) {
+    // One degenerate, one not: the degenerate one is the hull of its corners, so when its free
+    // (unshared) corners lie strictly on one side of the other's plane, its only points in that
+    // plane are in the hull of the shared corners — nothing beyond the shared part. Settles most
+    // such pairs without rationals.
+    if (ta.degenerate != tb.degenerate) {
+      const Triangle& solid = ta.degenerate ? tb : ta;
+      const Vector3d* const* flat = ta.degenerate ? a : b;
+      const int* flat_free = ta.degenerate ? a_free : b_free;
+      const int num_free = ta.degenerate ? na : nb;
+      int side = 0;
+      bool one_side = true;
+      for (int k = 0; k < num_free && one_side; ++k) {
+        const int o = orient3d(solid.a, solid.b, solid.c, *flat[flat_free[k]]);
+        one_side = o != 0 && (side == 0 || o == side);
+        side = o;
+      }
+      if (one_side && side != 0) return false;
+    }
+    std::vector<Q3> shared;
+    for (int i = 0; i < 3; ++i) {
+      if (shared_with_b[static_cast<std::size_t>(i)] >= 0) shared.push_back(rational(*a[i]));
+    }
+    return meet_beyond_shared_rational(
+        {rational(q.a0), rational(q.a1), rational(q.a2)},
+        {rational(q.b0), rational(q.b1), rational(q.b2)},
+        shared);
+  }
+
   assert(na == nb);
 
   if (shared_count == 1) {

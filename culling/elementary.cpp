@@ -203,8 +203,8 @@ void run_dcd_tests(
     assert(p.a < p.b);
     int count = 0;
     const ccd::SharedCorners shared = topology.shared_corners(p.a, p.b, count);
+    const auto& ta = topology.triangle(p.a);
     if (use_fans && count > 0) {
-      const auto& ta = topology.triangle(p.a);
       for (std::size_t k = 0; k < 3; ++k) {
         if (shared[k] >= 0 && certified[static_cast<std::size_t>(ta[k])] != 0) {
           o.hit = false;
@@ -214,7 +214,6 @@ void run_dcd_tests(
       }
     }
     o.tested = true;
-    const auto& ta = topology.triangle(p.a);
     const auto& tb = topology.triangle(p.b);
     const ccd::TriangleTriangleQuery q{
         row(x, ta[0]), row(x, ta[1]), row(x, ta[2]), row(x, tb[0]), row(x, tb[1]), row(x, tb[2])};

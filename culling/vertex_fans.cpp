@@ -38,6 +38,7 @@ VertexFans::VertexFans(
   }
   offsets_.assign(nv + 1, 0);
   closed_.assign(nv, 0);
+  std::vector<std::int32_t> ends;  // the sides' end spokes of one vertex, reused
   for (std::size_t v = 0; v < nv; ++v) {
     offsets_[v + 1] = offsets_[v];
     if (broken[v]) continue;
@@ -51,8 +52,7 @@ VertexFans::VertexFans(
     // boundary vertex). The walk must visit every side.
     bool ok = true;
     for (auto it = begin; it + 1 != end && ok; ++it) ok = it->first != (it + 1)->first;
-    std::vector<std::int32_t> ends;
-    ends.reserve(m);
+    ends.clear();
     for (auto it = begin; it != end; ++it) ends.push_back(it->second);
     std::sort(ends.begin(), ends.end());
     for (std::size_t i = 0; i + 1 < m && ok; ++i) ok = ends[i] != ends[i + 1];
