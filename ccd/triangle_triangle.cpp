@@ -308,6 +308,61 @@ bool meet_beyond_shared_rational(const std::array<Q3, 3>& a,
 
 Q3 rational(const Vector3d& p) { return lift<mpq_class>(p); }
 
+// shared_with_b seen from b: corner j of b is corner inverse[j] of a.
+SharedCorners inverse(const SharedCorners& shared_with_b) {
+  SharedCorners out = kNoSharedCorners;
+  for (int i = 0; i < 3; ++i) {
+    const int j = shared_with_b[static_cast<std::size_t>(i)];
+    if (j >= 0) out[static_cast<std::size_t>(j)] = static_cast<std::int8_t>(i);
+  }
+  return out;
+}
+
+// A zero-area triangle F (corners `flat`, collinear: F is the segment they span) and a
+// non-degenerate triangle S (`solid`, corners `solid_corners` in the order of its Triangle) that
+// share one or two corners (`flat_to_solid`, as triangles_intersect's argument): is some point of
+// F n S outside the hull of the shared corners? Exact, and without rationals:
+// - F lies on a line L through a shared corner v, which is a corner of S and so in S's plane. If a
+//   corner of F is off that plane, L meets the plane in v alone, and F n S is in {v}: no.
+// - Otherwise F lies in S's plane. Two shared corners s0 != s1 (equal positions would make S
+//   degenerate) put L on the line of S's edge s0 s1, which meets S in that edge: no.
+// - One shared corner v: F n S is a segment from v; it goes beyond v iff for some corner c != v of
+//   F, c - v lies in the closed cone of S at v, spanned by e1 = s1 - v and e2 = s2 - v (the other
+//   two corners). Writing c - v = alpha e1 + beta e2 in the plane: cross(e1, c - v) = beta
+//   cross(e1, e2) and cross(c - v, e2) = alpha cross(e1, e2), so both signs are read from 2D
+//   orientations in a projection that is injective on the plane.
+bool flat_meets_beyond_shared(
+    const Vector3d* const flat[3],
+    const SharedCorners& flat_to_solid,
+    const Triangle& solid,
+    const Vector3d* const solid_corners[3]) {
+  int shared_count = 0;
+  int v_index = -1;  // a corner of the solid triangle that is shared
+  for (int i = 0; i < 3; ++i) {
+    const int j = flat_to_solid[static_cast<std::size_t>(i)];
+    if (j < 0) {
+      if (orient3d(solid.a, solid.b, solid.c, *flat[i]) != 0) return false;
+    } else {
+      ++shared_count;
+      v_index = j;
+    }
+  }
+  if (shared_count >= 2) return false;
+  const Vector3d& v = *solid_corners[v_index];
+  const Vector3d& s1 = *solid_corners[(v_index + 1) % 3];
+  const Vector3d& s2 = *solid_corners[(v_index + 2) % 3];
+  const Projection pr = projection_of(solid);
+  const int turn = orient2d(v, s1, s2, pr.i, pr.j);  // nonzero: pr keeps the triangle's area
+  for (int i = 0; i < 3; ++i) {
+    const Vector3d& c = *flat[i];
+    if (c == v) continue;
+    if (orient2d(v, s1, c, pr.i, pr.j) * turn >= 0 && orient2d(v, c, s2, pr.i, pr.j) * turn >= 0) {
+      return true;
+    }
+  }
+  return false;
+}
+
 }  // namespace
 
 bool triangles_intersect(const TriangleTriangleQuery& q, const SharedCorners& shared_with_b) {
@@ -345,25 +400,11 @@ bool triangles_intersect(const TriangleTriangleQuery& q, const SharedCorners& sh
     if (!b_is_shared[j]) b_free[nb++] = j;
   }
 
-  if (ta.degenerate || tb.degenerate) {
-    // One degenerate, one not: the degenerate one is the hull of its corners, so when its free
-    // (unshared) corners lie strictly on one side of the other's plane, its only points in that
-    // plane are in the hull of the shared corners — nothing beyond the shared part. Settles most
-    // such pairs without rationals.
-    if (ta.degenerate != tb.degenerate) {
-      const Triangle& solid = ta.degenerate ? tb : ta;
-      const Vector3d* const* flat = ta.degenerate ? a : b;
-      const int* flat_free = ta.degenerate ? a_free : b_free;
-      const int num_free = ta.degenerate ? na : nb;
-      int side = 0;
-      bool one_side = true;
-      for (int k = 0; k < num_free && one_side; ++k) {
-        const int o = orient3d(solid.a, solid.b, solid.c, *flat[flat_free[k]]);
-        one_side = o != 0 && (side == 0 || o == side);
-        side = o;
-      }
-      if (one_side && side != 0) return false;
-    }
+  if (ta.degenerate != tb.degenerate) {
+    return ta.degenerate ? flat_meets_beyond_shared(a, shared_with_b, tb, b)
+                         : flat_meets_beyond_shared(b, inverse(shared_with_b), ta, a);
+  }
+  if (ta.degenerate) {  // both degenerate: rare enough for the rational enumeration
     std::vector<Q3> shared;
     for (int i = 0; i < 3; ++i) {
       if (shared_with_b[static_cast<std::size_t>(i)] >= 0) shared.push_back(rational(*a[i]));

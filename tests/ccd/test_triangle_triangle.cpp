@@ -332,5 +332,75 @@ TEST(TriangleTriangle, SharedEdgeNeighboursOfRotatedStrips) {
   EXPECT_GT(hits, 0);
 }
 
+// A zero-area triangle (three collinear corners) next to a non-degenerate one, sharing a corner or
+// two: the case real rigs have at collapsed seams, decided without rationals (flat against solid).
+// On a grid, so that the flat triangle often lies exactly in the solid one's plane, with its line
+// pointing into the solid one's corner, along an edge, away from it, or out of the plane.
+TEST(TriangleTriangle, FlatNeighboursOfSolidTrianglesAgreeWithBruteForce) {
+  std::mt19937_64 rng(2026);
+  std::uniform_int_distribution<int> coord(-2, 2);
+  const auto grid = [&](bool in_plane) {
+    return V(0.5 * coord(rng), 0.5 * coord(rng), in_plane ? 0.0 : 0.5 * coord(rng));
+  };
+  int hits = 0, misses = 0, coplanar = 0, two_shared = 0;
+  for (int n = 0; n < 4000; ++n) {
+    const bool planar = n % 4 != 3;  // mostly in the plane z = 0, where the exact zeros are
+    V s[3] = {grid(true), grid(true), grid(true)};
+    if (!planar) s[2] = grid(false);
+    if (orient3d(s[0], s[1], s[2], s[0] + V(0, 0, 1)) == 0 &&
+        orient3d(s[0], s[1], s[2], s[0] + V(1, 0, 0)) == 0 &&
+        orient3d(s[0], s[1], s[2], s[0] + V(0, 1, 0)) == 0) {
+      continue;  // the solid triangle came out degenerate
+    }
+    const int share = 1 + (n % 3 == 0 ? 1 : 0);
+    const int v = std::uniform_int_distribution<int>(0, 2)(rng);
+    V f[3];
+    f[0] = s[v];
+    SharedCorners shared = kNoSharedCorners;  // flat corner -> solid corner
+    shared[0] = static_cast<std::int8_t>(v);
+    if (share == 2) {
+      const int w = (v + 1 + (n / 3) % 2) % 3;
+      f[1] = s[w];
+      shared[1] = static_cast<std::int8_t>(w);
+      f[2] = f[0] + 0.5 * coord(rng) * (f[1] - f[0]);
+      ++two_shared;
+    } else {
+      V d = grid(n % 8 != 7);
+      if (n % 5 == 0) d = s[(v + 1) % 3] - s[v];  // along an edge of the solid triangle
+      f[1] = f[0] + 0.5 * coord(rng) * d;
+      f[2] = f[0] + 0.5 * coord(rng) * d;
+    }
+    const int at =
+        std::uniform_int_distribution<int>(0, 2)(rng);  // where the flat one's shared corners go
+    std::swap(f[0], f[at]);
+    std::swap(shared[0], shared[static_cast<std::size_t>(at)]);
+    const bool flat_first = n % 2 == 0;
+    TriangleTriangleQuery q = flat_first
+                                  ? TriangleTriangleQuery{f[0], f[1], f[2], s[0], s[1], s[2]}
+                                  : TriangleTriangleQuery{s[0], s[1], s[2], f[0], f[1], f[2]};
+    SharedCorners arg = shared;
+    if (!flat_first) {
+      arg = kNoSharedCorners;
+      for (int i = 0; i < 3; ++i) {
+        if (shared[static_cast<std::size_t>(i)] >= 0)
+          arg[static_cast<std::size_t>(shared[static_cast<std::size_t>(i)])] =
+              static_cast<std::int8_t>(i);
+      }
+    }
+    coplanar += (orient3d(s[0], s[1], s[2], f[0]) == 0 && orient3d(s[0], s[1], s[2], f[1]) == 0 &&
+                 orient3d(s[0], s[1], s[2], f[2]) == 0)
+                    ? 1
+                    : 0;
+    const bool expected = brute_intersect(q, arg);
+    ASSERT_EQ(triangles_intersect(q, arg), expected) << "case " << n;
+    (expected ? hits : misses) += 1;
+  }
+  // Both answers, many exactly coplanar cases, and shared edges among them.
+  EXPECT_GT(hits, 300);
+  EXPECT_GT(misses, 300);
+  EXPECT_GT(coplanar, 1500);
+  EXPECT_GT(two_shared, 800);
+}
+
 }  // namespace
 }  // namespace skelcd::ccd
