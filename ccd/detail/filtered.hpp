@@ -1,7 +1,8 @@
 #pragma once
 // Exact signs of polynomial expressions in double inputs: evaluate once in floating point while
-// tracking a proven error bound (a dynamic filter); only when the sign is not certain, evaluate again
-// in GMP rationals. A predicate is written once as a template over the number type.
+// tracking a proven error bound (a dynamic filter); only when the sign is not certain, evaluate
+// again exactly, as a floating-point expansion (or, near underflow or overflow, in GMP rationals).
+// A predicate is written once as a template over the number type.
 //
 //   const int s = exact_sign([&]<typename T>() { return orient3d(lift<T>(a), ...); });
 //
@@ -10,13 +11,14 @@
 // with - as +), |computed - exact| <= fl((k + 1) eps P_hat) when no product underflows; a possible
 // underflow or overflow sends the predicate to the exact path.
 
+#include <gmpxx.h>
+
+#include <Eigen/Core>
 #include <algorithm>
 #include <cfloat>
 #include <cmath>
 
-#include <Eigen/Core>
-#include <gmpxx.h>
-
+#include "ccd/detail/expansion.hpp"
 #include "ccd/detail/float_bounds.hpp"
 
 namespace skelcd::ccd::detail {
@@ -66,6 +68,10 @@ inline Filtered lift<Filtered>(double x) {
   return Filtered::leaf(x);
 }
 template <>
+inline Expansion lift<Expansion>(double x) {
+  return Expansion(x);
+}
+template <>
 inline mpq_class lift<mpq_class>(double x) {
   return mpq_class(x);
 }
@@ -106,13 +112,17 @@ inline int rational_sign(const mpq_class& q) {
   return (s > 0) - (s < 0);
 }
 
-/// Exact sign of the expression `predicate` builds: filtered double first, GMP when undecided.
+/// Exact sign of the expression `predicate` builds: filtered double first; when undecided, an
+/// exact floating-point expansion (expansion.hpp); GMP rationals only when the expansion could have
+/// underflowed or overflowed.
 /// @param predicate a generic lambda `[&]<typename T>() -> T`, evaluated with T = Filtered and, if
-/// needed, T = mpq_class.
+/// needed, T = Expansion and T = mpq_class.
 template <typename Predicate>
 int exact_sign(const Predicate& predicate) {
   const int s = filtered_sign(predicate.template operator()<Filtered>());
   if (s != 2) return s;
+  const Expansion e = predicate.template operator()<Expansion>();
+  if (!e.unsafe()) return e.sign();
   return rational_sign(mpq_class(predicate.template operator()<mpq_class>()));
 }
 

@@ -1,0 +1,109 @@
+// Floating-point expansions (ccd/detail/expansion.hpp) against GMP rationals: the sign of sums and
+// products of doubles must be exact, including exact zeros and cancellations far below one ulp of
+// the terms, and inputs where a product could leave the exact range must be flagged, not guessed.
+
+#include <gmpxx.h>
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+
+#include "ccd/detail/expansion.hpp"
+#include "ccd/detail/filtered.hpp"
+
+namespace skelcd::ccd::detail {
+namespace {
+
+int rational_sign_of(const mpq_class& q) {
+  return mpq_sgn(q.get_mpq_t()) > 0 ? 1 : (mpq_sgn(q.get_mpq_t()) < 0 ? -1 : 0);
+}
+
+// orient3d of four points over number type T, as the predicates write it.
+template <typename T>
+T orient(
+    const Eigen::Vector3d& a,
+    const Eigen::Vector3d& b,
+    const Eigen::Vector3d& c,
+    const Eigen::Vector3d& d) {
+  const auto pa = lift<T>(a);
+  return dot(cross(lift<T>(b) - pa, lift<T>(c) - pa), lift<T>(d) - pa);
+}
+
+TEST(Expansion, SignsOfSumsAndProductsAreExact) {
+  const Expansion one(1.0);
+  const Expansion tiny(0x1p-60);
+  // (1 + 2^-60) - 1 - 2^-60 = 0, (1 + 2^-60) - 1 > 0: far below double precision.
+  EXPECT_EQ(((one + tiny) - one - tiny).sign(), 0);
+  EXPECT_EQ(((one + tiny) - one).sign(), 1);
+  EXPECT_EQ((one - (one + tiny)).sign(), -1);
+  // (1 + 2^-30)^2 - 1 - 2^-29 = 2^-60 exactly.
+  const Expansion x = one + Expansion(0x1p-30);
+  EXPECT_EQ((x * x - one - Expansion(0x1p-29) - Expansion(0x1p-60)).sign(), 0);
+  EXPECT_EQ((x * x - one - Expansion(0x1p-29)).sign(), 1);
+  EXPECT_EQ(Expansion().sign(), 0);
+  EXPECT_EQ((Expansion(3.0) * Expansion()).sign(), 0);
+  EXPECT_FALSE((x * x).unsafe());
+}
+
+TEST(Expansion, OrientationSignsAgreeWithRationals) {
+  std::mt19937_64 rng(11);
+  std::uniform_real_distribution<double> unit(-1.0, 1.0);
+  std::uniform_int_distribution<int> grid(-3, 3);
+  std::uniform_int_distribution<int> scale_exp(-40, 40);
+  int zeros = 0, nonzeros = 0;
+  for (int n = 0; n < 20000; ++n) {
+    // Coplanar points on a rotated or scaled grid (exact zeros and near misses after rounding),
+    // and generic points nudged by one ulp.
+    const double s = std::ldexp(1.0, scale_exp(rng));
+    Eigen::Vector3d p[4];
+    for (auto& v : p) {
+      if (n % 2 == 0) {
+        v = s * Eigen::Vector3d(grid(rng), grid(rng), n % 4 == 0 ? 0 : grid(rng)) +
+            Eigen::Vector3d(0.1, 0.3, 0.7) * s;
+      } else {
+        v = s * Eigen::Vector3d(unit(rng), unit(rng), unit(rng));
+      }
+    }
+    if (n % 2 == 1) p[3] = p[0] + (p[1] - p[0]) * 0.5 + (p[2] - p[0]) * 0.25;  // nearly coplanar
+    if (n % 3 == 0) {
+      double& c = p[n % 4][n % 3];
+      c = std::nextafter(c, n % 5 ? 10.0 : -10.0);
+    }
+    const Expansion e = orient<Expansion>(p[0], p[1], p[2], p[3]);
+    ASSERT_FALSE(e.unsafe()) << "case " << n;
+    const int expected = rational_sign_of(orient<mpq_class>(p[0], p[1], p[2], p[3]));
+    ASSERT_EQ(e.sign(), expected) << "case " << n;
+    (expected == 0 ? zeros : nonzeros) += 1;
+  }
+  EXPECT_GT(zeros, 2000);
+  EXPECT_GT(nonzeros, 10000);
+}
+
+TEST(Expansion, ProductsNearUnderflowOrOverflowAreFlagged) {
+  // Leaves outside [2^-300, 2^300] and products outside the exact range of two-product are flagged,
+  // so that exact_sign falls back to rationals.
+  EXPECT_TRUE(Expansion(0x1p-400).unsafe());
+  EXPECT_TRUE(Expansion(0x1p+400).unsafe());
+  EXPECT_TRUE(Expansion(std::nan("")).unsafe());
+  const Expansion small(0x1p-290);
+  EXPECT_FALSE(small.unsafe());
+  EXPECT_TRUE((small * small * small).unsafe());
+  const Expansion big(0x1p+290);
+  EXPECT_TRUE((big * big * big * big).unsafe());
+  // exact_sign still answers them exactly through the rational path.
+  EXPECT_EQ(
+      exact_sign([]<typename T>() -> T {
+        const T a = lift<T>(0x1p-290);
+        return T(a * a * a * a - a * a * a * a);
+      }),
+      0);
+  EXPECT_EQ(
+      exact_sign([]<typename T>() -> T {
+        const T a = lift<T>(0x1p-290);
+        return T(a * a * a * a * (lift<T>(1.0) + lift<T>(0x1p-80)) - a * a * a * a);
+      }),
+      1);
+}
+
+}  // namespace
+}  // namespace skelcd::ccd::detail
