@@ -175,7 +175,8 @@ def check(model_or_path: Union[Model, str, os.PathLike], clip: Optional[str] = N
           query: str = "both", min_separation: float = 0.0, threads: int = 1,
           log: Union[str, os.PathLike, None] = None, gamma: float = 0.05, seed: int = 1,
           segmentation: Union[str, os.PathLike, None] = None, baseline: str = "rest",
-          baseline_slack: int = 2, allow=(), allow_adjacent_bones: bool = False) -> CheckResult:
+          baseline_slack: int = 2, allow=(), allow_adjacent_bones: bool = False,
+          full_dcd: bool = False) -> CheckResult:
     """Checks one clip for self-collision, as ``skelcd check MODEL -o LOG`` does.
 
     model_or_path: a Model from ``load``, or a path loaded with default options.
@@ -191,6 +192,9 @@ def check(model_or_path: Union[Model, str, os.PathLike], clip: Optional[str] = N
     baseline, baseline_slack, allow, allow_adjacent_bones: what findings are compared with and
         which pairs are allowed (``--baseline rest|sample:K|none|LOG.h5``, ``--baseline-slack``,
         ``--allow A:B`` per item of ``allow``, ``--allow-adjacent-bones``; docs/events.md).
+    full_dcd: test every candidate at every sample (``--full-dcd``); by default, with both
+        queries, each DCD updates the previous one from the interval's CCD contacts (the same
+        pairs; docs/culling.md "Incremental DCD").
     The GIL is released while checking; Ctrl-C stops a serial check between rows.
     Raises InvalidInput (bad option, clip, frame range, method) or IoError (unreadable file, a
     log that cannot be written), with the command line's messages.
@@ -206,6 +210,8 @@ def check(model_or_path: Union[Model, str, os.PathLike], clip: Optional[str] = N
         arguments["allow"] = list(allow)
     if allow_adjacent_bones:
         arguments["allow_adjacent_bones"] = True
+    if full_dcd:
+        arguments["full_dcd"] = True
     if method in ("rvbc", "dynamic", "auto"):
         arguments.update(gamma=gamma, seed=seed, segmentation=segmentation)
     command_line = _call_text("check", {"model": model.argument,
@@ -215,7 +221,8 @@ def check(model_or_path: Union[Model, str, os.PathLike], clip: Optional[str] = N
         float(min_separation), int(threads), "" if log is None else os.fspath(log), float(gamma),
         int(seed), "" if segmentation is None else os.fspath(segmentation), command_line,
         os.fspath(baseline) if isinstance(baseline, os.PathLike) else str(baseline),
-        int(baseline_slack), [str(a) for a in allow], bool(allow_adjacent_bones))
+        int(baseline_slack), [str(a) for a in allow], bool(allow_adjacent_bones),
+        bool(full_dcd))
     return _result(raw)
 
 

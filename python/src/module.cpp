@@ -322,7 +322,8 @@ py::dict check(
     const std::string& baseline,
     std::int32_t baseline_slack,
     const std::vector<std::string>& allow,
-    bool allow_adjacent_bones) {
+    bool allow_adjacent_bones,
+    bool full_dcd) {
   // Options refused with the CLI's own messages (tools/cli/cmd_check.cpp).
   const auto parsed_accuracy = ccd::parse_accuracy(accuracy);
   if (!parsed_accuracy)
@@ -342,6 +343,7 @@ py::dict check(
   request.query = *parsed_query;
   request.min_separation = min_separation;
   request.threads = threads;
+  request.incremental_dcd = !full_dcd;
   request.radial_view =
       tools::RadialViewArguments{.gamma = gamma, .seed = seed, .segmentation = segmentation};
   request.baseline = tools::parse_baseline(baseline);
@@ -542,7 +544,8 @@ PYBIND11_MODULE(_skelcd, m) {
       py::arg("baseline"),
       py::arg("baseline_slack"),
       py::arg("allow"),
-      py::arg("allow_adjacent_bones"));
+      py::arg("allow_adjacent_bones"),
+      py::arg("full_dcd") = false);
   m.def("read_log", &read_log, py::arg("path"));
   m.def("method_names", &skelcd::tools::check_method_names);
   // The /frames columns' counters and stages, in the log's order (FRAME_DTYPE is built from them).

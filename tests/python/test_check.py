@@ -93,6 +93,16 @@ def test_threads_do_not_change_the_findings():
         assert np.array_equal(getattr(serial, name), getattr(parallel, name))
 
 
+def test_full_dcd_finds_the_same_pairs_with_more_tests():
+    incremental = skelcd.check("assets/characters/RobotExpressive.glb", frames="0:20")
+    full = skelcd.check("assets/characters/RobotExpressive.glb", frames="0:20", full_dcd=True)
+    for name in ("contacts", "dcd_pairs"):
+        assert np.array_equal(getattr(incremental, name), getattr(full, name))
+    dcd = incremental.rows["kind"] == 0
+    assert len(incremental.dcd_pairs) > 0
+    assert incremental.rows["tt_tests"][dcd].sum() * 3 < full.rows["tt_tests"][dcd].sum()
+
+
 def test_one_sample_is_dcd_only():
     result = skelcd.check("assets/characters/Fox.glb", clip="Walk", frames=4)
     assert list(result.rows["sample"]) == [4] and list(result.rows["kind"]) == [0]

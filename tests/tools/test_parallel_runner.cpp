@@ -127,6 +127,58 @@ TEST(ParallelRunner, RealCharacterRowsEqualSerialForBvhDynamicAndAuto) {
   }
 }
 
+// Incremental DCD (RunOptions::incremental_dcd, the default with both queries) against full DCD at
+// every sample: the same contacts and DCD pairs in every row, far fewer triangle tests, and each
+// block (serial or parallel) starting with a full DCD.
+TEST(ParallelRunner, IncrementalDcdRowsHoldTheFullDcdsPairsWithFewerTests) {
+  const auto l = load(kCharacter);
+  for (const char* method : {"bvh", "auto"}) {
+    SCOPED_TRACE(method);
+    std::vector<FrameReport> rows[2];
+    for (const int incremental : {0, 1}) {
+      RunOptions options;
+      options.method = method;
+      options.frames = parse_frame_range("30:55");
+      options.threads = 2;
+      options.block_samples = 8;
+      options.incremental_dcd = incremental != 0;
+      (void)setup_radial_view(RadialViewArguments{}, l.model, *l.motion, options);
+      ClipRunner runner(*l.motion, options);
+      rows[incremental] = collect(runner);
+    }
+    ASSERT_EQ(rows[0].size(), rows[1].size());
+    std::int64_t full_tests = 0, incremental_tests = 0;
+    std::size_t dcd_pairs = 0;
+    bool changes = false;
+    bool have_previous = false;
+    std::vector<DcdPairRow> previous;
+    for (std::size_t i = 0; i < rows[0].size(); ++i) {
+      const auto& full = rows[0][i];
+      const auto& inc = rows[1][i];
+      const std::string where = "row " + std::to_string(i);
+      EXPECT_EQ(full.contacts, inc.contacts) << where;
+      EXPECT_EQ(full.dcd_pairs, inc.dcd_pairs) << where;
+      if (full.row.kind != QueryKind::dcd) continue;
+      EXPECT_EQ(full.row.counters.dcd_pairs, inc.row.counters.dcd_pairs) << where;
+      full_tests += full.row.counters.tt_tests;
+      incremental_tests += inc.row.counters.tt_tests;
+      dcd_pairs += full.dcd_pairs.size();
+      // A block's first sample is a full DCD: the same counters as the full run's row.
+      if ((full.row.sample - 30) % 8 == 0) {
+        EXPECT_EQ(full.row.counters.candidate_pairs, inc.row.counters.candidate_pairs) << where;
+      }
+      std::vector<DcdPairRow> now = full.dcd_pairs;
+      for (auto& p : now) p.frame = 0;
+      if (have_previous && now != previous) changes = true;
+      previous = std::move(now);
+      have_previous = true;
+    }
+    EXPECT_GT(dcd_pairs, 0u) << "no DCD pairs: the clip proves nothing";
+    EXPECT_TRUE(changes) << "the pairs must change over the clip";
+    EXPECT_LT(incremental_tests * 3, full_tests) << "the update must test far fewer pairs";
+  }
+}
+
 // The rope (a closed tube) coils into itself from sample 17 of 24.
 const std::string kRope = "gen:rope?triangles=200&frames=24";
 

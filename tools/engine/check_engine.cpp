@@ -39,6 +39,7 @@ RunOptions run_options(const CheckRequest& r) {
   o.query = r.query;
   o.min_separation = r.min_separation;
   o.threads = r.threads;
+  o.incremental_dcd = r.incremental_dcd;
   o.elementary_tests_done = r.tests_done;
   return o;
 }

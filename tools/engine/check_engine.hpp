@@ -30,6 +30,9 @@ struct CheckRequest {
   QuerySet query = QuerySet::both;
   double min_separation = 0;        ///< contact distance, model units
   std::int32_t threads = 1;         ///< 0: all cores
+  /// With both queries, each DCD after the first updates the previous one from the interval's
+  /// CCD contacts (RunOptions::incremental_dcd); false: full DCD at every sample.
+  bool incremental_dcd = true;
   RadialViewArguments radial_view;  ///< γ, seed, segmentation file of rvbc/dynamic/auto
   /// What findings are compared with (docs/events.md): the rig's rest pose by default.
   BaselineSpec baseline;

@@ -15,6 +15,7 @@
 #include <mutex>
 #include <utility>
 
+#include "culling/incremental_dcd.hpp"
 #include "culling/method_registry.hpp"
 #include "culling/routed_method.hpp"
 #include "skinning/errors.hpp"
@@ -68,6 +69,9 @@ struct RowContext {
   const skinning::Topology& topology;
   const FeatureNumbering& numbering;
   bool bones;
+  /// DCD at k+1 from the DCD at k and the CCD contacts of k → k+1 (culling/incremental_dcd.hpp)
+  /// with these elementary tests; null: every DCD is a full query of the method.
+  const culling::ElementaryTests* incremental_dcd = nullptr;
 };
 
 /// One posed sample: welded positions and, when the method needs them, the bone transforms.
@@ -180,6 +184,12 @@ struct Worker {
   skinning::Positions posed;
   PosedSample samples[2];
   culling::FrameResult result;
+  // Incremental DCD: the last DCD's pairs and the last CCD's contacts, with their samples.
+  std::unique_ptr<culling::DcdUpdater> updater;
+  std::vector<culling::TrianglePair> previous_pairs;
+  std::int32_t previous_sample = -2;
+  std::vector<culling::CcdContact> contacts;
+  std::int32_t contacts_interval = -2;
 };
 
 /// Runs the rows of `sequence` with `w`, passing each completed row to `emit`, in order.
@@ -187,6 +197,13 @@ template <class Emit>
 void check_samples(
     const RowContext& context, const SampleSequence& sequence, Worker& w, Emit&& emit) {
   FrameReport report;
+  // Each sequence starts with a full DCD, so that a block's rows do not depend on what the worker
+  // checked before.
+  w.previous_sample = -2;
+  w.contacts_interval = -2;
+  if (context.incremental_dcd != nullptr && !w.updater) {
+    w.updater = std::make_unique<culling::DcdUpdater>(context.motion.mesh(), context.topology);
+  }
   run_sequence(
       sequence,
       [&](std::int32_t k, int slot) { return pose_sample(context, k, w.posed, w.samples[slot]); },
@@ -194,8 +211,17 @@ void check_samples(
         const auto start = Clock::now();
         w.result.clear();
         const PosedSample& x = w.samples[slot];
-        w.method->detect_dcd(
-            culling::Instant{.x = x.welded, .bones = x.bones, .sample = k}, w.result);
+        if (w.updater && w.previous_sample == k - 1 && w.contacts_interval == k - 1) {
+          w.updater->update(
+              w.previous_pairs, w.contacts, x.welded, *context.incremental_dcd, w.result);
+        } else {
+          w.method->detect_dcd(
+              culling::Instant{.x = x.welded, .bones = x.bones, .sample = k}, w.result);
+        }
+        if (w.updater) {
+          w.previous_pairs.assign(w.result.dcd_pairs.begin(), w.result.dcd_pairs.end());
+          w.previous_sample = k;
+        }
         make_report(context, QueryKind::dcd, k, w.result, skin_us, start, report);
         emit(report);
       },
@@ -213,6 +239,10 @@ void check_samples(
                 .sample_t0 = k,
                 .sample_t1 = k + 1},
             w.result);
+        if (w.updater) {
+          w.contacts.assign(w.result.contacts.begin(), w.result.contacts.end());
+          w.contacts_interval = k;
+        }
         make_report(context, QueryKind::ccd, k, w.result, skin_us, start, report);
         emit(report);
       });
@@ -352,10 +382,23 @@ ClipRunner::ClipRunner(
     method_ = culling::make_method(options.method, motion.mesh(), topology_, method_options_);
   }
   if (!method_) throw InvalidInput("method '" + options.method + "' could not be built");
+  // Incremental DCD needs every contact of the interval: the registered methods with a CCD that
+  // never misses (not `fast`), the ccd/ kernels, and both queries.
+  incremental_dcd_ = options.incremental_dcd && !factory_ &&
+                     options.accuracy != ccd::Accuracy::fast && options.query == QuerySet::both &&
+                     method_options_.elementary.vertex_face == nullptr &&
+                     method_options_.elementary.edge_edge == nullptr &&
+                     method_options_.elementary.triangles == nullptr;
   bones_ = motion.num_bones() > 0 && needs_bone_poses(options.method, method_options_);
 
-  // Threads: blocks of consecutive samples (a DCD at k, then the CCD k → k+1) go to workers.
+  // Threads: blocks of consecutive samples (a DCD at k, then the CCD k → k+1) go to workers. The
+  // blocks do not depend on the thread count: with incremental DCD each block starts with a full
+  // DCD, in a serial run too, so that every row is the same on any number of threads.
   const std::int32_t wanted = resolve_threads(options.threads);
+  units_ = plan_.samples - (options.query != QuerySet::ccd ? 0 : 1);
+  block_samples_ = options.block_samples > 0
+                       ? options.block_samples
+                       : std::clamp(units_ / 16, std::int32_t{4}, std::int32_t{64});
   if (wanted > 1) {
     if (!factory_) {
       const culling::MethodInfo* m = culling::find_method(options.method);
@@ -365,13 +408,8 @@ ClipRunner::ClipRunner(
     } else if (!options.factory_methods_stateless) {
       plan_.serial_reason = "the method factory's methods are not known to be stateless";
     }
-    const bool dcd = options.query != QuerySet::ccd;
-    const std::int32_t units = plan_.samples - (dcd ? 0 : 1);
-    const std::int32_t block =
-        options.block_samples > 0
-            ? options.block_samples
-            : std::clamp(units / (wanted * 8), std::int32_t{4}, std::int32_t{64});
-    const std::int32_t blocks = (units + block - 1) / block;
+    const std::int32_t block = block_samples_;
+    const std::int32_t blocks = (units_ + block - 1) / block;
     if (plan_.serial_reason.empty() && blocks > 1) {
       plan_.threads = std::min(wanted, blocks);
       plan_.block_samples = block;
@@ -403,7 +441,12 @@ void ClipRunner::run_serial(const FrameCallback& on_frame) {
 
 void ClipRunner::run_queries_in_order(const FrameCallback& on_frame) {
   const FeatureNumbering numbering(motion_.mesh(), topology_);
-  const RowContext context{motion_, topology_, numbering, bones_};
+  const RowContext context{
+      motion_,
+      topology_,
+      numbering,
+      bones_,
+      incremental_dcd_ ? &method_options_.elementary : nullptr};
   const bool dcd = options_.query != QuerySet::ccd;
   const SampleSequence all{
       .first = plan_.first_sample,
@@ -413,12 +456,27 @@ void ClipRunner::run_queries_in_order(const FrameCallback& on_frame) {
       .ccd = options_.query != QuerySet::dcd};
   Worker w;
   w.method = method_.get();
-  check_samples(context, all, w, on_frame);
+  if (!incremental_dcd_) {
+    check_samples(context, all, w, on_frame);
+    return;
+  }
+  // The blocks of a parallel run, one after the other (each starts with a full DCD).
+  for (std::int32_t first = all.first; first < all.end; first += block_samples_) {
+    SampleSequence block = all;
+    block.first = first;
+    block.end = std::min(all.end, first + block_samples_);
+    check_samples(context, block, w, on_frame);
+  }
 }
 
 void ClipRunner::run_parallel(const FrameCallback& on_frame) {
   const FeatureNumbering numbering(motion_.mesh(), topology_);
-  const RowContext context{motion_, topology_, numbering, bones_};
+  const RowContext context{
+      motion_,
+      topology_,
+      numbering,
+      bones_,
+      incremental_dcd_ ? &method_options_.elementary : nullptr};
   const bool dcd = options_.query != QuerySet::ccd;
   const bool ccd = options_.query != QuerySet::dcd;
   const std::int32_t last = plan_.last_sample;

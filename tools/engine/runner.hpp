@@ -61,6 +61,11 @@ struct RunOptions {
   /// When set, elementary tests add to it as they finish (culling::ElementaryTests::tests_done):
   /// a progress line can move inside one long query.
   std::atomic<std::int64_t>* elementary_tests_done = nullptr;
+  /// With both queries, the DCD at sample k+1 is the DCD at k updated from the contacts of the
+  /// CCD k → k+1 (culling/incremental_dcd.hpp; the same pairs as a full DCD, proof in
+  /// docs/culling.md "Incremental DCD"). Only for registered methods (no factory) and accuracies
+  /// that never miss; false: every DCD is a full query (`--full-dcd`).
+  bool incremental_dcd = true;
 };
 
 /// What a run will do, resolved against the motion's sample count.
@@ -119,6 +124,10 @@ class ClipRunner {
   skinning::Topology topology_;
   std::unique_ptr<culling::CullingMethod> method_;
   bool bones_ = false;  ///< the queries carry the bones' transforms (the method needs them)
+  bool incremental_dcd_ = false;
+  std::int32_t units_ = 0;          ///< sample units k of the run (DCD at k, then CCD k → k+1)
+  std::int32_t block_samples_ = 4;  ///< units per block, whatever the thread count  ///< DCD
+                                    ///< updated from the CCD contacts (RunOptions::incremental_dcd)
 };
 
 /// Maps welded ids (culling's numbering) back to the file's own numbering (part, index).
