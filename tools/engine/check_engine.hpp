@@ -28,8 +28,8 @@ struct CheckRequest {
   std::string method = "auto";
   ccd::Accuracy accuracy = ccd::Accuracy::conservative;
   QuerySet query = QuerySet::both;
-  double min_separation = 0;        ///< contact distance, model units
-  std::int32_t threads = 1;         ///< 0: all cores
+  double min_separation = 0;  ///< contact distance, model units
+  std::int32_t threads = 1;   ///< 0: all cores
   /// With both queries, each DCD after the first updates the previous one from the interval's
   /// CCD contacts (RunOptions::incremental_dcd); false: full DCD at every sample.
   bool incremental_dcd = true;
