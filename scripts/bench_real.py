@@ -12,7 +12,9 @@ DCD: `dcd_vs_cgal MODEL --json` (bench/real/dcd_vs_cgal.cpp; built by `make benc
 libcgal-dev is installed) poses --samples frames spread over the first clip (each frame of a cloth
 step) and times skelcd's `bvh` DCD and CGAL 5.5's self_intersections, one thread each, fastest of
 --repeat runs, and compares the pairs (CGAL's extra pairs at vertices its soup-to-mesh conversion
-duplicated are counted apart, see the source).
+duplicated are counted apart, see the source). It also times `incremental`: the DCD a clip
+check runs at a sample after the first, the previous sample's pairs updated from the interval's CCD
+contacts (culling/incremental_dcd.hpp; the previous DCD and the CCD untimed, as the check has them).
 
 CCD: `skelcd check MODEL --query ccd --threads 1 --method M --json -o LOG` for each method, each in
 its own process so that its peak RSS (ru_maxrss from wait4) is its own. A clip whose bvh run takes
@@ -89,7 +91,8 @@ def contact_set(log):
 
 
 def dcd_rows(dcd, model, samples, repeat, timeout):
-    cmd = [dcd, model, "--json", "--samples", str(samples), "--repeat", str(repeat)]
+    cmd = [dcd, model, "--json", "--samples", str(samples), "--repeat", str(repeat),
+           "--methods", "bvh,incremental"]
     code, out, err, _, _ = run_measured(cmd, timeout)
     rows = [json.loads(line) for line in out.splitlines() if line.startswith("{")]
     if code == 2 or not rows:
@@ -191,25 +194,31 @@ def main():
         results.append(r)
 
     # The table.
-    print("| model | triangles | DCD frames | skelcd DCD ms | CGAL ms | × CGAL (min) | pairs | "
+    print("| model | triangles | DCD frames | skelcd DCD ms | CGAL ms | × CGAL (min) | "
+          "incremental ms | × CGAL (min) | pairs | "
           "CCD intervals | bvh ms | kdop ms | dynamic ms | auto ms | bvh/dynamic | bvh/auto | "
           "peak RSS MiB (bvh, auto) | contacts |")
-    print("|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|")
-    all_frames, per_model_tri = [], []
+    print("|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|")
+    all_frames, all_incremental, per_model_tri = [], [], []
     for r in results:
-        dcd = r.get("dcd", [])
+        inc = [d for d in r.get("dcd", []) if d["method"] == "incremental"]
+        dcd = [d for d in r.get("dcd", []) if d["method"] != "incremental"]
         tri = r.get("triangles", 0)
         ccd = r["ccd"]
         if dcd:
             speed = [d["speedup"] for d in dcd]
+            inc_speed = [d["speedup"] for d in inc]
+            inc_cols = (f"{sum(d['skelcd_ms'] for d in inc) / len(inc):.4f} | "
+                        f"{geomean(inc_speed):.0f} ({min(inc_speed):.0f})") if inc else "– | –"
             dcd_cols = (f"{len(dcd)} | {sum(d['skelcd_ms'] for d in dcd) / len(dcd):.2f} | "
                         f"{sum(d['cgal_ms'] for d in dcd) / len(dcd):.2f} | "
-                        f"{geomean(speed):.2f} ({min(speed):.2f}) | "
+                        f"{geomean(speed):.2f} ({min(speed):.2f}) | {inc_cols} | "
                         f"{max(d['skelcd_pairs'] for d in dcd)}")
             if tri >= args.min_triangles:
                 all_frames += speed
+                all_incremental += inc_speed
         else:
-            dcd_cols = "– | – | – | – | –"
+            dcd_cols = "– | – | – | – | – | – | –"
 
         def ms(m):
             return f"{ccd[m]['ms_per_interval']:.2f}" if ccd.get(m) else "n/a"
@@ -234,6 +243,10 @@ def main():
         print(f"DCD speed-up over CGAL (frames of models with >= {args.min_triangles} triangles, "
               f"{len(all_frames)} frames): geometric mean {geomean(all_frames):.2f}, "
               f"minimum {min(all_frames):.2f}")
+    if all_incremental:
+        print(f"Incremental DCD (a clip check's DCD after its first sample, from the previous "
+              f"sample and the interval's CCD contacts) over CGAL ({len(all_incremental)} frames): "
+              f"geometric mean {geomean(all_incremental):.0f}, minimum {min(all_incremental):.1f}")
     big = [r for r in results if r.get("triangles", 0) >= args.min_triangles]
     for m in CCD_METHODS[1:]:
         vals = [r["ccd"]["bvh"]["ms_per_interval"] / r["ccd"][m]["ms_per_interval"]
