@@ -7,6 +7,7 @@
 #include "culling/bvh.hpp"
 #include "culling/candidates.hpp"
 #include "culling/detail/method_base.hpp"
+#include "culling/pair_blocks.hpp"
 #include "culling/traversal.hpp"
 #include "culling/vertex_bounds.hpp"
 #include "skinning/errors.hpp"
@@ -40,16 +41,13 @@ class BvhMethod final : public MethodBase {
       const MethodOptions& options)
       : MethodBase(name, mesh, topology, options),
         bvh_(topology_.welded_triangles(), welded_rest_positions(mesh, topology), options.bvh) {
-    // Everything an interval touches is sized here; only the candidate lists may still grow
-    // (their size depends on the motion), and they keep their capacity between intervals.
+    // Everything an interval touches is sized here; only the blocks' feature candidates and the
+    // caller's findings may still grow (with the motion), and they keep their capacity.
     const auto num_faces = static_cast<std::size_t>(topology_.num_triangles());
     bounds_.vertices.reserve(static_cast<std::size_t>(topology_.num_vertices()));
     bounds_.edges.reserve(static_cast<std::size_t>(topology_.num_edges()));
     bounds_.triangles.reserve(num_faces);
     scratch_.reserve_self(bvh_);
-    pairs_.reserve(16 * num_faces);
-    features_.vf.reserve(4 * num_faces);
-    features_.ee.reserve(4 * num_faces);
   }
 
   void dcd(const Instant& at, FrameResult& out) override {
@@ -61,25 +59,19 @@ class BvhMethod final : public MethodBase {
     bounds_.derive(topology_, /*with_edges=*/false);
     bvh_.refit(bounds_.triangles);
     const auto t1 = Clock::now();
-    out.times.refit_us += micros(t0, t1);
     // Self traversal → overlapping triangle pairs → the DCD rules → tests, in blocks as the CCD
     // (bounded memory), the vertex fans certified once for the instant.
-    const std::size_t first = out.dcd_pairs.size();
-    const std::span<const std::uint8_t> fans = certify_dcd_fans(topology_, x, tests_);
-    out.times.elementary_us += micros(t1, Clock::now());
+    blocks_.start_dcd(topology_, x, tests_, out);
     start_self_traversal<N>(bvh_, scratch_);
-    for (bool done = false; !done;) {
-      const auto b0 = Clock::now();
-      pairs_.clear();
-      done = self_traverse_some<N>(
-          bvh_, bounds_.triangles, scratch_, pairs_, out.counters.bv_tests, kCcdBlockPairs);
-      dcd_filter_triangle_pairs(topology_, pairs_, out.counters);
-      const auto b1 = Clock::now();
-      run_dcd_tests(topology_, pairs_, x, tests_, fans, out);
-      out.times.traverse_us += micros(b0, b1);
-      out.times.elementary_us += micros(b1, Clock::now());
-    }
-    std::sort(out.dcd_pairs.begin() + static_cast<std::ptrdiff_t>(first), out.dcd_pairs.end());
+    blocks_.drain([&](std::vector<TrianglePair>& pairs, std::size_t max_pairs) {
+      return self_traverse_some<N>(
+          bvh_, bounds_.triangles, scratch_, pairs, out.counters.bv_tests, max_pairs);
+    });
+    blocks_.finish();
+    const auto t2 = Clock::now();
+    out.times.refit_us += micros(t0, t1);
+    out.times.traverse_us += micros(t1, t2) - blocks_.test_us();
+    out.times.elementary_us += blocks_.test_us();
   }
 
   void ccd(const Interval& interval, FrameResult& out) override {
@@ -93,37 +85,29 @@ class BvhMethod final : public MethodBase {
     bounds_.derive(topology_);
     bvh_.refit(bounds_.triangles);
     const auto t1 = Clock::now();
-    out.times.refit_us += micros(t0, t1);
     // Self traversal → triangle pairs → de-duplicated feature pairs → tests, in blocks of
-    // kCcdBlockPairs triangle pairs: the candidates held at once stay bounded on any motion (the
+    // block_pairs triangle pairs: the candidates held at once stay bounded on any motion (the
     // de-duplication is by ownership within each triangle pair, so blocks never repeat a test).
-    const std::size_t first = out.contacts.size();
+    blocks_.start_ccd(topology_, bounds_, x_t0, x_t1, tests_, options_.accuracy, ccd_options_, out);
     start_self_traversal<N>(bvh_, scratch_);
-    for (bool done = false; !done;) {
-      const auto b0 = Clock::now();
-      pairs_.clear();
-      features_.clear();
-      done = self_traverse_some<N>(
-          bvh_, bounds_.triangles, scratch_, pairs_, out.counters.bv_tests, kCcdBlockPairs);
-      ccd_candidates_from_triangle_pairs<N>(topology_, pairs_, bounds_, features_, out.counters);
-      const auto b1 = Clock::now();
-      run_ccd_tests(topology_, features_, x_t0, x_t1, tests_, options_.accuracy, ccd_options_, out);
-      out.times.traverse_us += micros(b0, b1);
-      out.times.elementary_us += micros(b1, Clock::now());
-    }
-    // Each block's contacts are sorted; the interval's are sorted as one (in place).
-    std::sort(
-        out.contacts.begin() + static_cast<std::ptrdiff_t>(first),
-        out.contacts.end(),
-        [](const CcdContact& a, const CcdContact& b) { return a.before(b); });
+    blocks_.drain([&](std::vector<TrianglePair>& pairs, std::size_t max_pairs) {
+      return self_traverse_some<N>(
+          bvh_, bounds_.triangles, scratch_, pairs, out.counters.bv_tests, max_pairs);
+    });
+    blocks_.finish();
+    const auto t2 = Clock::now();
+    out.times.refit_us += micros(t0, t1);
+    out.times.traverse_us += micros(t1, t2) - blocks_.test_us();
+    out.times.elementary_us += blocks_.test_us();
   }
 
  private:
   Bvh<N> bvh_;
   FeatureBounds<N> bounds_;
   TraversalScratch scratch_;
-  std::vector<TrianglePair> pairs_;
-  FeatureCandidates features_;
+  PairBlocks<N> blocks_{
+      options_.block_pairs,
+      block_reserve(options_.block_pairs, bvh_.leaf_size(), topology_.num_triangles())};
 };
 
 }  // namespace

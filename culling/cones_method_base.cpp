@@ -50,7 +50,10 @@ ConeMethodBase::ConeMethodBase(
       descent_(descent),
       // The cone theorems say "no intersection", not "no pair within a distance": with a contact
       // distance the method culls nothing and equals `bvh` (docs/dual-cone.md).
-      cull_enabled_(options.min_separation == 0.0) {
+      cull_enabled_(options.min_separation == 0.0),
+      blocks_(
+          options.block_pairs,
+          block_reserve(options.block_pairs, bvh_.leaf_size(), topology_.num_triangles())) {
   if (needs_contours) contours_ = NodeContours(bvh_, topology_);
   const auto num_faces = static_cast<std::size_t>(topology_.num_triangles());
   bounds_.vertices.reserve(static_cast<std::size_t>(topology_.num_vertices()));
@@ -59,9 +62,6 @@ ConeMethodBase::ConeMethodBase(
   const auto depth = static_cast<std::size_t>(bvh_.depth());
   self_stack_.reserve(4 * depth + 8);
   pair_stack_.reserve(2 * depth + 8);
-  pairs_.reserve(16 * num_faces);
-  features_.vf.reserve(4 * num_faces);
-  features_.ee.reserve(4 * num_faces);
 }
 
 void ConeMethodBase::dcd(const Instant& at, FrameResult& out) {
@@ -80,16 +80,15 @@ void ConeMethodBase::dcd(const Instant& at, FrameResult& out) {
     refit_extra(interval);
   }
   const auto t1 = Clock::now();
-  // Cone-culled self traversal → triangle pairs → the DCD rules.
-  pairs_.clear();
+  // Cone-culled self traversal → triangle pairs → the DCD rules → tests, in blocks of
+  // block_pairs pairs (bounded memory), the vertex fans certified once for the instant.
+  blocks_.start_dcd(topology_, x, tests_, out);
   traverse(interval, out.counters.bv_tests);
-  dcd_filter_triangle_pairs(topology_, pairs_, out.counters);
+  blocks_.finish();
   const auto t2 = Clock::now();
-  run_dcd_tests(topology_, pairs_, x, tests_, out);
-  const auto t3 = Clock::now();
   out.times.refit_us += micros(t0, t1);
-  out.times.traverse_us += micros(t1, t2);
-  out.times.elementary_us += micros(t2, t3);
+  out.times.traverse_us += micros(t1, t2) - blocks_.test_us();
+  out.times.elementary_us += blocks_.test_us();
 }
 
 void ConeMethodBase::ccd(const culling::Interval& query, FrameResult& out) {
@@ -111,42 +110,15 @@ void ConeMethodBase::ccd(const culling::Interval& query, FrameResult& out) {
   }
   const auto t1 = Clock::now();
   // Cone-culled self traversal → triangle pairs → de-duplicated feature pairs → tests, in blocks
-  // of kCcdBlockPairs pairs (bounded memory). A culled node's triangle pairs produce only feature
+  // of block_pairs pairs (bounded memory). A culled node's triangle pairs produce only feature
   // pairs inside a surface proven free of contact.
-  const std::size_t first = out.contacts.size();
-  pairs_.clear();
-  block_ = {.x_t0 = &x_t0, .x_t1 = &x_t1, .out = &out, .elementary_us = 0.0};
+  blocks_.start_ccd(topology_, bounds_, x_t0, x_t1, tests_, options_.accuracy, ccd_options_, out);
   traverse(interval, out.counters.bv_tests);
-  flush_ccd_block();
-  const double elementary_us = block_.elementary_us;
-  block_ = {};
-  // Each block's contacts are sorted; the interval's are sorted as one (in place).
-  std::sort(
-      out.contacts.begin() + static_cast<std::ptrdiff_t>(first),
-      out.contacts.end(),
-      [](const CcdContact& a, const CcdContact& b) { return a.before(b); });
+  blocks_.finish();
   const auto t2 = Clock::now();
   out.times.refit_us += micros(t0, t1);
-  out.times.traverse_us += micros(t1, t2) - elementary_us;
-  out.times.elementary_us += elementary_us;
-}
-
-void ConeMethodBase::flush_ccd_block() {
-  const auto t0 = Clock::now();
-  FrameResult& out = *block_.out;
-  features_.clear();
-  ccd_candidates_from_triangle_pairs<3>(topology_, pairs_, bounds_, features_, out.counters);
-  run_ccd_tests(
-      topology_,
-      features_,
-      *block_.x_t0,
-      *block_.x_t1,
-      tests_,
-      options_.accuracy,
-      ccd_options_,
-      out);
-  pairs_.clear();
-  block_.elementary_us += micros(t0, Clock::now());
+  out.times.traverse_us += micros(t1, t2) - blocks_.test_us();
+  out.times.elementary_us += blocks_.test_us();
 }
 
 bool ConeMethodBase::normal_test(std::int32_t n, Eigen::Vector3d& axis) {
@@ -223,7 +195,7 @@ void ConeMethodBase::collide(std::int32_t a, std::int32_t b, std::int64_t& bv_te
       if (single) {  // one-triangle leaves: the node test was the triangle test
         const std::int32_t ta = order[sz(nx.begin)];
         const std::int32_t tb = order[sz(ny.begin)];
-        pairs_.push_back({std::min(ta, tb), std::max(ta, tb)});
+        blocks_.pairs().push_back({std::min(ta, tb), std::max(ta, tb)});
         pair_added();
         continue;
       }
@@ -233,7 +205,7 @@ void ConeMethodBase::collide(std::int32_t a, std::int32_t b, std::int64_t& bv_te
           const std::int32_t tb = order[sz(j)];
           ++bv_tests;
           if (tri[sz(ta)].overlaps(tri[sz(tb)])) {
-            pairs_.push_back({std::min(ta, tb), std::max(ta, tb)});
+            blocks_.pairs().push_back({std::min(ta, tb), std::max(ta, tb)});
           }
         }
       }
@@ -261,7 +233,8 @@ void ConeMethodBase::leaf_self(std::int32_t leaf, std::int64_t& bv_tests) {
     for (std::int32_t j = i + 1; j < node.end; ++j) {
       const std::int32_t tb = order[sz(j)];
       ++bv_tests;
-      if (tri[sz(ta)].overlaps(tri[sz(tb)])) pairs_.push_back({std::min(ta, tb), std::max(ta, tb)});
+      if (tri[sz(ta)].overlaps(tri[sz(tb)]))
+        blocks_.pairs().push_back({std::min(ta, tb), std::max(ta, tb)});
     }
   }
   pair_added();

@@ -17,6 +17,7 @@
 #include "culling/cones_method.hpp"
 #include "culling/contour.hpp"
 #include "culling/detail/method_base.hpp"
+#include "culling/pair_blocks.hpp"
 
 namespace skelcd::culling::detail {
 
@@ -80,28 +81,15 @@ class ConeMethodBase : public MethodBase, public ConeStatistics {
   /// The triangle pairs inside one leaf (leaf_size > 1).
   void leaf_self(std::int32_t leaf, std::int64_t& bv_tests);
 
-  /// CCD: tests the pairs gathered so far (features, elementary tests into the interval's
-  /// result) and empties them — when kCcdBlockPairs are waiting, and at the end of the traversal.
-  void flush_ccd_block();
-  void pair_added() {
-    if (block_.out != nullptr && pairs_.size() >= kCcdBlockPairs) flush_ccd_block();
-  }
+  /// Tests the pairs gathered so far (a block) once block_pairs are waiting: DCD and CCD alike.
+  void pair_added() { blocks_.flush_if_full(); }
 
-  /// The interval being tested while a CCD traversal runs (out == nullptr otherwise: DCD).
-  struct CcdBlock {
-    const skinning::Positions* x_t0 = nullptr;
-    const skinning::Positions* x_t1 = nullptr;
-    FrameResult* out = nullptr;
-    double elementary_us = 0.0;  ///< µs spent in flushes (tests), apart from the traversal
-  };
-  CcdBlock block_{};
   Descent descent_;
   bool cull_enabled_;
   FeatureBounds<3> bounds_;
   std::vector<std::int32_t> self_stack_;
   std::vector<std::pair<std::int32_t, std::int32_t>> pair_stack_;
-  std::vector<TrianglePair> pairs_;
-  FeatureCandidates features_;
+  PairBlocks<3> blocks_;
 };
 
 }  // namespace skelcd::culling::detail

@@ -32,6 +32,9 @@ MethodBase::MethodBase(
         "culling::make_method: the exact accuracy supports only min_separation = 0, got " +
         std::to_string(options.min_separation));
   }
+  if (options.block_pairs == 0) {
+    throw InvalidInput("culling::make_method: block_pairs must be >= 1, got 0");
+  }
   ccd_options_.min_separation = options.min_separation;
 }
 

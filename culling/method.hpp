@@ -3,6 +3,7 @@
 // a mesh's topology and then answers, per instant (DCD) or per interval (CCD), which primitive pairs
 // collide — through the shared elementary tests of ccd/ at the requested accuracy.
 
+#include <cstddef>
 #include <cstdint>
 #include <memory>
 #include <span>
@@ -12,6 +13,7 @@
 
 #include "ccd/accuracy.hpp"
 #include "culling/bvh.hpp"
+#include "culling/candidates.hpp"
 #include "culling/elementary.hpp"
 #include "culling/frame_result.hpp"
 #include "skinning/mesh.hpp"
@@ -47,6 +49,10 @@ struct MethodOptions {
   /// when it is > 0.
   std::int32_t num_bones = 0;
   MethodParameters parameters{};
+  /// Triangle pairs per block of the feature and elementary stages (docs/culling.md "Bounded
+  /// memory"): what a query holds at once grows with it, not with the motion. The findings do not
+  /// depend on it; tests make it small to cut a query into many blocks. ≥ 1.
+  std::size_t block_pairs = kCcdBlockPairs;
 };
 
 /// Where one connected component (Topology::components) goes under `auto` (routed_method.hpp).

@@ -14,6 +14,7 @@
 #include "culling/enhanced_dual_cone.hpp"
 #include "culling/method_registry.hpp"
 #include "culling/normal_cone.hpp"
+#include "culling/pair_blocks.hpp"
 #include "culling/traversal.hpp"
 #include "culling/vertex_bounds.hpp"
 #include "skinning/errors.hpp"
@@ -149,7 +150,10 @@ class AutoMethod final : public detail::MethodBase {
       const skinning::Topology& topology,
       const MethodOptions& options,
       const RoutingOptions& routing)
-      : MethodBase("auto", mesh, topology, options) {
+      : MethodBase("auto", mesh, topology, options),
+        blocks_(
+            options.block_pairs,
+            block_reserve(options.block_pairs, options.bvh.leaf_size, topology_.num_triangles())) {
     // The plan, with each component's part taken from the mesh.
     routes_ = route_components(topology, options, routing);
     const auto components = components_of(topology);
@@ -194,7 +198,6 @@ class AutoMethod final : public detail::MethodBase {
     bounds_.triangles.reserve(num_faces);
     scratch_.reserve(
         static_cast<std::size_t>(4 * std::max(open_bvh_.depth(), closed_bvh_.depth()) + 8));
-    pairs_.reserve(num_faces);
   }
 
   [[nodiscard]] std::span<const ComponentRoute> component_routes() const override {
@@ -210,23 +213,20 @@ class AutoMethod final : public detail::MethodBase {
     bounds_.derive(topology_, /*with_edges=*/false);
     refit_groups();
     const auto t1 = Clock::now();
-    pairs_.clear();
+    // The `bvh` groups' own pairs and the pairs between the groups, tested in blocks of
+    // block_pairs (bounded memory).
+    blocks_.start_dcd(topology_, x, tests_, out);
     traverse_own(out.counters.bv_tests);
-    for (auto& p : pairs_) {
-      if (p.a > p.b) std::swap(p.a, p.b);
-    }
-    dcd_filter_triangle_pairs(topology_, pairs_, out.counters);
+    blocks_.finish();
     const auto t2 = Clock::now();
-    run_dcd_tests(topology_, pairs_, x, tests_, out);
-    const auto t3 = Clock::now();
     // Merge: sorted, each pair once.
     std::sort(out.dcd_pairs.begin(), out.dcd_pairs.end());
     out.dcd_pairs.erase(
         std::unique(out.dcd_pairs.begin(), out.dcd_pairs.end()), out.dcd_pairs.end());
     out.counters.dcd_pairs = static_cast<std::int64_t>(out.dcd_pairs.size());
     out.times.refit_us += micros(t0, t1);
-    out.times.traverse_us += micros(t1, t2);
-    out.times.elementary_us += micros(t2, t3);
+    out.times.traverse_us += micros(t1, t2) - blocks_.test_us();
+    out.times.elementary_us += blocks_.test_us();
   }
 
   void ccd(const Interval& interval, FrameResult& out) override {
@@ -240,32 +240,11 @@ class AutoMethod final : public detail::MethodBase {
     bounds_.derive(topology_);
     refit_groups();
     const auto t1 = Clock::now();
-    // The `bvh` groups' own pairs, tested in blocks of kCcdBlockPairs (bounded memory).
-    double elementary_us = 0.0;
-    const auto flush = [&] {
-      const auto f0 = Clock::now();
-      features_.clear();
-      ccd_candidates_from_triangle_pairs<3>(topology_, pairs_, bounds_, features_, out.counters);
-      run_ccd_tests(topology_, features_, x_t0, x_t1, tests_, options_.accuracy, ccd_options_, out);
-      pairs_.clear();
-      elementary_us += micros(f0, Clock::now());
-    };
-    pairs_.clear();
-    const std::span<const Aabb> tri(bounds_.triangles);
-    for (const AabbBvh* group : {&open_bvh_, &closed_bvh_}) {
-      const bool own = group == &open_bvh_ ? open_method_ == nullptr : closed_method_ == nullptr;
-      if (group->empty() || !own) continue;
-      start_self_traversal<3>(*group, scratch_);
-      for (bool done = false; !done;) {
-        done = self_traverse_some<3>(
-            *group, tri, scratch_, pairs_, out.counters.bv_tests, kCcdBlockPairs);
-        flush();
-      }
-    }
-    if (!open_bvh_.empty() && !closed_bvh_.empty()) {
-      pair_traverse<3>(open_bvh_, tri, closed_bvh_, tri, scratch_, pairs_, out.counters.bv_tests);
-      flush();
-    }
+    // The `bvh` groups' own pairs and the pairs between the groups, tested in blocks of
+    // block_pairs (bounded memory).
+    blocks_.start_ccd(topology_, bounds_, x_t0, x_t1, tests_, options_.accuracy, ccd_options_, out);
+    traverse_own(out.counters.bv_tests);
+    blocks_.finish();
     const auto t2 = Clock::now();
     // Merge: canonical order, each pair once (a vertex shared by an open and a closed component
     // can reach one feature pair from two groups), earliest time of impact kept.
@@ -283,8 +262,8 @@ class AutoMethod final : public detail::MethodBase {
         c.begin(), c.end(), [](const CcdContact& x) { return x.kind == CcdContact::Kind::vf; });
     out.counters.ee_contacts = static_cast<std::int64_t>(c.size()) - out.counters.vf_contacts;
     out.times.refit_us += micros(t0, t1);
-    out.times.traverse_us += micros(t1, t2) - elementary_us;
-    out.times.elementary_us += elementary_us;
+    out.times.traverse_us += micros(t1, t2) - blocks_.test_us();
+    out.times.elementary_us += blocks_.test_us();
   }
 
  private:
@@ -323,17 +302,24 @@ class AutoMethod final : public detail::MethodBase {
     if (!closed_bvh_.empty()) closed_bvh_.refit(bounds_.triangles);
   }
 
-  /// The `bvh` groups' self pairs and the pairs between the groups.
+  /// The `bvh` groups' self pairs and the pairs between the groups, into blocks_ in
+  /// installments.
   void traverse_own(std::int64_t& bv_tests) {
     const std::span<const Aabb> tri(bounds_.triangles);
-    if (!open_bvh_.empty() && open_method_ == nullptr) {
-      self_traverse<3>(open_bvh_, tri, scratch_, pairs_, bv_tests);
-    }
-    if (!closed_bvh_.empty() && closed_method_ == nullptr) {
-      self_traverse<3>(closed_bvh_, tri, scratch_, pairs_, bv_tests);
+    for (const AabbBvh* group : {&open_bvh_, &closed_bvh_}) {
+      const bool own = group == &open_bvh_ ? open_method_ == nullptr : closed_method_ == nullptr;
+      if (group->empty() || !own) continue;
+      start_self_traversal<3>(*group, scratch_);
+      blocks_.drain([&](std::vector<TrianglePair>& pairs, std::size_t max_pairs) {
+        return self_traverse_some<3>(*group, tri, scratch_, pairs, bv_tests, max_pairs);
+      });
     }
     if (!open_bvh_.empty() && !closed_bvh_.empty()) {
-      pair_traverse<3>(open_bvh_, tri, closed_bvh_, tri, scratch_, pairs_, bv_tests);
+      start_pair_traversal<3>(open_bvh_, closed_bvh_, scratch_);
+      blocks_.drain([&](std::vector<TrianglePair>& pairs, std::size_t max_pairs) {
+        return pair_traverse_some<3>(
+            open_bvh_, tri, closed_bvh_, tri, scratch_, pairs, bv_tests, max_pairs);
+      });
     }
   }
 
@@ -346,8 +332,7 @@ class AutoMethod final : public detail::MethodBase {
   std::unique_ptr<CullingMethod> closed_method_;
   FeatureBounds<3> bounds_;
   TraversalScratch scratch_;
-  std::vector<TrianglePair> pairs_;
-  FeatureCandidates features_;
+  PairBlocks<3> blocks_;
   FrameResult sub_;
 };
 

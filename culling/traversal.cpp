@@ -169,23 +169,29 @@ void self_traverse(
 }
 
 template <int N>
-void pair_traverse(
+void start_pair_traversal(const Bvh<N>& a, const Bvh<N>& b, TraversalScratch& scratch) {
+  scratch.reserve_pair(a, b);
+  scratch.stack.clear();
+  if (!a.empty() && !b.empty()) push(scratch.stack, 0, 0);
+}
+
+template <int N>
+bool pair_traverse_some(
     const Bvh<N>& a,
     std::span<const Dop<N>> triangle_bounds_a,
     const Bvh<N>& b,
     std::span<const Dop<N>> triangle_bounds_b,
     TraversalScratch& scratch,
     std::vector<TrianglePair>& out,
-    std::int64_t& bv_tests) {
-  if (a.empty() || b.empty()) return;
+    std::int64_t& bv_tests,
+    std::size_t max_pairs) {
+  if (a.empty() || b.empty()) return true;
   const auto nodes_a = a.nodes();
   const auto nodes_b = b.nodes();
   const bool single = a.leaf_size() == 1 && b.leaf_size() == 1;
-  scratch.reserve_pair(a, b);
   auto& stack = scratch.stack;
-  stack.clear();
-  push(stack, 0, 0);
   while (!stack.empty()) {
+    if (out.size() >= max_pairs) return false;
     const Entry e = stack.back();
     stack.pop_back();
     ++bv_tests;
@@ -209,6 +215,28 @@ void pair_traverse(
     }
     split_pair(stack, e.a, na, e.b, nb);
   }
+  return true;
+}
+
+template <int N>
+void pair_traverse(
+    const Bvh<N>& a,
+    std::span<const Dop<N>> triangle_bounds_a,
+    const Bvh<N>& b,
+    std::span<const Dop<N>> triangle_bounds_b,
+    TraversalScratch& scratch,
+    std::vector<TrianglePair>& out,
+    std::int64_t& bv_tests) {
+  start_pair_traversal(a, b, scratch);
+  pair_traverse_some(
+      a,
+      triangle_bounds_a,
+      b,
+      triangle_bounds_b,
+      scratch,
+      out,
+      bv_tests,
+      std::numeric_limits<std::size_t>::max());
 }
 
 template void start_self_traversal<3>(const Bvh<3>&, TraversalScratch&);
@@ -239,6 +267,26 @@ template void self_traverse<8>(
     TraversalScratch&,
     std::vector<TrianglePair>&,
     std::int64_t&);
+template void start_pair_traversal<3>(const Bvh<3>&, const Bvh<3>&, TraversalScratch&);
+template void start_pair_traversal<8>(const Bvh<8>&, const Bvh<8>&, TraversalScratch&);
+template bool pair_traverse_some<3>(
+    const Bvh<3>&,
+    std::span<const Dop<3>>,
+    const Bvh<3>&,
+    std::span<const Dop<3>>,
+    TraversalScratch&,
+    std::vector<TrianglePair>&,
+    std::int64_t&,
+    std::size_t);
+template bool pair_traverse_some<8>(
+    const Bvh<8>&,
+    std::span<const Dop<8>>,
+    const Bvh<8>&,
+    std::span<const Dop<8>>,
+    TraversalScratch&,
+    std::vector<TrianglePair>&,
+    std::int64_t&,
+    std::size_t);
 template void pair_traverse<3>(
     const Bvh<3>&,
     std::span<const Dop<3>>,

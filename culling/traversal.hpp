@@ -83,4 +83,19 @@ void pair_traverse(
     std::vector<TrianglePair>& out,
     std::int64_t& bv_tests);
 
+/// The pair traversal in installments, as start_self_traversal / self_traverse_some: over all
+/// installments the pairs are exactly pair_traverse's, each once, in the same order.
+template <int N>
+void start_pair_traversal(const Bvh<N>& a, const Bvh<N>& b, TraversalScratch& scratch);
+template <int N>
+bool pair_traverse_some(
+    const Bvh<N>& a,
+    std::span<const Dop<N>> triangle_bounds_a,
+    const Bvh<N>& b,
+    std::span<const Dop<N>> triangle_bounds_b,
+    TraversalScratch& scratch,
+    std::vector<TrianglePair>& out,
+    std::int64_t& bv_tests,
+    std::size_t max_pairs);
+
 }  // namespace skelcd::culling

@@ -159,6 +159,27 @@ void check_pair(const Case& c, int leaf_a, int leaf_b) {
     ASSERT_EQ(p.a % 2, 0) << "a must come from the first hierarchy";
     ASSERT_EQ(p.b % 2, 1);
   }
+  // In installments (auto's blocks between its groups): the same pairs in the same order, the
+  // same volume tests, no installment larger than a block plus one leaf pair's.
+  for (const std::size_t block : {std::size_t{1}, std::size_t{7}, std::size_t{100}}) {
+    std::vector<TrianglePair> all, part;
+    std::int64_t tests = 0;
+    int installments = 0;
+    start_pair_traversal<N>(a, b, scratch);
+    for (bool done = false; !done; ++installments) {
+      part.clear();
+      done = pair_traverse_some<N>(
+          a, bounds.triangles, b, bounds.triangles, scratch, part, tests, block);
+      ASSERT_LT(part.size(), block + static_cast<std::size_t>(leaf_a * leaf_b));
+      all.insert(all.end(), part.begin(), part.end());
+    }
+    EXPECT_EQ(all, got) << c.name << ", block " << block;
+    EXPECT_EQ(tests, bv_tests) << c.name << ", block " << block;
+    EXPECT_EQ(scratch.stack.capacity(), capacity);
+    if (got.size() > block) {
+      EXPECT_GT(installments, 1);
+    }
+  }
   std::sort(got.begin(), got.end());
   std::sort(want.begin(), want.end());
   EXPECT_EQ(got, want) << c.name;

@@ -1,0 +1,125 @@
+#include "culling/pair_blocks.hpp"
+
+#include <algorithm>
+#include <cassert>
+#include <chrono>
+#include <utility>
+
+namespace skelcd::culling {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double micros(Clock::time_point from, Clock::time_point to) {
+  return std::chrono::duration<double, std::micro>(to - from).count();
+}
+
+}  // namespace
+
+template <int N>
+PairBlocks<N>::PairBlocks(std::size_t block_pairs, std::size_t reserve_pairs)
+    : block_pairs_(std::max<std::size_t>(1, block_pairs)) {
+  pairs_.reserve(reserve_pairs);
+  // A triangle pair yields at most 6 VF and 9 EE candidates; most yield a few.
+  features_.vf.reserve(2 * reserve_pairs);
+  features_.ee.reserve(2 * reserve_pairs);
+}
+
+template <int N>
+void PairBlocks<N>::start(
+    const FeatureTopology& topology, const ElementaryTests& tests, FrameResult& out) {
+  topology_ = &topology;
+  tests_ = &tests;
+  out_ = &out;
+  pairs_.clear();
+  blocks_ = 0;
+  feature_us_ = 0.0;
+  test_us_ = 0.0;
+}
+
+template <int N>
+void PairBlocks<N>::start_ccd(
+    const FeatureTopology& topology,
+    const FeatureBounds<N>& bounds,
+    const skinning::Positions& x_t0,
+    const skinning::Positions& x_t1,
+    const ElementaryTests& tests,
+    ccd::Accuracy accuracy,
+    const ccd::CcdOptions& options,
+    FrameResult& out) {
+  start(topology, tests, out);
+  continuous_ = true;
+  bounds_ = &bounds;
+  x_t0_ = &x_t0;
+  x_t1_ = &x_t1;
+  accuracy_ = accuracy;
+  ccd_options_ = &options;
+  first_ = out.contacts.size();
+}
+
+template <int N>
+void PairBlocks<N>::start_dcd(
+    const FeatureTopology& topology,
+    const skinning::Positions& x,
+    const ElementaryTests& tests,
+    FrameResult& out) {
+  start(topology, tests, out);
+  continuous_ = false;
+  x_t0_ = &x;
+  x_t1_ = &x;
+  first_ = out.dcd_pairs.size();
+  // Once per instant, for every block (valid until this thread's next certify_dcd_fans).
+  const auto t0 = Clock::now();
+  fans_ = certify_dcd_fans(topology, x, tests);
+  test_us_ += micros(t0, Clock::now());
+}
+
+template <int N>
+void PairBlocks<N>::flush() {
+  assert(out_ != nullptr);
+  if (pairs_.empty()) return;
+  FrameResult& out = *out_;
+  const auto t0 = Clock::now();
+  if (continuous_) {
+    features_.clear();
+    ccd_candidates_from_triangle_pairs<N>(*topology_, pairs_, *bounds_, features_, out.counters);
+    const auto t1 = Clock::now();
+    run_ccd_tests(*topology_, features_, *x_t0_, *x_t1_, *tests_, accuracy_, *ccd_options_, out);
+    feature_us_ += micros(t0, t1);
+    test_us_ += micros(t1, Clock::now());
+  } else {
+    // Pairs across two hierarchies come as (triangle of a, triangle of b): DCD wants a < b.
+    for (auto& p : pairs_) {
+      if (p.b < p.a) std::swap(p.a, p.b);
+    }
+    dcd_filter_triangle_pairs(*topology_, pairs_, out.counters);
+    const auto t1 = Clock::now();
+    run_dcd_tests(*topology_, pairs_, *x_t0_, *tests_, fans_, out);
+    feature_us_ += micros(t0, t1);
+    test_us_ += micros(t1, Clock::now());
+  }
+  pairs_.clear();
+  ++blocks_;
+}
+
+template <int N>
+void PairBlocks<N>::finish() {
+  flush();
+  FrameResult& out = *out_;
+  if (continuous_) {
+    // Each block's contacts are sorted; the query's are sorted as one (in place).
+    std::sort(
+        out.contacts.begin() + static_cast<std::ptrdiff_t>(first_),
+        out.contacts.end(),
+        [](const CcdContact& a, const CcdContact& b) { return a.before(b); });
+  } else {
+    std::sort(out.dcd_pairs.begin() + static_cast<std::ptrdiff_t>(first_), out.dcd_pairs.end());
+  }
+  out_ = nullptr;
+  fans_ = {};
+}
+
+template class PairBlocks<3>;
+template class PairBlocks<8>;
+
+}  // namespace skelcd::culling

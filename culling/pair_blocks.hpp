@@ -1,0 +1,121 @@
+#pragma once
+// Bounded memory (docs/culling.md "Bounded memory"): one query's triangle pairs go through the
+// feature stage and the elementary tests a block at a time, so that what is held at once (the
+// pairs, their feature candidates, the tests' outcomes) is bounded by the block size whatever the
+// motion. A producer — a traversal in installments (drain) or one that pushes pairs as it goes and
+// asks flush_if_full — fills the block; every method with a traversal shares this one loop.
+
+#include <algorithm>
+#include <cstddef>
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "culling/candidates.hpp"
+#include "culling/elementary.hpp"
+#include "culling/feature_topology.hpp"
+#include "culling/frame_result.hpp"
+#include "skinning/mesh.hpp"
+
+namespace skelcd::culling {
+
+/// What a block of `block_pairs` may hold, to reserve up front: the block, passed by at most one
+/// leaf pair's pairs (leaf_size²), and never more than a first guess of a whole query's
+/// (16 per triangle) when the block is larger than that.
+[[nodiscard]] inline std::size_t block_reserve(
+    std::size_t block_pairs, std::int32_t leaf_size, std::int32_t num_triangles) {
+  const auto leaf = static_cast<std::size_t>(leaf_size);
+  return std::min(block_pairs, 16 * static_cast<std::size_t>(num_triangles)) + leaf * leaf;
+}
+
+/// The stages of one query, a block of at most about `block_pairs` triangle pairs at a time.
+/// start_ccd / start_dcd bind the query; producers append to pairs(); finish() tests what is left
+/// and sorts the query's findings. Blocks never repeat a test (the CCD feature de-duplication is
+/// by ownership within each triangle pair; DCD tests triangle pairs themselves), and the findings
+/// are sorted canonically at the end, so the output does not depend on where blocks are cut.
+/// @note Allocation-free once its vectors have reached the sizes an earlier query needed.
+template <int N>
+class PairBlocks {
+ public:
+  /// @param block_pairs triangle pairs per block (MethodOptions::block_pairs), ≥ 1.
+  /// @param reserve_pairs capacity reserved up front for the pairs (a block, plus a leaf pair's).
+  explicit PairBlocks(std::size_t block_pairs = kCcdBlockPairs, std::size_t reserve_pairs = 0);
+
+  /// Starts a CCD query over x_t0 → x_t1: each block → ccd_candidates_from_triangle_pairs (volumes
+  /// `bounds`) → run_ccd_tests into `out`. Pairs may come in either order within a pair.
+  /// The references must outlive the query (until finish()).
+  void start_ccd(
+      const FeatureTopology& topology,
+      const FeatureBounds<N>& bounds,
+      const skinning::Positions& x_t0,
+      const skinning::Positions& x_t1,
+      const ElementaryTests& tests,
+      ccd::Accuracy accuracy,
+      const ccd::CcdOptions& options,
+      FrameResult& out);
+
+  /// Starts a DCD query at x: each block → (a, b) ordered → dcd_filter_triangle_pairs →
+  /// run_dcd_tests into `out`, with the vertex fans certified once here for the whole instant.
+  void start_dcd(
+      const FeatureTopology& topology,
+      const skinning::Positions& x,
+      const ElementaryTests& tests,
+      FrameResult& out);
+
+  /// The pending block: producers append here.
+  [[nodiscard]] std::vector<TrianglePair>& pairs() { return pairs_; }
+  [[nodiscard]] std::size_t block_pairs() const { return block_pairs_; }
+  [[nodiscard]] bool full() const { return pairs_.size() >= block_pairs_; }
+
+  /// Tests the pending pairs (if any) and empties the block.
+  void flush();
+  void flush_if_full() {
+    if (full()) flush();
+  }
+
+  /// Runs a traversal in installments: `step(pairs, max_pairs)` appends pairs until pairs holds
+  /// at least max_pairs (self_traverse_some, pair_traverse_some) and returns true when the
+  /// traversal is done; each full block is tested before the next installment. A partial last
+  /// block stays pending for the next producer or finish().
+  template <class Step>
+  void drain(Step&& step) {
+    for (bool done = false; !done;) {
+      done = step(pairs_, block_pairs_);
+      flush_if_full();
+    }
+  }
+
+  /// Tests what is pending, then sorts the findings appended since start_* canonically (contacts
+  /// by (kind, a, b), DCD pairs by (a, b)) in place. Ends the query.
+  void finish();
+
+  /// Blocks tested in this query (at least 1 once anything was tested).
+  [[nodiscard]] std::int64_t blocks() const { return blocks_; }
+  /// µs of this query spent in the feature stage (and DCD filter) and in the elementary tests.
+  [[nodiscard]] double feature_us() const { return feature_us_; }
+  [[nodiscard]] double test_us() const { return test_us_; }
+
+ private:
+  void start(const FeatureTopology& topology, const ElementaryTests& tests, FrameResult& out);
+
+  std::size_t block_pairs_;
+  std::vector<TrianglePair> pairs_;
+  FeatureCandidates features_;
+  // The query being run (null between queries).
+  const FeatureTopology* topology_ = nullptr;
+  const ElementaryTests* tests_ = nullptr;
+  FrameResult* out_ = nullptr;
+  bool continuous_ = false;
+  const FeatureBounds<N>* bounds_ = nullptr;
+  const skinning::Positions* x_t0_ = nullptr;
+  const skinning::Positions* x_t1_ = nullptr;
+  ccd::Accuracy accuracy_ = ccd::Accuracy::conservative;
+  const ccd::CcdOptions* ccd_options_ = nullptr;
+  std::span<const std::uint8_t> fans_;
+  std::size_t first_ = 0;  ///< out's findings before this query
+  std::int64_t blocks_ = 0;
+  double feature_us_ = 0.0;
+  double test_us_ = 0.0;
+};
+
+}  // namespace skelcd::culling
