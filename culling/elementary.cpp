@@ -60,6 +60,7 @@ struct Outcome {
   double toi_lower = 0;
   double toi_upper = 0;
   bool tested = true;  ///< false: settled without a test (DCD, a certified vertex fan)
+  bool kept = true;    ///< false: dropped by the DCD filter (filter_and_run_dcd_tests)
 };
 
 /// Per calling thread, reused across calls: grows to the largest candidate list it has seen.
@@ -186,12 +187,15 @@ std::span<const std::uint8_t> certify_dcd_fans(
   return tl_certified_fans;
 }
 
-void run_dcd_tests(
+namespace {
+
+void dcd_tests(
     const FeatureTopology& topology,
     std::span<const TrianglePair> pairs,
     const skinning::Positions& x,
     const ElementaryTests& tests,
     std::span<const std::uint8_t> certified,
+    bool filter,
     FrameResult& out) {
   assert(tests.triangles != nullptr);
   const std::size_t first = out.dcd_pairs.size();
@@ -201,8 +205,17 @@ void run_dcd_tests(
   const auto outcomes = evaluate(pairs.size(), tests, [&](std::size_t i, Outcome& o) {
     const TrianglePair& p = pairs[i];
     assert(p.a < p.b);
+    o.kept = true;
+    if (filter && topology.triangles_excluded(p.a, p.b)) {
+      o = Outcome{.hit = false, .tested = false, .kept = false};
+      return;
+    }
     int count = 0;
     const ccd::SharedCorners shared = topology.shared_corners(p.a, p.b, count);
+    if (filter && count >= 3) {  // a duplicate face on the same three vertices
+      o = Outcome{.hit = false, .tested = false, .kept = false};
+      return;
+    }
     const auto& ta = topology.triangle(p.a);
     if (use_fans && count > 0) {
       for (std::size_t k = 0; k < 3; ++k) {
@@ -221,12 +234,35 @@ void run_dcd_tests(
   });
   for (std::size_t i = 0; i < outcomes.size(); ++i) {
     // Pairs settled by a fan are candidates (candidate_pairs) but not tests.
+    if (filter && outcomes[i].kept) ++out.counters.candidate_pairs;
     if (outcomes[i].tested) ++out.counters.tt_tests;
     if (!outcomes[i].hit) continue;
     ++out.counters.dcd_pairs;
     out.dcd_pairs.push_back(pairs[i]);
   }
   std::sort(out.dcd_pairs.begin() + static_cast<std::ptrdiff_t>(first), out.dcd_pairs.end());
+}
+
+}  // namespace
+
+void run_dcd_tests(
+    const FeatureTopology& topology,
+    std::span<const TrianglePair> pairs,
+    const skinning::Positions& x,
+    const ElementaryTests& tests,
+    std::span<const std::uint8_t> certified,
+    FrameResult& out) {
+  dcd_tests(topology, pairs, x, tests, certified, false, out);
+}
+
+void filter_and_run_dcd_tests(
+    const FeatureTopology& topology,
+    std::span<const TrianglePair> pairs,
+    const skinning::Positions& x,
+    const ElementaryTests& tests,
+    std::span<const std::uint8_t> certified,
+    FrameResult& out) {
+  dcd_tests(topology, pairs, x, tests, certified, true, out);
 }
 
 }  // namespace skelcd::culling

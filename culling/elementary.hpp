@@ -111,4 +111,15 @@ void run_dcd_tests(
     std::span<const std::uint8_t> certified_fans,
     FrameResult& out);
 
+/// dcd_filter_triangle_pairs (candidates.hpp) and run_dcd_tests in one pass: pairs that are
+/// part-excluded or duplicate faces are dropped, the others counted in candidate_pairs and tested,
+/// with each pair's shared corners looked up once (the traversing methods' blocks).
+void filter_and_run_dcd_tests(
+    const FeatureTopology& topology,
+    std::span<const TrianglePair> pairs,
+    const skinning::Positions& x,
+    const ElementaryTests& tests,
+    std::span<const std::uint8_t> certified_fans,
+    FrameResult& out);
+
 }  // namespace skelcd::culling

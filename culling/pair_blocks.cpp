@@ -92,9 +92,8 @@ void PairBlocks<N>::flush() {
     for (auto& p : pairs_) {
       if (p.b < p.a) std::swap(p.a, p.b);
     }
-    dcd_filter_triangle_pairs(*topology_, pairs_, out.counters);
     const auto t1 = Clock::now();
-    run_dcd_tests(*topology_, pairs_, *x_t0_, *tests_, fans_, out);
+    filter_and_run_dcd_tests(*topology_, pairs_, *x_t0_, *tests_, fans_, out);
     feature_us_ += micros(t0, t1);
     test_us_ += micros(t1, Clock::now());
   }

@@ -54,8 +54,8 @@ class PairBlocks {
       const ccd::CcdOptions& options,
       FrameResult& out);
 
-  /// Starts a DCD query at x: each block → (a, b) ordered → dcd_filter_triangle_pairs →
-  /// run_dcd_tests into `out`, with the vertex fans certified once here for the whole instant.
+  /// Starts a DCD query at x: each block → (a, b) ordered → filter_and_run_dcd_tests (the DCD
+  /// filter and the tests in one pass) into `out`, with the vertex fans certified once here.
   void start_dcd(
       const FeatureTopology& topology,
       const skinning::Positions& x,
