@@ -66,6 +66,9 @@ BenchOptions to_bench_options(const BenchArguments& a) {
   const auto query = parse_query_set(a.query);
   if (!query) throw InvalidInput("--query '" + a.query + "': expected ccd, dcd or both");
   o.run.query = *query;
+  // Every method and accuracy pays a full DCD at every sample: `check` updates it from the CCD
+  // contacts except with `fast`, which would make the accuracies' times incomparable.
+  o.run.incremental_dcd = false;
   const auto reference = parse_reference_choice(a.reference);
   if (!reference) {
     throw InvalidInput("--reference '" + a.reference + "': expected auto, brute or bvh");
