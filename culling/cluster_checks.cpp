@@ -1,6 +1,7 @@
 #include "culling/cluster_checks.hpp"
 
 #include <cassert>
+#include <limits>
 #include <utility>
 
 namespace skelcd::culling {
@@ -96,7 +97,14 @@ void node_class_masks(
 }
 
 template <int N>
-void masked_self_traverse(
+void start_masked_self_traversal(const Bvh<N>& bvh, TraversalScratch& scratch) {
+  scratch.reserve_self(bvh);
+  scratch.stack.clear();
+  if (!bvh.empty()) push(scratch.stack, 0, 0);
+}
+
+template <int N>
+bool masked_self_traverse_some(
     const Bvh<N>& bvh,
     std::span<const Dop<N>> triangle_bounds,
     std::span<const std::uint8_t> node_mask,
@@ -104,16 +112,15 @@ void masked_self_traverse(
     MaskedPairs which,
     TraversalScratch& scratch,
     std::vector<TrianglePair>& out,
-    std::int64_t& bv_tests) {
-  if (bvh.empty()) return;
+    std::int64_t& bv_tests,
+    std::size_t max_pairs) {
+  if (bvh.empty()) return true;
   const auto nodes = bvh.nodes();
   const auto bounds = bvh.node_bounds();
   const auto order = bvh.triangle_order();
-  scratch.reserve_self(bvh);
   auto& stack = scratch.stack;
-  stack.clear();
-  push(stack, 0, 0);
   while (!stack.empty()) {
+    if (out.size() >= max_pairs) return false;
     const Entry e = stack.back();
     stack.pop_back();
     const std::uint8_t ma = node_mask[at(e.a)];
@@ -143,10 +150,41 @@ void masked_self_traverse(
       split_pair(stack, e.a, na, e.b, nb);
     }
   }
+  return true;
 }
 
 template <int N>
-void masked_pair_traverse(
+void masked_self_traverse(
+    const Bvh<N>& bvh,
+    std::span<const Dop<N>> triangle_bounds,
+    std::span<const std::uint8_t> node_mask,
+    std::span<const std::uint8_t> triangle_mask,
+    MaskedPairs which,
+    TraversalScratch& scratch,
+    std::vector<TrianglePair>& out,
+    std::int64_t& bv_tests) {
+  start_masked_self_traversal(bvh, scratch);
+  masked_self_traverse_some(
+      bvh,
+      triangle_bounds,
+      node_mask,
+      triangle_mask,
+      which,
+      scratch,
+      out,
+      bv_tests,
+      std::numeric_limits<std::size_t>::max());
+}
+
+template <int N>
+void start_masked_pair_traversal(const Bvh<N>& a, const Bvh<N>& b, TraversalScratch& scratch) {
+  scratch.reserve_pair(a, b);
+  scratch.stack.clear();
+  if (!a.empty() && !b.empty()) push(scratch.stack, 0, 0);
+}
+
+template <int N>
+bool masked_pair_traverse_some(
     const Bvh<N>& a,
     std::span<const std::uint8_t> node_mask_a,
     const Bvh<N>& b,
@@ -156,15 +194,14 @@ void masked_pair_traverse(
     MaskedPairs which,
     TraversalScratch& scratch,
     std::vector<TrianglePair>& out,
-    std::int64_t& bv_tests) {
-  if (a.empty() || b.empty()) return;
+    std::int64_t& bv_tests,
+    std::size_t max_pairs) {
+  if (a.empty() || b.empty()) return true;
   const auto nodes_a = a.nodes();
   const auto nodes_b = b.nodes();
-  scratch.reserve_pair(a, b);
   auto& stack = scratch.stack;
-  stack.clear();
-  push(stack, 0, 0);
   while (!stack.empty()) {
+    if (out.size() >= max_pairs) return false;
     const Entry e = stack.back();
     stack.pop_back();
     if (!node_pair_wanted(node_mask_a[at(e.a)], node_mask_b[at(e.b)], which)) continue;
@@ -179,6 +216,34 @@ void masked_pair_traverse(
     }
     split_pair(stack, e.a, na, e.b, nb);
   }
+  return true;
+}
+
+template <int N>
+void masked_pair_traverse(
+    const Bvh<N>& a,
+    std::span<const std::uint8_t> node_mask_a,
+    const Bvh<N>& b,
+    std::span<const std::uint8_t> node_mask_b,
+    std::span<const Dop<N>> triangle_bounds,
+    std::span<const std::uint8_t> triangle_mask,
+    MaskedPairs which,
+    TraversalScratch& scratch,
+    std::vector<TrianglePair>& out,
+    std::int64_t& bv_tests) {
+  start_masked_pair_traversal(a, b, scratch);
+  masked_pair_traverse_some(
+      a,
+      node_mask_a,
+      b,
+      node_mask_b,
+      triangle_bounds,
+      triangle_mask,
+      which,
+      scratch,
+      out,
+      bv_tests,
+      std::numeric_limits<std::size_t>::max());
 }
 
 template void node_class_masks<3>(
@@ -201,5 +266,54 @@ template void masked_pair_traverse<8>(
     const Bvh<8>&, std::span<const std::uint8_t>, const Bvh<8>&, std::span<const std::uint8_t>,
     std::span<const Dop<8>>, std::span<const std::uint8_t>, MaskedPairs, TraversalScratch&,
     std::vector<TrianglePair>&, std::int64_t&);
+
+template void start_masked_self_traversal<3>(const Bvh<3>&, TraversalScratch&);
+template void start_masked_self_traversal<8>(const Bvh<8>&, TraversalScratch&);
+template bool masked_self_traverse_some<3>(
+    const Bvh<3>&,
+    std::span<const Dop<3>>,
+    std::span<const std::uint8_t>,
+    std::span<const std::uint8_t>,
+    MaskedPairs,
+    TraversalScratch&,
+    std::vector<TrianglePair>&,
+    std::int64_t&,
+    std::size_t);
+template bool masked_self_traverse_some<8>(
+    const Bvh<8>&,
+    std::span<const Dop<8>>,
+    std::span<const std::uint8_t>,
+    std::span<const std::uint8_t>,
+    MaskedPairs,
+    TraversalScratch&,
+    std::vector<TrianglePair>&,
+    std::int64_t&,
+    std::size_t);
+template void start_masked_pair_traversal<3>(const Bvh<3>&, const Bvh<3>&, TraversalScratch&);
+template void start_masked_pair_traversal<8>(const Bvh<8>&, const Bvh<8>&, TraversalScratch&);
+template bool masked_pair_traverse_some<3>(
+    const Bvh<3>&,
+    std::span<const std::uint8_t>,
+    const Bvh<3>&,
+    std::span<const std::uint8_t>,
+    std::span<const Dop<3>>,
+    std::span<const std::uint8_t>,
+    MaskedPairs,
+    TraversalScratch&,
+    std::vector<TrianglePair>&,
+    std::int64_t&,
+    std::size_t);
+template bool masked_pair_traverse_some<8>(
+    const Bvh<8>&,
+    std::span<const std::uint8_t>,
+    const Bvh<8>&,
+    std::span<const std::uint8_t>,
+    std::span<const Dop<8>>,
+    std::span<const std::uint8_t>,
+    MaskedPairs,
+    TraversalScratch&,
+    std::vector<TrianglePair>&,
+    std::int64_t&,
+    std::size_t);
 
 }  // namespace skelcd::culling

@@ -57,6 +57,26 @@ void masked_self_traverse(
     std::vector<TrianglePair>& out,
     std::int64_t& bv_tests);
 
+/// The masked self traversal in installments, so that its pairs can be tested in bounded blocks
+/// (culling/pair_blocks.hpp), as start_self_traversal / self_traverse_some (traversal.hpp): each
+/// masked_self_traverse_some appends pairs until `out` holds at least `max_pairs` (passing it by at
+/// most one leaf pair's pairs) and returns true once finished. Over all installments the pairs are
+/// exactly masked_self_traverse's, in the same order, with the same bv_tests; `scratch` must not be
+/// used for anything else in between.
+template <int N>
+void start_masked_self_traversal(const Bvh<N>& bvh, TraversalScratch& scratch);
+template <int N>
+bool masked_self_traverse_some(
+    const Bvh<N>& bvh,
+    std::span<const Dop<N>> triangle_bounds,
+    std::span<const std::uint8_t> node_mask,
+    std::span<const std::uint8_t> triangle_mask,
+    MaskedPairs which,
+    TraversalScratch& scratch,
+    std::vector<TrianglePair>& out,
+    std::int64_t& bv_tests,
+    std::size_t max_pairs);
+
 /// Pair traversal of two hierarchies (two atomic clusters of one mega cluster) with masks:
 /// appends every (triangle of a, triangle of b) whose volumes overlap and that `which` selects.
 template <int N>
@@ -71,5 +91,22 @@ void masked_pair_traverse(
     TraversalScratch& scratch,
     std::vector<TrianglePair>& out,
     std::int64_t& bv_tests);
+
+/// The masked pair traversal in installments, as masked_self_traverse_some.
+template <int N>
+void start_masked_pair_traversal(const Bvh<N>& a, const Bvh<N>& b, TraversalScratch& scratch);
+template <int N>
+bool masked_pair_traverse_some(
+    const Bvh<N>& a,
+    std::span<const std::uint8_t> node_mask_a,
+    const Bvh<N>& b,
+    std::span<const std::uint8_t> node_mask_b,
+    std::span<const Dop<N>> triangle_bounds,
+    std::span<const std::uint8_t> triangle_mask,
+    MaskedPairs which,
+    TraversalScratch& scratch,
+    std::vector<TrianglePair>& out,
+    std::int64_t& bv_tests,
+    std::size_t max_pairs);
 
 }  // namespace skelcd::culling

@@ -70,8 +70,11 @@ std::int64_t relative_aabb_filter(
     const skinning::Positions& x_t0,
     const skinning::Positions& x_t1,
     double half_width,
-    std::vector<TrianglePair>& pairs) {
-  const auto kept = std::remove_if(pairs.begin(), pairs.end(), [&](const TrianglePair& p) {
+    std::vector<TrianglePair>& pairs,
+    std::size_t first) {
+  assert(first <= pairs.size());
+  const auto from = pairs.begin() + static_cast<std::ptrdiff_t>(first);
+  const auto kept = std::remove_if(from, pairs.end(), [&](const TrianglePair& p) {
     if (shares_vertex(topology.triangle(p.a), topology.triangle(p.b))) return false;
     return !relative_boxes_overlap(topology, p, x_t0, x_t1, half_width);
   });

@@ -6,6 +6,7 @@
 // common velocity is the mean of the six (any vector would be sound; the mean makes the boxes
 // small). Rounding is outward: each relative end position is bracketed by the doubles around it.
 
+#include <cstddef>
 #include <cstdint>
 #include <vector>
 
@@ -26,14 +27,16 @@ namespace skelcd::culling {
     const skinning::Positions& x_t1,
     double half_width);
 
-/// Removes, in place (order kept), the pairs without a shared vertex whose relative boxes are
-/// apart; pairs sharing a vertex stay (their boxes always meet). Returns the number removed.
-/// Allocation-free.
+/// Removes, in place (order kept), the pairs from pairs[first] on without a shared vertex whose
+/// relative boxes are apart; pairs sharing a vertex stay (their boxes always meet). Returns the
+/// number removed. Allocation-free.
+/// @param first pairs before it are kept as they are (a block's pairs filtered as they come).
 std::int64_t relative_aabb_filter(
     const FeatureTopology& topology,
     const skinning::Positions& x_t0,
     const skinning::Positions& x_t1,
     double half_width,
-    std::vector<TrianglePair>& pairs);
+    std::vector<TrianglePair>& pairs,
+    std::size_t first = 0);
 
 }  // namespace skelcd::culling
