@@ -98,13 +98,19 @@ RadialViewMethod::RadialViewMethod(
       bvh_(culling::make_method("bvh", mesh, topology, method_options_)),
       builder_(clusters_, options.clusters),
       edge_face_offsets_(topology.edge_face_offsets),
-      edge_faces_(topology.edge_faces) {
+      edge_faces_(topology.edge_faces),
+      blocks_(
+          method_options.block_pairs,
+          culling::block_reserve(
+              method_options.block_pairs,
+              method_options.bvh.leaf_size,
+              topology_.num_triangles())) {
   num_bones_ = num_bones;
   ccd_options_.min_separation = method_options.min_separation;
   const auto num_faces = at(topology_.num_triangles());
   const auto num_atomic = at(clusters_.num_atomic());
   const auto num_components = at(clusters_.num_components());
-  // Everything an interval touches is sized here; only candidate lists may still grow.
+  // Everything an interval touches is sized here (the candidates' blocks by blocks_).
   bounds_.vertices.reserve(at(topology_.num_vertices()));
   bounds_.edges.reserve(at(topology_.num_edges()));
   bounds_.triangles.reserve(num_faces);
@@ -127,9 +133,6 @@ RadialViewMethod::RadialViewMethod(
   carry_clean_.assign(num_components, 0);
   carry_contact_.assign(num_components, 0);
   dcd_clean_.assign(num_components, 0);
-  pairs_.reserve(16 * num_faces);
-  features_.vf.reserve(4 * num_faces);
-  features_.ee.reserve(4 * num_faces);
 }
 
 void RadialViewMethod::check_positions(
@@ -336,35 +339,84 @@ void RadialViewMethod::compute_masks() {
 
 // --- intra- and inter-cluster checks (§6) ---------------------------------------------------------
 
-void RadialViewMethod::traverse(MaskedPairs which, culling::FrameResult& out) {
+std::int64_t RadialViewMethod::traverse(
+    MaskedPairs which,
+    const skinning::Positions& x_t0,
+    const skinning::Positions& x_t1,
+    double half_width,
+    culling::FrameResult& out) {
   const std::span<const culling::Aabb> tri_bounds(bounds_.triangles);
   std::int64_t& bv_tests = out.counters.bv_tests;
   const bool retest = which == MaskedPairs::skipped;
   const auto wanted = [&](std::int32_t a) {
     return !retest || escalate_[at(clusters_.component_of_atomic(a))] != 0;
   };
+  // Each traversal runs in installments; the pairs of an installment go through the relative AABB
+  // filter (§6) as they come, and every full block is tested before the traversal goes on.
+  std::int64_t found = 0;
+  const auto stream = [&](auto&& some) {
+    blocks_.drain([&](std::vector<culling::TrianglePair>& pairs, std::size_t max_pairs) {
+      const std::size_t first = pairs.size();
+      const bool done = some(pairs, max_pairs);
+      found += static_cast<std::int64_t>(pairs.size() - first);
+      if (options_.relative_aabb) {
+        stats_.relative_aabb_culled +=
+            culling::relative_aabb_filter(topology_, x_t0, x_t1, half_width, pairs, first);
+      }
+      return done;
+    });
+  };
   // Intra-cluster: each atomic cluster against itself, with the masks of its mega cluster.
   for (std::int32_t a = 0; a < clusters_.num_atomic(); ++a) {
     if (!wanted(a)) continue;
-    culling::masked_self_traverse<3>(clusters_.local_bvh(a), tri_bounds, node_masks_[at(a)],
-                                     triangle_mask_, which, scratch_, pairs_, bv_tests);
+    const auto& local = clusters_.local_bvh(a);
+    culling::start_masked_self_traversal<3>(local, scratch_);
+    stream([&](std::vector<culling::TrianglePair>& pairs, std::size_t max_pairs) {
+      return culling::masked_self_traverse_some<3>(
+          local,
+          tri_bounds,
+          node_masks_[at(a)],
+          triangle_mask_,
+          which,
+          scratch_,
+          pairs,
+          bv_tests,
+          max_pairs);
+    });
   }
   // Atomic cluster pairs whose swept volumes meet (the global hierarchy's self traversal): within
   // one mega cluster with masks (intra-cluster check across atomic clusters), across mega
   // clusters without (inter-cluster check).
   for (const auto& cp : cluster_pairs_) {
     const bool same_mega = classes_.atomic_mega[at(cp.a)] == classes_.atomic_mega[at(cp.b)];
+    const auto& local_a = clusters_.local_bvh(cp.a);
+    const auto& local_b = clusters_.local_bvh(cp.b);
     if (same_mega) {
       if (!wanted(cp.a)) continue;
-      culling::masked_pair_traverse<3>(clusters_.local_bvh(cp.a), node_masks_[at(cp.a)],
-                                       clusters_.local_bvh(cp.b), node_masks_[at(cp.b)],
-                                       tri_bounds, triangle_mask_, which, scratch_, pairs_,
-                                       bv_tests);
+      culling::start_masked_pair_traversal<3>(local_a, local_b, scratch_);
+      stream([&](std::vector<culling::TrianglePair>& pairs, std::size_t max_pairs) {
+        return culling::masked_pair_traverse_some<3>(
+            local_a,
+            node_masks_[at(cp.a)],
+            local_b,
+            node_masks_[at(cp.b)],
+            tri_bounds,
+            triangle_mask_,
+            which,
+            scratch_,
+            pairs,
+            bv_tests,
+            max_pairs);
+      });
     } else if (!retest) {
-      culling::pair_traverse<3>(clusters_.local_bvh(cp.a), tri_bounds, clusters_.local_bvh(cp.b),
-                                tri_bounds, scratch_, pairs_, bv_tests);
+      culling::start_pair_traversal<3>(local_a, local_b, scratch_);
+      stream([&](std::vector<culling::TrianglePair>& pairs, std::size_t max_pairs) {
+        return culling::pair_traverse_some<3>(
+            local_a, tri_bounds, local_b, tri_bounds, scratch_, pairs, bv_tests, max_pairs);
+      });
     }
   }
+  return found;
 }
 
 void RadialViewMethod::ccd(const culling::Interval& interval, culling::FrameResult& out) {
@@ -426,24 +478,17 @@ void RadialViewMethod::ccd(const culling::Interval& interval, culling::FrameResu
   compute_masks();
   const auto t_traverse = Clock::now();
 
-  // 4. Intra- and inter-cluster checks, relative AABBs, feature pairs.
-  pairs_.clear();
+  // 4. Intra- and inter-cluster checks, relative AABBs, feature pairs and (5.) the elementary
+  //    tests, a block of triangle pairs at a time.
   cluster_pairs_.clear();
   culling::self_traverse<3>(clusters_.global_bvh(), cluster_bounds_, scratch_, cluster_pairs_,
                             out.counters.bv_tests);
-  traverse(MaskedPairs::tested, out);
-  if (options_.relative_aabb) {
-    stats_.relative_aabb_culled +=
-        culling::relative_aabb_filter(topology_, x_t0, x_t1, half_width, pairs_);
-  }
-  features_.clear();
-  culling::ccd_candidates_from_triangle_pairs<3>(topology_, pairs_, bounds_, features_,
-                                                 out.counters);
-  const auto t_elementary = Clock::now();
-
-  // 5. Elementary tests.
-  culling::run_ccd_tests(topology_, features_, x_t0, x_t1, tests_, method_options_.accuracy,
-                         ccd_options_, out);
+  blocks_.start_ccd(
+      topology_, bounds_, x_t0, x_t1, tests_, method_options_.accuracy, ccd_options_, out);
+  (void)traverse(MaskedPairs::tested, x_t0, x_t1, half_width, out);
+  blocks_.finish();
+  stats_.blocks += blocks_.blocks();
+  const double test_us = blocks_.test_us();
   const auto t_escalate = Clock::now();
 
   // 6. The argument guarantees the first contact of a component, not the ones after it: where a
@@ -475,29 +520,21 @@ void RadialViewMethod::ccd(const culling::Interval& interval, culling::FrameResu
     }
     if (any) {
       const auto e0 = Clock::now();
-      pairs_.clear();
-      traverse(MaskedPairs::skipped, out);
-      stats_.skipped_pairs_retested += static_cast<std::int64_t>(pairs_.size());
-      if (options_.relative_aabb) {
-        stats_.relative_aabb_culled +=
-            culling::relative_aabb_filter(topology_, x_t0, x_t1, half_width, pairs_);
-      }
-      features_.clear();
-      culling::ccd_candidates_from_triangle_pairs<3>(topology_, pairs_, bounds_, features_,
-                                                     out.counters);
-      const auto e1 = Clock::now();
       const std::size_t before = out.contacts.size();
-      culling::run_ccd_tests(topology_, features_, x_t0, x_t1, tests_, method_options_.accuracy,
-                             ccd_options_, out);
+      blocks_.start_ccd(
+          topology_, bounds_, x_t0, x_t1, tests_, method_options_.accuracy, ccd_options_, out);
+      stats_.skipped_pairs_retested += traverse(MaskedPairs::skipped, x_t0, x_t1, half_width, out);
+      blocks_.finish();
+      stats_.blocks += blocks_.blocks();
       stats_.escalation_contacts += static_cast<std::int64_t>(out.contacts.size() - before);
       // Both runs are sorted; one canonical order for the whole interval (in place).
       std::inplace_merge(
           out.contacts.begin(), out.contacts.begin() + static_cast<std::ptrdiff_t>(before),
           out.contacts.end(),
           [](const culling::CcdContact& a, const culling::CcdContact& b) { return a.before(b); });
-      const auto e2 = Clock::now();
-      escalate_traverse_us = micros(e0, e1);
-      escalate_elementary_us = micros(e1, e2);
+      const auto e1 = Clock::now();
+      escalate_elementary_us = blocks_.test_us();
+      escalate_traverse_us = micros(e0, e1) - escalate_elementary_us;
     }
   }
   const auto t_end = Clock::now();
@@ -527,8 +564,8 @@ void RadialViewMethod::ccd(const culling::Interval& interval, culling::FrameResu
   out.times.refit_us += micros(t_refit, t_classify);
   out.times.classify_us += classes_.classify_us + micros(t_masks, t_traverse);
   out.times.merge_us += classes_.merge_us;
-  out.times.traverse_us += micros(t_traverse, t_elementary) + escalate_traverse_us;
-  out.times.elementary_us += micros(t_elementary, t_escalate) + escalate_elementary_us;
+  out.times.traverse_us += micros(t_traverse, t_escalate) - test_us + escalate_traverse_us;
+  out.times.elementary_us += test_us + escalate_elementary_us;
   (void)t_end;
 }
 

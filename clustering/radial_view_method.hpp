@@ -3,7 +3,8 @@
 // culling::CullingMethod interface. Per interval: classify every triangle against its (mega)
 // cluster's observer, skip the pairs of one mega cluster whose features are all positive (or all
 // negative), traverse the rest through the atomic clusters' local hierarchies and the global one,
-// filter with relative AABBs, then the shared feature stage and elementary tests of culling/.
+// filter with relative AABBs, then the shared feature stage and elementary tests of culling/, one
+// bounded block of pairs at a time (culling/pair_blocks.hpp).
 //
 // The radial-view argument has preconditions; this method checks them instead of assuming them
 // (docs/radial-view.md): the argument is applied only to closed, consistently oriented components
@@ -27,6 +28,7 @@
 #include "culling/elementary.hpp"
 #include "culling/feature_topology.hpp"
 #include "culling/method.hpp"
+#include "culling/pair_blocks.hpp"
 #include "culling/traversal.hpp"
 #include "segmentation/segmentation.hpp"
 
@@ -55,6 +57,8 @@ struct RadialViewStats {
   std::int64_t relative_aabb_culled = 0;  ///< candidate pairs removed by the relative AABB filter
   std::int64_t skipped_pairs_retested = 0;  ///< overlapping skipped pairs tested on escalation
   std::int64_t escalation_contacts = 0;     ///< contacts found only by the escalation pass
+  /// Blocks of candidate triangle pairs tested, both passes (MethodOptions::block_pairs each).
+  std::int64_t blocks = 0;
 };
 
 class RadialViewMethod final : public culling::CullingMethod {
@@ -98,7 +102,14 @@ class RadialViewMethod final : public culling::CullingMethod {
   void check_positions(const skinning::Positions& x, const char* call, const char* which) const;
   void start_status(const skinning::Positions& x_t0, culling::FrameResult& out);
   void compute_masks();
-  void traverse(culling::MaskedPairs which, culling::FrameResult& out);
+  /// Streams the pairs `which` selects into blocks_ (a query started there), each installment
+  /// through the relative AABB filter; returns the pairs found before the filter.
+  std::int64_t traverse(
+      culling::MaskedPairs which,
+      const skinning::Positions& x_t0,
+      const skinning::Positions& x_t1,
+      double half_width,
+      culling::FrameResult& out);
   void record_dcd(const skinning::Positions& x, const culling::FrameResult& result);
 
   std::string name_;
@@ -127,8 +138,9 @@ class RadialViewMethod final : public culling::CullingMethod {
   std::vector<Status> status_;          // per component, at the interval's start
   std::vector<std::uint8_t> culled_;    // per component: pairs were skipped this interval
   std::vector<std::uint8_t> escalate_;  // per component
-  std::vector<culling::TrianglePair> cluster_pairs_, pairs_;
-  culling::FeatureCandidates features_;
+  std::vector<culling::TrianglePair> cluster_pairs_;
+  // The candidate triangle pairs of a pass, in bounded blocks (docs/culling.md "Bounded memory").
+  culling::PairBlocks<3> blocks_;
   culling::TraversalScratch scratch_;
 
   // The start-of-interval knowledge carried between queries: components free of

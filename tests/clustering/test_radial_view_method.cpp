@@ -5,6 +5,10 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cstddef>
+#include <limits>
+#include <string>
+#include <vector>
 
 #include "clustering/radial_view_method.hpp"
 #include "clustering/radial_view_methods.hpp"
@@ -70,6 +74,92 @@ TEST(RadialViewMethod, RopeCoilsIntoItself) {
   std::int32_t escalated = 0;
   for (const auto& st : c.dynamic.stats) escalated += st.components_escalated;
   EXPECT_EQ(escalated, 1);  // once, at the first contact; then the component stays intersecting
+}
+
+/// One interval's findings of a radial-view method: the DCD at its start (when asked) and its CCD.
+struct BlockedInterval {
+  culling::FrameResult dcd, ccd;
+  RadialViewStats stats;
+};
+
+std::vector<BlockedInterval> run_blocked(
+    RadialViewScene& scene,
+    const std::string& name,
+    std::size_t block_pairs,
+    std::int32_t first,
+    std::int32_t last,
+    bool with_dcd) {
+  auto m = scene.method(name, {}, culling::MethodOptions{.block_pairs = block_pairs});
+  const auto& rv = dynamic_cast<const RadialViewMethod&>(*m);
+  std::vector<BlockedInterval> run;
+  skinning::Positions x0, x1;
+  scene.welded(first, x1);
+  for (std::int32_t i = first; i < last; ++i) {
+    std::swap(x0, x1);
+    scene.welded(i + 1, x1);
+    BlockedInterval r;
+    if (with_dcd) {
+      scene.poses->select_samples(i, i);
+      m->detect_dcd(x0, r.dcd);
+    }
+    scene.poses->select_samples(i, i + 1);
+    m->detect_ccd(x0, x1, r.ccd);
+    r.stats = rv.last_stats();
+    run.push_back(std::move(r));
+  }
+  return run;
+}
+
+void expect_same_counters(const culling::Counters& got, const culling::Counters& want) {
+#define SKELCD_EXPECT_COUNTER(name, meaning) EXPECT_EQ(got.name, want.name) << #name;
+  SKELCD_COUNTERS(SKELCD_EXPECT_COUNTER)
+#undef SKELCD_EXPECT_COUNTER
+}
+
+TEST(RadialViewMethod, SmallBlocksFindExactlyWhatOnePieceFinds) {
+  // Bounded memory (docs/culling.md): the cluster traversals, the relative AABB filter and the
+  // escalation pass stream their pairs through blocks of MethodOptions::block_pairs. The coiling
+  // rope closes its coil in these intervals: pairs are skipped, then re-tested on escalation.
+  constexpr std::size_t kSmallBlock = 16;
+  constexpr std::size_t kOnePiece = std::numeric_limits<std::size_t>::max();
+  RadialViewScene scene(generated("gen:rope?triangles=4000&frames=40"));
+  for (const char* name : {"rvbc", "dynamic"}) {
+    for (const bool with_dcd : {false, true}) {
+      SCOPED_TRACE(std::string(name) + (with_dcd ? ", DCD and CCD" : ", CCD only"));
+      const auto whole = run_blocked(scene, name, kOnePiece, 18, 30, with_dcd);
+      const auto blocked = run_blocked(scene, name, kSmallBlock, 18, 30, with_dcd);
+      ASSERT_EQ(blocked.size(), whole.size());
+      std::int64_t contacts = 0, escalation_blocks = 0, most_blocks = 0;
+      for (std::size_t i = 0; i < whole.size(); ++i) {
+        SCOPED_TRACE("interval " + std::to_string(18 + i));
+        const auto& w = whole[i];
+        const auto& b = blocked[i];
+        EXPECT_EQ(b.ccd.contacts, w.ccd.contacts);  // kind, ids and times of impact, in order
+        EXPECT_EQ(b.dcd.dcd_pairs, w.dcd.dcd_pairs);
+        expect_same_counters(b.ccd.counters, w.ccd.counters);
+        expect_same_counters(b.dcd.counters, w.dcd.counters);
+        EXPECT_EQ(b.stats.components_culled, w.stats.components_culled);
+        EXPECT_EQ(b.stats.components_dcd, w.stats.components_dcd);
+        EXPECT_EQ(b.stats.components_dirty, w.stats.components_dirty);
+        EXPECT_EQ(b.stats.components_assumed_dirty, w.stats.components_assumed_dirty);
+        EXPECT_EQ(b.stats.components_escalated, w.stats.components_escalated);
+        EXPECT_EQ(b.stats.relative_aabb_culled, w.stats.relative_aabb_culled);
+        EXPECT_EQ(b.stats.skipped_pairs_retested, w.stats.skipped_pairs_retested);
+        EXPECT_EQ(b.stats.escalation_contacts, w.stats.escalation_contacts);
+        EXPECT_LE(w.stats.blocks, 2);  // one piece: one block per pass
+        contacts += static_cast<std::int64_t>(w.ccd.contacts.size());
+        most_blocks = std::max(most_blocks, b.stats.blocks);
+        if (b.stats.components_escalated > 0) {
+          escalation_blocks = b.stats.blocks;
+          // The escalation pass itself spans blocks: more re-tested pairs than one block holds.
+          EXPECT_GT(b.stats.skipped_pairs_retested, static_cast<std::int64_t>(8 * kSmallBlock));
+        }
+      }
+      EXPECT_GT(contacts, 0);  // the coil does close
+      EXPECT_GT(most_blocks, 8);
+      EXPECT_GT(escalation_blocks, 8);  // some interval escalated, in many blocks
+    }
+  }
 }
 
 TEST(RadialViewMethod, FingersAndTentaclesTouch) {
