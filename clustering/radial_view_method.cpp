@@ -133,6 +133,8 @@ RadialViewMethod::RadialViewMethod(
   carry_clean_.assign(num_components, 0);
   carry_contact_.assign(num_components, 0);
   dcd_clean_.assign(num_components, 0);
+  dcd_pairs_.reserve(culling::block_reserve(
+      method_options.block_pairs, method_options.bvh.leaf_size, topology_.num_triangles()));
 }
 
 void RadialViewMethod::check_positions(
@@ -223,36 +225,24 @@ void RadialViewMethod::start_status(const skinning::Positions& x_t0, culling::Fr
   std::int64_t bv_tests = 0;
   cluster_pairs_.clear();
   culling::self_traverse<3>(global, cluster_bounds_, scratch_, cluster_pairs_, bv_tests);
-  dcd_pairs_.clear();
-  const std::span<const culling::Aabb> tri_bounds(static_bounds_.triangles);
-  for (std::int32_t a = 0; a < num_atomic; ++a) {
-    if (cluster_bounds_[at(a)].lo[0] > cluster_bounds_[at(a)].hi[0]) continue;  // empty
-    culling::self_traverse<3>(clusters_.local_bvh(a), tri_bounds, scratch_, dcd_pairs_, bv_tests);
-  }
-  for (const auto& cp : cluster_pairs_) {
-    if (clusters_.component_of_atomic(cp.a) != clusters_.component_of_atomic(cp.b)) continue;
-    const std::size_t first = dcd_pairs_.size();
-    culling::pair_traverse<3>(clusters_.local_bvh(cp.a), tri_bounds, clusters_.local_bvh(cp.b),
-                              tri_bounds, scratch_, dcd_pairs_, bv_tests);
-    for (std::size_t i = first; i < dcd_pairs_.size(); ++i) {
-      if (dcd_pairs_[i].b < dcd_pairs_[i].a) std::swap(dcd_pairs_[i].a, dcd_pairs_[i].b);
-    }
-  }
-  const auto traversed = Clock::now();
-  // The exact triangle test, pair by pair: pairs without a shared vertex first (an intersecting one
-  // settles its component at once), then adjacent pairs, most of which an exact orientation
-  // proves apart beyond the shared vertex or edge without the full test.
   for (std::int32_t k = 0; k < num_components; ++k) {
     if (unknown(k)) {
       status_[at(k)] = Status::clean;
       ++stats_.components_dcd;
     }
   }
+  const auto dirty = [&](std::int32_t k) { return status_[at(k)] == Status::dirty; };
+
+  // The exact triangle test, pair by pair: pairs without a shared vertex first (an intersecting one
+  // settles its component at once), then adjacent pairs, most of which an exact orientation
+  // proves apart beyond the shared vertex or edge without the full test.
   std::int64_t tt_tests = 0;
-  for (const bool adjacent : {false, true}) {
+  double test_us = 0.0;
+  const auto test_pairs = [&](bool adjacent) {
+    const auto t0 = Clock::now();
     for (const auto& p : dcd_pairs_) {
       const std::int32_t k = clusters_.component_of_triangle(p.a);
-      if (status_[at(k)] == Status::dirty || topology_.triangles_excluded(p.a, p.b)) continue;
+      if (dirty(k) || topology_.triangles_excluded(p.a, p.b)) continue;
       int shared_count = 0;
       const ccd::SharedCorners shared = topology_.shared_corners(p.a, p.b, shared_count);
       if ((shared_count > 0) != adjacent || shared_count >= 3) continue;  // 3: duplicate face
@@ -269,12 +259,59 @@ void RadialViewMethod::start_status(const skinning::Positions& x_t0, culling::Fr
         status_[at(k)] = Status::dirty;
       }
     }
-  }
+    test_us += micros(t0, Clock::now());
+  };
+  // Bounded memory: the pairs come from the traversals in installments of block_pairs and are
+  // tested as they come, so one pass over them never holds them whole. Non-adjacent pairs all
+  // come before adjacent ones, so the traversals run twice: the second time only over components
+  // not yet found dirty, and without counting its volume tests again. The tests made (tt_tests),
+  // the volume tests counted and the outcome are those of testing all pairs in one piece (the
+  // first pass traverses everything, as the one-piece pass did, whatever it has found).
+  const std::size_t block = method_options_.block_pairs;
+  const std::span<const culling::Aabb> tri_bounds(static_bounds_.triangles);
+  const auto pass = [&](bool adjacent, std::int64_t& volume_tests) {
+    const auto stream = [&](auto&& some) {
+      for (bool done = false; !done;) {
+        dcd_pairs_.clear();
+        done = some(dcd_pairs_, block);
+        if (!adjacent) stats_.dcd_pass_pairs += static_cast<std::int64_t>(dcd_pairs_.size());
+        for (auto& p : dcd_pairs_) {
+          if (p.b < p.a) std::swap(p.a, p.b);  // across two hierarchies: (a of one, b of other)
+        }
+        test_pairs(adjacent);
+      }
+    };
+    for (std::int32_t a = 0; a < num_atomic; ++a) {
+      if (cluster_bounds_[at(a)].lo[0] > cluster_bounds_[at(a)].hi[0]) continue;  // empty
+      if (adjacent && dirty(clusters_.component_of_atomic(a))) continue;          // nothing to test
+      const auto& local = clusters_.local_bvh(a);
+      culling::start_self_traversal<3>(local, scratch_);
+      stream([&](std::vector<culling::TrianglePair>& pairs, std::size_t max_pairs) {
+        return culling::self_traverse_some<3>(
+            local, tri_bounds, scratch_, pairs, volume_tests, max_pairs);
+      });
+    }
+    for (const auto& cp : cluster_pairs_) {
+      const std::int32_t k = clusters_.component_of_atomic(cp.a);
+      if (k != clusters_.component_of_atomic(cp.b) || (adjacent && dirty(k))) continue;
+      const auto& local_a = clusters_.local_bvh(cp.a);
+      const auto& local_b = clusters_.local_bvh(cp.b);
+      culling::start_pair_traversal<3>(local_a, local_b, scratch_);
+      stream([&](std::vector<culling::TrianglePair>& pairs, std::size_t max_pairs) {
+        return culling::pair_traverse_some<3>(
+            local_a, tri_bounds, local_b, tri_bounds, scratch_, pairs, volume_tests, max_pairs);
+      });
+    }
+  };
+  pass(/*adjacent=*/false, bv_tests);
+  std::int64_t counted_once = 0;
+  pass(/*adjacent=*/true, counted_once);
+  dcd_pairs_.clear();
   out.counters.bv_tests += bv_tests;
   out.counters.tt_tests += tt_tests;
   const auto end = Clock::now();
-  out.times.traverse_us += micros(start, traversed);
-  out.times.elementary_us += micros(traversed, end);
+  out.times.traverse_us += micros(start, end) - test_us;
+  out.times.elementary_us += test_us;
 }
 
 // --- class masks: which pairs of a mega cluster may be skipped -----------------------------------

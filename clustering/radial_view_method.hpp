@@ -50,6 +50,7 @@ struct RadialViewStats {
   std::int32_t components_culled = 0;  ///< components where pairs were skipped
   std::int32_t components_open = 0;    ///< not closed / not consistently oriented / mixed parts
   std::int32_t components_dcd = 0;     ///< components proven at the start by a DCD pass here
+  std::int64_t dcd_pass_pairs = 0;     ///< triangle pairs that pass's traversals found
   std::int32_t components_dirty = 0;   ///< self-intersecting at the start: nothing skipped there
   /// Of those, assumed so without a DCD pass: they had a self-contact in the previous interval.
   std::int32_t components_assumed_dirty = 0;

@@ -117,8 +117,9 @@ void expect_same_counters(const culling::Counters& got, const culling::Counters&
 }
 
 TEST(RadialViewMethod, SmallBlocksFindExactlyWhatOnePieceFinds) {
-  // Bounded memory (docs/culling.md): the cluster traversals, the relative AABB filter and the
-  // escalation pass stream their pairs through blocks of MethodOptions::block_pairs. The coiling
+  // Bounded memory (docs/culling.md): the cluster traversals, the relative AABB filter, the
+  // escalation pass and the precondition DCD pass stream their pairs in blocks of
+  // MethodOptions::block_pairs. The coiling
   // rope closes its coil in these intervals: pairs are skipped, then re-tested on escalation.
   constexpr std::size_t kSmallBlock = 16;
   constexpr std::size_t kOnePiece = std::numeric_limits<std::size_t>::max();
@@ -129,7 +130,7 @@ TEST(RadialViewMethod, SmallBlocksFindExactlyWhatOnePieceFinds) {
       const auto whole = run_blocked(scene, name, kOnePiece, 18, 30, with_dcd);
       const auto blocked = run_blocked(scene, name, kSmallBlock, 18, 30, with_dcd);
       ASSERT_EQ(blocked.size(), whole.size());
-      std::int64_t contacts = 0, escalation_blocks = 0, most_blocks = 0;
+      std::int64_t contacts = 0, escalation_blocks = 0, most_blocks = 0, dcd_pass_pairs = 0;
       for (std::size_t i = 0; i < whole.size(); ++i) {
         SCOPED_TRACE("interval " + std::to_string(18 + i));
         const auto& w = whole[i];
@@ -140,6 +141,7 @@ TEST(RadialViewMethod, SmallBlocksFindExactlyWhatOnePieceFinds) {
         expect_same_counters(b.dcd.counters, w.dcd.counters);
         EXPECT_EQ(b.stats.components_culled, w.stats.components_culled);
         EXPECT_EQ(b.stats.components_dcd, w.stats.components_dcd);
+        EXPECT_EQ(b.stats.dcd_pass_pairs, w.stats.dcd_pass_pairs);
         EXPECT_EQ(b.stats.components_dirty, w.stats.components_dirty);
         EXPECT_EQ(b.stats.components_assumed_dirty, w.stats.components_assumed_dirty);
         EXPECT_EQ(b.stats.components_escalated, w.stats.components_escalated);
@@ -149,6 +151,7 @@ TEST(RadialViewMethod, SmallBlocksFindExactlyWhatOnePieceFinds) {
         EXPECT_LE(w.stats.blocks, 2);  // one piece: one block per pass
         contacts += static_cast<std::int64_t>(w.ccd.contacts.size());
         most_blocks = std::max(most_blocks, b.stats.blocks);
+        dcd_pass_pairs = std::max(dcd_pass_pairs, b.stats.dcd_pass_pairs);
         if (b.stats.components_escalated > 0) {
           escalation_blocks = b.stats.blocks;
           // The escalation pass itself spans blocks: more re-tested pairs than one block holds.
@@ -158,6 +161,11 @@ TEST(RadialViewMethod, SmallBlocksFindExactlyWhatOnePieceFinds) {
       EXPECT_GT(contacts, 0);  // the coil does close
       EXPECT_GT(most_blocks, 8);
       EXPECT_GT(escalation_blocks, 8);  // some interval escalated, in many blocks
+      // Without a DCD at the start, the first interval proves its components clean by a DCD pass
+      // of its own, which streams its pairs in blocks too (counters compared above).
+      if (!with_dcd) {
+        EXPECT_GT(dcd_pass_pairs, static_cast<std::int64_t>(8 * kSmallBlock));
+      }
     }
   }
 }
