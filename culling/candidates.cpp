@@ -133,22 +133,11 @@ void ccd_candidates_brute_force(
   counters.candidate_pairs += static_cast<std::int64_t>(num_faces) * (num_faces - 1) / 2;
 }
 
-namespace {
-
-/// The DCD rules for one triangle pair: not part-excluded, not a duplicate face.
-inline bool dcd_keep(const FeatureTopology& topology, const TrianglePair& p) {
-  if (topology.triangles_excluded(p.a, p.b)) return false;
-  int shared = 0;
-  (void)topology.shared_corners(p.a, p.b, shared);
-  return shared < 3;
-}
-
-}  // namespace
-
 void dcd_filter_triangle_pairs(
     const FeatureTopology& topology, std::vector<TrianglePair>& pairs, Counters& counters) {
-  const auto kept = std::remove_if(
-      pairs.begin(), pairs.end(), [&](const TrianglePair& p) { return !dcd_keep(topology, p); });
+  const auto kept = std::remove_if(pairs.begin(), pairs.end(), [&](const TrianglePair& p) {
+    return !dcd_checks_pair(topology, p);
+  });
   pairs.erase(kept, pairs.end());
   counters.candidate_pairs += static_cast<std::int64_t>(pairs.size());
 }
@@ -167,7 +156,7 @@ void dcd_candidates_brute_force(
       ++tests;
       if (!ba.overlaps(triangle_bounds[at(b)])) continue;
       const TrianglePair p{a, b};
-      if (dcd_keep(topology, p)) out.push_back(p);
+      if (dcd_checks_pair(topology, p)) out.push_back(p);
     }
   }
   counters.bv_tests += tests;

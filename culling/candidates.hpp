@@ -92,6 +92,15 @@ void ccd_candidates_brute_force(
     FeatureCandidates& out,
     Counters& counters);
 
+/// The DCD rules for one triangle pair: not part-excluded, not a duplicate face (the same three
+/// welded vertices). Pairs sharing one or two vertices are checked: the exact test handles them.
+[[nodiscard]] inline bool dcd_checks_pair(const FeatureTopology& topology, const TrianglePair& p) {
+  if (topology.triangles_excluded(p.a, p.b)) return false;
+  int shared = 0;
+  (void)topology.shared_corners(p.a, p.b, shared);
+  return shared < 3;
+}
+
 /// DCD feature stage: keeps (in place, order kept) the triangle pairs to test: drops
 /// part-excluded pairs and pairs of triangles on the same three welded vertices (duplicate
 /// faces). Pairs sharing one or two vertices stay: the exact test handles them. Counts

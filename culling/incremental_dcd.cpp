@@ -4,6 +4,8 @@
 #include <chrono>
 #include <cstddef>
 
+#include "culling/candidates.hpp"
+
 namespace skelcd::culling {
 namespace {
 
@@ -43,11 +45,8 @@ void DcdUpdater::affected_pairs(
   out.clear();
   const auto add = [&](std::int32_t a, std::int32_t b) {
     if (a == b) return;
-    if (b < a) std::swap(a, b);
-    if (features_.triangles_excluded(a, b)) return;
-    int shared = 0;
-    (void)features_.shared_corners(a, b, shared);
-    if (shared < 3) out.push_back({a, b});  // three shared corners: a duplicate face
+    const TrianglePair p{std::min(a, b), std::max(a, b)};
+    if (dcd_checks_pair(features_, p)) out.push_back(p);
   };
   for (const CcdContact& c : contacts) {
     if (c.kind == CcdContact::Kind::vf) {
