@@ -21,25 +21,23 @@ namespace skelcd::culling {
 namespace {
 
 struct Outcome {
-  std::size_t changed = 0;   ///< pairs whose status differs between the two ends
-  std::size_t affected = 0;  ///< pairs the update tested again
+  std::size_t changed = 0;     ///< pairs whose status differs between the two ends
+  std::size_t affected = 0;    ///< pairs the update tested again
+  std::size_t candidates = 0;  ///< candidate pairs of the full DCD at the end
 };
 
-/// Full DCD at x0 and x1, CCD x0 → x1 with `accuracy`, the update; expects the updated pairs to
-/// be the full DCD's at x1.
+/// Full DCD at x0 and x1, CCD x0 → x1 by `method` (a `bvh` of the mesh at some accuracy), the
+/// update; expects the updated pairs to be the full DCD's at x1.
 Outcome expect_update_is_full_dcd(
-    const skinning::Mesh& mesh,
-    const skinning::Topology& topology,
+    CullingMethod& method,
     DcdUpdater& updater,
     const skinning::Positions& x0,
     const skinning::Positions& x1,
-    ccd::Accuracy accuracy,
     const std::string& what) {
-  auto method = make_method("bvh", mesh, topology, MethodOptions{.accuracy = accuracy});
   FrameResult start, end, interval, updated;
-  method->detect_dcd(x0, start);
-  method->detect_dcd(x1, end);
-  method->detect_ccd(x0, x1, interval);
+  method.detect_dcd(x0, start);
+  method.detect_dcd(x1, end);
+  method.detect_ccd(x0, x1, interval);
   updater.update(start.dcd_pairs, interval.contacts, x1, ElementaryTests{}, updated);
   EXPECT_EQ(updated.dcd_pairs, end.dcd_pairs) << what;
   EXPECT_EQ(updated.counters.dcd_pairs, static_cast<std::int64_t>(end.dcd_pairs.size())) << what;
@@ -50,7 +48,10 @@ Outcome expect_update_is_full_dcd(
       end.dcd_pairs.begin(),
       end.dcd_pairs.end(),
       std::back_inserter(changed));
-  return {changed.size(), static_cast<std::size_t>(updated.counters.candidate_pairs)};
+  return {
+      changed.size(),
+      static_cast<std::size_t>(updated.counters.candidate_pairs),
+      static_cast<std::size_t>(end.counters.candidate_pairs)};
 }
 
 skinning::Positions rows(std::initializer_list<Eigen::RowVector3d> points) {
@@ -109,13 +110,12 @@ TEST(IncrementalDcd, CasesOfTheProof) {
     const skinning::Topology topology = skinning::build_topology(mesh);
     DcdUpdater updater(mesh, topology);
     for (const auto accuracy : {ccd::Accuracy::conservative, ccd::Accuracy::exact}) {
+      const auto method = make_method("bvh", mesh, topology, MethodOptions{.accuracy = accuracy});
       const Outcome o = expect_update_is_full_dcd(
-          mesh,
-          topology,
+          *method,
           updater,
           c.x0,
           c.x1,
-          accuracy,
           std::string(c.what) + " " + std::string(ccd::to_string(accuracy)));
       EXPECT_EQ(o.changed, 1u) << c.what << ": the case must change the pair's status";
     }
@@ -134,6 +134,10 @@ TEST(IncrementalDcd, GridMotionsAgreeWithTheFullDcd) {
   const skinning::Topology topology = skinning::build_topology(mesh);
   ASSERT_EQ(topology.num_welded_vertices(), 10);
   DcdUpdater updater(mesh, topology);
+  const auto conservative =
+      make_method("bvh", mesh, topology, MethodOptions{.accuracy = ccd::Accuracy::conservative});
+  const auto exact =
+      make_method("bvh", mesh, topology, MethodOptions{.accuracy = ccd::Accuracy::exact});
   std::mt19937_64 rng(14);
   std::uniform_int_distribution<int> coord(-2, 2);
   const auto grid_positions = [&] {
@@ -148,9 +152,9 @@ TEST(IncrementalDcd, GridMotionsAgreeWithTheFullDcd) {
     const skinning::Positions x0 = grid_positions();
     skinning::Positions x1 = grid_positions();
     if (n % 3 == 0) x1.topRows(5) = x0.topRows(5);  // part of the mesh stays, the rest moves
-    const auto accuracy = n % 4 == 0 ? ccd::Accuracy::exact : ccd::Accuracy::conservative;
-    const Outcome o = expect_update_is_full_dcd(
-        mesh, topology, updater, x0, x1, accuracy, "case " + std::to_string(n));
+    CullingMethod& method = n % 4 == 0 ? *exact : *conservative;
+    const Outcome o =
+        expect_update_is_full_dcd(method, updater, x0, x1, "case " + std::to_string(n));
     if (::testing::Test::HasFailure()) return;
     changed += o.changed;
     affected += o.affected;
@@ -181,6 +185,7 @@ TEST(IncrementalDcd, RealCharactersAgreeWithTheFullDcd) {
     const skinning::Topology topology = skinning::build_topology(mesh);
     const auto motion = model.motion({.clip = c.clip});
     DcdUpdater updater(mesh, topology);
+    const auto method = make_method("bvh", mesh, topology);
     skinning::Positions file_positions, x0, x1;
     skinning::gather_welded(topology, mesh.rest_positions, x0);
     const int n = motion->num_samples();
@@ -190,18 +195,10 @@ TEST(IncrementalDcd, RealCharactersAgreeWithTheFullDcd) {
       motion->positions(k, file_positions);
       skinning::gather_welded(topology, file_positions, x1);
       const Outcome o = expect_update_is_full_dcd(
-          mesh,
-          topology,
-          updater,
-          x0,
-          x1,
-          ccd::Accuracy::conservative,
-          c.file + " to sample " + std::to_string(k));
+          *method, updater, x0, x1, c.file + " to sample " + std::to_string(k));
       changed += o.changed;
       affected += o.affected;
-      FrameResult full;
-      make_method("bvh", mesh, topology)->detect_dcd(x1, full);
-      pairs += static_cast<std::size_t>(full.counters.candidate_pairs);
+      pairs += o.candidates;
       std::swap(x0, x1);
     }
     EXPECT_LT(affected * 4, pairs) << c.file << ": the update must test far fewer pairs";
