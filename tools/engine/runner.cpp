@@ -395,10 +395,10 @@ ClipRunner::ClipRunner(
   // blocks do not depend on the thread count: with incremental DCD each block starts with a full
   // DCD, in a serial run too, so that every row is the same on any number of threads.
   const std::int32_t wanted = resolve_threads(options.threads);
-  units_ = plan_.samples - (options.query != QuerySet::ccd ? 0 : 1);
+  const std::int32_t units = plan_.samples - (options.query != QuerySet::ccd ? 0 : 1);
   block_samples_ = options.block_samples > 0
                        ? options.block_samples
-                       : std::clamp(units_ / 16, std::int32_t{4}, std::int32_t{64});
+                       : std::clamp(units / 16, std::int32_t{4}, std::int32_t{64});
   if (wanted > 1) {
     if (!factory_) {
       const culling::MethodInfo* m = culling::find_method(options.method);
@@ -409,7 +409,7 @@ ClipRunner::ClipRunner(
       plan_.serial_reason = "the method factory's methods are not known to be stateless";
     }
     const std::int32_t block = block_samples_;
-    const std::int32_t blocks = (units_ + block - 1) / block;
+    const std::int32_t blocks = (units + block - 1) / block;
     if (plan_.serial_reason.empty() && blocks > 1) {
       plan_.threads = std::min(wanted, blocks);
       plan_.block_samples = block;

@@ -124,10 +124,10 @@ class ClipRunner {
   skinning::Topology topology_;
   std::unique_ptr<culling::CullingMethod> method_;
   bool bones_ = false;  ///< the queries carry the bones' transforms (the method needs them)
+  /// DCD updated from the CCD contacts (RunOptions::incremental_dcd).
   bool incremental_dcd_ = false;
-  std::int32_t units_ = 0;          ///< sample units k of the run (DCD at k, then CCD k → k+1)
-  std::int32_t block_samples_ = 4;  ///< units per block, whatever the thread count  ///< DCD
-                                    ///< updated from the CCD contacts (RunOptions::incremental_dcd)
+  /// Sample units (DCD at k, then CCD k → k+1) per block, whatever the thread count.
+  std::int32_t block_samples_ = 4;
 };
 
 /// Maps welded ids (culling's numbering) back to the file's own numbering (part, index).
