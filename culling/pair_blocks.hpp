@@ -91,7 +91,8 @@ class PairBlocks {
 
   /// Blocks tested in this query (at least 1 once anything was tested).
   [[nodiscard]] std::int64_t blocks() const { return blocks_; }
-  /// µs of this query spent in the feature stage (and DCD filter) and in the elementary tests.
+  /// µs of this query spent in the feature stage (CCD; DCD only orders its pairs) and in the
+  /// elementary tests (DCD: the filter and the triangle tests, filter_and_run_dcd_tests).
   [[nodiscard]] double feature_us() const { return feature_us_; }
   [[nodiscard]] double test_us() const { return test_us_; }
 
