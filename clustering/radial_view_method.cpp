@@ -4,9 +4,11 @@
 #include <array>
 #include <chrono>
 #include <cmath>
+#include <optional>
 #include <utility>
 
 #include "ccd/orientation.hpp"
+#include "clustering/side_winding.hpp"
 #include "culling/cluster_checks.hpp"
 #include "culling/relative_aabb.hpp"
 #include "culling/vertex_bounds.hpp"
@@ -28,52 +30,11 @@ bool same_positions(const skinning::Positions& a, const skinning::Positions& b) 
   return a.rows() == b.rows() && std::equal(a.data(), a.data() + a.size(), b.data());
 }
 
-/// True when triangles a and b, which share one vertex or one edge (shared: corner i of a is
-/// corner shared[i] of b, else −1), are proven to meet nowhere beyond it by exact orientations:
-/// - an edge: b's third corner off a's plane (b minus the edge lies strictly on one side);
-/// - a vertex: b's other two corners strictly on one side of a's plane, or a's of b's plane.
-/// False means "not proven": the full test decides.
-bool apart_beyond_shared(
-    const std::array<Eigen::Vector3d, 3>& a,
-    const std::array<Eigen::Vector3d, 3>& b,
-    const ccd::SharedCorners& shared) {
-  std::array<bool, 3> b_shared{false, false, false};
-  int count = 0;
-  for (const auto j : shared) {
-    if (j >= 0 && !b_shared[static_cast<std::size_t>(j)]) {
-      b_shared[static_cast<std::size_t>(j)] = true;
-      ++count;
-    }
-  }
-  const auto side = [](const std::array<Eigen::Vector3d, 3>& t, const Eigen::Vector3d& p) {
-    return ccd::orient3d(t[0], t[1], t[2], p);
-  };
-  if (count == 2) {
-    for (std::size_t j = 0; j < 3; ++j) {
-      if (!b_shared[j]) return side(a, b[j]) != 0;
-    }
-    return false;
-  }
-  if (count != 1) return false;
-  // The two corners of b that are not shared, and the two of a.
-  std::array<std::size_t, 2> bo{}, ao{};
-  std::size_t nb = 0, na = 0;
-  for (std::size_t j = 0; j < 3; ++j) {
-    if (!b_shared[j] && nb < 2) bo[nb++] = j;
-  }
-  for (std::size_t i = 0; i < 3; ++i) {
-    if (shared[i] < 0 && na < 2) ao[na++] = i;
-  }
-  if (nb == 2) {
-    const int s0 = side(a, b[bo[0]]);
-    if (s0 != 0 && s0 == side(a, b[bo[1]])) return true;
-  }
-  if (na == 2) {
-    const int s0 = side(b, a[ao[0]]);
-    if (s0 != 0 && s0 == side(b, a[ao[1]])) return true;
-  }
-  return false;
-}
+/// Patches smaller than this are not classified (their triangles are tested as Hᵘ): a ray costs
+/// a pass over the component, and a few triangles skipped save less than that.
+constexpr std::int32_t kMinPatch = 8;
+/// Triangles of a patch tried before it is given up (each with its own ray tilt).
+constexpr int kPatchAttempts = 6;
 
 }  // namespace
 
@@ -96,6 +57,7 @@ RadialViewMethod::RadialViewMethod(
       tests_(culling::with_ccd_defaults(method_options.elementary)),
       // The bvh method checks the method options (min_separation, accuracy) as every method does.
       bvh_(culling::make_method("bvh", mesh, topology, method_options_)),
+      updater_(mesh, topology),
       builder_(clusters_, options.clusters),
       edge_face_offsets_(topology.edge_face_offsets),
       edge_faces_(topology.edge_faces),
@@ -125,16 +87,30 @@ RadialViewMethod::RadialViewMethod(
   scratch_.reserve(std::max(
       4 * deepest + 4,
       4 * static_cast<std::size_t>(clusters_.global_bvh().depth()) + 4));
+  node_stack_.reserve(2 * deepest + 2);
   vertex_label_.resize(at(topology_.num_vertices()));
   edge_label_.resize(at(topology_.num_edges()));
   status_.assign(num_components, Status::unknown);
   culled_.assign(num_components, 0);
-  escalate_.assign(num_components, 0);
-  carry_clean_.assign(num_components, 0);
-  carry_contact_.assign(num_components, 0);
-  dcd_clean_.assign(num_components, 0);
-  dcd_pairs_.reserve(culling::block_reserve(
-      method_options.block_pairs, method_options.bvh.leaf_size, topology_.num_triangles()));
+  component_escalated_.assign(num_components, 0);
+  cut_.assign(num_faces, 0);
+  skippable_.assign(num_faces, 0);
+  patch_.assign(num_faces, -1);
+  escalated_.assign(num_faces, 0);
+  patch_order_.reserve(num_faces);
+  // Component → triangles (CSR), for the rays of the patches.
+  component_offsets_.assign(num_components + 1, 0);
+  for (std::int32_t f = 0; f < topology_.num_triangles(); ++f) {
+    ++component_offsets_[at(clusters_.component_of_triangle(f)) + 1];
+  }
+  for (std::size_t k = 0; k < num_components; ++k) {
+    component_offsets_[k + 1] += component_offsets_[k];
+  }
+  component_triangles_.resize(num_faces);
+  std::vector<std::int32_t> next(component_offsets_.begin(), component_offsets_.end() - 1);
+  for (std::int32_t f = 0; f < topology_.num_triangles(); ++f) {
+    component_triangles_[at(next[at(clusters_.component_of_triangle(f))]++)] = f;
+  }
 }
 
 void RadialViewMethod::check_positions(
@@ -152,12 +128,9 @@ void RadialViewMethod::check_positions(
 void RadialViewMethod::record_dcd(
     const skinning::Positions& x,
     const culling::FrameResult& result) {
+  if (!options_.guard) return;
   dcd_x_ = x;
-  std::fill(dcd_clean_.begin(), dcd_clean_.end(), 1);
-  for (const auto& p : result.dcd_pairs) {
-    const std::int32_t k = clusters_.component_of_triangle(p.a);
-    if (k == clusters_.component_of_triangle(p.b)) dcd_clean_[at(k)] = 0;
-  }
+  dcd_pairs_.assign(result.dcd_pairs.begin(), result.dcd_pairs.end());
   has_dcd_ = true;
 }
 
@@ -173,6 +146,7 @@ void RadialViewMethod::dcd(const culling::Instant& at, culling::FrameResult& out
 void RadialViewMethod::start_status(const skinning::Positions& x_t0, culling::FrameResult& out) {
   const std::int32_t num_components = clusters_.num_components();
   std::fill(status_.begin(), status_.end(), Status::unknown);
+  std::fill(cut_.begin(), cut_.end(), 0);
   const bool culling_possible = method_options_.min_separation == 0.0;
   if (!culling_possible) return;  // nothing is skipped: the start state does not matter
   if (!options_.guard) {
@@ -181,137 +155,108 @@ void RadialViewMethod::start_status(const skinning::Positions& x_t0, culling::Fr
     }
     return;
   }
-  // Known from the previous interval (its end is this start) or from a DCD at these positions.
-  const bool carried = has_carry_ && same_positions(x_t0, carry_x_);
-  const bool dcd_known = has_dcd_ && same_positions(x_t0, dcd_x_);
-  bool any_unknown = false;
+  // The intersecting pairs at x_t0: from a DCD at these positions, from the previous interval
+  // (its end is this start), else a DCD here.
+  if (has_dcd_ && same_positions(x_t0, dcd_x_)) {
+    start_pairs_.assign(dcd_pairs_.begin(), dcd_pairs_.end());
+  } else if (has_carry_ && same_positions(x_t0, carry_x_)) {
+    start_pairs_.swap(carry_pairs_);
+  } else {
+    scratch_result_.clear();
+    bvh_->detect_dcd(x_t0, scratch_result_);
+    start_pairs_.assign(scratch_result_.dcd_pairs.begin(), scratch_result_.dcd_pairs.end());
+    out.counters.bv_tests += scratch_result_.counters.bv_tests;
+    out.counters.tt_tests += scratch_result_.counters.tt_tests;
+    out.times.traverse_us += scratch_result_.times.traverse_us;
+    out.times.elementary_us += scratch_result_.times.elementary_us;
+    stats_.dcd_pass_pairs = scratch_result_.counters.candidate_pairs;
+    for (std::int32_t k = 0; k < num_components; ++k) {
+      stats_.components_dcd += clusters_.component_ok(k) ? 1 : 0;
+    }
+  }
+  has_carry_ = false;
   for (std::int32_t k = 0; k < num_components; ++k) {
-    if (!clusters_.component_ok(k)) continue;
-    if (carried && carry_clean_[at(k)] != 0) {
-      status_[at(k)] = Status::clean;
-    } else if (dcd_known) {
-      status_[at(k)] = dcd_clean_[at(k)] != 0 ? Status::clean : Status::dirty;
-    } else if (carried && carry_contact_[at(k)] != 0) {
-      // A self-contact in the previous interval: most likely still intersecting. Taking it as
-      // dirty without a DCD pass is safe (nothing is skipped there); the first interval without
-      // a self-contact runs the pass and may find it clean again.
-      status_[at(k)] = Status::dirty;
-      ++stats_.components_assumed_dirty;
-    } else {
-      any_unknown = true;
-    }
+    if (clusters_.component_ok(k)) status_[at(k)] = Status::clean;
   }
-  if (!any_unknown) return;
+  for (const auto& p : start_pairs_) {
+    const std::int32_t k = clusters_.component_of_triangle(p.a);
+    if (k != clusters_.component_of_triangle(p.b) || !clusters_.component_ok(k)) continue;
+    status_[at(k)] = Status::dirty;
+    cut_[at(p.a)] = 1;
+    cut_[at(p.b)] = 1;
+  }
+}
 
-  // A DCD pass over the unknown components: every pair of their triangles within one component
-  // whose static boxes overlap, through the cluster hierarchies, then the exact triangle test.
-  const auto start = Clock::now();
-  const auto unknown = [&](std::int32_t k) { return status_[at(k)] == Status::unknown; };
-  culling::static_vertex_bounds<3>(x_t0, static_bounds_.vertices);
-  static_bounds_.derive(topology_, /*with_edges=*/false);
-  const std::int32_t num_atomic = clusters_.num_atomic();
-  for (std::int32_t a = 0; a < num_atomic; ++a) {
-    auto& local = clusters_.local_bvh(a);
-    const std::int32_t k = clusters_.component_of_atomic(a);
-    if (local.empty() || k < 0 || !clusters_.component_ok(k) || !unknown(k)) {
-      cluster_bounds_[at(a)] = culling::Aabb::empty();
-      continue;
-    }
-    local.refit(static_bounds_.triangles);
-    cluster_bounds_[at(a)] = local.node_bounds()[0];
-  }
-  auto& global = clusters_.global_bvh();
-  global.refit(cluster_bounds_);
-  std::int64_t bv_tests = 0;
-  cluster_pairs_.clear();
-  culling::self_traverse<3>(global, cluster_bounds_, scratch_, cluster_pairs_, bv_tests);
+void RadialViewMethod::classify_patches(const skinning::Positions& x_t0) {
+  // Clean culled components: every triangle is skippable (the surface is embedded, its front
+  // winding number the same everywhere). Dirty ones: the triangles of uncut patches whose front
+  // winding number is that of the component's largest classified patch.
+  const std::int32_t num_components = clusters_.num_components();
+  const auto& triangles = topology_.welded_triangles();
+  patch_order_.clear();
+  patch_offsets_.assign(1, 0);
   for (std::int32_t k = 0; k < num_components; ++k) {
-    if (unknown(k)) {
-      status_[at(k)] = Status::clean;
-      ++stats_.components_dcd;
+    const auto first = static_cast<std::ptrdiff_t>(component_offsets_[at(k)]);
+    const auto last = static_cast<std::ptrdiff_t>(component_offsets_[at(k) + 1]);
+    const std::span<const std::int32_t> surface(
+        component_triangles_.data() + first, static_cast<std::size_t>(last - first));
+    const bool dirty = status_[at(k)] == Status::dirty;
+    for (const std::int32_t f : surface) {
+      skippable_[at(f)] = culled_[at(k)] != 0 && !dirty ? 1 : 0;
+      patch_[at(f)] = -1;
     }
-  }
-  const auto dirty = [&](std::int32_t k) { return status_[at(k)] == Status::dirty; };
-
-  // The exact triangle test, pair by pair: pairs without a shared vertex first (an intersecting one
-  // settles its component at once), then adjacent pairs, most of which an exact orientation
-  // proves apart beyond the shared vertex or edge without the full test.
-  std::int64_t tt_tests = 0;
-  double test_us = 0.0;
-  const auto test_pairs = [&](bool adjacent) {
-    const auto t0 = Clock::now();
-    for (const auto& p : dcd_pairs_) {
-      const std::int32_t k = clusters_.component_of_triangle(p.a);
-      if (dirty(k) || topology_.triangles_excluded(p.a, p.b)) continue;
-      int shared_count = 0;
-      const ccd::SharedCorners shared = topology_.shared_corners(p.a, p.b, shared_count);
-      if ((shared_count > 0) != adjacent || shared_count >= 3) continue;  // 3: duplicate face
-      const auto& ta = topology_.triangle(p.a);
-      const auto& tb = topology_.triangle(p.b);
-      const auto row = [&](std::int32_t v) -> Eigen::Vector3d {
-        return x_t0.row(static_cast<Eigen::Index>(v)).transpose();
-      };
-      const std::array<Eigen::Vector3d, 3> a{row(ta[0]), row(ta[1]), row(ta[2])};
-      const std::array<Eigen::Vector3d, 3> b{row(tb[0]), row(tb[1]), row(tb[2])};
-      if (adjacent && apart_beyond_shared(a, b, shared)) continue;
-      ++tt_tests;
-      if (tests_.triangles({a[0], a[1], a[2], b[0], b[1], b[2]}, shared)) {
-        status_[at(k)] = Status::dirty;
-      }
-    }
-    test_us += micros(t0, Clock::now());
-  };
-  // Bounded memory: the pairs come from the traversals in installments of block_pairs and are
-  // tested as they come, so one pass over them never holds them whole. Non-adjacent pairs all
-  // come before adjacent ones, so the traversals run twice: the second time only over components
-  // not yet found dirty, and without counting its volume tests again. The tests made (tt_tests),
-  // the volume tests counted and the outcome are those of testing all pairs in one piece (the
-  // first pass traverses everything, as the one-piece pass did, whatever it has found).
-  const std::size_t block = method_options_.block_pairs;
-  const std::span<const culling::Aabb> tri_bounds(static_bounds_.triangles);
-  const auto pass = [&](bool adjacent, std::int64_t& volume_tests) {
-    const auto stream = [&](auto&& some) {
-      for (bool done = false; !done;) {
-        dcd_pairs_.clear();
-        done = some(dcd_pairs_, block);
-        if (!adjacent) stats_.dcd_pass_pairs += static_cast<std::int64_t>(dcd_pairs_.size());
-        for (auto& p : dcd_pairs_) {
-          if (p.b < p.a) std::swap(p.a, p.b);  // across two hierarchies: (a of one, b of other)
+    if (culled_[at(k)] == 0 || !dirty) continue;
+    // Patches: uncut triangles joined across edges (the component is closed and manifold, so
+    // each edge has two triangles).
+    const std::size_t patches_before = patch_offsets_.size() - 1;
+    for (const std::int32_t seed : surface) {
+      if (cut_[at(seed)] != 0 || patch_[at(seed)] >= 0) continue;
+      const auto id = static_cast<std::int32_t>(patch_offsets_.size() - 1);
+      std::size_t head = patch_order_.size();
+      patch_order_.push_back(seed);
+      patch_[at(seed)] = id;
+      while (head < patch_order_.size()) {
+        const std::int32_t f = patch_order_[head++];
+        for (int s = 0; s < 3; ++s) {
+          const std::int32_t e = topology_.face_edge(f, s);
+          for (auto i = edge_face_offsets_[at(e)]; i < edge_face_offsets_[at(e) + 1]; ++i) {
+            const std::int32_t g = edge_faces_[at(i)];
+            if (cut_[at(g)] != 0 || patch_[at(g)] >= 0) continue;
+            patch_[at(g)] = id;
+            patch_order_.push_back(g);
+          }
         }
-        test_pairs(adjacent);
       }
-    };
-    for (std::int32_t a = 0; a < num_atomic; ++a) {
-      if (cluster_bounds_[at(a)].lo[0] > cluster_bounds_[at(a)].hi[0]) continue;  // empty
-      if (adjacent && dirty(clusters_.component_of_atomic(a))) continue;          // nothing to test
-      const auto& local = clusters_.local_bvh(a);
-      culling::start_self_traversal<3>(local, scratch_);
-      stream([&](std::vector<culling::TrianglePair>& pairs, std::size_t max_pairs) {
-        return culling::self_traverse_some<3>(
-            local, tri_bounds, scratch_, pairs, volume_tests, max_pairs);
-      });
+      patch_offsets_.push_back(static_cast<std::int32_t>(patch_order_.size()));
     }
-    for (const auto& cp : cluster_pairs_) {
-      const std::int32_t k = clusters_.component_of_atomic(cp.a);
-      if (k != clusters_.component_of_atomic(cp.b) || (adjacent && dirty(k))) continue;
-      const auto& local_a = clusters_.local_bvh(cp.a);
-      const auto& local_b = clusters_.local_bvh(cp.b);
-      culling::start_pair_traversal<3>(local_a, local_b, scratch_);
-      stream([&](std::vector<culling::TrianglePair>& pairs, std::size_t max_pairs) {
-        return culling::pair_traverse_some<3>(
-            local_a, tri_bounds, local_b, tri_bounds, scratch_, pairs, volume_tests, max_pairs);
-      });
+    // One ray per patch, largest patch first: its value is the component's.
+    std::vector<std::pair<std::int32_t, std::int32_t>> by_size;  // (−size, patch)
+    for (std::size_t p = patches_before; p + 1 < patch_offsets_.size(); ++p) {
+      const std::int32_t size = patch_offsets_[p + 1] - patch_offsets_[p];
+      ++stats_.patches;
+      if (size >= kMinPatch) by_size.emplace_back(-size, static_cast<std::int32_t>(p));
     }
-  };
-  pass(/*adjacent=*/false, bv_tests);
-  std::int64_t counted_once = 0;
-  pass(/*adjacent=*/true, counted_once);
-  dcd_pairs_.clear();
-  out.counters.bv_tests += bv_tests;
-  out.counters.tt_tests += tt_tests;
-  const auto end = Clock::now();
-  out.times.traverse_us += micros(start, end) - test_us;
-  out.times.elementary_us += test_us;
+    std::sort(by_size.begin(), by_size.end());
+    std::optional<int> value;
+    for (const auto& [minus_size, p] : by_size) {
+      const std::int32_t begin = patch_offsets_[at(p)];
+      const std::int32_t size = -minus_size;
+      std::optional<int> w;
+      for (int attempt = 0; attempt < kPatchAttempts && !w; ++attempt) {
+        // Spread the tries over the patch (BFS order: the seed's neighbourhood first).
+        const std::int32_t f = patch_order_[at(begin + (attempt * size) / kPatchAttempts)];
+        w = front_winding(surface, triangles, x_t0, f, attempt);
+      }
+      if (!w) continue;
+      ++stats_.patches_classified;
+      if (!value) value = w;
+      if (*w != *value) continue;
+      for (std::int32_t i = begin; i < begin + size; ++i) skippable_[at(patch_order_[at(i)])] = 1;
+    }
+    for (const std::int32_t f : surface) {
+      stats_.triangles_kept_out += skippable_[at(f)] == 0 ? 1 : 0;
+    }
+  }
 }
 
 // --- class masks: which pairs of a mega cluster may be skipped -----------------------------------
@@ -325,7 +270,7 @@ void RadialViewMethod::compute_masks() {
   // the argument rules out (docs/radial-view.md, "Why features, not triangles").
   const auto label = [&](std::int32_t f) -> std::int64_t {
     const std::int32_t k = clusters_.component_of_triangle(f);
-    if (culled_[at(k)] == 0) return -1;
+    if (culled_[at(k)] == 0 || skippable_[at(f)] == 0) return -1;
     const OrientationClass c = classes_.triangle_class[at(f)];
     if (c == OrientationClass::uncertain) return -1;
     const std::int32_t mega = classes_.atomic_mega[at(clusters_.atomic_of(f))];
@@ -384,10 +329,6 @@ std::int64_t RadialViewMethod::traverse(
     culling::FrameResult& out) {
   const std::span<const culling::Aabb> tri_bounds(bounds_.triangles);
   std::int64_t& bv_tests = out.counters.bv_tests;
-  const bool retest = which == MaskedPairs::skipped;
-  const auto wanted = [&](std::int32_t a) {
-    return !retest || escalate_[at(clusters_.component_of_atomic(a))] != 0;
-  };
   // Each traversal runs in installments; the pairs of an installment go through the relative AABB
   // filter (§6) as they come, and every full block is tested before the traversal goes on.
   std::int64_t found = 0;
@@ -405,7 +346,6 @@ std::int64_t RadialViewMethod::traverse(
   };
   // Intra-cluster: each atomic cluster against itself, with the masks of its mega cluster.
   for (std::int32_t a = 0; a < clusters_.num_atomic(); ++a) {
-    if (!wanted(a)) continue;
     const auto& local = clusters_.local_bvh(a);
     culling::start_masked_self_traversal<3>(local, scratch_);
     stream([&](std::vector<culling::TrianglePair>& pairs, std::size_t max_pairs) {
@@ -429,7 +369,6 @@ std::int64_t RadialViewMethod::traverse(
     const auto& local_a = clusters_.local_bvh(cp.a);
     const auto& local_b = clusters_.local_bvh(cp.b);
     if (same_mega) {
-      if (!wanted(cp.a)) continue;
       culling::start_masked_pair_traversal<3>(local_a, local_b, scratch_);
       stream([&](std::vector<culling::TrianglePair>& pairs, std::size_t max_pairs) {
         return culling::masked_pair_traverse_some<3>(
@@ -445,7 +384,7 @@ std::int64_t RadialViewMethod::traverse(
             bv_tests,
             max_pairs);
       });
-    } else if (!retest) {
+    } else {
       culling::start_pair_traversal<3>(local_a, local_b, scratch_);
       stream([&](std::vector<culling::TrianglePair>& pairs, std::size_t max_pairs) {
         return culling::pair_traverse_some<3>(
@@ -453,6 +392,105 @@ std::int64_t RadialViewMethod::traverse(
       });
     }
   }
+  return found;
+}
+
+// --- the local guard's re-tests --------------------------------------------------------------
+
+void RadialViewMethod::escalate(
+    const culling::FrameResult& out, std::size_t from, std::int32_t round) {
+  // The triangles at every vertex of a contact's two features: the contact's triangles and the
+  // owners of their features (docs/radial-view.md, "The local guard": re-testing their skipped
+  // pairs re-tests every skipped feature pair at those triangles).
+  const auto mark_vertex = [&](std::int32_t w) {
+    for (const std::int32_t f : clusters_.vertex_triangles(w)) {
+      const std::uint8_t m = triangle_mask_[at(f)];
+      if (escalated_[at(f)] != 0 || (m != culling::kMaskPositive && m != culling::kMaskNegative)) {
+        continue;
+      }
+      escalated_[at(f)] = round;
+      frontier_.push_back(f);
+      ++stats_.triangles_escalated;
+      const std::int32_t k = clusters_.component_of_triangle(f);
+      if (component_escalated_[at(k)] == 0) {
+        component_escalated_[at(k)] = 1;
+        ++stats_.components_escalated;
+      }
+    }
+  };
+  for (std::size_t i = from; i < out.contacts.size(); ++i) {
+    const auto& c = out.contacts[i];
+    if (c.kind == culling::CcdContact::Kind::vf) {
+      mark_vertex(c.a);
+      for (const std::int32_t w : topology_.triangle(c.b)) mark_vertex(w);
+    } else {
+      for (const std::int32_t w : topology_.edge(c.a)) mark_vertex(w);
+      for (const std::int32_t w : topology_.edge(c.b)) mark_vertex(w);
+    }
+  }
+}
+
+std::int64_t RadialViewMethod::retest_frontier(
+    std::int32_t round,
+    const skinning::Positions& x_t0,
+    const skinning::Positions& x_t1,
+    double half_width,
+    culling::FrameResult& out) {
+  // The pairs the masked traversal skipped: both triangles of one mega cluster with the same
+  // single-sign mask, their swept boxes overlapping. A pair with a triangle of an earlier round
+  // was tested in that round; two of this round are taken once, from the smaller id.
+  const std::span<const culling::Aabb> tri_bounds(bounds_.triangles);
+  std::int64_t& bv_tests = out.counters.bv_tests;
+  std::int64_t found = 0;
+  std::size_t next = 0;
+  blocks_.drain([&](std::vector<culling::TrianglePair>& pairs, std::size_t max_pairs) {
+    const std::size_t first = pairs.size();
+    while (next < frontier_.size() && pairs.size() - first < max_pairs) {
+      const std::int32_t t = frontier_[next++];
+      const std::uint8_t mask = triangle_mask_[at(t)];
+      const culling::Aabb& box = tri_bounds[at(t)];
+      const std::int32_t mega = classes_.atomic_mega[at(clusters_.atomic_of(t))];
+      for (std::int32_t a = 0; a < clusters_.num_atomic(); ++a) {
+        if (classes_.atomic_mega[at(a)] != mega) continue;
+        ++bv_tests;
+        if (!cluster_bounds_[at(a)].overlaps(box)) continue;
+        const auto& local = clusters_.local_bvh(a);
+        const auto nodes = local.nodes();
+        const auto node_bounds = local.node_bounds();
+        const auto order = local.triangle_order();
+        const auto& masks = node_masks_[at(a)];
+        node_stack_.clear();
+        node_stack_.push_back(0);
+        while (!node_stack_.empty()) {
+          const std::int32_t n = node_stack_.back();
+          node_stack_.pop_back();
+          if ((masks[at(n)] & mask) == 0) continue;
+          ++bv_tests;
+          if (!node_bounds[at(n)].overlaps(box)) continue;
+          const auto& node = nodes[at(n)];
+          if (!node.is_leaf()) {
+            node_stack_.push_back(node.right);
+            node_stack_.push_back(n + 1);
+            continue;
+          }
+          for (std::int32_t i = node.begin; i < node.end; ++i) {
+            const std::int32_t u = order[at(i)];
+            if (u == t || triangle_mask_[at(u)] != mask) continue;
+            const std::int32_t r = escalated_[at(u)];
+            if ((r != 0 && r < round) || (r == round && u < t)) continue;
+            if (!tri_bounds[at(u)].overlaps(box)) continue;
+            pairs.push_back(culling::TrianglePair{std::min(t, u), std::max(t, u)});
+          }
+        }
+      }
+    }
+    found += static_cast<std::int64_t>(pairs.size() - first);
+    if (options_.relative_aabb) {
+      stats_.relative_aabb_culled +=
+          culling::relative_aabb_filter(topology_, x_t0, x_t1, half_width, pairs, first);
+    }
+    return next == frontier_.size();
+  });
   return found;
 }
 
@@ -480,16 +518,20 @@ void RadialViewMethod::ccd(const culling::Interval& interval, culling::FrameResu
   const std::int32_t num_components = clusters_.num_components();
   stats_.components = num_components;
 
-  // 1. Which components the radial-view argument may be applied to in this interval.
+  // 1. Which components the radial-view argument may be applied to in this interval, and where
+  //    in them: the intersecting pairs at the start, the uncut patches and their winding numbers.
   start_status(x_t0, out);
   const bool culling_possible = method_options_.min_separation == 0.0;
   for (std::int32_t k = 0; k < num_components; ++k) {
-    culled_[at(k)] = culling_possible && clusters_.component_ok(k) &&
-                     status_[at(k)] == Status::clean;
+    culled_[at(k)] =
+        culling_possible && clusters_.component_ok(k) && status_[at(k)] != Status::unknown;
     stats_.components_culled += culled_[at(k)];
     stats_.components_open += clusters_.component_ok(k) ? 0 : 1;
     stats_.components_dirty += status_[at(k)] == Status::dirty ? 1 : 0;
   }
+  for (const std::uint8_t c : cut_) stats_.triangles_cut += c;
+  const auto t_patches = Clock::now();
+  classify_patches(x_t0);
 
   // 2. Swept volumes of the interval, local hierarchies, then the global one over their roots.
   const auto t_refit = Clock::now();
@@ -528,70 +570,56 @@ void RadialViewMethod::ccd(const culling::Interval& interval, culling::FrameResu
   const double test_us = blocks_.test_us();
   const auto t_escalate = Clock::now();
 
-  // 6. The argument guarantees the first contact of a component, not the ones after it: where a
-  //    component that had pairs skipped has a self-contact, test the skipped pairs too.
-  const auto component_of_contact = [&](const culling::CcdContact& c) -> std::int32_t {
-    std::int32_t ka = -1;
-    std::int32_t kb = -1;
-    if (c.kind == culling::CcdContact::Kind::vf) {
-      ka = clusters_.component_of_vertex(c.a);
-      kb = clusters_.component_of_triangle(c.b);
-    } else {
-      ka = clusters_.component_of_vertex(topology_.edge(c.a)[0]);
-      kb = clusters_.component_of_vertex(topology_.edge(c.b)[0]);
-    }
-    return ka == kb ? ka : -1;
-  };
+  // 6. The argument guarantees the first contact at a pair of skippable triangles, not the ones
+  //    after it: wherever a contact touches a skippable triangle, test its skipped pairs too,
+  //    round after round, until no new contact touches one (docs/radial-view.md, "The local
+  //    guard").
   double escalate_traverse_us = 0.0;
   double escalate_elementary_us = 0.0;
   if (options_.guard) {
-    std::fill(escalate_.begin(), escalate_.end(), 0);
-    bool any = false;
-    for (const auto& c : out.contacts) {
-      const std::int32_t k = component_of_contact(c);
-      if (k >= 0 && culled_[at(k)] != 0 && escalate_[at(k)] == 0) {
-        escalate_[at(k)] = 1;
-        ++stats_.components_escalated;
-        any = true;
-      }
-    }
-    if (any) {
+    std::fill(escalated_.begin(), escalated_.end(), 0);
+    std::fill(component_escalated_.begin(), component_escalated_.end(), 0);
+    frontier_.clear();
+    for (std::int32_t round = 1;; ++round) {
+      // New contacts are merged into the sorted list wherever they sort: look at all of them
+      // (marking is idempotent).
+      escalate(out, 0, round);
+      if (frontier_.empty()) break;
+      ++stats_.escalation_rounds;
       const auto e0 = Clock::now();
       const std::size_t before = out.contacts.size();
       blocks_.start_ccd(
           topology_, bounds_, x_t0, x_t1, tests_, method_options_.accuracy, ccd_options_, out);
-      stats_.skipped_pairs_retested += traverse(MaskedPairs::skipped, x_t0, x_t1, half_width, out);
+      stats_.skipped_pairs_retested += retest_frontier(round, x_t0, x_t1, half_width, out);
       blocks_.finish();
       stats_.blocks += blocks_.blocks();
       stats_.escalation_contacts += static_cast<std::int64_t>(out.contacts.size() - before);
-      // Both runs are sorted; one canonical order for the whole interval (in place).
+      // The new contacts are sorted; one canonical order for the whole interval (in place).
       std::inplace_merge(
           out.contacts.begin(), out.contacts.begin() + static_cast<std::ptrdiff_t>(before),
           out.contacts.end(),
           [](const culling::CcdContact& a, const culling::CcdContact& b) { return a.before(b); });
       const auto e1 = Clock::now();
-      escalate_elementary_us = blocks_.test_us();
-      escalate_traverse_us = micros(e0, e1) - escalate_elementary_us;
+      escalate_elementary_us += blocks_.test_us();
+      escalate_traverse_us += micros(e0, e1) - blocks_.test_us();
+      frontier_.clear();
+      if (before == out.contacts.size()) break;
     }
   }
-  const auto t_end = Clock::now();
 
-  // 7. What the next interval may assume at its start (these positions' end): components that
-  //    were free of self-intersection here and had no self-contact stay free of it.
-  if (options_.guard && culling_possible) {
-    for (std::int32_t k = 0; k < num_components; ++k) {
-      carry_clean_[at(k)] = status_[at(k)] == Status::clean ? 1 : 0;
-      carry_contact_[at(k)] = 0;
-    }
-    for (const auto& c : out.contacts) {
-      const std::int32_t k = component_of_contact(c);
-      if (k < 0) continue;
-      carry_clean_[at(k)] = 0;
-      carry_contact_[at(k)] = 1;
-    }
+  // 7. The intersecting pairs at the interval's end, for the next interval's start: this one's
+  //    start pairs updated from its contacts (complete: nothing is missed), when the contacts
+  //    come from a CCD that never misses.
+  if (options_.guard && culling_possible && method_options_.accuracy != ccd::Accuracy::fast) {
+    scratch_result_.clear();
+    updater_.update(start_pairs_, out.contacts, x_t1, tests_, scratch_result_);
+    carry_pairs_.assign(scratch_result_.dcd_pairs.begin(), scratch_result_.dcd_pairs.end());
     carry_x_ = x_t1;
     has_carry_ = true;
+    out.counters.tt_tests += scratch_result_.counters.tt_tests;
+    escalate_elementary_us += scratch_result_.times.elementary_us;
   }
+  const auto t_end = Clock::now();
 
   // Counters and stage times (paper Table 3: RV-update = classify + merge).
   out.counters.atomic_clusters += clusters_.num_atomic();
@@ -599,7 +627,8 @@ void RadialViewMethod::ccd(const culling::Interval& interval, culling::FrameResu
   out.counters.h_minus += classes_.h_minus;
   out.counters.h_uncertain += classes_.h_uncertain;
   out.times.refit_us += micros(t_refit, t_classify);
-  out.times.classify_us += classes_.classify_us + micros(t_masks, t_traverse);
+  out.times.classify_us +=
+      classes_.classify_us + micros(t_masks, t_traverse) + micros(t_patches, t_refit);
   out.times.merge_us += classes_.merge_us;
   out.times.traverse_us += micros(t_traverse, t_escalate) - test_us + escalate_traverse_us;
   out.times.elementary_us += test_us + escalate_elementary_us;

@@ -7,12 +7,14 @@
 // bounded block of pairs at a time (culling/pair_blocks.hpp).
 //
 // The radial-view argument has preconditions; this method checks them instead of assuming them
-// (docs/radial-view.md): the argument is applied only to closed, consistently oriented components
-// that are free of self-intersection at the interval's start (proven by a DCD pass, or carried
-// over from the previous interval), and when such a component has any self-contact in the
-// interval, the pairs it skipped are tested too (the argument guarantees only the first contact).
-// Contacts therefore equal those of `bvh` exactly. DCD queries are answered by the `bvh` method:
-// orientation at one instant says nothing about interpenetration.
+// (docs/radial-view.md, "The local guard"): the argument is applied only to closed, consistently
+// oriented components; where such a component intersects itself at the interval's start, only
+// triangles of its uncut patches with the component's front winding number may be skipped (one
+// exact ray per patch); and wherever a contact touches a skippable triangle, that triangle's
+// skipped pairs are tested too, round after round until no new contact touches one (the
+// argument guarantees only the first contact). Contacts therefore equal those of `bvh` exactly. DCD
+// queries are answered by the `bvh` method: orientation at one instant says nothing about
+// interpenetration.
 
 #include <cstdint>
 #include <memory>
@@ -27,6 +29,7 @@
 #include "culling/cluster_checks.hpp"
 #include "culling/elementary.hpp"
 #include "culling/feature_topology.hpp"
+#include "culling/incremental_dcd.hpp"
 #include "culling/method.hpp"
 #include "culling/pair_blocks.hpp"
 #include "culling/traversal.hpp"
@@ -39,27 +42,36 @@ struct RadialViewOptions {
   MegaClusterOptions clusters{};
   /// Relative AABB filter on non-adjacent candidate pairs (§6).
   bool relative_aabb = true;
-  /// Check the preconditions and re-test skipped pairs where a component has a self-contact.
-  /// Off only to show what the bare theory misses (tests/clustering): then contacts may be lost.
+  /// Check the preconditions (the local guard: patches at the start, re-tests around every
+  /// self-contact). Off only to show what the bare theory misses (tests/clustering): then
+  /// contacts may be lost.
   bool guard = true;
 };
 
 /// What the last detect_ccd did beyond the counters of FrameResult.
 struct RadialViewStats {
   std::int32_t components = 0;         ///< components of the mesh
-  std::int32_t components_culled = 0;  ///< components where pairs were skipped
+  std::int32_t components_culled = 0;  ///< components where pairs may be skipped
   std::int32_t components_open = 0;    ///< not closed / not consistently oriented / mixed parts
-  std::int32_t components_dcd = 0;     ///< components proven at the start by a DCD pass here
-  std::int64_t dcd_pass_pairs = 0;     ///< triangle pairs that pass's traversals found
-  std::int32_t components_dirty = 0;   ///< self-intersecting at the start: nothing skipped there
-  /// Of those, assumed so without a DCD pass: they had a self-contact in the previous interval.
-  std::int32_t components_assumed_dirty = 0;
-  std::int32_t components_escalated = 0;  ///< had a self-contact: skipped pairs re-tested
+  /// Components whose start was known from a full DCD made here (no DCD at these positions, no
+  /// previous interval ending there).
+  std::int32_t components_dcd = 0;
+  std::int64_t dcd_pass_pairs = 0;    ///< candidate triangle pairs of that DCD
+  std::int32_t components_dirty = 0;  ///< self-intersecting at the start (patches classified)
+  /// Components with a triangle escalated: a self-contact touched its skippable triangles.
+  std::int32_t components_escalated = 0;
   std::int64_t relative_aabb_culled = 0;  ///< candidate pairs removed by the relative AABB filter
   std::int64_t skipped_pairs_retested = 0;  ///< overlapping skipped pairs tested on escalation
-  std::int64_t escalation_contacts = 0;     ///< contacts found only by the escalation pass
-  /// Blocks of candidate triangle pairs tested, both passes (MethodOptions::block_pairs each).
+  std::int64_t escalation_contacts = 0;     ///< contacts found only by the escalation passes
+  /// Blocks of candidate triangle pairs tested, all passes (MethodOptions::block_pairs each).
   std::int64_t blocks = 0;
+  // The local guard (docs/radial-view.md, "The local guard").
+  std::int64_t triangles_cut = 0;        ///< in a self-intersecting pair of their component
+  std::int64_t patches = 0;              ///< uncut patches of the dirty components
+  std::int64_t patches_classified = 0;   ///< … whose front winding number a ray decided
+  std::int64_t triangles_kept_out = 0;   ///< of dirty components, not skippable (cut, off-value)
+  std::int64_t triangles_escalated = 0;  ///< skippable triangles whose skipped pairs were tested
+  std::int32_t escalation_rounds = 0;    ///< rounds until no new contact touched one
 };
 
 class RadialViewMethod final : public culling::CullingMethod {
@@ -101,12 +113,28 @@ class RadialViewMethod final : public culling::CullingMethod {
   enum class Status : std::uint8_t { unknown, clean, dirty };
 
   void check_positions(const skinning::Positions& x, const char* call, const char* which) const;
+  /// The intersecting pairs at x_t0 (known, carried or from a DCD here), each component's status
+  /// and the cut triangles.
   void start_status(const skinning::Positions& x_t0, culling::FrameResult& out);
+  /// The uncut patches of the dirty culled components and their front winding numbers: which
+  /// triangles may be skipped (skippable_).
+  void classify_patches(const skinning::Positions& x_t0);
   void compute_masks();
   /// Streams the pairs `which` selects into blocks_ (a query started there), each installment
   /// through the relative AABB filter; returns the pairs found before the filter.
   std::int64_t traverse(
       culling::MaskedPairs which,
+      const skinning::Positions& x_t0,
+      const skinning::Positions& x_t1,
+      double half_width,
+      culling::FrameResult& out);
+  /// Marks the skippable triangles at the vertices of the contacts out.contacts[from…] that are
+  /// not marked yet (round `round`), appending them to frontier_.
+  void escalate(const culling::FrameResult& out, std::size_t from, std::int32_t round);
+  /// Streams the skipped pairs of frontier_'s triangles into blocks_ (each once: not with a
+  /// triangle of an earlier round), through the relative AABB filter; returns the pairs found.
+  std::int64_t retest_frontier(
+      std::int32_t round,
       const skinning::Positions& x_t0,
       const skinning::Positions& x_t1,
       double half_width,
@@ -124,8 +152,10 @@ class RadialViewMethod final : public culling::CullingMethod {
   culling::ElementaryTests tests_;
   ccd::CcdOptions ccd_options_;
   std::unique_ptr<culling::CullingMethod> bvh_;  // DCD
+  culling::DcdUpdater updater_;                  // the intersecting pairs from one end to the next
   MegaClusterBuilder builder_;
   std::vector<std::int32_t> edge_face_offsets_, edge_faces_;
+  std::vector<std::int32_t> component_offsets_, component_triangles_;  // CSR component → triangles
 
   // Per interval.
   IntervalObservers observers_;
@@ -136,27 +166,32 @@ class RadialViewMethod final : public culling::CullingMethod {
   std::vector<std::uint8_t> triangle_mask_;
   std::vector<std::vector<std::uint8_t>> node_masks_;
   std::vector<std::int64_t> vertex_label_, edge_label_;
-  std::vector<Status> status_;          // per component, at the interval's start
-  std::vector<std::uint8_t> culled_;    // per component: pairs were skipped this interval
-  std::vector<std::uint8_t> escalate_;  // per component
+  std::vector<Status> status_;           // per component, at the interval's start
+  std::vector<std::uint8_t> culled_;     // per component: pairs may be skipped this interval
+  std::vector<std::uint8_t> cut_;        // per triangle: in a self-intersecting pair at the start
+  std::vector<std::uint8_t> skippable_;  // per triangle: its patch has its component's value
+  std::vector<std::int32_t> patch_;      // per triangle of a dirty component: its patch, or −1
+  std::vector<std::int32_t> patch_order_, patch_offsets_;  // CSR patch → triangles (BFS order)
+  std::vector<std::int32_t> escalated_;  // per triangle: the round it was escalated in, or 0
+  std::vector<std::int32_t> frontier_;   // triangles escalated in the current round
+  std::vector<std::uint8_t> component_escalated_;
   std::vector<culling::TrianglePair> cluster_pairs_;
   // The candidate triangle pairs of a pass, in bounded blocks (docs/culling.md "Bounded memory").
   culling::PairBlocks<3> blocks_;
   culling::TraversalScratch scratch_;
+  std::vector<std::int32_t> node_stack_;
 
-  // The start-of-interval knowledge carried between queries: components free of
-  // self-intersection at positions carry_x_ (the last interval's end), and the DCD findings at
-  // dcd_x_ (the last detect_dcd).
+  // The intersecting pairs at the interval's start, and what may tell them without a DCD: the
+  // last detect_dcd (at dcd_x_) and the pairs at the last interval's end (carry_x_), updated from
+  // its contacts (culling/incremental_dcd.hpp).
+  std::vector<culling::TrianglePair> start_pairs_;
   bool has_carry_ = false;
   skinning::Positions carry_x_;
-  std::vector<std::uint8_t> carry_clean_;
-  std::vector<std::uint8_t> carry_contact_;  // had a self-contact: assumed still intersecting
+  std::vector<culling::TrianglePair> carry_pairs_;
   bool has_dcd_ = false;
   skinning::Positions dcd_x_;
-  std::vector<std::uint8_t> dcd_clean_;
-  // Precondition DCD scratch.
-  culling::FeatureBounds<3> static_bounds_;
   std::vector<culling::TrianglePair> dcd_pairs_;
+  culling::FrameResult scratch_result_;
 };
 
 }  // namespace skelcd::clustering

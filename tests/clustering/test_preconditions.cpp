@@ -7,12 +7,13 @@
 // - Intersecting start: the argument does not apply at all. Guarded, the DCD pass at the start
 //   marks the component and nothing is skipped there.
 // docs/radial-view.md ("Preconditions") explains both.
-#include <algorithm>
-#include <array>
-#include <memory>
+#include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
-#include <gtest/gtest.h>
+#include <algorithm>
+#include <array>
+#include <map>
+#include <memory>
 
 #include "clustering/radial_view_method.hpp"
 #include "culling/method.hpp"
@@ -74,6 +75,82 @@ USlab make_slab(int strips) {
   m.vertex_index_in_part.resize(vs.size());
   for (std::size_t v = 0; v < vs.size(); ++v) m.vertex_index_in_part[v] = static_cast<std::int32_t>(v);
   m.part_names = {"slab"};
+  s.topology = skinning::build_topology(m);
+  for (const auto& v : vs) s.upper.push_back(v.z() > 0.5);
+  return s;
+}
+
+/// A finer U-slab (the same section, gridded: cells of 0.2 × 0.2 in (x, z), `strips` strips of
+/// width 1/strips along y in [0, 1]), so that patches of the surface lie away from its cuts: the
+/// section is the union of the cells inside the U, the caps are those cells, the sides their
+/// boundary edges extruded. Outward, closed, one component.
+USlab make_grid_slab(int strips) {
+  constexpr int nx = 20, nz = 5;
+  const auto inside = [&](int i, int k) {
+    if (i < 0 || k < 0 || i >= nx || k >= nz) return false;
+    const double xc = 0.2 * (i + 0.5), zc = 0.2 * (k + 0.5);
+    return zc < 0.2 || zc > 0.8 || xc > 3.2;
+  };
+  USlab s;
+  std::vector<V3> vs;
+  std::vector<std::array<std::int32_t, 3>> fs;
+  std::map<std::array<int, 3>, std::int32_t> ids;
+  const auto id = [&](int i, int k, int level) {
+    const auto [it, added] = ids.try_emplace({i, k, level}, static_cast<std::int32_t>(vs.size()));
+    if (added) vs.emplace_back(0.2 * i, static_cast<double>(level) / strips, 0.2 * k);
+    return it->second;
+  };
+  for (int i = 0; i < nx; ++i) {
+    for (int k = 0; k < nz; ++k) {
+      if (!inside(i, k)) continue;
+      // Corners counter-clockwise in (x, z): the cap at y = 0 faces −y, the one at y = 1 +y.
+      const std::array<std::array<int, 2>, 4> c{{{i, k}, {i + 1, k}, {i + 1, k + 1}, {i, k + 1}}};
+      const auto at = [&](int corner, int level) {
+        return id(
+            c[static_cast<std::size_t>(corner)][0], c[static_cast<std::size_t>(corner)][1], level);
+      };
+      fs.push_back({at(0, 0), at(1, 0), at(2, 0)});
+      fs.push_back({at(0, 0), at(2, 0), at(3, 0)});
+      fs.push_back({at(0, strips), at(2, strips), at(1, strips)});
+      fs.push_back({at(0, strips), at(3, strips), at(2, strips)});
+      // Boundary edges (P → Q counter-clockwise, the neighbour across it outside), extruded.
+      const std::array<std::array<int, 2>, 4> across{
+          {{i, k - 1}, {i + 1, k}, {i, k + 1}, {i - 1, k}}};
+      for (int e = 0; e < 4; ++e) {
+        if (inside(
+                across[static_cast<std::size_t>(e)][0], across[static_cast<std::size_t>(e)][1])) {
+          continue;
+        }
+        for (int level = 0; level < strips; ++level) {
+          const std::int32_t a = at(e, level), b = at((e + 1) % 4, level);
+          const std::int32_t cc = at((e + 1) % 4, level + 1), d = at(e, level + 1);
+          fs.push_back({a, cc, b});
+          fs.push_back({a, d, cc});
+        }
+      }
+    }
+  }
+  auto& m = s.mesh;
+  m.rest_positions.resize(static_cast<Eigen::Index>(vs.size()), 3);
+  for (std::size_t i = 0; i < vs.size(); ++i) {
+    m.rest_positions.row(static_cast<Eigen::Index>(i)) = vs[i];
+  }
+  m.triangles.resize(static_cast<Eigen::Index>(fs.size()), 3);
+  for (std::size_t f = 0; f < fs.size(); ++f) {
+    for (int k = 0; k < 3; ++k) {
+      m.triangles(static_cast<Eigen::Index>(f), k) = fs[f][static_cast<std::size_t>(k)];
+    }
+  }
+  m.face_part.assign(fs.size(), 0);
+  m.face_index_in_part.resize(fs.size());
+  for (std::size_t f = 0; f < fs.size(); ++f)
+    m.face_index_in_part[f] = static_cast<std::int32_t>(f);
+  m.vertex_part.assign(vs.size(), 0);
+  m.vertex_index_in_part.resize(vs.size());
+  for (std::size_t v = 0; v < vs.size(); ++v) {
+    m.vertex_index_in_part[v] = static_cast<std::int32_t>(v);
+  }
+  m.part_names = {"grid slab"};
   s.topology = skinning::build_topology(m);
   for (const auto& v : vs) s.upper.push_back(v.z() > 0.5);
   return s;
@@ -187,7 +264,9 @@ TEST(Preconditions, IntersectingStartIsDetected) {
   ASSERT_FALSE(r.brute.contacts.empty());
   EXPECT_EQ(keys(r.guarded), keys(r.brute));
   EXPECT_EQ(r.guarded_stats.components_dirty, 1);
-  EXPECT_EQ(r.guarded_stats.components_culled, 0);
+  // The local guard keeps the cut triangles (and their patches' rims) out of the skipped pairs.
+  EXPECT_GT(r.guarded_stats.triangles_cut, 0);
+  EXPECT_GE(r.guarded_stats.triangles_kept_out, r.guarded_stats.triangles_cut);
   EXPECT_LT(keys(r.bare).size(), keys(r.brute).size());
 }
 
@@ -201,6 +280,62 @@ TEST(Preconditions, NoContactNoWork) {
   EXPECT_EQ(r.guarded_stats.components_escalated, 0);
   EXPECT_EQ(r.guarded_stats.components_culled, 1);
   EXPECT_LT(r.guarded.counters.candidate_pairs, r.brute.counters.candidate_pairs);
+}
+
+TEST(Preconditions, SkinInsideAnOverlapIsNotSkippedAgainstTheOuterSkin) {
+  // The local guard's winding rule (docs/radial-view.md, "The local guard"): the upper arm of a
+  // gridded U-slab is sunk into the lower arm at t = 0 (the bridge blends between them), so the
+  // arm's underside lies inside the lower arm — a patch whose front winding number is 1, not the
+  // outer skin's 0. During the interval only a bump in the middle of the lower arm's bottom rises
+  // through that underside. Both faces face away from the observer below (H⁻) and, seen along a
+  // ray, nothing lies between them: the alternation the theorem needs fails there, and no other
+  // contact happens anywhere to trigger a re-test. Skipping by class alone (as if the underside
+  // were outer skin) loses these contacts; the guard keeps the underside's patch out.
+  const USlab s = make_grid_slab(10);
+  ASSERT_EQ(s.topology.components.size(), 1u);
+  ASSERT_TRUE(s.topology.components[0].closed);
+  skinning::Positions p0 = s.mesh.rest_positions;
+  for (Eigen::Index v = 0; v < p0.rows(); ++v) {
+    const double t = std::clamp((p0(v, 2) - 0.2) / 0.6, 0.0, 1.0);
+    p0.row(v) += t * V3(-0.1, 0.13, -0.73).transpose();
+  }
+  skinning::Positions p1 = p0;
+  int bump = 0;
+  for (Eigen::Index v = 0; v < p1.rows(); ++v) {
+    const V3 r = s.mesh.rest_positions.row(v);
+    const double d2 = (r.x() - 1.0) * (r.x() - 1.0) + (r.y() - 0.5) * (r.y() - 0.5);
+    if (r.z() != 0.0 || d2 >= 0.35 * 0.35) continue;
+    p1(v, 2) += 0.12 * (1.0 - d2 / (0.35 * 0.35));
+    ++bump;
+  }
+  ASSERT_GT(bump, 10);
+  skinning::Positions x0, x1;
+  skinning::gather_welded(s.topology, p0, x0);
+  skinning::gather_welded(s.topology, p1, x1);
+  culling::FrameResult brute, guarded, bare;
+  culling::make_method("brute", s.mesh, s.topology)->detect_ccd(x0, x1, brute);
+  ASSERT_FALSE(brute.contacts.empty());
+  const auto seg = one_cluster(s);
+  const auto poses = still_bone();
+  RadialViewStats stats;
+  for (const bool guard : {true, false}) {
+    RadialViewOptions o;
+    o.clusters.merge = false;
+    o.guard = guard;
+    RadialViewMethod m("rvbc", s.mesh, s.topology, seg, poses, 1, {}, o);
+    m.detect_ccd(x0, x1, guard ? guarded : bare);
+    if (guard) stats = m.last_stats();
+  }
+  EXPECT_EQ(keys(guarded), keys(brute));
+  EXPECT_EQ(stats.components_dirty, 1);
+  EXPECT_EQ(stats.components_culled, 1);
+  EXPECT_GT(stats.patches_classified, 1);
+  // More kept out than the cut triangles: the off-value patches (the underside inside the lower
+  // arm, the lower arm's top inside the upper one).
+  EXPECT_GT(stats.triangles_kept_out, stats.triangles_cut + 40);
+  EXPECT_EQ(stats.escalation_contacts, 0);  // found by the first pass, not by a re-test
+  // Bare (everything of one class skipped), the contacts are lost: the test above can fail.
+  EXPECT_LT(keys(bare).size(), keys(brute).size());
 }
 
 }  // namespace

@@ -143,12 +143,16 @@ TEST(RadialViewMethod, SmallBlocksFindExactlyWhatOnePieceFinds) {
         EXPECT_EQ(b.stats.components_dcd, w.stats.components_dcd);
         EXPECT_EQ(b.stats.dcd_pass_pairs, w.stats.dcd_pass_pairs);
         EXPECT_EQ(b.stats.components_dirty, w.stats.components_dirty);
-        EXPECT_EQ(b.stats.components_assumed_dirty, w.stats.components_assumed_dirty);
+        EXPECT_EQ(b.stats.triangles_cut, w.stats.triangles_cut);
+        EXPECT_EQ(b.stats.patches_classified, w.stats.patches_classified);
+        EXPECT_EQ(b.stats.triangles_kept_out, w.stats.triangles_kept_out);
+        EXPECT_EQ(b.stats.triangles_escalated, w.stats.triangles_escalated);
+        EXPECT_EQ(b.stats.escalation_rounds, w.stats.escalation_rounds);
         EXPECT_EQ(b.stats.components_escalated, w.stats.components_escalated);
         EXPECT_EQ(b.stats.relative_aabb_culled, w.stats.relative_aabb_culled);
         EXPECT_EQ(b.stats.skipped_pairs_retested, w.stats.skipped_pairs_retested);
         EXPECT_EQ(b.stats.escalation_contacts, w.stats.escalation_contacts);
-        EXPECT_LE(w.stats.blocks, 2);  // one piece: one block per pass
+        EXPECT_LE(w.stats.blocks, 1 + w.stats.escalation_rounds);  // one piece: one block per pass
         contacts += static_cast<std::int64_t>(w.ccd.contacts.size());
         most_blocks = std::max(most_blocks, b.stats.blocks);
         dcd_pass_pairs = std::max(dcd_pass_pairs, b.stats.dcd_pass_pairs);
@@ -252,28 +256,40 @@ TEST(RadialViewMethod, RealCharacters) {
   }
 }
 
-TEST(RadialViewMethod, CesiumMansWalkTripsTheGuardAndStillFindsWhatBvhFinds) {
+TEST(RadialViewMethod, CesiumMansWalkIntersectsItselfAndTheLocalGuardStillFindsWhatBvhFinds) {
   // CesiumMan is one closed component that intersects itself at every sample of its walk, which
-  // breaks the radial-view precondition (free of self-intersection at the interval's start). The
-  // DCD at each interval's start must see it: the component is dirty in every interval, nothing
-  // is skipped in it, and the contacts stay bvh's. (The guard works per component, so here it
-  // turns the orientation-class culling off for the whole clip: docs/radial-view.md.)
+  // breaks the radial-view precondition where it intersects. The local guard (docs/radial-view.md)
+  // keeps out the cut triangles and every patch whose front winding number is not the skin's, skips
+  // pairs among the rest, and re-tests around every contact: the contacts stay bvh's (compare).
   RadialViewScene scene(loaded(test::asset("characters/CesiumMan.glb")), 0);
   const auto c = compare(scene, 0, 12, test::DcdQueries::every);
   ASSERT_GT(c.bvh.contacts.size(), 0u);
+  const auto num_triangles = static_cast<std::int64_t>(scene.rig->mesh.num_triangles());
   for (const ClipRun* run : {&c.rvbc, &c.dynamic}) {
     ASSERT_EQ(run->stats.size(), 12u);
+    std::int64_t escalated = 0;
     for (const auto& st : run->stats) {
       EXPECT_EQ(st.components, 1);
-      EXPECT_EQ(st.components_open, 0);  // closed: the radial view applies, were it not dirty
+      EXPECT_EQ(st.components_open, 0);
       EXPECT_EQ(st.components_dirty, 1);
-      EXPECT_EQ(st.components_culled, 0);
+      EXPECT_EQ(st.components_culled, 1);
+      EXPECT_GT(st.triangles_cut, 0);
+      EXPECT_GT(st.patches_classified, 0);
+      // Cut and off-value triangles are kept out, most of the skin is not.
+      EXPECT_GE(st.triangles_kept_out, st.triangles_cut);
+      EXPECT_LT(2 * st.triangles_kept_out, num_triangles);
+      escalated += st.triangles_escalated;
     }
+    EXPECT_GT(escalated, 0);  // the walk's contacts touch skippable triangles
   }
-  // Without the DCD at each start (CCD only after the first), the method cannot know and must
-  // not assume: the component stays dirty and the contacts stay bvh's.
+  // Without the DCD at each start (CCD only after the first), the start pairs are carried from
+  // one interval to the next (updated from its contacts): the same patches, the same contacts.
   const auto ccd_only = compare(scene, 0, 12, test::DcdQueries::first);
-  for (const auto& st : ccd_only.dynamic.stats) EXPECT_EQ(st.components_culled, 0);
+  ASSERT_EQ(ccd_only.dynamic.stats.size(), c.dynamic.stats.size());
+  for (std::size_t i = 0; i < c.dynamic.stats.size(); ++i) {
+    EXPECT_EQ(ccd_only.dynamic.stats[i].triangles_cut, c.dynamic.stats[i].triangles_cut);
+    EXPECT_EQ(ccd_only.dynamic.stats[i].triangles_kept_out, c.dynamic.stats[i].triangles_kept_out);
+  }
 }
 
 TEST(RadialViewMethod, BcnEpilepticIsOpenAndItsRestPoseInterpenetrates) {
