@@ -35,6 +35,9 @@ bool same_positions(const skinning::Positions& a, const skinning::Positions& b) 
 constexpr std::int32_t kMinPatch = 8;
 /// Triangles of a patch tried before it is given up (each with its own ray tilt).
 constexpr int kPatchAttempts = 6;
+/// Boundary loops up to this many edges are capped with ghost triangles (eye sockets, cuffs, a
+/// robot tube's end); longer ones (a garment's hem) would cut much of the mesh.
+constexpr std::int32_t kMaxGhostLoop = 64;
 
 }  // namespace
 
@@ -47,20 +50,56 @@ RadialViewMethod::RadialViewMethod(
     std::int32_t num_bones,
     const culling::MethodOptions& method_options,
     const RadialViewOptions& options)
+    : RadialViewMethod(
+          std::move(name),
+          mesh,
+          topology,
+          // Loops up to kMaxGhostLoop edges; none when the segmentation does not fit (reported
+          // below by ClusterSet).
+          segmentation ? cap_small_loops(mesh, topology, *segmentation, kMaxGhostLoop) : nullptr,
+          segmentation,  // copied: the argument above reads it (evaluation order is unspecified)
+          std::move(poses),
+          num_bones,
+          method_options,
+          options) {}
+
+RadialViewMethod::RadialViewMethod(
+    std::string name,
+    const skinning::Mesh& real_mesh,
+    const skinning::Topology& real_topology,
+    std::unique_ptr<GhostCaps> ghosts,
+    std::shared_ptr<const segmentation::Segmentation> segmentation,
+    std::shared_ptr<const BonePoses> poses,
+    std::int32_t num_bones,
+    const culling::MethodOptions& method_options,
+    const RadialViewOptions& options)
     : name_(std::move(name)),
-      segmentation_(std::move(segmentation)),
+      ghosts_(std::move(ghosts)),
+      real_vertices_(real_topology.num_welded_vertices()),
+      real_triangles_(static_cast<std::int32_t>(real_topology.welded_triangles.rows())),
+      segmentation_(ghosts_ ? ghosts_->segmentation : std::move(segmentation)),
       poses_(std::move(poses)),
-      topology_(mesh, topology),
-      clusters_(mesh, topology, *segmentation_, num_bones, method_options.bvh),
+      topology_(ghosts_ ? ghosts_->mesh : real_mesh, ghosts_ ? ghosts_->topology : real_topology),
+      clusters_(
+          ghosts_ ? ghosts_->mesh : real_mesh,
+          ghosts_ ? ghosts_->topology : real_topology,
+          *segmentation_,
+          num_bones,
+          method_options.bvh),
       method_options_(method_options),
       options_(options),
       tests_(culling::with_ccd_defaults(method_options.elementary)),
       // The bvh method checks the method options (min_separation, accuracy) as every method does.
-      bvh_(culling::make_method("bvh", mesh, topology, method_options_)),
-      updater_(mesh, topology),
+      bvh_(culling::make_method(
+          "bvh",
+          ghosts_ ? ghosts_->mesh : real_mesh,
+          ghosts_ ? ghosts_->topology : real_topology,
+          method_options_)),
+      updater_(ghosts_ ? ghosts_->mesh : real_mesh, ghosts_ ? ghosts_->topology : real_topology),
       builder_(clusters_, options.clusters),
-      edge_face_offsets_(topology.edge_face_offsets),
-      edge_faces_(topology.edge_faces),
+      edge_face_offsets_(
+          ghosts_ ? ghosts_->topology.edge_face_offsets : real_topology.edge_face_offsets),
+      edge_faces_(ghosts_ ? ghosts_->topology.edge_faces : real_topology.edge_faces),
       blocks_(
           method_options.block_pairs,
           culling::block_reserve(
@@ -111,17 +150,54 @@ RadialViewMethod::RadialViewMethod(
   for (std::int32_t f = 0; f < topology_.num_triangles(); ++f) {
     component_triangles_[at(next[at(clusters_.component_of_triangle(f))]++)] = f;
   }
+  if (ghosts_) {  // everything is built: keep only the loops and the edge map
+    ghosts_->mesh = skinning::Mesh{};
+    ghosts_->topology = skinning::Topology{};
+    ghosts_->segmentation.reset();
+  }
+}
+
+const skinning::Positions& RadialViewMethod::with_ghosts(
+    const skinning::Positions& x, skinning::Positions& capped) const {
+  if (!ghosts_) return x;
+  place_ghost_centres(*ghosts_, x, capped);
+  return capped;
+}
+
+void RadialViewMethod::drop_ghosts(culling::FrameResult& out) {
+  if (!ghosts_) return;
+  const auto ghost_pair = [&](const culling::TrianglePair& p) {
+    return p.a >= real_triangles_ || p.b >= real_triangles_;
+  };
+  std::erase_if(out.dcd_pairs, ghost_pair);
+  const std::size_t before = out.contacts.size();
+  std::erase_if(out.contacts, [&](culling::CcdContact& c) {
+    if (c.kind == culling::CcdContact::Kind::vf) {
+      return c.a >= real_vertices_ || c.b >= real_triangles_;
+    }
+    const std::int32_t a = ghosts_->real_edge[at(c.a)];
+    const std::int32_t b = ghosts_->real_edge[at(c.b)];
+    if (a < 0 || b < 0) return true;
+    c.a = a;
+    c.b = b;
+    return false;
+  });
+  stats_.ghost_contacts += static_cast<std::int64_t>(before - out.contacts.size());
+  // Renumbered edges: the canonical order again.
+  std::sort(
+      out.contacts.begin(),
+      out.contacts.end(),
+      [](const culling::CcdContact& a, const culling::CcdContact& b) { return a.before(b); });
 }
 
 void RadialViewMethod::check_positions(
     const skinning::Positions& x,
     const char* call,
     const char* which) const {
-  if (x.rows() != topology_.num_vertices()) {
+  if (x.rows() != real_vertices_) {
     throw InvalidInput(
         "clustering::" + name_ + "::" + call + ": " + which + " has " + std::to_string(x.rows()) +
-        " rows, expected one per welded vertex (" + std::to_string(topology_.num_vertices()) +
-        ")");
+        " rows, expected one per welded vertex (" + std::to_string(real_vertices_) + ")");
   }
 }
 
@@ -135,10 +211,11 @@ void RadialViewMethod::record_dcd(
 }
 
 void RadialViewMethod::dcd(const culling::Instant& at, culling::FrameResult& out) {
-  const skinning::Positions& x = at.x;
-  check_positions(x, "detect_dcd", "x");
+  check_positions(at.x, "detect_dcd", "x");
+  const skinning::Positions& x = with_ghosts(at.x, capped_x0_);
   bvh_->detect_dcd(x, out);
-  record_dcd(x, out);
+  record_dcd(x, out);  // with the ghosts' pairs: the next interval's cuts need them
+  drop_ghosts(out);
 }
 
 // --- preconditions at the interval's start ------------------------------------------------------
@@ -270,7 +347,8 @@ void RadialViewMethod::compute_masks() {
   // the argument rules out (docs/radial-view.md, "Why features, not triangles").
   const auto label = [&](std::int32_t f) -> std::int64_t {
     const std::int32_t k = clusters_.component_of_triangle(f);
-    if (culled_[at(k)] == 0 || skippable_[at(f)] == 0) return -1;
+    // Ghost triangles are Hᵘ: tested against everything, never skipped.
+    if (culled_[at(k)] == 0 || skippable_[at(f)] == 0 || f >= real_triangles_) return -1;
     const OrientationClass c = classes_.triangle_class[at(f)];
     if (c == OrientationClass::uncertain) return -1;
     const std::int32_t mega = classes_.atomic_mega[at(clusters_.atomic_of(f))];
@@ -495,10 +573,12 @@ std::int64_t RadialViewMethod::retest_frontier(
 }
 
 void RadialViewMethod::ccd(const culling::Interval& interval, culling::FrameResult& out) {
-  const skinning::Positions& x_t0 = interval.x_t0;
-  const skinning::Positions& x_t1 = interval.x_t1;
-  check_positions(x_t0, "detect_ccd", "x_t0");
-  check_positions(x_t1, "detect_ccd", "x_t1");
+  check_positions(interval.x_t0, "detect_ccd", "x_t0");
+  check_positions(interval.x_t1, "detect_ccd", "x_t1");
+  // The capped mesh's positions (ghost centres placed); the findings of ghost features are used
+  // by the guard, then dropped (drop_ghosts, at the end).
+  const skinning::Positions& x_t0 = with_ghosts(interval.x_t0, capped_x0_);
+  const skinning::Positions& x_t1 = with_ghosts(interval.x_t1, capped_x1_);
   // The observers ride their bones: the interval's own transforms, else (a driver that selects
   // them itself) the BonePoses given at construction.
   std::span<const skinning::BoneTransform> bones_t0 = interval.bones_t0;
@@ -619,6 +699,8 @@ void RadialViewMethod::ccd(const culling::Interval& interval, culling::FrameResu
     out.counters.tt_tests += scratch_result_.counters.tt_tests;
     escalate_elementary_us += scratch_result_.times.elementary_us;
   }
+  stats_.ghost_loops = ghosts_ ? ghosts_->num_loops() : 0;
+  drop_ghosts(out);
   const auto t_end = Clock::now();
 
   // Counters and stage times (paper Table 3: RV-update = classify + merge).

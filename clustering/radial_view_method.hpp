@@ -24,6 +24,7 @@
 
 #include "clustering/bone_poses.hpp"
 #include "clustering/cluster_set.hpp"
+#include "clustering/ghost_caps.hpp"
 #include "clustering/mega_clusters.hpp"
 #include "culling/candidates.hpp"
 #include "culling/cluster_checks.hpp"
@@ -72,6 +73,8 @@ struct RadialViewStats {
   std::int64_t triangles_kept_out = 0;   ///< of dirty components, not skippable (cut, off-value)
   std::int64_t triangles_escalated = 0;  ///< skippable triangles whose skipped pairs were tested
   std::int32_t escalation_rounds = 0;    ///< rounds until no new contact touched one
+  std::int32_t ghost_loops = 0;          ///< boundary loops closed by ghost triangles
+  std::int64_t ghost_contacts = 0;       ///< contacts of a ghost's features (used, not reported)
 };
 
 class RadialViewMethod final : public culling::CullingMethod {
@@ -112,6 +115,23 @@ class RadialViewMethod final : public culling::CullingMethod {
  private:
   enum class Status : std::uint8_t { unknown, clean, dirty };
 
+  /// The mesh the method works on: `mesh` with its small holes capped (ghost_caps.hpp), or `mesh`.
+  RadialViewMethod(
+      std::string name,
+      const skinning::Mesh& mesh,
+      const skinning::Topology& topology,
+      std::unique_ptr<GhostCaps> ghosts,
+      std::shared_ptr<const segmentation::Segmentation> segmentation,
+      std::shared_ptr<const BonePoses> poses,
+      std::int32_t num_bones,
+      const culling::MethodOptions& method_options,
+      const RadialViewOptions& options);
+  /// `x` (the real mesh's welded positions), or it with the ghost centres placed, in `capped`.
+  const skinning::Positions& with_ghosts(
+      const skinning::Positions& x, skinning::Positions& capped) const;
+  /// Drops the findings of ghost features from `out` and renumbers edges to the real mesh's.
+  void drop_ghosts(culling::FrameResult& out);
+
   void check_positions(const skinning::Positions& x, const char* call, const char* which) const;
   /// The intersecting pairs at x_t0 (known, carried or from a DCD here), each component's status
   /// and the cut triangles.
@@ -142,6 +162,12 @@ class RadialViewMethod final : public culling::CullingMethod {
   void record_dcd(const skinning::Positions& x, const culling::FrameResult& result);
 
   std::string name_;
+  // Ghost caps (built before everything below, which works on the capped mesh); the capped
+  // mesh and topology are released once the members are built.
+  std::unique_ptr<GhostCaps> ghosts_;
+  std::int32_t real_vertices_ = 0;
+  std::int32_t real_triangles_ = 0;
+  skinning::Positions capped_x0_, capped_x1_;
   std::shared_ptr<const segmentation::Segmentation> segmentation_;
   std::shared_ptr<const BonePoses> poses_;
   std::int32_t num_bones_ = 0;

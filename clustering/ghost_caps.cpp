@@ -1,0 +1,171 @@
+#include "clustering/ghost_caps.hpp"
+
+#include <algorithm>
+#include <map>
+#include <utility>
+
+namespace skelcd::clustering {
+namespace {
+
+std::size_t at(std::int32_t i) { return static_cast<std::size_t>(i); }
+
+}  // namespace
+
+std::unique_ptr<GhostCaps> cap_small_loops(
+    const skinning::Mesh& mesh,
+    const skinning::Topology& topology,
+    const segmentation::Segmentation& segmentation,
+    std::int32_t max_loop) {
+  const auto num_faces = static_cast<std::int32_t>(topology.welded_triangles.rows());
+  const std::int32_t num_welded = topology.num_welded_vertices();
+  if (topology.boundary_edges.empty() ||
+      static_cast<std::int32_t>(segmentation.triangle_cluster.size()) != num_faces ||
+      mesh.num_triangles() != num_faces) {
+    return nullptr;
+  }
+  // Components with a non-manifold edge stay open.
+  std::vector<std::uint8_t> bad_component(topology.components.size(), 0);
+  for (const std::int32_t e : topology.non_manifold_edges) {
+    const auto f = topology.edge_faces[at(topology.edge_face_offsets[at(e)])];
+    bad_component[at(topology.face_component[at(f)])] = 1;
+  }
+  // Oriented boundary edges (as their face has them) and the face behind each.
+  struct Side {
+    std::int32_t from, to, face;
+  };
+  std::vector<Side> sides;
+  std::vector<std::int32_t> out_count(at(num_welded), 0), in_count(at(num_welded), 0);
+  std::vector<std::int32_t> next_side(at(num_welded), -1);  // the side leaving a vertex
+  for (const std::int32_t e : topology.boundary_edges) {
+    const auto f = topology.edge_faces[at(topology.edge_face_offsets[at(e)])];
+    for (int k = 0; k < 3; ++k) {
+      if (topology.face_edges(f, k) != e) continue;
+      const Side s{topology.welded_triangles(f, k), topology.welded_triangles(f, (k + 1) % 3), f};
+      ++out_count[at(s.from)];
+      ++in_count[at(s.to)];
+      next_side[at(s.from)] = static_cast<std::int32_t>(sides.size());
+      sides.push_back(s);
+      break;
+    }
+  }
+  // Walk each loop head to tail; keep it when every vertex has one side in and one out, it
+  // closes within max_loop sides, and its component may be capped.
+  auto caps = std::make_unique<GhostCaps>();
+  caps->real_vertices = num_welded;
+  caps->real_triangles = num_faces;
+  caps->loop_offsets.push_back(0);
+  std::vector<std::uint8_t> seen(sides.size(), 0);
+  std::vector<std::int32_t> loop_sides;
+  std::vector<std::pair<std::int32_t, std::int32_t>> ghost_sides;  // (side, centre)
+  for (std::size_t s0 = 0; s0 < sides.size(); ++s0) {
+    if (seen[s0] != 0) continue;
+    loop_sides.clear();
+    bool simple = true;
+    auto s = static_cast<std::int32_t>(s0);
+    while (s >= 0 && seen[at(s)] == 0) {
+      seen[at(s)] = 1;
+      loop_sides.push_back(s);
+      const std::int32_t v = sides[at(s)].to;
+      if (out_count[at(v)] != 1 || in_count[at(v)] != 1) simple = false;
+      s = next_side[at(v)];
+    }
+    const bool closed = s == static_cast<std::int32_t>(s0);
+    const auto component = topology.face_component[at(sides[s0].face)];
+    if (!simple || !closed || static_cast<std::int32_t>(loop_sides.size()) > max_loop ||
+        loop_sides.size() < 3 || bad_component[at(component)] != 0) {
+      continue;
+    }
+    const std::int32_t centre = caps->num_loops();
+    for (const std::int32_t i : loop_sides) {
+      caps->loop_vertices.push_back(sides[at(i)].from);
+      ghost_sides.emplace_back(i, centre);
+    }
+    caps->loop_offsets.push_back(static_cast<std::int32_t>(caps->loop_vertices.size()));
+  }
+  if (caps->num_loops() == 0) return nullptr;
+
+  // The capped mesh: centres after the file vertices, ghosts (to, from, centre) after the
+  // triangles — the loop edge reversed, so that the orientation stays consistent.
+  skinning::Mesh& m = caps->mesh;
+  m = mesh;
+  const auto num_file = static_cast<Eigen::Index>(mesh.num_vertices());
+  const std::int32_t loops = caps->num_loops();
+  m.rest_positions.conservativeResize(num_file + loops, 3);
+  for (std::int32_t j = 0; j < loops; ++j) {
+    Eigen::RowVector3d sum = Eigen::RowVector3d::Zero();
+    const auto first = caps->loop_offsets[at(j)];
+    const auto last = caps->loop_offsets[at(j) + 1];
+    for (auto i = first; i < last; ++i) {
+      const auto v = topology.representative_vertex[at(caps->loop_vertices[at(i)])];
+      sum += mesh.rest_positions.row(v);
+    }
+    m.rest_positions.row(num_file + j) = sum / static_cast<double>(last - first);
+    const auto any = topology.representative_vertex[at(caps->loop_vertices[at(first)])];
+    m.vertex_part.push_back(mesh.vertex_part[at(any)]);
+    m.vertex_index_in_part.push_back(-1);
+  }
+  const auto num_ghosts = static_cast<Eigen::Index>(ghost_sides.size());
+  m.triangles.conservativeResize(num_faces + num_ghosts, 3);
+  auto seg = std::make_shared<segmentation::Segmentation>(segmentation);
+  for (Eigen::Index g = 0; g < num_ghosts; ++g) {
+    const auto& [i, centre] = ghost_sides[static_cast<std::size_t>(g)];
+    const Side& s = sides[at(i)];
+    m.triangles(num_faces + g, 0) = topology.representative_vertex[at(s.to)];
+    m.triangles(num_faces + g, 1) = topology.representative_vertex[at(s.from)];
+    m.triangles(num_faces + g, 2) = static_cast<std::int32_t>(num_file + centre);
+    m.face_part.push_back(mesh.face_part[at(s.face)]);
+    m.face_index_in_part.push_back(-1);
+    const std::int32_t cluster = segmentation.triangle_cluster[at(s.face)];
+    seg->triangle_cluster.push_back(cluster);
+    seg->clusters[at(cluster)].triangles.push_back(static_cast<std::int32_t>(num_faces + g));
+  }
+  caps->segmentation = std::move(seg);
+  caps->topology = skinning::build_topology(m);
+  // The real vertices keep their welded ids, each centre gets its own.
+  const auto& t = caps->topology;
+  if (t.num_welded_vertices() != num_welded + loops) return nullptr;
+  for (Eigen::Index v = 0; v < num_file; ++v) {
+    if (t.welded_of_vertex[static_cast<std::size_t>(v)] !=
+        topology.welded_of_vertex[static_cast<std::size_t>(v)]) {
+      return nullptr;
+    }
+  }
+  for (std::int32_t j = 0; j < loops; ++j) {
+    if (t.welded_of_vertex[static_cast<std::size_t>(num_file + j)] != num_welded + j) {
+      return nullptr;
+    }
+  }
+  // Edge ids: the capped topology numbers its edges its own way.
+  std::map<std::pair<std::int32_t, std::int32_t>, std::int32_t> real;
+  for (std::int32_t e = 0; e < topology.num_edges(); ++e) {
+    const auto a = topology.edges(e, 0), b = topology.edges(e, 1);
+    real.emplace(std::minmax(a, b), e);
+  }
+  caps->real_edge.assign(at(t.num_edges()), -1);
+  for (std::int32_t e = 0; e < t.num_edges(); ++e) {
+    const auto a = t.edges(e, 0), b = t.edges(e, 1);
+    if (a >= num_welded || b >= num_welded) continue;
+    const auto it = real.find(std::minmax(a, b));
+    if (it != real.end()) caps->real_edge[at(e)] = it->second;
+  }
+  return caps;
+}
+
+void place_ghost_centres(
+    const GhostCaps& caps, const skinning::Positions& x, skinning::Positions& capped) {
+  const std::int32_t loops = caps.num_loops();
+  capped.resize(static_cast<Eigen::Index>(caps.real_vertices + loops), 3);
+  capped.topRows(x.rows()) = x;
+  for (std::int32_t j = 0; j < loops; ++j) {
+    Eigen::RowVector3d sum = Eigen::RowVector3d::Zero();
+    const auto first = caps.loop_offsets[at(j)];
+    const auto last = caps.loop_offsets[at(j) + 1];
+    for (auto i = first; i < last; ++i) {
+      sum += x.row(static_cast<Eigen::Index>(caps.loop_vertices[at(i)]));
+    }
+    capped.row(static_cast<Eigen::Index>(caps.real_vertices + j)) =
+        sum / static_cast<double>(last - first);
+  }
+}
+
+}  // namespace skelcd::clustering
