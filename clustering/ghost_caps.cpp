@@ -23,62 +23,18 @@ std::unique_ptr<GhostCaps> cap_small_loops(
       mesh.num_triangles() != num_faces) {
     return nullptr;
   }
-  // Components with a non-manifold edge stay open.
-  std::vector<std::uint8_t> bad_component(topology.components.size(), 0);
-  for (const std::int32_t e : topology.non_manifold_edges) {
-    const auto f = topology.edge_faces[at(topology.edge_face_offsets[at(e)])];
-    bad_component[at(topology.face_component[at(f)])] = 1;
-  }
-  // Oriented boundary edges (as their face has them) and the face behind each.
-  struct Side {
-    std::int32_t from, to, face;
-  };
-  std::vector<Side> sides;
-  std::vector<std::int32_t> out_count(at(num_welded), 0), in_count(at(num_welded), 0);
-  std::vector<std::int32_t> next_side(at(num_welded), -1);  // the side leaving a vertex
-  for (const std::int32_t e : topology.boundary_edges) {
-    const auto f = topology.edge_faces[at(topology.edge_face_offsets[at(e)])];
-    for (int k = 0; k < 3; ++k) {
-      if (topology.face_edges(f, k) != e) continue;
-      const Side s{topology.welded_triangles(f, k), topology.welded_triangles(f, (k + 1) % 3), f};
-      ++out_count[at(s.from)];
-      ++in_count[at(s.to)];
-      next_side[at(s.from)] = static_cast<std::int32_t>(sides.size());
-      sides.push_back(s);
-      break;
-    }
-  }
-  // Walk each loop head to tail; keep it when every vertex has one side in and one out, it
-  // closes within max_loop sides, and its component may be capped.
+  const auto loops_found = skinning::small_simple_loops(topology, max_loop);
+  if (loops_found.empty()) return nullptr;
   auto caps = std::make_unique<GhostCaps>();
   caps->real_vertices = num_welded;
   caps->real_triangles = num_faces;
   caps->loop_offsets.push_back(0);
-  std::vector<std::uint8_t> seen(sides.size(), 0);
-  std::vector<std::int32_t> loop_sides;
-  std::vector<std::pair<std::int32_t, std::int32_t>> ghost_sides;  // (side, centre)
-  for (std::size_t s0 = 0; s0 < sides.size(); ++s0) {
-    if (seen[s0] != 0) continue;
-    loop_sides.clear();
-    bool simple = true;
-    auto s = static_cast<std::int32_t>(s0);
-    while (s >= 0 && seen[at(s)] == 0) {
-      seen[at(s)] = 1;
-      loop_sides.push_back(s);
-      const std::int32_t v = sides[at(s)].to;
-      if (out_count[at(v)] != 1 || in_count[at(v)] != 1) simple = false;
-      s = next_side[at(v)];
-    }
-    const bool closed = s == static_cast<std::int32_t>(s0);
-    const auto component = topology.face_component[at(sides[s0].face)];
-    if (!simple || !closed || static_cast<std::int32_t>(loop_sides.size()) > max_loop ||
-        loop_sides.size() < 3 || bad_component[at(component)] != 0) {
-      continue;
-    }
+  std::vector<std::pair<skinning::BoundarySide, std::int32_t>> ghost_sides;  // (side, centre)
+  for (const auto& loop : loops_found) {
     const std::int32_t centre = caps->num_loops();
-    for (const std::int32_t i : loop_sides) {
-      caps->loop_vertices.push_back(sides[at(i)].from);
-      ghost_sides.emplace_back(i, centre);
+    for (const auto& side : loop) {
+      caps->loop_vertices.push_back(side.from);
+      ghost_sides.emplace_back(side, centre);
     }
     caps->loop_offsets.push_back(static_cast<std::int32_t>(caps->loop_vertices.size()));
   }
@@ -108,8 +64,7 @@ std::unique_ptr<GhostCaps> cap_small_loops(
   m.triangles.conservativeResize(num_faces + num_ghosts, 3);
   auto seg = std::make_shared<segmentation::Segmentation>(segmentation);
   for (Eigen::Index g = 0; g < num_ghosts; ++g) {
-    const auto& [i, centre] = ghost_sides[static_cast<std::size_t>(g)];
-    const Side& s = sides[at(i)];
+    const auto& [s, centre] = ghost_sides[static_cast<std::size_t>(g)];
     m.triangles(num_faces + g, 0) = topology.representative_vertex[at(s.to)];
     m.triangles(num_faces + g, 1) = topology.representative_vertex[at(s.from)];
     m.triangles(num_faces + g, 2) = static_cast<std::int32_t>(num_file + centre);

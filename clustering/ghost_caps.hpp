@@ -16,6 +16,10 @@
 
 namespace skelcd::clustering {
 
+/// Boundary loops up to this many edges are capped (eye sockets, cuffs, a robot tube's end);
+/// longer ones (a garment's hem) would cut much of the mesh.
+inline constexpr std::int32_t kMaxGhostLoop = 64;
+
 struct GhostCaps {
   /// The mesh with the ghost centres appended after its vertices and the ghost triangles after its
   /// triangles, its welded topology (the real vertices and triangles keep their welded ids) and

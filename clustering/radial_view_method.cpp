@@ -35,9 +35,6 @@ bool same_positions(const skinning::Positions& a, const skinning::Positions& b) 
 constexpr std::int32_t kMinPatch = 8;
 /// Triangles of a patch tried before it is given up (each with its own ray tilt).
 constexpr int kPatchAttempts = 6;
-/// Boundary loops up to this many edges are capped with ghost triangles (eye sockets, cuffs, a
-/// robot tube's end); longer ones (a garment's hem) would cut much of the mesh.
-constexpr std::int32_t kMaxGhostLoop = 64;
 
 }  // namespace
 

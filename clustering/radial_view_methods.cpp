@@ -5,6 +5,7 @@
 #include <string>
 #include <utility>
 
+#include "clustering/ghost_caps.hpp"
 #include "clustering/radial_view_method.hpp"
 #include "culling/method_registry.hpp"
 #include "skinning/errors.hpp"
@@ -73,6 +74,7 @@ culling::MethodInfo radial_view_info(
           },
       .route = route,
       .route_priority = route == culling::RouteKind::closed ? 10 : 0,
+      .closes_holes_up_to = kMaxGhostLoop,
       .order = order,
       .make =
           [n](const skinning::Mesh& mesh,

@@ -60,6 +60,9 @@ struct ComponentRoute {
   std::int32_t component = -1;  ///< index into Topology::components
   std::int32_t part = -1;       ///< Mesh part of its first triangle
   bool closed = false;          ///< no boundary and no non-manifold edge
+  /// Open, but every hole a small loop the closed group's method closes itself
+  /// (MethodInfo::closes_holes_up_to): routed with the closed components.
+  bool capped = false;
   std::int32_t num_triangles = 0;
   std::string method;  ///< the method testing its pairs within its group
 };

@@ -54,6 +54,10 @@ struct MethodInfo {
   /// needs are met (highest first).
   RouteKind route = RouteKind::none;
   int route_priority = 0;
+  /// Boundary loops of up to this many edges the method closes itself (radial view's ghost caps,
+  /// skinning::small_simple_loops): `auto` routes an open component whose every hole is such a
+  /// loop to it as if it were closed. 0: none.
+  std::int32_t closes_holes_up_to = 0;
   /// Position in listings (--help, `bench`): ascending, then by name.
   int order = 0;
   MethodFactory make{};

@@ -163,9 +163,11 @@ class AutoMethod final : public detail::MethodBase {
       auto& r = routes_[c];
       if (r.part < 0 && !components[c].faces.empty())
         r.part = topology_.face_part(components[c].faces[0]);
+      // Closed, or every hole one the closed method caps itself (ComponentRoute::capped).
+      const bool closed = r.closed || r.capped;
       for (const std::int32_t f : components[c].faces) {
-        (components[c].closed ? closed_triangles_ : open_triangles_).push_back(f);
-        open_face[sz(f)] = components[c].closed ? 0 : 1;
+        (closed ? closed_triangles_ : open_triangles_).push_back(f);
+        open_face[sz(f)] = closed ? 0 : 1;
       }
     }
     std::sort(open_triangles_.begin(), open_triangles_.end());
@@ -346,6 +348,25 @@ std::vector<ComponentRoute> route_components(
   check_group_method(routing.open_method, /*open=*/true);
   check_group_method(closed_name, /*open=*/false);
   const auto components = components_of(topology);
+  // Open components whose every hole the closed method closes itself go with the closed ones.
+  std::vector<std::uint8_t> capped(components.size(), 0);
+  const MethodInfo* closed_info = find_method(closed_name);
+  if (closed_info != nullptr && closed_info->closes_holes_up_to > 0 &&
+      !topology.components.empty() && !topology.face_component.empty()) {
+    std::vector<std::int32_t> holes(components.size(), 0), closable(components.size(), 0);
+    for (const std::int32_t e : topology.boundary_edges) {
+      const auto f = topology.edge_faces[sz(topology.edge_face_offsets[sz(e)])];
+      ++holes[sz(topology.face_component[sz(f)])];
+    }
+    for (const auto& loop :
+         skinning::small_simple_loops(topology, closed_info->closes_holes_up_to)) {
+      closable[sz(topology.face_component[sz(loop.front().face)])] +=
+          static_cast<std::int32_t>(loop.size());
+    }
+    for (std::size_t c = 0; c < components.size(); ++c) {
+      capped[c] = !components[c].closed && holes[c] > 0 && holes[c] == closable[c] ? 1 : 0;
+    }
+  }
   std::vector<ComponentRoute> routes;
   routes.reserve(components.size());
   for (std::size_t c = 0; c < components.size(); ++c) {
@@ -353,8 +374,9 @@ std::vector<ComponentRoute> route_components(
     r.component = static_cast<std::int32_t>(c);
     r.part = components[c].part;
     r.closed = components[c].closed;
+    r.capped = capped[c] != 0;
     r.num_triangles = static_cast<std::int32_t>(components[c].faces.size());
-    r.method = r.closed ? closed_name : routing.open_method;
+    r.method = r.closed || r.capped ? closed_name : routing.open_method;
     routes.push_back(std::move(r));
   }
   return routes;

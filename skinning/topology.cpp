@@ -317,4 +317,54 @@ void gather_welded(const Topology& topology, const Positions& positions, Positio
   }
 }
 
+std::vector<std::vector<BoundarySide>> small_simple_loops(
+    const Topology& topology, std::int32_t max_edges) {
+  const auto at = [](std::int32_t i) { return static_cast<std::size_t>(i); };
+  std::vector<std::vector<BoundarySide>> loops;
+  if (topology.boundary_edges.empty()) return loops;
+  std::vector<std::uint8_t> bad_component(topology.components.size(), 0);
+  for (const std::int32_t e : topology.non_manifold_edges) {
+    const auto f = topology.edge_faces[at(topology.edge_face_offsets[at(e)])];
+    bad_component[at(topology.face_component[at(f)])] = 1;
+  }
+  const auto nw = at(topology.num_welded_vertices());
+  std::vector<BoundarySide> sides;
+  std::vector<std::int32_t> out_count(nw, 0), in_count(nw, 0), leaving(nw, -1);
+  for (const std::int32_t e : topology.boundary_edges) {
+    const auto f = topology.edge_faces[at(topology.edge_face_offsets[at(e)])];
+    for (int k = 0; k < 3; ++k) {
+      if (topology.face_edges(f, k) != e) continue;
+      const BoundarySide s{
+          topology.welded_triangles(f, k), topology.welded_triangles(f, (k + 1) % 3), f};
+      ++out_count[at(s.from)];
+      ++in_count[at(s.to)];
+      leaving[at(s.from)] = static_cast<std::int32_t>(sides.size());
+      sides.push_back(s);
+      break;
+    }
+  }
+  std::vector<std::uint8_t> seen(sides.size(), 0);
+  std::vector<BoundarySide> loop;
+  for (std::size_t s0 = 0; s0 < sides.size(); ++s0) {
+    if (seen[s0] != 0) continue;
+    loop.clear();
+    bool simple = true;
+    auto s = static_cast<std::int32_t>(s0);
+    while (s >= 0 && seen[at(s)] == 0) {
+      seen[at(s)] = 1;
+      loop.push_back(sides[at(s)]);
+      const std::int32_t v = sides[at(s)].to;
+      if (out_count[at(v)] != 1 || in_count[at(v)] != 1) simple = false;
+      s = leaving[at(v)];
+    }
+    const bool closed = s == static_cast<std::int32_t>(s0);
+    const auto component = topology.face_component[at(sides[s0].face)];
+    if (simple && closed && loop.size() >= 3 &&
+        static_cast<std::int32_t>(loop.size()) <= max_edges && bad_component[at(component)] == 0) {
+      loops.push_back(loop);
+    }
+  }
+  return loops;
+}
+
 }  // namespace skelcd::skinning

@@ -68,6 +68,19 @@ struct WeldOptions {
 /// @throws InvalidInput when the mesh fails validate_mesh.
 [[nodiscard]] Topology build_topology(const Mesh& mesh, const WeldOptions& options = {});
 
+/// A boundary edge as its one triangle runs it (from → to, welded ids).
+struct BoundarySide {
+  std::int32_t from = -1;
+  std::int32_t to = -1;
+  std::int32_t face = -1;
+};
+
+/// The boundary loops a fan can close (radial view's ghost caps): simple cycles of at most
+/// `max_edges` edges — every vertex of the loop on exactly one side in and one side out, head to
+/// tail — in components without non-manifold edges. Each loop is its sides in order.
+[[nodiscard]] std::vector<std::vector<BoundarySide>> small_simple_loops(
+    const Topology& topology, std::int32_t max_edges);
+
 /// Gathers welded positions: row w of `welded` is row representative_vertex[w] of `positions`.
 /// @param positions #V × 3 file-vertex positions.  @param welded resized to #W × 3.
 void gather_welded(const Topology& topology, const Positions& positions, Positions& welded);
