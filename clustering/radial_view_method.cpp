@@ -397,11 +397,7 @@ void RadialViewMethod::compute_masks() {
 // --- intra- and inter-cluster checks (§6) ---------------------------------------------------------
 
 std::int64_t RadialViewMethod::traverse(
-    MaskedPairs which,
-    const skinning::Positions& x_t0,
-    const skinning::Positions& x_t1,
-    double half_width,
-    culling::FrameResult& out) {
+    MaskedPairs which, double half_width, culling::FrameResult& out) {
   const std::span<const culling::Aabb> tri_bounds(bounds_.triangles);
   std::int64_t& bv_tests = out.counters.bv_tests;
   // Each traversal runs in installments; the pairs of an installment go through the relative AABB
@@ -413,8 +409,7 @@ std::int64_t RadialViewMethod::traverse(
       const bool done = some(pairs, max_pairs);
       found += static_cast<std::int64_t>(pairs.size() - first);
       if (options_.relative_aabb) {
-        stats_.relative_aabb_culled +=
-            culling::relative_aabb_filter(topology_, x_t0, x_t1, half_width, pairs, first);
+        stats_.relative_aabb_culled += relative_filter_.filter(topology_, half_width, pairs, first);
       }
       return done;
     });
@@ -506,11 +501,7 @@ void RadialViewMethod::escalate(
 }
 
 std::int64_t RadialViewMethod::retest_frontier(
-    std::int32_t round,
-    const skinning::Positions& x_t0,
-    const skinning::Positions& x_t1,
-    double half_width,
-    culling::FrameResult& out) {
+    std::int32_t round, double half_width, culling::FrameResult& out) {
   // The pairs the masked traversal skipped: both triangles of one mega cluster with the same
   // single-sign mask, their swept boxes overlapping. A pair with a triangle of an earlier round
   // was tested in that round; two of this round are taken once, from the smaller id.
@@ -561,8 +552,7 @@ std::int64_t RadialViewMethod::retest_frontier(
     }
     found += static_cast<std::int64_t>(pairs.size() - first);
     if (options_.relative_aabb) {
-      stats_.relative_aabb_culled +=
-          culling::relative_aabb_filter(topology_, x_t0, x_t1, half_width, pairs, first);
+      stats_.relative_aabb_culled += relative_filter_.filter(topology_, half_width, pairs, first);
     }
     return next == frontier_.size();
   });
@@ -625,6 +615,7 @@ void RadialViewMethod::ccd(const culling::Interval& interval, culling::FrameResu
     cluster_bounds_[at(a)] = local.node_bounds()[0];
   }
   clusters_.global_bvh().refit(cluster_bounds_);
+  if (options_.relative_aabb) relative_filter_.prepare(topology_, x_t0, x_t1);
   const auto t_classify = Clock::now();
 
   // 3. RV update: observers ride their bones; classes and mega clusters (§3.1, §5).
@@ -641,7 +632,7 @@ void RadialViewMethod::ccd(const culling::Interval& interval, culling::FrameResu
                             out.counters.bv_tests);
   blocks_.start_ccd(
       topology_, bounds_, x_t0, x_t1, tests_, method_options_.accuracy, ccd_options_, out);
-  (void)traverse(MaskedPairs::tested, x_t0, x_t1, half_width, out);
+  (void)traverse(MaskedPairs::tested, half_width, out);
   blocks_.finish();
   stats_.blocks += blocks_.blocks();
   const double test_us = blocks_.test_us();
@@ -667,7 +658,7 @@ void RadialViewMethod::ccd(const culling::Interval& interval, culling::FrameResu
       const std::size_t before = out.contacts.size();
       blocks_.start_ccd(
           topology_, bounds_, x_t0, x_t1, tests_, method_options_.accuracy, ccd_options_, out);
-      stats_.skipped_pairs_retested += retest_frontier(round, x_t0, x_t1, half_width, out);
+      stats_.skipped_pairs_retested += retest_frontier(round, half_width, out);
       blocks_.finish();
       stats_.blocks += blocks_.blocks();
       stats_.escalation_contacts += static_cast<std::int64_t>(out.contacts.size() - before);

@@ -33,6 +33,7 @@
 #include "culling/incremental_dcd.hpp"
 #include "culling/method.hpp"
 #include "culling/pair_blocks.hpp"
+#include "culling/relative_aabb.hpp"
 #include "culling/traversal.hpp"
 #include "segmentation/segmentation.hpp"
 
@@ -142,23 +143,13 @@ class RadialViewMethod final : public culling::CullingMethod {
   void compute_masks();
   /// Streams the pairs `which` selects into blocks_ (a query started there), each installment
   /// through the relative AABB filter; returns the pairs found before the filter.
-  std::int64_t traverse(
-      culling::MaskedPairs which,
-      const skinning::Positions& x_t0,
-      const skinning::Positions& x_t1,
-      double half_width,
-      culling::FrameResult& out);
+  std::int64_t traverse(culling::MaskedPairs which, double half_width, culling::FrameResult& out);
   /// Marks the skippable triangles at the vertices of the contacts out.contacts[from…] that are
   /// not marked yet (round `round`), appending them to frontier_.
   void escalate(const culling::FrameResult& out, std::size_t from, std::int32_t round);
   /// Streams the skipped pairs of frontier_'s triangles into blocks_ (each once: not with a
   /// triangle of an earlier round), through the relative AABB filter; returns the pairs found.
-  std::int64_t retest_frontier(
-      std::int32_t round,
-      const skinning::Positions& x_t0,
-      const skinning::Positions& x_t1,
-      double half_width,
-      culling::FrameResult& out);
+  std::int64_t retest_frontier(std::int32_t round, double half_width, culling::FrameResult& out);
   void record_dcd(const skinning::Positions& x, const culling::FrameResult& result);
 
   std::string name_;
@@ -188,6 +179,7 @@ class RadialViewMethod final : public culling::CullingMethod {
   IntervalClasses classes_;
   RadialViewStats stats_;
   culling::FeatureBounds<3> bounds_;
+  culling::RelativeAabbFilter relative_filter_;
   std::vector<culling::Aabb> cluster_bounds_;
   std::vector<std::uint8_t> triangle_mask_;
   std::vector<std::vector<std::uint8_t>> node_masks_;

@@ -83,4 +83,61 @@ std::int64_t relative_aabb_filter(
   return removed;
 }
 
+void RelativeAabbFilter::prepare(
+    const FeatureTopology& topology,
+    const skinning::Positions& x_t0,
+    const skinning::Positions& x_t1) {
+  const std::int32_t num_triangles = topology.num_triangles();
+  triangles_.resize(static_cast<std::size_t>(num_triangles));
+  for (std::int32_t f = 0; f < num_triangles; ++f) {
+    Triangle& t = triangles_[static_cast<std::size_t>(f)];
+    const auto& corners = topology.triangle(f);
+    for (std::size_t k = 0; k < 3; ++k) {
+      const auto c = static_cast<Eigen::Index>(k);
+      const auto v0 = static_cast<Eigen::Index>(corners[0]);
+      const auto v1 = static_cast<Eigen::Index>(corners[1]);
+      const auto v2 = static_cast<Eigen::Index>(corners[2]);
+      t.lo0[k] = std::min({x_t0(v0, c), x_t0(v1, c), x_t0(v2, c)});
+      t.hi0[k] = std::max({x_t0(v0, c), x_t0(v1, c), x_t0(v2, c)});
+      t.lo1[k] = std::min({x_t1(v0, c), x_t1(v1, c), x_t1(v2, c)});
+      t.hi1[k] = std::max({x_t1(v0, c), x_t1(v1, c), x_t1(v2, c)});
+      t.displacement[k] =
+          ((x_t1(v0, c) - x_t0(v0, c)) + (x_t1(v1, c) - x_t0(v1, c))) + (x_t1(v2, c) - x_t0(v2, c));
+    }
+  }
+}
+
+bool RelativeAabbFilter::overlap(const TrianglePair& pair, double half_width) const {
+  assert(half_width >= 0.0);
+  const Triangle& a = triangles_[static_cast<std::size_t>(pair.a)];
+  const Triangle& b = triangles_[static_cast<std::size_t>(pair.b)];
+  Aabb ra, rb;
+  for (std::size_t k = 0; k < 3; ++k) {
+    const double w = (a.displacement[k] + b.displacement[k]) / 6.0;
+    ra.lo[k] = std::min(a.lo0[k], next_down(a.lo1[k] - w));
+    ra.hi[k] = std::max(a.hi0[k], next_up(a.hi1[k] - w));
+    rb.lo[k] = std::min(b.lo0[k], next_down(b.lo1[k] - w));
+    rb.hi[k] = std::max(b.hi0[k], next_up(b.hi1[k] - w));
+  }
+  ra.inflate(half_width);
+  rb.inflate(half_width);
+  return ra.overlaps(rb);
+}
+
+std::int64_t RelativeAabbFilter::filter(
+    const FeatureTopology& topology,
+    double half_width,
+    std::vector<TrianglePair>& pairs,
+    std::size_t first) const {
+  assert(first <= pairs.size());
+  const auto from = pairs.begin() + static_cast<std::ptrdiff_t>(first);
+  const auto kept = std::remove_if(from, pairs.end(), [&](const TrianglePair& p) {
+    if (shares_vertex(topology.triangle(p.a), topology.triangle(p.b))) return false;
+    return !overlap(p, half_width);
+  });
+  const auto removed = static_cast<std::int64_t>(pairs.end() - kept);
+  pairs.erase(kept, pairs.end());
+  return removed;
+}
+
 }  // namespace skelcd::culling
