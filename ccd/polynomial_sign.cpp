@@ -61,23 +61,35 @@ PolynomialSign subdivided_sign(const std::array<double, 4>& b, double error, int
   return left == right ? left : PolynomialSign::uncertain;
 }
 
+// y x z and its permanent (the same with absolute values, both products added): the factor that
+// det(x, y, z) = x . (y x z) shares between the two x's of the blossom.
+struct CrossPerm {
+  double cx, cy, cz;  // y x z
+  double px, py, pz;  // |y| "x" |z| with + for -
+};
+
+CrossPerm cross_and_permanent(const Eigen::Vector3d& y, const Eigen::Vector3d& z) {
+  const double ay0 = std::abs(y[0]), ay1 = std::abs(y[1]), ay2 = std::abs(y[2]);
+  const double az0 = std::abs(z[0]), az1 = std::abs(z[1]), az2 = std::abs(z[2]);
+  return {
+      y[1] * z[2] - y[2] * z[1],
+      y[2] * z[0] - y[0] * z[2],
+      y[0] * z[1] - y[1] * z[0],
+      ay1 * az2 + ay2 * az1,
+      ay2 * az0 + ay0 * az2,
+      ay0 * az1 + ay1 * az0};
+}
+
 // det(x, y, z) = x . (y x z) and its permanent (the same with absolute values, all terms added).
 struct DetPerm {
   double det;
   double perm;
 };
 
-DetPerm det_perm(const Eigen::Vector3d& x, const Eigen::Vector3d& y, const Eigen::Vector3d& z) {
-  const double cx = y[1] * z[2] - y[2] * z[1];
-  const double cy = y[2] * z[0] - y[0] * z[2];
-  const double cz = y[0] * z[1] - y[1] * z[0];
-  const Eigen::Vector3d ay = y.cwiseAbs();
-  const Eigen::Vector3d az = z.cwiseAbs();
-  const double px = ay[1] * az[2] + ay[2] * az[1];
-  const double py = ay[2] * az[0] + ay[0] * az[2];
-  const double pz = ay[0] * az[1] + ay[1] * az[0];
-  return {x[0] * cx + x[1] * cy + x[2] * cz,
-          std::abs(x[0]) * px + std::abs(x[1]) * py + std::abs(x[2]) * pz};
+DetPerm det_perm(const Eigen::Vector3d& x, const CrossPerm& yz) {
+  return {
+      x[0] * yz.cx + x[1] * yz.cy + x[2] * yz.cz,
+      std::abs(x[0]) * yz.px + std::abs(x[1]) * yz.py + std::abs(x[2]) * yz.pz};
 }
 
 }  // namespace
@@ -85,15 +97,21 @@ DetPerm det_perm(const Eigen::Vector3d& x, const Eigen::Vector3d& y, const Eigen
 namespace detail {
 
 BernsteinCubic trilinear_determinant(const DifferenceTriple& t0, const DifferenceTriple& t1) {
-  // Blossom of the trilinear det: b_i averages the dets with i factors taken at t = 1.
-  const DetPerm d000 = det_perm(t0.x, t0.y, t0.z);
-  const DetPerm d100 = det_perm(t1.x, t0.y, t0.z);
-  const DetPerm d010 = det_perm(t0.x, t1.y, t0.z);
-  const DetPerm d001 = det_perm(t0.x, t0.y, t1.z);
-  const DetPerm d011 = det_perm(t0.x, t1.y, t1.z);
-  const DetPerm d101 = det_perm(t1.x, t0.y, t1.z);
-  const DetPerm d110 = det_perm(t1.x, t1.y, t0.z);
-  const DetPerm d111 = det_perm(t1.x, t1.y, t1.z);
+  // Blossom of the trilinear det: b_i averages the dets with i factors taken at t = 1. The four
+  // y x z factors are each shared by two dets (x at t0 and at t1); every det is the same sequence
+  // of roundings as a det computed on its own, so the coefficients do not depend on the sharing.
+  const CrossPerm yz00 = cross_and_permanent(t0.y, t0.z);
+  const CrossPerm yz10 = cross_and_permanent(t1.y, t0.z);
+  const CrossPerm yz01 = cross_and_permanent(t0.y, t1.z);
+  const CrossPerm yz11 = cross_and_permanent(t1.y, t1.z);
+  const DetPerm d000 = det_perm(t0.x, yz00);
+  const DetPerm d100 = det_perm(t1.x, yz00);
+  const DetPerm d010 = det_perm(t0.x, yz10);
+  const DetPerm d001 = det_perm(t0.x, yz01);
+  const DetPerm d011 = det_perm(t0.x, yz11);
+  const DetPerm d101 = det_perm(t1.x, yz01);
+  const DetPerm d110 = det_perm(t1.x, yz10);
+  const DetPerm d111 = det_perm(t1.x, yz11);
   BernsteinCubic f;
   f.coefficients = {d000.det, (d100.det + d010.det + d001.det) / 3.0,
                     (d011.det + d101.det + d110.det) / 3.0, d111.det};
@@ -105,7 +123,8 @@ BernsteinCubic trilinear_determinant(const DifferenceTriple& t0, const Differenc
   // Underflow: each of the 6 products y*z may lose kUnderflowUnit, then scaled by |x| <= mx; each
   // x*(.) product and the /3 may lose one more.
   const double mx = std::max(t0.x.cwiseAbs().maxCoeff(), t1.x.cwiseAbs().maxCoeff());
-  const double underflow = 16 * kUnderflowUnit * (1.0 + mx);
+  // 16 kUnderflowUnit (1 + mx) = 2^-1070 (1 + mx), computed without a subnormal product.
+  const double underflow = detail::times_subnormal_power_of_two<1070>(1.0 + mx);
   f.error = add_up(relative, underflow);
   return f;
 }

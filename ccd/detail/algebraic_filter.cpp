@@ -140,7 +140,8 @@ BernsteinQuartic cross_dot_quartic(const QuadrupleDifferences& q) {
   for (const auto* v : {&q.a_t0, &q.b_t0, &q.c_t0, &q.d_t0, &q.a_t1, &q.b_t1, &q.c_t1, &q.d_t1}) {
     m = std::max(m, v->cwiseAbs().maxCoeff());
   }
-  const double underflow = 64 * kUnderflowUnit * (1.0 + m * m);
+  // 64 kUnderflowUnit (1 + m^2) = 2^-1068 (1 + m^2), computed without a subnormal product.
+  const double underflow = times_subnormal_power_of_two<1068>(1.0 + m * m);
   out.error = add_up(relative, underflow);
   return out;
 }
