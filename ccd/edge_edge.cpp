@@ -4,20 +4,19 @@
 
 #include <cassert>
 
-#include "ccd/detail/fast_ccd.hpp"
+#include "ccd/after_swept_aabbs.hpp"
 #include "ccd/detail/conservative_pipeline.hpp"
+#include "ccd/detail/fast_ccd.hpp"
 #include "ccd/exact_ccd.hpp"
 #include "ccd/filters.hpp"
 
 namespace skelcd::ccd {
 namespace {
 
-// conservative: swept AABBs, then the pipeline of detail/conservative_pipeline.hpp.
-CcdResult conservative(const EdgeEdgeQuery& q, const CcdOptions& options, CcdStats& stats) {
-  if (swept_aabbs_disjoint(q, options.min_separation)) {
-    ++stats.aabb_rejected;
-    return {};
-  }
+// conservative, once the swept AABBs are known to overlap: the pipeline of
+// detail/conservative_pipeline.hpp.
+CcdResult conservative_after_aabbs(
+    const EdgeEdgeQuery& q, const CcdOptions& options, CcdStats& stats) {
   // c(t) = (b0 - a0) . ((a1 - a0) x (b1 - b0)); n = d_a x d_b.
   const detail::DifferenceTriple t0{q.eb0_t0 - q.ea0_t0, q.ea1_t0 - q.ea0_t0, q.eb1_t0 - q.eb0_t0};
   const detail::DifferenceTriple t1{q.eb0_t1 - q.ea0_t1, q.ea1_t1 - q.ea0_t1, q.eb1_t1 - q.eb0_t1};
@@ -43,6 +42,15 @@ CcdResult conservative(const EdgeEdgeQuery& q, const CcdOptions& options, CcdSta
   problem.g_t1 = q.eb0_t1 - q.eb1_t1;
   problem.triangle_domain = false;
   return detail::conservative_pipeline(t0, t1, quartics, problem, options, stats);
+}
+
+// conservative: swept AABBs, then the rest of the pipeline.
+CcdResult conservative(const EdgeEdgeQuery& q, const CcdOptions& options, CcdStats& stats) {
+  if (swept_aabbs_disjoint(q, options.min_separation)) {
+    ++stats.aabb_rejected;
+    return {};
+  }
+  return conservative_after_aabbs(q, options, stats);
 }
 
 }  // namespace
@@ -72,6 +80,17 @@ CcdResult edge_edge_ccd(const EdgeEdgeQuery& query,
   ++stats.queries;
   if (r.hit) ++stats.hits;
   return r;
+}
+
+CcdResult edge_edge_ccd_after_swept_aabbs(
+    const EdgeEdgeQuery& query, Accuracy accuracy, const CcdOptions& options) {
+  // With min_separation 0 the swept-AABB stage rejects exactly the queries whose boxes are
+  // disjoint (fl(x - y) > 0 iff x > y), which the precondition rules out: skip it.
+  if (accuracy != Accuracy::conservative || options.min_separation != 0.0) {
+    return edge_edge_ccd(query, accuracy, options);
+  }
+  CcdStats stats;
+  return conservative_after_aabbs(query, options, stats);
 }
 
 }  // namespace skelcd::ccd

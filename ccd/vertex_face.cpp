@@ -4,20 +4,19 @@
 
 #include <cassert>
 
-#include "ccd/detail/fast_ccd.hpp"
+#include "ccd/after_swept_aabbs.hpp"
 #include "ccd/detail/conservative_pipeline.hpp"
+#include "ccd/detail/fast_ccd.hpp"
 #include "ccd/exact_ccd.hpp"
 #include "ccd/filters.hpp"
 
 namespace skelcd::ccd {
 namespace {
 
-// conservative: swept AABBs, then the pipeline of detail/conservative_pipeline.hpp.
-CcdResult conservative(const VertexFaceQuery& q, const CcdOptions& options, CcdStats& stats) {
-  if (swept_aabbs_disjoint(q, options.min_separation)) {
-    ++stats.aabb_rejected;
-    return {};
-  }
+// conservative, once the swept AABBs are known to overlap: the pipeline of
+// detail/conservative_pipeline.hpp.
+CcdResult conservative_after_aabbs(
+    const VertexFaceQuery& q, const CcdOptions& options, CcdStats& stats) {
   // c(t) = (p - a) . ((b - a) x (c - a)).
   const detail::DifferenceTriple t0{q.v_t0 - q.f0_t0, q.f1_t0 - q.f0_t0, q.f2_t0 - q.f0_t0};
   const detail::DifferenceTriple t1{q.v_t1 - q.f0_t1, q.f1_t1 - q.f0_t1, q.f2_t1 - q.f0_t1};
@@ -44,6 +43,15 @@ CcdResult conservative(const VertexFaceQuery& q, const CcdOptions& options, CcdS
   problem.g_t1 = q.f0_t1 - q.f2_t1;
   problem.triangle_domain = true;
   return detail::conservative_pipeline(t0, t1, quartics, problem, options, stats);
+}
+
+// conservative: swept AABBs, then the rest of the pipeline.
+CcdResult conservative(const VertexFaceQuery& q, const CcdOptions& options, CcdStats& stats) {
+  if (swept_aabbs_disjoint(q, options.min_separation)) {
+    ++stats.aabb_rejected;
+    return {};
+  }
+  return conservative_after_aabbs(q, options, stats);
 }
 
 }  // namespace
@@ -74,6 +82,17 @@ CcdResult vertex_face_ccd(const VertexFaceQuery& query,
   ++stats.queries;
   if (r.hit) ++stats.hits;
   return r;
+}
+
+CcdResult vertex_face_ccd_after_swept_aabbs(
+    const VertexFaceQuery& query, Accuracy accuracy, const CcdOptions& options) {
+  // With min_separation 0 the swept-AABB stage rejects exactly the queries whose boxes are
+  // disjoint (fl(x - y) > 0 iff x > y), which the precondition rules out: skip it.
+  if (accuracy != Accuracy::conservative || options.min_separation != 0.0) {
+    return vertex_face_ccd(query, accuracy, options);
+  }
+  CcdStats stats;
+  return conservative_after_aabbs(query, options, stats);
 }
 
 }  // namespace skelcd::ccd

@@ -16,28 +16,6 @@ inline bool share_endpoint(
   return a[0] == b[0] || a[0] == b[1] || a[1] == b[0] || a[1] == b[1];
 }
 
-/// VF pairs of the vertices owned by triangle `owner` against face `face`.
-template <int N>
-inline void owned_vertices_vs_face(
-    const FeatureTopology& topology,
-    std::int32_t owner,
-    std::uint8_t owned,
-    std::int32_t face,
-    const FeatureBounds<N>& bounds,
-    FeatureCandidates& out,
-    std::int64_t& feature_bv_tests) {
-  const auto& corners = topology.triangle(owner);
-  const auto& face_corners = topology.triangle(face);
-  const Dop<N>& face_bounds = bounds.triangles[at(face)];
-  for (std::size_t k = 0; k < 3; ++k) {
-    if ((owned & (1u << k)) == 0) continue;
-    const std::int32_t v = corners[k];
-    if (is_corner(v, face_corners) || topology.vertex_face_excluded(v, face)) continue;
-    ++feature_bv_tests;
-    if (bounds.vertices[at(v)].overlaps(face_bounds)) out.vf.push_back({v, face});
-  }
-}
-
 }  // namespace
 
 template <int N>
@@ -61,6 +39,66 @@ void FeatureBounds<N>::derive(const FeatureTopology& topology, bool with_edges) 
   }
 }
 
+namespace {
+
+/// The feature stage of ccd_candidates_from_triangle_pairs, with the part-exclusion checks compiled
+/// in or out (`kExclusions` = topology.has_exclusions(): without exclusions every *_excluded is
+/// false). Reads one OwnedFeatures record per triangle instead of the owned bits, corners, side
+/// edges and their endpoints from four arrays; the pairs, the rules and the order of what is
+/// appended are those of the bit-by-bit loop.
+template <int N, bool kExclusions>
+void owned_feature_pairs(
+    const FeatureTopology& topology,
+    std::span<const TrianglePair> pairs,
+    const FeatureBounds<N>& bounds,
+    FeatureCandidates& out,
+    std::int64_t& feature_bv_tests,
+    std::int64_t& candidate_pairs) {
+  using Owned = FeatureTopology::OwnedFeatures;
+  // VF pairs of the vertices `owner` owns against face `face`.
+  const auto vertices_vs_face = [&](const Owned& owner, const Owned& face, std::int32_t f) {
+    const Dop<N>& face_bounds = bounds.triangles[at(f)];
+    for (std::size_t k = 0; k < owner.num_vertices; ++k) {
+      const std::int32_t v = owner.vertices[k];
+      if (is_corner(v, face.corners)) continue;
+      if constexpr (kExclusions) {
+        if (topology.vertex_face_excluded(v, f)) continue;
+      }
+      ++feature_bv_tests;
+      if (bounds.vertices[at(v)].overlaps(face_bounds)) out.vf.push_back({v, f});
+    }
+  };
+  for (const TrianglePair& p : pairs) {
+    if constexpr (kExclusions) {
+      if (topology.owned_pairs_excluded(p.a, p.b)) continue;
+    }
+    ++candidate_pairs;
+    const Owned& a = topology.owned_features(p.a);
+    const Owned& b = topology.owned_features(p.b);
+    // VF: the vertices each triangle owns against the other triangle's face.
+    vertices_vs_face(a, b, p.b);
+    vertices_vs_face(b, a, p.a);
+    // EE: the edges a owns against the edges b owns.
+    for (std::size_t i = 0; i < a.num_edges; ++i) {
+      const std::int32_t ea = a.edges[i];
+      const Dop<N>& bounds_a = bounds.edges[at(ea)];
+      for (std::size_t j = 0; j < b.num_edges; ++j) {
+        const std::int32_t eb = b.edges[j];
+        if (share_endpoint(a.edge_ends[i], b.edge_ends[j])) continue;
+        if constexpr (kExclusions) {
+          if (topology.edges_excluded(ea, eb)) continue;
+        }
+        ++feature_bv_tests;
+        if (bounds_a.overlaps(bounds.edges[at(eb)])) {
+          out.ee.push_back({std::min(ea, eb), std::max(ea, eb)});
+        }
+      }
+    }
+  }
+}
+
+}  // namespace
+
 template <int N>
 void ccd_candidates_from_triangle_pairs(
     const FeatureTopology& topology,
@@ -70,30 +108,10 @@ void ccd_candidates_from_triangle_pairs(
     Counters& counters) {
   std::int64_t feature_bv_tests = 0;
   std::int64_t candidate_pairs = 0;
-  for (const TrianglePair& p : pairs) {
-    if (topology.owned_pairs_excluded(p.a, p.b)) continue;
-    ++candidate_pairs;
-    const std::uint8_t owned_a = topology.owned(p.a);
-    const std::uint8_t owned_b = topology.owned(p.b);
-    // VF: the vertices each triangle owns against the other triangle's face.
-    owned_vertices_vs_face<N>(topology, p.a, owned_a, p.b, bounds, out, feature_bv_tests);
-    owned_vertices_vs_face<N>(topology, p.b, owned_b, p.a, bounds, out, feature_bv_tests);
-    // EE: the edges a owns against the edges b owns.
-    if ((owned_a >> 3) == 0 || (owned_b >> 3) == 0) continue;
-    for (int i = 0; i < 3; ++i) {
-      if ((owned_a & (1u << (3 + i))) == 0) continue;
-      const std::int32_t ea = topology.face_edge(p.a, i);
-      const auto& ends_a = topology.edge(ea);
-      for (int j = 0; j < 3; ++j) {
-        if ((owned_b & (1u << (3 + j))) == 0) continue;
-        const std::int32_t eb = topology.face_edge(p.b, j);
-        if (share_endpoint(ends_a, topology.edge(eb)) || topology.edges_excluded(ea, eb)) continue;
-        ++feature_bv_tests;
-        if (bounds.edges[at(ea)].overlaps(bounds.edges[at(eb)])) {
-          out.ee.push_back({std::min(ea, eb), std::max(ea, eb)});
-        }
-      }
-    }
+  if (topology.has_exclusions()) {
+    owned_feature_pairs<N, true>(topology, pairs, bounds, out, feature_bv_tests, candidate_pairs);
+  } else {
+    owned_feature_pairs<N, false>(topology, pairs, bounds, out, feature_bv_tests, candidate_pairs);
   }
   counters.feature_bv_tests += feature_bv_tests;
   counters.candidate_pairs += candidate_pairs;

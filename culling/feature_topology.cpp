@@ -127,6 +127,20 @@ FeatureTopology::FeatureTopology(const skinning::Mesh& mesh, const skinning::Top
       }
     }
   }
+  owned_features_.resize(num_faces);
+  for (std::size_t f = 0; f < num_faces; ++f) {
+    OwnedFeatures& o = owned_features_[f];
+    o = {};
+    o.corners = triangles_[f];
+    for (std::size_t k = 0; k < 3; ++k) {
+      if (owned_[f] & (1u << k)) o.vertices[o.num_vertices++] = triangles_[f][k];
+      if (owned_[f] & (1u << (3 + k))) {
+        const std::int32_t e = face_edges_[f][k];
+        o.edge_ends[o.num_edges] = edges_[static_cast<std::size_t>(e)];
+        o.edges[o.num_edges++] = e;
+      }
+    }
+  }
   for (std::size_t e = 0; e < num_edges; ++e) {
     if (edge_owner_[e] < 0) {
       throw InvalidInput(at("edge", static_cast<std::int64_t>(e)) + " is a side of no triangle");

@@ -56,6 +56,20 @@ class FeatureTopology {
   [[nodiscard]] std::uint8_t owned(std::int32_t f) const {
     return owned_[static_cast<std::size_t>(f)];
   }
+  /// What the CCD feature stage reads of one triangle, in one cache line: its corners, the
+  /// vertices and edges it owns in corner / side order (the set bits of owned(f), collapsed sides
+  /// never among them) and the owned edges' endpoints.
+  struct alignas(64) OwnedFeatures {
+    std::array<std::int32_t, 3> corners;
+    std::array<std::int32_t, 3> vertices;                  ///< the first num_vertices are owned
+    std::array<std::int32_t, 3> edges;                     ///< the first num_edges are owned
+    std::array<std::array<std::int32_t, 2>, 3> edge_ends;  ///< endpoints of edges[i]
+    std::uint8_t num_vertices;
+    std::uint8_t num_edges;
+  };
+  [[nodiscard]] const OwnedFeatures& owned_features(std::int32_t f) const {
+    return owned_features_[static_cast<std::size_t>(f)];
+  }
   /// The triangle owning vertex v (its first incident triangle), or -1 when v is on no triangle.
   [[nodiscard]] std::int32_t vertex_owner(std::int32_t v) const {
     return vertex_owner_[static_cast<std::size_t>(v)];
@@ -116,6 +130,7 @@ class FeatureTopology {
   std::vector<std::array<std::int32_t, 2>> edges_;
   std::vector<std::array<std::int32_t, 3>> face_edges_;
   std::vector<std::uint8_t> owned_;
+  std::vector<OwnedFeatures> owned_features_;
   std::vector<std::int32_t> vertex_owner_;
   std::vector<std::int32_t> edge_owner_;
 

@@ -5,6 +5,8 @@
 #include <chrono>
 #include <utility>
 
+#include "ccd/after_swept_aabbs.hpp"
+
 namespace skelcd::culling {
 namespace {
 
@@ -12,6 +14,22 @@ using Clock = std::chrono::steady_clock;
 
 double micros(Clock::time_point from, Clock::time_point to) {
   return std::chrono::duration<double, std::micro>(to - from).count();
+}
+
+// Every feature pair of ccd_candidates_from_triangle_pairs passed the volume filter with the
+// swept volumes of the interval (vertex_bounds.hpp: on the coordinate axes of Aabb and Kdop16 the
+// positions' own min / max, grown by min_separation / 2). With min_separation 0 those are exactly
+// the swept AABBs the ccd/ kernels test first, and they overlap: the kernels may skip that stage
+// (ccd/after_swept_aabbs.hpp, which checks the distance and accuracy; the results are the same).
+// Substituted tests are left alone.
+ElementaryTests after_swept_aabbs(ElementaryTests tests) {
+  if (tests.vertex_face == static_cast<ElementaryTests::VertexFaceFn>(&ccd::vertex_face_ccd)) {
+    tests.vertex_face = &ccd::vertex_face_ccd_after_swept_aabbs;
+  }
+  if (tests.edge_edge == static_cast<ElementaryTests::EdgeEdgeFn>(&ccd::edge_edge_ccd)) {
+    tests.edge_edge = &ccd::edge_edge_ccd_after_swept_aabbs;
+  }
+  return tests;
 }
 
 }  // namespace
@@ -84,7 +102,15 @@ void PairBlocks<N>::flush() {
     features_.clear();
     ccd_candidates_from_triangle_pairs<N>(*topology_, pairs_, *bounds_, features_, out.counters);
     const auto t1 = Clock::now();
-    run_ccd_tests(*topology_, features_, *x_t0_, *x_t1_, *tests_, accuracy_, *ccd_options_, out);
+    run_ccd_tests(
+        *topology_,
+        features_,
+        *x_t0_,
+        *x_t1_,
+        after_swept_aabbs(*tests_),
+        accuracy_,
+        *ccd_options_,
+        out);
     feature_us_ += micros(t0, t1);
     test_us_ += micros(t1, Clock::now());
   } else {

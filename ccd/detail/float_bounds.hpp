@@ -7,7 +7,9 @@
 // Products that may underflow are covered by an absolute term (kUnderflowUnit per operation, scaled
 // by what multiplies the result afterwards).
 
+#include <bit>
 #include <cmath>
+#include <cstdint>
 
 #if defined(__FAST_MATH__)
 #error "ccd/ rounding-error bounds assume IEEE arithmetic: do not build it with -ffast-math"
@@ -23,6 +25,36 @@ inline constexpr double kRoundUp = 1.0 + 0x1p-50;
 /// Absolute error one underflowing product or quotient can add: half the smallest subnormal, with
 /// margin (2^-1074).
 inline constexpr double kUnderflowUnit = 0x1p-1074;
+
+/// 2^e for -1022 <= e <= 1023, at compile time.
+[[nodiscard]] constexpr double power_of_two(int e) {
+  double p = 1.0;
+  for (; e > 0; --e) p *= 2.0;
+  for (; e < 0; ++e) p *= 0.5;
+  return p;
+}
+
+/// fl(2^-K · y) for y >= 0 (or NaN), K in (1022, 1074]: the underflow terms `m * kUnderflowUnit
+/// * (1 + ...)` of the bounds, bit for bit, without a multiplication whose result is subnormal —
+/// x86 takes a microcode assist for each of those (about 30 ns here, against 0.5 ns for a normal
+/// product), which made one such term the most expensive line of the coplanarity filter.
+/// A product below 2^-1022 is a subnormal, the exact y · 2^(1074-K) rounded to an integer (to
+/// nearest, ties to even) in units of 2^-1074: adding 2^52 to that value (< 2^52) rounds it the
+/// same way, and the integer is then the difference of the bit patterns, which is also the bit
+/// pattern of the subnormal (2^52 units is 2^-1022, the smallest normal, when it rounds up). A
+/// larger product is a normal number: y · 2^-600 · 2^(600-K), two exact power-of-two scalings.
+template <int K>
+[[nodiscard]] inline double times_subnormal_power_of_two(double y) {
+  static_assert(K > 1022 && K <= 1074);
+  constexpr double kToUnits = power_of_two(1074 - K);  // 2^-K in units of 2^-1074
+  constexpr double kLimit = power_of_two(K - 1022);    // y · 2^-K < 2^-1022 below this
+  if (y >= 0.0 && y < kLimit) {
+    const double shifted = y * kToUnits + 0x1p52;
+    return std::bit_cast<double>(
+        std::bit_cast<std::uint64_t>(shifted) - std::bit_cast<std::uint64_t>(0x1p52));
+  }
+  return (y * 0x1p-600) * power_of_two(600 - K);
+}
 
 /// Error bound of a +,-,* expression evaluated in floating point whose rounding count is at most
 /// k (each leaf-to-root chain of a product term sees at most k roundings), given the computed

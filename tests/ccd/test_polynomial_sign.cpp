@@ -3,16 +3,22 @@
 // inputs chosen to hurt (cancellation after a 1e6 translation, 1e-6 / 1e6 scales, roots near and
 // at the interval ends, underflow).
 
-#include "ccd/polynomial_sign.hpp"
-
-#include <random>
-
-#include <Eigen/Geometry>
 #include <gmpxx.h>
 #include <gtest/gtest.h>
 
+#include <Eigen/Geometry>
+#include <bit>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <random>
+#include <vector>
+
+#include "ccd/detail/float_bounds.hpp"
 #include "ccd/detail/rational_polynomial.hpp"
+#include "ccd/detail/trilinear_cubic.hpp"
 #include "ccd/filters.hpp"
+#include "ccd/polynomial_sign.hpp"
 
 namespace skelcd::ccd {
 namespace {
@@ -219,6 +225,125 @@ TEST(Filters, CoplanarityFilter) {
   EdgeEdgeQuery through = ee;
   through.ea0_t1.z() = through.ea1_t1.z() = -0.5;
   EXPECT_FALSE(coplanarity_filter_rejects(through));
+}
+
+// The reference: the product as the hardware computes it (a multiplication into the subnormal
+// range, rounded to nearest even), which the bounds were written with.
+template <int K>
+void expect_subnormal_products_bit_for_bit(std::mt19937_64& rng) {
+  volatile double tiny = detail::power_of_two(-K);  // volatile: multiplied at run time
+  constexpr double kLimit = detail::power_of_two(K - 1022);
+  constexpr double kUnits = detail::power_of_two(1074 - K);
+  std::vector<double> ys = {
+      0.0,
+      1.0,
+      1.5,
+      2.0,
+      3.0,
+      kLimit,
+      std::nextafter(kLimit, 0.0),
+      std::nextafter(kLimit, 1e300),
+      2 * kLimit,
+      1e300,
+      std::numeric_limits<double>::infinity()};
+  // Products exactly halfway between two subnormals (ties: to even) and next to them.
+  for (double n = 0; n < 64; ++n) {
+    const double half = (n + 0.5) / kUnits;
+    ys.insert(ys.end(), {half, std::nextafter(half, 0.0), std::nextafter(half, 1e300)});
+  }
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  for (int i = 0; i < 20000; ++i) {
+    ys.push_back(1.0 + std::ldexp(unit(rng), static_cast<int>(rng() % 60)));  // 1 + m: up to 2^60
+  }
+  for (const double y : ys) {
+    const double expected = tiny * y;
+    EXPECT_EQ(
+        std::bit_cast<std::uint64_t>(detail::times_subnormal_power_of_two<K>(y)),
+        std::bit_cast<std::uint64_t>(expected))
+        << "K = " << K << ", y = " << y;
+  }
+  const double nan =
+      detail::times_subnormal_power_of_two<K>(std::numeric_limits<double>::quiet_NaN());
+  EXPECT_TRUE(std::isnan(nan));
+}
+
+TEST(FloatBounds, SubnormalProductsBitForBit) {
+  std::mt19937_64 rng(17);
+  expect_subnormal_products_bit_for_bit<1068>(rng);  // the algebraic filter's underflow term
+  expect_subnormal_products_bit_for_bit<1070>(rng);  // the trilinear cubic's
+  expect_subnormal_products_bit_for_bit<1023>(rng);
+  expect_subnormal_products_bit_for_bit<1074>(rng);
+}
+
+// The trilinear cubic as first written: each of the eight dets computed on its own, the underflow
+// term a plain product. The coefficients and the bound must not change by a bit when the cross
+// products are shared and the underflow term avoids a subnormal product.
+BernsteinCubic reference_trilinear(
+    const detail::DifferenceTriple& t0, const detail::DifferenceTriple& t1) {
+  struct DetPerm {
+    double det, perm;
+  };
+  const auto det_perm = [](const V& x, const V& y, const V& z) {
+    const double cx = y[1] * z[2] - y[2] * z[1];
+    const double cy = y[2] * z[0] - y[0] * z[2];
+    const double cz = y[0] * z[1] - y[1] * z[0];
+    const V ay = y.cwiseAbs();
+    const V az = z.cwiseAbs();
+    const double px = ay[1] * az[2] + ay[2] * az[1];
+    const double py = ay[2] * az[0] + ay[0] * az[2];
+    const double pz = ay[0] * az[1] + ay[1] * az[0];
+    return DetPerm{
+        x[0] * cx + x[1] * cy + x[2] * cz,
+        std::abs(x[0]) * px + std::abs(x[1]) * py + std::abs(x[2]) * pz};
+  };
+  const DetPerm d000 = det_perm(t0.x, t0.y, t0.z), d100 = det_perm(t1.x, t0.y, t0.z),
+                d010 = det_perm(t0.x, t1.y, t0.z), d001 = det_perm(t0.x, t0.y, t1.z),
+                d011 = det_perm(t0.x, t1.y, t1.z), d101 = det_perm(t1.x, t0.y, t1.z),
+                d110 = det_perm(t1.x, t1.y, t0.z), d111 = det_perm(t1.x, t1.y, t1.z);
+  BernsteinCubic f;
+  f.coefficients = {
+      d000.det,
+      (d100.det + d010.det + d001.det) / 3.0,
+      (d011.det + d101.det + d110.det) / 3.0,
+      d111.det};
+  const double perm = std::max(
+      {d000.perm,
+       (d100.perm + d010.perm + d001.perm) / 3.0,
+       (d011.perm + d101.perm + d110.perm) / 3.0,
+       d111.perm});
+  const double relative = detail::rounding_bound(11, perm);
+  const double mx = std::max(t0.x.cwiseAbs().maxCoeff(), t1.x.cwiseAbs().maxCoeff());
+  volatile double unit = detail::kUnderflowUnit;
+  const double underflow = 16 * unit * (1.0 + mx);
+  f.error = detail::add_up(relative, underflow);
+  return f;
+}
+
+TEST(MovingOrientationCubic, SameBitsAsEachDetOnItsOwn) {
+  std::mt19937_64 rng(23);
+  std::uniform_real_distribution<double> u(-1, 1);
+  const auto point = [&] { return V(u(rng), u(rng), u(rng)); };
+  for (int n = 0; n < 20000; ++n) {
+    MovingOrientationQuery q{
+        point(), point(), point(), point(), point(), point(), point(), point()};
+    if (n % 3 == 1) q.q_t1 = q.a_t1 + 0.5 * (q.b_t1 - q.a_t1);  // coplanar at t1, up to rounding
+    if (n % 11 == 2) q.b_t0 = q.a_t0;                           // a collapsed side
+    const double scale = (n % 5 == 0) ? 1e-6 : (n % 5 == 1) ? 1e6 : (n % 5 == 2) ? 1e-160 : 1.0;
+    for (V* p : {&q.a_t0, &q.b_t0, &q.c_t0, &q.q_t0, &q.a_t1, &q.b_t1, &q.c_t1, &q.q_t1})
+      *p *= scale;
+    const detail::DifferenceTriple t0{q.a_t0 - q.q_t0, q.b_t0 - q.a_t0, q.c_t0 - q.a_t0};
+    const detail::DifferenceTriple t1{q.a_t1 - q.q_t1, q.b_t1 - q.a_t1, q.c_t1 - q.a_t1};
+    const BernsteinCubic expected = reference_trilinear(t0, t1);
+    const BernsteinCubic f = moving_orientation_cubic(q);
+    for (std::size_t i = 0; i < 4; ++i) {
+      ASSERT_EQ(
+          std::bit_cast<std::uint64_t>(f.coefficients[i]),
+          std::bit_cast<std::uint64_t>(expected.coefficients[i]))
+          << n << " coefficient " << i;
+    }
+    ASSERT_EQ(std::bit_cast<std::uint64_t>(f.error), std::bit_cast<std::uint64_t>(expected.error))
+        << n;
+  }
 }
 
 }  // namespace

@@ -293,6 +293,28 @@ TEST(FeatureTopology, EveryVertexAndEdgeHasExactlyOneOwner) {
   }
 }
 
+TEST(FeatureTopology, OwnedFeaturesListTheOwnedBitsInOrder) {
+  for (const Scene& s : scenes()) {
+    const FeatureTopology t(s.mesh, s.topology);
+    for (std::int32_t f = 0; f < t.num_triangles(); ++f) {
+      const FeatureTopology::OwnedFeatures& o = t.owned_features(f);
+      EXPECT_EQ(o.corners, t.triangle(f)) << s.name << " triangle " << f;
+      std::vector<std::int32_t> vertices, edges;
+      for (int k = 0; k < 3; ++k) {
+        if (t.owned(f) & (1u << k)) vertices.push_back(t.triangle(f)[static_cast<std::size_t>(k)]);
+        if (t.owned(f) & (1u << (3 + k))) edges.push_back(t.face_edge(f, k));
+      }
+      ASSERT_EQ(o.num_vertices, vertices.size()) << s.name << " triangle " << f;
+      ASSERT_EQ(o.num_edges, edges.size()) << s.name << " triangle " << f;
+      for (std::size_t i = 0; i < vertices.size(); ++i) EXPECT_EQ(o.vertices[i], vertices[i]);
+      for (std::size_t i = 0; i < edges.size(); ++i) {
+        EXPECT_EQ(o.edges[i], edges[i]);
+        EXPECT_EQ(o.edge_ends[i], t.edge(edges[i])) << s.name << " triangle " << f;
+      }
+    }
+  }
+}
+
 template <int N>
 void check_hierarchy_matches_brute_force(double min_separation) {
   for (const Scene& s : scenes()) {
