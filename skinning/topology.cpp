@@ -329,7 +329,7 @@ std::vector<std::vector<BoundarySide>> small_simple_loops(
   }
   const auto nw = at(topology.num_welded_vertices());
   std::vector<BoundarySide> sides;
-  std::vector<std::int32_t> out_count(nw, 0), in_count(nw, 0), leaving(nw, -1);
+  std::vector<std::int32_t> out_count(nw, 0), in_count(nw, 0);
   for (const std::int32_t e : topology.boundary_edges) {
     const auto f = topology.edge_faces[at(topology.edge_face_offsets[at(e)])];
     for (int k = 0; k < 3; ++k) {
@@ -338,30 +338,70 @@ std::vector<std::vector<BoundarySide>> small_simple_loops(
           topology.welded_triangles(f, k), topology.welded_triangles(f, (k + 1) % 3), f};
       ++out_count[at(s.from)];
       ++in_count[at(s.to)];
-      leaving[at(s.from)] = static_cast<std::int32_t>(sides.size());
       sides.push_back(s);
       break;
     }
   }
-  std::vector<std::uint8_t> seen(sides.size(), 0);
-  std::vector<BoundarySide> loop;
-  for (std::size_t s0 = 0; s0 < sides.size(); ++s0) {
-    if (seen[s0] != 0) continue;
-    loop.clear();
-    bool simple = true;
-    auto s = static_cast<std::int32_t>(s0);
-    while (s >= 0 && seen[at(s)] == 0) {
-      seen[at(s)] = 1;
-      loop.push_back(sides[at(s)]);
-      const std::int32_t v = sides[at(s)].to;
-      if (out_count[at(v)] != 1 || in_count[at(v)] != 1) simple = false;
-      s = leaving[at(v)];
+  // CSR: the sides leaving each vertex. A vertex with as many sides in as out lies on cycles; a
+  // pinch vertex (two or more of each) is where the walk below splits a loop into simple cycles.
+  std::vector<std::int32_t> offsets(nw + 1, 0);
+  for (const auto& s : sides) ++offsets[at(s.from) + 1];
+  for (std::size_t v = 0; v < nw; ++v) offsets[v + 1] += offsets[v];
+  std::vector<std::int32_t> leaving_sides(sides.size());
+  {
+    std::vector<std::int32_t> fill(offsets.begin(), offsets.end() - 1);
+    for (std::size_t i = 0; i < sides.size(); ++i) {
+      leaving_sides[at(fill[at(sides[i].from)]++)] = static_cast<std::int32_t>(i);
     }
-    const bool closed = s == static_cast<std::int32_t>(s0);
-    const auto component = topology.face_component[at(sides[s0].face)];
-    if (simple && closed && loop.size() >= 3 &&
-        static_cast<std::int32_t>(loop.size()) <= max_edges && bad_component[at(component)] == 0) {
-      loops.push_back(loop);
+  }
+  std::vector<std::int32_t> next_leaving(offsets.begin(), offsets.end() - 1);
+  std::vector<std::uint8_t> used(sides.size(), 0);
+  std::vector<std::int32_t> position(nw, -1);  // index in `path` of the side leaving a vertex
+  std::vector<std::int32_t> path;
+  const auto unused_leaving = [&](std::int32_t v) -> std::int32_t {
+    for (auto& k = next_leaving[at(v)]; k < offsets[at(v) + 1]; ++k) {
+      const std::int32_t i = leaving_sides[at(k)];
+      if (used[at(i)] == 0) return i;
+    }
+    return -1;
+  };
+  for (std::size_t s0 = 0; s0 < sides.size(); ++s0) {
+    if (used[s0] != 0) continue;
+    // Walk head to tail; whenever the walk comes back to a vertex of its path, the sides since
+    // then are a simple cycle: cut it off and go on from there.
+    path.assign(1, static_cast<std::int32_t>(s0));
+    used[s0] = 1;
+    position[at(sides[s0].from)] = 0;
+    std::int32_t v = sides[s0].to;
+    while (!path.empty()) {
+      if (position[at(v)] >= 0) {
+        const auto first = static_cast<std::size_t>(position[at(v)]);
+        std::vector<BoundarySide> cycle;
+        for (std::size_t i = first; i < path.size(); ++i) {
+          cycle.push_back(sides[at(path[i])]);
+          position[at(sides[at(path[i])].from)] = -1;
+        }
+        path.resize(first);
+        const auto component = topology.face_component[at(cycle.front().face)];
+        const bool balanced = std::all_of(cycle.begin(), cycle.end(), [&](const BoundarySide& c) {
+          return out_count[at(c.from)] == in_count[at(c.from)];
+        });
+        if (balanced && cycle.size() >= 3 && static_cast<std::int32_t>(cycle.size()) <= max_edges &&
+            bad_component[at(component)] == 0) {
+          loops.push_back(std::move(cycle));
+        }
+        if (path.empty()) break;
+      }
+      const std::int32_t t = unused_leaving(v);
+      if (t < 0) {  // an open chain (inconsistent orientation): not capped
+        for (const std::int32_t i : path) position[at(sides[at(i)].from)] = -1;
+        path.clear();
+        break;
+      }
+      position[at(v)] = static_cast<std::int32_t>(path.size());
+      path.push_back(t);
+      used[at(t)] = 1;
+      v = sides[at(t)].to;
     }
   }
   return loops;

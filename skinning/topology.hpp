@@ -75,9 +75,11 @@ struct BoundarySide {
   std::int32_t face = -1;
 };
 
-/// The boundary loops a fan can close (radial view's ghost caps): simple cycles of at most
-/// `max_edges` edges — every vertex of the loop on exactly one side in and one side out, head to
-/// tail — in components without non-manifold edges. Each loop is its sides in order.
+/// The boundary loops a fan can close (radial view's ghost caps): the boundary sides, walked head
+/// to tail, as simple cycles of 3 to `max_edges` sides in components without non-manifold edges —
+/// a loop through a pinch vertex (two or more sides in and out) is split there into simple cycles,
+/// each closed by its own fan; sides that do not close into a cycle (inconsistent orientation)
+/// are left out. Each loop is its sides in order.
 [[nodiscard]] std::vector<std::vector<BoundarySide>> small_simple_loops(
     const Topology& topology, std::int32_t max_edges);
 

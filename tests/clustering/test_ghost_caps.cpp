@@ -157,18 +157,46 @@ TEST(GhostCaps, AnOpenTubeIsClosedConsistentlyAndKeepsItsIds) {
   }
 }
 
-TEST(GhostCaps, LongAndPinchedLoopsStayOpen) {
+TEST(GhostCaps, LongLoopsStayOpenPinchedOnesAreSplit) {
   const skinning::Mesh tube = open_tube(4, 40);
   const skinning::Topology tube_topology = skinning::build_topology(tube);
   EXPECT_EQ(cap_small_loops(tube, tube_topology, two_clusters(tube), 39), nullptr);
   const auto caps = cap_small_loops(tube, tube_topology, two_clusters(tube), 40);
   ASSERT_NE(caps, nullptr);
   EXPECT_EQ(caps->num_loops(), 2);
-  // Two triangles meeting at one vertex: its boundary passes that vertex twice.
-  const skinning::Mesh bowtie =
-      make_mesh({{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {-1, 0, 0}, {-1, -1, 0}}, {{0, 1, 2}, {0, 3, 4}});
-  const skinning::Topology bowtie_topology = skinning::build_topology(bowtie);
-  EXPECT_EQ(cap_small_loops(bowtie, bowtie_topology, two_clusters(bowtie), 64), nullptr);
+  // Two open tubes sharing one vertex of their end rings: the boundary passes that vertex twice.
+  // Split there, each ring gets its own fan (one spoke per fan at the shared vertex), and the
+  // capped surface has no boundary and no non-manifold edge.
+  skinning::Mesh pinched = open_tube(3, 8);
+  {
+    const skinning::Mesh other = open_tube(3, 8);
+    const auto nv = static_cast<std::int32_t>(pinched.num_vertices());
+    const auto nf = pinched.num_triangles();
+    skinning::Positions v(2 * nv, 3);
+    v << pinched.rest_positions, other.rest_positions;
+    // The second tube mirrored beyond x = 0, its ring 0 touching the first's at vertex 0 only.
+    for (Eigen::Index i = nv; i < 2 * nv; ++i) {
+      v(i, 0) = -v(i, 0);
+      v(i, 1) = -v(i, 1) + 2.0 * v(0, 1);
+      v(i, 2) = -v(i, 2) + 2.0 * v(0, 2);
+    }
+    skinning::Triangles t(2 * nf, 3);
+    t.topRows(nf) = pinched.triangles;
+    t.bottomRows(nf) = other.triangles.array() + nv;
+    for (Eigen::Index f = nf; f < 2 * nf; ++f) std::swap(t(f, 1), t(f, 2));  // mirrored: flip
+    std::vector<V3> vs;
+    for (Eigen::Index i = 0; i < v.rows(); ++i) vs.emplace_back(v.row(i).transpose());
+    std::vector<Eigen::Vector3i> fs;
+    for (Eigen::Index f = 0; f < t.rows(); ++f) fs.emplace_back(t.row(f).transpose());
+    pinched = make_mesh(vs, fs);
+  }
+  const skinning::Topology pinched_topology = skinning::build_topology(pinched);
+  ASSERT_EQ(pinched_topology.components.size(), 2u);  // edge-connected: two, sharing a vertex
+  const auto split = cap_small_loops(pinched, pinched_topology, two_clusters(pinched), 64);
+  ASSERT_NE(split, nullptr);
+  EXPECT_EQ(split->num_loops(), 4);  // the two far rings, and the pinched pair split in two
+  EXPECT_TRUE(split->topology.boundary_edges.empty());
+  EXPECT_TRUE(split->topology.non_manifold_edges.empty());
   // A segmentation that does not fit: no caps (the method reports the mismatch).
   segmentation::Segmentation short_seg = two_clusters(tube);
   short_seg.triangle_cluster.pop_back();

@@ -53,9 +53,9 @@ TEST(RoutesLog, AutoWritesWhereEachComponentWent) {
   const auto topology = skinning::build_topology(*loaded.mesh);
   const auto header = read_log(log).header;
   ASSERT_EQ(header.routes.size(), topology.components.size());
-  // Open components whose every hole is a small simple loop (at most 64 edges, no vertex twice) in
-  // a component without non-manifold edges are capped by the radial-view method and go with the
-  // closed ones; the others go to the open method.
+  // Open components whose every hole is a small loop (at most 64 edges; none of the robot's loops
+  // passes a vertex twice, which would split it) in a component without non-manifold edges are
+  // capped by the radial-view method and go with the closed ones; the others go to the open method.
   std::vector<std::uint8_t> small_holes(topology.components.size(), 1);
   for (const auto& loop : topology.boundary_loops) {
     const std::set<std::int32_t> distinct(loop.begin(), loop.end());
