@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "clustering/ghost_caps.hpp"
+#include "tests/culling/procedural_meshes.hpp"
 
 namespace skelcd::clustering {
 namespace {
@@ -16,24 +17,11 @@ namespace {
 using V3 = Eigen::Vector3d;
 
 skinning::Mesh make_mesh(const std::vector<V3>& vs, const std::vector<Eigen::Vector3i>& fs) {
-  skinning::Mesh m;
-  m.rest_positions.resize(static_cast<Eigen::Index>(vs.size()), 3);
-  for (std::size_t i = 0; i < vs.size(); ++i) {
-    m.rest_positions.row(static_cast<Eigen::Index>(i)) = vs[i];
-  }
-  m.triangles.resize(static_cast<Eigen::Index>(fs.size()), 3);
-  for (std::size_t f = 0; f < fs.size(); ++f) m.triangles.row(static_cast<Eigen::Index>(f)) = fs[f];
-  m.face_part.assign(fs.size(), 0);
-  m.face_index_in_part.resize(fs.size());
-  for (std::size_t f = 0; f < fs.size(); ++f)
-    m.face_index_in_part[f] = static_cast<std::int32_t>(f);
-  m.vertex_part.assign(vs.size(), 0);
-  m.vertex_index_in_part.resize(vs.size());
-  for (std::size_t v = 0; v < vs.size(); ++v) {
-    m.vertex_index_in_part[v] = static_cast<std::int32_t>(v);
-  }
-  m.part_names = {"part"};
-  return m;
+  skinning::Positions x(static_cast<Eigen::Index>(vs.size()), 3);
+  for (std::size_t i = 0; i < vs.size(); ++i) x.row(static_cast<Eigen::Index>(i)) = vs[i];
+  skinning::Triangles t(static_cast<Eigen::Index>(fs.size()), 3);
+  for (std::size_t f = 0; f < fs.size(); ++f) t.row(static_cast<Eigen::Index>(f)) = fs[f];
+  return test::single_part_mesh(std::move(x), std::move(t));
 }
 
 /// An open tube along x: `rings` rings of `sides` vertices, outward faces, both ends open.

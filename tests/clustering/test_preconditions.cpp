@@ -18,6 +18,7 @@
 #include "clustering/radial_view_method.hpp"
 #include "culling/method.hpp"
 #include "skinning/topology.hpp"
+#include "tests/culling/procedural_meshes.hpp"
 
 namespace skelcd::clustering {
 namespace {
@@ -130,28 +131,16 @@ USlab make_grid_slab(int strips) {
       }
     }
   }
-  auto& m = s.mesh;
-  m.rest_positions.resize(static_cast<Eigen::Index>(vs.size()), 3);
-  for (std::size_t i = 0; i < vs.size(); ++i) {
-    m.rest_positions.row(static_cast<Eigen::Index>(i)) = vs[i];
-  }
-  m.triangles.resize(static_cast<Eigen::Index>(fs.size()), 3);
+  skinning::Positions x(static_cast<Eigen::Index>(vs.size()), 3);
+  for (std::size_t i = 0; i < vs.size(); ++i) x.row(static_cast<Eigen::Index>(i)) = vs[i];
+  skinning::Triangles t(static_cast<Eigen::Index>(fs.size()), 3);
   for (std::size_t f = 0; f < fs.size(); ++f) {
     for (int k = 0; k < 3; ++k) {
-      m.triangles(static_cast<Eigen::Index>(f), k) = fs[f][static_cast<std::size_t>(k)];
+      t(static_cast<Eigen::Index>(f), k) = fs[f][static_cast<std::size_t>(k)];
     }
   }
-  m.face_part.assign(fs.size(), 0);
-  m.face_index_in_part.resize(fs.size());
-  for (std::size_t f = 0; f < fs.size(); ++f)
-    m.face_index_in_part[f] = static_cast<std::int32_t>(f);
-  m.vertex_part.assign(vs.size(), 0);
-  m.vertex_index_in_part.resize(vs.size());
-  for (std::size_t v = 0; v < vs.size(); ++v) {
-    m.vertex_index_in_part[v] = static_cast<std::int32_t>(v);
-  }
-  m.part_names = {"grid slab"};
-  s.topology = skinning::build_topology(m);
+  s.mesh = test::single_part_mesh(std::move(x), std::move(t), "grid slab");
+  s.topology = skinning::build_topology(s.mesh);
   for (const auto& v : vs) s.upper.push_back(v.z() > 0.5);
   return s;
 }
