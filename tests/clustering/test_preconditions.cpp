@@ -85,7 +85,8 @@ USlab make_slab(int strips) {
 /// width 1/strips along y in [0, 1]), so that patches of the surface lie away from its cuts: the
 /// section is the union of the cells inside the U, the caps are those cells, the sides their
 /// boundary edges extruded. Outward, closed, one component.
-USlab make_grid_slab(int strips) {
+/// `hole`: (cell i, strip) of the upper arm's underside left out (a hole in the surface).
+USlab make_grid_slab(int strips, const std::vector<std::array<int, 2>>& hole = {}) {
   constexpr int nx = 20, nz = 5;
   const auto inside = [&](int i, int k) {
     if (i < 0 || k < 0 || i >= nx || k >= nz) return false;
@@ -123,6 +124,11 @@ USlab make_grid_slab(int strips) {
           continue;
         }
         for (int level = 0; level < strips; ++level) {
+          const bool underside = k == 4 && e == 0;
+          if (underside &&
+              std::find(hole.begin(), hole.end(), std::array<int, 2>{i, level}) != hole.end()) {
+            continue;
+          }
           const std::int32_t a = at(e, level), b = at((e + 1) % 4, level);
           const std::int32_t cc = at((e + 1) % 4, level + 1), d = at(e, level + 1);
           fs.push_back({a, cc, b});
@@ -324,6 +330,59 @@ TEST(Preconditions, SkinInsideAnOverlapIsNotSkippedAgainstTheOuterSkin) {
   EXPECT_GT(stats.triangles_kept_out, stats.triangles_cut + 40);
   EXPECT_EQ(stats.escalation_contacts, 0);  // found by the first pass, not by a re-test
   // Bare (everything of one class skipped), the contacts are lost: the test above can fail.
+  EXPECT_LT(keys(bare).size(), keys(brute).size());
+}
+
+TEST(Preconditions, AGhostCapIsTheEnteringSheetAndItsContactTriggersTheRetest) {
+  // The ghost caps' role in the proof (docs/radial-view.md, "Open parts with ghost triangles"):
+  // the upper arm's underside has a hole, capped by a ghost fan. A spike rises from the lower arm's
+  // top through the hole, without touching its rim, into the upper arm, and meets the upper arm's
+  // top from inside. The spike's faces and the top face away from the observer below (H⁺), so
+  // their pairs are skipped; seen along a ray the only sheet between them is the ghost cap, and
+  // the spike's contacts with the ghost are the only ones that can trigger the re-test. Ghost
+  // contacts are never reported, but they must escalate.
+  const USlab s = make_grid_slab(10, {{{4, 4}, {5, 4}, {4, 5}, {5, 5}}});
+  ASSERT_EQ(s.topology.components.size(), 1u);
+  ASSERT_EQ(s.topology.boundary_loops.size(), 1u);
+  skinning::Positions p0 = s.mesh.rest_positions;
+  for (Eigen::Index v = 0; v < p0.rows(); ++v) {
+    const double t = std::clamp((p0(v, 2) - 0.2) / 0.6, 0.0, 1.0);
+    p0.row(v) += t * V3(0.03, 0.02, 0.0).transpose();  // the hole around the spike, off its centre
+  }
+  skinning::Positions p1 = p0;
+  int spikes = 0;
+  for (Eigen::Index v = 0; v < p1.rows(); ++v) {
+    const V3 r = s.mesh.rest_positions.row(v);
+    if (std::abs(r.x() - 1.0) < 1e-12 && std::abs(r.y() - 0.5) < 1e-12 &&
+        std::abs(r.z() - 0.2) < 1e-12) {
+      p1(v, 2) = 1.05;
+      ++spikes;
+    }
+  }
+  ASSERT_EQ(spikes, 1);
+  skinning::Positions x0, x1;
+  skinning::gather_welded(s.topology, p0, x0);
+  skinning::gather_welded(s.topology, p1, x1);
+  culling::FrameResult brute, guarded, bare;
+  culling::make_method("brute", s.mesh, s.topology)->detect_ccd(x0, x1, brute);
+  ASSERT_FALSE(brute.contacts.empty());
+  const auto seg = one_cluster(s);
+  const auto poses = still_bone();
+  RadialViewStats stats;
+  for (const bool guard : {true, false}) {
+    RadialViewOptions o;
+    o.clusters.merge = false;
+    o.guard = guard;
+    RadialViewMethod m("rvbc", s.mesh, s.topology, seg, poses, 1, {}, o);
+    m.detect_ccd(x0, x1, guard ? guarded : bare);
+    if (guard) stats = m.last_stats();
+  }
+  EXPECT_EQ(keys(guarded), keys(brute));
+  EXPECT_EQ(stats.ghost_loops, 1);
+  EXPECT_EQ(stats.components_open, 0);
+  EXPECT_EQ(stats.components_culled, 1);
+  EXPECT_GT(stats.ghost_contacts, 0);       // the spike through the cap: used, not reported
+  EXPECT_GT(stats.escalation_contacts, 0);  // the spike against the top: found by the re-test
   EXPECT_LT(keys(bare).size(), keys(brute).size());
 }
 
