@@ -676,9 +676,10 @@ void RadialViewMethod::ccd(const culling::Interval& interval, culling::FrameResu
   }
 
   // 7. The intersecting pairs at the interval's end, for the next interval's start: this one's
-  //    start pairs updated from its contacts (complete: nothing is missed), when the contacts
-  //    come from a CCD that never misses.
-  if (options_.guard && culling_possible && method_options_.accuracy != ccd::Accuracy::fast) {
+  //    start pairs updated from its contacts (exact when nothing is missed: conservative and
+  //    exact accuracy; `fast` guarantees nothing, and a contact it misses may leave a pair out
+  //    here too — a full DCD per interval would cost more than the fast kernels save).
+  if (options_.guard && culling_possible) {
     scratch_result_.clear();
     updater_.update(start_pairs_, out.contacts, x_t1, tests_, scratch_result_);
     carry_pairs_.assign(scratch_result_.dcd_pairs.begin(), scratch_result_.dcd_pairs.end());
