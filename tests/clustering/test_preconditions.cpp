@@ -194,10 +194,12 @@ struct Runs {
   RadialViewStats guarded_stats, bare_stats;
 };
 
-Runs run_all(const USlab& s, const V3& shift_t0, const V3& shift_t1) {
+/// brute, then rvbc guarded and bare (one cluster, the observer below), from file-vertex positions
+/// p0 to p1.
+Runs run_positions(const USlab& s, const skinning::Positions& p0, const skinning::Positions& p1) {
   skinning::Positions x0, x1;
-  skinning::gather_welded(s.topology, moved(s, shift_t0), x0);
-  skinning::gather_welded(s.topology, moved(s, shift_t1), x1);
+  skinning::gather_welded(s.topology, p0, x0);
+  skinning::gather_welded(s.topology, p1, x1);
   Runs r;
   culling::make_method("brute", s.mesh, s.topology)->detect_ccd(x0, x1, r.brute);
   const auto seg = one_cluster(s);
@@ -211,6 +213,10 @@ Runs run_all(const USlab& s, const V3& shift_t0, const V3& shift_t1) {
     (guard ? r.guarded_stats : r.bare_stats) = m.last_stats();
   }
   return r;
+}
+
+Runs run_all(const USlab& s, const V3& shift_t0, const V3& shift_t1) {
+  return run_positions(s, moved(s, shift_t0), moved(s, shift_t1));
 }
 
 TEST(Preconditions, SlabIsAClosedConsistentlyOrientedComponent) {
@@ -304,24 +310,10 @@ TEST(Preconditions, SkinInsideAnOverlapIsNotSkippedAgainstTheOuterSkin) {
     ++bump;
   }
   ASSERT_GT(bump, 10);
-  skinning::Positions x0, x1;
-  skinning::gather_welded(s.topology, p0, x0);
-  skinning::gather_welded(s.topology, p1, x1);
-  culling::FrameResult brute, guarded, bare;
-  culling::make_method("brute", s.mesh, s.topology)->detect_ccd(x0, x1, brute);
-  ASSERT_FALSE(brute.contacts.empty());
-  const auto seg = one_cluster(s);
-  const auto poses = still_bone();
-  RadialViewStats stats;
-  for (const bool guard : {true, false}) {
-    RadialViewOptions o;
-    o.clusters.merge = false;
-    o.guard = guard;
-    RadialViewMethod m("rvbc", s.mesh, s.topology, seg, poses, 1, {}, o);
-    m.detect_ccd(x0, x1, guard ? guarded : bare);
-    if (guard) stats = m.last_stats();
-  }
-  EXPECT_EQ(keys(guarded), keys(brute));
+  const Runs r = run_positions(s, p0, p1);
+  ASSERT_FALSE(r.brute.contacts.empty());
+  const RadialViewStats& stats = r.guarded_stats;
+  EXPECT_EQ(keys(r.guarded), keys(r.brute));
   EXPECT_EQ(stats.components_dirty, 1);
   EXPECT_EQ(stats.components_culled, 1);
   EXPECT_GT(stats.patches_classified, 1);
@@ -330,7 +322,7 @@ TEST(Preconditions, SkinInsideAnOverlapIsNotSkippedAgainstTheOuterSkin) {
   EXPECT_GT(stats.triangles_kept_out, stats.triangles_cut + 40);
   EXPECT_EQ(stats.escalation_contacts, 0);  // found by the first pass, not by a re-test
   // Bare (everything of one class skipped), the contacts are lost: the test above can fail.
-  EXPECT_LT(keys(bare).size(), keys(brute).size());
+  EXPECT_LT(keys(r.bare).size(), keys(r.brute).size());
 }
 
 TEST(Preconditions, AGhostCapIsTheEnteringSheetAndItsContactTriggersTheRetest) {
@@ -360,30 +352,16 @@ TEST(Preconditions, AGhostCapIsTheEnteringSheetAndItsContactTriggersTheRetest) {
     }
   }
   ASSERT_EQ(spikes, 1);
-  skinning::Positions x0, x1;
-  skinning::gather_welded(s.topology, p0, x0);
-  skinning::gather_welded(s.topology, p1, x1);
-  culling::FrameResult brute, guarded, bare;
-  culling::make_method("brute", s.mesh, s.topology)->detect_ccd(x0, x1, brute);
-  ASSERT_FALSE(brute.contacts.empty());
-  const auto seg = one_cluster(s);
-  const auto poses = still_bone();
-  RadialViewStats stats;
-  for (const bool guard : {true, false}) {
-    RadialViewOptions o;
-    o.clusters.merge = false;
-    o.guard = guard;
-    RadialViewMethod m("rvbc", s.mesh, s.topology, seg, poses, 1, {}, o);
-    m.detect_ccd(x0, x1, guard ? guarded : bare);
-    if (guard) stats = m.last_stats();
-  }
-  EXPECT_EQ(keys(guarded), keys(brute));
+  const Runs r = run_positions(s, p0, p1);
+  ASSERT_FALSE(r.brute.contacts.empty());
+  const RadialViewStats& stats = r.guarded_stats;
+  EXPECT_EQ(keys(r.guarded), keys(r.brute));
   EXPECT_EQ(stats.ghost_loops, 1);
   EXPECT_EQ(stats.components_open, 0);
   EXPECT_EQ(stats.components_culled, 1);
   EXPECT_GT(stats.ghost_contacts, 0);       // the spike through the cap: used, not reported
   EXPECT_GT(stats.escalation_contacts, 0);  // the spike against the top: found by the re-test
-  EXPECT_LT(keys(bare).size(), keys(brute).size());
+  EXPECT_LT(keys(r.bare).size(), keys(r.brute).size());
 }
 
 }  // namespace
