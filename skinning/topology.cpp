@@ -150,6 +150,23 @@ void build_adjacency(Topology& topo) {
 // face's side (a → b); at every step the walk prefers an unvisited boundary edge leaving the
 // current vertex in that orientation, so that loops around pinch vertices close where they should.
 // A walk that cannot return to its start (inconsistently oriented faces) is kept as an open chain.
+/// Each boundary edge as its one face runs it (from → to), in boundary_edges order.
+std::vector<BoundarySide> boundary_sides(const Topology& topo) {
+  std::vector<BoundarySide> sides;
+  sides.reserve(topo.boundary_edges.size());
+  for (const std::int32_t e : topo.boundary_edges) {
+    const auto f = topo.edge_faces[static_cast<std::size_t>(
+        topo.edge_face_offsets[static_cast<std::size_t>(e)])];
+    for (int k = 0; k < 3; ++k) {
+      if (topo.face_edges(f, k) == e) {
+        sides.push_back({topo.welded_triangles(f, k), topo.welded_triangles(f, (k + 1) % 3), f});
+        break;
+      }
+    }
+  }
+  return sides;
+}
+
 void build_boundary_loops(Topology& topo) {
   topo.boundary_loops.clear();
   const auto nb = topo.boundary_edges.size();
@@ -157,16 +174,10 @@ void build_boundary_loops(Topology& topo) {
   const auto nw = static_cast<std::size_t>(topo.num_welded_vertices());
   // Oriented ends of each boundary edge.
   std::vector<std::int32_t> from(nb), to(nb);
+  const std::vector<BoundarySide> sides = boundary_sides(topo);
   for (std::size_t i = 0; i < nb; ++i) {
-    const auto e = topo.boundary_edges[i];
-    const auto f = topo.edge_faces[static_cast<std::size_t>(topo.edge_face_offsets[static_cast<std::size_t>(e)])];
-    for (int k = 0; k < 3; ++k) {
-      if (topo.face_edges(f, k) == e) {
-        from[i] = topo.welded_triangles(f, k);
-        to[i] = topo.welded_triangles(f, (k + 1) % 3);
-        break;
-      }
-    }
+    from[i] = sides[i].from;
+    to[i] = sides[i].to;
   }
   // CSR: boundary edges incident to each welded vertex.
   std::vector<std::int32_t> offsets(nw + 1, 0);
@@ -328,19 +339,11 @@ std::vector<std::vector<BoundarySide>> small_simple_loops(
     bad_component[at(topology.face_component[at(f)])] = 1;
   }
   const auto nw = at(topology.num_welded_vertices());
-  std::vector<BoundarySide> sides;
+  const std::vector<BoundarySide> sides = boundary_sides(topology);
   std::vector<std::int32_t> out_count(nw, 0), in_count(nw, 0);
-  for (const std::int32_t e : topology.boundary_edges) {
-    const auto f = topology.edge_faces[at(topology.edge_face_offsets[at(e)])];
-    for (int k = 0; k < 3; ++k) {
-      if (topology.face_edges(f, k) != e) continue;
-      const BoundarySide s{
-          topology.welded_triangles(f, k), topology.welded_triangles(f, (k + 1) % 3), f};
-      ++out_count[at(s.from)];
-      ++in_count[at(s.to)];
-      sides.push_back(s);
-      break;
-    }
+  for (const auto& s : sides) {
+    ++out_count[at(s.from)];
+    ++in_count[at(s.to)];
   }
   // CSR: the sides leaving each vertex. A vertex with as many sides in as out lies on cycles; a
   // pinch vertex (two or more of each) is where the walk below splits a loop into simple cycles.
