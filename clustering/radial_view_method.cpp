@@ -30,6 +30,16 @@ bool same_positions(const skinning::Positions& a, const skinning::Positions& b) 
   return a.rows() == b.rows() && std::equal(a.data(), a.data() + a.size(), b.data());
 }
 
+/// The mesh and topology the method works on: the capped ones when there are ghost caps.
+const skinning::Mesh& used_mesh(
+    const std::unique_ptr<GhostCaps>& ghosts, const skinning::Mesh& real) {
+  return ghosts ? ghosts->mesh : real;
+}
+const skinning::Topology& used_topology(
+    const std::unique_ptr<GhostCaps>& ghosts, const skinning::Topology& real) {
+  return ghosts ? ghosts->topology : real;
+}
+
 /// Patches smaller than this are not classified (their triangles are tested as Hᵘ): a ray costs
 /// a pass over the component, and a few triangles skipped save less than that.
 constexpr std::int32_t kMinPatch = 8;
@@ -76,10 +86,10 @@ RadialViewMethod::RadialViewMethod(
       real_triangles_(static_cast<std::int32_t>(real_topology.welded_triangles.rows())),
       segmentation_(ghosts_ ? ghosts_->segmentation : std::move(segmentation)),
       poses_(std::move(poses)),
-      topology_(ghosts_ ? ghosts_->mesh : real_mesh, ghosts_ ? ghosts_->topology : real_topology),
+      topology_(used_mesh(ghosts_, real_mesh), used_topology(ghosts_, real_topology)),
       clusters_(
-          ghosts_ ? ghosts_->mesh : real_mesh,
-          ghosts_ ? ghosts_->topology : real_topology,
+          used_mesh(ghosts_, real_mesh),
+          used_topology(ghosts_, real_topology),
           *segmentation_,
           num_bones,
           method_options.bvh),
@@ -89,14 +99,13 @@ RadialViewMethod::RadialViewMethod(
       // The bvh method checks the method options (min_separation, accuracy) as every method does.
       bvh_(culling::make_method(
           "bvh",
-          ghosts_ ? ghosts_->mesh : real_mesh,
-          ghosts_ ? ghosts_->topology : real_topology,
+          used_mesh(ghosts_, real_mesh),
+          used_topology(ghosts_, real_topology),
           method_options_)),
-      updater_(ghosts_ ? ghosts_->mesh : real_mesh, ghosts_ ? ghosts_->topology : real_topology),
+      updater_(used_mesh(ghosts_, real_mesh), used_topology(ghosts_, real_topology)),
       builder_(clusters_, options.clusters),
-      edge_face_offsets_(
-          ghosts_ ? ghosts_->topology.edge_face_offsets : real_topology.edge_face_offsets),
-      edge_faces_(ghosts_ ? ghosts_->topology.edge_faces : real_topology.edge_faces),
+      edge_face_offsets_(used_topology(ghosts_, real_topology).edge_face_offsets),
+      edge_faces_(used_topology(ghosts_, real_topology).edge_faces),
       blocks_(
           method_options.block_pairs,
           culling::block_reserve(
@@ -134,18 +143,13 @@ RadialViewMethod::RadialViewMethod(
   patch_.assign(num_faces, -1);
   escalated_.assign(num_faces, 0);
   patch_order_.reserve(num_faces);
-  // Component → triangles (CSR), for the rays of the patches.
-  component_offsets_.assign(num_components + 1, 0);
-  for (std::int32_t f = 0; f < topology_.num_triangles(); ++f) {
-    ++component_offsets_[at(clusters_.component_of_triangle(f)) + 1];
-  }
-  for (std::size_t k = 0; k < num_components; ++k) {
-    component_offsets_[k + 1] += component_offsets_[k];
-  }
-  component_triangles_.resize(num_faces);
-  std::vector<std::int32_t> next(component_offsets_.begin(), component_offsets_.end() - 1);
-  for (std::int32_t f = 0; f < topology_.num_triangles(); ++f) {
-    component_triangles_[at(next[at(clusters_.component_of_triangle(f))]++)] = f;
+  // Component → triangles (CSR, from Topology::components), for the rays of the patches.
+  const auto& components = used_topology(ghosts_, real_topology).components;
+  component_offsets_.assign(1, 0);
+  component_triangles_.reserve(num_faces);
+  for (const auto& c : components) {
+    component_triangles_.insert(component_triangles_.end(), c.faces.begin(), c.faces.end());
+    component_offsets_.push_back(static_cast<std::int32_t>(component_triangles_.size()));
   }
   if (ghosts_) {  // everything is built: keep only the loops and the edge map
     ghosts_->mesh = skinning::Mesh{};
@@ -304,22 +308,23 @@ void RadialViewMethod::classify_patches(const skinning::Positions& x_t0) {
       patch_offsets_.push_back(static_cast<std::int32_t>(patch_order_.size()));
     }
     // One ray per patch, largest patch first: its value is the component's.
-    std::vector<std::pair<std::int32_t, std::int32_t>> by_size;  // (−size, patch)
+    patch_sizes_.clear();
     for (std::size_t p = patches_before; p + 1 < patch_offsets_.size(); ++p) {
       const std::int32_t size = patch_offsets_[p + 1] - patch_offsets_[p];
       ++stats_.patches;
-      if (size >= kMinPatch) by_size.emplace_back(-size, static_cast<std::int32_t>(p));
+      if (size >= kMinPatch) patch_sizes_.emplace_back(-size, static_cast<std::int32_t>(p));
     }
-    std::sort(by_size.begin(), by_size.end());
+    std::sort(patch_sizes_.begin(), patch_sizes_.end());
+    const culling::Aabb box = surface_box(surface, triangles, x_t0);
     std::optional<int> value;
-    for (const auto& [minus_size, p] : by_size) {
+    for (const auto& [minus_size, p] : patch_sizes_) {
       const std::int32_t begin = patch_offsets_[at(p)];
       const std::int32_t size = -minus_size;
       std::optional<int> w;
       for (int attempt = 0; attempt < kPatchAttempts && !w; ++attempt) {
         // Spread the tries over the patch (BFS order: the seed's neighbourhood first).
         const std::int32_t f = patch_order_[at(begin + (attempt * size) / kPatchAttempts)];
-        w = front_winding(surface, triangles, x_t0, f, attempt);
+        w = front_winding(surface, box, triangles, x_t0, f, attempt);
       }
       if (!w) continue;
       ++stats_.patches_classified;
@@ -396,8 +401,7 @@ void RadialViewMethod::compute_masks() {
 
 // --- intra- and inter-cluster checks (§6) ---------------------------------------------------------
 
-std::int64_t RadialViewMethod::traverse(
-    MaskedPairs which, double half_width, culling::FrameResult& out) {
+std::int64_t RadialViewMethod::traverse(double half_width, culling::FrameResult& out) {
   const std::span<const culling::Aabb> tri_bounds(bounds_.triangles);
   std::int64_t& bv_tests = out.counters.bv_tests;
   // Each traversal runs in installments; the pairs of an installment go through the relative AABB
@@ -424,7 +428,7 @@ std::int64_t RadialViewMethod::traverse(
           tri_bounds,
           node_masks_[at(a)],
           triangle_mask_,
-          which,
+          MaskedPairs::tested,
           scratch_,
           pairs,
           bv_tests,
@@ -448,7 +452,7 @@ std::int64_t RadialViewMethod::traverse(
             node_masks_[at(cp.b)],
             tri_bounds,
             triangle_mask_,
-            which,
+            MaskedPairs::tested,
             scratch_,
             pairs,
             bv_tests,
@@ -467,8 +471,7 @@ std::int64_t RadialViewMethod::traverse(
 
 // --- the local guard's re-tests --------------------------------------------------------------
 
-void RadialViewMethod::escalate(
-    const culling::FrameResult& out, std::size_t from, std::int32_t round) {
+void RadialViewMethod::escalate(const culling::FrameResult& out, std::int32_t round) {
   // The triangles at every vertex of a contact's two features: the contact's triangles and the
   // owners of their features (docs/radial-view.md, "The local guard": re-testing their skipped
   // pairs re-tests every skipped feature pair at those triangles).
@@ -488,8 +491,7 @@ void RadialViewMethod::escalate(
       }
     }
   };
-  for (std::size_t i = from; i < out.contacts.size(); ++i) {
-    const auto& c = out.contacts[i];
+  for (const auto& c : out.contacts) {
     if (c.kind == culling::CcdContact::Kind::vf) {
       mark_vertex(c.a);
       for (const std::int32_t w : topology_.triangle(c.b)) mark_vertex(w);
@@ -632,7 +634,7 @@ void RadialViewMethod::ccd(const culling::Interval& interval, culling::FrameResu
                             out.counters.bv_tests);
   blocks_.start_ccd(
       topology_, bounds_, x_t0, x_t1, tests_, method_options_.accuracy, ccd_options_, out);
-  (void)traverse(MaskedPairs::tested, half_width, out);
+  (void)traverse(half_width, out);
   blocks_.finish();
   stats_.blocks += blocks_.blocks();
   const double test_us = blocks_.test_us();
@@ -651,7 +653,7 @@ void RadialViewMethod::ccd(const culling::Interval& interval, culling::FrameResu
     for (std::int32_t round = 1;; ++round) {
       // New contacts are merged into the sorted list wherever they sort: look at all of them
       // (marking is idempotent).
-      escalate(out, 0, round);
+      escalate(out, round);
       if (frontier_.empty()) break;
       ++stats_.escalation_rounds;
       const auto e0 = Clock::now();

@@ -141,12 +141,12 @@ class RadialViewMethod final : public culling::CullingMethod {
   /// triangles may be skipped (skippable_).
   void classify_patches(const skinning::Positions& x_t0);
   void compute_masks();
-  /// Streams the pairs `which` selects into blocks_ (a query started there), each installment
-  /// through the relative AABB filter; returns the pairs found before the filter.
-  std::int64_t traverse(culling::MaskedPairs which, double half_width, culling::FrameResult& out);
-  /// Marks the skippable triangles at the vertices of the contacts out.contacts[from…] that are
-  /// not marked yet (round `round`), appending them to frontier_.
-  void escalate(const culling::FrameResult& out, std::size_t from, std::int32_t round);
+  /// Streams the pairs the masks do not skip into blocks_ (a query started there), each
+  /// installment through the relative AABB filter; returns the pairs found before the filter.
+  std::int64_t traverse(double half_width, culling::FrameResult& out);
+  /// Marks the skippable triangles at the vertices of out.contacts that are not marked yet
+  /// (round `round`), appending them to frontier_.
+  void escalate(const culling::FrameResult& out, std::int32_t round);
   /// Streams the skipped pairs of frontier_'s triangles into blocks_ (each once: not with a
   /// triangle of an earlier round), through the relative AABB filter; returns the pairs found.
   std::int64_t retest_frontier(std::int32_t round, double half_width, culling::FrameResult& out);
@@ -190,6 +190,7 @@ class RadialViewMethod final : public culling::CullingMethod {
   std::vector<std::uint8_t> skippable_;  // per triangle: its patch has its component's value
   std::vector<std::int32_t> patch_;      // per triangle of a dirty component: its patch, or −1
   std::vector<std::int32_t> patch_order_, patch_offsets_;  // CSR patch → triangles (BFS order)
+  std::vector<std::pair<std::int32_t, std::int32_t>> patch_sizes_;  // (−size, patch) to classify
   std::vector<std::int32_t> escalated_;  // per triangle: the round it was escalated in, or 0
   std::vector<std::int32_t> frontier_;   // triangles escalated in the current round
   std::vector<std::uint8_t> component_escalated_;

@@ -4,7 +4,6 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
-#include <limits>
 
 #include "ccd/orientation.hpp"
 
@@ -50,8 +49,27 @@ constexpr std::array<std::array<double, 3>, 8> kTilts{{
 
 }  // namespace
 
+culling::Aabb surface_box(
+    std::span<const std::int32_t> surface,
+    const skinning::Triangles& triangles,
+    const skinning::Positions& x) {
+  culling::Aabb box = culling::Aabb::empty();
+  for (const std::int32_t t : surface) {
+    for (int k = 0; k < 3; ++k) {
+      const auto v = static_cast<Eigen::Index>(triangles(t, k));
+      for (std::size_t c = 0; c < 3; ++c) {
+        const double p = x(v, static_cast<Eigen::Index>(c));
+        box.lo[c] = std::min(box.lo[c], p);
+        box.hi[c] = std::max(box.hi[c], p);
+      }
+    }
+  }
+  return box;
+}
+
 std::optional<int> front_winding(
     std::span<const std::int32_t> surface,
+    const culling::Aabb& box,
     const skinning::Triangles& triangles,
     const skinning::Positions& x,
     std::int32_t f,
@@ -74,16 +92,9 @@ std::optional<int> front_winding(
   int side = 0;
   if (segment_meets(back, front, a, b, c, side) != Meet::cross || side != 1) return std::nullopt;
 
-  // The surface's box; the ray ends beyond it, where w = 0.
-  V lo = V::Constant(std::numeric_limits<double>::infinity());
-  V hi = -lo;
-  for (const std::int32_t t : surface) {
-    for (int k = 0; k < 3; ++k) {
-      const V p = corner(t, k);
-      lo = lo.cwiseMin(p);
-      hi = hi.cwiseMax(p);
-    }
-  }
+  // The ray ends beyond the surface's box, where w = 0.
+  const V lo(box.lo[0], box.lo[1], box.lo[2]);
+  const V hi(box.hi[0], box.hi[1], box.hi[2]);
   const auto& tilt = kTilts[static_cast<std::size_t>(attempt) % kTilts.size()];
   const double scale = 1.0 + static_cast<double>(attempt / static_cast<int>(kTilts.size()));
   V d = nh + scale * V(tilt[0], tilt[1], tilt[2]);

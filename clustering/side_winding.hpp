@@ -8,13 +8,21 @@
 #include <optional>
 #include <span>
 
+#include "culling/dop.hpp"
 #include "skinning/mesh.hpp"
 
 namespace skelcd::clustering {
 
+/// The box of the corners of `surface` (ids into `triangles`) at positions x: front_winding's
+/// rays end beyond it. Computed once per surface and instant, for all its rays.
+[[nodiscard]] culling::Aabb surface_box(
+    std::span<const std::int32_t> surface,
+    const skinning::Triangles& triangles,
+    const skinning::Positions& x);
+
 /// The winding number w of the closed, consistently oriented surface `surface` (ids into
-/// `triangles`, f among them) just in front of triangle f — on the side its normal
-/// (b − a) × (c − a) points to, near its centroid. w is 0 far away and drops by one across a
+/// `triangles`, f among them; `box` its surface_box) just in front of triangle f — on the side its
+/// normal (b − a) × (c − a) points to, near its centroid. w is 0 far away and drops by one across a
 /// triangle along its normal (an outward-oriented embedded surface: 1 inside, 0 outside).
 ///
 /// Exact, or nothing: a short segment through f near its centroid, along its normal, must cross
@@ -26,6 +34,7 @@ namespace skelcd::clustering {
 /// O(|surface|) per call.
 [[nodiscard]] std::optional<int> front_winding(
     std::span<const std::int32_t> surface,
+    const culling::Aabb& box,
     const skinning::Triangles& triangles,
     const skinning::Positions& x,
     std::int32_t f,

@@ -59,12 +59,13 @@ MeshData flipped(MeshData m) {
 /// `may_miss`: where surfaces cross, the short segment of a triangle cut by another may meet it).
 std::vector<int> winding_of_every_triangle(const MeshData& m, bool may_miss = false) {
   const auto ids = all_triangles(m);
+  const culling::Aabb box = surface_box(ids, m.F, m.V);
   std::vector<int> values;
   int undecided_first = 0;
   for (const std::int32_t f : ids) {
     std::optional<int> w;
     for (int attempt = 0; attempt < 6 && !w; ++attempt) {
-      w = front_winding(ids, m.F, m.V, f, attempt);
+      w = front_winding(ids, box, m.F, m.V, f, attempt);
       if (!w && attempt == 0) ++undecided_first;
     }
     EXPECT_TRUE(may_miss || w.has_value()) << "triangle " << f;
@@ -139,7 +140,8 @@ TEST(SideWinding, UndecidableAttemptsSayNothing) {
   // A degenerate triangle: no normal, no answer.
   MeshData flat = sphere;
   flat.V.row(flat.F(0, 1)) = flat.V.row(flat.F(0, 0));
-  EXPECT_FALSE(front_winding(ids, flat.F, flat.V, 0, 0).has_value());
+  EXPECT_FALSE(
+      front_winding(ids, surface_box(ids, flat.F, flat.V), flat.F, flat.V, 0, 0).has_value());
   // A second sheet within the short segment in front of triangle 0: the segment meets it.
   const V3 a = row(sphere, sphere.F(0, 0)), b = row(sphere, sphere.F(0, 1)),
            c = row(sphere, sphere.F(0, 2));
@@ -147,8 +149,9 @@ TEST(SideWinding, UndecidableAttemptsSayNothing) {
   const MeshData close_shell = moved(sphere, 1e-6 * n);
   const MeshData both = test::concat(sphere, close_shell);
   const auto both_ids = all_triangles(both);
+  const culling::Aabb both_box = surface_box(both_ids, both.F, both.V);
   for (int attempt = 0; attempt < 3; ++attempt) {
-    EXPECT_FALSE(front_winding(both_ids, both.F, both.V, 0, attempt).has_value());
+    EXPECT_FALSE(front_winding(both_ids, both_box, both.F, both.V, 0, attempt).has_value());
   }
   // An axis-aligned box (coplanar faces, edges along the axes): the tilted rays decide.
   MeshData box = test::from_lists(
