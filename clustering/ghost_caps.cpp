@@ -38,7 +38,6 @@ std::unique_ptr<GhostCaps> cap_small_loops(
     }
     caps->loop_offsets.push_back(static_cast<std::int32_t>(caps->loop_vertices.size()));
   }
-  if (caps->num_loops() == 0) return nullptr;
 
   // The capped mesh: centres after the file vertices, ghosts (to, from, centre) after the
   // triangles — the loop edge reversed, so that the orientation stays consistent.
@@ -46,16 +45,14 @@ std::unique_ptr<GhostCaps> cap_small_loops(
   m = mesh;
   const auto num_file = static_cast<Eigen::Index>(mesh.num_vertices());
   const std::int32_t loops = caps->num_loops();
+  // The centres at rest, as every query places them.
+  skinning::Positions welded_rest, capped_rest;
+  skinning::gather_welded(topology, mesh.rest_positions, welded_rest);
+  place_ghost_centres(*caps, welded_rest, capped_rest);
   m.rest_positions.conservativeResize(num_file + loops, 3);
   for (std::int32_t j = 0; j < loops; ++j) {
-    Eigen::RowVector3d sum = Eigen::RowVector3d::Zero();
+    m.rest_positions.row(num_file + j) = capped_rest.row(num_welded + j);
     const auto first = caps->loop_offsets[at(j)];
-    const auto last = caps->loop_offsets[at(j) + 1];
-    for (auto i = first; i < last; ++i) {
-      const auto v = topology.representative_vertex[at(caps->loop_vertices[at(i)])];
-      sum += mesh.rest_positions.row(v);
-    }
-    m.rest_positions.row(num_file + j) = sum / static_cast<double>(last - first);
     const auto any = topology.representative_vertex[at(caps->loop_vertices[at(first)])];
     m.vertex_part.push_back(mesh.vertex_part[at(any)]);
     m.vertex_index_in_part.push_back(-1);
