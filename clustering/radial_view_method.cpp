@@ -133,6 +133,7 @@ RadialViewMethod::RadialViewMethod(
       4 * deepest + 4,
       4 * static_cast<std::size_t>(clusters_.global_bvh().depth()) + 4));
   node_stack_.reserve(2 * deepest + 2);
+  triangle_label_.resize(at(topology_.num_triangles()));
   vertex_label_.resize(at(topology_.num_vertices()));
   edge_label_.resize(at(topology_.num_edges()));
   status_.assign(num_components, Status::unknown);
@@ -315,16 +316,26 @@ void RadialViewMethod::classify_patches(const skinning::Positions& x_t0) {
       if (size >= kMinPatch) patch_sizes_.emplace_back(-size, static_cast<std::int32_t>(p));
     }
     std::sort(patch_sizes_.begin(), patch_sizes_.end());
-    const culling::Aabb box = surface_box(surface, triangles, x_t0);
+    // The rays end beyond the component's box at x_t0; the union of its clusters' swept boxes
+    // contains it (no pass over the surface).
+    culling::Aabb box = culling::Aabb::empty();
+    for (std::int32_t a = 0; a < clusters_.num_atomic(); ++a) {
+      if (clusters_.component_of_atomic(a) == k) box.merge(cluster_bounds_[at(a)]);
+    }
     std::optional<int> value;
     for (const auto& [minus_size, p] : patch_sizes_) {
       const std::int32_t begin = patch_offsets_[at(p)];
       const std::int32_t size = -minus_size;
       std::optional<int> w;
       for (int attempt = 0; attempt < kPatchAttempts && !w; ++attempt) {
-        // Spread the tries over the patch (BFS order: the seed's neighbourhood first).
+        // Spread the tries over the patch (BFS order: the seed's neighbourhood first). The count
+        // runs over the triangles the hierarchies say may meet the ray: the same as over the
+        // whole surface (count_winding).
         const std::int32_t f = patch_order_[at(begin + (attempt * size) / kPatchAttempts)];
-        w = front_winding(surface, box, triangles, x_t0, f, attempt);
+        const std::optional<WindingRay> ray = winding_ray(box, triangles, x_t0, f, attempt);
+        if (!ray) continue;
+        gather_ray_candidates(k, *ray);
+        w = count_winding(*ray, ray_candidates_, triangles, x_t0, f);
       }
       if (!w) continue;
       ++stats_.patches_classified;
@@ -334,6 +345,61 @@ void RadialViewMethod::classify_patches(const skinning::Positions& x_t0) {
     }
     for (const std::int32_t f : surface) {
       stats_.triangles_kept_out += skippable_[at(f)] == 0 ? 1 : 0;
+    }
+  }
+}
+
+void RadialViewMethod::gather_ray_candidates(std::int32_t k, const WindingRay& ray) {
+  // Both segments against the swept boxes, which contain the triangles at x_t0: the global
+  // hierarchy over the atomic clusters, then the local ones of k's clusters.
+  const auto may_meet = [&](const culling::Aabb& b) {
+    return segment_meets_box(ray.front, ray.far, b) || segment_meets_box(ray.back, ray.front, b);
+  };
+  ray_candidates_.clear();
+  const auto& global = clusters_.global_bvh();
+  if (global.empty()) return;
+  const auto global_nodes = global.nodes();
+  const auto global_bounds = global.node_bounds();
+  const auto global_order = global.triangle_order();
+  ray_stack_.assign(1, 0);
+  std::vector<std::int32_t>& stack = ray_stack_;
+  std::size_t local_base = 0;
+  while (stack.size() > local_base) {
+    const std::int32_t n = stack.back();
+    stack.pop_back();
+    if (!may_meet(global_bounds[at(n)])) continue;
+    const auto& node = global_nodes[at(n)];
+    if (!node.is_leaf()) {
+      stack.push_back(node.right);
+      stack.push_back(n + 1);
+      continue;
+    }
+    for (std::int32_t i = node.begin; i < node.end; ++i) {
+      const std::int32_t a = global_order[at(i)];
+      if (clusters_.component_of_atomic(a) != k) continue;
+      const auto& local = clusters_.local_bvh(a);
+      if (local.empty()) continue;
+      const auto nodes = local.nodes();
+      const auto bounds = local.node_bounds();
+      const auto order = local.triangle_order();
+      local_base = stack.size();
+      stack.push_back(0);
+      while (stack.size() > local_base) {
+        const std::int32_t m = stack.back();
+        stack.pop_back();
+        if (!may_meet(bounds[at(m)])) continue;
+        const auto& ln = nodes[at(m)];
+        if (!ln.is_leaf()) {
+          stack.push_back(ln.right);
+          stack.push_back(m + 1);
+          continue;
+        }
+        for (std::int32_t j = ln.begin; j < ln.end; ++j) {
+          const std::int32_t t = order[at(j)];
+          if (ln.size() == 1 || may_meet(bounds_.triangles[at(t)])) ray_candidates_.push_back(t);
+        }
+      }
+      local_base = 0;
     }
   }
 }
@@ -356,11 +422,13 @@ void RadialViewMethod::compute_masks() {
     const std::int32_t mega = classes_.atomic_mega[at(clusters_.atomic_of(f))];
     return 2 * static_cast<std::int64_t>(mega) + (c == OrientationClass::negative ? 1 : 0);
   };
+  const std::int32_t num_faces = topology_.num_triangles();
+  for (std::int32_t f = 0; f < num_faces; ++f) triangle_label_[at(f)] = label(f);
   const std::int32_t num_vertices = topology_.num_vertices();
   for (std::int32_t w = 0; w < num_vertices; ++w) {
     std::int64_t l = -2;
     for (const std::int32_t f : clusters_.vertex_triangles(w)) {
-      const std::int64_t lf = label(f);
+      const std::int64_t lf = triangle_label_[at(f)];
       l = (l == -2 || l == lf) ? lf : -1;
       if (l == -1) break;
     }
@@ -370,15 +438,14 @@ void RadialViewMethod::compute_masks() {
   for (std::int32_t e = 0; e < num_edges; ++e) {
     std::int64_t l = -2;
     for (auto i = edge_face_offsets_[at(e)]; i < edge_face_offsets_[at(e) + 1]; ++i) {
-      const std::int64_t lf = label(edge_faces_[at(i)]);
+      const std::int64_t lf = triangle_label_[at(edge_faces_[at(i)])];
       l = (l == -2 || l == lf) ? lf : -1;
       if (l == -1) break;
     }
     edge_label_[at(e)] = l < 0 ? -1 : l;
   }
-  const std::int32_t num_faces = topology_.num_triangles();
   for (std::int32_t f = 0; f < num_faces; ++f) {
-    const std::int64_t l = label(f);
+    const std::int64_t l = triangle_label_[at(f)];
     std::uint8_t mask = culling::kMaskOther;
     if (l >= 0) {
       const std::uint8_t owned = topology_.owned(f);
@@ -599,8 +666,6 @@ void RadialViewMethod::ccd(const culling::Interval& interval, culling::FrameResu
     stats_.components_dirty += status_[at(k)] == Status::dirty ? 1 : 0;
   }
   for (const std::uint8_t c : cut_) stats_.triangles_cut += c;
-  const auto t_patches = Clock::now();
-  classify_patches(x_t0);
 
   // 2. Swept volumes of the interval, local hierarchies, then the global one over their roots.
   const auto t_refit = Clock::now();
@@ -618,6 +683,9 @@ void RadialViewMethod::ccd(const culling::Interval& interval, culling::FrameResu
   }
   clusters_.global_bvh().refit(cluster_bounds_);
   if (options_.relative_aabb) relative_filter_.prepare(topology_, x_t0, x_t1);
+  const auto t_patches = Clock::now();
+  // 1'. The patches' winding numbers: their rays gather triangles through the refit hierarchies.
+  classify_patches(x_t0);
   const auto t_classify = Clock::now();
 
   // 3. RV update: observers ride their bones; classes and mega clusters (§3.1, §5).
@@ -699,9 +767,9 @@ void RadialViewMethod::ccd(const culling::Interval& interval, culling::FrameResu
   out.counters.mega_clusters += classes_.num_mega();
   out.counters.h_minus += classes_.h_minus;
   out.counters.h_uncertain += classes_.h_uncertain;
-  out.times.refit_us += micros(t_refit, t_classify);
+  out.times.refit_us += micros(t_refit, t_patches);
   out.times.classify_us +=
-      classes_.classify_us + micros(t_masks, t_traverse) + micros(t_patches, t_refit);
+      classes_.classify_us + micros(t_masks, t_traverse) + micros(t_patches, t_classify);
   out.times.merge_us += classes_.merge_us;
   out.times.traverse_us += micros(t_traverse, t_escalate) - test_us + escalate_traverse_us;
   out.times.elementary_us += test_us + escalate_elementary_us;

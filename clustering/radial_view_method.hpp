@@ -26,6 +26,7 @@
 #include "clustering/cluster_set.hpp"
 #include "clustering/ghost_caps.hpp"
 #include "clustering/mega_clusters.hpp"
+#include "clustering/side_winding.hpp"
 #include "culling/candidates.hpp"
 #include "culling/cluster_checks.hpp"
 #include "culling/elementary.hpp"
@@ -138,8 +139,12 @@ class RadialViewMethod final : public culling::CullingMethod {
   /// and the cut triangles.
   void start_status(const skinning::Positions& x_t0, culling::FrameResult& out);
   /// The uncut patches of the dirty culled components and their front winding numbers: which
-  /// triangles may be skipped (skippable_).
+  /// triangles may be skipped (skippable_). Needs the hierarchies refit over the interval's swept
+  /// volumes (they contain the triangles at x_t0): the rays gather their triangles through them.
   void classify_patches(const skinning::Positions& x_t0);
+  /// The triangles of component k whose swept boxes either segment of `ray` may meet, into
+  /// ray_candidates_: every triangle of k that can meet them (count_winding's precondition).
+  void gather_ray_candidates(std::int32_t k, const WindingRay& ray);
   void compute_masks();
   /// Streams the pairs the masks do not skip into blocks_ (a query started there), each
   /// installment through the relative AABB filter; returns the pairs found before the filter.
@@ -183,7 +188,7 @@ class RadialViewMethod final : public culling::CullingMethod {
   std::vector<culling::Aabb> cluster_bounds_;
   std::vector<std::uint8_t> triangle_mask_;
   std::vector<std::vector<std::uint8_t>> node_masks_;
-  std::vector<std::int64_t> vertex_label_, edge_label_;
+  std::vector<std::int64_t> triangle_label_, vertex_label_, edge_label_;  // compute_masks'
   std::vector<Status> status_;           // per component, at the interval's start
   std::vector<std::uint8_t> culled_;     // per component: pairs may be skipped this interval
   std::vector<std::uint8_t> cut_;        // per triangle: in a self-intersecting pair at the start
@@ -199,6 +204,7 @@ class RadialViewMethod final : public culling::CullingMethod {
   culling::PairBlocks<3> blocks_;
   culling::TraversalScratch scratch_;
   std::vector<std::int32_t> node_stack_;
+  std::vector<std::int32_t> ray_stack_, ray_candidates_;  // gather_ray_candidates' scratch
 
   // The intersecting pairs at the interval's start, and what may tell them without a DCD: the
   // last detect_dcd (at dcd_x_) and the pairs at the last interval's end (carry_x_), updated from

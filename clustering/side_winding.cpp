@@ -67,19 +67,18 @@ culling::Aabb surface_box(
   return box;
 }
 
-std::optional<int> front_winding(
-    std::span<const std::int32_t> surface,
+std::optional<WindingRay> winding_ray(
     const culling::Aabb& box,
     const skinning::Triangles& triangles,
     const skinning::Positions& x,
     std::int32_t f,
     int attempt) {
-  const auto corner = [&](std::int32_t t, int k) -> V {
-    return x.row(static_cast<Eigen::Index>(triangles(t, k))).transpose();
+  const auto corner = [&](int k) -> V {
+    return x.row(static_cast<Eigen::Index>(triangles(f, k))).transpose();
   };
-  const V a = corner(f, 0);
-  const V b = corner(f, 1);
-  const V c = corner(f, 2);
+  const V a = corner(0);
+  const V b = corner(1);
+  const V c = corner(2);
   const V n = (b - a).cross(c - a);
   const double len = n.norm();
   if (!(len > 0.0) || !std::isfinite(len)) return std::nullopt;
@@ -87,11 +86,13 @@ std::optional<int> front_winding(
   // The short segment [back, front] through f near its centroid, along its normal.
   const V centroid = (a + b + c) / 3.0;
   const double delta = 1e-3 * std::sqrt(len);
-  const V front = centroid + delta * nh;
-  const V back = centroid - delta * nh;
+  WindingRay ray;
+  ray.front = centroid + delta * nh;
+  ray.back = centroid - delta * nh;
   int side = 0;
-  if (segment_meets(back, front, a, b, c, side) != Meet::cross || side != 1) return std::nullopt;
-
+  if (segment_meets(ray.back, ray.front, a, b, c, side) != Meet::cross || side != 1) {
+    return std::nullopt;
+  }
   // The ray ends beyond the surface's box, where w = 0.
   const V lo(box.lo[0], box.lo[1], box.lo[2]);
   const V hi(box.hi[0], box.hi[1], box.hi[2]);
@@ -100,12 +101,29 @@ std::optional<int> front_winding(
   V d = nh + scale * V(tilt[0], tilt[1], tilt[2]);
   if (!(d.norm() > 0.0)) return std::nullopt;
   d.normalize();
-  const double reach = 2.0 * ((hi - lo).norm() + (front - 0.5 * (lo + hi)).norm()) + 1.0;
-  const V far = front + reach * d;
-  if (!((far.array() < lo.array()).any() || (far.array() > hi.array()).any()) || !far.allFinite()) {
+  const double reach = 2.0 * ((hi - lo).norm() + (ray.front - 0.5 * (lo + hi)).norm()) + 1.0;
+  ray.far = ray.front + reach * d;
+  ray.dir = d;
+  if (!((ray.far.array() < lo.array()).any() || (ray.far.array() > hi.array()).any()) ||
+      !ray.far.allFinite()) {
     return std::nullopt;
   }
+  return ray;
+}
 
+std::optional<int> count_winding(
+    const WindingRay& ray,
+    std::span<const std::int32_t> candidates,
+    const skinning::Triangles& triangles,
+    const skinning::Positions& x,
+    std::int32_t f) {
+  const auto corner = [&](std::int32_t t, int k) -> V {
+    return x.row(static_cast<Eigen::Index>(triangles(t, k))).transpose();
+  };
+  const V& back = ray.back;
+  const V& front = ray.front;
+  const V& far = ray.far;
+  const V& d = ray.dir;
   // Rejects triangles away from the ray by projections on d and on two directions across it,
   // with margins far above the rounding of the projections (a margin only lets more triangles
   // through to the exact test).
@@ -113,16 +131,15 @@ std::optional<int> front_winding(
   d.cwiseAbs().minCoeff(&axis);
   const V u = d.cross(V::Unit(axis)).normalized();
   const V v = d.cross(u);
-  const V ray = far - front;
-  const double ray_u = ray.dot(u);
-  const double ray_v = ray.dot(v);
-  const double ray_d = ray.dot(d);
-  const double ray_margin = 1e-12 * ray.cwiseAbs().sum();
+  const V span = far - front;
+  const double ray_u = span.dot(u);
+  const double ray_v = span.dot(v);
+  const double ray_d = span.dot(d);
+  const double ray_margin = 1e-12 * span.cwiseAbs().sum();
   const V seg_lo = back.cwiseMin(front);
   const V seg_hi = back.cwiseMax(front);
-
   int w = 0;
-  for (const std::int32_t t : surface) {
+  for (const std::int32_t t : candidates) {
     const std::array<V, 3> p{corner(t, 0), corner(t, 1), corner(t, 2)};
     // The short segment meets no other triangle (exact box test, then the exact one).
     if (t != f) {
@@ -161,6 +178,56 @@ std::optional<int> front_winding(
     if (m == Meet::cross) w += sign;
   }
   return w;
+}
+
+std::optional<int> front_winding(
+    std::span<const std::int32_t> surface,
+    const culling::Aabb& box,
+    const skinning::Triangles& triangles,
+    const skinning::Positions& x,
+    std::int32_t f,
+    int attempt) {
+  const std::optional<WindingRay> ray = winding_ray(box, triangles, x, f, attempt);
+  if (!ray) return std::nullopt;
+  return count_winding(*ray, surface, triangles, x, f);
+}
+
+bool segment_meets_box(const V& p, const V& q, const culling::Aabb& box) {
+  // Slab test on the box grown by a margin far above the rounding of the arithmetic below (each
+  // step is a few roundings of quantities bounded by `scale`); the parameter range [0, 1] is
+  // grown too. Growing only lets more boxes through.
+  double scale = 0.0;
+  for (std::size_t c = 0; c < 3; ++c) {
+    scale = std::max({scale, std::abs(box.lo[c]), std::abs(box.hi[c])});
+    scale = std::max(
+        {scale,
+         std::abs(p[static_cast<Eigen::Index>(c)]),
+         std::abs(q[static_cast<Eigen::Index>(c)])});
+  }
+  if (!std::isfinite(scale)) return true;
+  const double margin = 1e-9 * scale;
+  double t_lo = -1e-9;
+  double t_hi = 1.0 + 1e-9;
+  for (std::size_t c = 0; c < 3; ++c) {
+    const auto i = static_cast<Eigen::Index>(c);
+    const double lo = box.lo[c] - margin;
+    const double hi = box.hi[c] + margin;
+    if (!(lo <= hi)) return false;  // an empty box
+    const double s = p[i];
+    const double e = q[i] - p[i];
+    if (std::abs(e) <= margin) {
+      // Nearly parallel to the slab: the whole segment is within `margin` of s along this axis.
+      if (s + margin < lo || s - margin > hi) return false;
+      continue;
+    }
+    double t0 = (lo - s) / e;
+    double t1 = (hi - s) / e;
+    if (t0 > t1) std::swap(t0, t1);
+    t_lo = std::max(t_lo, t0 - 1e-9);
+    t_hi = std::min(t_hi, t1 + 1e-9);
+    if (t_lo > t_hi) return false;
+  }
+  return true;
 }
 
 }  // namespace skelcd::clustering

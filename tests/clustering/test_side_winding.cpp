@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "clustering/side_winding.hpp"
+#include "culling/bvh.hpp"
 #include "tests/segmentation/mini_rigs.hpp"
 
 namespace skelcd::clustering {
@@ -169,6 +170,150 @@ TEST(SideWinding, UndecidableAttemptsSayNothing) {
        {3, 0, 4},
        {3, 4, 7}});
   for (const int w : winding_of_every_triangle(box)) EXPECT_EQ(w, 0);
+}
+
+/// Does the closed box hold a point of [p, q]? Checked on the segment's points at 4,097 evenly
+/// spaced parameters and at the parameters where it crosses each face plane (computed in long
+/// double): a reference for segment_meets_box's "false" answers, which must never be wrong.
+bool sampled_meet(const V3& p, const V3& q, const culling::Aabb& box) {
+  const auto inside = [&](long double t) {
+    for (Eigen::Index c = 0; c < 3; ++c) {
+      const long double x =
+          static_cast<long double>(p[c]) + t * (static_cast<long double>(q[c]) - p[c]);
+      const auto i = static_cast<std::size_t>(c);
+      if (x < static_cast<long double>(box.lo[i]) || x > static_cast<long double>(box.hi[i])) {
+        return false;
+      }
+    }
+    return true;
+  };
+  for (int k = 0; k <= 4096; ++k) {
+    if (inside(static_cast<long double>(k) / 4096.0L)) return true;
+  }
+  for (Eigen::Index c = 0; c < 3; ++c) {
+    const long double e = static_cast<long double>(q[c]) - p[c];
+    if (e == 0.0L) continue;
+    for (const double face :
+         {box.lo[static_cast<std::size_t>(c)], box.hi[static_cast<std::size_t>(c)]}) {
+      const long double t = (static_cast<long double>(face) - p[c]) / e;
+      if (t >= 0.0L && t <= 1.0L && inside(t)) return true;
+    }
+  }
+  return false;
+}
+
+TEST(SideWinding, SegmentBoxTestNeverMissesAMeeting) {
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  int misses = 0, meets = 0;
+  for (const double scale : {1e-9, 1.0, 1e9}) {
+    for (int trial = 0; trial < 4000; ++trial) {
+      culling::Aabb box = culling::Aabb::empty();
+      const V3 corner = scale * V3(u(rng), u(rng), u(rng));
+      const V3 other = corner + scale * 0.3 * V3(u(rng), u(rng), u(rng));
+      for (Eigen::Index c = 0; c < 3; ++c) {
+        const auto i = static_cast<std::size_t>(c);
+        box.lo[i] = std::min(corner[c], other[c]);
+        box.hi[i] = std::max(corner[c], other[c]);
+      }
+      V3 p = scale * V3(u(rng), u(rng), u(rng));
+      V3 q = scale * V3(u(rng), u(rng), u(rng));
+      switch (trial % 4) {
+        case 1:  // q on a face of the box: touching counts
+          q[trial % 3] = box.hi[static_cast<std::size_t>(trial % 3)];
+          break;
+        case 2:  // along an axis, in a face's plane
+          q = p;
+          q[(trial + 1) % 3] += scale * u(rng);
+          p[trial % 3] = q[trial % 3] = box.lo[static_cast<std::size_t>(trial % 3)];
+          break;
+        case 3:  // a point segment at a corner of the box
+          p = q = V3(box.lo[0], box.hi[1], box.lo[2]);
+          break;
+        default:
+          break;
+      }
+      const bool says = segment_meets_box(p, q, box);
+      if (!says) {
+        ++misses;
+        EXPECT_FALSE(sampled_meet(p, q, box)) << "scale " << scale << " trial " << trial;
+      } else {
+        ++meets;
+      }
+      if (trial % 4 == 3) {
+        EXPECT_TRUE(says);  // the corner itself
+      }
+    }
+  }
+  // Both answers occur: the test prunes, it is not always true.
+  EXPECT_GT(misses, 3000);
+  EXPECT_GT(meets, 3000);
+}
+
+TEST(SideWinding, CountOverHierarchyCandidatesEqualsTheWholeSurface) {
+  // The method's rays count only the triangles whose boxes a hierarchy says the segments may
+  // meet (RadialViewMethod::gather_ray_candidates); the answer, decided or not, must be the same
+  // as over the whole surface — on overlapping spheres and a tube, where rays cross many sheets.
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> u(-0.6, 0.6);
+  std::size_t gathered = 0, whole = 0;
+  int decided = 0;
+  for (int trial = 0; trial < 3; ++trial) {
+    const MeshData a = test::icosphere(2);
+    const MeshData b = moved(test::icosphere(2), V3(1.0 + u(rng), u(rng), u(rng)), 0.9);
+    const MeshData c = moved(test::closed_tube(3.0, 0.35, 10, 9, 0.2), V3(-1.0, u(rng), u(rng)));
+    const MeshData all = test::concat(test::concat(a, b), c);
+    const auto ids = all_triangles(all);
+    const culling::Aabb box = surface_box(ids, all.F, all.V);
+    std::vector<culling::Aabb> bounds(ids.size());
+    for (const std::int32_t t : ids) {
+      culling::Aabb tb = culling::Aabb::empty();
+      for (Eigen::Index k = 0; k < 3; ++k) {
+        for (Eigen::Index c3 = 0; c3 < 3; ++c3) {
+          const double x = all.V(all.F(t, k), c3);
+          const auto i = static_cast<std::size_t>(c3);
+          tb.lo[i] = std::min(tb.lo[i], x);
+          tb.hi[i] = std::max(tb.hi[i], x);
+        }
+      }
+      bounds[static_cast<std::size_t>(t)] = tb;
+    }
+    culling::AabbBvh bvh(all.F, all.V);
+    bvh.refit(bounds);
+    for (const std::int32_t f : ids) {
+      for (int attempt = 0; attempt < 2; ++attempt) {
+        const auto ray = winding_ray(box, all.F, all.V, f, attempt);
+        if (!ray) continue;
+        std::vector<std::int32_t> candidates, stack{0};
+        while (!stack.empty()) {
+          const std::int32_t n = stack.back();
+          stack.pop_back();
+          const culling::Aabb& nb = bvh.node_bounds()[static_cast<std::size_t>(n)];
+          if (!segment_meets_box(ray->front, ray->far, nb) &&
+              !segment_meets_box(ray->back, ray->front, nb)) {
+            continue;
+          }
+          const culling::BvhNode& node = bvh.nodes()[static_cast<std::size_t>(n)];
+          if (!node.is_leaf()) {
+            stack.push_back(node.right);
+            stack.push_back(n + 1);
+            continue;
+          }
+          for (std::int32_t s = node.begin; s < node.end; ++s) {
+            candidates.push_back(bvh.triangle_order()[static_cast<std::size_t>(s)]);
+          }
+        }
+        const auto over_candidates = count_winding(*ray, candidates, all.F, all.V, f);
+        EXPECT_EQ(over_candidates, front_winding(ids, box, all.F, all.V, f, attempt))
+            << "trial " << trial << " triangle " << f << " attempt " << attempt;
+        decided += over_candidates ? 1 : 0;
+        gathered += candidates.size();
+        whole += ids.size();
+      }
+    }
+  }
+  EXPECT_GT(decided, 3000);
+  EXPECT_LT(4 * gathered, whole);  // the hierarchy prunes most of the surface
 }
 
 }  // namespace
