@@ -152,6 +152,19 @@ RadialViewMethod::RadialViewMethod(
     component_triangles_.insert(component_triangles_.end(), c.faces.begin(), c.faces.end());
     component_offsets_.push_back(static_cast<std::int32_t>(component_triangles_.size()));
   }
+  if (ghosts_) {
+    // Pairs of two ghosts are never tested (traverse): sound only because ghosts own no real
+    // feature — they come after the real triangles and features go to their first triangle.
+    for (std::int32_t g = real_triangles_; g < topology_.num_triangles(); ++g) {
+      const auto& owned = topology_.owned_features(g);
+      for (std::size_t i = 0; i < owned.num_vertices; ++i) {
+        if (owned.vertices[i] < real_vertices_) ghosts_own_real_features_ = true;
+      }
+      for (std::size_t i = 0; i < owned.num_edges; ++i) {
+        if (ghosts_->real_edge[at(owned.edges[i])] >= 0) ghosts_own_real_features_ = true;
+      }
+    }
+  }
   if (ghosts_) {  // everything is built: keep only the loops and the edge map
     ghosts_->mesh = skinning::Mesh{};
     ghosts_->topology = skinning::Topology{};
@@ -260,35 +273,39 @@ void RadialViewMethod::start_status(const skinning::Positions& x_t0, culling::Fr
   for (const auto& p : start_pairs_) {
     const std::int32_t k = clusters_.component_of_triangle(p.a);
     if (k != clusters_.component_of_triangle(p.b) || !clusters_.component_ok(k)) continue;
+    // Two ghosts: their contacts are not tested (traverse), so the carried set does not know
+    // these pairs; every ghost is cut below instead.
+    if (p.a >= real_triangles_ && p.b >= real_triangles_) continue;
     status_[at(k)] = Status::dirty;
     cut_[at(p.a)] = 1;
     cut_[at(p.b)] = 1;
   }
+  // Ghosts are always cut (docs/radial-view.md, "Open parts with ghost triangles"): patches hold
+  // real triangles only, and whether two ghosts intersect never matters.
+  const auto num_triangles = static_cast<std::int32_t>(cut_.size());
+  for (std::int32_t g = real_triangles_; g < num_triangles; ++g) {
+    const std::int32_t k = clusters_.component_of_triangle(g);
+    if (!clusters_.component_ok(k)) continue;
+    status_[at(k)] = Status::dirty;
+    cut_[at(g)] = 1;
+  }
 }
 
-void RadialViewMethod::classify_patches(const skinning::Positions& x_t0) {
-  // Clean culled components: every triangle is skippable (the surface is embedded, its front
-  // winding number the same everywhere). Dirty ones: the triangles of uncut patches whose front
-  // winding number is that of the component's largest classified patch.
+void RadialViewMethod::build_patches() {
+  // Patches: uncut triangles of the dirty culled components joined across edges (the component is
+  // closed and manifold, so each edge has two triangles), component by component.
   const std::int32_t num_components = clusters_.num_components();
-  const auto& triangles = topology_.welded_triangles();
   patch_order_.clear();
   patch_offsets_.assign(1, 0);
+  component_patches_.assign(at(num_components) + 1, 0);
+  std::fill(patch_.begin(), patch_.end(), -1);
   for (std::int32_t k = 0; k < num_components; ++k) {
+    component_patches_[at(k)] = static_cast<std::int32_t>(patch_offsets_.size() - 1);
+    if (culled_[at(k)] == 0 || status_[at(k)] != Status::dirty) continue;
     const auto first = static_cast<std::ptrdiff_t>(component_offsets_[at(k)]);
     const auto last = static_cast<std::ptrdiff_t>(component_offsets_[at(k) + 1]);
-    const std::span<const std::int32_t> surface(
-        component_triangles_.data() + first, static_cast<std::size_t>(last - first));
-    const bool dirty = status_[at(k)] == Status::dirty;
-    for (const std::int32_t f : surface) {
-      skippable_[at(f)] = culled_[at(k)] != 0 && !dirty ? 1 : 0;
-      patch_[at(f)] = -1;
-    }
-    if (culled_[at(k)] == 0 || !dirty) continue;
-    // Patches: uncut triangles joined across edges (the component is closed and manifold, so
-    // each edge has two triangles).
-    const std::size_t patches_before = patch_offsets_.size() - 1;
-    for (const std::int32_t seed : surface) {
+    for (std::ptrdiff_t i = first; i < last; ++i) {
+      const std::int32_t seed = component_triangles_[static_cast<std::size_t>(i)];
       if (cut_[at(seed)] != 0 || patch_[at(seed)] >= 0) continue;
       const auto id = static_cast<std::int32_t>(patch_offsets_.size() - 1);
       std::size_t head = patch_order_.size();
@@ -298,8 +315,8 @@ void RadialViewMethod::classify_patches(const skinning::Positions& x_t0) {
         const std::int32_t f = patch_order_[head++];
         for (int s = 0; s < 3; ++s) {
           const std::int32_t e = topology_.face_edge(f, s);
-          for (auto i = edge_face_offsets_[at(e)]; i < edge_face_offsets_[at(e) + 1]; ++i) {
-            const std::int32_t g = edge_faces_[at(i)];
+          for (auto j = edge_face_offsets_[at(e)]; j < edge_face_offsets_[at(e) + 1]; ++j) {
+            const std::int32_t g = edge_faces_[at(j)];
             if (cut_[at(g)] != 0 || patch_[at(g)] >= 0) continue;
             patch_[at(g)] = id;
             patch_order_.push_back(g);
@@ -308,40 +325,71 @@ void RadialViewMethod::classify_patches(const skinning::Positions& x_t0) {
       }
       patch_offsets_.push_back(static_cast<std::int32_t>(patch_order_.size()));
     }
+  }
+  component_patches_[at(num_components)] = static_cast<std::int32_t>(patch_offsets_.size() - 1);
+}
+
+void RadialViewMethod::classify_patches(const skinning::Positions& x_t0) {
+  // Clean culled components: every triangle is skippable (the surface is embedded, its front
+  // winding number the same everywhere). Dirty ones: the triangles of uncut patches whose front
+  // winding number is that of the component's largest classified patch.
+  const std::int32_t num_components = clusters_.num_components();
+  const auto& triangles = topology_.welded_triangles();
+  build_patches();
+  for (std::int32_t k = 0; k < num_components; ++k) {
+    const auto first = static_cast<std::ptrdiff_t>(component_offsets_[at(k)]);
+    const auto last = static_cast<std::ptrdiff_t>(component_offsets_[at(k) + 1]);
+    const std::span<const std::int32_t> surface(
+        component_triangles_.data() + first, static_cast<std::size_t>(last - first));
+    const bool dirty = status_[at(k)] == Status::dirty;
+    for (const std::int32_t f : surface) skippable_[at(f)] = culled_[at(k)] != 0 && !dirty ? 1 : 0;
+    if (culled_[at(k)] == 0 || !dirty) continue;
     // One ray per patch, largest patch first: its value is the component's.
     patch_sizes_.clear();
-    for (std::size_t p = patches_before; p + 1 < patch_offsets_.size(); ++p) {
-      const std::int32_t size = patch_offsets_[p + 1] - patch_offsets_[p];
+    for (std::int32_t p = component_patches_[at(k)]; p < component_patches_[at(k) + 1]; ++p) {
+      const std::int32_t size = patch_offsets_[at(p) + 1] - patch_offsets_[at(p)];
       ++stats_.patches;
-      if (size >= kMinPatch) patch_sizes_.emplace_back(-size, static_cast<std::int32_t>(p));
+      if (size >= kMinPatch) patch_sizes_.emplace_back(-size, p);
     }
     std::sort(patch_sizes_.begin(), patch_sizes_.end());
-    // The rays end beyond the component's box at x_t0; the union of its clusters' swept boxes
-    // contains it (no pass over the surface).
-    culling::Aabb box = culling::Aabb::empty();
-    for (std::int32_t a = 0; a < clusters_.num_atomic(); ++a) {
-      if (clusters_.component_of_atomic(a) == k) box.merge(cluster_bounds_[at(a)]);
-    }
-    std::optional<int> value;
-    for (const auto& [minus_size, p] : patch_sizes_) {
-      const std::int32_t begin = patch_offsets_[at(p)];
-      const std::int32_t size = -minus_size;
-      std::optional<int> w;
-      for (int attempt = 0; attempt < kPatchAttempts && !w; ++attempt) {
-        // Spread the tries over the patch (BFS order: the seed's neighbourhood first). The count
-        // runs over the triangles the hierarchies say may meet the ray: the same as over the
-        // whole surface (count_winding).
-        const std::int32_t f = patch_order_[at(begin + (attempt * size) / kPatchAttempts)];
-        const std::optional<WindingRay> ray = winding_ray(box, triangles, x_t0, f, attempt);
-        if (!ray) continue;
-        gather_ray_candidates(k, *ray);
-        w = count_winding(*ray, ray_candidates_, triangles, x_t0, f);
+    const auto make_skippable = [&](std::int32_t p) {
+      for (std::int32_t i = patch_offsets_[at(p)]; i < patch_offsets_[at(p) + 1]; ++i) {
+        skippable_[at(patch_order_[at(i)])] = 1;
       }
-      if (!w) continue;
+    };
+    if (patch_sizes_.size() == 1) {
+      // The only patch to classify: its value is the component's whatever it is, no ray needed
+      // (its triangles all see one front value, which is all the argument asks of a skipped pair).
       ++stats_.patches_classified;
-      if (!value) value = w;
-      if (*w != *value) continue;
-      for (std::int32_t i = begin; i < begin + size; ++i) skippable_[at(patch_order_[at(i)])] = 1;
+      make_skippable(patch_sizes_.front().second);
+    } else if (!patch_sizes_.empty()) {
+      // The rays end beyond the component's box at x_t0; the union of its clusters' swept boxes
+      // contains it (no pass over the surface).
+      culling::Aabb box = culling::Aabb::empty();
+      for (std::int32_t a = 0; a < clusters_.num_atomic(); ++a) {
+        if (clusters_.component_of_atomic(a) == k) box.merge(cluster_bounds_[at(a)]);
+      }
+      std::optional<int> value;
+      for (const auto& [minus_size, p] : patch_sizes_) {
+        const std::int32_t begin = patch_offsets_[at(p)];
+        const std::int32_t size = -minus_size;
+        std::optional<int> w;
+        for (int attempt = 0; attempt < kPatchAttempts && !w; ++attempt) {
+          // Spread the tries over the patch (BFS order: the seed's neighbourhood first). The
+          // count runs over the triangles the hierarchies say may meet the ray: the same as over
+          // the whole surface (count_winding).
+          const std::int32_t f = patch_order_[at(begin + (attempt * size) / kPatchAttempts)];
+          const std::optional<WindingRay> ray = winding_ray(box, triangles, x_t0, f, attempt);
+          if (!ray) continue;
+          gather_ray_candidates(k, *ray);
+          w = count_winding(*ray, ray_candidates_, triangles, x_t0, f);
+          ++stats_.rays;
+        }
+        if (!w) continue;
+        ++stats_.patches_classified;
+        if (!value) value = w;
+        if (*w == *value) make_skippable(p);
+      }
     }
     for (const std::int32_t f : surface) {
       stats_.triangles_kept_out += skippable_[at(f)] == 0 ? 1 : 0;
@@ -481,6 +529,19 @@ std::int64_t RadialViewMethod::traverse(double half_width, culling::FrameResult&
       found += static_cast<std::int64_t>(pairs.size() - first);
       if (options_.relative_aabb) {
         stats_.relative_aabb_culled += relative_filter_.filter(topology_, half_width, pairs, first);
+      }
+      if (ghosts_ && !ghosts_own_real_features_) {
+        // Two ghosts own only ghost features (centres, spokes, ghost faces: real features are
+        // owned by real triangles, which come first): no contact between those is reported or
+        // needed (docs/radial-view.md, "Open parts with ghost triangles").
+        const auto kept = std::remove_if(
+            pairs.begin() + static_cast<std::ptrdiff_t>(first),
+            pairs.end(),
+            [&](const culling::TrianglePair& p) {
+              return p.a >= real_triangles_ && p.b >= real_triangles_;
+            });
+        stats_.ghost_pairs_skipped += static_cast<std::int64_t>(pairs.end() - kept);
+        pairs.erase(kept, pairs.end());
       }
       return done;
     });

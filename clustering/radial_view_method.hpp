@@ -69,14 +69,18 @@ struct RadialViewStats {
   /// Blocks of candidate triangle pairs tested, all passes (MethodOptions::block_pairs each).
   std::int64_t blocks = 0;
   // The local guard (docs/radial-view.md, "The local guard").
-  std::int64_t triangles_cut = 0;        ///< in a self-intersecting pair of their component
-  std::int64_t patches = 0;              ///< uncut patches of the dirty components
-  std::int64_t patches_classified = 0;   ///< … whose front winding number a ray decided
+  std::int64_t triangles_cut = 0;  ///< in a self-intersecting pair of their component
+  std::int64_t patches = 0;        ///< uncut patches of the dirty components
+  /// … whose front winding number is known: a ray decided it, or the patch is the only one of
+  /// its component large enough to classify (its value is the component's, no ray needed)
+  std::int64_t patches_classified = 0;
+  std::int64_t rays = 0;                 ///< rays cast to classify patches
   std::int64_t triangles_kept_out = 0;   ///< of dirty components, not skippable (cut, off-value)
   std::int64_t triangles_escalated = 0;  ///< skippable triangles whose skipped pairs were tested
   std::int32_t escalation_rounds = 0;    ///< rounds until no new contact touched one
   std::int32_t ghost_loops = 0;          ///< boundary loops closed by ghost triangles
   std::int64_t ghost_contacts = 0;       ///< contacts of a ghost's features (used, not reported)
+  std::int64_t ghost_pairs_skipped = 0;  ///< candidate pairs of two ghosts, never tested
 };
 
 class RadialViewMethod final : public culling::CullingMethod {
@@ -142,6 +146,9 @@ class RadialViewMethod final : public culling::CullingMethod {
   /// triangles may be skipped (skippable_). Needs the hierarchies refit over the interval's swept
   /// volumes (they contain the triangles at x_t0): the rays gather their triangles through them.
   void classify_patches(const skinning::Positions& x_t0);
+  /// The patch partition of the dirty culled components (patch_, patch_order_, patch_offsets_,
+  /// component_patches_) from cut_, status_ and culled_.
+  void build_patches();
   /// The triangles of component k whose swept boxes either segment of `ray` may meet, into
   /// ray_candidates_: every triangle of k that can meet them (count_winding's precondition).
   void gather_ray_candidates(std::int32_t k, const WindingRay& ray);
@@ -161,6 +168,7 @@ class RadialViewMethod final : public culling::CullingMethod {
   // Ghost caps (built before everything below, which works on the capped mesh); the capped
   // mesh and topology are released once the members are built.
   std::unique_ptr<GhostCaps> ghosts_;
+  bool ghosts_own_real_features_ = false;  // never, by construction (checked when built)
   std::int32_t real_vertices_ = 0;
   std::int32_t real_triangles_ = 0;
   skinning::Positions capped_x0_, capped_x1_;
@@ -196,6 +204,7 @@ class RadialViewMethod final : public culling::CullingMethod {
   std::vector<std::int32_t> patch_;      // per triangle of a dirty component: its patch, or −1
   std::vector<std::int32_t> patch_order_, patch_offsets_;  // CSR patch → triangles (BFS order)
   std::vector<std::pair<std::int32_t, std::int32_t>> patch_sizes_;  // (−size, patch) to classify
+  std::vector<std::int32_t> component_patches_;  // CSR component → its patches (ids)
   std::vector<std::int32_t> escalated_;  // per triangle: the round it was escalated in, or 0
   std::vector<std::int32_t> frontier_;   // triangles escalated in the current round
   std::vector<std::uint8_t> component_escalated_;

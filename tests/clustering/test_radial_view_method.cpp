@@ -327,6 +327,27 @@ TEST(RadialViewMethod, BcnEpilepticIsOpenAndItsRestPoseInterpenetrates) {
   }
 }
 
+TEST(RadialViewMethod, GhostPairsAreNotTestedAndALonePatchNeedsNoRay) {
+  // BCN_Epileptic, capped everywhere: ghosts are always cut, so every capped part is classified at
+  // every interval; a part whose real triangles form the only patch large enough to classify needs
+  // no ray (its value is the part's). Pairs of two ghosts are never tested. Contacts: bvh's, also
+  // when the start pairs are carried from interval to interval (where ghost pairs go stale).
+  RadialViewScene scene(loaded(test::assimp_model("X/BCN_Epileptic.X")));
+  for (const auto dcd : {test::DcdQueries::every, test::DcdQueries::first}) {
+    const auto c = compare(scene, 0, 8, dcd);
+    std::int64_t ghost_pairs = 0, rays = 0, classified = 0;
+    for (const auto& st : c.dynamic.stats) {
+      EXPECT_EQ(st.components_dirty, st.components_culled);  // every culled part has caps
+      ghost_pairs += st.ghost_pairs_skipped;
+      rays += st.rays;
+      classified += st.patches_classified;
+    }
+    EXPECT_GT(ghost_pairs, 1000);
+    EXPECT_GT(classified, 0);
+    EXPECT_LT(rays, classified);
+  }
+}
+
 TEST(RadialViewMethod, ContactDistanceTurnsTheSkippingOff) {
   // The radial-view argument is about touching; with a contact distance nothing is skipped and
   // the contacts stay those of bvh.
