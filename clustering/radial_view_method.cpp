@@ -4,6 +4,7 @@
 #include <array>
 #include <chrono>
 #include <cmath>
+#include <numeric>
 #include <optional>
 #include <utility>
 
@@ -24,6 +25,90 @@ std::size_t at(std::int32_t i) { return static_cast<std::size_t>(i); }
 
 double micros(Clock::time_point from, Clock::time_point to) {
   return std::chrono::duration<double, std::micro>(to - from).count();
+}
+
+/// The order in which the triangles take their features (culling::FeatureTopology): the rims
+/// first, one side of each. A triangle's rest label is its atomic cluster and its class at rest,
+/// seen from the cluster's observer (positive or not); a rim is a side between two labels. A
+/// feature on a rim is impure whenever the two sides end up with different labels in an interval
+/// (other mega clusters, other signs), and its owner is then tested as Hᵘ (compute_masks). Taken
+/// in triangle order, the rim features are spread over the triangles on both sides of every rim.
+/// Taken first by the triangles on the side of the higher label, they are all owned by one strip,
+/// and the other side is left to be skipped. Ghosts come last, so they never own a real feature
+/// (traverse). Empty (triangle order) when the segmentation does not fit: ClusterSet reports that.
+std::vector<std::int32_t> rim_first_order(
+    const skinning::Mesh& mesh,
+    const skinning::Topology& topology,
+    const segmentation::Segmentation& segmentation,
+    std::int32_t real_triangles) {
+  const auto num_faces = static_cast<std::size_t>(topology.welded_triangles.rows());
+  const auto& cluster = segmentation.triangle_cluster;
+  if (cluster.size() != num_faces ||
+      topology.edge_face_offsets.size() != static_cast<std::size_t>(topology.edges.rows()) + 1) {
+    return {};
+  }
+  for (const std::int32_t c : cluster) {
+    if (c < 0 || static_cast<std::size_t>(c) >= segmentation.clusters.size()) return {};
+  }
+  const auto rest = [&](std::int32_t w) -> Eigen::Vector3d {
+    return mesh.rest_positions.row(topology.representative_vertex[at(w)]).transpose();
+  };
+  std::vector<std::int64_t> label(num_faces);
+  for (std::size_t f = 0; f < num_faces; ++f) {
+    const auto r = static_cast<Eigen::Index>(f);
+    const Eigen::Vector3d a = rest(topology.welded_triangles(r, 0));
+    const Eigen::Vector3d b = rest(topology.welded_triangles(r, 1));
+    const Eigen::Vector3d c = rest(topology.welded_triangles(r, 2));
+    const MovingTriangle t{a, b, c, a, b, c};
+    const segmentation::Observer& o = segmentation.clusters[at(cluster[f])].observer;
+    OrientationClass k = OrientationClass::uncertain;
+    if (o.kind == segmentation::ObserverKind::point) {
+      const Eigen::Vector3d q = o.segment.midpoint();
+      k = classify(t, MovingPoint{q, q});
+    } else {
+      k = classify(
+          t, MovingSegment{o.segment.head, o.segment.tail, o.segment.head, o.segment.tail});
+    }
+    label[f] =
+        2 * static_cast<std::int64_t>(cluster[f]) + (k == OrientationClass::positive ? 0 : 1);
+  }
+  // Rank 0: a side on a rim with a lower label across it; 1: any other corner or side on a rim;
+  // 2: inside one label; 3: ghosts.
+  std::vector<std::uint8_t> rank(num_faces, 2);
+  constexpr std::int64_t kUnset = -2;
+  constexpr std::int64_t kMixed = -3;
+  std::vector<std::int64_t> vertex_label(
+      static_cast<std::size_t>(topology.num_welded_vertices()), kUnset);
+  for (std::size_t f = 0; f < num_faces; ++f) {
+    if (static_cast<std::int32_t>(f) >= real_triangles) continue;
+    for (Eigen::Index k = 0; k < 3; ++k) {
+      auto& l = vertex_label[at(topology.welded_triangles(static_cast<Eigen::Index>(f), k))];
+      l = (l == kUnset || l == label[f]) ? label[f] : kMixed;
+    }
+  }
+  for (std::size_t f = 0; f < num_faces; ++f) {
+    const auto r = static_cast<Eigen::Index>(f);
+    if (static_cast<std::int32_t>(f) >= real_triangles) {
+      rank[f] = 3;
+      continue;
+    }
+    for (Eigen::Index k = 0; k < 3 && rank[f] != 0; ++k) {
+      if (vertex_label[at(topology.welded_triangles(r, k))] == kMixed) rank[f] = 1;
+      const std::int32_t e = topology.face_edges(r, k);
+      if (e < 0) continue;
+      for (auto i = topology.edge_face_offsets[at(e)]; i < topology.edge_face_offsets[at(e) + 1];
+           ++i) {
+        const std::int32_t g = topology.edge_faces[at(i)];
+        if (g < real_triangles && label[at(g)] < label[f]) rank[f] = 0;
+      }
+    }
+  }
+  std::vector<std::int32_t> order(num_faces);
+  std::iota(order.begin(), order.end(), 0);
+  std::stable_sort(order.begin(), order.end(), [&](std::int32_t a, std::int32_t b) {
+    return rank[at(a)] < rank[at(b)];
+  });
+  return order;
 }
 
 bool same_positions(const skinning::Positions& a, const skinning::Positions& b) {
@@ -86,7 +171,15 @@ RadialViewMethod::RadialViewMethod(
       real_triangles_(static_cast<std::int32_t>(real_topology.welded_triangles.rows())),
       segmentation_(ghosts_ ? ghosts_->segmentation : std::move(segmentation)),
       poses_(std::move(poses)),
-      topology_(used_mesh(ghosts_, real_mesh), used_topology(ghosts_, real_topology)),
+      topology_(
+          used_mesh(ghosts_, real_mesh),
+          used_topology(ghosts_, real_topology),
+          segmentation_ && options.rims_first ? rim_first_order(
+                                                    used_mesh(ghosts_, real_mesh),
+                                                    used_topology(ghosts_, real_topology),
+                                                    *segmentation_,
+                                                    real_triangles_)
+                                              : std::vector<std::int32_t>{}),
       clusters_(
           used_mesh(ghosts_, real_mesh),
           used_topology(ghosts_, real_topology),

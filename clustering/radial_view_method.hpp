@@ -49,6 +49,10 @@ struct RadialViewOptions {
   /// self-contact). Off only to show what the bare theory misses (tests/clustering): then
   /// contacts may be lost.
   bool guard = true;
+  /// Give the features on the rims between atomic clusters and between rest classes to one side
+  /// of each rim (culling::FeatureTopology's owner order), so that fewer triangles own an impure
+  /// feature and are tested as Hᵘ. Off: triangle order (tests compare the two).
+  bool rims_first = true;
 };
 
 /// What the last detect_ccd did beyond the counters of FrameResult.

@@ -33,7 +33,10 @@ void build_csr(
 
 }  // namespace
 
-FeatureTopology::FeatureTopology(const skinning::Mesh& mesh, const skinning::Topology& topology)
+FeatureTopology::FeatureTopology(
+    const skinning::Mesh& mesh,
+    const skinning::Topology& topology,
+    std::span<const std::int32_t> owner_order)
     : welded_triangles_(topology.welded_triangles), num_vertices_(topology.num_welded_vertices()) {
   const auto num_faces = static_cast<std::size_t>(topology.welded_triangles.rows());
   const auto num_edges = static_cast<std::size_t>(topology.edges.rows());
@@ -106,13 +109,29 @@ FeatureTopology::FeatureTopology(const skinning::Mesh& mesh, const skinning::Top
   }
   face_part_ = mesh.face_part;
 
-  // Representative triangles: every vertex and edge goes to its first incident triangle (in
-  // triangle order), and to one corner / side of it (a degenerate triangle may list a vertex
-  // twice).
+  // Representative triangles: every vertex and edge goes to its first incident triangle (in the
+  // owner order, else triangle order), and to one corner / side of it (a degenerate triangle may
+  // list a vertex twice).
+  if (!owner_order.empty()) {
+    std::vector<std::uint8_t> seen(num_faces, 0);
+    bool permutation = owner_order.size() == num_faces;
+    for (std::size_t i = 0; permutation && i < owner_order.size(); ++i) {
+      const std::int32_t f = owner_order[i];
+      permutation = f >= 0 && static_cast<std::size_t>(f) < num_faces &&
+                    seen[static_cast<std::size_t>(f)] == 0;
+      if (permutation) seen[static_cast<std::size_t>(f)] = 1;
+    }
+    if (!permutation) {
+      throw InvalidInput(
+          "culling: the owner order (" + std::to_string(owner_order.size()) +
+          " entries) is not a permutation of the " + std::to_string(num_faces) + " triangles");
+    }
+  }
   owned_.assign(num_faces, 0);
   vertex_owner_.assign(num_vertices, -1);
   edge_owner_.assign(num_edges, -1);
-  for (std::size_t f = 0; f < num_faces; ++f) {
+  for (std::size_t i = 0; i < num_faces; ++i) {
+    const auto f = owner_order.empty() ? i : static_cast<std::size_t>(owner_order[i]);
     for (std::size_t k = 0; k < 3; ++k) {
       auto& vo = vertex_owner_[static_cast<std::size_t>(triangles_[f][k])];
       if (vo < 0) {

@@ -26,8 +26,16 @@ class FeatureTopology {
   ///        representative_vertex (#W) are used.
   /// @throws InvalidInput naming "culling" and the offending index when the two disagree: sizes,
   ///         ids out of range, a face_edges entry that is not the side it claims (-1 is accepted
-  ///         for a collapsed side only), a part id of an excluded pair outside [0, num_parts).
-  FeatureTopology(const skinning::Mesh& mesh, const skinning::Topology& topology);
+  ///         for a collapsed side only), a part id of an excluded pair outside [0, num_parts),
+  ///         or an owner_order that is not a permutation of the triangles.
+  /// @param owner_order the order in which the triangles take the vertices and edges no earlier
+  ///        triangle took (a permutation of 0 … #F−1); empty: triangle order. Any order gives each
+  ///        feature exactly one owner; a method may choose one that gathers features it treats
+  ///        alike into few triangles (clustering::RadialViewMethod: the cluster rims).
+  FeatureTopology(
+      const skinning::Mesh& mesh,
+      const skinning::Topology& topology,
+      std::span<const std::int32_t> owner_order = {});
 
   [[nodiscard]] std::int32_t num_vertices() const { return num_vertices_; }
   [[nodiscard]] std::int32_t num_triangles() const {
@@ -70,11 +78,12 @@ class FeatureTopology {
   [[nodiscard]] const OwnedFeatures& owned_features(std::int32_t f) const {
     return owned_features_[static_cast<std::size_t>(f)];
   }
-  /// The triangle owning vertex v (its first incident triangle), or -1 when v is on no triangle.
+  /// The triangle owning vertex v (its first incident triangle in the owner order), or -1 when v
+  /// is on no triangle.
   [[nodiscard]] std::int32_t vertex_owner(std::int32_t v) const {
     return vertex_owner_[static_cast<std::size_t>(v)];
   }
-  /// The triangle owning edge e (its first incident triangle).
+  /// The triangle owning edge e (its first incident triangle in the owner order).
   [[nodiscard]] std::int32_t edge_owner(std::int32_t e) const {
     return edge_owner_[static_cast<std::size_t>(e)];
   }

@@ -348,6 +348,39 @@ TEST(RadialViewMethod, GhostPairsAreNotTestedAndALonePatchNeedsNoRay) {
   }
 }
 
+TEST(RadialViewMethod, RimFeaturesOwnedFromOneSideLeaveMorePairsSkipped) {
+  // A feature on a rim between two atomic clusters (or two rest classes) is impure whenever the
+  // two sides get different labels, and its owner is then tested as Hᵘ. Owned from one side of
+  // each rim (RadialViewOptions::rims_first), fewer triangles are Hᵘ: fewer candidate pairs, the
+  // same contacts.
+  for (const auto& path :
+       {test::asset("characters/CesiumMan.glb"), test::assimp_model("X/BCN_Epileptic.X")}) {
+    SCOPED_TRACE(path.string());
+    RadialViewScene scene(loaded(path), 0);
+    std::vector<ClipRun> runs;
+    for (const bool rims_first : {true, false}) {
+      RadialViewOptions o;
+      o.rims_first = rims_first;
+      RadialViewMethod m(
+          "dynamic",
+          scene.rig->mesh,
+          scene.topology,
+          scene.segmentation,
+          scene.poses,
+          scene.rig->skeleton.num_bones(),
+          scene.options(),
+          o);
+      runs.push_back(run_clip(scene, m, 0, 8, test::DcdQueries::first));
+    }
+    auto bvh = scene.method("bvh");
+    EXPECT_EQ(runs[0].contacts, run_clip(scene, *bvh, 0, 8).contacts);
+    EXPECT_EQ(runs[1].contacts, runs[0].contacts);
+    EXPECT_LT(
+        total(runs[0], &culling::Counters::candidate_pairs),
+        total(runs[1], &culling::Counters::candidate_pairs));
+  }
+}
+
 TEST(RadialViewMethod, ContactDistanceTurnsTheSkippingOff) {
   // The radial-view argument is about touching; with a contact distance nothing is skipped and
   // the contacts stay those of bvh.
