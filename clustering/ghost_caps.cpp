@@ -15,7 +15,8 @@ std::unique_ptr<GhostCaps> cap_small_loops(
     const skinning::Mesh& mesh,
     const skinning::Topology& topology,
     const segmentation::Segmentation& segmentation,
-    std::int32_t max_loop) {
+    std::int32_t max_loop,
+    std::int32_t triangles_per_ghost) {
   const auto num_faces = static_cast<std::int32_t>(topology.welded_triangles.rows());
   const std::int32_t num_welded = topology.num_welded_vertices();
   if (topology.boundary_edges.empty() ||
@@ -23,7 +24,7 @@ std::unique_ptr<GhostCaps> cap_small_loops(
       mesh.num_triangles() != num_faces) {
     return nullptr;
   }
-  const auto loops_found = skinning::small_simple_loops(topology, max_loop);
+  const auto loops_found = skinning::closing_loops(topology, max_loop, triangles_per_ghost);
   if (loops_found.empty()) return nullptr;
   auto caps = std::make_unique<GhostCaps>();
   caps->real_vertices = num_welded;

@@ -75,6 +75,7 @@ culling::MethodInfo radial_view_info(
       .route = route,
       .route_priority = route == culling::RouteKind::closed ? 10 : 0,
       .closes_holes_up_to = kMaxGhostLoop,
+      .closes_holes_triangles_per_side = kMinTrianglesPerGhost,
       .order = order,
       .make =
           [n](const skinning::Mesh& mesh,

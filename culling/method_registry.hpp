@@ -58,6 +58,9 @@ struct MethodInfo {
   /// skinning::small_simple_loops): `auto` routes an open component whose every hole is such a
   /// loop to it as if it were closed. 0: none.
   std::int32_t closes_holes_up_to = 0;
+  /// … in a component with at least this many triangles per side of those loops
+  /// (skinning::closing_loops).
+  std::int32_t closes_holes_triangles_per_side = 0;
   /// Position in listings (--help, `bench`): ascending, then by name.
   int order = 0;
   MethodFactory make{};

@@ -353,18 +353,11 @@ std::vector<ComponentRoute> route_components(
   const MethodInfo* closed_info = find_method(closed_name);
   if (closed_info != nullptr && closed_info->closes_holes_up_to > 0 &&
       !topology.components.empty() && !topology.face_component.empty()) {
-    std::vector<std::int32_t> holes(components.size(), 0), closable(components.size(), 0);
-    for (const std::int32_t e : topology.boundary_edges) {
-      const auto f = topology.edge_faces[sz(topology.edge_face_offsets[sz(e)])];
-      ++holes[sz(topology.face_component[sz(f)])];
-    }
-    for (const auto& loop :
-         skinning::small_simple_loops(topology, closed_info->closes_holes_up_to)) {
-      closable[sz(topology.face_component[sz(loop.front().face)])] +=
-          static_cast<std::int32_t>(loop.size());
-    }
-    for (std::size_t c = 0; c < components.size(); ++c) {
-      capped[c] = !components[c].closed && holes[c] > 0 && holes[c] == closable[c] ? 1 : 0;
+    for (const auto& loop : skinning::closing_loops(
+             topology,
+             closed_info->closes_holes_up_to,
+             closed_info->closes_holes_triangles_per_side)) {
+      capped[sz(topology.face_component[sz(loop.front().face)])] = 1;
     }
   }
   std::vector<ComponentRoute> routes;

@@ -410,4 +410,27 @@ std::vector<std::vector<BoundarySide>> small_simple_loops(
   return loops;
 }
 
+std::vector<std::vector<BoundarySide>> closing_loops(
+    const Topology& topology, std::int32_t max_edges, std::int32_t triangles_per_side) {
+  const auto at = [](std::int32_t i) { return static_cast<std::size_t>(i); };
+  auto loops = small_simple_loops(topology, max_edges);
+  if (loops.empty()) return loops;
+  // Per component: its boundary edges, and the sides of its closable loops.
+  std::vector<std::int64_t> holes(topology.components.size(), 0), sides(holes.size(), 0);
+  for (const std::int32_t e : topology.boundary_edges) {
+    const auto f = topology.edge_faces[at(topology.edge_face_offsets[at(e)])];
+    ++holes[at(topology.face_component[at(f)])];
+  }
+  for (const auto& loop : loops) {
+    sides[at(topology.face_component[at(loop.front().face)])] +=
+        static_cast<std::int64_t>(loop.size());
+  }
+  std::erase_if(loops, [&](const std::vector<BoundarySide>& loop) {
+    const auto c = at(topology.face_component[at(loop.front().face)]);
+    const auto triangles = static_cast<std::int64_t>(topology.components[c].faces.size());
+    return holes[c] != sides[c] || triangles < triangles_per_side * sides[c];
+  });
+  return loops;
+}
+
 }  // namespace skelcd::skinning

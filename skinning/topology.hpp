@@ -83,6 +83,14 @@ struct BoundarySide {
 [[nodiscard]] std::vector<std::vector<BoundarySide>> small_simple_loops(
     const Topology& topology, std::int32_t max_edges);
 
+/// The small_simple_loops worth closing with fans: those of the components whose every boundary
+/// edge lies on such a loop (so that closing them closes the component) and that have at least
+/// `triangles_per_side` triangles per side of those loops (a fan adds one triangle per side; on
+/// a small part the fans' own pairs cost more than closing it saves). Each loop is its sides in
+/// order, as small_simple_loops gives them.
+[[nodiscard]] std::vector<std::vector<BoundarySide>> closing_loops(
+    const Topology& topology, std::int32_t max_edges, std::int32_t triangles_per_side);
+
 /// Gathers welded positions: row w of `welded` is row representative_vertex[w] of `positions`.
 /// @param positions #V × 3 file-vertex positions.  @param welded resized to #W × 3.
 void gather_welded(const Topology& topology, const Positions& positions, Positions& welded);

@@ -70,7 +70,7 @@ TEST(GhostCaps, AnOpenTubeIsClosedConsistentlyAndKeepsItsIds) {
   const skinning::Topology topology = skinning::build_topology(mesh);
   ASSERT_EQ(topology.boundary_loops.size(), 2u);
   const auto seg = two_clusters(mesh);
-  const auto caps = cap_small_loops(mesh, topology, seg, 64);
+  const auto caps = cap_small_loops(mesh, topology, seg, 64, 0);
   ASSERT_NE(caps, nullptr);
   EXPECT_EQ(caps->num_loops(), 2);
   const auto& t = caps->topology;
@@ -148,8 +148,8 @@ TEST(GhostCaps, AnOpenTubeIsClosedConsistentlyAndKeepsItsIds) {
 TEST(GhostCaps, LongLoopsStayOpenPinchedOnesAreSplit) {
   const skinning::Mesh tube = open_tube(4, 40);
   const skinning::Topology tube_topology = skinning::build_topology(tube);
-  EXPECT_EQ(cap_small_loops(tube, tube_topology, two_clusters(tube), 39), nullptr);
-  const auto caps = cap_small_loops(tube, tube_topology, two_clusters(tube), 40);
+  EXPECT_EQ(cap_small_loops(tube, tube_topology, two_clusters(tube), 39, 0), nullptr);
+  const auto caps = cap_small_loops(tube, tube_topology, two_clusters(tube), 40, 0);
   ASSERT_NE(caps, nullptr);
   EXPECT_EQ(caps->num_loops(), 2);
   // Two open tubes sharing one vertex of their end rings: the boundary passes that vertex twice.
@@ -180,7 +180,7 @@ TEST(GhostCaps, LongLoopsStayOpenPinchedOnesAreSplit) {
   }
   const skinning::Topology pinched_topology = skinning::build_topology(pinched);
   ASSERT_EQ(pinched_topology.components.size(), 2u);  // edge-connected: two, sharing a vertex
-  const auto split = cap_small_loops(pinched, pinched_topology, two_clusters(pinched), 64);
+  const auto split = cap_small_loops(pinched, pinched_topology, two_clusters(pinched), 64, 0);
   ASSERT_NE(split, nullptr);
   EXPECT_EQ(split->num_loops(), 4);  // the two far rings, and the pinched pair split in two
   EXPECT_TRUE(split->topology.boundary_edges.empty());
@@ -188,7 +188,41 @@ TEST(GhostCaps, LongLoopsStayOpenPinchedOnesAreSplit) {
   // A segmentation that does not fit: no caps (the method reports the mismatch).
   segmentation::Segmentation short_seg = two_clusters(tube);
   short_seg.triangle_cluster.pop_back();
-  EXPECT_EQ(cap_small_loops(tube, tube_topology, short_seg, 64), nullptr);
+  EXPECT_EQ(cap_small_loops(tube, tube_topology, short_seg, 64, 0), nullptr);
+}
+
+TEST(GhostCaps, APartIsCappedWholeAndOnlyWhenLargeEnough) {
+  // 6 rings of 12 sides: 120 triangles, two end loops of 12 sides (24 ghosts).
+  const skinning::Mesh tube = open_tube(6, 12);
+  const skinning::Topology topology = skinning::build_topology(tube);
+  const auto seg = two_clusters(tube);
+  const auto triangles = tube.num_triangles();
+  const auto per_side = static_cast<std::int32_t>(triangles / 24);
+  ASSERT_EQ(triangles % 24, 0);
+  ASSERT_NE(cap_small_loops(tube, topology, seg, 64, per_side), nullptr);
+  EXPECT_EQ(cap_small_loops(tube, topology, seg, 64, per_side + 1), nullptr);
+  EXPECT_EQ(skinning::closing_loops(topology, 64, per_side).size(), 2u);
+  EXPECT_TRUE(skinning::closing_loops(topology, 64, per_side + 1).empty());
+  // A triangle taken out of its side makes a third hole, of 3 sides. With loops of up to 11
+  // sides only that hole could be closed, which would leave the part open: nothing is capped.
+  // Up to 12, all three: capped.
+  std::vector<V3> vs;
+  for (Eigen::Index i = 0; i < tube.rest_positions.rows(); ++i) {
+    vs.emplace_back(tube.rest_positions.row(i).transpose());
+  }
+  std::vector<Eigen::Vector3i> fs;
+  for (Eigen::Index f = 0; f < tube.triangles.rows(); ++f) {
+    if (f != 30) fs.emplace_back(tube.triangles.row(f).transpose());
+  }
+  const skinning::Mesh holed = make_mesh(vs, fs);
+  const skinning::Topology holed_topology = skinning::build_topology(holed);
+  ASSERT_EQ(skinning::small_simple_loops(holed_topology, 11).size(), 1u);
+  EXPECT_TRUE(skinning::closing_loops(holed_topology, 11, 0).empty());
+  EXPECT_EQ(cap_small_loops(holed, holed_topology, two_clusters(holed), 11, 0), nullptr);
+  const auto all = cap_small_loops(holed, holed_topology, two_clusters(holed), 12, 0);
+  ASSERT_NE(all, nullptr);
+  EXPECT_EQ(all->num_loops(), 3);
+  EXPECT_TRUE(all->topology.boundary_edges.empty());
 }
 
 }  // namespace

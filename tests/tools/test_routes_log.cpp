@@ -11,6 +11,7 @@
 #include <utility>
 #include <vector>
 
+#include "clustering/ghost_caps.hpp"
 #include "skinning/load.hpp"
 #include "skinning/topology.hpp"
 #include "tests/support/test_support.hpp"
@@ -54,9 +55,11 @@ TEST(RoutesLog, AutoWritesWhereEachComponentWent) {
   const auto header = read_log(log).header;
   ASSERT_EQ(header.routes.size(), topology.components.size());
   // Open components whose every hole is a small loop (at most 64 edges; none of the robot's loops
-  // passes a vertex twice, which would split it) in a component without non-manifold edges are
-  // capped by the radial-view method and go with the closed ones; the others go to the open method.
+  // passes a vertex twice, which would split it) in a component without non-manifold edges, with
+  // at least kMinTrianglesPerGhost triangles per loop edge, are capped by the radial-view method
+  // and go with the closed ones; the others go to the open method.
   std::vector<std::uint8_t> small_holes(topology.components.size(), 1);
+  std::vector<std::size_t> loop_edges(topology.components.size(), 0);
   for (const auto& loop : topology.boundary_loops) {
     const std::set<std::int32_t> distinct(loop.begin(), loop.end());
     const bool small = loop.size() <= 64 && distinct.size() == loop.size();
@@ -65,11 +68,21 @@ TEST(RoutesLog, AutoWritesWhereEachComponentWent) {
         const auto row = topology.welded_triangles.row(f);
         if (distinct.count(row(0)) + distinct.count(row(1)) + distinct.count(row(2)) > 0) {
           if (!small) small_holes[c] = 0;
+          loop_edges[c] += loop.size();
           break;
         }
       }
     }
   }
+  std::int32_t too_small = 0;
+  for (std::size_t c = 0; c < topology.components.size(); ++c) {
+    const auto per_edge = static_cast<std::size_t>(clustering::kMinTrianglesPerGhost);
+    if (small_holes[c] != 0 && topology.components[c].faces.size() < per_edge * loop_edges[c]) {
+      small_holes[c] = 0;
+      ++too_small;
+    }
+  }
+  EXPECT_GT(too_small, 0);  // the robot's small parts: their caps would cost more than they save
   for (const std::int32_t e : topology.non_manifold_edges) {
     const auto f = topology.edge_faces[static_cast<std::size_t>(
         topology.edge_face_offsets[static_cast<std::size_t>(e)])];
