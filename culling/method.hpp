@@ -63,6 +63,10 @@ struct ComponentRoute {
   /// Open, but every hole a small loop the closed group's method closes itself
   /// (MethodInfo::closes_holes_up_to): routed with the closed components.
   bool capped = false;
+  /// Open, not capped, and smaller than RoutingOptions::min_open_triangles: routed with the
+  /// closed components (whose method tests it as it tests any open part: like `bvh` for the
+  /// radial-view methods).
+  bool small = false;
   std::int32_t num_triangles = 0;
   std::string method;  ///< the method testing its pairs within its group
 };

@@ -163,8 +163,9 @@ class AutoMethod final : public detail::MethodBase {
       auto& r = routes_[c];
       if (r.part < 0 && !components[c].faces.empty())
         r.part = topology_.face_part(components[c].faces[0]);
-      // Closed, or every hole one the closed method caps itself (ComponentRoute::capped).
-      const bool closed = r.closed || r.capped;
+      // Closed, every hole one the closed method caps itself (ComponentRoute::capped), or a small
+      // open part (ComponentRoute::small).
+      const bool closed = r.closed || r.capped || r.small;
       for (const std::int32_t f : components[c].faces) {
         (closed ? closed_triangles_ : open_triangles_).push_back(f);
         open_face[sz(f)] = closed ? 0 : 1;
@@ -181,18 +182,29 @@ class AutoMethod final : public detail::MethodBase {
     const std::string open_name = routing.open_method;
     const std::string closed_name = closed_method_name(options, routing);
     if (!open_triangles_.empty()) {
-      open_bvh_ = AabbBvh(topology_.welded_triangles(), rest, open_triangles_, options.bvh);
       open_method_ = make_group_method(open_name, mesh, topology, options, open_triangles_);
     }
     if (!closed_triangles_.empty()) {
-      closed_bvh_ = AabbBvh(topology_.welded_triangles(), rest, closed_triangles_, options.bvh);
       if (whole_mesh_method(closed_name)) {
-        // A whole-mesh method (`dynamic`): the open triangles are excluded.
-        closed_method_ =
-            make_method(closed_name, closed_only_mesh(mesh, open_face), topology, options);
+        // A whole-mesh method (`dynamic`): the open triangles are excluded — when there are any
+        // (the exclusions would otherwise cost it the culling of clusters that span parts).
+        closed_method_ = make_method(
+            closed_name,
+            open_triangles_.empty() ? mesh : closed_only_mesh(mesh, open_face),
+            topology,
+            options);
       } else {
         closed_method_ = make_group_method(closed_name, mesh, topology, options, closed_triangles_);
       }
+    }
+    // A group's hierarchy is traversed here when `bvh` tests its pairs (no method of its own), or
+    // for the pairs between the two groups.
+    const bool both = !open_triangles_.empty() && !closed_triangles_.empty();
+    if (!open_triangles_.empty() && (open_method_ == nullptr || both)) {
+      open_bvh_ = AabbBvh(topology_.welded_triangles(), rest, open_triangles_, options.bvh);
+    }
+    if (!closed_triangles_.empty() && (closed_method_ == nullptr || both)) {
+      closed_bvh_ = AabbBvh(topology_.welded_triangles(), rest, closed_triangles_, options.bvh);
     }
     const auto num_faces = nf;
     bounds_.vertices.reserve(static_cast<std::size_t>(topology_.num_vertices()));
@@ -210,6 +222,7 @@ class AutoMethod final : public detail::MethodBase {
     const skinning::Positions& x = at.x;
     check_positions(x, "detect_dcd", "x");
     run_groups([&](CullingMethod& m, FrameResult& r) { m.detect_dcd(at, r); }, out);
+    if (open_bvh_.empty() && closed_bvh_.empty()) return;  // one group, its own method's answer
     const auto t0 = Clock::now();
     static_vertex_bounds<3>(x, bounds_.vertices);
     bounds_.derive(topology_, /*with_edges=*/false);
@@ -237,6 +250,7 @@ class AutoMethod final : public detail::MethodBase {
     check_positions(x_t0, "detect_ccd", "x_t0");
     check_positions(x_t1, "detect_ccd", "x_t1");
     run_groups([&](CullingMethod& m, FrameResult& r) { m.detect_ccd(interval, r); }, out);
+    if (open_bvh_.empty() && closed_bvh_.empty()) return;  // one group, its own method's answer
     const auto t0 = Clock::now();
     swept_vertex_bounds<3>(x_t0, x_t1, 0.5 * options_.min_separation, bounds_.vertices);
     bounds_.derive(topology_);
@@ -369,7 +383,8 @@ std::vector<ComponentRoute> route_components(
     r.closed = components[c].closed;
     r.capped = capped[c] != 0;
     r.num_triangles = static_cast<std::int32_t>(components[c].faces.size());
-    r.method = r.closed || r.capped ? closed_name : routing.open_method;
+    r.small = !r.closed && !r.capped && r.num_triangles < routing.min_open_triangles;
+    r.method = r.closed || r.capped || r.small ? closed_name : routing.open_method;
     routes.push_back(std::move(r));
   }
   return routes;

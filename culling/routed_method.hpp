@@ -30,6 +30,10 @@ struct RoutingOptions {
   /// Method for closed components: empty picks the best registered closed-part method whose needs
   /// are met, else kClosedFallbackMethod. Otherwise any name above, or any registered method.
   std::string closed_method;
+  /// Open components with fewer triangles go with the closed ones (ComponentRoute::small): the
+  /// cone methods have nothing to gain on a small open part, and a group of its own costs `auto`
+  /// the group's hierarchies and the traversal between the groups (docs/dual-cone.md, "Routing").
+  std::int32_t min_open_triangles = 256;
 };
 
 /// The methods `auto` uses for the open and the closed components under `options`: {open, closed}.

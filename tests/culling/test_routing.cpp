@@ -125,12 +125,17 @@ TEST(Routing, ClothFunnelRoutesThreeClothPartsAndTheFunnelAndMatchesBvh) {
   auto a = make_method("auto", s.mesh, s.topo);
   const auto routes = routes_of(*a);
   ASSERT_EQ(routes.size(), 4u);
-  int open = 0;
+  int open = 0, small = 0;
+  const RoutingOptions routing;
   for (const auto& r : routes) {
     open += r.closed ? 0 : 1;
-    EXPECT_EQ(r.method, r.closed ? "bvh" : "enhanced-dual-cone");
+    // Open parts under RoutingOptions::min_open_triangles go with the closed ones.
+    EXPECT_EQ(r.small, !r.closed && r.num_triangles < routing.min_open_triangles);
+    small += r.small ? 1 : 0;
+    EXPECT_EQ(r.method, r.closed || r.small ? "bvh" : "enhanced-dual-cone");
   }
   EXPECT_EQ(open, 3);
+  EXPECT_EQ(small, 1);  // the 200-triangle piece of cloth
   auto b = make_method("bvh", s.mesh, s.topo);
   EXPECT_EQ(dcd(*a, s.frames[1]).dcd_pairs, dcd(*b, s.frames[1]).dcd_pairs);
   EXPECT_EQ(keys(ccd(*a, s.frames[0], s.frames[1])), keys(ccd(*b, s.frames[0], s.frames[1])));
@@ -146,9 +151,13 @@ TEST(Routing, RobotExpressiveCharacterRoutesItsOpenAndClosedPartsAndMatchesBvh) 
   auto a = make_method("auto", mesh, topo);
   int open = 0;
   int closed = 0;
+  const RoutingOptions routing;
   for (const auto& r : routes_of(*a)) {
     (r.closed ? closed : open) += 1;
-    EXPECT_EQ(r.method, r.closed ? "bvh" : "enhanced-dual-cone");
+    // Its open parts are small (at most 54 triangles): with the closed ones, where `bvh` (no rig
+    // given here, so no caps) tests them.
+    EXPECT_EQ(r.small, !r.closed && r.num_triangles < routing.min_open_triangles);
+    EXPECT_EQ(r.method, r.closed || r.small ? "bvh" : "enhanced-dual-cone");
   }
   EXPECT_GT(open, 0);
   EXPECT_GT(closed, 0);

@@ -100,8 +100,10 @@ TEST(RoutesLog, AutoWritesWhereEachComponentWent) {
     const bool closed = closed_by_edges(topology.welded_triangles, component.faces);
     EXPECT_EQ(route.closed, closed) << "component " << i;
     // A rig played by its clip: closed components go to the radial-view method, and so do open
-    // ones with small holes only.
-    EXPECT_EQ(route.method, closed || small_holes[i] != 0 ? "dynamic" : "enhanced-dual-cone")
+    // ones with small holes only, and open ones too small for a group of their own.
+    const bool small = component.faces.size() < 256;  // RoutingOptions::min_open_triangles
+    EXPECT_EQ(
+        route.method, closed || small_holes[i] != 0 || small ? "dynamic" : "enhanced-dual-cone")
         << "component " << i;
     if (!closed) open_methods.insert(route.method);
     triangles += route.triangles;
@@ -109,8 +111,43 @@ TEST(RoutesLog, AutoWritesWhereEachComponentWent) {
   }
   EXPECT_EQ(triangles, loaded.mesh->num_triangles());
   EXPECT_EQ(kinds.size(), 2u) << "the robot has both open and closed components";
-  // Its open parts: most have small holes (capped), two have non-manifold edges (not).
-  EXPECT_EQ(open_methods, (std::set<std::string>{"dynamic", "enhanced-dual-cone"}));
+  // Its open parts: two are capped, the others (two with non-manifold edges) are all small.
+  EXPECT_EQ(open_methods, (std::set<std::string>{"dynamic"}));
+}
+
+TEST(RoutesLog, AutoWithEveryComponentInOneGroupIsThatGroupsMethod) {
+  // Testwuson (54 parts, 53 of them small and open) and RobotExpressive: every component goes with
+  // the closed ones, so `auto` is `dynamic` over the whole mesh — the same candidate pairs, tests
+  // and findings at every frame (no group split, no part exclusions added for an empty open group).
+  for (const auto& model :
+       {skelcd::test::assimp_model("X/Testwuson.X"),
+        skelcd::test::asset("characters/RobotExpressive.glb")}) {
+    SCOPED_TRACE(model.string());
+    const auto dir = skelcd::test::temp_dir("routes-one-group");
+    std::vector<LogData> logs;
+    for (const char* method : {"auto", "dynamic"}) {
+      const auto log = dir / (std::string(method) + ".h5");
+      const auto r = run_skelcd(
+          {"check", model.string(), "--method", method, "--frames", "0:5", "-o", log.string()});
+      ASSERT_EQ(r.exit_code, 0) << r.err;
+      logs.push_back(read_log(log));
+    }
+    for (const auto& route : logs[0].header.routes) EXPECT_EQ(route.method, "dynamic");
+    ASSERT_EQ(logs[0].frames.size(), logs[1].frames.size());
+    std::int64_t candidates = 0;
+    for (std::size_t i = 0; i < logs[0].frames.size(); ++i) {
+      const auto& a = logs[0].frames[i];
+      const auto& b = logs[1].frames[i];
+      EXPECT_EQ(a.counters.candidate_pairs, b.counters.candidate_pairs) << "row " << i;
+      EXPECT_EQ(a.counters.vf_tests, b.counters.vf_tests) << "row " << i;
+      EXPECT_EQ(a.counters.ee_tests, b.counters.ee_tests) << "row " << i;
+      EXPECT_EQ(a.counters.tt_tests, b.counters.tt_tests) << "row " << i;
+      candidates += a.counters.candidate_pairs;
+    }
+    EXPECT_GT(candidates, 0);
+    EXPECT_EQ(logs[0].contacts.size(), logs[1].contacts.size());
+    EXPECT_EQ(logs[0].dcd_pairs.size(), logs[1].dcd_pairs.size());
+  }
 }
 
 TEST(RoutesLog, AutoFindsWhatBvhFindsOnACharacterWithOpenParts) {
@@ -144,7 +181,7 @@ TEST(RoutesLog, SceneLogsHoldTheRoutesOfEveryAutoObject) {
   std::ofstream(scene) << "frames = \"0:1\"\n"
                        << "[objects.bot]\nmodel = \"" << bot
                        << "\"\nchecks = [\"self-dcd\", \"self-ccd\"]\nmethod = \"auto\"\n"
-                       << "[objects.sheet]\nmodel = \"gen:cloth?triangles=200&frames=4\"\n"
+                       << "[objects.sheet]\nmodel = \"gen:cloth?triangles=400&frames=4\"\n"
                        << "checks = [\"self-ccd\"]\nmethod = \"auto\"\n"
                        << "[objects.rope]\nmodel = \"gen:rope?triangles=200&frames=4\"\n"
                        << "checks = [\"self-dcd\"]\n";
