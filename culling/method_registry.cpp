@@ -94,7 +94,8 @@ void add_culling_methods(Registry& r) {
       {.name = "auto",
        .description =
            "per connected part: closed parts to the best closed-part method whose needs are met "
-           "(dynamic on a rig), open parts to enhanced-dual-cone, else bvh",
+           "(dynamic on a rig, else bvh), and with them open parts it caps or under 256 "
+           "triangles; other open parts to enhanced-dual-cone",
        // `auto` carries what the methods it routes to carry.
        .serial_reason =
            [](const MethodOptions& options, bool dcd_before_each_ccd) {
