@@ -1,6 +1,8 @@
 #include "culling/bvh.hpp"
 
 #include <algorithm>
+#include <array>
+#include <limits>
 #include <numeric>
 #include <string>
 
@@ -69,6 +71,112 @@ void Bvh<N>::build(const skinning::Triangles& triangles, const skinning::Positio
   for (std::size_t i = 0; i < order_.size(); ++i) order_[i] = items_[i].id;
   node_bounds_.assign(nodes_.size(), Volume::empty());
   items_ = {};
+  build_wide();
+  // Slot volumes: padded by one group of four, empty (lo = +inf, hi = −inf) until refit.
+  slot_stride_ = order_.size() + WideBvhNode<N>::kLanes;
+  constexpr auto kN = static_cast<std::size_t>(N);
+  slot_bounds_.assign(2 * kN * slot_stride_, 0.0);
+  for (std::size_t k = 0; k < kN; ++k) {
+    std::fill_n(
+        slot_bounds_.begin() + static_cast<std::ptrdiff_t>(k * slot_stride_),
+        slot_stride_,
+        std::numeric_limits<double>::infinity());
+    std::fill_n(
+        slot_bounds_.begin() + static_cast<std::ptrdiff_t>((kN + k) * slot_stride_),
+        slot_stride_,
+        -std::numeric_limits<double>::infinity());
+  }
+}
+
+template <int N>
+void Bvh<N>::build_wide() {
+  wide_.clear();
+  wide_depth_ = 0;
+  if (nodes_.empty()) return;
+  // The virtual root (one lane: the root), then the inner nodes depth first. Every wide node but
+  // the virtual root is a distinct inner node of the binary tree: fewer than #nodes in all.
+  wide_.reserve(nodes_.size());
+  wide_.emplace_back();
+  WideBvhNode<N>& root = wide_[0];
+  for (int k = 0; k < N; ++k) {
+    for (int i = 0; i < WideBvhNode<N>::kWidth; ++i) {
+      root.lo[k][i] = std::numeric_limits<float>::infinity();
+      root.hi[k][i] = -std::numeric_limits<float>::infinity();
+    }
+  }
+  root.num_children = 1;
+  root.node[0] = 0;
+  root.count[0] = nodes_[0].size();
+  root.child[0] = ~nodes_[0].begin;
+  wide_depth_ = 1;
+  if (nodes_[0].size() > bucket_size(leaf_size_)) {
+    const std::int32_t w = build_wide_node(0, 2);
+    wide_[0].child[0] = w;
+  }
+}
+
+template <int N>
+std::int32_t Bvh<N>::build_wide_node(std::int32_t node, int depth) {
+  using Wide = WideBvhNode<N>;
+  const auto index = static_cast<std::int32_t>(wide_.size());
+  wide_.emplace_back();
+  wide_depth_ = std::max(wide_depth_, depth);
+  // Collapse: start from the two children and, while fewer than four, replace the one with the
+  // most triangles (the first on ties) that is larger than a bucket by its two children, in place
+  // (left, right). A node larger than a bucket is larger than a leaf: it has children.
+  const int bucket = bucket_size(leaf_size_);
+  std::array<std::int32_t, Wide::kWidth> lanes{};
+  const BvhNode& n = nodes_[static_cast<std::size_t>(node)];
+  lanes[0] = node + 1;
+  lanes[1] = n.right;
+  int used = 2;
+  while (used < Wide::kWidth) {
+    int pick = -1;
+    for (int i = 0; i < used; ++i) {
+      const BvhNode& c = nodes_[static_cast<std::size_t>(lanes[static_cast<std::size_t>(i)])];
+      if (c.size() <= bucket) continue;
+      if (pick < 0 ||
+          c.size() >
+              nodes_[static_cast<std::size_t>(lanes[static_cast<std::size_t>(pick)])].size()) {
+        pick = i;
+      }
+    }
+    if (pick < 0) break;
+    const std::int32_t split = lanes[static_cast<std::size_t>(pick)];
+    for (int i = used; i > pick + 1; --i) {
+      lanes[static_cast<std::size_t>(i)] = lanes[static_cast<std::size_t>(i - 1)];
+    }
+    lanes[static_cast<std::size_t>(pick)] = split + 1;
+    lanes[static_cast<std::size_t>(pick + 1)] = nodes_[static_cast<std::size_t>(split)].right;
+    ++used;
+  }
+  // Lanes: unused ones empty; leaves point into triangle_order, inner children to their wide node.
+  {
+    Wide& w = wide_[static_cast<std::size_t>(index)];
+    for (int k = 0; k < N; ++k) {
+      for (int i = 0; i < Wide::kWidth; ++i) {
+        w.lo[k][i] = std::numeric_limits<float>::infinity();
+        w.hi[k][i] = -std::numeric_limits<float>::infinity();
+      }
+    }
+    for (int i = 0; i < Wide::kWidth; ++i) {
+      w.child[i] = 0;
+      w.count[i] = 0;
+      w.node[i] = 0;
+    }
+    w.num_children = used;
+  }
+  for (int i = 0; i < used; ++i) {
+    const std::int32_t c = lanes[static_cast<std::size_t>(i)];
+    const BvhNode& cn = nodes_[static_cast<std::size_t>(c)];
+    // build_wide_node grows wide_: no reference into it is held across the call.
+    const std::int32_t child = cn.size() <= bucket ? ~cn.begin : build_wide_node(c, depth + 1);
+    Wide& w = wide_[static_cast<std::size_t>(index)];
+    w.child[i] = child;
+    w.count[i] = cn.size();
+    w.node[i] = c;
+  }
+  return index;
 }
 
 template <int N>
@@ -107,20 +215,40 @@ std::int32_t Bvh<N>::build_range(std::int32_t begin, std::int32_t end, int depth
 
 template <int N>
 void Bvh<N>::refit(std::span<const Volume> triangle_bounds) {
-  // Depth-first order puts every child after its parent, so one backward sweep is bottom-up.
+  constexpr auto kN = static_cast<std::size_t>(N);
+  double* const slot_lo = slot_bounds_.data();
+  double* const slot_hi = slot_lo + kN * slot_stride_;
+  // Depth-first order puts every child after its parent, so one backward sweep is bottom-up. A
+  // leaf also copies its triangles' volumes to their slots, axis by axis, for the bucket tests.
   for (std::size_t n = nodes_.size(); n-- > 0;) {
     const BvhNode& node = nodes_[n];
     Volume v;
     if (node.is_leaf()) {
-      v = triangle_bounds[static_cast<std::size_t>(order_[static_cast<std::size_t>(node.begin)])];
-      for (std::int32_t s = node.begin + 1; s < node.end; ++s) {
-        v.merge(triangle_bounds[static_cast<std::size_t>(order_[static_cast<std::size_t>(s)])]);
+      v = Volume::empty();
+      for (auto s = static_cast<std::size_t>(node.begin); s < static_cast<std::size_t>(node.end);
+           ++s) {
+        const Volume& t = triangle_bounds[static_cast<std::size_t>(order_[s])];
+        for (std::size_t k = 0; k < kN; ++k) {
+          slot_lo[k * slot_stride_ + s] = t.lo[k];
+          slot_hi[k * slot_stride_ + s] = t.hi[k];
+        }
+        v.merge(t);
       }
     } else {
       v = node_bounds_[n + 1];
       v.merge(node_bounds_[static_cast<std::size_t>(node.right)]);
     }
     node_bounds_[n] = v;
+  }
+  // The wide copy: each lane's binary node volume, rounded outwards to floats.
+  for (WideBvhNode<N>& w : wide_) {
+    for (int i = 0; i < w.num_children; ++i) {
+      const Volume& v = node_bounds_[static_cast<std::size_t>(w.node[i])];
+      for (std::size_t k = 0; k < kN; ++k) {
+        w.lo[k][i] = float_below(v.lo[k]);
+        w.hi[k][i] = float_above(v.hi[k]);
+      }
+    }
   }
 }
 
