@@ -217,24 +217,26 @@ class Walk {
     const std::int32_t begin_b = ~pb.child[lane_of(sb)];
     const std::int32_t end_b = begin_b + pb.count[lane_of(sb)];
     const bool same = kSelf && sa == sb;
+    std::int64_t tests = 0;
     for (std::int32_t i = begin_a; i < end_a; ++i) {
       const std::int32_t ti = order_a_[to_size(i)];
       for (std::int32_t j0 = same ? i + 1 : begin_b; j0 < end_b; j0 += kWidth) {
         const std::int32_t n = std::min(kWidth, end_b - j0);
         unsigned mask = overlap_slots(to_size(i), to_size(j0)) & ((1u << n) - 1u);
-        bv_tests_ += n;
+        tests += n;
         while (mask != 0) {
           const std::int32_t tj = order_b_[to_size(j0 + std::countr_zero(mask))];
           mask &= mask - 1;
-          // Ordered a < b within one tree, as given across two.
-          if (kSelf && tj < ti) {
-            out_.push_back({tj, ti});
+          // Ordered a < b within one tree (a select, not a branch), as given across two.
+          if constexpr (kSelf) {
+            out_.push_back({std::min(ti, tj), std::max(ti, tj)});
           } else {
             out_.push_back({ti, tj});
           }
         }
       }
     }
+    bv_tests_ += tests;
   }
 
   /// Bit j set when the volume of slot sb + j of b overlaps that of slot sa of a (exact: double;
