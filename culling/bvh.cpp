@@ -72,20 +72,6 @@ void Bvh<N>::build(const skinning::Triangles& triangles, const skinning::Positio
   node_bounds_.assign(nodes_.size(), Volume::empty());
   items_ = {};
   build_wide();
-  // Slot volumes: padded by one group of four, empty (lo = +inf, hi = −inf) until refit.
-  slot_stride_ = order_.size() + WideBvhNode<N>::kLanes;
-  constexpr auto kN = static_cast<std::size_t>(N);
-  slot_bounds_.assign(2 * kN * slot_stride_, 0.0);
-  for (std::size_t k = 0; k < kN; ++k) {
-    std::fill_n(
-        slot_bounds_.begin() + static_cast<std::ptrdiff_t>(k * slot_stride_),
-        slot_stride_,
-        std::numeric_limits<double>::infinity());
-    std::fill_n(
-        slot_bounds_.begin() + static_cast<std::ptrdiff_t>((kN + k) * slot_stride_),
-        slot_stride_,
-        -std::numeric_limits<double>::infinity());
-  }
 }
 
 template <int N>
@@ -93,9 +79,9 @@ void Bvh<N>::build_wide() {
   wide_.clear();
   wide_depth_ = 0;
   if (nodes_.empty()) return;
-  // The virtual root (one lane: the root), then the inner nodes depth first. Every wide node but
-  // the virtual root is a distinct inner node of the binary tree: fewer than #nodes in all.
-  wide_.reserve(nodes_.size());
+  // The virtual root (one lane: the root), then the inner nodes depth first, counted first so that
+  // the vector is allocated once at its size (about #F / 12 nodes).
+  wide_.reserve(nodes_[0].size() > bucket_size(leaf_size_) ? 1 + count_wide(0) : 1);
   wide_.emplace_back();
   WideBvhNode<N>& root = wide_[0];
   for (int k = 0; k < N; ++k) {
@@ -116,21 +102,17 @@ void Bvh<N>::build_wide() {
 }
 
 template <int N>
-std::int32_t Bvh<N>::build_wide_node(std::int32_t node, int depth) {
-  using Wide = WideBvhNode<N>;
-  const auto index = static_cast<std::int32_t>(wide_.size());
-  wide_.emplace_back();
-  wide_depth_ = std::max(wide_depth_, depth);
+int Bvh<N>::wide_lanes(
+    std::int32_t node, std::array<std::int32_t, WideBvhNode<N>::kWidth>& lanes) const {
   // Collapse: start from the two children and, while fewer than four, replace the one with the
   // most triangles (the first on ties) that is larger than a bucket by its two children, in place
   // (left, right). A node larger than a bucket is larger than a leaf: it has children.
   const int bucket = bucket_size(leaf_size_);
-  std::array<std::int32_t, Wide::kWidth> lanes{};
   const BvhNode& n = nodes_[static_cast<std::size_t>(node)];
   lanes[0] = node + 1;
   lanes[1] = n.right;
   int used = 2;
-  while (used < Wide::kWidth) {
+  while (used < WideBvhNode<N>::kWidth) {
     int pick = -1;
     for (int i = 0; i < used; ++i) {
       const BvhNode& c = nodes_[static_cast<std::size_t>(lanes[static_cast<std::size_t>(i)])];
@@ -150,6 +132,31 @@ std::int32_t Bvh<N>::build_wide_node(std::int32_t node, int depth) {
     lanes[static_cast<std::size_t>(pick + 1)] = nodes_[static_cast<std::size_t>(split)].right;
     ++used;
   }
+  return used;
+}
+
+template <int N>
+std::size_t Bvh<N>::count_wide(std::int32_t node) const {
+  std::array<std::int32_t, WideBvhNode<N>::kWidth> lanes{};
+  const int used = wide_lanes(node, lanes);
+  std::size_t count = 1;
+  for (int i = 0; i < used; ++i) {
+    const std::int32_t c = lanes[static_cast<std::size_t>(i)];
+    if (nodes_[static_cast<std::size_t>(c)].size() > bucket_size(leaf_size_))
+      count += count_wide(c);
+  }
+  return count;
+}
+
+template <int N>
+std::int32_t Bvh<N>::build_wide_node(std::int32_t node, int depth) {
+  using Wide = WideBvhNode<N>;
+  const auto index = static_cast<std::int32_t>(wide_.size());
+  wide_.emplace_back();
+  wide_depth_ = std::max(wide_depth_, depth);
+  const int bucket = bucket_size(leaf_size_);
+  std::array<std::int32_t, Wide::kWidth> lanes{};
+  const int used = wide_lanes(node, lanes);
   // Lanes: unused ones empty; leaves point into triangle_order, inner children to their wide node.
   {
     Wide& w = wide_[static_cast<std::size_t>(index)];
@@ -216,23 +223,14 @@ std::int32_t Bvh<N>::build_range(std::int32_t begin, std::int32_t end, int depth
 template <int N>
 void Bvh<N>::refit(std::span<const Volume> triangle_bounds) {
   constexpr auto kN = static_cast<std::size_t>(N);
-  double* const slot_lo = slot_bounds_.data();
-  double* const slot_hi = slot_lo + kN * slot_stride_;
-  // Depth-first order puts every child after its parent, so one backward sweep is bottom-up. A
-  // leaf also copies its triangles' volumes to their slots, axis by axis, for the bucket tests.
+  // Depth-first order puts every child after its parent, so one backward sweep is bottom-up.
   for (std::size_t n = nodes_.size(); n-- > 0;) {
     const BvhNode& node = nodes_[n];
     Volume v;
     if (node.is_leaf()) {
-      v = Volume::empty();
-      for (auto s = static_cast<std::size_t>(node.begin); s < static_cast<std::size_t>(node.end);
-           ++s) {
-        const Volume& t = triangle_bounds[static_cast<std::size_t>(order_[s])];
-        for (std::size_t k = 0; k < kN; ++k) {
-          slot_lo[k * slot_stride_ + s] = t.lo[k];
-          slot_hi[k * slot_stride_ + s] = t.hi[k];
-        }
-        v.merge(t);
+      v = triangle_bounds[static_cast<std::size_t>(order_[static_cast<std::size_t>(node.begin)])];
+      for (std::int32_t s = node.begin + 1; s < node.end; ++s) {
+        v.merge(triangle_bounds[static_cast<std::size_t>(order_[static_cast<std::size_t>(s)])]);
       }
     } else {
       v = node_bounds_[n + 1];

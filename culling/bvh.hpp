@@ -3,6 +3,7 @@
 // interval. Flat layout: nodes in depth-first order, a node's left child right after it, its
 // triangles one contiguous range of triangle_order().
 
+#include <array>
 #include <cstddef>
 #include <cstdint>
 #include <span>
@@ -37,7 +38,7 @@ struct BvhNode {
 /// float_above), axis by axis four children side by side (SoA), so that one volume is tested
 /// against all four children at once. Half the bytes of double volumes; the float test is
 /// conservative (two volumes that overlap in double overlap in float), and the traversals test
-/// triangle pairs again with the exact double volumes (Bvh::slot_bounds).
+/// triangle pairs again with the exact double volumes.
 template <int N>
 struct alignas(16) WideBvhNode {
   static constexpr int kWidth = 4;
@@ -106,25 +107,19 @@ class Bvh {
   /// Wide nodes on the longest path from the virtual root to a leaf, the virtual root included
   /// (1 when the tree is one leaf; 0 when empty).
   [[nodiscard]] int wide_depth() const { return wide_depth_; }
-  /// The triangles' volumes of the last refit by slot of triangle_order(), axis by axis (SoA):
-  /// slot_bounds()[k · slot_stride() + s] is the low end on axis k of triangle
-  /// triangle_order()[s], slot_bounds()[(N + k) · slot_stride() + s] the high end; slots from
-  /// #triangles to slot_stride() are empty volumes (padding for four-wide loads).
-  [[nodiscard]] std::span<const double> slot_bounds() const { return slot_bounds_; }
-  [[nodiscard]] std::size_t slot_stride() const { return slot_stride_; }
 
  private:
   void build(const skinning::Triangles& triangles, const skinning::Positions& positions);
   std::int32_t build_range(std::int32_t begin, std::int32_t end, int depth);
   void build_wide();
+  int wide_lanes(std::int32_t node, std::array<std::int32_t, WideBvhNode<N>::kWidth>& lanes) const;
+  std::size_t count_wide(std::int32_t node) const;
   std::int32_t build_wide_node(std::int32_t node, int depth);
 
   std::vector<BvhNode> nodes_;
   std::vector<Volume> node_bounds_;
   std::vector<std::int32_t> order_;
   std::vector<WideBvhNode<N>> wide_;
-  std::vector<double> slot_bounds_;
-  std::size_t slot_stride_ = 0;
   struct Item {
     Eigen::Vector3d centroid;
     std::int32_t id;

@@ -77,24 +77,12 @@ class Walk {
         wide_b_(b.wide_nodes()),
         order_a_(a.triangle_order()),
         order_b_(b.triangle_order()),
-        slots_a_(a.slot_bounds()),
-        slots_b_(b.slot_bounds()),
-        stride_a_(a.slot_stride()),
-        stride_b_(b.slot_stride()),
+        bounds_a_(bounds_a),
+        bounds_b_(bounds_b),
         stack_(stack),
         out_(out),
         bv_tests_(bv_tests),
-        max_pairs_(max_pairs) {
-    // The bucket tests read the volumes of the last refit, by slot: those must be these.
-    assert(
-        a.triangle_order().empty() ||
-        a.slot_bounds()[0] == bounds_a[to_size(a.triangle_order()[0])].lo[0]);
-    assert(
-        b.triangle_order().empty() ||
-        b.slot_bounds()[0] == bounds_b[to_size(b.triangle_order()[0])].lo[0]);
-    (void)bounds_a;
-    (void)bounds_b;
-  }
+        max_pairs_(max_pairs) {}
 
   /// Runs until the stack is empty (true) or `out` holds max_pairs (false).
   bool run() {
@@ -208,7 +196,7 @@ class Walk {
   }
 
   /// The triangle pairs of two bucket slots (one bucket's own pairs when they are the same),
-  /// each tested with the exact double volumes, one triangle against four at a time.
+  /// each tested with the exact double volumes.
   void leaf_pairs(std::int32_t sa, std::int32_t sb) {
     const WideBvhNode<N>& pa = wide_a_[node_of(sa)];
     const WideBvhNode<N>& pb = wide_b_[node_of(sb)];
@@ -222,7 +210,7 @@ class Walk {
       const std::int32_t ti = order_a_[to_size(i)];
       for (std::int32_t j0 = same ? i + 1 : begin_b; j0 < end_b; j0 += kWidth) {
         const std::int32_t n = std::min(kWidth, end_b - j0);
-        unsigned mask = overlap_slots(to_size(i), to_size(j0)) & ((1u << n) - 1u);
+        unsigned mask = overlap_slots(bounds_a_[to_size(ti)], j0, n);
         tests += n;
         while (mask != 0) {
           const std::int32_t tj = order_b_[to_size(j0 + std::countr_zero(mask))];
@@ -239,48 +227,27 @@ class Walk {
     bv_tests_ += tests;
   }
 
-  /// Bit j set when the volume of slot sb + j of b overlaps that of slot sa of a (exact: double;
-  /// slots past b's last are padding, to be masked by the caller).
-  [[nodiscard]] unsigned overlap_slots(std::size_t sa, std::size_t sb) const {
-    constexpr auto kN = static_cast<std::size_t>(N);
-    const double* a = slots_a_.data();
-    const double* b = slots_b_.data();
-#if defined(__SSE2__)
-    __m128d ok01 = _mm_castsi128_pd(_mm_set1_epi32(-1));
-    __m128d ok23 = ok01;
-    for (std::size_t k = 0; k < kN; ++k) {
-      const __m128d a_lo = _mm_set1_pd(a[k * stride_a_ + sa]);
-      const __m128d a_hi = _mm_set1_pd(a[(kN + k) * stride_a_ + sa]);
-      const double* b_lo = b + k * stride_b_ + sb;
-      const double* b_hi = b + (kN + k) * stride_b_ + sb;
-      ok01 = _mm_and_pd(ok01, _mm_cmple_pd(_mm_loadu_pd(b_lo), a_hi));
-      ok01 = _mm_and_pd(ok01, _mm_cmple_pd(a_lo, _mm_loadu_pd(b_hi)));
-      ok23 = _mm_and_pd(ok23, _mm_cmple_pd(_mm_loadu_pd(b_lo + 2), a_hi));
-      ok23 = _mm_and_pd(ok23, _mm_cmple_pd(a_lo, _mm_loadu_pd(b_hi + 2)));
-    }
-    return static_cast<unsigned>(_mm_movemask_pd(ok01) | (_mm_movemask_pd(ok23) << 2));
-#else
+  /// Bit c set when the volume of triangle ti overlaps that of the triangle in slot sb + c of b,
+  /// for c < n (exact: double), without a branch per test.
+  [[nodiscard]] unsigned overlap_slots(const Dop<N>& ti, std::int32_t sb, std::int32_t n) const {
     unsigned mask = 0;
-    for (std::size_t j = 0; j < 4; ++j) {
-      bool hit = true;
-      for (std::size_t k = 0; k < kN; ++k) {
-        hit = hit && b[k * stride_b_ + sb + j] <= a[(kN + k) * stride_a_ + sa] &&
-              a[k * stride_a_ + sa] <= b[(kN + k) * stride_b_ + sb + j];
+    for (std::int32_t c = 0; c < n; ++c) {
+      const Dop<N>& tj = bounds_b_[to_size(order_b_[to_size(sb + c)])];
+      bool ok = true;
+      for (std::size_t k = 0; k < static_cast<std::size_t>(N); ++k) {
+        ok = ok & (ti.lo[k] <= tj.hi[k]) & (tj.lo[k] <= ti.hi[k]);
       }
-      mask |= static_cast<unsigned>(hit) << j;
+      mask |= static_cast<unsigned>(ok) << c;
     }
     return mask;
-#endif
   }
 
   std::span<const WideBvhNode<N>> wide_a_;
   std::span<const WideBvhNode<N>> wide_b_;
   std::span<const std::int32_t> order_a_;
   std::span<const std::int32_t> order_b_;
-  std::span<const double> slots_a_;
-  std::span<const double> slots_b_;
-  std::size_t stride_a_;
-  std::size_t stride_b_;
+  std::span<const Dop<N>> bounds_a_;
+  std::span<const Dop<N>> bounds_b_;
   std::vector<Entry>& stack_;
   std::vector<TrianglePair>& out_;
   std::int64_t& bv_tests_;
