@@ -1,6 +1,8 @@
 #include "culling/bvh.hpp"
 
 #include <algorithm>
+#include <array>
+#include <limits>
 #include <numeric>
 #include <string>
 
@@ -69,6 +71,119 @@ void Bvh<N>::build(const skinning::Triangles& triangles, const skinning::Positio
   for (std::size_t i = 0; i < order_.size(); ++i) order_[i] = items_[i].id;
   node_bounds_.assign(nodes_.size(), Volume::empty());
   items_ = {};
+  build_wide();
+}
+
+template <int N>
+void Bvh<N>::build_wide() {
+  wide_.clear();
+  wide_depth_ = 0;
+  if (nodes_.empty()) return;
+  // The virtual root (one lane: the root), then the inner nodes depth first, counted first so that
+  // the vector is allocated once at its size (about #F / 12 nodes).
+  wide_.reserve(nodes_[0].size() > bucket_size(leaf_size_) ? 1 + count_wide(0) : 1);
+  wide_.emplace_back();
+  WideBvhNode<N>& root = wide_[0];
+  for (int k = 0; k < N; ++k) {
+    for (int i = 0; i < WideBvhNode<N>::kWidth; ++i) {
+      root.lo[k][i] = std::numeric_limits<float>::infinity();
+      root.hi[k][i] = -std::numeric_limits<float>::infinity();
+    }
+  }
+  root.num_children = 1;
+  root.node[0] = 0;
+  root.count[0] = nodes_[0].size();
+  root.child[0] = ~nodes_[0].begin;
+  wide_depth_ = 1;
+  if (nodes_[0].size() > bucket_size(leaf_size_)) {
+    const std::int32_t w = build_wide_node(0, 2);
+    wide_[0].child[0] = w;
+  }
+}
+
+template <int N>
+int Bvh<N>::wide_lanes(
+    std::int32_t node, std::array<std::int32_t, WideBvhNode<N>::kWidth>& lanes) const {
+  // Collapse: start from the two children and, while fewer than four, replace the one with the
+  // most triangles (the first on ties) that is larger than a bucket by its two children, in place
+  // (left, right). A node larger than a bucket is larger than a leaf: it has children.
+  const int bucket = bucket_size(leaf_size_);
+  const BvhNode& n = nodes_[static_cast<std::size_t>(node)];
+  lanes[0] = node + 1;
+  lanes[1] = n.right;
+  int used = 2;
+  while (used < WideBvhNode<N>::kWidth) {
+    int pick = -1;
+    for (int i = 0; i < used; ++i) {
+      const BvhNode& c = nodes_[static_cast<std::size_t>(lanes[static_cast<std::size_t>(i)])];
+      if (c.size() <= bucket) continue;
+      if (pick < 0 ||
+          c.size() >
+              nodes_[static_cast<std::size_t>(lanes[static_cast<std::size_t>(pick)])].size()) {
+        pick = i;
+      }
+    }
+    if (pick < 0) break;
+    const std::int32_t split = lanes[static_cast<std::size_t>(pick)];
+    for (int i = used; i > pick + 1; --i) {
+      lanes[static_cast<std::size_t>(i)] = lanes[static_cast<std::size_t>(i - 1)];
+    }
+    lanes[static_cast<std::size_t>(pick)] = split + 1;
+    lanes[static_cast<std::size_t>(pick + 1)] = nodes_[static_cast<std::size_t>(split)].right;
+    ++used;
+  }
+  return used;
+}
+
+template <int N>
+std::size_t Bvh<N>::count_wide(std::int32_t node) const {
+  std::array<std::int32_t, WideBvhNode<N>::kWidth> lanes{};
+  const int used = wide_lanes(node, lanes);
+  std::size_t count = 1;
+  for (int i = 0; i < used; ++i) {
+    const std::int32_t c = lanes[static_cast<std::size_t>(i)];
+    if (nodes_[static_cast<std::size_t>(c)].size() > bucket_size(leaf_size_))
+      count += count_wide(c);
+  }
+  return count;
+}
+
+template <int N>
+std::int32_t Bvh<N>::build_wide_node(std::int32_t node, int depth) {
+  using Wide = WideBvhNode<N>;
+  const auto index = static_cast<std::int32_t>(wide_.size());
+  wide_.emplace_back();
+  wide_depth_ = std::max(wide_depth_, depth);
+  const int bucket = bucket_size(leaf_size_);
+  std::array<std::int32_t, Wide::kWidth> lanes{};
+  const int used = wide_lanes(node, lanes);
+  // Lanes: unused ones empty; leaves point into triangle_order, inner children to their wide node.
+  {
+    Wide& w = wide_[static_cast<std::size_t>(index)];
+    for (int k = 0; k < N; ++k) {
+      for (int i = 0; i < Wide::kWidth; ++i) {
+        w.lo[k][i] = std::numeric_limits<float>::infinity();
+        w.hi[k][i] = -std::numeric_limits<float>::infinity();
+      }
+    }
+    for (int i = 0; i < Wide::kWidth; ++i) {
+      w.child[i] = 0;
+      w.count[i] = 0;
+      w.node[i] = 0;
+    }
+    w.num_children = used;
+  }
+  for (int i = 0; i < used; ++i) {
+    const std::int32_t c = lanes[static_cast<std::size_t>(i)];
+    const BvhNode& cn = nodes_[static_cast<std::size_t>(c)];
+    // build_wide_node grows wide_: no reference into it is held across the call.
+    const std::int32_t child = cn.size() <= bucket ? ~cn.begin : build_wide_node(c, depth + 1);
+    Wide& w = wide_[static_cast<std::size_t>(index)];
+    w.child[i] = child;
+    w.count[i] = cn.size();
+    w.node[i] = c;
+  }
+  return index;
 }
 
 template <int N>
@@ -107,6 +222,7 @@ std::int32_t Bvh<N>::build_range(std::int32_t begin, std::int32_t end, int depth
 
 template <int N>
 void Bvh<N>::refit(std::span<const Volume> triangle_bounds) {
+  constexpr auto kN = static_cast<std::size_t>(N);
   // Depth-first order puts every child after its parent, so one backward sweep is bottom-up.
   for (std::size_t n = nodes_.size(); n-- > 0;) {
     const BvhNode& node = nodes_[n];
@@ -121,6 +237,16 @@ void Bvh<N>::refit(std::span<const Volume> triangle_bounds) {
       v.merge(node_bounds_[static_cast<std::size_t>(node.right)]);
     }
     node_bounds_[n] = v;
+  }
+  // The wide copy: each lane's binary node volume, rounded outwards to floats.
+  for (WideBvhNode<N>& w : wide_) {
+    for (int i = 0; i < w.num_children; ++i) {
+      const Volume& v = node_bounds_[static_cast<std::size_t>(w.node[i])];
+      for (std::size_t k = 0; k < kN; ++k) {
+        w.lo[k][i] = float_below(v.lo[k]);
+        w.hi[k][i] = float_above(v.hi[k]);
+      }
+    }
   }
 }
 

@@ -3,6 +3,8 @@
 // interval. Flat layout: nodes in depth-first order, a node's left child right after it, its
 // triangles one contiguous range of triangle_order().
 
+#include <array>
+#include <cstddef>
 #include <cstdint>
 #include <span>
 #include <vector>
@@ -24,6 +26,34 @@ struct BvhNode {
   std::int32_t right = 0;  ///< index of the right child; 0 for a leaf (the left child is index + 1)
   [[nodiscard]] bool is_leaf() const { return right == 0; }
   [[nodiscard]] std::int32_t size() const { return end - begin; }
+};
+
+/// Most triangles in a bucket of the traversals' wide tree (Bvh::wide_nodes) with leaves of
+/// `leaf_size`: a subtree of at most this many triangles is one bucket, whose triangles are tested
+/// against another bucket's all at once; so a traversal step may emit up to its square in pairs.
+[[nodiscard]] constexpr int bucket_size(int leaf_size) { return leaf_size > 4 ? leaf_size : 4; }
+
+/// A node of the traversals' copy of the hierarchy (Bvh::wide_nodes): up to four children, each a
+/// binary node of the tree, with their volumes as floats rounded outwards (float_below /
+/// float_above), axis by axis four children side by side (SoA), so that one volume is tested
+/// against all four children at once. Half the bytes of double volumes; the float test is
+/// conservative (two volumes that overlap in double overlap in float), and the traversals test
+/// triangle pairs again with the exact double volumes.
+template <int N>
+struct alignas(16) WideBvhNode {
+  static constexpr int kWidth = 4;
+  /// lo[k][i], hi[k][i]: child i's interval on axis k; unused lanes are empty (+inf, −inf).
+  static constexpr auto kAxes = static_cast<std::size_t>(N);
+  static constexpr auto kLanes = static_cast<std::size_t>(kWidth);
+  float lo[kAxes][kLanes];
+  float hi[kAxes][kLanes];
+  /// child[i] >= 0: the wide node holding child i's children; child[i] < 0: child i is a bucket
+  /// (a subtree of at most bucket_size(leaf_size) triangles) holding the triangles
+  /// triangle_order()[~child[i] .. ~child[i] + count[i]).
+  std::int32_t child[kLanes];
+  std::int32_t count[kLanes];  ///< triangles under child i (0 for an unused lane)
+  std::int32_t node[kLanes];   ///< child i's index in nodes() (refit reads its volume)
+  std::int32_t num_children;   ///< lanes in use, 1..4 (lanes 0 .. num_children − 1)
 };
 
 /// Hierarchy of Dop<N> volumes (Dop<3>: AABB, Dop<8>: 16-DOP) over a set of triangles.
@@ -52,7 +82,8 @@ class Bvh {
 
   /// Bottom-up refit: a leaf's volume is the union of its triangles' volumes, a parent's the
   /// union of its children's. Unions are exact (min/max), so every node contains its triangles'
-  /// volumes exactly as given. Allocation-free.
+  /// volumes exactly as given; the wide nodes' float volumes contain them too (rounded
+  /// outwards). Allocation-free.
   /// @param triangle_bounds indexed by triangle id (#F of the `triangles` built from).
   void refit(std::span<const Volume> triangle_bounds);
 
@@ -65,19 +96,37 @@ class Bvh {
   [[nodiscard]] int depth() const { return depth_; }
   [[nodiscard]] int leaf_size() const { return leaf_size_; }
 
+  /// The same tree collapsed into nodes of up to four children for the traversals
+  /// (culling/traversal.hpp): wide_nodes()[0] is a virtual root whose one child is nodes()[0];
+  /// every other wide node is an inner node of the binary tree with more than
+  /// bucket_size(leaf_size()) triangles and holds the up to four descendants found by replacing,
+  /// while fewer than four, the child with the most triangles among those with more than
+  /// bucket_size by its two children. Children of at most bucket_size triangles are buckets.
+  /// Empty when the tree is.
+  [[nodiscard]] std::span<const WideBvhNode<N>> wide_nodes() const { return wide_; }
+  /// Wide nodes on the longest path from the virtual root to a leaf, the virtual root included
+  /// (1 when the tree is one leaf; 0 when empty).
+  [[nodiscard]] int wide_depth() const { return wide_depth_; }
+
  private:
   void build(const skinning::Triangles& triangles, const skinning::Positions& positions);
   std::int32_t build_range(std::int32_t begin, std::int32_t end, int depth);
+  void build_wide();
+  int wide_lanes(std::int32_t node, std::array<std::int32_t, WideBvhNode<N>::kWidth>& lanes) const;
+  std::size_t count_wide(std::int32_t node) const;
+  std::int32_t build_wide_node(std::int32_t node, int depth);
 
   std::vector<BvhNode> nodes_;
   std::vector<Volume> node_bounds_;
   std::vector<std::int32_t> order_;
+  std::vector<WideBvhNode<N>> wide_;
   struct Item {
     Eigen::Vector3d centroid;
     std::int32_t id;
   };
   std::vector<Item> items_;  // build-time only, by slot; freed after the build
   int depth_ = 0;
+  int wide_depth_ = 0;
   int leaf_size_ = 1;
 };
 

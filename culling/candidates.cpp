@@ -1,6 +1,8 @@
 #include "culling/candidates.hpp"
 
 #include <algorithm>
+#include <array>
+#include <cstddef>
 
 namespace skelcd::culling {
 namespace {
@@ -41,6 +43,21 @@ void FeatureBounds<N>::derive(const FeatureTopology& topology, bool with_edges) 
 
 namespace {
 
+/// Overlap of two closed volumes as one bit, without branches: about half the feature pairs of a
+/// candidate triangle pair overlap, so a branch on each comparison is mispredicted often.
+template <int N>
+inline bool overlap_bit(const Dop<N>& a, const Dop<N>& b) {
+  bool ok = true;
+  for (std::size_t k = 0; k < static_cast<std::size_t>(N); ++k) {
+    ok = ok & (a.lo[k] <= b.hi[k]) & (b.lo[k] <= a.hi[k]);
+  }
+  return ok;
+}
+
+/// Triangle pairs per chunk of the feature stage: a chunk's candidates are written to fixed
+/// buffers without branches (a slot is written, then kept or not) and appended at once.
+constexpr std::size_t kChunkPairs = 64;
+
 /// The feature stage of ccd_candidates_from_triangle_pairs, with the part-exclusion checks compiled
 /// in or out (`kExclusions` = topology.has_exclusions(): without exclusions every *_excluded is
 /// false). Reads one OwnedFeatures record per triangle instead of the owned bits, corners, side
@@ -55,19 +72,33 @@ void owned_feature_pairs(
     std::int64_t& feature_bv_tests,
     std::int64_t& candidate_pairs) {
   using Owned = FeatureTopology::OwnedFeatures;
-  // VF pairs of the vertices `owner` owns against face `face`.
+  // At most 3 + 3 VF and 3 × 3 EE candidates per triangle pair.
+  std::array<VertexFacePair, 6 * kChunkPairs> vf;
+  std::array<EdgeEdgePair, 9 * kChunkPairs> ee;
+  std::size_t num_vf = 0;
+  std::size_t num_ee = 0;
+  std::int64_t tests = 0;
+  // VF pairs of the vertices `owner` owns against face `face`: each slot is written, and kept
+  // when the pair is not on a corner of the face and the volumes overlap.
   const auto vertices_vs_face = [&](const Owned& owner, const Owned& face, std::int32_t f) {
     const Dop<N>& face_bounds = bounds.triangles[at(f)];
     for (std::size_t k = 0; k < owner.num_vertices; ++k) {
       const std::int32_t v = owner.vertices[k];
-      if (is_corner(v, face.corners)) continue;
-      if constexpr (kExclusions) {
-        if (topology.vertex_face_excluded(v, f)) continue;
-      }
-      ++feature_bv_tests;
-      if (bounds.vertices[at(v)].overlaps(face_bounds)) out.vf.push_back({v, f});
+      bool wanted = !is_corner(v, face.corners);
+      if constexpr (kExclusions) wanted = wanted && !topology.vertex_face_excluded(v, f);
+      tests += wanted;
+      vf[num_vf] = {v, f};
+      num_vf += static_cast<std::size_t>(wanted) &
+                static_cast<std::size_t>(overlap_bit(bounds.vertices[at(v)], face_bounds));
     }
   };
+  const auto flush = [&] {
+    out.vf.insert(out.vf.end(), vf.begin(), vf.begin() + static_cast<std::ptrdiff_t>(num_vf));
+    out.ee.insert(out.ee.end(), ee.begin(), ee.begin() + static_cast<std::ptrdiff_t>(num_ee));
+    num_vf = 0;
+    num_ee = 0;
+  };
+  std::size_t in_chunk = 0;
   for (const TrianglePair& p : pairs) {
     if constexpr (kExclusions) {
       if (topology.owned_pairs_excluded(p.a, p.b)) continue;
@@ -84,17 +115,21 @@ void owned_feature_pairs(
       const Dop<N>& bounds_a = bounds.edges[at(ea)];
       for (std::size_t j = 0; j < b.num_edges; ++j) {
         const std::int32_t eb = b.edges[j];
-        if (share_endpoint(a.edge_ends[i], b.edge_ends[j])) continue;
-        if constexpr (kExclusions) {
-          if (topology.edges_excluded(ea, eb)) continue;
-        }
-        ++feature_bv_tests;
-        if (bounds_a.overlaps(bounds.edges[at(eb)])) {
-          out.ee.push_back({std::min(ea, eb), std::max(ea, eb)});
-        }
+        bool wanted = !share_endpoint(a.edge_ends[i], b.edge_ends[j]);
+        if constexpr (kExclusions) wanted = wanted && !topology.edges_excluded(ea, eb);
+        tests += wanted;
+        ee[num_ee] = {std::min(ea, eb), std::max(ea, eb)};
+        num_ee += static_cast<std::size_t>(wanted) &
+                  static_cast<std::size_t>(overlap_bit(bounds_a, bounds.edges[at(eb)]));
       }
     }
+    if (++in_chunk == kChunkPairs) {
+      flush();
+      in_chunk = 0;
+    }
   }
+  flush();
+  feature_bv_tests += tests;
 }
 
 }  // namespace

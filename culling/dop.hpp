@@ -32,6 +32,24 @@ namespace skelcd::culling {
 /// Largest double smaller than `x` (x finite, not the lowest double).
 [[nodiscard]] inline double next_down(double x) { return -next_up(-x); }
 
+/// The largest float not above `x` (x finite): bounds rounded outwards for the traversal's float
+/// volumes (culling/bvh.hpp). Never a subnormal, so that the bound holds also where the CPU
+/// flushes subnormals to zero: a result in (0, FLT_MIN) becomes 0, in (−FLT_MIN, 0) −FLT_MIN.
+[[nodiscard]] inline float float_below(double x) {
+  constexpr float kMin = std::numeric_limits<float>::min();
+  const float f = static_cast<float>(x);  // nearest (±inf beyond the float range)
+  // One step down when rounding went up, as next_down on the bits of a float (+inf steps to the
+  // largest float); a select rather than a branch: rounding goes up about half the time.
+  const auto bits = std::bit_cast<std::int32_t>(-f + 0.0f);
+  const float below = -std::bit_cast<float>(bits + ((bits >> 31) | 1));
+  const float r = static_cast<double>(f) > x ? below : f;
+  if (r > -kMin && r < kMin) return x >= 0.0 ? 0.0f : -kMin;
+  return r;
+}
+
+/// The smallest float not below `x` (x finite), never a subnormal (as float_below).
+[[nodiscard]] inline float float_above(double x) { return -float_below(-x); }
+
 /// The slab axes of Dop<N> (not normalised; integer components).
 /// - N = 3 (AABB): x, y, z.
 /// - N = 8 (16-DOP): x, y, z, x+y, x+z, y+z, x−y, x−z — the three coordinate axes and five of the

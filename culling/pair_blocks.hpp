@@ -11,6 +11,7 @@
 #include <span>
 #include <vector>
 
+#include "culling/bvh.hpp"
 #include "culling/candidates.hpp"
 #include "culling/elementary.hpp"
 #include "culling/feature_topology.hpp"
@@ -20,12 +21,13 @@
 namespace skelcd::culling {
 
 /// What a block of `block_pairs` may hold, to reserve up front: the block, passed by at most one
-/// leaf pair's pairs (leaf_size²), and never more than a first guess of a whole query's
-/// (16 per triangle) when the block is larger than that.
+/// bucket pair's pairs (bucket_size(leaf_size)², culling/bvh.hpp; a leaf pair's, leaf_size², is
+/// no more), and never more than a first guess of a whole query's (16 per triangle) when the
+/// block is larger than that.
 [[nodiscard]] inline std::size_t block_reserve(
     std::size_t block_pairs, std::int32_t leaf_size, std::int32_t num_triangles) {
-  const auto leaf = static_cast<std::size_t>(leaf_size);
-  return std::min(block_pairs, 16 * static_cast<std::size_t>(num_triangles)) + leaf * leaf;
+  const auto bucket = static_cast<std::size_t>(bucket_size(leaf_size));
+  return std::min(block_pairs, 16 * static_cast<std::size_t>(num_triangles)) + bucket * bucket;
 }
 
 /// The stages of one query, a block of at most about `block_pairs` triangle pairs at a time.
@@ -38,7 +40,8 @@ template <int N>
 class PairBlocks {
  public:
   /// @param block_pairs triangle pairs per block (MethodOptions::block_pairs), ≥ 1.
-  /// @param reserve_pairs capacity reserved up front for the pairs (a block, plus a leaf pair's).
+  /// @param reserve_pairs capacity reserved up front for the pairs (a block, plus a bucket
+  /// pair's: block_reserve).
   explicit PairBlocks(std::size_t block_pairs = kCcdBlockPairs, std::size_t reserve_pairs = 0);
 
   /// Starts a CCD query over x_t0 → x_t1: each block → ccd_candidates_from_triangle_pairs (volumes

@@ -1,10 +1,15 @@
 #include "culling/traversal.hpp"
 
 #include <algorithm>
+#include <array>
+#include <bit>
 #include <cassert>
 #include <cstdint>
 #include <limits>
-#include <utility>
+
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
 
 namespace skelcd::culling {
 namespace {
@@ -19,69 +24,237 @@ inline void push(std::vector<Entry>& stack, std::int32_t a, std::int32_t b) {
 
 inline std::size_t to_size(std::int32_t i) { return static_cast<std::size_t>(i); }
 
-/// Appends a pair: ordered a < b within one tree (`self_tree`), as given across two trees.
-inline void emit(std::vector<TrianglePair>& out, std::int32_t ta, std::int32_t tb, bool self_tree) {
-  if (self_tree && tb < ta) std::swap(ta, tb);
-  out.push_back({ta, tb});
+// A slot is one child of a wide node: node · 4 + lane. Stack entries hold two slots; an entry
+// whose first slot is negative (~slot) is a leaf pair whose float volumes overlap, put off
+// because the installment was full (its exact test and pairs come when it is popped).
+constexpr int kWidth = 4;
+inline std::int32_t slot(std::int32_t node, int lane) { return node * kWidth + lane; }
+inline std::size_t node_of(std::int32_t s) { return to_size(s >> 2); }
+inline int lane_of(std::int32_t s) { return s & (kWidth - 1); }
+
+/// Bit i set when child i of `w` (i < w.num_children) overlaps lane `lane` of `q` in float.
+template <int N>
+inline unsigned overlap_lanes(const WideBvhNode<N>& w, const WideBvhNode<N>& q, int lane) {
+  const unsigned used = (1u << w.num_children) - 1u;
+#if defined(__SSE2__)
+  __m128 ok = _mm_castsi128_ps(_mm_set1_epi32(-1));
+  for (int k = 0; k < N; ++k) {
+    const __m128 q_lo = _mm_set1_ps(q.lo[k][lane]);
+    const __m128 q_hi = _mm_set1_ps(q.hi[k][lane]);
+    ok = _mm_and_ps(ok, _mm_cmple_ps(_mm_load_ps(w.lo[k]), q_hi));
+    ok = _mm_and_ps(ok, _mm_cmple_ps(q_lo, _mm_load_ps(w.hi[k])));
+  }
+  return static_cast<unsigned>(_mm_movemask_ps(ok)) & used;
+#else
+  unsigned mask = 0;
+  for (int i = 0; i < kWidth; ++i) {
+    bool hit = true;
+    for (int k = 0; k < N; ++k) {
+      hit = hit && w.lo[k][i] <= q.hi[k][lane] && q.lo[k][lane] <= w.hi[k][i];
+    }
+    mask |= static_cast<unsigned>(hit) << i;
+  }
+  return mask & used;
+#endif
 }
 
-/// The triangle pairs of two leaves (or of one leaf with itself when `same`), of one tree when
-/// `self_tree`.
-template <int N>
-void leaf_pairs(
-    const BvhNode& la,
-    std::span<const std::int32_t> order_a,
-    std::span<const Dop<N>> bounds_a,
-    const BvhNode& lb,
-    std::span<const std::int32_t> order_b,
-    std::span<const Dop<N>> bounds_b,
-    bool same,
-    bool self_tree,
-    bool single_triangle_leaves,
-    std::vector<TrianglePair>& out,
-    std::int64_t& bv_tests) {
-  if (same) {
-    for (std::int32_t i = la.begin; i < la.end; ++i) {
-      const std::int32_t ti = order_a[to_size(i)];
-      for (std::int32_t j = i + 1; j < la.end; ++j) {
-        const std::int32_t tj = order_a[to_size(j)];
-        ++bv_tests;
-        if (bounds_a[to_size(ti)].overlaps(bounds_a[to_size(tj)])) emit(out, ti, tj, true);
+/// One traversal over wide nodes: of one tree with itself (kSelf: a and b are the same tree) or of
+/// two trees. Entries on the stack are slot pairs whose float volumes overlap (the first entry
+/// excepted: it is the virtual roots, never tested).
+template <int N, bool kSelf>
+class Walk {
+ public:
+  Walk(
+      const Bvh<N>& a,
+      std::span<const Dop<N>> bounds_a,
+      const Bvh<N>& b,
+      std::span<const Dop<N>> bounds_b,
+      std::vector<Entry>& stack,
+      std::vector<TrianglePair>& out,
+      std::int64_t& bv_tests,
+      std::size_t max_pairs)
+      : wide_a_(a.wide_nodes()),
+        wide_b_(b.wide_nodes()),
+        order_a_(a.triangle_order()),
+        order_b_(b.triangle_order()),
+        bounds_a_(bounds_a),
+        bounds_b_(bounds_b),
+        stack_(stack),
+        out_(out),
+        bv_tests_(bv_tests),
+        max_pairs_(max_pairs) {}
+
+  /// Runs until the stack is empty (true) or `out` holds max_pairs (false).
+  bool run() {
+    while (!stack_.empty()) {
+      if (out_.size() >= max_pairs_) return false;
+      const Entry e = stack_.back();
+      stack_.pop_back();
+      if (e.a < 0) {
+        leaf_pairs(~e.a, e.b);
+      } else if (kSelf && e.a == e.b) {
+        self_slot(e.a);
+      } else {
+        node_pair(e.a, e.b);
       }
     }
-    return;
+    return true;
   }
-  if (single_triangle_leaves) {
-    // A one-triangle leaf's volume is its triangle's: the node test just made was this test.
-    emit(out, order_a[to_size(la.begin)], order_b[to_size(lb.begin)], self_tree);
-    return;
+
+ private:
+  /// A slot against itself: pairs inside its child. A leaf's own pairs (leaf_size > 1); a wide
+  /// node's children each against itself, and each two of them whose volumes overlap.
+  void self_slot(std::int32_t s) {
+    const WideBvhNode<N>& parent = wide_a_[node_of(s)];
+    const std::int32_t c = parent.child[lane_of(s)];
+    if (c < 0) {
+      if (parent.count[lane_of(s)] > 1) leaf_pairs(s, s);  // popped: the installment has room
+      return;
+    }
+    const WideBvhNode<N>& w = wide_a_[to_size(c)];
+    const int m = w.num_children;
+    for (int i = 0; i < m; ++i) {
+      if (w.child[i] >= 0 || w.count[i] > 1) push(stack_, slot(c, i), slot(c, i));
+    }
+    for (int i = 0; i + 1 < m; ++i) {
+      // Children i < j: lanes above i.
+      unsigned mask = overlap_lanes<N>(w, w, i) & ~((2u << i) - 1u);
+      bv_tests_ += m - 1 - i;
+      while (mask != 0) {
+        const int j = std::countr_zero(mask);
+        mask &= mask - 1;
+        if (w.child[i] < 0 && w.child[j] < 0) {
+          leaf_pair(slot(c, i), slot(c, j));
+        } else {
+          push(stack_, slot(c, i), slot(c, j));
+        }
+      }
+    }
+    push_deferred();
   }
-  for (std::int32_t i = la.begin; i < la.end; ++i) {
-    const std::int32_t ti = order_a[to_size(i)];
-    for (std::int32_t j = lb.begin; j < lb.end; ++j) {
-      const std::int32_t tj = order_b[to_size(j)];
-      ++bv_tests;
-      if (bounds_a[to_size(ti)].overlaps(bounds_b[to_size(tj)])) emit(out, ti, tj, self_tree);
+
+  /// Two slots (of a and of b) whose volumes overlap, not both leaves: the children of the one
+  /// with more triangles (a leaf is never split) against the other, four at a time.
+  void node_pair(std::int32_t sa, std::int32_t sb) {
+    const WideBvhNode<N>& pa = wide_a_[node_of(sa)];
+    const WideBvhNode<N>& pb = wide_b_[node_of(sb)];
+    const int la = lane_of(sa);
+    const int lb = lane_of(sb);
+    const std::int32_t ca = pa.child[la];
+    const std::int32_t cb = pb.child[lb];
+    if (ca < 0 && cb < 0) {
+      leaf_pairs(sa, sb);  // the virtual roots of two one-leaf trees (popped: there is room)
+      return;
+    }
+    if (cb < 0 || (ca >= 0 && pa.count[la] >= pb.count[lb])) {
+      const WideBvhNode<N>& w = wide_a_[to_size(ca)];
+      unsigned mask = overlap_lanes<N>(w, pb, lb);
+      bv_tests_ += w.num_children;
+      while (mask != 0) {
+        const int i = std::countr_zero(mask);
+        mask &= mask - 1;
+        if (w.child[i] < 0 && cb < 0) {
+          leaf_pair(slot(ca, i), sb);
+        } else {
+          push(stack_, slot(ca, i), sb);
+        }
+      }
+    } else {
+      const WideBvhNode<N>& w = wide_b_[to_size(cb)];
+      unsigned mask = overlap_lanes<N>(w, pa, la);
+      bv_tests_ += w.num_children;
+      while (mask != 0) {
+        const int j = std::countr_zero(mask);
+        mask &= mask - 1;
+        if (w.child[j] < 0 && ca < 0) {
+          leaf_pair(sa, slot(cb, j));
+        } else {
+          push(stack_, sa, slot(cb, j));
+        }
+      }
+    }
+    push_deferred();
+  }
+
+  /// Two leaf slots met while splitting an entry: their pairs now, or put off when the
+  /// installment is full, so that it passes max_pairs by one bucket pair's pairs at most.
+  void leaf_pair(std::int32_t sa, std::int32_t sb) {
+    if (out_.size() >= max_pairs_) {
+      deferred_[num_deferred_++] = {~sa, sb};
+      return;
+    }
+    leaf_pairs(sa, sb);
+  }
+
+  /// Pushes the leaf pairs put off while splitting one entry, last first, so that they are
+  /// popped first and in the order met: the pairs come in the order of an uninterrupted run.
+  void push_deferred() {
+    while (num_deferred_ > 0) {
+      const Entry& e = deferred_[--num_deferred_];
+      push(stack_, e.a, e.b);
     }
   }
-}
 
-/// Descends a node pair whose volumes overlap and are not both leaves: splits the node with
-/// more triangles (a leaf is never split). Node ids a and b may belong to different trees.
-inline void split_pair(
-    std::vector<Entry>& stack,
-    std::int32_t a,
-    const BvhNode& na,
-    std::int32_t b,
-    const BvhNode& nb) {
-  if (nb.is_leaf() || (!na.is_leaf() && na.size() >= nb.size())) {
-    push(stack, na.right, b);
-    push(stack, a + 1, b);
-  } else {
-    push(stack, a, nb.right);
-    push(stack, a, b + 1);
+  /// The triangle pairs of two bucket slots (one bucket's own pairs when they are the same),
+  /// each tested with the exact double volumes.
+  void leaf_pairs(std::int32_t sa, std::int32_t sb) {
+    const WideBvhNode<N>& pa = wide_a_[node_of(sa)];
+    const WideBvhNode<N>& pb = wide_b_[node_of(sb)];
+    const std::int32_t begin_a = ~pa.child[lane_of(sa)];
+    const std::int32_t end_a = begin_a + pa.count[lane_of(sa)];
+    const std::int32_t begin_b = ~pb.child[lane_of(sb)];
+    const std::int32_t end_b = begin_b + pb.count[lane_of(sb)];
+    const bool same = kSelf && sa == sb;
+    std::int64_t tests = 0;
+    for (std::int32_t i = begin_a; i < end_a; ++i) {
+      const std::int32_t ti = order_a_[to_size(i)];
+      for (std::int32_t j0 = same ? i + 1 : begin_b; j0 < end_b; j0 += kWidth) {
+        const std::int32_t n = std::min(kWidth, end_b - j0);
+        unsigned mask = overlap_slots(bounds_a_[to_size(ti)], j0, n);
+        tests += n;
+        while (mask != 0) {
+          const std::int32_t tj = order_b_[to_size(j0 + std::countr_zero(mask))];
+          mask &= mask - 1;
+          // Ordered a < b within one tree (a select, not a branch), as given across two.
+          if constexpr (kSelf) {
+            out_.push_back({std::min(ti, tj), std::max(ti, tj)});
+          } else {
+            out_.push_back({ti, tj});
+          }
+        }
+      }
+    }
+    bv_tests_ += tests;
   }
-}
+
+  /// Bit c set when the volume of triangle ti overlaps that of the triangle in slot sb + c of b,
+  /// for c < n (exact: double), without a branch per test.
+  [[nodiscard]] unsigned overlap_slots(const Dop<N>& ti, std::int32_t sb, std::int32_t n) const {
+    unsigned mask = 0;
+    for (std::int32_t c = 0; c < n; ++c) {
+      const Dop<N>& tj = bounds_b_[to_size(order_b_[to_size(sb + c)])];
+      bool ok = true;
+      for (std::size_t k = 0; k < static_cast<std::size_t>(N); ++k) {
+        ok = ok & (ti.lo[k] <= tj.hi[k]) & (tj.lo[k] <= ti.hi[k]);
+      }
+      mask |= static_cast<unsigned>(ok) << c;
+    }
+    return mask;
+  }
+
+  std::span<const WideBvhNode<N>> wide_a_;
+  std::span<const WideBvhNode<N>> wide_b_;
+  std::span<const std::int32_t> order_a_;
+  std::span<const std::int32_t> order_b_;
+  std::span<const Dop<N>> bounds_a_;
+  std::span<const Dop<N>> bounds_b_;
+  std::vector<Entry>& stack_;
+  std::vector<TrianglePair>& out_;
+  std::int64_t& bv_tests_;
+  std::size_t max_pairs_;
+  std::array<Entry, 6> deferred_{};  // at most one per pair of four children
+  std::size_t num_deferred_ = 0;
+};
 
 }  // namespace
 
@@ -89,7 +262,7 @@ template <int N>
 void start_self_traversal(const Bvh<N>& bvh, TraversalScratch& scratch) {
   scratch.reserve_self(bvh);
   scratch.stack.clear();
-  if (!bvh.empty()) push(scratch.stack, 0, 0);
+  if (!bvh.empty()) push(scratch.stack, 0, 0);  // the virtual root's one child against itself
 }
 
 template <int N>
@@ -101,59 +274,9 @@ bool self_traverse_some(
     std::int64_t& bv_tests,
     std::size_t max_pairs) {
   if (bvh.empty()) return true;
-  const auto nodes = bvh.nodes();
-  const auto bounds = bvh.node_bounds();
-  const auto order = bvh.triangle_order();
-  const bool single = bvh.leaf_size() == 1;
-  auto& stack = scratch.stack;
-  while (!stack.empty()) {
-    if (out.size() >= max_pairs) return false;
-    const Entry e = stack.back();
-    stack.pop_back();
-    const BvhNode& na = nodes[to_size(e.a)];
-    if (e.a == e.b) {
-      // A node against itself: pairs inside each child, then pairs across the two children.
-      if (na.is_leaf()) {
-        leaf_pairs<N>(
-            na,
-            order,
-            triangle_bounds,
-            na,
-            order,
-            triangle_bounds,
-            true,
-            true,
-            single,
-            out,
-            bv_tests);
-      } else {
-        push(stack, e.a + 1, na.right);
-        push(stack, na.right, na.right);
-        push(stack, e.a + 1, e.a + 1);
-      }
-      continue;
-    }
-    ++bv_tests;
-    if (!bounds[to_size(e.a)].overlaps(bounds[to_size(e.b)])) continue;
-    const BvhNode& nb = nodes[to_size(e.b)];
-    if (na.is_leaf() && nb.is_leaf()) {
-      leaf_pairs<N>(
-          na,
-          order,
-          triangle_bounds,
-          nb,
-          order,
-          triangle_bounds,
-          false,
-          true,
-          single,
-          out,
-          bv_tests);
-    } else {
-      split_pair(stack, e.a, na, e.b, nb);
-    }
-  }
-  return true;
+  return Walk<N, true>(
+             bvh, triangle_bounds, bvh, triangle_bounds, scratch.stack, out, bv_tests, max_pairs)
+      .run();
 }
 
 template <int N>
@@ -172,7 +295,7 @@ template <int N>
 void start_pair_traversal(const Bvh<N>& a, const Bvh<N>& b, TraversalScratch& scratch) {
   scratch.reserve_pair(a, b);
   scratch.stack.clear();
-  if (!a.empty() && !b.empty()) push(scratch.stack, 0, 0);
+  if (!a.empty() && !b.empty()) push(scratch.stack, 0, 0);  // the two virtual roots' children
 }
 
 template <int N>
@@ -186,36 +309,9 @@ bool pair_traverse_some(
     std::int64_t& bv_tests,
     std::size_t max_pairs) {
   if (a.empty() || b.empty()) return true;
-  const auto nodes_a = a.nodes();
-  const auto nodes_b = b.nodes();
-  const bool single = a.leaf_size() == 1 && b.leaf_size() == 1;
-  auto& stack = scratch.stack;
-  while (!stack.empty()) {
-    if (out.size() >= max_pairs) return false;
-    const Entry e = stack.back();
-    stack.pop_back();
-    ++bv_tests;
-    if (!a.node_bounds()[to_size(e.a)].overlaps(b.node_bounds()[to_size(e.b)])) continue;
-    const BvhNode& na = nodes_a[to_size(e.a)];
-    const BvhNode& nb = nodes_b[to_size(e.b)];
-    if (na.is_leaf() && nb.is_leaf()) {
-      leaf_pairs<N>(
-          na,
-          a.triangle_order(),
-          triangle_bounds_a,
-          nb,
-          b.triangle_order(),
-          triangle_bounds_b,
-          false,
-          false,
-          single,
-          out,
-          bv_tests);
-      continue;
-    }
-    split_pair(stack, e.a, na, e.b, nb);
-  }
-  return true;
+  return Walk<N, false>(
+             a, triangle_bounds_a, b, triangle_bounds_b, scratch.stack, out, bv_tests, max_pairs)
+      .run();
 }
 
 template <int N>

@@ -3,6 +3,7 @@
 // two hierarchies against each other (inter-object). They report triangle pairs whose volumes
 // overlap; what to test inside a pair is the caller's business (culling/candidates.hpp).
 
+#include <algorithm>
 #include <cstdint>
 #include <span>
 #include <vector>
@@ -22,17 +23,26 @@ struct TraversalScratch {
   };
   std::vector<Entry> stack;
 
-  /// Reserves the proven maximum stack size of self_traverse(bvh): 4·depth + 1 entries (the
-  /// self part of a path descends at most depth levels leaving two siblings pending each, the
-  /// pair part at most 2·depth levels leaving one).
+  /// Reserves the proven maximum stack size of a self traversal of `bvh`, over its wide nodes
+  /// (self_traverse) or its binary nodes (masked_self_traverse, culling/cluster_checks.hpp).
+  /// Wide: 9·(wide_depth − 1) + 1 entries — an entry's processing pushes at most one entry per
+  /// child or per two children (a node against itself: 4 + 6, so 9 left pending besides the one
+  /// processed next; two nodes: 4, so 3), and a path descends at most wide_depth − 1 self levels
+  /// from the root, then at most 2·(wide_depth − L) pair levels below self level L.
+  /// Binary: 4·depth + 1 (two pending per self level, one per pair level).
   template <int N>
   void reserve_self(const Bvh<N>& bvh) {
-    reserve(4 * static_cast<std::size_t>(bvh.depth()) + 4);
+    reserve(std::max(
+        9 * static_cast<std::size_t>(bvh.wide_depth()) + 4,
+        4 * static_cast<std::size_t>(bvh.depth()) + 4));
   }
-  /// Reserves the maximum stack size of pair_traverse(a, b): depth(a) + depth(b) + 1.
+  /// Reserves the maximum stack size of a pair traversal of (a, b): wide 3·(wide_depth(a) +
+  /// wide_depth(b)) + 1 (three pending per level of either tree); binary depth(a) + depth(b) + 1.
   template <int N>
   void reserve_pair(const Bvh<N>& a, const Bvh<N>& b) {
-    reserve(static_cast<std::size_t>(a.depth() + b.depth()) + 4);
+    reserve(std::max(
+        3 * static_cast<std::size_t>(a.wide_depth() + b.wide_depth()) + 4,
+        static_cast<std::size_t>(a.depth() + b.depth()) + 4));
   }
   void reserve(std::size_t n) {
     if (stack.capacity() < n) stack.reserve(n);
@@ -41,10 +51,13 @@ struct TraversalScratch {
 
 /// Self traversal: appends to `out` every pair of distinct triangles (a < b) of `bvh` whose
 /// volumes in `triangle_bounds` overlap — exactly those, each once (tests/culling prove it against
-/// all pairs). Node vs itself → both children vs themselves and the children against each other;
-/// two nodes → their volumes are tested and the one with more triangles is split.
+/// all pairs). Over the wide nodes (Bvh::wide_nodes): a node against itself → each child against
+/// itself, and each two children whose float volumes overlap against each other; two nodes → the
+/// children of the one with more triangles are tested against the other, four at once. Float
+/// volumes are rounded outwards, so they let through every pair the double volumes would (and
+/// a few more); a triangle pair is emitted only when its exact double volumes overlap.
 /// @param triangle_bounds indexed by triangle id; the volumes `bvh` was refit from.
-/// @param bv_tests incremented once per node-pair and triangle-pair volume test.
+/// @param bv_tests incremented once per node-pair (float) and triangle-pair (double) volume test.
 /// @note Allocation-free once `scratch` is reserved and `out` has the capacity.
 template <int N>
 void self_traverse(
@@ -56,8 +69,9 @@ void self_traverse(
 
 /// The self traversal in installments, so that its pairs can be tested in bounded blocks
 /// (bounded memory on any motion): start_self_traversal seeds `scratch`; each self_traverse_some
-/// appends pairs until `out` holds at least `max_pairs` (it may pass that by one leaf pair's
-/// pairs, at most leaf_size² − 1) and returns true once the traversal is finished. Over all
+/// appends pairs until `out` holds at least `max_pairs` (it may pass that by one bucket pair's
+/// pairs, at most bucket_size(leaf_size)² − 1: Bvh::wide_nodes) and returns true once the
+/// traversal is finished. Over all
 /// installments the pairs are exactly self_traverse's, each once; `scratch` must not be used for
 /// anything else in between.
 template <int N>

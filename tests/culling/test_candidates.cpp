@@ -9,6 +9,7 @@
 #include <limits>
 #include <numbers>
 #include <set>
+#include <utility>
 
 #include "culling/bvh.hpp"
 #include "culling/candidates.hpp"
@@ -429,6 +430,112 @@ TEST(CcdCandidates, PartExclusionsApplyPerFeatureAndRespectSharedVertices) {
     EXPECT_TRUE(seam_pair_seen) << "the scene should exercise a vertex shared by two parts";
     EXPECT_TRUE(t.has_exclusions());
   }
+}
+
+// The feature stage as it was written before it wrote its candidates without branches, pair by
+// pair and test by test: the reference the stage must match exactly — the same candidates in the
+// same order, the same counters.
+template <int N>
+void reference_feature_stage(
+    const FeatureTopology& t,
+    std::span<const TrianglePair> pairs,
+    const FeatureBounds<N>& bounds,
+    FeatureCandidates& out,
+    Counters& counters) {
+  const auto at = [](std::int32_t i) { return static_cast<std::size_t>(i); };
+  for (const TrianglePair& p : pairs) {
+    if (t.owned_pairs_excluded(p.a, p.b)) continue;
+    ++counters.candidate_pairs;
+    for (const auto& [owner, face] : {std::pair{p.a, p.b}, std::pair{p.b, p.a}}) {
+      const auto& o = t.owned_features(owner);
+      const auto& corners = t.triangle(face);
+      for (std::size_t k = 0; k < o.num_vertices; ++k) {
+        const std::int32_t v = o.vertices[k];
+        if (v == corners[0] || v == corners[1] || v == corners[2]) continue;
+        if (t.vertex_face_excluded(v, face)) continue;
+        ++counters.feature_bv_tests;
+        if (bounds.vertices[at(v)].overlaps(bounds.triangles[at(face)]))
+          out.vf.push_back({v, face});
+      }
+    }
+    const auto& a = t.owned_features(p.a);
+    const auto& b = t.owned_features(p.b);
+    for (std::size_t i = 0; i < a.num_edges; ++i) {
+      for (std::size_t j = 0; j < b.num_edges; ++j) {
+        const auto& ea = t.edge(a.edges[i]);
+        const auto& eb = t.edge(b.edges[j]);
+        if (ea[0] == eb[0] || ea[0] == eb[1] || ea[1] == eb[0] || ea[1] == eb[1]) continue;
+        if (t.edges_excluded(a.edges[i], b.edges[j])) continue;
+        ++counters.feature_bv_tests;
+        if (bounds.edges[at(a.edges[i])].overlaps(bounds.edges[at(b.edges[j])])) {
+          out.ee.push_back({std::min(a.edges[i], b.edges[j]), std::max(a.edges[i], b.edges[j])});
+        }
+      }
+    }
+  }
+}
+
+template <int N>
+void expect_feature_stage_matches_reference(const Scene& s, double min_separation) {
+  SCOPED_TRACE(s.name + ", N = " + std::to_string(N));
+  const Built<N> b = bounds_of<N>(s, min_separation);
+  Bvh<N> bvh(b.topology.welded_triangles(), s.x_t0);
+  bvh.refit(b.bounds.triangles);
+  TraversalScratch scratch;
+  std::vector<TrianglePair> pairs;
+  std::int64_t bv_tests = 0;
+  self_traverse<N>(bvh, b.bounds.triangles, scratch, pairs, bv_tests);
+  // Both orders within a pair, and every triangle pair too (most do not overlap), in several
+  // chunk alignments: the stage takes any pairs.
+  std::vector<TrianglePair> swapped = pairs;
+  for (auto& p : swapped) std::swap(p.a, p.b);
+  std::vector<TrianglePair> all;
+  for (std::int32_t f = 0; f < b.topology.num_triangles(); ++f) {
+    for (std::int32_t g = f + 1; g < b.topology.num_triangles(); ++g) all.push_back({f, g});
+  }
+  for (const auto* list : {&pairs, &swapped, &all}) {
+    ASSERT_GT(list->size(), 200u);
+    for (const std::size_t skip : {std::size_t{0}, std::size_t{37}}) {
+      const std::span<const TrianglePair> in(list->data() + skip, list->size() - skip);
+      FeatureCandidates want, got;
+      Counters want_counters, got_counters;
+      reference_feature_stage<N>(b.topology, in, b.bounds, want, want_counters);
+      ccd_candidates_from_triangle_pairs<N>(b.topology, in, b.bounds, got, got_counters);
+      EXPECT_FALSE(want.vf.empty());
+      EXPECT_FALSE(want.ee.empty());
+      EXPECT_EQ(got.vf, want.vf);
+      EXPECT_EQ(got.ee, want.ee);
+      EXPECT_EQ(got_counters.feature_bv_tests, want_counters.feature_bv_tests);
+      EXPECT_EQ(got_counters.candidate_pairs, want_counters.candidate_pairs);
+    }
+  }
+}
+
+TEST(CcdCandidates, FeatureStageMatchesThePairByPairReferenceExactly) {
+  for (const Scene& s : scenes()) {
+    expect_feature_stage_matches_reference<3>(s, 0.0);
+    expect_feature_stage_matches_reference<8>(s, 0.0);
+    expect_feature_stage_matches_reference<3>(s, 0.05);
+  }
+  // With part exclusions (the other instantiation of the stage).
+  auto a = test::sheet(6, 6, 1.0, 1.0);
+  auto c = test::sheet(6, 6, 1.0, 1.0);
+  c.rest_positions = test::translated(c.rest_positions, Eigen::Vector3d(1.0, 0.0, 0.0));
+  auto cross = test::tube(6, 6, 0.2, 1.0);
+  cross.rest_positions = test::translated(cross.rest_positions, Eigen::Vector3d(1.0, 0.5, -0.5));
+  auto mesh = test::combine(test::combine(a, c), cross);
+  mesh.excluded_part_pairs = {{0, 1}, {2, 2}};
+  const Scene parts = make_scene("parts", mesh, [](const auto& x) {
+    skinning::Positions y = x;
+    for (Eigen::Index v = 0; v < y.rows(); ++v) {
+      y(v, 0) += 0.3 * std::sin(5.0 * x(v, 1));
+      y(v, 2) += 0.3 * std::sin(4.0 * x(v, 0));
+    }
+    return y;
+  });
+  ASSERT_TRUE(FeatureTopology(parts.mesh, parts.topology).has_exclusions());
+  expect_feature_stage_matches_reference<3>(parts, 0.0);
+  expect_feature_stage_matches_reference<8>(parts, 0.0);
 }
 
 TEST(DcdCandidates, HierarchyPathMatchesBruteForceAndKeepsSharedVertexPairs) {

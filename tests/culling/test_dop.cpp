@@ -4,6 +4,7 @@
 #include <cmath>
 #include <limits>
 #include <random>
+#include <vector>
 
 #include "culling/dop.hpp"
 #include "tests/culling/exact_dop.hpp"
@@ -36,6 +37,67 @@ TEST(NextUpDown, MatchNextafterAcrossSignsAndMagnitudes) {
     EXPECT_EQ(next_up(v), std::nextafter(v, inf)) << v;
     EXPECT_EQ(next_down(v), std::nextafter(v, -inf)) << v;
   }
+}
+
+// The traversals' float volumes (culling/bvh.hpp) round each bound outwards to the nearest float
+// that is not subnormal: below x for a low end, above for a high end, and no farther than needed.
+TEST(FloatBounds, RoundOutwardsToTheNearestNormalFloat) {
+  const float fmax = std::numeric_limits<float>::max();
+  const float fmin = std::numeric_limits<float>::min();
+  std::vector<double> values = {
+      0.0,
+      -0.0,
+      1.0,
+      -1.0,
+      0.1,
+      -0.1,
+      1.0 + 1e-8,
+      1.0 - 1e-8,
+      -1.0 - 1e-8,
+      1e-40,  // a float subnormal
+      -1e-40,
+      1e-310,  // a double subnormal
+      -1e-310,
+      static_cast<double>(fmin),
+      -static_cast<double>(fmin),
+      static_cast<double>(fmax),
+      -static_cast<double>(fmax),
+      next_up(static_cast<double>(fmax)),
+      next_down(-static_cast<double>(fmax)),
+      1e39,
+      -1e39,
+      3.5e300,
+      -3.5e300};
+  std::mt19937_64 rng(7);
+  std::uniform_real_distribution<double> mantissa(-1.0, 1.0);
+  std::uniform_int_distribution<int> exponent(-140, 140);
+  for (int i = 0; i < 20000; ++i) values.push_back(std::ldexp(mantissa(rng), exponent(rng)));
+  for (const double x : values) {
+    const float lo = float_below(x);
+    const float hi = float_above(x);
+    ASSERT_LE(static_cast<double>(lo), x) << x;
+    ASSERT_GE(static_cast<double>(hi), x) << x;
+    // Never subnormal (sound where subnormals are flushed to zero).
+    ASSERT_TRUE(lo == 0.0f || std::isinf(lo) || std::abs(lo) >= fmin) << x;
+    ASSERT_TRUE(hi == 0.0f || std::isinf(hi) || std::abs(hi) >= fmin) << x;
+    // The nearest such float: the next one inwards passes x, unless x is subnormal-small.
+    if (std::abs(x) >= static_cast<double>(fmin) && std::abs(x) <= static_cast<double>(fmax)) {
+      ASSERT_GT(static_cast<double>(std::nextafter(lo, std::numeric_limits<float>::infinity())), x)
+          << x;
+      ASSERT_LT(static_cast<double>(std::nextafter(hi, -std::numeric_limits<float>::infinity())), x)
+          << x;
+    }
+    if (static_cast<double>(static_cast<float>(x)) == x &&
+        std::abs(x) >= static_cast<double>(fmin)) {
+      ASSERT_EQ(static_cast<double>(lo), x);  // a float already: kept
+      ASSERT_EQ(static_cast<double>(hi), x);
+    }
+  }
+  EXPECT_EQ(float_above(1e39), std::numeric_limits<float>::infinity());
+  EXPECT_EQ(float_below(1e39), fmax);
+  EXPECT_EQ(float_above(1e-310), fmin);
+  EXPECT_EQ(float_below(1e-310), 0.0f);
+  EXPECT_EQ(float_below(-1e-310), -fmin);
 }
 
 TEST(Dop, AabbOfPointIsThePointExactly) {

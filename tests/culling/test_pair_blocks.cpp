@@ -53,7 +53,7 @@ void expect_blocks_change_nothing(const OpenScene& s) {
       SCOPED_TRACE(s.name + ", " + method + (continuous ? ", CCD" : ", DCD"));
       const FrameResult whole = run(method, s, kOnePiece, continuous, 0);
       const FrameResult blocked = run(method, s, kSmallBlock, continuous, 0);
-      // Many blocks: a block holds at most kSmallBlock pairs plus one leaf pair's (leaf size 1).
+      // Many blocks: a block holds at most kSmallBlock pairs plus one bucket pair's (16).
       EXPECT_GT(whole.counters.candidate_pairs, static_cast<std::int64_t>(8 * kSmallBlock));
       if (method != "dual-cone") {  // dual-cone may miss them all (it is kept to show that)
         EXPECT_FALSE(continuous ? whole.contacts.empty() : whole.dcd_pairs.empty());

@@ -4,6 +4,8 @@
 
 #include <algorithm>
 #include <numeric>
+#include <random>
+#include <string>
 
 #include "culling/candidates.hpp"
 #include "culling/traversal.hpp"
@@ -93,8 +95,9 @@ void check_self(const Case& c, int leaf_size) {
   const auto nf = static_cast<std::int64_t>(ft.num_triangles());
   EXPECT_LT(bv_tests, nf * (nf - 1) / 8) << "the hierarchy culled almost nothing";
 
-  // In installments of at most `block` pairs (+ one leaf pair's), emptied in between as the CCD
+  // In installments of at most `block` pairs (+ one bucket pair's), emptied in between as the CCD
   // blocks do: the same pairs, each once, the same volume tests, and no installment too large.
+  const auto bucket = static_cast<std::size_t>(bucket_size(leaf_size));
   for (const std::size_t block : {std::size_t{1}, std::size_t{7}, std::size_t{100}}) {
     std::vector<TrianglePair> all, part;
     std::int64_t tests = 0;
@@ -103,7 +106,7 @@ void check_self(const Case& c, int leaf_size) {
     for (bool done = false; !done; ++installments) {
       part.clear();
       done = self_traverse_some<N>(bvh, bounds.triangles, scratch, part, tests, block);
-      ASSERT_LT(part.size(), block + static_cast<std::size_t>(leaf_size * leaf_size));
+      ASSERT_LT(part.size(), block + bucket * bucket);
       all.insert(all.end(), part.begin(), part.end());
     }
     std::sort(all.begin(), all.end());
@@ -160,7 +163,8 @@ void check_pair(const Case& c, int leaf_a, int leaf_b) {
     ASSERT_EQ(p.b % 2, 1);
   }
   // In installments (auto's blocks between its groups): the same pairs in the same order, the
-  // same volume tests, no installment larger than a block plus one leaf pair's.
+  // same volume tests, no installment larger than a block plus one bucket pair's.
+  const auto bucket = static_cast<std::size_t>(bucket_size(std::max(leaf_a, leaf_b)));
   for (const std::size_t block : {std::size_t{1}, std::size_t{7}, std::size_t{100}}) {
     std::vector<TrianglePair> all, part;
     std::int64_t tests = 0;
@@ -170,7 +174,7 @@ void check_pair(const Case& c, int leaf_a, int leaf_b) {
       part.clear();
       done = pair_traverse_some<N>(
           a, bounds.triangles, b, bounds.triangles, scratch, part, tests, block);
-      ASSERT_LT(part.size(), block + static_cast<std::size_t>(leaf_a * leaf_b));
+      ASSERT_LT(part.size(), block + bucket * bucket);
       all.insert(all.end(), part.begin(), part.end());
     }
     EXPECT_EQ(all, got) << c.name << ", block " << block;
@@ -190,6 +194,118 @@ TEST(PairTraverse, FindsExactlyTheOverlappingCrossPairs) {
     check_pair<3>(c, 1, 1);
     check_pair<3>(c, 4, 1);
     check_pair<8>(c, 2, 5);
+  }
+}
+
+// Volumes that are not of any motion, where the float node volumes must not decide: boxes on a
+// lattice of step `step` around `base`, so that many touch exactly (shared bounds) and many miss
+// by one or two double ulps — which vanish in float — at magnitudes from double subnormals to
+// beyond the float range. The traversals must report exactly the pairs whose double volumes
+// overlap. Triangles are degenerate, at the boxes' centres (the tree splits by them).
+template <int N>
+struct BoxSoup {
+  skinning::Triangles triangles;
+  skinning::Positions centres;
+  std::vector<Dop<N>> boxes;
+};
+
+template <int N>
+BoxSoup<N> box_soup(int count, double base, double step, std::uint64_t seed) {
+  std::mt19937_64 rng(seed);
+  std::uniform_int_distribution<int> cell(0, N == 3 ? 6 : 2);  // 8 axes must all overlap
+  std::uniform_int_distribution<int> width(0, 2);
+  std::uniform_int_distribution<int> nudge(-2, 2);
+  const auto at = [&](int i) { return base + step * i; };
+  const auto nudged = [&](double x) {
+    const int n = nudge(rng);  // -2 .. 2 ulps, or exactly on the lattice
+    for (int k = 0; k < n; ++k) x = next_up(x);
+    for (int k = 0; k > n; --k) x = next_down(x);
+    return x;
+  };
+  BoxSoup<N> s;
+  s.triangles.resize(count, 3);
+  s.centres.resize(3 * count, 3);
+  for (int f = 0; f < count; ++f) {
+    Dop<N> d;
+    for (std::size_t k = 0; k < static_cast<std::size_t>(N); ++k) {
+      const int c = cell(rng);
+      d.lo[k] = nudged(at(c));
+      d.hi[k] = std::max(d.lo[k], nudged(at(c + width(rng))));
+    }
+    s.boxes.push_back(d);
+    for (int v = 0; v < 3; ++v) {
+      s.triangles(f, v) = 3 * f + v;
+      for (int k = 0; k < 3; ++k) {
+        const auto kk = static_cast<std::size_t>(k);
+        s.centres(3 * f + v, k) = 0.5 * d.lo[kk] + 0.5 * d.hi[kk];
+      }
+    }
+  }
+  return s;
+}
+
+template <int N>
+void check_box_soup(const BoxSoup<N>& s, int leaf_size, const std::string& what) {
+  SCOPED_TRACE(what + ", N = " + std::to_string(N) + ", leaf_size = " + std::to_string(leaf_size));
+  const std::span<const Dop<N>> boxes(s.boxes);
+  const auto want = all_overlapping_pairs<N>(boxes);
+  ASSERT_FALSE(want.empty());
+  ASSERT_LT(want.size(), s.boxes.size() * (s.boxes.size() - 1) / 2) << "nothing to cull";
+  Bvh<N> bvh(s.triangles, s.centres, BvhOptions{leaf_size});
+  bvh.refit(boxes);
+  TraversalScratch scratch;
+  std::vector<TrianglePair> got;
+  std::int64_t bv_tests = 0;
+  self_traverse<N>(bvh, boxes, scratch, got, bv_tests);
+  std::sort(got.begin(), got.end());
+  EXPECT_EQ(got, want);
+  // Across two trees: the even and the odd boxes.
+  std::vector<std::int32_t> even, odd;
+  for (std::int32_t f = 0; f < static_cast<std::int32_t>(s.boxes.size()); ++f) {
+    (f % 2 ? odd : even).push_back(f);
+  }
+  Bvh<N> a(s.triangles, s.centres, even, BvhOptions{leaf_size});
+  Bvh<N> b(s.triangles, s.centres, odd, BvhOptions{1});
+  a.refit(boxes);
+  b.refit(boxes);
+  std::vector<TrianglePair> cross, want_cross;
+  pair_traverse<N>(a, boxes, b, boxes, scratch, cross, bv_tests);
+  for (auto& p : cross) {
+    ASSERT_EQ(p.a % 2, 0);
+    if (p.b < p.a) std::swap(p.a, p.b);
+  }
+  for (const auto& p : want) {
+    if (p.a % 2 != p.b % 2) want_cross.push_back(p);
+  }
+  std::sort(cross.begin(), cross.end());
+  EXPECT_EQ(cross, want_cross);
+}
+
+TEST(SelfTraverse, FloatNodeVolumesNeverDecideAPair) {
+  struct Scale {
+    const char* name;
+    double base;
+    double step;
+  };
+  const Scale scales[] = {
+      {"unit lattice", 0.0, 1.0},
+      {"1e-8 apart near 1", 1.0, 1e-8},
+      {"1e-8 apart near -1", -1.0, 1e-8},
+      {"around zero, tiny", -3e-30, 1e-30},
+      {"double subnormals", -3e-310, 1e-310},
+      {"beyond the float range", 1e39, 1e33},
+      {"huge", -3e300, 1e300},
+      {"float ulps near 1", 1.0, 1.2e-7},
+  };
+  for (const Scale& sc : scales) {
+    for (const std::uint64_t seed : {1u, 2u}) {
+      const std::string what = std::string(sc.name) + ", seed " + std::to_string(seed);
+      for (const int leaf : {1, 2, 4, 5}) {
+        check_box_soup<3>(box_soup<3>(300, sc.base, sc.step, seed), leaf, what);
+      }
+      check_box_soup<8>(box_soup<8>(300, sc.base, sc.step, seed), 1, what);
+      check_box_soup<8>(box_soup<8>(300, sc.base, sc.step, seed), 3, what);
+    }
   }
 }
 
