@@ -18,6 +18,7 @@
 #include "ccd/detail/conservative_pipeline.hpp"
 #include "ccd/detail/float_bounds.hpp"
 #include "ccd/detail/inclusion_solver.hpp"
+#include "ccd/detail/lanes.hpp"
 #include "ccd/detail/trilinear_cubic.hpp"
 #include "ccd/filters.hpp"
 #include "tests/ccd/cloth_funnel.hpp"
@@ -185,6 +186,52 @@ AlgebraicVerdict reference_algebraic_filter(
     node.depth = right.depth;
   }
   return {AlgebraicOutcome::separated, 1.0, 1.0};
+}
+
+// trilinear_determinant before it was split into coefficients and error (clustering and
+// segmentation use it through moving_orientation_cubic).
+BernsteinCubic reference_trilinear_determinant(
+    const detail::DifferenceTriple& t0, const detail::DifferenceTriple& t1) {
+  using namespace detail;
+  // Blossom of the trilinear det: b_i averages the dets d_ijk = X_i . (Y_j x Z_k) with i + j + k
+  // factors taken at t = 1, and the permanents likewise. Each det is evaluated as
+  // x0 c0 + x1 c1 + x2 c2, c = y x z, two at a time: lane 0 takes Y_0, lane 1 Y_1.
+  const Lanes3 y = lanes3(t0.y, t1.y);
+  const Lanes3 z0 = lanes3(t0.z, t0.z);
+  const Lanes3 z1 = lanes3(t1.z, t1.z);
+  const Lanes3 x0 = lanes3(t0.x, t0.x);
+  const Lanes3 x1 = lanes3(t1.x, t1.x);
+  const Lanes3 c_z0 = cross(y, z0);  // {Y0 x Z0, Y1 x Z0}
+  const Lanes3 c_z1 = cross(y, z1);  // {Y0 x Z1, Y1 x Z1}
+  const Lanes3 ay = lane_abs(y);
+  const Lanes3 p_z0 = cross_permanent(ay, lane_abs(z0));
+  const Lanes3 p_z1 = cross_permanent(ay, lane_abs(z1));
+  const Lanes3 ax0 = lane_abs(x0), ax1 = lane_abs(x1);
+  const Lanes d0x0 = dot(x0, c_z0);  // {d000, d010}
+  const Lanes d1x0 = dot(x1, c_z0);  // {d100, d110}
+  const Lanes d0x1 = dot(x0, c_z1);  // {d001, d011}
+  const Lanes d1x1 = dot(x1, c_z1);  // {d101, d111}
+  const Lanes p0x0 = dot(ax0, p_z0), p1x0 = dot(ax1, p_z0);
+  const Lanes p0x1 = dot(ax0, p_z1), p1x1 = dot(ax1, p_z1);
+  // The middle coefficients {(d100 + d010 + d001) / 3, (d011 + d101 + d110) / 3}, summed in that
+  // order.
+  const Lanes mid =
+      ((Lanes{d1x0[0], d0x1[1]} + Lanes{d0x0[1], d1x1[0]}) + Lanes{d0x1[0], d1x0[1]}) / 3.0;
+  const Lanes mid_perm =
+      ((Lanes{p1x0[0], p0x1[1]} + Lanes{p0x0[1], p1x1[0]}) + Lanes{p0x1[0], p1x0[1]}) / 3.0;
+  BernsteinCubic f;
+  f.coefficients = {d0x0[0], mid[0], mid[1], d1x1[1]};
+  const double perm = std::max({p0x0[0], mid_perm[0], mid_perm[1], p1x1[1]});
+  // Rounding count per product term: difference 1 each for x, y, z; y*z 3; the cross-product
+  // difference 4; x * (.) 6; the two sums of the dot 8; the two sums and the /3 of the average 11.
+  const double relative = rounding_bound(11, perm);
+  // Underflow: each of the 6 products y*z may lose kUnderflowUnit, then scaled by |x| <= mx; each
+  // x*(.) product and the /3 may lose one more.
+  const double mx = std::max(t0.x.cwiseAbs().maxCoeff(), t1.x.cwiseAbs().maxCoeff());
+  // 16 kUnderflowUnit (1 + mx) = 2^-1070 (1 + mx), computed without a subnormal product.
+  const double underflow = detail::times_subnormal_power_of_two<1070>(1.0 + mx);
+  f.error = add_up(relative, underflow);
+  return f;
 }
 
 // conservative_pipeline before the screen, the pairs and the early exit.
@@ -493,8 +540,9 @@ TEST(KernelEquivalence, NonFiniteAndDegenerateInput) {
 // ---- The pieces. ----
 
 TEST(KernelEquivalence, ScreenBoundIsAboveTheExactBound) {
-  // trilinear_screen's coefficients are trilinear_determinant's, bit for bit, and its error bound
-  // is >= the exact one whenever finite; when it certifies a sign, so does cubic_sign.
+  // trilinear_determinant is what it was; trilinear_screen's coefficients are its coefficients,
+  // bit for bit, and the screen's error bound is >= the exact one whenever finite; when it
+  // certifies a sign, so does cubic_sign.
   test::RandomQueryGenerator gen(10);
   std::mt19937_64 rng(10);
   int certified = 0;
@@ -508,6 +556,10 @@ TEST(KernelEquivalence, ScreenBoundIsAboveTheExactBound) {
         (p[4] - p[5]) * scale, (p[6] - p[5]) * scale, (p[7] - p[5]) * scale};
     const detail::TrilinearScreen screen = detail::trilinear_screen(t0, t1);
     const BernsteinCubic exact = detail::trilinear_determinant(t0, t1);
+    const BernsteinCubic before = reference_trilinear_determinant(t0, t1);
+    for (std::size_t k = 0; k < 4; ++k)
+      ASSERT_TRUE(same_bits(exact.coefficients[k], before.coefficients[k]));
+    ASSERT_TRUE(same_bits(exact.error, before.error));
     for (std::size_t k = 0; k < 4; ++k)
       ASSERT_TRUE(same_bits(screen.coefficients[k], exact.coefficients[k]));
     if (std::isfinite(screen.error_upper)) {
