@@ -22,26 +22,31 @@ CcdResult conservative_after_aabbs(
   const detail::DifferenceTriple t1{q.eb0_t1 - q.ea0_t1, q.ea1_t1 - q.ea0_t1, q.eb1_t1 - q.eb0_t1};
   // With w = b0 - a0: the segment parameters are u / nn and v / nn, nn = n . n, where
   // u = (w x d_b) . n, nn - u = ((a1 - b0) x d_b) . n, v = (w x d_a) . n, nn - v = (d_a x (b1 - a0)) . n.
-  const auto quartics = [&](detail::BernsteinQuartic* g, double* lengths) {
-    g[0] = detail::cross_dot_quartic({t0.x, t0.z, t0.y, t0.z, t1.x, t1.z, t1.y, t1.z});
-    g[1] = detail::cross_dot_quartic({q.ea1_t0 - q.eb0_t0, t0.z, t0.y, t0.z, q.ea1_t1 - q.eb0_t1, t1.z, t1.y, t1.z});
-    g[2] = detail::cross_dot_quartic({t0.x, t0.y, t0.y, t0.z, t1.x, t1.y, t1.y, t1.z});
-    g[3] = detail::cross_dot_quartic({t0.y, q.eb1_t0 - q.ea0_t0, t0.y, t0.z, t1.y, q.eb1_t1 - q.ea0_t1, t1.y, t1.z});
+  const auto quartic_inputs = [&](detail::QuadrupleDifferences* g, double* lengths) {
+    g[0] = {t0.x, t0.z, t0.y, t0.z, t1.x, t1.z, t1.y, t1.z};
+    g[1] = {q.ea1_t0 - q.eb0_t0, t0.z, t0.y, t0.z, q.ea1_t1 - q.eb0_t1, t1.z, t1.y, t1.z};
+    g[2] = {t0.x, t0.y, t0.y, t0.z, t1.x, t1.y, t1.y, t1.z};
+    g[3] = {t0.y, q.eb1_t0 - q.ea0_t0, t0.y, t0.z, t1.y, q.eb1_t1 - q.ea0_t1, t1.y, t1.z};
     // Within s of contact: u, nn - u >= -s |n| |d_b|; v, nn - v >= -s |n| |d_a| (docs/ccd.md).
-    lengths[0] = lengths[1] = detail::norm_bound(t0.z, t1.z);
-    lengths[2] = lengths[3] = detail::norm_bound(t0.y, t1.y);
+    if (lengths != nullptr) {
+      lengths[0] = lengths[1] = detail::norm_bound(t0.z, t1.z);
+      lengths[2] = lengths[3] = detail::norm_bound(t0.y, t1.y);
+    }
     return 4;
   };
   // F(t, u, v) = (a0 + u (a1 - a0)) - (b0 + v (b1 - b0)) = (a0 - b0) + u (a1 - a0) + v (b0 - b1).
-  detail::InclusionProblem problem;
-  problem.d_t0 = q.ea0_t0 - q.eb0_t0;
-  problem.e_t0 = t0.y;
-  problem.g_t0 = q.eb0_t0 - q.eb1_t0;
-  problem.d_t1 = q.ea0_t1 - q.eb0_t1;
-  problem.e_t1 = t1.y;
-  problem.g_t1 = q.eb0_t1 - q.eb1_t1;
-  problem.triangle_domain = false;
-  return detail::conservative_pipeline(t0, t1, quartics, problem, options, stats);
+  const auto problem = [&] {
+    detail::InclusionProblem p;
+    p.d_t0 = q.ea0_t0 - q.eb0_t0;
+    p.e_t0 = t0.y;
+    p.g_t0 = q.eb0_t0 - q.eb1_t0;
+    p.d_t1 = q.ea0_t1 - q.eb0_t1;
+    p.e_t1 = t1.y;
+    p.g_t1 = q.eb0_t1 - q.eb1_t1;
+    p.triangle_domain = false;
+    return p;
+  };
+  return detail::conservative_pipeline(t0, t1, quartic_inputs, problem, options, stats);
 }
 
 // conservative: swept AABBs, then the rest of the pipeline.

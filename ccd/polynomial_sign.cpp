@@ -12,6 +12,7 @@
 #include <cstdint>
 
 #include "ccd/detail/float_bounds.hpp"
+#include "ccd/detail/lanes.hpp"
 #include "ccd/detail/trilinear_cubic.hpp"
 
 namespace skelcd::ccd {
@@ -21,6 +22,8 @@ using detail::add_up;
 using detail::kEps;
 using detail::kRoundUp;
 using detail::kUnderflowUnit;
+using detail::Lanes;
+using detail::Lanes3;
 using detail::rounding_bound;
 
 double max_abs(const std::array<double, 4>& c) {
@@ -62,75 +65,21 @@ PolynomialSign subdivided_sign(const std::array<double, 4>& b, double error, int
   return left == right ? left : PolynomialSign::uncertain;
 }
 
-// Two doubles, each operation done once per lane (GCC/Clang vector extension: one SSE2
-// instruction on x86-64): each lane's result is the scalar expression's, bit for bit, since a lane
-// goes through the same IEEE operations in the same order.
-using Lanes = double __attribute__((vector_size(16)));
-using LaneBits = std::uint64_t __attribute__((vector_size(16)));
-
-// |v| per lane as std::abs does it: the sign bit cleared.
-inline Lanes lane_abs(Lanes v) {
-  constexpr std::uint64_t kMagnitude = ~(std::uint64_t{1} << 63);
-  return std::bit_cast<Lanes>(std::bit_cast<LaneBits>(v) & kMagnitude);
-}
-
-// A 3-vector per lane.
-struct Lanes3 {
-  Lanes x, y, z;
-};
-
-inline Lanes3 lanes3(const Eigen::Vector3d& lane0, const Eigen::Vector3d& lane1) {
-  return {Lanes{lane0[0], lane1[0]}, Lanes{lane0[1], lane1[1]}, Lanes{lane0[2], lane1[2]}};
-}
-
-inline Lanes3 lane_abs(const Lanes3& v) { return {lane_abs(v.x), lane_abs(v.y), lane_abs(v.z)}; }
-
-// y x z per lane.
-inline Lanes3 cross(const Lanes3& y, const Lanes3& z) {
-  return {y.y * z.z - y.z * z.y, y.z * z.x - y.x * z.z, y.x * z.y - y.y * z.x};
-}
-
-// The permanent of y x z (absolute values, both products added), from |y| and |z|.
-inline Lanes3 cross_permanent(const Lanes3& ay, const Lanes3& az) {
-  return {ay.y * az.z + ay.z * az.y, ay.z * az.x + ay.x * az.z, ay.x * az.y + ay.y * az.x};
-}
-
-// x . c per lane, summed left to right.
-inline Lanes dot(const Lanes3& x, const Lanes3& c) { return x.x * c.x + x.y * c.y + x.z * c.z; }
-
 }  // namespace
 
 namespace detail {
 
-BernsteinCubic trilinear_determinant(const DifferenceTriple& t0, const DifferenceTriple& t1) {
-  // Blossom of the trilinear det: b_i averages the dets d_ijk = X_i . (Y_j x Z_k) with i + j + k
-  // factors taken at t = 1, and the permanents likewise. Each det is evaluated as
-  // x0 c0 + x1 c1 + x2 c2, c = y x z, two at a time: lane 0 takes Y_0, lane 1 Y_1.
-  const Lanes3 y = lanes3(t0.y, t1.y);
-  const Lanes3 z0 = lanes3(t0.z, t0.z);
-  const Lanes3 z1 = lanes3(t1.z, t1.z);
-  const Lanes3 x0 = lanes3(t0.x, t0.x);
-  const Lanes3 x1 = lanes3(t1.x, t1.x);
-  const Lanes3 c_z0 = cross(y, z0);  // {Y0 x Z0, Y1 x Z0}
-  const Lanes3 c_z1 = cross(y, z1);  // {Y0 x Z1, Y1 x Z1}
-  const Lanes3 ay = lane_abs(y);
-  const Lanes3 p_z0 = cross_permanent(ay, lane_abs(z0));
-  const Lanes3 p_z1 = cross_permanent(ay, lane_abs(z1));
-  const Lanes3 ax0 = lane_abs(x0), ax1 = lane_abs(x1);
-  const Lanes d0x0 = dot(x0, c_z0);  // {d000, d010}
-  const Lanes d1x0 = dot(x1, c_z0);  // {d100, d110}
-  const Lanes d0x1 = dot(x0, c_z1);  // {d001, d011}
-  const Lanes d1x1 = dot(x1, c_z1);  // {d101, d111}
+// The blossom of the trilinear det: b_i averages the dets d_ijk = X_i . (Y_j x Z_k) with i + j + k
+// factors taken at t = 1, and the permanents likewise (the coefficients: trilinear_cubic.hpp).
+double trilinear_error(const DifferenceTriple& t0, const DifferenceTriple& t1) {
+  const Lanes3 ay = lane_abs(lanes3(t0.y, t1.y));
+  const Lanes3 p_z0 = cross_permanent(ay, lane_abs(lanes3(t0.z, t0.z)));
+  const Lanes3 p_z1 = cross_permanent(ay, lane_abs(lanes3(t1.z, t1.z)));
+  const Lanes3 ax0 = lane_abs(lanes3(t0.x, t0.x)), ax1 = lane_abs(lanes3(t1.x, t1.x));
   const Lanes p0x0 = dot(ax0, p_z0), p1x0 = dot(ax1, p_z0);
   const Lanes p0x1 = dot(ax0, p_z1), p1x1 = dot(ax1, p_z1);
-  // The middle coefficients {(d100 + d010 + d001) / 3, (d011 + d101 + d110) / 3}, summed in that
-  // order.
-  const Lanes mid =
-      ((Lanes{d1x0[0], d0x1[1]} + Lanes{d0x0[1], d1x1[0]}) + Lanes{d0x1[0], d1x0[1]}) / 3.0;
   const Lanes mid_perm =
       ((Lanes{p1x0[0], p0x1[1]} + Lanes{p0x0[1], p1x1[0]}) + Lanes{p0x1[0], p1x0[1]}) / 3.0;
-  BernsteinCubic f;
-  f.coefficients = {d0x0[0], mid[0], mid[1], d1x1[1]};
   const double perm = std::max({p0x0[0], mid_perm[0], mid_perm[1], p1x1[1]});
   // Rounding count per product term: difference 1 each for x, y, z; y*z 3; the cross-product
   // difference 4; x * (.) 6; the two sums of the dot 8; the two sums and the /3 of the average 11.
@@ -140,8 +89,11 @@ BernsteinCubic trilinear_determinant(const DifferenceTriple& t0, const Differenc
   const double mx = std::max(t0.x.cwiseAbs().maxCoeff(), t1.x.cwiseAbs().maxCoeff());
   // 16 kUnderflowUnit (1 + mx) = 2^-1070 (1 + mx), computed without a subnormal product.
   const double underflow = detail::times_subnormal_power_of_two<1070>(1.0 + mx);
-  f.error = add_up(relative, underflow);
-  return f;
+  return add_up(relative, underflow);
+}
+
+BernsteinCubic trilinear_determinant(const DifferenceTriple& t0, const DifferenceTriple& t1) {
+  return {trilinear_coefficients(t0, t1), trilinear_error(t0, t1)};
 }
 
 double cross_norm_bound(const DifferenceTriple& t0, const DifferenceTriple& t1) {

@@ -22,27 +22,32 @@ CcdResult conservative_after_aabbs(
   const detail::DifferenceTriple t1{q.v_t1 - q.f0_t1, q.f1_t1 - q.f0_t1, q.f2_t1 - q.f0_t1};
   // Inside conditions n . ((b - a) x (p - a)), n . ((c - b) x (p - b)), n . ((a - c) x (p - c)),
   // n = (b - a) x (c - a): each (A x B) . (C x D) of single differences.
-  const auto quartics = [&](detail::BernsteinQuartic* g, double* lengths) {
+  const auto quartic_inputs = [&](detail::QuadrupleDifferences* g, double* lengths) {
     const Eigen::Vector3d bc_t0 = q.f2_t0 - q.f1_t0, bc_t1 = q.f2_t1 - q.f1_t1;
     const Eigen::Vector3d ca_t0 = q.f0_t0 - q.f2_t0, ca_t1 = q.f0_t1 - q.f2_t1;
-    g[0] = detail::cross_dot_quartic({t0.y, t0.z, t0.y, t0.x, t1.y, t1.z, t1.y, t1.x});
-    g[1] = detail::cross_dot_quartic({t0.y, t0.z, bc_t0, q.v_t0 - q.f1_t0, t1.y, t1.z, bc_t1, q.v_t1 - q.f1_t1});
-    g[2] = detail::cross_dot_quartic({t0.y, t0.z, ca_t0, q.v_t0 - q.f2_t0, t1.y, t1.z, ca_t1, q.v_t1 - q.f2_t1});
-    lengths[0] = detail::norm_bound(t0.y, t1.y);
-    lengths[1] = detail::norm_bound(bc_t0, bc_t1);
-    lengths[2] = detail::norm_bound(ca_t0, ca_t1);
+    g[0] = {t0.y, t0.z, t0.y, t0.x, t1.y, t1.z, t1.y, t1.x};
+    g[1] = {t0.y, t0.z, bc_t0, q.v_t0 - q.f1_t0, t1.y, t1.z, bc_t1, q.v_t1 - q.f1_t1};
+    g[2] = {t0.y, t0.z, ca_t0, q.v_t0 - q.f2_t0, t1.y, t1.z, ca_t1, q.v_t1 - q.f2_t1};
+    if (lengths != nullptr) {
+      lengths[0] = detail::norm_bound(t0.y, t1.y);
+      lengths[1] = detail::norm_bound(bc_t0, bc_t1);
+      lengths[2] = detail::norm_bound(ca_t0, ca_t1);
+    }
     return 3;
   };
   // F(t, u, v) = p - (a + u (b - a) + v (c - a)) = (p - a) + u (a - b) + v (a - c).
-  detail::InclusionProblem problem;
-  problem.d_t0 = t0.x;
-  problem.e_t0 = q.f0_t0 - q.f1_t0;
-  problem.g_t0 = q.f0_t0 - q.f2_t0;
-  problem.d_t1 = t1.x;
-  problem.e_t1 = q.f0_t1 - q.f1_t1;
-  problem.g_t1 = q.f0_t1 - q.f2_t1;
-  problem.triangle_domain = true;
-  return detail::conservative_pipeline(t0, t1, quartics, problem, options, stats);
+  const auto problem = [&] {
+    detail::InclusionProblem p;
+    p.d_t0 = t0.x;
+    p.e_t0 = q.f0_t0 - q.f1_t0;
+    p.g_t0 = q.f0_t0 - q.f2_t0;
+    p.d_t1 = t1.x;
+    p.e_t1 = q.f0_t1 - q.f1_t1;
+    p.g_t1 = q.f0_t1 - q.f2_t1;
+    p.triangle_domain = true;
+    return p;
+  };
+  return detail::conservative_pipeline(t0, t1, quartic_inputs, problem, options, stats);
 }
 
 // conservative: swept AABBs, then the rest of the pipeline.

@@ -2,13 +2,13 @@
 
 #include "ccd/detail/algebraic_filter.hpp"
 
+#include <Eigen/Geometry>
 #include <algorithm>
 #include <cassert>
 #include <cmath>
 
-#include <Eigen/Geometry>
-
 #include "ccd/detail/float_bounds.hpp"
+#include "ccd/detail/lanes.hpp"
 
 namespace skelcd::ccd::detail {
 namespace {
@@ -60,13 +60,52 @@ double halve(const std::array<double, M>& b, double e, std::array<double, M>& le
   return add_up(add_up(e, rounding_bound(n, add_up(m, e))), n * kUnderflowUnit);
 }
 
+// halve for two polynomials at once, lane k halving the k-th: the same operations per lane.
+template <std::size_t M>
+Lanes halve(
+    const std::array<Lanes, M>& b,
+    Lanes e,
+    std::array<Lanes, M>& left,
+    std::array<Lanes, M>& right) {
+  std::array<Lanes, M> w = b;
+  Lanes m = {0.0, 0.0};
+  for (const Lanes x : b) m = lane_max(m, lane_abs(x));  // std::max(m, std::abs(x))
+  left[0] = w[0];
+  right[M - 1] = w[M - 1];
+#pragma GCC unroll 8
+  for (std::size_t level = 1; level < M; ++level) {
+#pragma GCC unroll 8
+    for (std::size_t i = 0; i + level < M; ++i) w[i] = (w[i] + w[i + 1]) * 0.5;
+    left[level] = w[0];
+    right[M - 1 - level] = w[M - 1 - level];
+  }
+  const auto n = static_cast<int>(M) - 1;
+  // add_up and rounding_bound per lane.
+  const Lanes bound = (static_cast<double>(n + 1) * kEps) * ((m + e) * kRoundUp);
+  return ((e + bound) * kRoundUp + n * kUnderflowUnit) * kRoundUp;
+}
+
+// Bits of "every coefficient > e" and of "every coefficient < -e", per lane.
+template <std::size_t M>
+void hull_masks(const std::array<Lanes, M>& b, Lanes e, LaneBits& pos, LaneBits& neg) {
+  pos = b[0] > e;
+  neg = -b[0] > e;
+  for (std::size_t i = 1; i < M; ++i) {
+    pos &= b[i] > e;
+    neg &= -b[i] > e;
+  }
+}
+
+// The quartics travel in pairs, quartic 2p + k in lane k of pair p.
+constexpr int kPairs = kMaxQuartics / 2;
+
 struct Node {
   double lo, hi;
   int depth;
   std::array<double, 4> c;
   double c_err;
-  std::array<std::array<double, 5>, kMaxQuartics> g;
-  std::array<double, kMaxQuartics> g_err;
+  std::array<std::array<Lanes, 5>, kPairs> g;
+  std::array<Lanes, kPairs> g_err;
 };
 
 // A certain root of c in [lo, hi] (certified sign change): narrow toward the first root while the
@@ -151,6 +190,65 @@ BernsteinQuartic cross_dot_quartic(const QuadrupleDifferences& q) {
   return out;
 }
 
+void cross_dot_quartic_pair(
+    const QuadrupleDifferences& q0,
+    const QuadrupleDifferences& q1,
+    BernsteinQuartic& g0,
+    BernsteinQuartic& g1) {
+  // cross_dot_quartic with lane 0 doing q0 and lane 1 doing q1: the same operations in the same
+  // order per lane (detail/lanes.hpp).
+  const Lanes3 a[2] = {lanes3(q0.a_t0, q1.a_t0), lanes3(q0.a_t1, q1.a_t1)};
+  const Lanes3 b[2] = {lanes3(q0.b_t0, q1.b_t0), lanes3(q0.b_t1, q1.b_t1)};
+  const Lanes3 c[2] = {lanes3(q0.c_t0, q1.c_t0), lanes3(q0.c_t1, q1.c_t1)};
+  const Lanes3 d[2] = {lanes3(q0.d_t0, q1.d_t0), lanes3(q0.d_t1, q1.d_t1)};
+  const Lanes3 aa[2] = {lane_abs(a[0]), lane_abs(a[1])};
+  const Lanes3 ab_[2] = {lane_abs(b[0]), lane_abs(b[1])};
+  const Lanes3 ac[2] = {lane_abs(c[0]), lane_abs(c[1])};
+  const Lanes3 ad[2] = {lane_abs(d[0]), lane_abs(d[1])};
+  // Factor pairs: A x B with (A, B) at times (mask & 1, mask & 2), C x D at (mask & 4, mask & 8).
+  Lanes3 ab[4], ab_perm[4], cd[4], cd_perm[4];
+  for (int k = 0; k < 4; ++k) {
+    const int i = k & 1, j = k >> 1;
+    ab[k] = cross(a[i], b[j]);
+    ab_perm[k] = cross_permanent(aa[i], ab_[j]);
+    cd[k] = cross(c[i], d[j]);
+    cd_perm[k] = cross_permanent(ac[i], ad[j]);
+  }
+  static constexpr int kBits[4] = {0, 1, 1, 2};
+  Lanes sum[5] = {};
+  Lanes perm[5] = {};
+#pragma GCC unroll 4
+  for (int i = 0; i < 4; ++i) {
+#pragma GCC unroll 4
+    for (int j = 0; j < 4; ++j) {
+      const int level = kBits[i] + kBits[j];
+      sum[level] += dot(ab[i], cd[j]);
+      perm[level] += dot(ab_perm[i], cd_perm[j]);
+    }
+  }
+  static constexpr double kTerms[5] = {1.0, 4.0, 6.0, 4.0, 1.0};
+  Lanes p = {0.0, 0.0};
+  for (std::size_t i = 0; i < 5; ++i) {
+    const Lanes value = sum[i] / kTerms[i];
+    g0.coefficients[i] = value[0];
+    g1.coefficients[i] = value[1];
+    p = lane_max(p, perm[i] / kTerms[i]);
+  }
+  // The largest coordinate magnitude of each quadruple (finite by the precondition, so any order
+  // of comparisons finds the same value).
+  Lanes m = {0.0, 0.0};
+  for (int t = 0; t < 2; ++t) {
+    m = lane_max(
+        m,
+        lane_max(lane_max(max_abs(a[t]), max_abs(b[t])), lane_max(max_abs(c[t]), max_abs(d[t]))));
+  }
+  // As in cross_dot_quartic.
+  g0.error =
+      add_up(rounding_bound(18, p[0]), times_subnormal_power_of_two<1068>(1.0 + m[0] * m[0]));
+  g1.error =
+      add_up(rounding_bound(18, p[1]), times_subnormal_power_of_two<1068>(1.0 + m[1] * m[1]));
+}
+
 AlgebraicVerdict algebraic_filter(const BernsteinCubic& c, const BernsteinQuartic* g, int count, double toi_tolerance) {
   assert(count >= 0 && count <= kMaxQuartics);
   // Overflowed bounds (coordinates near the double range) prove nothing: leave it to the solver.
@@ -166,20 +264,35 @@ AlgebraicVerdict algebraic_filter(const BernsteinCubic& c, const BernsteinQuarti
   node.depth = 0;
   node.c = c.coefficients;
   node.c_err = c.error;
-  for (int i = 0; i < count; ++i) {
-    node.g[static_cast<std::size_t>(i)] = g[i].coefficients;
-    node.g_err[static_cast<std::size_t>(i)] = g[i].error;
+  // Quartic i in lane i % 2 of pair i / 2. With an odd count the last lane repeats the quartic
+  // before it and is never looked at (not zeros: halving a zero error would make a subnormal
+  // product each time, a microcode assist).
+  const int pairs = (count + 1) / 2;
+  for (int i = 0; i < 2 * pairs; ++i) {
+    const BernsteinQuartic& q = g[std::min(i, count - 1)];
+    const auto p = static_cast<std::size_t>(i / 2);
+    const int lane = i % 2;
+    for (std::size_t k = 0; k < 5; ++k) node.g[p][k][lane] = q.coefficients[k];
+    node.g_err[p][lane] = q.error;
+  }
+  // Lanes that hold a quartic.
+  LaneBits used[kPairs];
+  for (int p = 0; p < kPairs; ++p) {
+    used[p] = LaneBits{2 * p < count ? ~0ull : 0ull, 2 * p + 1 < count ? ~0ull : 0ull};
   }
   int visited = 0;
   for (;;) {
     // Coplanarity excluded here, or some inside condition failing throughout?
     bool excluded = hull_sign(node.c, node.c_err) != 0;
     bool all_positive = true;
-    for (int i = 0; i < count && !excluded; ++i) {
-      const auto ii = static_cast<std::size_t>(i);
-      const int s = hull_sign(node.g[ii], node.g_err[ii]);
-      if (s < 0) excluded = true;
-      if (s <= 0) all_positive = false;
+    for (int p = 0; p < pairs && !excluded; ++p) {
+      const auto pp = static_cast<std::size_t>(p);
+      LaneBits pos, neg;
+      hull_masks(node.g[pp], node.g_err[pp], pos, neg);
+      neg &= used[p];
+      pos = pos | ~used[p];
+      if ((neg[0] | neg[1]) != 0) excluded = true;
+      if ((pos[0] & pos[1]) == 0) all_positive = false;
     }
     if (excluded) {
       if (size == 0) break;
@@ -202,12 +315,12 @@ AlgebraicVerdict algebraic_filter(const BernsteinCubic& c, const BernsteinQuarti
     right.c_err = halve(node.c, node.c_err, left_c, right.c);
     node.c = left_c;
     node.c_err = right.c_err;
-    for (int i = 0; i < count; ++i) {
-      const auto ii = static_cast<std::size_t>(i);
-      std::array<double, 5> left_g;
-      right.g_err[ii] = halve(node.g[ii], node.g_err[ii], left_g, right.g[ii]);
-      node.g[ii] = left_g;
-      node.g_err[ii] = right.g_err[ii];
+    for (int p = 0; p < pairs; ++p) {
+      const auto pp = static_cast<std::size_t>(p);
+      std::array<Lanes, 5> left_g;
+      right.g_err[pp] = halve(node.g[pp], node.g_err[pp], left_g, right.g[pp]);
+      node.g[pp] = left_g;
+      node.g_err[pp] = right.g_err[pp];
     }
     node.hi = mid;
     node.depth = right.depth;

@@ -36,6 +36,16 @@ struct QuadrupleDifferences {
 /// (A(t) x B(t)) . (C(t) x D(t)) in Bernstein form on [0,1], with its rounding-error bound.
 [[nodiscard]] BernsteinQuartic cross_dot_quartic(const QuadrupleDifferences& q);
 
+/// cross_dot_quartic of q0 into g0 and of q1 into g1, bit for bit, computed together (each vector
+/// operation does one step of both), about half the cost of two calls.
+/// @pre every coordinate of q0 and q1 is finite (the largest magnitude, which enters the
+/// underflow term, is then the same whatever order it is found in).
+void cross_dot_quartic_pair(
+    const QuadrupleDifferences& q0,
+    const QuadrupleDifferences& q1,
+    BernsteinQuartic& g0,
+    BernsteinQuartic& g1);
+
 enum class AlgebraicOutcome : std::uint8_t { separated, contact, undecided };
 
 struct AlgebraicVerdict {

@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "ccd/ccd_types.hpp"
 #include "ccd/detail/algebraic_filter.hpp"
@@ -25,31 +26,99 @@ inline double norm_bound(const Eigen::Vector3d& x_t0, const Eigen::Vector3d& x_t
   return std::sqrt(m * kRoundUp) * kRoundUp;
 }
 
-/// @param coplanarity_t0/_t1 X, Y, Z with c(t) = X . (Y x Z) and n = Y x Z.
-/// @param make_quartics fills arrays of BernsteinQuartic and of edge-length bounds L_i and returns
-/// how many (<= 4): at a point within distance s of contact, g_i >= -s |n| L_i (docs/ccd.md).
-template <typename MakeQuartics>
-CcdResult conservative_pipeline(const DifferenceTriple& coplanarity_t0,
-                                const DifferenceTriple& coplanarity_t1,
-                                MakeQuartics&& make_quartics,
-                                InclusionProblem& problem,
-                                const CcdOptions& options,
-                                CcdStats& stats) {
+/// The hull of the coefficients proves one sign on all of [0,1]: cubic_sign's first test, with the
+/// finiteness checks it makes.
+inline bool certified_sign(const std::array<double, 4>& b, double error) {
+  // Written as "b > error" so that NaN falls through; |b| < inf for cubic_sign's isfinite.
+  constexpr double kMax = std::numeric_limits<double>::max();
+  const bool finite = std::abs(b[0]) <= kMax && std::abs(b[1]) <= kMax && std::abs(b[2]) <= kMax &&
+                      std::abs(b[3]) <= kMax;
+  const bool positive = b[0] > error && b[1] > error && b[2] > error && b[3] > error;
+  const bool negative = -b[0] > error && -b[1] > error && -b[2] > error && -b[3] > error;
+  return finite && (positive || negative);
+}
+
+/// Some quartic certified negative on all of [0,1].
+inline bool certified_negative(const BernsteinQuartic& g) {
+  const auto& b = g.coefficients;
+  const double e = g.error;
+  return -b[0] > e && -b[1] > e && -b[2] > e && -b[3] > e && -b[4] > e;
+}
+
+// Largest coordinate magnitude of the coplanarity differences under which every difference of the
+// query's points has magnitude <= 2^192 (docs/ccd.md), so that every quartic's error bound is
+// finite.
+inline constexpr double kQuarticScreenMagnitude = 0x1p190;
+
+/// @param coplanarity_t0/_t1 X, Y, Z with c(t) = X . (Y x Z) and n = Y x Z; every point of the
+/// query appears in one of them.
+/// @param make_quartic_inputs fills arrays of QuadrupleDifferences and of edge-length bounds L_i
+/// and returns how many (3 or 4): at a point within distance s of contact, g_i >= -s |n| L_i
+/// (docs/ccd.md). Every vector is a difference of two of the query's points. `lengths` is null
+/// when min_separation is 0 (they are not needed).
+/// @param make_problem returns the solver's InclusionProblem (only the few queries that reach it
+/// pay for it).
+template <typename MakeQuarticInputs, typename MakeProblem>
+CcdResult conservative_pipeline(
+    const DifferenceTriple& coplanarity_t0,
+    const DifferenceTriple& coplanarity_t1,
+    MakeQuarticInputs&& make_quartic_inputs,
+    MakeProblem&& make_problem,
+    const CcdOptions& options,
+    CcdStats& stats) {
   const double s = options.min_separation;
-  BernsteinCubic c = trilinear_determinant(coplanarity_t0, coplanarity_t1);
+  // Stage 1, the coplanarity cubic. First with an error bound from the largest coordinate
+  // magnitudes, >= the exact bound of trilinear_error: when that certifies a sign, so would
+  // cubic_sign (same coefficients, smaller error, no subdivision needed). Otherwise the exact
+  // bound and cubic_sign as before.
+  const TrilinearScreen screen = trilinear_screen(coplanarity_t0, coplanarity_t1);
   double normal_bound = 0.0;
+  double margin = 0.0;
   if (s > 0.0) {
     // |c(t)| <= s |n(t)| <= s N at any time within s: widen the error by s N (docs/ccd.md).
     normal_bound = cross_norm_bound(coplanarity_t0, coplanarity_t1);
-    c.error = add_up(c.error, s * normal_bound * kRoundUp);
+    margin = s * normal_bound * kRoundUp;
   }
+  if (certified_sign(
+          screen.coefficients, s > 0.0 ? add_up(screen.error_upper, margin) : screen.error_upper)) {
+    ++stats.coplanarity_rejected;
+    return {};
+  }
+  BernsteinCubic c{screen.coefficients, trilinear_error(coplanarity_t0, coplanarity_t1)};
+  if (s > 0.0) c.error = add_up(c.error, margin);
   if (cubic_sign(c, kCoplanaritySubdivisions) != PolynomialSign::uncertain) {
     ++stats.coplanarity_rejected;
     return {};
   }
+  // Stage 2, the inside quartics, two at a time when the coordinates allow.
+  QuadrupleDifferences inputs[4];
   BernsteinQuartic g[4];
   double lengths[4] = {0.0, 0.0, 0.0, 0.0};
-  const int count = make_quartics(g, lengths);
+  const int count = make_quartic_inputs(inputs, s > 0.0 ? lengths : nullptr);
+  // Finite end coefficients mean finite X, Y, Z at both times (each coordinate reaches b_0 or b_3
+  // through products and sums, which keep inf and NaN), hence finite points; with the magnitude
+  // bound every quartic below is finite with a finite error.
+  const bool screened = std::isfinite(c.coefficients[0]) && std::isfinite(c.coefficients[3]) &&
+                        screen.magnitude <= kQuarticScreenMagnitude;
+  if (screened) {
+    cross_dot_quartic_pair(inputs[0], inputs[1], g[0], g[1]);
+    // algebraic_filter's first step, on the first two: with every error finite, a quartic
+    // certified negative on [0,1] excludes the root interval and the answer is "separated". The
+    // others need not be computed.
+    if (s == 0.0 && std::isfinite(c.error) && std::isfinite(g[0].error) &&
+        std::isfinite(g[1].error) && (certified_negative(g[0]) || certified_negative(g[1]))) {
+      ++stats.algebraic_rejected;
+      return {};
+    }
+    if (count == 4) {
+      cross_dot_quartic_pair(inputs[2], inputs[3], g[2], g[3]);
+    } else {
+      BernsteinQuartic unused;
+      cross_dot_quartic_pair(inputs[2], inputs[2], g[2], unused);
+    }
+  } else {
+    for (int i = 0; i < count; ++i) g[i] = cross_dot_quartic(inputs[i]);
+  }
   if (s > 0.0) {
     // Within s of contact, g_i >= -s |n| L_i >= -s N L_i: widen each error by that.
     for (int i = 0; i < count; ++i) g[i].error = add_up(g[i].error, s * normal_bound * lengths[i] * kRoundUp * kRoundUp);
@@ -63,6 +132,7 @@ CcdResult conservative_pipeline(const DifferenceTriple& coplanarity_t0,
     ++stats.algebraic_hits;
     return {true, v.t_lo, v.t_hi, CcdStatus::contact};
   }
+  InclusionProblem problem = make_problem();
   problem.t_begin = v.t_lo;  // [0, t_lo) is excluded
   const InclusionResult r = solve_inclusion(problem, options);
   ++stats.solver_runs;
