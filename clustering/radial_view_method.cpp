@@ -496,53 +496,34 @@ void RadialViewMethod::gather_ray_candidates(std::int32_t k, const WindingRay& r
   const auto may_meet = [&](const culling::Aabb& b) {
     return segment_meets_box(ray.front, ray.far, b) || segment_meets_box(ray.back, ray.front, b);
   };
+  // The items (ids in triangle_order) of the leaves whose boxes may meet a segment; `single`
+  // when the leaf holds only that item, whose box was then the one just tested.
+  const auto walk =
+      [&](const culling::AabbBvh& bvh, std::vector<std::int32_t>& stack, auto&& item) {
+        if (bvh.empty()) return;
+        stack.assign(1, 0);
+        while (!stack.empty()) {
+          const std::int32_t n = stack.back();
+          stack.pop_back();
+          if (!may_meet(bvh.node_bounds()[at(n)])) continue;
+          const auto& node = bvh.nodes()[at(n)];
+          if (!node.is_leaf()) {
+            stack.push_back(node.right);
+            stack.push_back(n + 1);
+            continue;
+          }
+          for (std::int32_t i = node.begin; i < node.end; ++i) {
+            item(bvh.triangle_order()[at(i)], node.size() == 1);
+          }
+        }
+      };
   ray_candidates_.clear();
-  const auto& global = clusters_.global_bvh();
-  if (global.empty()) return;
-  const auto global_nodes = global.nodes();
-  const auto global_bounds = global.node_bounds();
-  const auto global_order = global.triangle_order();
-  ray_stack_.assign(1, 0);
-  std::vector<std::int32_t>& stack = ray_stack_;
-  std::size_t local_base = 0;
-  while (stack.size() > local_base) {
-    const std::int32_t n = stack.back();
-    stack.pop_back();
-    if (!may_meet(global_bounds[at(n)])) continue;
-    const auto& node = global_nodes[at(n)];
-    if (!node.is_leaf()) {
-      stack.push_back(node.right);
-      stack.push_back(n + 1);
-      continue;
-    }
-    for (std::int32_t i = node.begin; i < node.end; ++i) {
-      const std::int32_t a = global_order[at(i)];
-      if (clusters_.component_of_atomic(a) != k) continue;
-      const auto& local = clusters_.local_bvh(a);
-      if (local.empty()) continue;
-      const auto nodes = local.nodes();
-      const auto bounds = local.node_bounds();
-      const auto order = local.triangle_order();
-      local_base = stack.size();
-      stack.push_back(0);
-      while (stack.size() > local_base) {
-        const std::int32_t m = stack.back();
-        stack.pop_back();
-        if (!may_meet(bounds[at(m)])) continue;
-        const auto& ln = nodes[at(m)];
-        if (!ln.is_leaf()) {
-          stack.push_back(ln.right);
-          stack.push_back(m + 1);
-          continue;
-        }
-        for (std::int32_t j = ln.begin; j < ln.end; ++j) {
-          const std::int32_t t = order[at(j)];
-          if (ln.size() == 1 || may_meet(bounds_.triangles[at(t)])) ray_candidates_.push_back(t);
-        }
-      }
-      local_base = 0;
-    }
-  }
+  walk(clusters_.global_bvh(), ray_stack_, [&](std::int32_t a, bool) {
+    if (clusters_.component_of_atomic(a) != k) return;
+    walk(clusters_.local_bvh(a), ray_local_stack_, [&](std::int32_t t, bool single) {
+      if (single || may_meet(bounds_.triangles[at(t)])) ray_candidates_.push_back(t);
+    });
+  });
 }
 
 // --- class masks: which pairs of a mega cluster may be skipped -----------------------------------

@@ -217,7 +217,8 @@ class RadialViewMethod final : public culling::CullingMethod {
   culling::PairBlocks<3> blocks_;
   culling::TraversalScratch scratch_;
   std::vector<std::int32_t> node_stack_;
-  std::vector<std::int32_t> ray_stack_, ray_candidates_;  // gather_ray_candidates' scratch
+  std::vector<std::int32_t> ray_stack_, ray_local_stack_,
+      ray_candidates_;  // gather_ray_candidates'
 
   // The intersecting pairs at the interval's start, and what may tell them without a DCD: the
   // last detect_dcd (at dcd_x_) and the pairs at the last interval's end (carry_x_), updated from
