@@ -42,9 +42,15 @@ namespace skelcd::culling {
   // largest float); a select rather than a branch: rounding goes up about half the time.
   const auto bits = std::bit_cast<std::int32_t>(-f + 0.0f);
   const float below = -std::bit_cast<float>(bits + ((bits >> 31) | 1));
-  const float r = static_cast<double>(f) > x ? below : f;
-  if (r > -kMin && r < kMin) return x >= 0.0 ? 0.0f : -kMin;
-  return r;
+  // Selects on the bits: compilers turn a ?: on floats into a branch, which mispredicts on
+  // coordinates (the refit converts six per triangle).
+  const auto pick = [](bool c, float a, float b) {
+    const auto ia = std::bit_cast<std::int32_t>(a);
+    const auto ib = std::bit_cast<std::int32_t>(b);
+    return std::bit_cast<float>(ib ^ ((ia ^ ib) & -static_cast<std::int32_t>(c)));
+  };
+  const float r = pick(static_cast<double>(f) > x, below, f);
+  return pick(r > -kMin && r < kMin, pick(x >= 0.0, 0.0f, -kMin), r);
 }
 
 /// The smallest float not below `x` (x finite), never a subnormal (as float_below).

@@ -4,6 +4,7 @@
 // overlap; what to test inside a pair is the caller's business (culling/candidates.hpp).
 
 #include <algorithm>
+#include <array>
 #include <cstdint>
 #include <span>
 #include <vector>
@@ -12,6 +13,51 @@
 #include "culling/frame_result.hpp"
 
 namespace skelcd::culling {
+
+class FeatureTopology;
+
+/// The static half of a FanSieve, for one hierarchy: its triangles' corners by slot of
+/// Bvh::triangle_order, and which slots near each other share a vertex.
+struct SlotAdjacency {
+  /// Half the window: window[s] covers the slots s − kReach .. s + kReach − 1.
+  static constexpr std::int32_t kReach = 32;
+
+  SlotAdjacency() = default;
+  SlotAdjacency(const FeatureTopology& topology, std::span<const std::int32_t> order);
+
+  /// corners[s]: the vertex ids of triangle order[s], then −1; all four −1 for a triangle that
+  /// repeats a vertex (never settled).
+  std::vector<std::array<std::int32_t, 4>> corners;
+  /// Bit d of window[s] (d ≠ kReach) is set when the triangles in slots s and s + d − kReach
+  /// share one or two vertices and their parts are not excluded — the pairs a certified vertex
+  /// settles when every corner of slot s is certified, as a mask to take four at a time.
+  std::vector<std::uint64_t> window;
+};
+
+/// What a DCD self traversal settles instead of emitting (docs/culling.md "DCD"): two triangles
+/// that share a vertex whose fan is certified at the instant (culling/vertex_fans.hpp) have no
+/// common point beyond what they share, so the pair needs no test. Those pairs are 80–95 % of a
+/// DCD's candidates on real meshes; dropping them where the traversal finds them saves their
+/// emission, their block and their filter. The pairs the sieve lets through are exactly the
+/// others: a pair sharing no certified vertex, one sharing three vertices (a duplicate face, which
+/// the DCD filter drops) and any pair with a degenerate triangle.
+struct FanSieve {
+  const SlotAdjacency* slots = nullptr;
+  /// Per vertex: its fan is certified at the instant (VertexFans::certify).
+  std::span<const std::uint8_t> certified;
+  /// Per slot: all three corners are certified (certified_slots); filled by the caller.
+  std::span<const std::uint8_t> full;
+  /// For its part-pair exclusions: a settled pair of excluded parts is no candidate.
+  const FeatureTopology* topology = nullptr;
+  /// Settled pairs that are candidates (not excluded), as the DCD filter would count them.
+  std::int64_t settled = 0;
+};
+
+/// FanSieve::full of `slots` for the instant's `certified` vertices, into `full` (resized).
+void certified_slots(
+    const SlotAdjacency& slots,
+    std::span<const std::uint8_t> certified,
+    std::vector<std::uint8_t>& full);
 
 /// Caller-owned scratch of a traversal: the stack of pending node pairs. Reserve it once for the
 /// hierarchies it will traverse; a traversal then allocates nothing. One per thread when
@@ -84,6 +130,17 @@ bool self_traverse_some(
     std::vector<TrianglePair>& out,
     std::int64_t& bv_tests,
     std::size_t max_pairs);
+/// The same, the pairs `sieve` settles counted in it instead of appended (DCD). The pairs
+/// appended plus those settled or excluded are exactly self_traverse's.
+template <int N>
+bool self_traverse_some(
+    const Bvh<N>& bvh,
+    std::span<const Dop<N>> triangle_bounds,
+    TraversalScratch& scratch,
+    std::vector<TrianglePair>& out,
+    std::int64_t& bv_tests,
+    std::size_t max_pairs,
+    FanSieve& sieve);
 
 /// Pair traversal: appends to `out` every (triangle of a, triangle of b) whose volumes overlap,
 /// each once; `TrianglePair::a` is a triangle id of `a`'s triangles, `TrianglePair::b` of `b`'s.
