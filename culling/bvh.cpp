@@ -70,6 +70,13 @@ void Bvh<N>::build(const skinning::Triangles& triangles, const skinning::Positio
   }
   for (std::size_t i = 0; i < order_.size(); ++i) order_[i] = items_[i].id;
   node_bounds_.assign(nodes_.size(), Volume::empty());
+  slot_bounds_.assign(2 * static_cast<std::size_t>(N) * slot_stride(), 0.0f);
+  for (std::size_t k = 0; k < static_cast<std::size_t>(N); ++k) {
+    float* lo = slot_bounds_.data() + k * slot_stride();
+    float* hi = slot_bounds_.data() + (static_cast<std::size_t>(N) + k) * slot_stride();
+    std::fill(lo, lo + slot_stride(), std::numeric_limits<float>::infinity());
+    std::fill(hi, hi + slot_stride(), -std::numeric_limits<float>::infinity());
+  }
   items_ = {};
   build_wide();
 }
@@ -223,14 +230,26 @@ std::int32_t Bvh<N>::build_range(std::int32_t begin, std::int32_t end, int depth
 template <int N>
 void Bvh<N>::refit(std::span<const Volume> triangle_bounds) {
   constexpr auto kN = static_cast<std::size_t>(N);
-  // Depth-first order puts every child after its parent, so one backward sweep is bottom-up.
+  // Depth-first order puts every child after its parent, so one backward sweep is bottom-up. A
+  // leaf also writes its triangles' float volumes by slot.
+  const std::size_t stride = slot_stride();
+  const auto slot_floats = [&](std::size_t s, const Volume& t) {
+    for (std::size_t k = 0; k < kN; ++k) {
+      slot_bounds_[k * stride + s] = float_below(t.lo[k]);
+      slot_bounds_[(kN + k) * stride + s] = float_above(t.hi[k]);
+    }
+  };
   for (std::size_t n = nodes_.size(); n-- > 0;) {
     const BvhNode& node = nodes_[n];
     Volume v;
     if (node.is_leaf()) {
-      v = triangle_bounds[static_cast<std::size_t>(order_[static_cast<std::size_t>(node.begin)])];
-      for (std::int32_t s = node.begin + 1; s < node.end; ++s) {
-        v.merge(triangle_bounds[static_cast<std::size_t>(order_[static_cast<std::size_t>(s)])]);
+      const auto first = static_cast<std::size_t>(node.begin);
+      v = triangle_bounds[static_cast<std::size_t>(order_[first])];
+      slot_floats(first, v);
+      for (auto s = first + 1; s < static_cast<std::size_t>(node.end); ++s) {
+        const Volume& t = triangle_bounds[static_cast<std::size_t>(order_[s])];
+        slot_floats(s, t);
+        v.merge(t);
       }
     } else {
       v = node_bounds_[n + 1];

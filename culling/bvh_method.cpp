@@ -48,6 +48,7 @@ class BvhMethod final : public MethodBase {
     bounds_.edges.reserve(static_cast<std::size_t>(topology_.num_edges()));
     bounds_.triangles.reserve(num_faces);
     scratch_.reserve_self(bvh_);
+    full_slots_.reserve(num_faces);
   }
 
   void dcd(const Instant& at, FrameResult& out) override {
@@ -61,13 +62,21 @@ class BvhMethod final : public MethodBase {
     const auto t1 = Clock::now();
     // Self traversal → overlapping triangle pairs → the DCD rules → tests, in blocks as the CCD
     // (bounded memory), the vertex fans certified once for the instant.
+    // Pairs sharing a certified vertex are settled where the traversal finds them (FanSieve).
     blocks_.start_dcd(topology_, x, tests_, out);
     start_self_traversal<N>(bvh_, scratch_);
+    FanSieve sieve{
+        .slots = &slots_, .certified = blocks_.fans(), .full = {}, .topology = &topology_};
+    if (!sieve.certified.empty()) {
+      certified_slots(slots_, sieve.certified, full_slots_);
+      sieve.full = full_slots_;
+    }
     blocks_.drain([&](std::vector<TrianglePair>& pairs, std::size_t max_pairs) {
       return self_traverse_some<N>(
-          bvh_, bounds_.triangles, scratch_, pairs, out.counters.bv_tests, max_pairs);
+          bvh_, bounds_.triangles, scratch_, pairs, out.counters.bv_tests, max_pairs, sieve);
     });
     blocks_.finish();
+    out.counters.candidate_pairs += sieve.settled;
     const auto t2 = Clock::now();
     out.times.refit_us += micros(t0, t1);
     out.times.traverse_us += micros(t1, t2) - blocks_.test_us();
@@ -103,6 +112,8 @@ class BvhMethod final : public MethodBase {
 
  private:
   Bvh<N> bvh_;
+  SlotAdjacency slots_{topology_, bvh_.triangle_order()};
+  std::vector<std::uint8_t> full_slots_;
   FeatureBounds<N> bounds_;
   TraversalScratch scratch_;
   PairBlocks<N> blocks_{

@@ -65,6 +65,10 @@ class PairBlocks {
       const ElementaryTests& tests,
       FrameResult& out);
 
+  /// The DCD query's certified vertex fans (empty when the tests do not use them): what a
+  /// FanSieve of the producer may settle pairs with.
+  [[nodiscard]] std::span<const std::uint8_t> fans() const { return fans_; }
+
   /// The pending block: producers append here.
   [[nodiscard]] std::vector<TrianglePair>& pairs() { return pairs_; }
   [[nodiscard]] std::size_t block_pairs() const { return block_pairs_; }

@@ -11,6 +11,8 @@
 #include <emmintrin.h>
 #endif
 
+#include "culling/feature_topology.hpp"
+
 namespace skelcd::culling {
 namespace {
 
@@ -23,6 +25,9 @@ inline void push(std::vector<Entry>& stack, std::int32_t a, std::int32_t b) {
 }
 
 inline std::size_t to_size(std::int32_t i) { return static_cast<std::size_t>(i); }
+
+/// Set bits of 0..15 (std::popcount is a library call without -mpopcnt).
+constexpr std::array<std::int8_t, 16> kBitsIn4{0, 1, 1, 2, 1, 2, 2, 3, 1, 2, 2, 3, 2, 3, 3, 4};
 
 // A slot is one child of a wide node: node · 4 + lane. Stack entries hold two slots; an entry
 // whose first slot is negative (~slot) is a leaf pair whose float volumes overlap, put off
@@ -61,7 +66,29 @@ inline unsigned overlap_lanes(const WideBvhNode<N>& w, const WideBvhNode<N>& q, 
 /// One traversal over wide nodes: of one tree with itself (kSelf: a and b are the same tree) or of
 /// two trees. Entries on the stack are slot pairs whose float volumes overlap (the first entry
 /// excepted: it is the virtual roots, never tested).
-template <int N, bool kSelf>
+/// Bit i set when corner i (0..2) of `a` is a vertex of `b` (corners as in FanSieve::corners;
+/// negative ids never match).
+inline unsigned shared_lanes(
+    const std::array<std::int32_t, 4>& a, const std::array<std::int32_t, 4>& b) {
+#if defined(__SSE2__)
+  const __m128i va = _mm_loadu_si128(reinterpret_cast<const __m128i*>(a.data()));
+  __m128i eq = _mm_cmpeq_epi32(va, _mm_set1_epi32(b[0]));
+  eq = _mm_or_si128(eq, _mm_cmpeq_epi32(va, _mm_set1_epi32(b[1])));
+  eq = _mm_or_si128(eq, _mm_cmpeq_epi32(va, _mm_set1_epi32(b[2])));
+  eq = _mm_and_si128(eq, _mm_cmpgt_epi32(va, _mm_set1_epi32(-1)));
+  return static_cast<unsigned>(_mm_movemask_ps(_mm_castsi128_ps(eq))) & 7u;
+#else
+  unsigned mask = 0;
+  for (std::size_t i = 0; i < 3; ++i) {
+    const bool hit = a[i] >= 0 && (a[i] == b[0] || a[i] == b[1] || a[i] == b[2]);
+    mask |= static_cast<unsigned>(hit) << i;
+  }
+  return mask;
+#endif
+}
+
+/// kSieve: a FanSieve settles pairs instead of emitting them (self traversal only).
+template <int N, bool kSelf, bool kSieve = false>
 class Walk {
  public:
   Walk(
@@ -72,8 +99,12 @@ class Walk {
       std::vector<Entry>& stack,
       std::vector<TrianglePair>& out,
       std::int64_t& bv_tests,
-      std::size_t max_pairs)
-      : wide_a_(a.wide_nodes()),
+      std::size_t max_pairs,
+      FanSieve* sieve = nullptr)
+      : sieve_(sieve),
+        a_(a),
+        b_(b),
+        wide_a_(a.wide_nodes()),
         wide_b_(b.wide_nodes()),
         order_a_(a.triangle_order()),
         order_b_(b.triangle_order()),
@@ -210,11 +241,31 @@ class Walk {
       const std::int32_t ti = order_a_[to_size(i)];
       for (std::int32_t j0 = same ? i + 1 : begin_b; j0 < end_b; j0 += kWidth) {
         const std::int32_t n = std::min(kWidth, end_b - j0);
-        unsigned mask = overlap_slots(bounds_a_[to_size(ti)], j0, n);
+        // Four slots of b at once in float (the slots past the tree's last are empty), which only
+        // prunes; then the pairs left, one by one.
+        unsigned mask = float_overlap_slots(i, j0) & ((1u << n) - 1u);
         tests += n;
+        if constexpr (kSieve) {
+          // Every corner of slot i certified: its window settles the neighbours it shares a
+          // vertex with, four at a time (a pair that shares one overlaps: its bit is in mask).
+          const std::int32_t d = j0 - i + SlotAdjacency::kReach;
+          if (sieve_->full[to_size(i)] != 0 && d >= 0 && d <= 2 * SlotAdjacency::kReach - 4) {
+            const auto settled =
+                static_cast<unsigned>(sieve_->slots->window[to_size(i)] >> d) & mask;
+            sieve_->settled += kBitsIn4[settled];
+            mask &= ~settled;
+          }
+        }
         while (mask != 0) {
-          const std::int32_t tj = order_b_[to_size(j0 + std::countr_zero(mask))];
+          const std::int32_t sj = j0 + std::countr_zero(mask);
+          const std::int32_t tj = order_b_[to_size(sj)];
           mask &= mask - 1;
+          // Two triangles that share a vertex always overlap (both volumes hold it): a settled
+          // pair needs no exact volume test.
+          if constexpr (kSieve) {
+            if (settles(i, sj, ti, tj)) continue;
+          }
+          if (!overlap(bounds_a_[to_size(ti)], bounds_b_[to_size(tj)])) continue;
           // Ordered a < b within one tree (a select, not a branch), as given across two.
           if constexpr (kSelf) {
             out_.push_back({std::min(ti, tj), std::max(ti, tj)});
@@ -227,21 +278,60 @@ class Walk {
     bv_tests_ += tests;
   }
 
-  /// Bit c set when the volume of triangle ti overlaps that of the triangle in slot sb + c of b,
-  /// for c < n (exact: double), without a branch per test.
-  [[nodiscard]] unsigned overlap_slots(const Dop<N>& ti, std::int32_t sb, std::int32_t n) const {
+  /// Bit c set when the float volume of slot si of a overlaps that of slot sb + c of b, c < 4.
+  [[nodiscard]] unsigned float_overlap_slots(std::int32_t si, std::int32_t sb) const {
+#if defined(__SSE2__)
+    __m128 ok = _mm_castsi128_ps(_mm_set1_epi32(-1));
+    for (int k = 0; k < N; ++k) {
+      const __m128 a_lo = _mm_set1_ps(a_.slot_lo(k)[to_size(si)]);
+      const __m128 a_hi = _mm_set1_ps(a_.slot_hi(k)[to_size(si)]);
+      ok = _mm_and_ps(ok, _mm_cmple_ps(_mm_loadu_ps(b_.slot_lo(k) + sb), a_hi));
+      ok = _mm_and_ps(ok, _mm_cmple_ps(a_lo, _mm_loadu_ps(b_.slot_hi(k) + sb)));
+    }
+    return static_cast<unsigned>(_mm_movemask_ps(ok));
+#else
     unsigned mask = 0;
-    for (std::int32_t c = 0; c < n; ++c) {
-      const Dop<N>& tj = bounds_b_[to_size(order_b_[to_size(sb + c)])];
-      bool ok = true;
-      for (std::size_t k = 0; k < static_cast<std::size_t>(N); ++k) {
-        ok = ok & (ti.lo[k] <= tj.hi[k]) & (tj.lo[k] <= ti.hi[k]);
+    for (int c = 0; c < kWidth; ++c) {
+      bool hit = true;
+      for (int k = 0; k < N; ++k) {
+        hit = hit && b_.slot_lo(k)[to_size(sb + c)] <= a_.slot_hi(k)[to_size(si)] &&
+              a_.slot_lo(k)[to_size(si)] <= b_.slot_hi(k)[to_size(sb + c)];
       }
-      mask |= static_cast<unsigned>(ok) << c;
+      mask |= static_cast<unsigned>(hit) << c;
     }
     return mask;
+#endif
   }
 
+  /// The exact (double) volume test of a triangle pair.
+  [[nodiscard]] static bool overlap(const Dop<N>& a, const Dop<N>& b) {
+    bool ok = true;
+    for (std::size_t k = 0; k < static_cast<std::size_t>(N); ++k) {
+      ok = ok & (a.lo[k] <= b.hi[k]) & (b.lo[k] <= a.hi[k]);
+    }
+    return ok;
+  }
+
+  /// The pair of slots (si, sj) holding (ti, tj) shares a certified vertex (and not three
+  /// vertices): count it in the sieve unless its parts are excluded, and drop it.
+  bool settles(std::int32_t si, std::int32_t sj, std::int32_t ti, std::int32_t tj) {
+    const auto& ci = sieve_->slots->corners[to_size(si)];
+    const unsigned shared = shared_lanes(ci, sieve_->slots->corners[to_size(sj)]);
+    if (shared == 0 || shared == 7u) return false;
+    for (unsigned m = shared; m != 0; m &= m - 1) {
+      if (sieve_->certified[to_size(ci[static_cast<std::size_t>(std::countr_zero(m))])] != 0) {
+        if (!sieve_->topology->triangles_excluded(std::min(ti, tj), std::max(ti, tj))) {
+          ++sieve_->settled;
+        }
+        return true;
+      }
+    }
+    return false;
+  }
+
+  FanSieve* sieve_;
+  const Bvh<N>& a_;
+  const Bvh<N>& b_;
   std::span<const WideBvhNode<N>> wide_a_;
   std::span<const WideBvhNode<N>> wide_b_;
   std::span<const std::int32_t> order_a_;
@@ -277,6 +367,69 @@ bool self_traverse_some(
   return Walk<N, true>(
              bvh, triangle_bounds, bvh, triangle_bounds, scratch.stack, out, bv_tests, max_pairs)
       .run();
+}
+
+template <int N>
+bool self_traverse_some(
+    const Bvh<N>& bvh,
+    std::span<const Dop<N>> triangle_bounds,
+    TraversalScratch& scratch,
+    std::vector<TrianglePair>& out,
+    std::int64_t& bv_tests,
+    std::size_t max_pairs,
+    FanSieve& sieve) {
+  if (bvh.empty()) return true;
+  assert(sieve.slots != nullptr && sieve.topology != nullptr);
+  assert(sieve.slots->corners.size() == bvh.triangle_order().size());
+  assert(sieve.certified.empty() || sieve.full.size() == sieve.slots->corners.size());
+  if (sieve.certified.empty()) {
+    return self_traverse_some(bvh, triangle_bounds, scratch, out, bv_tests, max_pairs);
+  }
+  return Walk<N, true, true>(
+             bvh,
+             triangle_bounds,
+             bvh,
+             triangle_bounds,
+             scratch.stack,
+             out,
+             bv_tests,
+             max_pairs,
+             &sieve)
+      .run();
+}
+
+SlotAdjacency::SlotAdjacency(const FeatureTopology& topology, std::span<const std::int32_t> order)
+    : corners(order.size()), window(order.size(), 0) {
+  for (std::size_t s = 0; s < order.size(); ++s) {
+    const auto& t = topology.triangle(order[s]);
+    const bool degenerate = t[0] == t[1] || t[1] == t[2] || t[0] == t[2];
+    corners[s] = degenerate ? std::array<std::int32_t, 4>{-1, -1, -1, -1}
+                            : std::array<std::int32_t, 4>{t[0], t[1], t[2], -1};
+  }
+  const auto n = static_cast<std::int32_t>(order.size());
+  for (std::int32_t s = 0; s < n; ++s) {
+    for (std::int32_t d = 0; d < 2 * kReach; ++d) {
+      const std::int32_t o = s + d - kReach;
+      if (d == kReach || o < 0 || o >= n) continue;
+      const unsigned shared = shared_lanes(corners[to_size(s)], corners[to_size(o)]);
+      if (shared == 0 || shared == 7u) continue;
+      if (topology.triangles_excluded(order[to_size(s)], order[to_size(o)])) continue;
+      window[to_size(s)] |= std::uint64_t{1} << d;
+    }
+  }
+}
+
+void certified_slots(
+    const SlotAdjacency& slots,
+    std::span<const std::uint8_t> certified,
+    std::vector<std::uint8_t>& full) {
+  full.resize(slots.corners.size());
+  for (std::size_t s = 0; s < full.size(); ++s) {
+    const auto& c = slots.corners[s];
+    full[s] = static_cast<std::uint8_t>(
+        c[0] >= 0 && certified[to_size(c[0])] != 0 && certified[to_size(c[1])] != 0 &&
+        certified[to_size(c[2])] != 0);
+  }
 }
 
 template <int N>
@@ -351,6 +504,22 @@ template bool self_traverse_some<8>(
     std::vector<TrianglePair>&,
     std::int64_t&,
     std::size_t);
+template bool self_traverse_some<3>(
+    const Bvh<3>&,
+    std::span<const Dop<3>>,
+    TraversalScratch&,
+    std::vector<TrianglePair>&,
+    std::int64_t&,
+    std::size_t,
+    FanSieve&);
+template bool self_traverse_some<8>(
+    const Bvh<8>&,
+    std::span<const Dop<8>>,
+    TraversalScratch&,
+    std::vector<TrianglePair>&,
+    std::int64_t&,
+    std::size_t,
+    FanSieve&);
 template void self_traverse<3>(
     const Bvh<3>&,
     std::span<const Dop<3>>,
