@@ -4,11 +4,39 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <limits>
+#include <span>
 #include <utility>
+#include <vector>
 
 #include "ccd/orientation.hpp"
 
 namespace skelcd::culling {
+namespace {
+
+/// ccd::detail::cross_component_static on differences already taken: the sign of
+/// bx·cy − by·cx for (bx, by) = (b − a) and (cx, cy) = (c − a) in the two kept coordinates, rounded
+/// as that function rounds them, with its bound ((3 + 16ε) ε · permanent, which covers the
+/// differences' rounding) and its refusals. Bit for bit the same answer, without taking the same
+/// differences again for every sign of a fan.
+inline int cross_sign_static(double bx, double by, double cx, double cy) {
+  constexpr double kHalfUlp = std::numeric_limits<double>::epsilon() / 2.0;
+  constexpr double kErrBound = (3.0 + 16.0 * kHalfUlp) * kHalfUlp;
+  const double left = bx * cy;
+  const double right = by * cx;
+  const double det = left - right;
+  const double permanent = std::abs(left) + std::abs(right);
+  if (!(permanent > std::numeric_limits<double>::min() * 0x1p64) ||
+      !(permanent < std::numeric_limits<double>::infinity())) {
+    return ccd::detail::kUndecided;
+  }
+  const double bound = kErrBound * permanent;
+  if (det > bound) return 1;
+  if (-det > bound) return -1;
+  return ccd::detail::kUndecided;
+}
+
+}  // namespace
 
 VertexFans::VertexFans(
     std::span<const std::array<std::int32_t, 3>> triangles, std::int32_t num_vertices) {
@@ -97,29 +125,44 @@ bool VertexFans::certified(const skinning::Positions& x, std::int32_t v) const {
   // m triangles: (v, s[i], s[i + 1]), the last one wrapping around when the fan is closed.
   const std::size_t m = closed ? s.size() : (s.empty() ? 0 : s.size() - 1);
   if (m < (closed ? 3u : 1u)) return false;
-  const auto point = [&](std::int32_t i) { return Eigen::Vector3d(x(i, 0), x(i, 1), x(i, 2)); };
-  const auto spoke = [&](std::size_t i) { return point(s[i % s.size()]); };
-  const Eigen::Vector3d c = point(v);
+  // The spokes relative to v, once: every sign below is a function of these differences (the
+  // static filter would round the same subtractions each time it needs them).
+  // On the stack for fans of up to 32 spokes, else in this thread's buffer (kept).
+  constexpr std::size_t kStackSpokes = 32;
+  std::array<std::array<double, 3>, kStackSpokes + 1> on_stack;
+  thread_local std::vector<std::array<double, 3>> on_heap;
+  if (s.size() > kStackSpokes && on_heap.size() < s.size() + 1) on_heap.resize(s.size() + 1);
+  const std::span<std::array<double, 3>> d =
+      s.size() > kStackSpokes ? std::span<std::array<double, 3>>(on_heap) : on_stack;
+  const double cx = x(v, 0), cy = x(v, 1), cz = x(v, 2);
+  for (std::size_t i = 0; i < s.size(); ++i) {
+    d[i] = {x(s[i], 0) - cx, x(s[i], 1) - cy, x(s[i], 2) - cz};
+  }
+  d[s.size()] = d[0];  // spoke m of a closed fan is spoke 0
   // The projection: drop the axis where the fan's (approximate) normal is largest. Any choice is
   // sound; this one makes the certificate likely.
-  Eigen::Vector3d n = Eigen::Vector3d::Zero();
-  for (std::size_t i = 0; i < m; ++i) n += (spoke(i) - c).cross(spoke(i + 1) - c);
-  int k = 0;
-  if (std::abs(n.y()) > std::abs(n[k])) k = 1;
-  if (std::abs(n.z()) > std::abs(n[k])) k = 2;
-  const int i_axis = (k + 1) % 3;
-  const int j_axis = (k + 2) % 3;
-  // orient(p, q) in the projection: the k-th component of (p − v) × (q − v), or kUndecided.
-  const auto orient = [&](const Eigen::Vector3d& p, const Eigen::Vector3d& q) {
-    return ccd::detail::cross_component_static(c, p, q, i_axis, j_axis);
+  double nx = 0.0, ny = 0.0, nz = 0.0;
+  for (std::size_t i = 0; i < m; ++i) {
+    const auto& a = d[i];
+    const auto& b = d[i + 1];
+    nx += a[1] * b[2] - a[2] * b[1];
+    ny += a[2] * b[0] - a[0] * b[2];
+    nz += a[0] * b[1] - a[1] * b[0];
+  }
+  std::size_t k = 0;
+  if (std::abs(ny) > std::abs(nx)) k = 1;
+  if (std::abs(nz) > std::abs(k == 0 ? nx : ny)) k = 2;
+  const std::size_t i_axis = (k + 1) % 3;
+  const std::size_t j_axis = (k + 2) % 3;
+  // orient(p, q) in the projection: the k-th component of (p − v) × (q − v), decided by the
+  // static filter of ccd::detail::cross_component_static on the same differences, or kUndecided.
+  const auto orient = [&](std::size_t p, std::size_t q) {
+    return cross_sign_static(d[p][i_axis], d[p][j_axis], d[q][i_axis], d[q][j_axis]);
   };
-  const Eigen::Vector3d r = spoke(0);
   int sign = 0;
   int covering = 0;
   for (std::size_t i = 0; i < m; ++i) {
-    const Eigen::Vector3d a = spoke(i);
-    const Eigen::Vector3d b = spoke(i + 1);
-    const int o = orient(a, b);
+    const int o = orient(i, i + 1);
     if (o == ccd::detail::kUndecided) return false;
     if (sign == 0) sign = o;
     if (o != sign) return false;
@@ -129,8 +172,8 @@ bool VertexFans::certified(const skinning::Positions& x, std::int32_t v) const {
     if (i == 0) {
       ++covering;
     } else if (!closed || i + 1 < m) {
-      const int o1 = orient(a, r);
-      const int o2 = orient(r, b);
+      const int o1 = orient(i, 0);
+      const int o2 = orient(0, i + 1);
       if (o1 == ccd::detail::kUndecided || o2 == ccd::detail::kUndecided) return false;
       if (o1 == sign && o2 == sign) ++covering;
     }

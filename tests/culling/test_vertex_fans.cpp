@@ -10,7 +10,9 @@
 #include <string>
 #include <vector>
 
+#include "ccd/orientation.hpp"
 #include "ccd/triangle_triangle.hpp"
+#include "culling/feature_topology.hpp"
 #include "culling/method.hpp"
 #include "culling/vertex_fans.hpp"
 #include "skinning/load.hpp"
@@ -172,6 +174,100 @@ TEST(VertexFans, CertifiedFansNeverIntersectThemselves) {
   EXPECT_GT(certified, 500);
   EXPECT_GT(refused, 300);
   EXPECT_GT(refused_and_intersecting, 100);
+}
+
+/// VertexFans::certified as it was before it took the spokes' differences once (every sign through
+/// ccd::detail::cross_component_static on the points): the reference for the rewrite.
+bool certified_two_signs_per_sector(
+    const VertexFans& fans, const skinning::Positions& x, std::int32_t v) {
+  const std::span<const std::int32_t> s = fans.spokes(v);
+  const bool closed = fans.closed(v);
+  const std::size_t m = closed ? s.size() : (s.empty() ? 0 : s.size() - 1);
+  if (m < (closed ? 3u : 1u)) return false;
+  const auto point = [&](std::int32_t i) { return Eigen::Vector3d(x(i, 0), x(i, 1), x(i, 2)); };
+  const auto spoke = [&](std::size_t i) { return point(s[i % s.size()]); };
+  const Eigen::Vector3d c = point(v);
+  Eigen::Vector3d n = Eigen::Vector3d::Zero();
+  for (std::size_t i = 0; i < m; ++i) n += (spoke(i) - c).cross(spoke(i + 1) - c);
+  int k = 0;
+  if (std::abs(n.y()) > std::abs(n[k])) k = 1;
+  if (std::abs(n.z()) > std::abs(n[k])) k = 2;
+  const int i_axis = (k + 1) % 3;
+  const int j_axis = (k + 2) % 3;
+  const auto orient = [&](const Eigen::Vector3d& p, const Eigen::Vector3d& q) {
+    return ccd::detail::cross_component_static(c, p, q, i_axis, j_axis);
+  };
+  const Eigen::Vector3d r = spoke(0);
+  int sign = 0;
+  int covering = 0;
+  for (std::size_t i = 0; i < m; ++i) {
+    const Eigen::Vector3d a = spoke(i);
+    const Eigen::Vector3d b = spoke(i + 1);
+    const int o = orient(a, b);
+    if (o == ccd::detail::kUndecided) return false;
+    if (sign == 0) sign = o;
+    if (o != sign) return false;
+    if (i == 0) {
+      ++covering;
+    } else if (!closed || i + 1 < m) {
+      const int o1 = orient(a, r);
+      const int o2 = orient(r, b);
+      if (o1 == ccd::detail::kUndecided || o2 == ccd::detail::kUndecided) return false;
+      if (o1 == sign && o2 == sign) ++covering;
+    }
+  }
+  return covering == 1;
+}
+
+// The certificate from the spokes' differences taken once: the same answer as the filter on the
+// points on random fans, on lattice fans whose spokes fall exactly on the ray or on each other
+// (undecided signs), on fans of 40 spokes (past the stack buffer), and on every vertex of real
+// characters.
+TEST(VertexFans, DifferencesTakenOnceGiveTheSameCertificates) {
+  std::mt19937_64 rng(99);
+  std::uniform_int_distribution<int> lattice(-2, 2);
+  std::uniform_real_distribution<double> unit(-1.0, 1.0);
+  std::uniform_int_distribution<int> spokes(3, 9);
+  int certified = 0, refused = 0;
+  for (int n = 0; n < 20000; ++n) {
+    const int m = n % 50 == 1 ? 40 : spokes(rng);
+    const bool closed = n % 2 == 0;
+    const auto tris = fan(m, closed);
+    std::vector<Eigen::Vector3d> p{Eigen::Vector3d::Zero()};
+    double angle = 0;
+    for (int i = 0; i < m; ++i) {
+      if (n % 3 == 0) {  // a small lattice: exact zeros and repeated directions are common
+        p.emplace_back(lattice(rng), lattice(rng), lattice(rng) * 0.25);
+      } else {
+        const double radius = 0.2 + std::abs(unit(rng));
+        p.emplace_back(radius * std::cos(angle), radius * std::sin(angle), 0.5 * unit(rng));
+        angle += 3.0 * std::numbers::pi / m * (0.3 + std::abs(unit(rng)));
+      }
+    }
+    const auto x = positions(p);
+    const VertexFans fans(tris, m + 1);
+    const bool expected = certified_two_signs_per_sector(fans, x, 0);
+    ASSERT_EQ(fans.certified(x, 0), expected) << "case " << n;
+    ++(expected ? certified : refused);
+  }
+  EXPECT_GT(certified, 2000);
+  EXPECT_GT(refused, 2000);
+  for (const std::string file : {"CesiumMan.glb", "RobotExpressive.glb"}) {
+    const auto model = skinning::load_model(test::asset("characters/" + file));
+    const skinning::Topology topo = skinning::build_topology(*model.mesh);
+    const FeatureTopology ft(*model.mesh, topo);
+    const VertexFans& fans = ft.fans();
+    const auto motion = model.motion();
+    skinning::Positions posed, welded;
+    for (const int k : {0, motion->num_samples() / 2}) {
+      motion->positions(k, posed);
+      skinning::gather_welded(topo, posed, welded);
+      for (std::int32_t v = 0; v < topo.num_welded_vertices(); ++v) {
+        ASSERT_EQ(fans.certified(welded, v), certified_two_signs_per_sector(fans, welded, v))
+            << file << " sample " << k << " vertex " << v;
+      }
+    }
+  }
 }
 
 /// The exact triangle test under another name: run_dcd_tests settles pairs by fans only for
