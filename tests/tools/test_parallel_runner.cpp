@@ -179,6 +179,49 @@ TEST(ParallelRunner, IncrementalDcdRowsHoldTheFullDcdsPairsWithFewerTests) {
   }
 }
 
+// Without --block-samples the blocks are an even number of nearly equal runs (two workers finish
+// together): read from the rows, where a block's first DCD is a full one (the full run's counters)
+// and the others are updates.
+TEST(ParallelRunner, DefaultBlocksAreAnEvenNumberOfNearlyEqualRuns) {
+  for (const int frames : {100, 45}) {
+    SCOPED_TRACE(frames);
+    const auto l = load("gen:rope?triangles=200&frames=" + std::to_string(frames));
+    std::vector<FrameReport> rows[2];
+    RunPlan plan;
+    for (const int incremental : {0, 1}) {
+      RunOptions options;
+      options.method = "bvh";
+      options.threads = 2;
+      options.incremental_dcd = incremental != 0;
+      ClipRunner runner(*l.motion, options);
+      plan = runner.plan();
+      rows[incremental] = collect(runner);
+    }
+    ASSERT_EQ(rows[0].size(), rows[1].size());
+    std::vector<std::int32_t> starts;
+    for (std::size_t i = 0; i < rows[0].size(); ++i) {
+      const auto& full = rows[0][i].row;
+      const auto& inc = rows[1][i].row;
+      if (full.kind != QueryKind::dcd) continue;
+      if (full.counters.candidate_pairs == inc.counters.candidate_pairs &&
+          full.counters.tt_tests == inc.counters.tt_tests) {
+        starts.push_back(full.sample);
+      }
+    }
+    ASSERT_FALSE(starts.empty());
+    EXPECT_EQ(starts.front(), 0);
+    starts.push_back(frames);  // one past the last block
+    std::vector<std::int32_t> sizes;
+    for (std::size_t b = 0; b + 1 < starts.size(); ++b) sizes.push_back(starts[b + 1] - starts[b]);
+    const auto [smallest, largest] = std::minmax_element(sizes.begin(), sizes.end());
+    EXPECT_EQ(sizes.size() % 2, 0u) << "an even number of blocks";
+    EXPECT_LE(*largest - *smallest, 1) << "sizes differ by at most one sample";
+    EXPECT_EQ(plan.blocks, static_cast<std::int32_t>(sizes.size()));
+    EXPECT_EQ(plan.block_samples, *largest);
+    EXPECT_EQ(plan.threads, 2);
+  }
+}
+
 // The rope (a closed tube) coils into itself from sample 17 of 24.
 const std::string kRope = "gen:rope?triangles=200&frames=24";
 

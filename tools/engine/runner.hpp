@@ -53,7 +53,8 @@ struct RunOptions {
   /// A run is serial anyway when its method carries state between queries that would change its
   /// rows (RunPlan::serial_reason says why).
   std::int32_t threads = 1;
-  /// Samples per block a worker checks in a row (0: chosen from the clip length and threads).
+  /// Samples per block a worker checks in a row (0: chosen from the clip length: an even number
+  /// of blocks, whatever the thread count, whose sizes differ by at most one sample).
   std::int32_t block_samples = 0;
   /// The factory's methods keep no state between queries that changes their findings or counters
   /// (methods of make_method are classified by name; a custom factory's only through this).
@@ -76,7 +77,8 @@ struct RunPlan {
   std::int32_t intervals = 0;      ///< CCD intervals checked (0 for --query dcd)
   std::int64_t rows = 0;           ///< FrameReports the run produces
   std::int32_t threads = 1;        ///< workers the run uses (1: serial)
-  std::int32_t block_samples = 0;  ///< samples per block of a parallel run (0 when serial)
+  std::int32_t block_samples = 0;  ///< most samples in a block of a parallel run (0 when serial)
+  std::int32_t blocks = 0;         ///< blocks of a parallel run (0 when serial)
   /// Why a run asked for several threads is serial (empty when it is not).
   std::string serial_reason;
 };
@@ -126,8 +128,14 @@ class ClipRunner {
   bool bones_ = false;  ///< the queries carry the bones' transforms (the method needs them)
   /// DCD updated from the CCD contacts (RunOptions::incremental_dcd).
   bool incremental_dcd_ = false;
-  /// Sample units (DCD at k, then CCD k → k+1) per block, whatever the thread count.
-  std::int32_t block_samples_ = 4;
+  /// Block i's sample units [first, end) (a unit: the DCD at k, then the CCD k → k+1), whatever
+  /// the thread count: RunOptions::block_samples each, or the units split into blocks_ as equal as
+  /// can be.
+  [[nodiscard]] std::pair<std::int32_t, std::int32_t> block(std::int32_t i) const;
+
+  std::int32_t units_ = 0;          ///< sample units of the run, from plan_.first_sample
+  std::int32_t blocks_ = 1;         ///< blocks the units are cut into
+  std::int32_t block_samples_ = 0;  ///< RunOptions::block_samples (0: balanced blocks)
 };
 
 /// Maps welded ids (culling's numbering) back to the file's own numbering (part, index).
