@@ -7,8 +7,9 @@
 //
 // Shared corners: with one shared vertex s and both triangles non-degenerate, A n B is more than
 // {s} iff the edge of A opposite s meets B or the edge of B opposite s meets A; with a shared edge,
-// iff the triangles are coplanar and lie on the same side of it. Degenerate triangles that share
-// corners go to an exact rational enumeration of the extreme points of A n B.
+// iff the triangles are coplanar and lie on the same side of it. A degenerate triangle sharing
+// corners with a solid one is decided in the solid's plane (flat_meets_beyond_shared), two
+// degenerate ones on their common line (flats_meet_beyond_shared).
 //
 // The common cases first, with the same exact answers (issue 14): each triangle's plane normal is
 // computed once in doubles, with the permanents of its components, and serves as a static filter
@@ -25,7 +26,6 @@
 #include <cmath>
 #include <limits>
 #include <utility>
-#include <vector>
 
 #include "ccd/detail/filtered.hpp"
 #include "ccd/orientation.hpp"
@@ -417,80 +417,61 @@ bool triangles_meet(const Triangle& ta, const Triangle& tb, const int oa[3], con
   return false;
 }
 
-// --- exact rational enumeration (degenerate triangles with shared corners) ----------------------
+// --- two degenerate triangles with shared corners ------------------------------------------------
+// A zero-area triangle is the segment (or point) its corners span. Two of them sharing a vertex v
+// both lie on lines through v: if either is the point v, or the lines differ, they meet at v
+// alone. Otherwise they lie on one line, and the intersection is the overlap of two intervals of
+// it; it goes beyond the shared corners iff it reaches past their hull at either end. Exact signs
+// of polynomials of degree 2 (the old code enumerated extreme points in GMP rationals).
 
-using Q3 = detail::Point3<mpq_class>;
-
-bool is_zero(const Q3& v) { return v.x == 0 && v.y == 0 && v.z == 0; }
-bool equal(const Q3& a, const Q3& b) { return a.x == b.x && a.y == b.y && a.z == b.z; }
-
-bool q_on_segment(const Q3& p, const Q3& a, const Q3& b) {
-  return is_zero(cross(b - a, p - a)) && dot(p - a, p - b) <= 0;
+// Sign of (x - y) . (d - v): x before (-1), level with (0) or after (+1) y along v -> d.
+int along(const Vector3d& x, const Vector3d& y, const Vector3d& v, const Vector3d& d) {
+  return exact_sign(
+      [&]<typename T>() -> T { return dot(lift<T>(x) - lift<T>(y), lift<T>(d) - lift<T>(v)); });
 }
 
-bool q_in_triangle(const Q3& p, const Q3& a, const Q3& b, const Q3& c) {
-  const Q3 n = cross(b - a, c - a);
-  if (is_zero(n)) return q_on_segment(p, a, b) || q_on_segment(p, b, c) || q_on_segment(p, c, a);
-  if (dot(n, p - a) != 0) return false;
-  return dot(n, cross(b - a, p - a)) >= 0 && dot(n, cross(c - b, p - b)) >= 0 &&
-         dot(n, cross(a - c, p - c)) >= 0;
+// The first and last of `points` along v -> d.
+void extremes_along(
+    const Vector3d* const* points,
+    int n,
+    const Vector3d& v,
+    const Vector3d& d,
+    const Vector3d*& first,
+    const Vector3d*& last) {
+  first = last = points[0];
+  for (int i = 1; i < n; ++i) {
+    if (along(*points[i], *first, v, d) < 0) first = points[i];
+    if (along(*points[i], *last, v, d) > 0) last = points[i];
+  }
 }
 
-// Is some point of A n B outside the shared set (one point, or the segment between two)?
-bool meet_beyond_shared_rational(const std::array<Q3, 3>& a,
-                                 const std::array<Q3, 3>& b,
-                                 const std::vector<Q3>& shared) {
-  // Candidates for the extreme points of A n B: corners in the other triangle, single-point
-  // edge-edge intersections, and transversal edge-plane intersections inside the other triangle.
-  std::vector<Q3> candidates;
-  for (const auto& p : a) {
-    if (q_in_triangle(p, b[0], b[1], b[2])) candidates.push_back(p);
-  }
-  for (const auto& p : b) {
-    if (q_in_triangle(p, a[0], a[1], a[2])) candidates.push_back(p);
-  }
+bool flats_meet_beyond_shared(
+    const Vector3d* const a[3], const Vector3d* const b[3], const SharedCorners& shared_with_b) {
+  const Vector3d* shared[3];
+  int ns = 0;
   for (int i = 0; i < 3; ++i) {
-    const Q3& p = a[static_cast<std::size_t>(i)];
-    const Q3& q = a[static_cast<std::size_t>((i + 1) % 3)];
-    for (int j = 0; j < 3; ++j) {
-      const Q3& r = b[static_cast<std::size_t>(j)];
-      const Q3& s = b[static_cast<std::size_t>((j + 1) % 3)];
-      const Q3 d1 = q - p;
-      const Q3 d2 = s - r;
-      const Q3 w = r - p;
-      const Q3 n = cross(d1, d2);
-      if (is_zero(n) || dot(n, w) != 0) continue;  // parallel, or not coplanar
-      const mpq_class nn = dot(n, n);
-      const mpq_class u = dot(cross(w, d2), n) / nn;
-      const mpq_class v = dot(cross(w, d1), n) / nn;
-      if (u < 0 || u > 1 || v < 0 || v > 1) continue;
-      candidates.push_back({p.x + u * d1.x, p.y + u * d1.y, p.z + u * d1.z});
-    }
+    if (shared_with_b[static_cast<std::size_t>(i)] >= 0) shared[ns++] = a[i];
   }
-  const auto edge_plane = [&](const std::array<Q3, 3>& edges, const std::array<Q3, 3>& tri) {
-    const Q3 n = cross(tri[1] - tri[0], tri[2] - tri[0]);
-    if (is_zero(n)) return;
-    for (int i = 0; i < 3; ++i) {
-      const Q3& p = edges[static_cast<std::size_t>(i)];
-      const Q3& q = edges[static_cast<std::size_t>((i + 1) % 3)];
-      const mpq_class op = dot(n, p - tri[0]);
-      const mpq_class oq = dot(n, q - tri[0]);
-      if (!((op > 0 && oq < 0) || (op < 0 && oq > 0))) continue;
-      const mpq_class lambda = op / (op - oq);
-      const Q3 x{p.x + lambda * (q.x - p.x), p.y + lambda * (q.y - p.y), p.z + lambda * (q.z - p.z)};
-      if (q_in_triangle(x, tri[0], tri[1], tri[2])) candidates.push_back(x);
-    }
-  };
-  edge_plane(a, b);
-  edge_plane(b, a);
-  for (const auto& x : candidates) {
-    const bool in_shared = shared.size() == 1 ? equal(x, shared[0]) : q_on_segment(x, shared[0], shared[1]);
-    if (!in_shared) return true;
+  assert(ns > 0);
+  const Vector3d& v = *shared[0];
+  // A corner of each away from v: none means that triangle is the point v.
+  const Vector3d* da = nullptr;
+  const Vector3d* db = nullptr;
+  for (int i = 0; i < 3; ++i) {
+    if (da == nullptr && *a[i] != v) da = a[i];
+    if (db == nullptr && *b[i] != v) db = b[i];
   }
-  return false;
+  if (da == nullptr || db == nullptr) return false;
+  if (!collinear(v, *da, *db)) return false;  // two lines through v meet at v alone
+  // One line: compare along v -> da.
+  const Vector3d *a_first, *a_last, *b_first, *b_last, *s_first, *s_last;
+  extremes_along(a, 3, v, *da, a_first, a_last);
+  extremes_along(b, 3, v, *da, b_first, b_last);
+  extremes_along(shared, ns, v, *da, s_first, s_last);
+  const Vector3d* first = along(*a_first, *b_first, v, *da) > 0 ? a_first : b_first;
+  const Vector3d* last = along(*a_last, *b_last, v, *da) < 0 ? a_last : b_last;
+  return along(*first, *s_first, v, *da) < 0 || along(*last, *s_last, v, *da) > 0;
 }
-
-Q3 rational(const Vector3d& p) { return lift<mpq_class>(p); }
 
 // shared_with_b seen from b: corner j of b is corner inverse[j] of a.
 SharedCorners inverse(const SharedCorners& shared_with_b) {
@@ -590,15 +571,7 @@ bool no_shared_corner_intersect(const TriangleTriangleQuery& q) {
     return ta.degenerate ? flat_meets_beyond_shared(a, shared_with_b, tb, b)
                          : flat_meets_beyond_shared(b, inverse(shared_with_b), ta, a);
   }
-  // Both degenerate: rare enough for the rational enumeration.
-  std::vector<Q3> shared;
-  for (int i = 0; i < 3; ++i) {
-    if (shared_with_b[static_cast<std::size_t>(i)] >= 0) shared.push_back(rational(*a[i]));
-  }
-  return meet_beyond_shared_rational(
-      {rational(q.a0), rational(q.a1), rational(q.a2)},
-      {rational(q.b0), rational(q.b1), rational(q.b2)},
-      shared);
+  return flats_meet_beyond_shared(a, b, shared_with_b);
 }
 
 // The exact side test of the shared edge (s0, s1): fa and fb strictly on the same side of it.
@@ -666,13 +639,34 @@ bool shared_corners_intersect(
   assert(na == nb && ns == shared_count);
 
   if (shared_count == 1) {
-    // Beyond the shared vertex iff an edge opposite it meets the other triangle.
+    // Beyond the shared vertex v iff an edge opposite v meets the other triangle. Each plane
+    // passes through v: a triangle whose free corners are strictly on one side of the other's
+    // plane meets that plane at v alone, and then the triangles meet at v alone.
     const Vector3d& pa0 = *a[a_free[0]];
     const Vector3d& pa1 = *a[a_free[1]];
-    if (segment_triangle(pa0, pa1, tb, side(pb, pa0), side(pb, pa1))) return true;
+    const int oa0 = side(pb, pa0);
+    const int oa1 = side(pb, pa1);
+    if (oa0 * oa1 > 0) return false;
     const Vector3d& pb0 = *b[b_free[0]];
     const Vector3d& pb1 = *b[b_free[1]];
-    return segment_triangle(pb0, pb1, ta, side(pa, pb0), side(pa, pb1));
+    const int ob0 = side(pa, pb0);
+    const int ob1 = side(pa, pb1);
+    if (ob0 * ob1 > 0) return false;
+    if (oa0 != 0 && oa1 != 0 && ob0 != 0 && ob1 != 0) {
+      // Both free edges cross the other plane strictly, at X_a and X_b: a meets b's plane in the
+      // segment [v, X_a], b meets a's in [v, X_b], both on the line where the planes meet, and
+      // they overlap beyond v iff X_b lies in a's closed angle at v (whose trace on that line is
+      // the ray from v through X_a). orient3d(pb0, pb1, e0, e1) is X_b's side of a's edge
+      // (e0, e1) times the sign ob1 of the crossing (the segment is parallel to X_b - pb0, so
+      // the triple product reduces to the 2D orientation of (e0, e1, X_b) in a's plane): inside
+      // the angle iff both edges through v, in a's corner order, see X_b on their inner side.
+      const int v = s[0];
+      const int o1 = orient3d_filtered(pb0, pb1, *a[(v + 2) % 3], *a[v]);
+      const int o2 = orient3d_filtered(pb0, pb1, *a[v], *a[(v + 1) % 3]);
+      return ob1 * o1 >= 0 && ob1 * o2 >= 0;
+    }
+    // A free corner on the other's plane: the edges against the triangles.
+    return segment_triangle(pa0, pa1, tb, oa0, oa1) || segment_triangle(pb0, pb1, ta, ob0, ob1);
   }
 
   // Shared edge (s0, s1): beyond it iff coplanar with the free corners on the same side.

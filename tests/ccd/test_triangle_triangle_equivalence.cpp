@@ -30,35 +30,39 @@ namespace {
 using reference::triangles_intersect_reference;
 using V = Eigen::Vector3d;
 
-// Every SharedCorners a pair can have: the injective partial maps from a's corners to b's (1 + 9
-// + 18 + 6 = 34).
+// Every SharedCorners a pair can have: each of a's corners mapped to one of b's or to none (4^3 =
+// 64). Two of a's corners mapped to the same corner of b are one mesh vertex repeated by a
+// degenerate triangle (the DCD hands such pairs over: RobotExpressive has them); apply_shared
+// then gives them one position.
 std::vector<SharedCorners> all_shared_patterns() {
   std::vector<SharedCorners> out;
   for (int m0 = -1; m0 < 3; ++m0) {
     for (int m1 = -1; m1 < 3; ++m1) {
       for (int m2 = -1; m2 < 3; ++m2) {
-        const int m[3] = {m0, m1, m2};
-        bool injective = true;
-        for (int i = 0; i < 3; ++i) {
-          for (int j = i + 1; j < 3; ++j) injective = injective && (m[i] < 0 || m[i] != m[j]);
-        }
-        if (injective) {
-          out.push_back(
-              {static_cast<std::int8_t>(m0),
-               static_cast<std::int8_t>(m1),
-               static_cast<std::int8_t>(m2)});
-        }
+        out.push_back(
+            {static_cast<std::int8_t>(m0),
+             static_cast<std::int8_t>(m1),
+             static_cast<std::int8_t>(m2)});
       }
     }
   }
   return out;
 }
 
-// Gives b's shared corners the positions of a's.
+bool injective(const SharedCorners& shared) {
+  return (shared[0] < 0 || (shared[0] != shared[1] && shared[0] != shared[2])) &&
+         (shared[1] < 0 || shared[1] != shared[2]);
+}
+
+// Gives b's shared corners the positions of a's (and a's corners shared with the same corner of b
+// one position).
 void apply_shared(TriangleTriangleQuery& q, const SharedCorners& shared) {
-  const V* a[3] = {&q.a0, &q.a1, &q.a2};
+  V* a[3] = {&q.a0, &q.a1, &q.a2};
   V* b[3] = {&q.b0, &q.b1, &q.b2};
   for (std::size_t i = 0; i < 3; ++i) {
+    for (std::size_t k = 0; k < i; ++k) {
+      if (shared[i] >= 0 && shared[k] == shared[i]) *a[i] = *a[k];
+    }
     if (shared[i] >= 0) *b[static_cast<std::size_t>(shared[i])] = *a[i];
   }
 }
@@ -201,12 +205,12 @@ TEST(TriangleTriangleEquivalence, UniformRandomTriangles) {
 TEST(TriangleTriangleEquivalence, GridDegeneraciesEverySharedPatternEveryScale) {
   Generator gen(2);
   const auto patterns = all_shared_patterns();
-  ASSERT_EQ(patterns.size(), 34u);
+  ASSERT_EQ(patterns.size(), 64u);
   const double scales[] = {
       0x1p-1000, 0x1p-700, 0x1p-330, 0x1p-100, 0x1p-20, 1.0, 0x1p40, 0x1p150, 0x1p300};
   int n = 0;
   int hits = 0;
-  for (int round = 0; round < 12; ++round) {
+  for (int round = 0; round < 8; ++round) {
     for (int family = 0; family < kFamilies; ++family) {
       for (const SharedCorners& shared : patterns) {
         TriangleTriangleQuery q = gen.grid_query(family);
@@ -224,7 +228,7 @@ TEST(TriangleTriangleEquivalence, GridDegeneraciesEverySharedPatternEveryScale) 
       }
     }
   }
-  EXPECT_GT(hits, n / 5);
+  EXPECT_GT(hits, n / 8);
   EXPECT_LT(hits, n);
 }
 
@@ -234,7 +238,7 @@ TEST(TriangleTriangleEquivalence, NudgedContactsEverySharedPattern) {
   Generator gen(3);
   const auto patterns = all_shared_patterns();
   int n = 0;
-  for (int round = 0; round < 15; ++round) {
+  for (int round = 0; round < 8; ++round) {
     for (int family = 0; family < kFamilies; ++family) {
       for (const SharedCorners& shared : patterns) {
         TriangleTriangleQuery q = gen.grid_query(family);
@@ -293,12 +297,17 @@ TEST(TriangleTriangleEquivalence, NearlyCoplanarNeighboursFarFromTheOrigin) {
 // old code is not always right: the static filter of ccd::orient3d, which it calls, can take a
 // sign from a product that underflowed (see OldOrient3dFilterMissesAnUnderflow below). So both
 // are judged by the brute-force rational reference: the new test must always be right, and may
-// differ from the old one only where the old one is wrong.
+// differ from the old one only where the old one is wrong. Except with a repeated shared vertex
+// (two of a's corners shared with one corner of b): the old code's answer for a degenerate
+// triangle against a solid one counts two shared corners as a shared edge even when they are one
+// vertex, which the brute force does not, and the new code keeps the old answer there (the
+// other tests check it against the old code).
 TEST(TriangleTriangleEquivalence, ExtremeMagnitudesMixedInOneQuery) {
   Generator gen(5);
   const auto patterns = all_shared_patterns();
   const int exponents[] = {-1074, -1060, -1022, -700, -540, -400, -100, 0, 100, 300, 500};
   int old_wrong = 0;
+  int judged = 0;
   for (int n = 0; n < 1200; ++n) {
     V p[6];
     for (V& v : p) {
@@ -314,13 +323,23 @@ TEST(TriangleTriangleEquivalence, ExtremeMagnitudesMixedInOneQuery) {
     apply_shared(q, shared);
     const TriangleTriangleQuery swapped{q.b0, q.b1, q.b2, q.a0, q.a1, q.a2};
     const SharedCorners inv = inverse(shared);
+    if (!injective(shared)) {
+      // A repeated shared vertex: both implementations share a flaw there (see the note above).
+      ASSERT_EQ(triangles_intersect(q, shared), triangles_intersect_reference(q, shared))
+          << "extreme case " << n;
+      ASSERT_EQ(triangles_intersect(swapped, inv), triangles_intersect_reference(swapped, inv))
+          << "extreme case " << n << " (swapped)";
+      continue;
+    }
     const bool truth = test::brute_intersect(q, shared);
     ASSERT_EQ(triangles_intersect(q, shared), truth) << "extreme case " << n;
     ASSERT_EQ(triangles_intersect(swapped, inv), truth) << "extreme case " << n << " (swapped)";
     old_wrong += triangles_intersect_reference(q, shared) != truth ? 1 : 0;
     old_wrong += triangles_intersect_reference(swapped, inv) != truth ? 1 : 0;
+    judged += 2;
   }
-  std::cout << "  the old test was wrong on " << old_wrong << " of 2400 mixed-magnitude queries\n";
+  std::cout << "  the old test was wrong on " << old_wrong << " of " << judged
+            << " mixed-magnitude queries\n";
 }
 
 // The first such query the test above met. ccd::orient3d's static filter (ccd/orientation.hpp)
