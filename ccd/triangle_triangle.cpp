@@ -206,6 +206,9 @@ bool coplanar_segment_triangle(const Vector3d& p, const Vector3d& q, const Trian
 /// Below this a minor's permanent may hide an underflowed product (whose absolute error, 2^-1075,
 /// is then not within the slack of the relative bounds).
 constexpr double kMinorFloor = 0x1p-960;
+/// Minors whose permanents are all at least this make the side filter's underflow guard a single
+/// comparison (see sides).
+constexpr double kLargeMinor = 0x1p-900;
 
 struct Plane {
   const Vector3d* p0;
@@ -213,38 +216,45 @@ struct Plane {
   const Vector3d* p2;
   double n[3];
   double m[3];
-  bool certified_solid;  ///< some n_k is certainly nonzero: the triangle is not degenerate
+  bool large_minors;  ///< every m_k >= kLargeMinor
 };
 
-/// The minors of (p1 - p0) x (p2 - p0) and their permanents (no certification).
-inline Plane plane_minors(const Vector3d& p0, const Vector3d& p1, const Vector3d& p2) {
+/// The minors of (p1 - p0) x (p2 - p0) and their permanents.
+inline Plane plane_of(const Vector3d& p0, const Vector3d& p1, const Vector3d& p2) {
   const double ux = p1.x() - p0.x(), uy = p1.y() - p0.y(), uz = p1.z() - p0.z();
   const double vx = p2.x() - p0.x(), vy = p2.y() - p0.y(), vz = p2.z() - p0.z();
   const double yz = uy * vz, zy = uz * vy;
   const double zx = uz * vx, xz = ux * vz;
   const double xy = ux * vy, yx = uy * vx;
+  const double m0 = std::abs(yz) + std::abs(zy);
+  const double m1 = std::abs(zx) + std::abs(xz);
+  const double m2 = std::abs(xy) + std::abs(yx);
   return {
       &p0,
       &p1,
       &p2,
       {yz - zy, zx - xz, xy - yx},
-      {std::abs(yz) + std::abs(zy), std::abs(zx) + std::abs(xz), std::abs(xy) + std::abs(yx)},
-      false};
+      {m0, m1, m2},
+      (m0 >= kLargeMinor) && (m1 >= kLargeMinor) && (m2 >= kLargeMinor)};
 }
 
-inline Plane plane_of(const Vector3d& p0, const Vector3d& p1, const Vector3d& p2) {
-  Plane pl = plane_minors(p0, p1, p2);
-  // Shewchuk's orient2d bound on each component, (3 + 16 eps) eps m_k, taken as 4 eps m_k: the
-  // slack (about eps m_k) covers the two products' underflow (2^-1074) once m_k >= kMinorFloor.
-  // These are the components collinear() screens with the same filter. Branch-free (& and |).
+/// Some n_k is certainly nonzero: the triangle is not degenerate. Shewchuk's orient2d bound on
+/// each component, (3 + 16 eps) eps m_k, taken as 4 eps m_k: the slack (about eps m_k) covers the
+/// two products' underflow (2^-1074) once m_k >= kMinorFloor. These are the components collinear()
+/// screens with the same filter. Branch-free (& and |).
+inline bool certified_solid(const Plane& pl) {
   bool solid = false;
   for (int k = 0; k < 3; ++k) {
     const double m = pl.m[k];
     solid |= (m >= kMinorFloor) & (m < std::numeric_limits<double>::infinity()) &
              (std::abs(pl.n[k]) > 0x1p-51 * m);
   }
-  pl.certified_solid = solid;
-  return pl;
+  return solid;
+}
+
+/// The triangle of pl is degenerate, exactly (the filter first).
+inline bool degenerate(const Plane& pl) {
+  return !certified_solid(pl) && collinear(*pl.p0, *pl.p1, *pl.p2);
 }
 
 /// orient3d(p0, p1, p2, p) = sign of n . (p - p0), certain, or kUndecided. The determinant of the
@@ -274,36 +284,52 @@ inline int side(const Plane& pl, const Vector3d& p) {
   return s != detail::kUndecided ? s : orient3d_exact(*pl.p0, *pl.p1, *pl.p2, p);
 }
 
-/// The three sides(pl, *p[i]), exact: the filters computed together without branches, the exact
-/// predicate for any they leave undecided (rare).
-inline void sides(const Plane& pl, const Vector3d* const p[3], int o[3]) {
-  bool undecided[3];
-  bool any = false;
+/// The filter of side_static on three points without branches; bit i of the result is set where
+/// o[i] is not certain. With every m_k >= 2^-900 a minor's underflow (2^-1074) is under 2^-174
+/// m_k, so the guard reduces to P >= 2^-969 (for the three outer products, and a normal bound).
+template <bool kLargeMinors>
+inline unsigned sides_static(const Plane& pl, const Vector3d* const p[3], int o[3]) {
+  unsigned undecided = 0;
   for (int i = 0; i < 3; ++i) {
     const Vector3d& x = *p[i];
     const double wx = x.x() - pl.p0->x(), wy = x.y() - pl.p0->y(), wz = x.z() - pl.p0->z();
     const double det = pl.n[0] * wx + pl.n[1] * wy + pl.n[2] * wz;
     const double ax = std::abs(wx), ay = std::abs(wy), az = std::abs(wz);
     const double permanent = pl.m[0] * ax + pl.m[1] * ay + pl.m[2] * az;
-    const bool guarded = (permanent < std::numeric_limits<double>::infinity()) &
-                         (ax + ay + az + 1.0 <= permanent * 0x1p969);
+    bool guarded;
+    if constexpr (kLargeMinors) {
+      guarded = (permanent >= 0x1p-969) & (permanent < std::numeric_limits<double>::infinity());
+    } else {
+      guarded = (permanent < std::numeric_limits<double>::infinity()) &
+                (ax + ay + az + 1.0 <= permanent * 0x1p969);
+    }
     const double bound = 0x1p-50 * permanent;
     const int sign = static_cast<int>(det > bound) - static_cast<int>(-det > bound);
-    undecided[i] = !guarded | (sign == 0);
     o[i] = sign;
-    any |= undecided[i];
+    undecided |= static_cast<unsigned>(!guarded | (sign == 0)) << i;
   }
-  if (any) {
-    for (int i = 0; i < 3; ++i) {
-      if (undecided[i]) o[i] = orient3d_exact(*pl.p0, *pl.p1, *pl.p2, *p[i]);
-    }
+  return undecided;
+}
+
+/// o[i] = the exact orient3d where sides_static left it undecided (rare: out of line).
+[[gnu::noinline]] void settle_sides(
+    const Plane& pl, const Vector3d* const p[3], unsigned undecided, int o[3]) {
+  for (int i = 0; i < 3; ++i) {
+    if (undecided & (1u << i)) o[i] = orient3d_exact(*pl.p0, *pl.p1, *pl.p2, *p[i]);
   }
+}
+
+/// The three sides(pl, *p[i]), exact.
+inline void sides(const Plane& pl, const Vector3d* const p[3], int o[3]) {
+  const unsigned undecided =
+      pl.large_minors ? sides_static<true>(pl, p, o) : sides_static<false>(pl, p, o);
+  if (undecided != 0) settle_sides(pl, p, undecided, o);
 }
 
 /// orient3d(a, b, c, d), exact, through the same filter.
 inline int orient3d_filtered(
     const Vector3d& a, const Vector3d& b, const Vector3d& c, const Vector3d& d) {
-  return side(plane_minors(a, b, c), d);
+  return side(plane_of(a, b, c), d);
 }
 
 /// orient3d(p, q, c[e], c[e + 1]) for the three edges e of the triangle (c[0], c[1], c[2]), exact:
@@ -534,22 +560,21 @@ bool no_shared_corner_intersect(const TriangleTriangleQuery& q) {
   const Vector3d* a[3] = {&q.a0, &q.a1, &q.a2};
   const Vector3d* b[3] = {&q.b0, &q.b1, &q.b2};
   // Most candidate pairs are separated by one of the planes: a's corners against b's plane,
-  // then b's against a's (a degenerate triangle has no plane: zeros, as segment_triangle wants).
-  // Each plane once; degeneracy exact only when the filter cannot certify a normal component.
+  // then b's against a's. A degenerate triangle has no plane (the edge tests below want zeros):
+  // its exact sides are all 0, which the filter never contradicts, so degeneracy is settled only
+  // for pairs that no plane separates.
   const Plane pb = plane_of(q.b0, q.b1, q.b2);
-  const bool b_degenerate = !pb.certified_solid && collinear(q.b0, q.b1, q.b2);
-  int oa[3] = {0, 0, 0};
-  if (!b_degenerate) {
-    sides(pb, a, oa);
-    if (strictly_one_side(oa)) return false;
-  }
+  int oa[3];
+  sides(pb, a, oa);
+  if (strictly_one_side(oa)) return false;
   const Plane pa = plane_of(q.a0, q.a1, q.a2);
-  const bool a_degenerate = !pa.certified_solid && collinear(q.a0, q.a1, q.a2);
-  int ob[3] = {0, 0, 0};
-  if (!a_degenerate) {
-    sides(pa, b, ob);
-    if (strictly_one_side(ob)) return false;
-  }
+  int ob[3];
+  sides(pa, b, ob);
+  if (strictly_one_side(ob)) return false;
+  const bool b_degenerate = degenerate(pb);
+  const bool a_degenerate = degenerate(pa);
+  assert(!b_degenerate || (oa[0] == 0 && oa[1] == 0 && oa[2] == 0));
+  assert(!a_degenerate || (ob[0] == 0 && ob[1] == 0 && ob[2] == 0));
   if (!a_degenerate && !b_degenerate && oa[0] * oa[1] * oa[2] != 0 && ob[0] * ob[1] * ob[2] != 0) {
     return crossing_triangles_meet(a, b, oa, ob);
   }
@@ -612,8 +637,8 @@ bool shared_corners_intersect(
   const Vector3d* b[3] = {&q.b0, &q.b1, &q.b2};
   const Plane pa = plane_of(q.a0, q.a1, q.a2);
   const Plane pb = plane_of(q.b0, q.b1, q.b2);
-  const Triangle ta{q.a0, q.a1, q.a2, !pa.certified_solid && collinear(q.a0, q.a1, q.a2)};
-  const Triangle tb{q.b0, q.b1, q.b2, !pb.certified_solid && collinear(q.b0, q.b1, q.b2)};
+  const Triangle ta{q.a0, q.a1, q.a2, degenerate(pa)};
+  const Triangle tb{q.b0, q.b1, q.b2, degenerate(pb)};
   if (ta.degenerate || tb.degenerate) return degenerate_shared_intersect(q, shared_with_b, ta, tb);
 
   // Corners of a and b that are not shared (as many on each side: both are non-degenerate).
