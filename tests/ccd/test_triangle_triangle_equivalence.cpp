@@ -292,6 +292,73 @@ TEST(TriangleTriangleEquivalence, NearlyCoplanarNeighboursFarFromTheOrigin) {
   EXPECT_GT(hits, 1000);
 }
 
+// Corners within rounding of the other triangle's plane: b has two corners computed on a's plane
+// (inside a, so their true sides, tiny or zero, decide the answer) and one clearly off it, or
+// the reverse roles, or a shared corner with the third corner on the plane. The filters see
+// determinants of the size of their own error bound here, where a bound taken too small shows.
+TEST(TriangleTriangleEquivalence, CornersWithinRoundingOfThePlane) {
+  Generator gen(6);
+  int hits = 0;
+  for (int n = 0; n < 30000; ++n) {
+    const V origin = std::ldexp(1.0, gen.integer(-4, 10)) * gen.uniform_point();
+    const V a0 = origin + gen.uniform_point(), a1 = origin + gen.uniform_point(),
+            a2 = origin + gen.uniform_point();
+    const auto on_a = [&] {
+      const double u = 0.5 * (1.0 + gen.uniform()), v = 0.5 * (1.0 + gen.uniform()) * (1.0 - u);
+      return V(a0 + u * (a1 - a0) + v * (a2 - a0));
+    };
+    const V off = a0 + gen.uniform_point() + (a1 - a0).cross(a2 - a0) * (n % 2 ? 1.0 : -1.0);
+    TriangleTriangleQuery q{a0, a1, a2, on_a(), on_a(), off};
+    SharedCorners shared = kNoSharedCorners;
+    if (n % 3 == 1) {
+      q = {q.b0, q.b1, q.b2, a0, a1, a2};  // the near-plane corners on a's side
+    } else if (n % 3 == 2) {
+      q.b0 = a0;  // a shared vertex, one free corner of b on a's plane
+      shared = {0, -1, -1};
+    }
+    hits += expect_same(q, shared, "within rounding", n) ? 1 : 0;
+    if (::testing::Test::HasFailure()) return;
+  }
+  EXPECT_GT(hits, 1000);
+  EXPECT_LT(hits, 29000);
+}
+
+// Coplanar neighbours across a shared edge whose free corners lie within rounding of the edge's
+// line: the triangles are nearly degenerate, their normals small against their permanents, and
+// whether the free corners are on the same side (the answer, as they are coplanar) is decided
+// by signs the size of the rounding errors.
+TEST(TriangleTriangleEquivalence, CoplanarSlivers) {
+  Generator gen(7);
+  int hits = 0;
+  for (int n = 0; n < 20000; ++n) {
+    const double z = gen.uniform();  // the plane z = const: coplanar exactly
+    const V s0(gen.uniform(), gen.uniform(), z);
+    const V s1(gen.uniform(), gen.uniform(), z);
+    const auto near_line = [&] {
+      V p = s0 + (0.5 + 0.5 * gen.uniform()) * (s1 - s0);
+      p.z() = z;
+      return gen.integer(0, 1) ? gen.nudged(p) : p;
+    };
+    V fa = near_line(), fb = near_line();
+    fa.z() = fb.z() = z;
+    // Every corner order, and the edge shared as (0, 1), (1, 2) or (2, 0) of a.
+    const int rot = gen.integer(0, 2);
+    V ac[3];
+    ac[rot] = s0;
+    ac[(rot + 1) % 3] = s1;
+    ac[(rot + 2) % 3] = fa;
+    const bool flip = gen.integer(0, 1) != 0;
+    const TriangleTriangleQuery q{ac[0], ac[1], ac[2], flip ? s1 : s0, flip ? s0 : s1, fb};
+    SharedCorners shared = kNoSharedCorners;
+    shared[static_cast<std::size_t>(rot)] = static_cast<std::int8_t>(flip ? 1 : 0);
+    shared[static_cast<std::size_t>((rot + 1) % 3)] = static_cast<std::int8_t>(flip ? 0 : 1);
+    hits += expect_same(q, shared, "coplanar sliver", n) ? 1 : 0;
+    if (::testing::Test::HasFailure()) return;
+  }
+  EXPECT_GT(hits, 1000);
+  EXPECT_LT(hits, 19000);
+}
+
 // Coordinates at the ends of the double range, mixed within one query: subnormal differences,
 // products that underflow, sums near overflow (the filters must stand aside, not guess). Here the
 // old code is not always right: the static filter of ccd::orient3d, which it calls, can take a
