@@ -1,7 +1,8 @@
 // triangles_intersect as it was at 5b0653f (ccd/triangle_triangle.cpp), kept verbatim but for the
-// namespace and the function's name: the reference the faster test must agree with bit for bit
-// (tests/ccd/test_triangle_triangle_equivalence.cpp, tests/culling/test_triangle_triangle_real.cpp,
-// bench/ccd/bm_triangle_triangle.cpp). Do not edit it to follow changes of ccd/.
+// namespace, the function's name and clang-format's line breaks: the reference the faster test
+// must agree with bit for bit (tests/ccd/test_triangle_triangle_equivalence.cpp,
+// tests/culling/test_triangle_triangle_real.cpp, bench/ccd/bm_triangle_triangle.cpp). Do not edit
+// it to follow changes of ccd/. (It calls ccd::orient3d, which is not copied.)
 //
 // Exact triangle-triangle intersection (docs/ccd.md, "Triangle-triangle DCD").
 //
