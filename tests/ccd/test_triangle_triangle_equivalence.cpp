@@ -429,5 +429,18 @@ TEST(TriangleTriangleEquivalence, OldOrient3dFilterMissesAnUnderflow) {
   EXPECT_FALSE(triangles_intersect_reference(q));
 }
 
+// The old answer kept where it is wrong: a zero-area triangle repeating the vertex it shares
+// with a solid neighbour (a0 and a1 are both b's corner 1) and reaching into the neighbour from
+// it. The old code counts the two shared corners as a shared edge and answers no; the brute force
+// says they meet beyond the vertex. Fixing it is a change of answers, left to its own commit.
+TEST(TriangleTriangleEquivalence, RepeatedSharedVertexKeepsTheOldAnswer) {
+  const V o(0, 0, 0);
+  const TriangleTriangleQuery q{o, o, V(0.25, 0.25, 0), V(1, 0, 0), o, V(0, 1, 0)};
+  const SharedCorners shared{1, 1, -1};
+  EXPECT_TRUE(test::brute_intersect(q, shared));
+  EXPECT_FALSE(triangles_intersect_reference(q, shared));
+  EXPECT_FALSE(triangles_intersect(q, shared));
+}
+
 }  // namespace
 }  // namespace skelcd::ccd
