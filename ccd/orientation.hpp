@@ -25,9 +25,14 @@ inline constexpr int kUndecided = 2;
 /// Shewchuk's static orient3d filter ("Adaptive precision floating-point arithmetic and fast
 /// robust geometric predicates", 1997): D = det[a − d; b − d; c − d], evaluated in double on the
 /// rounded differences, is within (7 + 56ε) ε · permanent of the exact value (ε = 2⁻⁵³) when no
-/// product underflows. Returns the sign of −D = (d − a) · ((b − a) × (c − a)) when |D| exceeds
-/// the bound, kUndecided otherwise (also when the permanent is too small to rule out underflow,
-/// or not finite).
+/// product underflows. A product that underflows is off by up to η/2 (η = 2⁻¹⁰⁷⁴, the smallest
+/// subnormal) more, and a 2 × 2 minor's error is then multiplied by a coordinate difference that
+/// may be huge (2⁻⁵⁴⁰ · 2⁴⁹⁵ mixed in one query): the bound adds 2η · (|adz| + |bdz| + |cdz|) + 4η,
+/// which covers the six minors' products (η each after the minor's subtraction, grown by the outer
+/// product's rounding) and the three outer products (η/2 each); sums and differences of subnormals
+/// are exact. Returns the sign of −D = (d − a) · ((b − a) × (c − a)) when |D| exceeds the bound,
+/// kUndecided otherwise (also when the permanent is too small to rule out underflow, or not
+/// finite).
 inline int orient3d_static(
     const Eigen::Vector3d& a,
     const Eigen::Vector3d& b,
@@ -50,7 +55,9 @@ inline int orient3d_static(
       !(permanent < std::numeric_limits<double>::infinity())) {
     return kUndecided;
   }
-  const double bound = kErrBound * permanent;
+  constexpr double kEta = std::numeric_limits<double>::denorm_min();
+  const double bound = kErrBound * permanent +
+                       2.0 * kEta * (std::abs(adz) + std::abs(bdz) + std::abs(cdz)) + 4.0 * kEta;
   if (det > bound) return -1;
   if (-det > bound) return 1;
   return kUndecided;

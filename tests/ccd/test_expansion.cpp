@@ -10,6 +10,7 @@
 
 #include "ccd/detail/expansion.hpp"
 #include "ccd/detail/filtered.hpp"
+#include "ccd/orientation.hpp"
 
 namespace skelcd::ccd::detail {
 namespace {
@@ -77,6 +78,33 @@ TEST(Expansion, OrientationSignsAgreeWithRationals) {
   }
   EXPECT_GT(zeros, 2000);
   EXPECT_GT(nonzeros, 10000);
+}
+
+// orient3d's static filter (ccd/orientation.hpp) on coordinates mixed from the subnormals to
+// 2^495 within one query, where products underflow and are multiplied by huge differences: every
+// sign it decides is the rational one (it used to take a wrong sign from an underflowed product).
+TEST(Expansion, StaticOrient3dFilterIsRightWithUnderflowedProducts) {
+  std::mt19937_64 rng(2026);
+  std::uniform_real_distribution<double> mantissa(-1.0, 1.0);
+  std::uniform_int_distribution<int> pick(0, 11);
+  const int exponents[] = {-1074, -1060, -1022, -700, -540, -401, -100, 0, 100, 300, 495, 0};
+  int decided = 0;
+  for (int n = 0; n < 200000; ++n) {
+    Eigen::Vector3d p[4];
+    for (auto& v : p) {
+      for (int k = 0; k < 3; ++k) {
+        const int e = exponents[pick(rng)];
+        v[k] = pick(rng) < 3 ? 0.0 : std::ldexp(mantissa(rng), e);
+      }
+    }
+    const int s = orient3d_static(p[0], p[1], p[2], p[3]);
+    if (s == kUndecided) continue;
+    ++decided;
+    // orient3d_static's sign is that of (d − a) · ((b − a) × (c − a)).
+    const int expected = rational_sign_of(orient<mpq_class>(p[0], p[1], p[2], p[3]));
+    ASSERT_EQ(s, expected) << "case " << n;
+  }
+  EXPECT_GT(decided, 50000);
 }
 
 TEST(Expansion, ProductsNearUnderflowOrOverflowAreFlagged) {

@@ -362,13 +362,13 @@ TEST(TriangleTriangleEquivalence, CoplanarSlivers) {
 // Coordinates at the ends of the double range, mixed within one query: subnormal differences,
 // products that underflow, sums near overflow (the filters must stand aside, not guess). Here the
 // old code is not always right: the static filter of ccd::orient3d, which it calls, can take a
-// sign from a product that underflowed (see OldOrient3dFilterMissesAnUnderflow below). So both
-// are judged by the brute-force rational reference: the new test must always be right, and may
-// differ from the old one only where the old one is wrong. Except with a repeated shared vertex
-// (two of a's corners shared with one corner of b): the old code's answer for a degenerate
-// triangle against a solid one counts two shared corners as a shared edge even when they are one
-// vertex, which the brute force does not, and the new code keeps the old answer there (the
-// other tests check it against the old code).
+// sign from a product that underflowed (see Orient3dFilterAllowsForAnUnderflowedProduct below; the
+// filter is fixed now). So both are judged by the brute-force rational reference: the new test must
+// always be right, and may differ from the old one only where the old one is wrong. Except with a
+// repeated shared vertex (two of a's corners shared with one corner of b): the old code's answer
+// for a degenerate triangle against a solid one counts two shared corners as a shared edge even
+// when they are one vertex, which the brute force does not, and the new code keeps the old answer
+// there (the other tests check it against the old code).
 TEST(TriangleTriangleEquivalence, ExtremeMagnitudesMixedInOneQuery) {
   Generator gen(5);
   const auto patterns = all_shared_patterns();
@@ -410,11 +410,12 @@ TEST(TriangleTriangleEquivalence, ExtremeMagnitudesMixedInOneQuery) {
 }
 
 // The first such query the test above met. ccd::orient3d's static filter (ccd/orientation.hpp)
-// accepts it because its permanent is above 2^64 DBL_MIN, but one product underflows to zero and
-// is then multiplied by a coordinate near 2^495: orient3d(a1, b1, b2, b0) comes out -1 where the
-// exact sign is +1, and the old triangle test answers false. The new test's filters bound the
-// underflow (ccd/triangle_triangle.cpp) and answer as the rational reference does.
-TEST(TriangleTriangleEquivalence, OldOrient3dFilterMissesAnUnderflow) {
+// used to accept it because its permanent is above 2^64 DBL_MIN, but one product underflows to zero
+// and is then multiplied by a coordinate near 2^495: orient3d(a1, b1, b2, b0) came out -1 where
+// the exact sign is +1, and the old triangle test answered false. The filter's bound now allows
+// for underflowed products: orient3d leaves it to the exact path and is right, and both triangle
+// tests answer as the rational reference does. Without the underflow term this fails.
+TEST(TriangleTriangleEquivalence, Orient3dFilterAllowsForAnUnderflowedProduct) {
   const TriangleTriangleQuery q{
       V(0x1.12ca1ba4f44ecp-701, -0x1.4f264b29a43d4p-1, 0x0p+0),
       V(-0x1.09af6c1df1ea4p-703, -0x0.d241fed99bdc4p-1022, 0x1.b5b6f0ba74bd4p-542),
@@ -423,10 +424,10 @@ TEST(TriangleTriangleEquivalence, OldOrient3dFilterMissesAnUnderflow) {
       V(-0x1.e745f9aba8506p-541, 0x0.0000000000001p-1022, 0x1.220f3fe73f34p+495),
       V(-0x1.50467259ed7c6p-401, -0x1.c330bd81b2c5ap-401, 0x0p+0)};
   EXPECT_TRUE(test::brute_intersect(q, kNoSharedCorners));
+  EXPECT_EQ(orient3d_exact(q.a1, q.b1, q.b2, q.b0), 1);
+  EXPECT_EQ(orient3d(q.a1, q.b1, q.b2, q.b0), 1);
   EXPECT_TRUE(triangles_intersect(q));
-  EXPECT_NE(orient3d(q.a1, q.b1, q.b2, q.b0), orient3d_exact(q.a1, q.b1, q.b2, q.b0))
-      << "ccd::orient3d fixed? Then the old test agrees here too: update this test";
-  EXPECT_FALSE(triangles_intersect_reference(q));
+  EXPECT_TRUE(triangles_intersect_reference(q));
 }
 
 // The old answer kept where it is wrong: a zero-area triangle repeating the vertex it shares
