@@ -31,6 +31,13 @@ skinning::Positions welded_rest_positions(
   return rest;
 }
 
+/// The hierarchy options of a method that traverses only the wide copy (culling/traversal.hpp):
+/// no binary node volumes, 2·#F·sizeof(Dop<N>) bytes less (docs/culling.md "Bounded memory").
+BvhOptions traversal_only(BvhOptions options) {
+  options.node_volumes = false;
+  return options;
+}
+
 template <int N>
 class BvhMethod final : public MethodBase {
  public:
@@ -40,7 +47,10 @@ class BvhMethod final : public MethodBase {
       const skinning::Topology& topology,
       const MethodOptions& options)
       : MethodBase(name, mesh, topology, options),
-        bvh_(topology_.welded_triangles(), welded_rest_positions(mesh, topology), options.bvh) {
+        bvh_(
+            topology_.welded_triangles(),
+            welded_rest_positions(mesh, topology),
+            traversal_only(options.bvh)) {
     // Everything an interval touches is sized here; only the blocks' feature candidates and the
     // caller's findings may still grow (with the motion), and they keep their capacity.
     const auto num_faces = static_cast<std::size_t>(topology_.num_triangles());
