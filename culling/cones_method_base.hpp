@@ -30,6 +30,12 @@ class ConeMethodBase : public MethodBase, public ConeStatistics {
   [[nodiscard]] const ConeStatistics* cone_statistics() const override { return this; }
   [[nodiscard]] const NodeContours& contours() const override { return contours_; }
 
+  /// The hierarchy over this method's triangles, refit by each query, and the volumes of every
+  /// feature of the mesh at the last query (edges only after a CCD query): `auto` traverses the
+  /// pairs between its groups on these rather than on copies (docs/culling.md "Bounded memory").
+  [[nodiscard]] const AabbBvh& hierarchy() const { return bvh_; }
+  [[nodiscard]] const FeatureBounds<3>& feature_bounds() const { return bounds_; }
+
  protected:
   /// Where a self-test descends when its node is not culled.
   enum class Descent : std::uint8_t {
