@@ -55,7 +55,6 @@ class BvhMethod final : public MethodBase {
     // caller's findings may still grow (with the motion), and they keep their capacity.
     const auto num_faces = static_cast<std::size_t>(topology_.num_triangles());
     bounds_.vertices.reserve(static_cast<std::size_t>(topology_.num_vertices()));
-    bounds_.edges.reserve(static_cast<std::size_t>(topology_.num_edges()));
     bounds_.triangles.reserve(num_faces);
     scratch_.reserve_self(bvh_);
   }
@@ -90,9 +89,10 @@ class BvhMethod final : public MethodBase {
     check_positions(x_t0, "detect_ccd", "x_t0");
     check_positions(x_t1, "detect_ccd", "x_t1");
     const auto t0 = Clock::now();
-    // Refit over the swept volumes of the interval, grown by half the contact distance.
+    // Refit over the swept volumes of the interval, grown by half the contact distance. No edge
+    // volumes: the feature stage forms them from the vertices' (bounded memory).
     swept_vertex_bounds<N>(x_t0, x_t1, 0.5 * options_.min_separation, bounds_.vertices);
-    bounds_.derive(topology_);
+    bounds_.derive(topology_, /*with_edges=*/false);
     bvh_.refit(bounds_.triangles);
     const auto t1 = Clock::now();
     // Self traversal → triangle pairs → de-duplicated feature pairs → tests, in blocks of

@@ -57,7 +57,6 @@ ConeMethodBase::ConeMethodBase(
   if (needs_contours) contours_ = NodeContours(bvh_, topology_);
   const auto num_faces = static_cast<std::size_t>(topology_.num_triangles());
   bounds_.vertices.reserve(static_cast<std::size_t>(topology_.num_vertices()));
-  bounds_.edges.reserve(static_cast<std::size_t>(topology_.num_edges()));
   bounds_.triangles.reserve(num_faces);
   const auto depth = static_cast<std::size_t>(bvh_.depth());
   self_stack_.reserve(4 * depth + 8);
@@ -100,8 +99,9 @@ void ConeMethodBase::ccd(const culling::Interval& query, FrameResult& out) {
   stats_.culling_disabled = !cull_enabled_;
   const auto t0 = Clock::now();
   // Refit: swept volumes, the hierarchy, the continuous normal cones of the interval.
+  // No edge volumes: the feature stage forms them from the vertices' (bounded memory).
   swept_vertex_bounds<3>(x_t0, x_t1, 0.5 * options_.min_separation, bounds_.vertices);
-  bounds_.derive(topology_);
+  bounds_.derive(topology_, /*with_edges=*/false);
   bvh_.refit(bounds_.triangles);
   const Interval interval{&x_t0, &x_t1, true};
   if (cull_enabled_) {

@@ -31,7 +31,8 @@ class ConeMethodBase : public MethodBase, public ConeStatistics {
   [[nodiscard]] const NodeContours& contours() const override { return contours_; }
 
   /// The hierarchy over this method's triangles, refit by each query, and the volumes of every
-  /// feature of the mesh at the last query (edges only after a CCD query): `auto` traverses the
+  /// vertex and triangle of the mesh at the last query (no edges:
+  /// ccd_candidates_from_triangle_pairs forms theirs from the vertices'): `auto` traverses the
   /// pairs between its groups on these rather than on copies (docs/culling.md "Bounded memory").
   [[nodiscard]] const AabbBvh& hierarchy() const { return bvh_; }
   [[nodiscard]] const FeatureBounds<3>& feature_bounds() const { return bounds_; }

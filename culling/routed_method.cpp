@@ -232,7 +232,6 @@ class AutoMethod final : public detail::MethodBase {
       bounds_ = &cone->feature_bounds();
     } else {
       own_bounds_.vertices.reserve(static_cast<std::size_t>(topology_.num_vertices()));
-      own_bounds_.edges.reserve(static_cast<std::size_t>(topology_.num_edges()));
       own_bounds_.triangles.reserve(nf);
       bounds_ = &own_bounds_;
     }
@@ -295,7 +294,7 @@ class AutoMethod final : public detail::MethodBase {
     const auto t0 = Clock::now();
     if (bounds_ == &own_bounds_) {
       swept_vertex_bounds<3>(x_t0, x_t1, 0.5 * options_.min_separation, own_bounds_.vertices);
-      own_bounds_.derive(topology_);
+      own_bounds_.derive(topology_, /*with_edges=*/false);
     }
     refit_groups();
     const auto t1 = Clock::now();
