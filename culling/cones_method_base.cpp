@@ -37,8 +37,9 @@ ConeMethodBase::ConeMethodBase(
     const MethodOptions& options,
     Descent descent,
     bool needs_contours,
-    const std::vector<std::int32_t>* subset)
-    : MethodBase(name, mesh, topology, options),
+    const std::vector<std::int32_t>* subset,
+    std::shared_ptr<const FeatureTopology> features)
+    : MethodBase(name, mesh, topology, options, std::move(features)),
       bvh_(
           subset == nullptr
               ? AabbBvh(topology_.welded_triangles(), welded_rest(mesh, topology), options.bvh)

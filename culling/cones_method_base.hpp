@@ -8,6 +8,7 @@
 // culling/elementary.hpp. Internal to culling/.
 
 #include <cstdint>
+#include <memory>
 #include <span>
 #include <string_view>
 #include <vector>
@@ -54,6 +55,7 @@ class ConeMethodBase : public MethodBase, public ConeStatistics {
   /// @param needs_contours build the per-node contours (normal-cone, enhanced-dual-cone).
   /// @param subset when not null, the triangle ids the method covers (its hierarchy is built over
   ///        them only: pairs with a triangle outside are never reported) — for routing.
+  /// @param features when not null, the mesh's feature topology built by the caller (`auto`).
   ConeMethodBase(
       std::string_view name,
       const skinning::Mesh& mesh,
@@ -61,7 +63,8 @@ class ConeMethodBase : public MethodBase, public ConeStatistics {
       const MethodOptions& options,
       Descent descent,
       bool needs_contours,
-      const std::vector<std::int32_t>* subset);
+      const std::vector<std::int32_t>* subset,
+      std::shared_ptr<const FeatureTopology> features = {});
 
   /// The surface normal test (condition 1) of node n: its cone lies in a half-space, or — when
   /// the hierarchical cone is too loose — every normal of its triangles is proven to point into

@@ -249,6 +249,16 @@ class AutoMethod final : public detail::MethodBase {
       ++(h == &open_bvh_ || h == &closed_bvh_ ? r.own_hierarchies : r.shared_hierarchies);
     }
     r.own_feature_bounds = !traverses_nothing() && bounds_ == &own_bounds_;
+    // Feature topologies held by this method and its culling-module group methods.
+    std::vector<const FeatureTopology*> held{features_.get()};
+    for (const CullingMethod* m : {open_method_.get(), closed_method_.get()}) {
+      const auto* base = dynamic_cast<const detail::MethodBase*>(m);
+      if (base != nullptr &&
+          std::find(held.begin(), held.end(), base->feature_topology().get()) == held.end()) {
+        held.push_back(base->feature_topology().get());
+      }
+    }
+    r.feature_topologies = static_cast<std::int32_t>(held.size());
     return r;
   }
 
@@ -326,20 +336,29 @@ class AutoMethod final : public detail::MethodBase {
   }
 
  private:
-  static std::unique_ptr<CullingMethod> make_group_method(
+  /// A cone group method over `triangles`, on this method's own FeatureTopology (the same mesh and
+  /// topology: shared, not built again); null for `bvh`.
+  [[nodiscard]] std::unique_ptr<CullingMethod> make_group_method(
       const std::string& name,
       const skinning::Mesh& mesh,
       const skinning::Topology& topology,
       const MethodOptions& options,
-      const std::vector<std::int32_t>& triangles) {
+      const std::vector<std::int32_t>& triangles) const {
     if (name == "enhanced-dual-cone") {
       // The simple top-down scheme: measured faster than Algorithm 3's descent on most scenes of
       // bench/culling/bm_cones (docs/benchmarks.md, "## dual-cone"); same contacts.
       return make_enhanced_dual_cone_method(
-          mesh, topology, options, {.grandchildren_descent = false, .triangles = triangles});
+          mesh,
+          topology,
+          options,
+          {.grandchildren_descent = false, .triangles = triangles, .features = features_});
     }
-    if (name == "normal-cone") return make_normal_cone_method(mesh, topology, options, triangles);
-    if (name == "dual-cone") return make_dual_cone_method(mesh, topology, options, triangles);
+    if (name == "normal-cone") {
+      return make_normal_cone_method(mesh, topology, options, triangles, features_);
+    }
+    if (name == "dual-cone") {
+      return make_dual_cone_method(mesh, topology, options, triangles, features_);
+    }
     return nullptr;  // `bvh`: traversed here (traverse_own)
   }
 

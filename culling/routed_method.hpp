@@ -69,6 +69,10 @@ struct RoutedStructures {
   /// Feature volumes refit by `auto` itself (false: a cone group method's are read, or nothing is
   /// traversed here).
   bool own_feature_bounds = false;
+  /// Distinct feature topologies (culling::FeatureTopology) held by `auto` and those of its group
+  /// methods that are culling/'s own: 1 when its cone group methods share `auto`'s. (A whole-mesh
+  /// closed method, `dynamic`, gets another mesh and counts apart when it is one of culling/'s.)
+  std::int32_t feature_topologies = 0;
 };
 
 /// The structures of an `auto` method (make_routed_method).

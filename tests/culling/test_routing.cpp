@@ -228,7 +228,7 @@ TEST(Routing, ReadsItsConeGroupsHierarchyAndVolumesInsteadOfCopyingThem) {
   // Bounded memory (docs/culling.md): a group whose method is a cone method already holds a
   // hierarchy over its triangles and the volumes of every feature, refit by its own query just
   // before `auto` traverses between the groups; `auto` reads those and builds only the hierarchy
-  // of a group no method of its own tests.
+  // of a group no method of its own tests. Its cone group methods use its FeatureTopology.
   const OpenScene s = test::skirt_body_scene(9, 14, 16, 10, {0.3, 0.5});
   auto b = make_method("bvh", s.mesh, s.topo);
   struct Case {
@@ -246,6 +246,7 @@ TEST(Routing, ReadsItsConeGroupsHierarchyAndVolumesInsteadOfCopyingThem) {
     EXPECT_EQ(got.own_hierarchies, c.want.own_hierarchies) << c.open << " / " << c.closed;
     EXPECT_EQ(got.shared_hierarchies, c.want.shared_hierarchies) << c.open << " / " << c.closed;
     EXPECT_EQ(got.own_feature_bounds, c.want.own_feature_bounds) << c.open << " / " << c.closed;
+    EXPECT_EQ(got.feature_topologies, 1) << c.open << " / " << c.closed;
     // The shared volumes are those of the query at hand, whatever came before it: CCD, DCD (which
     // refits no edge volumes), CCD again, backwards.
     EXPECT_EQ(keys(ccd(*m, s.frames[0], s.frames[1])), keys(ccd(*b, s.frames[0], s.frames[1])))
@@ -262,6 +263,7 @@ TEST(Routing, ReadsItsConeGroupsHierarchyAndVolumesInsteadOfCopyingThem) {
   EXPECT_EQ(got.own_hierarchies, 0);
   EXPECT_EQ(got.shared_hierarchies, 0);
   EXPECT_FALSE(got.own_feature_bounds);
+  EXPECT_EQ(got.feature_topologies, 1);
   EXPECT_THROW_MESSAGE(
       (void)routed_structures(*b), InvalidInput, "routed_structures: method 'bvh' is not auto");
 }
