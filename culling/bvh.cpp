@@ -72,7 +72,7 @@ void Bvh<N>::build(const skinning::Triangles& triangles, const skinning::Positio
   }
   for (std::size_t i = 0; i < order_.size(); ++i) order_[i] = items_[i].id;
   if (node_volumes_) node_bounds_.assign(nodes_.size(), Volume::empty());
-  items_ = {};
+  std::vector<Item>().swap(items_);  // free it: `items_ = {}` would keep the capacity
   build_wide();
 }
 
