@@ -258,6 +258,8 @@ TEST(Log, RoundTripsEveryField) {
   }
   EXPECT_EQ(data.contacts, contacts);
   EXPECT_EQ(data.dcd_pairs, pairs);
+  // 3000 contacts in one append: 168 KB of rows, converted through the writer's 64 KiB buffers in
+  // strips (log_writer.cpp, kConversionBufferBytes).
   EXPECT_EQ(data.contacts.size(), 3005u);
   EXPECT_EQ(data.dcd_pairs.size(), 1502u);
 
