@@ -118,7 +118,8 @@ void owned_feature_pairs(
     // endpoints' (FeatureBounds::derive, bit for bit), formed here from corner volumes the VF
     // pairs above have just read, so that no per-edge volumes need be held (bounded memory).
     std::array<Dop<N>, 3> edges_b;
-    for (std::size_t j = 0; j < b.num_edges; ++j) edges_b[j] = edge_volume(b.edge_ends[j]);
+    const std::size_t num_edges_b = a.num_edges != 0 ? b.num_edges : 0;  // none needed otherwise
+    for (std::size_t j = 0; j < num_edges_b; ++j) edges_b[j] = edge_volume(b.edge_ends[j]);
     for (std::size_t i = 0; i < a.num_edges; ++i) {
       const std::int32_t ea = a.edges[i];
       const Dop<N> bounds_a = edge_volume(a.edge_ends[i]);
