@@ -15,7 +15,7 @@ Bvh<N>::Bvh(
     const skinning::Triangles& triangles,
     const skinning::Positions& positions,
     const BvhOptions& options)
-    : leaf_size_(options.leaf_size) {
+    : leaf_size_(options.leaf_size), node_volumes_(options.node_volumes) {
   order_.resize(static_cast<std::size_t>(triangles.rows()));
   std::iota(order_.begin(), order_.end(), 0);
   build(triangles, positions);
@@ -27,7 +27,9 @@ Bvh<N>::Bvh(
     const skinning::Positions& positions,
     std::span<const std::int32_t> subset,
     const BvhOptions& options)
-    : order_(subset.begin(), subset.end()), leaf_size_(options.leaf_size) {
+    : order_(subset.begin(), subset.end()),
+      leaf_size_(options.leaf_size),
+      node_volumes_(options.node_volumes) {
   for (std::size_t i = 0; i < order_.size(); ++i) {
     if (order_[i] < 0 || order_[i] >= triangles.rows()) {
       throw InvalidInput(
@@ -69,7 +71,7 @@ void Bvh<N>::build(const skinning::Triangles& triangles, const skinning::Positio
     build_range(0, static_cast<std::int32_t>(order_.size()), 0);
   }
   for (std::size_t i = 0; i < order_.size(); ++i) order_[i] = items_[i].id;
-  node_bounds_.assign(nodes_.size(), Volume::empty());
+  if (node_volumes_) node_bounds_.assign(nodes_.size(), Volume::empty());
   slot_bounds_.assign(2 * static_cast<std::size_t>(N) * slot_stride(), 0.0f);
   for (std::size_t k = 0; k < static_cast<std::size_t>(N); ++k) {
     float* lo = slot_bounds_.data() + k * slot_stride();
@@ -77,7 +79,7 @@ void Bvh<N>::build(const skinning::Triangles& triangles, const skinning::Positio
     std::fill(lo, lo + slot_stride(), std::numeric_limits<float>::infinity());
     std::fill(hi, hi + slot_stride(), -std::numeric_limits<float>::infinity());
   }
-  items_ = {};
+  std::vector<Item>().swap(items_);  // free it: `items_ = {}` would keep the capacity
   build_wide();
 }
 
@@ -230,6 +232,10 @@ std::int32_t Bvh<N>::build_range(std::int32_t begin, std::int32_t end, int depth
 template <int N>
 void Bvh<N>::refit(std::span<const Volume> triangle_bounds) {
   constexpr auto kN = static_cast<std::size_t>(N);
+  if (!node_volumes_) {
+    refit_wide_only(triangle_bounds);
+    return;
+  }
   // Depth-first order puts every child after its parent, so one backward sweep is bottom-up. A
   // leaf also writes its triangles' float volumes by slot.
   const std::size_t stride = slot_stride();
@@ -264,6 +270,53 @@ void Bvh<N>::refit(std::span<const Volume> triangle_bounds) {
       for (std::size_t k = 0; k < kN; ++k) {
         w.lo[k][i] = float_below(v.lo[k]);
         w.hi[k][i] = float_above(v.hi[k]);
+      }
+    }
+  }
+}
+
+template <int N>
+void Bvh<N>::refit_wide_only(std::span<const Volume> triangle_bounds) {
+  constexpr auto kN = static_cast<std::size_t>(N);
+  const std::size_t stride = slot_stride();
+  // A wide node's inner children come after it (built depth first), so one backward sweep is
+  // bottom-up. A bucket lane is its triangles' union, rounded outwards; an inner lane the union of
+  // the lanes of its wide node, which partition its triangles. float_below and float_above are
+  // monotone, so the min of rounded ends is the rounded min: the bits refit() gives.
+  for (std::size_t n = wide_.size(); n-- > 0;) {
+    WideBvhNode<N>& w = wide_[n];
+    for (int i = 0; i < w.num_children; ++i) {
+      if (w.child[i] < 0) {
+        // A bucket: its triangles' float volumes by slot, and their union.
+        const auto begin = static_cast<std::size_t>(~w.child[i]);
+        const auto end = begin + static_cast<std::size_t>(w.count[i]);
+        for (std::size_t k = 0; k < kN; ++k) {
+          float lo = std::numeric_limits<float>::infinity();
+          float hi = -std::numeric_limits<float>::infinity();
+          for (std::size_t s = begin; s < end; ++s) {
+            const Volume& t = triangle_bounds[static_cast<std::size_t>(order_[s])];
+            const float tl = float_below(t.lo[k]);
+            const float th = float_above(t.hi[k]);
+            slot_bounds_[k * stride + s] = tl;
+            slot_bounds_[(kN + k) * stride + s] = th;
+            lo = std::min(lo, tl);
+            hi = std::max(hi, th);
+          }
+          w.lo[k][i] = lo;
+          w.hi[k][i] = hi;
+        }
+      } else {
+        const WideBvhNode<N>& c = wide_[static_cast<std::size_t>(w.child[i])];
+        for (std::size_t k = 0; k < kN; ++k) {
+          float lo = c.lo[k][0];
+          float hi = c.hi[k][0];
+          for (int j = 1; j < c.num_children; ++j) {
+            lo = std::min(lo, c.lo[k][j]);
+            hi = std::max(hi, c.hi[k][j]);
+          }
+          w.lo[k][i] = lo;
+          w.hi[k][i] = hi;
+        }
       }
     }
   }

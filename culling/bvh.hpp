@@ -18,6 +18,11 @@ struct BvhOptions {
   /// Most triangles in a leaf (>= 1). Larger leaves: fewer nodes to refit and visit, more
   /// triangle-box tests inside leaf pairs (bench/culling measures the trade).
   int leaf_size = 1;
+  /// Keep the binary nodes' double volumes (Bvh::node_bounds), which the cone methods, the masked
+  /// traversals and radial view read. Without them (the `bvh`, `kdop` and `auto` traversals read
+  /// only the wide copy and the triangles' volumes) refit fills the wide nodes straight from the
+  /// triangles' volumes, with the same bits, and the tree holds 2·#F·sizeof(Dop<N>) bytes less.
+  bool node_volumes = true;
 };
 
 struct BvhNode {
@@ -83,11 +88,15 @@ class Bvh {
   /// Bottom-up refit: a leaf's volume is the union of its triangles' volumes, a parent's the
   /// union of its children's. Unions are exact (min/max), so every node contains its triangles'
   /// volumes exactly as given; the wide nodes' float volumes contain them too (rounded
-  /// outwards). Allocation-free.
+  /// outwards). Allocation-free. Without node volumes (BvhOptions::node_volumes) only the wide
+  /// nodes are filled: a bucket's lanes from its triangles, an inner lane as the union of its wide
+  /// node's lanes — float_below / float_above are monotone, so that is the rounding of the exact
+  /// union, bit for bit.
   /// @param triangle_bounds indexed by triangle id (#F of the `triangles` built from).
   void refit(std::span<const Volume> triangle_bounds);
 
   [[nodiscard]] std::span<const BvhNode> nodes() const { return nodes_; }
+  /// The binary nodes' volumes; empty when built without them (BvhOptions::node_volumes).
   [[nodiscard]] std::span<const Volume> node_bounds() const { return node_bounds_; }
   /// Triangle ids in leaf order; node n holds triangle_order()[n.begin .. n.end).
   [[nodiscard]] std::span<const std::int32_t> triangle_order() const { return order_; }
@@ -126,6 +135,7 @@ class Bvh {
   int wide_lanes(std::int32_t node, std::array<std::int32_t, WideBvhNode<N>::kWidth>& lanes) const;
   std::size_t count_wide(std::int32_t node) const;
   std::int32_t build_wide_node(std::int32_t node, int depth);
+  void refit_wide_only(std::span<const Volume> triangle_bounds);
 
   std::vector<BvhNode> nodes_;
   std::vector<Volume> node_bounds_;
@@ -142,6 +152,7 @@ class Bvh {
   int depth_ = 0;
   int wide_depth_ = 0;
   int leaf_size_ = 1;
+  bool node_volumes_ = true;
 };
 
 using AabbBvh = Bvh<3>;

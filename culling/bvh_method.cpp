@@ -31,6 +31,13 @@ skinning::Positions welded_rest_positions(
   return rest;
 }
 
+/// The hierarchy options of a method that traverses only the wide copy (culling/traversal.hpp):
+/// no binary node volumes, 2·#F·sizeof(Dop<N>) bytes less (docs/culling.md "Bounded memory").
+BvhOptions traversal_only(BvhOptions options) {
+  options.node_volumes = false;
+  return options;
+}
+
 template <int N>
 class BvhMethod final : public MethodBase {
  public:
@@ -40,12 +47,14 @@ class BvhMethod final : public MethodBase {
       const skinning::Topology& topology,
       const MethodOptions& options)
       : MethodBase(name, mesh, topology, options),
-        bvh_(topology_.welded_triangles(), welded_rest_positions(mesh, topology), options.bvh) {
+        bvh_(
+            topology_.welded_triangles(),
+            welded_rest_positions(mesh, topology),
+            traversal_only(options.bvh)) {
     // Everything an interval touches is sized here; only the blocks' feature candidates and the
     // caller's findings may still grow (with the motion), and they keep their capacity.
     const auto num_faces = static_cast<std::size_t>(topology_.num_triangles());
     bounds_.vertices.reserve(static_cast<std::size_t>(topology_.num_vertices()));
-    bounds_.edges.reserve(static_cast<std::size_t>(topology_.num_edges()));
     bounds_.triangles.reserve(num_faces);
     scratch_.reserve_self(bvh_);
     full_slots_.reserve(num_faces);
@@ -89,9 +98,10 @@ class BvhMethod final : public MethodBase {
     check_positions(x_t0, "detect_ccd", "x_t0");
     check_positions(x_t1, "detect_ccd", "x_t1");
     const auto t0 = Clock::now();
-    // Refit over the swept volumes of the interval, grown by half the contact distance.
+    // Refit over the swept volumes of the interval, grown by half the contact distance. No edge
+    // volumes: the feature stage forms them from the vertices' (bounded memory).
     swept_vertex_bounds<N>(x_t0, x_t1, 0.5 * options_.min_separation, bounds_.vertices);
-    bounds_.derive(topology_);
+    bounds_.derive(topology_, /*with_edges=*/false);
     bvh_.refit(bounds_.triangles);
     const auto t1 = Clock::now();
     // Self traversal → triangle pairs → de-duplicated feature pairs → tests, in blocks of

@@ -92,6 +92,11 @@ void owned_feature_pairs(
                 static_cast<std::size_t>(overlap_bit(bounds.vertices[at(v)], face_bounds));
     }
   };
+  const auto edge_volume = [&](const std::array<std::int32_t, 2>& ends) {
+    Dop<N> d = bounds.vertices[at(ends[0])];
+    d.merge(bounds.vertices[at(ends[1])]);
+    return d;
+  };
   const auto flush = [&] {
     out.vf.insert(out.vf.end(), vf.begin(), vf.begin() + static_cast<std::ptrdiff_t>(num_vf));
     out.ee.insert(out.ee.end(), ee.begin(), ee.begin() + static_cast<std::ptrdiff_t>(num_ee));
@@ -109,10 +114,15 @@ void owned_feature_pairs(
     // VF: the vertices each triangle owns against the other triangle's face.
     vertices_vs_face(a, b, p.b);
     vertices_vs_face(b, a, p.a);
-    // EE: the edges a owns against the edges b owns.
+    // EE: the edges a owns against the edges b owns. An edge's volume is the union of its
+    // endpoints' (FeatureBounds::derive, bit for bit), formed here from corner volumes the VF
+    // pairs above have just read, so that no per-edge volumes need be held (bounded memory).
+    std::array<Dop<N>, 3> edges_b;
+    const std::size_t num_edges_b = a.num_edges != 0 ? b.num_edges : 0;  // none needed otherwise
+    for (std::size_t j = 0; j < num_edges_b; ++j) edges_b[j] = edge_volume(b.edge_ends[j]);
     for (std::size_t i = 0; i < a.num_edges; ++i) {
       const std::int32_t ea = a.edges[i];
-      const Dop<N>& bounds_a = bounds.edges[at(ea)];
+      const Dop<N> bounds_a = edge_volume(a.edge_ends[i]);
       for (std::size_t j = 0; j < b.num_edges; ++j) {
         const std::int32_t eb = b.edges[j];
         bool wanted = !share_endpoint(a.edge_ends[i], b.edge_ends[j]);
@@ -120,7 +130,7 @@ void owned_feature_pairs(
         tests += wanted;
         ee[num_ee] = {std::min(ea, eb), std::max(ea, eb)};
         num_ee += static_cast<std::size_t>(wanted) &
-                  static_cast<std::size_t>(overlap_bit(bounds_a, bounds.edges[at(eb)]));
+                  static_cast<std::size_t>(overlap_bit(bounds_a, edges_b[j]));
       }
     }
     if (++in_chunk == kChunkPairs) {

@@ -57,8 +57,10 @@ struct FeatureBounds {
   std::vector<Dop<N>> edges;
   std::vector<Dop<N>> triangles;
 
-  /// Fills triangles (and edges, unless with_edges is false: DCD needs none) from `vertices`.
-  /// Allocation-free once the vectors have their sizes.
+  /// Fills triangles (and edges, unless with_edges is false) from `vertices`. DCD needs no edge
+  /// volumes, nor does ccd_candidates_from_triangle_pairs (it forms them from the vertices'); brute
+  /// force and the radial view's pair checks read them. Allocation-free once the vectors have
+  /// their sizes.
   void derive(const FeatureTopology& topology, bool with_edges = true);
 };
 
@@ -70,7 +72,9 @@ struct FeatureBounds {
 inline constexpr std::size_t kCcdBlockPairs = std::size_t{1} << 15;
 
 /// CCD feature stage of a hierarchy method: appends the feature pairs of each triangle pair in
-/// `pairs` (any order within a pair) to `out`.
+/// `pairs` (any order within a pair) to `out`. Reads bounds.vertices and bounds.triangles only:
+/// an edge's volume is formed as the union of its endpoints' (bit for bit what derive() stores),
+/// so the caller need not hold #E edge volumes.
 /// Counts counters.candidate_pairs (triangle pairs not wholly part-excluded) and
 /// counters.feature_bv_tests.
 template <int N>

@@ -37,8 +37,9 @@ ConeMethodBase::ConeMethodBase(
     const MethodOptions& options,
     Descent descent,
     bool needs_contours,
-    const std::vector<std::int32_t>* subset)
-    : MethodBase(name, mesh, topology, options),
+    const std::vector<std::int32_t>* subset,
+    std::shared_ptr<const FeatureTopology> features)
+    : MethodBase(name, mesh, topology, options, std::move(features)),
       bvh_(
           subset == nullptr
               ? AabbBvh(topology_.welded_triangles(), welded_rest(mesh, topology), options.bvh)
@@ -57,7 +58,6 @@ ConeMethodBase::ConeMethodBase(
   if (needs_contours) contours_ = NodeContours(bvh_, topology_);
   const auto num_faces = static_cast<std::size_t>(topology_.num_triangles());
   bounds_.vertices.reserve(static_cast<std::size_t>(topology_.num_vertices()));
-  bounds_.edges.reserve(static_cast<std::size_t>(topology_.num_edges()));
   bounds_.triangles.reserve(num_faces);
   const auto depth = static_cast<std::size_t>(bvh_.depth());
   self_stack_.reserve(4 * depth + 8);
@@ -100,8 +100,9 @@ void ConeMethodBase::ccd(const culling::Interval& query, FrameResult& out) {
   stats_.culling_disabled = !cull_enabled_;
   const auto t0 = Clock::now();
   // Refit: swept volumes, the hierarchy, the continuous normal cones of the interval.
+  // No edge volumes: the feature stage forms them from the vertices' (bounded memory).
   swept_vertex_bounds<3>(x_t0, x_t1, 0.5 * options_.min_separation, bounds_.vertices);
-  bounds_.derive(topology_);
+  bounds_.derive(topology_, /*with_edges=*/false);
   bvh_.refit(bounds_.triangles);
   const Interval interval{&x_t0, &x_t1, true};
   if (cull_enabled_) {

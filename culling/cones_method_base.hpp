@@ -8,6 +8,7 @@
 // culling/elementary.hpp. Internal to culling/.
 
 #include <cstdint>
+#include <memory>
 #include <span>
 #include <string_view>
 #include <vector>
@@ -30,6 +31,13 @@ class ConeMethodBase : public MethodBase, public ConeStatistics {
   [[nodiscard]] const ConeStatistics* cone_statistics() const override { return this; }
   [[nodiscard]] const NodeContours& contours() const override { return contours_; }
 
+  /// The hierarchy over this method's triangles, refit by each query, and the volumes of every
+  /// vertex and triangle of the mesh at the last query (no edges:
+  /// ccd_candidates_from_triangle_pairs forms theirs from the vertices'): `auto` traverses the
+  /// pairs between its groups on these rather than on copies (docs/culling.md "Bounded memory").
+  [[nodiscard]] const AabbBvh& hierarchy() const { return bvh_; }
+  [[nodiscard]] const FeatureBounds<3>& feature_bounds() const { return bounds_; }
+
  protected:
   /// Where a self-test descends when its node is not culled.
   enum class Descent : std::uint8_t {
@@ -47,6 +55,7 @@ class ConeMethodBase : public MethodBase, public ConeStatistics {
   /// @param needs_contours build the per-node contours (normal-cone, enhanced-dual-cone).
   /// @param subset when not null, the triangle ids the method covers (its hierarchy is built over
   ///        them only: pairs with a triangle outside are never reported) — for routing.
+  /// @param features when not null, the mesh's feature topology built by the caller (`auto`).
   ConeMethodBase(
       std::string_view name,
       const skinning::Mesh& mesh,
@@ -54,7 +63,8 @@ class ConeMethodBase : public MethodBase, public ConeStatistics {
       const MethodOptions& options,
       Descent descent,
       bool needs_contours,
-      const std::vector<std::int32_t>* subset);
+      const std::vector<std::int32_t>* subset,
+      std::shared_ptr<const FeatureTopology> features = {});
 
   /// The surface normal test (condition 1) of node n: its cone lies in a half-space, or — when
   /// the hierarchical cone is too loose — every normal of its triangles is proven to point into

@@ -15,7 +15,8 @@ class DualConeMethod final : public detail::ConeMethodBase {
       const skinning::Mesh& mesh,
       const skinning::Topology& topology,
       const MethodOptions& options,
-      const std::vector<std::int32_t>* subset)
+      const std::vector<std::int32_t>* subset,
+      std::shared_ptr<const FeatureTopology> features = {})
       : ConeMethodBase(
             "dual-cone",
             mesh,
@@ -23,7 +24,8 @@ class DualConeMethod final : public detail::ConeMethodBase {
             options,
             Descent::children,
             /*needs_contours=*/false,
-            subset) {
+            subset,
+            std::move(features)) {
     // Which sides of each triangle are boundary edges of the mesh (one incident face).
     const auto nf = static_cast<std::size_t>(topology_.num_triangles());
     boundary_sides_.assign(nf, 0);
@@ -111,8 +113,9 @@ std::unique_ptr<CullingMethod> make_dual_cone_method(
     const skinning::Mesh& mesh,
     const skinning::Topology& topology,
     const MethodOptions& options,
-    const std::vector<std::int32_t>& triangles) {
-  return std::make_unique<DualConeMethod>(mesh, topology, options, &triangles);
+    const std::vector<std::int32_t>& triangles,
+    std::shared_ptr<const FeatureTopology> features) {
+  return std::make_unique<DualConeMethod>(mesh, topology, options, &triangles, std::move(features));
 }
 
 }  // namespace skelcd::culling

@@ -20,7 +20,8 @@ class EnhancedDualConeMethod final : public detail::ConeMethodBase {
             options,
             variant.grandchildren_descent ? Descent::grandchildren : Descent::children,
             /*needs_contours=*/true,
-            variant.triangles.empty() ? nullptr : &variant.triangles) {}
+            variant.triangles.empty() ? nullptr : &variant.triangles,
+            variant.features) {}
 
  private:
   // EnhancedDualConeTest (Algorithms 1 and 4) of node n.

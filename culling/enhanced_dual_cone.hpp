@@ -33,6 +33,9 @@ struct EnhancedDualConeOptions {
   /// When not empty, the only triangles covered (welded triangle ids): pairs with a triangle
   /// outside the list are never reported. Routing uses it for the open components.
   std::vector<std::int32_t> triangles;
+  /// When not null, the mesh's FeatureTopology(mesh, topology), built by the caller (`auto`) and
+  /// shared rather than built again (docs/culling.md "Bounded memory").
+  std::shared_ptr<const FeatureTopology> features{};
 };
 
 /// The method with explicit variant options.

@@ -17,11 +17,21 @@ MethodBase::MethodBase(
     std::string_view name,
     const skinning::Mesh& mesh,
     const skinning::Topology& topology,
-    const MethodOptions& options)
+    const MethodOptions& options,
+    std::shared_ptr<const FeatureTopology> features)
     : name_(name),
-      topology_(mesh, topology),
+      features_(
+          features != nullptr ? std::move(features)
+                              : std::make_shared<const FeatureTopology>(mesh, topology)),
+      topology_(*features_),
       options_(options),
       tests_(with_ccd_defaults(options.elementary)) {
+  if (topology_.num_triangles() != topology.welded_triangles.rows()) {
+    throw InvalidInput(
+        "culling::make_method: the shared feature topology has " +
+        std::to_string(topology_.num_triangles()) + " triangles, the topology " +
+        std::to_string(topology.welded_triangles.rows()));
+  }
   if (!std::isfinite(options.min_separation) || options.min_separation < 0.0) {
     throw InvalidInput(
         "culling::make_method: min_separation must be finite and >= 0, got " +

@@ -12,7 +12,8 @@ class NormalConeMethod final : public detail::ConeMethodBase {
       const skinning::Mesh& mesh,
       const skinning::Topology& topology,
       const MethodOptions& options,
-      const std::vector<std::int32_t>* subset)
+      const std::vector<std::int32_t>* subset,
+      std::shared_ptr<const FeatureTopology> features = {})
       : ConeMethodBase(
             "normal-cone",
             mesh,
@@ -20,7 +21,8 @@ class NormalConeMethod final : public detail::ConeMethodBase {
             options,
             Descent::children,
             /*needs_contours=*/true,
-            subset) {}
+            subset,
+            std::move(features)) {}
 
  private:
   bool node_culled(std::int32_t n, const Interval& interval) override {
@@ -67,8 +69,10 @@ std::unique_ptr<CullingMethod> make_normal_cone_method(
     const skinning::Mesh& mesh,
     const skinning::Topology& topology,
     const MethodOptions& options,
-    const std::vector<std::int32_t>& triangles) {
-  return std::make_unique<NormalConeMethod>(mesh, topology, options, &triangles);
+    const std::vector<std::int32_t>& triangles,
+    std::shared_ptr<const FeatureTopology> features) {
+  return std::make_unique<NormalConeMethod>(
+      mesh, topology, options, &triangles, std::move(features));
 }
 
 }  // namespace skelcd::culling

@@ -23,11 +23,14 @@ namespace skelcd::culling {
 
 /// The same method over the triangles listed in `triangles` only (welded triangle ids): pairs
 /// with a triangle outside the list are never reported. Used by routing for the open parts.
+/// `features`, when not null, is the mesh's FeatureTopology(mesh, topology), built by the caller
+/// (`auto`) and shared rather than built again.
 /// @throws InvalidInput as make_method, or for a triangle id out of range.
 [[nodiscard]] std::unique_ptr<CullingMethod> make_normal_cone_method(
     const skinning::Mesh& mesh,
     const skinning::Topology& topology,
     const MethodOptions& options,
-    const std::vector<std::int32_t>& triangles);
+    const std::vector<std::int32_t>& triangles,
+    std::shared_ptr<const FeatureTopology> features = {});
 
 }  // namespace skelcd::culling

@@ -9,6 +9,7 @@
 
 #include "culling/bvh.hpp"
 #include "culling/candidates.hpp"
+#include "culling/cones_method_base.hpp"
 #include "culling/detail/method_base.hpp"
 #include "culling/dual_cone.hpp"
 #include "culling/enhanced_dual_cone.hpp"
@@ -198,20 +199,67 @@ class AutoMethod final : public detail::MethodBase {
       }
     }
     // A group's hierarchy is traversed here when `bvh` tests its pairs (no method of its own), or
-    // for the pairs between the two groups.
+    // for the pairs between the two groups. A cone method's group already has one, over the same
+    // triangles, split at the same rest pose, refit by that method's own query just before ours
+    // (run_groups), and the volumes of every feature of the mesh: those are read, not copied
+    // (bounded memory, docs/culling.md). Hierarchies built here are traversed on their wide copy
+    // only (culling/traversal.hpp): no binary node volumes.
     const bool both = !open_triangles_.empty() && !closed_triangles_.empty();
+    const auto* open_cone = dynamic_cast<const detail::ConeMethodBase*>(open_method_.get());
+    const auto* closed_cone = dynamic_cast<const detail::ConeMethodBase*>(closed_method_.get());
+    BvhOptions own_bvh = options.bvh;
+    own_bvh.node_volumes = false;
     if (!open_triangles_.empty() && (open_method_ == nullptr || both)) {
-      open_bvh_ = AabbBvh(topology_.welded_triangles(), rest, open_triangles_, options.bvh);
+      if (open_cone != nullptr) {
+        open_hierarchy_ = &open_cone->hierarchy();
+      } else {
+        open_bvh_ = AabbBvh(topology_.welded_triangles(), rest, open_triangles_, own_bvh);
+        open_hierarchy_ = &open_bvh_;
+      }
     }
     if (!closed_triangles_.empty() && (closed_method_ == nullptr || both)) {
-      closed_bvh_ = AabbBvh(topology_.welded_triangles(), rest, closed_triangles_, options.bvh);
+      if (closed_cone != nullptr) {
+        closed_hierarchy_ = &closed_cone->hierarchy();
+      } else {
+        closed_bvh_ = AabbBvh(topology_.welded_triangles(), rest, closed_triangles_, own_bvh);
+        closed_hierarchy_ = &closed_bvh_;
+      }
     }
-    const auto num_faces = nf;
-    bounds_.vertices.reserve(static_cast<std::size_t>(topology_.num_vertices()));
-    bounds_.edges.reserve(static_cast<std::size_t>(topology_.num_edges()));
-    bounds_.triangles.reserve(num_faces);
-    scratch_.reserve(
-        static_cast<std::size_t>(4 * std::max(open_bvh_.depth(), closed_bvh_.depth()) + 8));
+    if (open_hierarchy_ == nullptr && closed_hierarchy_ == nullptr)
+      return;  // nothing traversed here
+    const detail::ConeMethodBase* cone = open_cone != nullptr ? open_cone : closed_cone;
+    if (cone != nullptr) {
+      bounds_ = &cone->feature_bounds();
+    } else {
+      own_bounds_.vertices.reserve(static_cast<std::size_t>(topology_.num_vertices()));
+      own_bounds_.triangles.reserve(nf);
+      bounds_ = &own_bounds_;
+    }
+    const int depth = std::max(
+        open_hierarchy_ != nullptr ? open_hierarchy_->depth() : 0,
+        closed_hierarchy_ != nullptr ? closed_hierarchy_->depth() : 0);
+    scratch_.reserve(static_cast<std::size_t>(4 * depth + 8));
+  }
+
+  /// What this method holds for its own traversal (routed_structures).
+  [[nodiscard]] RoutedStructures structures() const {
+    RoutedStructures r;
+    for (const AabbBvh* h : {open_hierarchy_, closed_hierarchy_}) {
+      if (h == nullptr) continue;
+      ++(h == &open_bvh_ || h == &closed_bvh_ ? r.own_hierarchies : r.shared_hierarchies);
+    }
+    r.own_feature_bounds = !traverses_nothing() && bounds_ == &own_bounds_;
+    // Feature topologies held by this method and its culling-module group methods.
+    std::vector<const FeatureTopology*> held{features_.get()};
+    for (const CullingMethod* m : {open_method_.get(), closed_method_.get()}) {
+      const auto* base = dynamic_cast<const detail::MethodBase*>(m);
+      if (base != nullptr &&
+          std::find(held.begin(), held.end(), base->feature_topology().get()) == held.end()) {
+        held.push_back(base->feature_topology().get());
+      }
+    }
+    r.feature_topologies = static_cast<std::int32_t>(held.size());
+    return r;
   }
 
   [[nodiscard]] std::span<const ComponentRoute> component_routes() const override {
@@ -222,10 +270,12 @@ class AutoMethod final : public detail::MethodBase {
     const skinning::Positions& x = at.x;
     check_positions(x, "detect_dcd", "x");
     run_groups([&](CullingMethod& m, FrameResult& r) { m.detect_dcd(at, r); }, out);
-    if (open_bvh_.empty() && closed_bvh_.empty()) return;  // one group, its own method's answer
+    if (traverses_nothing()) return;  // one group, its own method's answer
     const auto t0 = Clock::now();
-    static_vertex_bounds<3>(x, bounds_.vertices);
-    bounds_.derive(topology_, /*with_edges=*/false);
+    if (bounds_ == &own_bounds_) {
+      static_vertex_bounds<3>(x, own_bounds_.vertices);
+      own_bounds_.derive(topology_, /*with_edges=*/false);
+    }
     refit_groups();
     const auto t1 = Clock::now();
     // The `bvh` groups' own pairs and the pairs between the groups, tested in blocks of
@@ -250,15 +300,18 @@ class AutoMethod final : public detail::MethodBase {
     check_positions(x_t0, "detect_ccd", "x_t0");
     check_positions(x_t1, "detect_ccd", "x_t1");
     run_groups([&](CullingMethod& m, FrameResult& r) { m.detect_ccd(interval, r); }, out);
-    if (open_bvh_.empty() && closed_bvh_.empty()) return;  // one group, its own method's answer
+    if (traverses_nothing()) return;  // one group, its own method's answer
     const auto t0 = Clock::now();
-    swept_vertex_bounds<3>(x_t0, x_t1, 0.5 * options_.min_separation, bounds_.vertices);
-    bounds_.derive(topology_);
+    if (bounds_ == &own_bounds_) {
+      swept_vertex_bounds<3>(x_t0, x_t1, 0.5 * options_.min_separation, own_bounds_.vertices);
+      own_bounds_.derive(topology_, /*with_edges=*/false);
+    }
     refit_groups();
     const auto t1 = Clock::now();
     // The `bvh` groups' own pairs and the pairs between the groups, tested in blocks of
     // block_pairs (bounded memory).
-    blocks_.start_ccd(topology_, bounds_, x_t0, x_t1, tests_, options_.accuracy, ccd_options_, out);
+    blocks_.start_ccd(
+        topology_, *bounds_, x_t0, x_t1, tests_, options_.accuracy, ccd_options_, out);
     traverse_own(out.counters.bv_tests);
     blocks_.finish();
     const auto t2 = Clock::now();
@@ -283,20 +336,29 @@ class AutoMethod final : public detail::MethodBase {
   }
 
  private:
-  static std::unique_ptr<CullingMethod> make_group_method(
+  /// A cone group method over `triangles`, on this method's own FeatureTopology (the same mesh and
+  /// topology: shared, not built again); null for `bvh`.
+  [[nodiscard]] std::unique_ptr<CullingMethod> make_group_method(
       const std::string& name,
       const skinning::Mesh& mesh,
       const skinning::Topology& topology,
       const MethodOptions& options,
-      const std::vector<std::int32_t>& triangles) {
+      const std::vector<std::int32_t>& triangles) const {
     if (name == "enhanced-dual-cone") {
       // The simple top-down scheme: measured faster than Algorithm 3's descent on most scenes of
       // bench/culling/bm_cones (docs/benchmarks.md, "## dual-cone"); same contacts.
       return make_enhanced_dual_cone_method(
-          mesh, topology, options, {.grandchildren_descent = false, .triangles = triangles});
+          mesh,
+          topology,
+          options,
+          {.grandchildren_descent = false, .triangles = triangles, .features = features_});
     }
-    if (name == "normal-cone") return make_normal_cone_method(mesh, topology, options, triangles);
-    if (name == "dual-cone") return make_dual_cone_method(mesh, topology, options, triangles);
+    if (name == "normal-cone") {
+      return make_normal_cone_method(mesh, topology, options, triangles, features_);
+    }
+    if (name == "dual-cone") {
+      return make_dual_cone_method(mesh, topology, options, triangles, features_);
+    }
     return nullptr;  // `bvh`: traversed here (traverse_own)
   }
 
@@ -313,28 +375,36 @@ class AutoMethod final : public detail::MethodBase {
     }
   }
 
+  [[nodiscard]] bool traverses_nothing() const {
+    return open_hierarchy_ == nullptr && closed_hierarchy_ == nullptr;
+  }
+
+  /// Refits the hierarchies built here (a cone method refits its own in its query).
   void refit_groups() {
-    if (!open_bvh_.empty()) open_bvh_.refit(bounds_.triangles);
-    if (!closed_bvh_.empty()) closed_bvh_.refit(bounds_.triangles);
+    if (!open_bvh_.empty()) open_bvh_.refit(bounds_->triangles);
+    if (!closed_bvh_.empty()) closed_bvh_.refit(bounds_->triangles);
   }
 
   /// The `bvh` groups' self pairs and the pairs between the groups, into blocks_ in
   /// installments.
   void traverse_own(std::int64_t& bv_tests) {
-    const std::span<const Aabb> tri(bounds_.triangles);
-    for (const AabbBvh* group : {&open_bvh_, &closed_bvh_}) {
-      const bool own = group == &open_bvh_ ? open_method_ == nullptr : closed_method_ == nullptr;
+    const std::span<const Aabb> tri(bounds_->triangles);
+    for (const AabbBvh* group : {open_hierarchy_, closed_hierarchy_}) {
+      if (group == nullptr) continue;
+      const bool own =
+          group == open_hierarchy_ ? open_method_ == nullptr : closed_method_ == nullptr;
       if (group->empty() || !own) continue;
       start_self_traversal<3>(*group, scratch_);
       blocks_.drain([&](std::vector<TrianglePair>& pairs, std::size_t max_pairs) {
         return self_traverse_some<3>(*group, tri, scratch_, pairs, bv_tests, max_pairs);
       });
     }
-    if (!open_bvh_.empty() && !closed_bvh_.empty()) {
-      start_pair_traversal<3>(open_bvh_, closed_bvh_, scratch_);
+    if (open_hierarchy_ != nullptr && closed_hierarchy_ != nullptr && !open_hierarchy_->empty() &&
+        !closed_hierarchy_->empty()) {
+      start_pair_traversal<3>(*open_hierarchy_, *closed_hierarchy_, scratch_);
       blocks_.drain([&](std::vector<TrianglePair>& pairs, std::size_t max_pairs) {
         return pair_traverse_some<3>(
-            open_bvh_, tri, closed_bvh_, tri, scratch_, pairs, bv_tests, max_pairs);
+            *open_hierarchy_, tri, *closed_hierarchy_, tri, scratch_, pairs, bv_tests, max_pairs);
       });
     }
   }
@@ -342,11 +412,16 @@ class AutoMethod final : public detail::MethodBase {
   std::vector<ComponentRoute> routes_;
   std::vector<std::int32_t> open_triangles_;
   std::vector<std::int32_t> closed_triangles_;
-  AabbBvh open_bvh_;
+  AabbBvh open_bvh_;  ///< built here when the open group has no cone method
   AabbBvh closed_bvh_;
   std::unique_ptr<CullingMethod> open_method_;
   std::unique_ptr<CullingMethod> closed_method_;
-  FeatureBounds<3> bounds_;
+  /// The groups' hierarchies this method traverses (null: not traversed here): its own, or a
+  /// cone group method's.
+  const AabbBvh* open_hierarchy_ = nullptr;
+  const AabbBvh* closed_hierarchy_ = nullptr;
+  FeatureBounds<3> own_bounds_;  ///< refit here only when no group method is a cone method
+  const FeatureBounds<3>* bounds_ = &own_bounds_;
   TraversalScratch scratch_;
   PairBlocks<3> blocks_;
   FrameResult sub_;
@@ -405,6 +480,15 @@ std::unique_ptr<CullingMethod> make_routed_method(
 
 std::span<const ComponentRoute> routes_of(const CullingMethod& method) {
   return method.component_routes();
+}
+
+RoutedStructures routed_structures(const CullingMethod& method) {
+  const auto* routed = dynamic_cast<const AutoMethod*>(&method);
+  if (routed == nullptr) {
+    throw InvalidInput(
+        "culling::routed_structures: method '" + std::string(method.name()) + "' is not auto");
+  }
+  return routed->structures();
 }
 
 }  // namespace skelcd::culling

@@ -59,6 +59,26 @@ struct RoutingOptions {
     const MethodOptions& options = {},
     const RoutingOptions& routing = {});
 
+/// What `auto` holds for its own traversal (its groups' self pairs under `bvh`, the pairs between
+/// the groups) beside its group methods (docs/culling.md "Bounded memory").
+struct RoutedStructures {
+  /// Hierarchies `auto` built itself: a group traversed here that has no cone method (`bvh`).
+  std::int32_t own_hierarchies = 0;
+  /// Group hierarchies read from the group's cone method rather than copied.
+  std::int32_t shared_hierarchies = 0;
+  /// Feature volumes refit by `auto` itself (false: a cone group method's are read, or nothing is
+  /// traversed here).
+  bool own_feature_bounds = false;
+  /// Distinct feature topologies (culling::FeatureTopology) held by `auto` and those of its group
+  /// methods that are culling/'s own: 1 when its cone group methods share `auto`'s. (A whole-mesh
+  /// closed method, `dynamic`, gets another mesh and counts apart when it is one of culling/'s.)
+  std::int32_t feature_topologies = 0;
+};
+
+/// The structures of an `auto` method (make_routed_method).
+/// @throws InvalidInput when `method` is not one.
+[[nodiscard]] RoutedStructures routed_structures(const CullingMethod& method);
+
 /// The routes of `method` (CullingMethod::component_routes): which method each component used
 /// under `auto` (for the log), empty for the other methods.
 [[nodiscard]] std::span<const ComponentRoute> routes_of(const CullingMethod& method);

@@ -3,6 +3,7 @@
 // and the checks and clock shared by the implementations. Internal to culling/.
 
 #include <chrono>
+#include <memory>
 #include <string>
 #include <string_view>
 
@@ -15,12 +16,22 @@ class MethodBase : public CullingMethod {
  public:
   [[nodiscard]] std::string_view name() const override { return name_; }
 
+  /// The method's feature topology, which another method of the same mesh and topology may share
+  /// (`auto` lends its own to its cone group methods: docs/culling.md "Bounded memory").
+  [[nodiscard]] const std::shared_ptr<const FeatureTopology>& feature_topology() const {
+    return features_;
+  }
+
  protected:
+  /// @param features when not null, a FeatureTopology(mesh, topology) another method built, used
+  ///        instead of building another one.
+  /// @throws InvalidInput for bad options, or features of another triangle count.
   MethodBase(
       std::string_view name,
       const skinning::Mesh& mesh,
       const skinning::Topology& topology,
-      const MethodOptions& options);
+      const MethodOptions& options,
+      std::shared_ptr<const FeatureTopology> features = {});
 
   /// @throws InvalidInput when `x` does not have one row per welded vertex.
   void check_positions(const skinning::Positions& x, const char* call, const char* which) const;
@@ -31,7 +42,8 @@ class MethodBase : public CullingMethod {
   }
 
   std::string name_;
-  FeatureTopology topology_;
+  std::shared_ptr<const FeatureTopology> features_;  ///< built here or lent by another method
+  const FeatureTopology& topology_;                  ///< *features_
   MethodOptions options_;
   ElementaryTests tests_;
   ccd::CcdOptions ccd_options_;

@@ -5,7 +5,11 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
+#include <limits>
 #include <numeric>
+#include <span>
+#include <string>
 
 #include "culling/bvh.hpp"
 #include "culling/candidates.hpp"
@@ -144,6 +148,106 @@ TEST(Bvh, BuildIsDeterministic) {
   ASSERT_EQ(a.nodes().size(), b.nodes().size());
   EXPECT_TRUE(
       std::equal(a.triangle_order().begin(), a.triangle_order().end(), b.triangle_order().begin()));
+}
+
+/// Every lane of a's wide nodes has b's bits (volumes, children, counts, nodes).
+template <int N>
+void expect_same_wide_nodes(const Bvh<N>& a, const Bvh<N>& b, const std::string& what) {
+  const auto wa = a.wide_nodes();
+  const auto wb = b.wide_nodes();
+  ASSERT_EQ(wa.size(), wb.size()) << what;
+  for (std::size_t n = 0; n < wa.size(); ++n) {
+    ASSERT_EQ(wa[n].num_children, wb[n].num_children) << what << " wide node " << n;
+    ASSERT_EQ(0, std::memcmp(wa[n].lo, wb[n].lo, sizeof(wa[n].lo))) << what << " wide node " << n;
+    ASSERT_EQ(0, std::memcmp(wa[n].hi, wb[n].hi, sizeof(wa[n].hi))) << what << " wide node " << n;
+    ASSERT_EQ(0, std::memcmp(wa[n].child, wb[n].child, sizeof(wa[n].child))) << what;
+    ASSERT_EQ(0, std::memcmp(wa[n].count, wb[n].count, sizeof(wa[n].count))) << what;
+  }
+}
+
+/// The triangles' float volumes by slot (Bvh::slot_lo / slot_hi) are their volumes in `bounds`
+/// rounded outwards, and the three slots past the last are empty.
+template <int N>
+void expect_slot_volumes(
+    const Bvh<N>& bvh, std::span<const Dop<N>> bounds, const std::string& what) {
+  const auto order = bvh.triangle_order();
+  for (int k = 0; k < N; ++k) {
+    for (std::size_t s = 0; s < order.size(); ++s) {
+      const Dop<N>& t = bounds[static_cast<std::size_t>(order[s])];
+      ASSERT_EQ(bvh.slot_lo(k)[s], float_below(t.lo[static_cast<std::size_t>(k)]))
+          << what << " slot " << s;
+      ASSERT_EQ(bvh.slot_hi(k)[s], float_above(t.hi[static_cast<std::size_t>(k)]))
+          << what << " slot " << s;
+    }
+    for (std::size_t s = order.size(); s < order.size() + 3; ++s) {
+      ASSERT_EQ(bvh.slot_lo(k)[s], std::numeric_limits<float>::infinity()) << what;
+      ASSERT_EQ(bvh.slot_hi(k)[s], -std::numeric_limits<float>::infinity()) << what;
+    }
+  }
+}
+
+template <int N>
+void check_without_node_volumes(
+    const skinning::Positions& x_t0,
+    const skinning::Positions& x_t1,
+    const Scene& s,
+    std::span<const std::int32_t> subset,
+    int leaf_size) {
+  const FeatureTopology topology(s.mesh, s.topology);
+  const std::string what = "N = " + std::to_string(N) + ", leaf " + std::to_string(leaf_size) +
+                           ", subset " + std::to_string(subset.size());
+  const BvhOptions with{.leaf_size = leaf_size};
+  const BvhOptions without{.leaf_size = leaf_size, .node_volumes = false};
+  Bvh<N> a = subset.empty() ? Bvh<N>(topology.welded_triangles(), x_t0, with)
+                            : Bvh<N>(topology.welded_triangles(), x_t0, subset, with);
+  Bvh<N> b = subset.empty() ? Bvh<N>(topology.welded_triangles(), x_t0, without)
+                            : Bvh<N>(topology.welded_triangles(), x_t0, subset, without);
+  EXPECT_FALSE(a.node_bounds().empty()) << what;
+  EXPECT_TRUE(b.node_bounds().empty()) << what;
+  // Two refits in a row (the second must not keep anything of the first): an instant, then an
+  // interval with a contact distance.
+  FeatureBounds<N> bounds;
+  static_vertex_bounds<N>(x_t0, bounds.vertices);
+  bounds.derive(topology, false);
+  a.refit(bounds.triangles);
+  b.refit(bounds.triangles);
+  expect_same_wide_nodes(a, b, what + ", static");
+  expect_slot_volumes<N>(a, bounds.triangles, what + ", static, with node volumes");
+  expect_slot_volumes<N>(b, bounds.triangles, what + ", static, without");
+  swept_vertex_bounds<N>(x_t0, x_t1, 0.005, bounds.vertices);
+  bounds.derive(topology);
+  a.refit(bounds.triangles);
+  b.refit(bounds.triangles);
+  expect_same_wide_nodes(a, b, what + ", swept");
+  expect_slot_volumes<N>(a, bounds.triangles, what + ", swept, with node volumes");
+  expect_slot_volumes<N>(b, bounds.triangles, what + ", swept, without");
+}
+
+TEST(Bvh, WithoutNodeVolumesRefitGivesTheWideNodesTheSameBits) {
+  // The `bvh`, `kdop` and `auto` hierarchies keep no binary node volumes (2·#F volumes less,
+  // docs/culling.md "Bounded memory"): their traversals read only the wide copy, which must be
+  // what the refit through the node volumes gives, bit for bit.
+  const Scene s = moving_tube();
+  const std::vector<std::int32_t> all;
+  const std::vector<std::int32_t> small{5, 9, 100, 3};
+  std::vector<std::int32_t> half;
+  for (std::int32_t f = 0; f < static_cast<std::int32_t>(s.topology.welded_triangles.rows());
+       f += 2) {
+    half.push_back(f);
+  }
+  for (const int leaf : {1, 2, 5, 9}) {
+    for (const auto& subset : {all, small, half}) {
+      check_without_node_volumes<3>(s.x_t0, s.x_t1, s, subset, leaf);
+      check_without_node_volumes<8>(s.x_t0, s.x_t1, s, subset, leaf);
+    }
+  }
+  // Far from the origin, where the floats round most of the doubles' bits away.
+  const skinning::Positions far_t0 =
+      test::translated(s.x_t0 * 1e3, Eigen::Vector3d(1e6, -1e6, 3e5));
+  const skinning::Positions far_t1 =
+      test::translated(s.x_t1 * 1e3, Eigen::Vector3d(1e6 + 0.1, -1e6, 3e5));
+  check_without_node_volumes<3>(far_t0, far_t1, s, all, 1);
+  check_without_node_volumes<8>(far_t0, far_t1, s, all, 1);
 }
 
 TEST(Bvh, EmptyAndSingleTriangle) {

@@ -93,7 +93,9 @@ void check(
   self_traverse<3>(bvh, bounds.triangles, scratch, all, plain_tests);
   const Expected e = reference(ft, bvh, all, certified);
   ASSERT_GT(e.near, 0) << "the window path is exercised";
-  if (expect_far) ASSERT_GT(e.far, 0) << "the pair-by-pair path is exercised";
+  if (expect_far) {
+    ASSERT_GT(e.far, 0) << "the pair-by-pair path is exercised";
+  }
 
   const SlotAdjacency slots(ft, bvh.triangle_order());
   std::vector<std::uint8_t> full;

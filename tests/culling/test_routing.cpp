@@ -224,6 +224,50 @@ TEST(Routing, OptionsChooseOtherGroupMethodsAndRejectUnknownOnes) {
       "'dynamic' cannot take the closed components");
 }
 
+TEST(Routing, ReadsItsConeGroupsHierarchyAndVolumesInsteadOfCopyingThem) {
+  // Bounded memory (docs/culling.md): a group whose method is a cone method already holds a
+  // hierarchy over its triangles and the volumes of every feature, refit by its own query just
+  // before `auto` traverses between the groups; `auto` reads those and builds only the hierarchy
+  // of a group no method of its own tests. Its cone group methods use its FeatureTopology.
+  const OpenScene s = test::skirt_body_scene(9, 14, 16, 10, {0.3, 0.5});
+  auto b = make_method("bvh", s.mesh, s.topo);
+  struct Case {
+    std::string open, closed;
+    RoutedStructures want;
+  };
+  for (const Case& c : std::vector<Case>{
+           {"enhanced-dual-cone", "", {.own_hierarchies = 1, .shared_hierarchies = 1}},
+           {"bvh", "enhanced-dual-cone", {.own_hierarchies = 1, .shared_hierarchies = 1}},
+           {"enhanced-dual-cone", "normal-cone", {.own_hierarchies = 0, .shared_hierarchies = 2}},
+           {"bvh", "bvh", {.own_hierarchies = 2, .own_feature_bounds = true}}}) {
+    auto m =
+        make_routed_method(s.mesh, s.topo, {}, {.open_method = c.open, .closed_method = c.closed});
+    const RoutedStructures got = routed_structures(*m);
+    EXPECT_EQ(got.own_hierarchies, c.want.own_hierarchies) << c.open << " / " << c.closed;
+    EXPECT_EQ(got.shared_hierarchies, c.want.shared_hierarchies) << c.open << " / " << c.closed;
+    EXPECT_EQ(got.own_feature_bounds, c.want.own_feature_bounds) << c.open << " / " << c.closed;
+    EXPECT_EQ(got.feature_topologies, 1) << c.open << " / " << c.closed;
+    // The shared volumes are those of the query at hand, whatever came before it: CCD, DCD (which
+    // refits no edge volumes), CCD again, backwards.
+    EXPECT_EQ(keys(ccd(*m, s.frames[0], s.frames[1])), keys(ccd(*b, s.frames[0], s.frames[1])))
+        << c.open << " / " << c.closed;
+    EXPECT_EQ(dcd(*m, s.frames[1]).dcd_pairs, dcd(*b, s.frames[1]).dcd_pairs);
+    EXPECT_EQ(keys(ccd(*m, s.frames[1], s.frames[0])), keys(ccd(*b, s.frames[1], s.frames[0])))
+        << c.open << " / " << c.closed;
+  }
+  // One open part alone: its cone method answers; `auto` traverses and holds nothing itself.
+  auto sheet = test::sheet(20, 20, 3.0, 3.0);
+  const auto topo = test::simple_topology(sheet);
+  auto alone = make_method("auto", sheet, topo);
+  const RoutedStructures got = routed_structures(*alone);
+  EXPECT_EQ(got.own_hierarchies, 0);
+  EXPECT_EQ(got.shared_hierarchies, 0);
+  EXPECT_FALSE(got.own_feature_bounds);
+  EXPECT_EQ(got.feature_topologies, 1);
+  EXPECT_THROW_MESSAGE(
+      (void)routed_structures(*b), InvalidInput, "routed_structures: method 'bvh' is not auto");
+}
+
 TEST(Routing, ComponentsAreFoundWhenTheTopologyHasNone) {
   // The culling tests' own topology builder fills no components.
   auto sphere = test::uv_sphere(8, 10);

@@ -14,6 +14,7 @@
 #include "tests/support/test_support.hpp"
 #include "tests/tools/cli_runner.hpp"
 #include "tools/io/file_hash.hpp"
+#include "tools/io/log/detail/hdf5_schema.hpp"
 #include "tools/io/log/log_reader.hpp"
 #include "tools/io/log/log_writer.hpp"
 
@@ -257,6 +258,8 @@ TEST(Log, RoundTripsEveryField) {
   }
   EXPECT_EQ(data.contacts, contacts);
   EXPECT_EQ(data.dcd_pairs, pairs);
+  // 3000 contacts in one append: 168 KB of rows, converted through the writer's 64 KiB buffers in
+  // strips (log_writer.cpp, kConversionBufferBytes).
   EXPECT_EQ(data.contacts.size(), 3005u);
   EXPECT_EQ(data.dcd_pairs.size(), 1502u);
 
@@ -685,6 +688,15 @@ TEST(FileHash, MatchesPublishedFnv1aVectors) {
   write_text(dir / "foobar.txt", "foobar");
   EXPECT_EQ(file_content_hash(dir / "foobar.txt"), "fnv1a64:85944171f73967e8");
   EXPECT_THROW_MESSAGE((void)file_content_hash(dir / "none"), IoError, "none");
+}
+
+TEST(Log, ContactRecordsHaveTheSizesBenchRealCounts) {
+  // scripts/bench_real.py (CONTACT_RECORD_BYTES) counts n × (32 + 56 + 56) bytes of a peak as the
+  // findings of an interval with n contacts, and the log writer's rows (56 each) inside its
+  // measured share: keep them in step.
+  EXPECT_EQ(sizeof(skelcd::culling::CcdContact), 32u);
+  EXPECT_EQ(sizeof(ContactRow), 56u);
+  EXPECT_EQ(sizeof(skelcd::tools::detail::ContactDisk), 56u);
 }
 
 }  // namespace

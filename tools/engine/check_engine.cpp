@@ -112,19 +112,22 @@ CheckOutcome check_model(
       model.motion(skinning::MotionRequest{.clip = request.clip, .rate_hz = request.fps});
   CheckOutcome outcome;
   outcome.radial_view = setup_radial_view(request.radial_view, model, *motion, options);
-  ClipRunner runner(*motion, options);
+  // The baseline and the allowances, refused (a bad sample, a log of another model, an unknown
+  // part) before the log is created. The baseline's DCD builds its own `bvh` and frees it before
+  // the runner builds its method: the two would otherwise be the run's peak memory together
+  // (docs/benchmarks.md "Real assets").
+  skinning::Topology topology = skinning::build_topology(motion->mesh());
+  const auto baseline = baseline_findings(request.baseline, *motion, topology);
+  ClipRunner runner(*motion, options, std::move(topology));
   outcome.plan = runner.plan();
   outcome.clip = motion->name();
   outcome.fps = motion->rate_hz();
   outcome.method = std::string(runner.method_name());
 
-  // The baseline and the allowances, refused (a bad sample, a log of another model, an unknown
-  // part) before the log is created.
   const skinning::Mesh& mesh = motion->mesh();
   const auto positions_at = [&motion](std::int32_t sample, skinning::Positions& out) {
     motion->positions(sample, out);
   };
-  const auto baseline = baseline_findings(request.baseline, *motion, runner.topology());
   outcome.baseline = describe(request.baseline);
   outcome.baseline_pairs = static_cast<std::int64_t>(baseline.pairs.size());
   const skinning::Rig* rig = model.rig && model.rig->mesh.num_vertices() == mesh.num_vertices()

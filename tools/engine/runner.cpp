@@ -368,16 +368,23 @@ std::int32_t resolve_threads(std::int32_t threads) {
 
 ClipRunner::ClipRunner(
     const skinning::Motion& motion, const RunOptions& options, MethodFactory factory)
+    : ClipRunner(motion, options, skinning::build_topology(motion.mesh()), std::move(factory)) {}
+
+ClipRunner::ClipRunner(
+    const skinning::Motion& motion,
+    const RunOptions& options,
+    skinning::Topology topology,
+    MethodFactory factory)
     : motion_(motion),
       options_(options),
       factory_(std::move(factory)),
       method_options_(method_options_of(options, motion)),
-      plan_(make_plan(motion, options)) {
+      plan_(make_plan(motion, options)),
+      topology_(std::move(topology)) {
   // Within one query the elementary tests may split over the threads asked for (identical
   // output); across queries, blocks of samples go to workers (below) when the method allows.
   method_options_.elementary.threads = resolve_threads(options.threads);
   method_options_.elementary.tests_done = options.elementary_tests_done;
-  topology_ = skinning::build_topology(motion.mesh());
   if (factory_) {
     method_ = factory_(motion.mesh(), topology_, method_options_);
   } else {

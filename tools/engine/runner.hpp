@@ -99,6 +99,15 @@ class ClipRunner {
   /// motion (frame range inside [0, num_samples)).
   /// @throws InvalidInput for a bad frame range, an unknown method or an unusable mesh.
   ClipRunner(const skinning::Motion& motion, const RunOptions& options, MethodFactory factory = {});
+  /// The same on a topology the caller built (skinning::build_topology(motion.mesh())), so that
+  /// what it computes on the topology first — the baseline DCD with its own `bvh` — is freed
+  /// before this runner builds its method, and the two never hold memory at once.
+  /// @pre topology == skinning::build_topology(motion.mesh()).
+  ClipRunner(
+      const skinning::Motion& motion,
+      const RunOptions& options,
+      skinning::Topology topology,
+      MethodFactory factory = {});
 
   [[nodiscard]] const RunPlan& plan() const { return plan_; }
   [[nodiscard]] const skinning::Topology& topology() const { return topology_; }

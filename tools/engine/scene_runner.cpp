@@ -560,7 +560,11 @@ SceneRunResult run_scene(const Scene& scene, const SceneRunOptions& options) {
                                   setup.segmentation_source;
         }
       }
-      runners[k] = std::make_unique<ClipRunner>(*lo.motion, ro);
+      // The baseline's DCD (its own `bvh`, freed on return) before the runner builds its method,
+      // so that the two do not hold memory at once (as check_model).
+      skinning::Topology topology = skinning::build_topology(lo.motion->mesh());
+      const auto baseline = baseline_findings(so.baseline, *lo.motion, topology);
+      runners[k] = std::make_unique<ClipRunner>(*lo.motion, ro, std::move(topology));
       // The labels and events of this self check (docs/events.md).
       const auto& mesh = lo.motion->mesh();
       const skinning::Rig* rig =
@@ -572,7 +576,7 @@ SceneRunResult run_scene(const Scene& scene, const SceneRunOptions& options) {
           mesh,
           runners[k]->topology(),
           rig,
-          baseline_findings(so.baseline, *motion, runners[k]->topology()),
+          baseline,
           so.allow,
           so.baseline_slack,
           [motion](std::int32_t sample, skinning::Positions& out) {

@@ -17,12 +17,32 @@ using detail::H5Handle;
 
 namespace {
 
-/// One extendible table: its dataset, the memory type of its rows and how many rows it holds.
+/// One extendible table: its dataset, the memory type of its rows, how many rows it holds and the
+/// transfer properties its appends use (transfer_properties).
 struct Table {
   H5Handle dataset;
   H5Handle memory_type;
   hsize_t rows = 0;
+  H5Handle transfer;
 };
+
+/// Bytes of HDF5's type-conversion buffer, and of its background buffer, for our appends: HDF5
+/// converts rows to the packed file layout through them, in strips of this size. Its default is
+/// 1 MiB each, kept in its free lists for the life of the process once used: 2 MiB of every
+/// checked clip's peak, whatever its findings (docs/benchmarks.md "Real assets").
+constexpr std::size_t kConversionBufferBytes = std::size_t{64} << 10;
+
+/// Dataset transfer properties with kConversionBufferBytes buffers (invalid if HDF5 refuses them:
+/// the appends then use the defaults).
+H5Handle transfer_properties() {
+  H5Handle properties(H5Pcreate(H5P_DATASET_XFER), H5Pclose);
+  if (properties.valid() &&
+      H5Pset_buffer(properties.get(), kConversionBufferBytes, nullptr, nullptr) < 0) {
+    detail::clear_hdf5_error();
+    return {};
+  }
+  return properties;
+}
 
 /// Rows per chunk: small enough that the chunk rewritten at every flush stays cheap.
 constexpr hsize_t kFrameChunkRows = 64;
@@ -78,6 +98,7 @@ Table create_table(
       H5Dclose);
   if (!table.dataset.valid()) fail("dataset");
   table.memory_type = std::move(memory_type);
+  table.transfer = transfer_properties();
   return table;
 }
 
@@ -101,7 +122,7 @@ void append_rows(
           table.memory_type.get(),
           memory_space.get(),
           file_space.get(),
-          H5P_DEFAULT,
+          table.transfer.valid() ? table.transfer.get() : H5P_DEFAULT,
           rows.data()) < 0) {
     fail();
   }
@@ -415,10 +436,14 @@ struct LogWriter::Impl {
                             H5P_DEFAULT)
                       : H5I_INVALID_HID,
         H5Dclose);
-    if (!dataset.valid() ||
-        (count > 0 &&
-         H5Dwrite(dataset.get(), memory_type.get(), H5S_ALL, H5S_ALL, H5P_DEFAULT, rows.data()) <
-             0)) {
+    const H5Handle transfer = transfer_properties();
+    if (!dataset.valid() || (count > 0 && H5Dwrite(
+                                              dataset.get(),
+                                              memory_type.get(),
+                                              H5S_ALL,
+                                              H5S_ALL,
+                                              transfer.valid() ? transfer.get() : H5P_DEFAULT,
+                                              rows.data()) < 0)) {
       throw IoError(where + ": cannot write /" + name + " (" + detail::take_hdf5_error() + ")");
     }
   }
