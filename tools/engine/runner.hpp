@@ -123,6 +123,9 @@ class ClipRunner {
   void run(const FrameCallback& on_frame);
 
  private:
+  /// The run's method, as the factory or culling::make_method builds it.
+  /// @throws InvalidInput when it cannot be built.
+  [[nodiscard]] std::unique_ptr<culling::CullingMethod> build_method() const;
   void run_serial(const FrameCallback& on_frame);
   void run_queries_in_order(const FrameCallback& on_frame);
   void run_parallel(const FrameCallback& on_frame);
@@ -134,6 +137,8 @@ class ClipRunner {
   RunPlan plan_;
   skinning::Topology topology_;
   std::unique_ptr<culling::CullingMethod> method_;
+  /// A parallel run's other workers' methods (plan_.threads − 1), built with method_.
+  std::vector<std::unique_ptr<culling::CullingMethod>> spare_methods_;
   bool bones_ = false;  ///< the queries carry the bones' transforms (the method needs them)
   /// DCD updated from the CCD contacts (RunOptions::incremental_dcd).
   bool incremental_dcd_ = false;
