@@ -72,10 +72,11 @@ void Bvh<N>::build(const skinning::Triangles& triangles, const skinning::Positio
   }
   for (std::size_t i = 0; i < order_.size(); ++i) order_[i] = items_[i].id;
   if (node_volumes_) node_bounds_.assign(nodes_.size(), Volume::empty());
-  slot_bounds_.assign(2 * static_cast<std::size_t>(N) * slot_stride(), 0.0f);
-  for (std::size_t k = 0; k < static_cast<std::size_t>(N); ++k) {
+  constexpr auto kAxes = static_cast<std::size_t>(kSlotAxes);
+  slot_bounds_.assign(2 * kAxes * slot_stride(), 0.0f);
+  for (std::size_t k = 0; k < kAxes; ++k) {
     float* lo = slot_bounds_.data() + k * slot_stride();
-    float* hi = slot_bounds_.data() + (static_cast<std::size_t>(N) + k) * slot_stride();
+    float* hi = slot_bounds_.data() + (kAxes + k) * slot_stride();
     std::fill(lo, lo + slot_stride(), std::numeric_limits<float>::infinity());
     std::fill(hi, hi + slot_stride(), -std::numeric_limits<float>::infinity());
   }
@@ -239,10 +240,11 @@ void Bvh<N>::refit(std::span<const Volume> triangle_bounds) {
   // Depth-first order puts every child after its parent, so one backward sweep is bottom-up. A
   // leaf also writes its triangles' float volumes by slot.
   const std::size_t stride = slot_stride();
+  constexpr auto kAxes = static_cast<std::size_t>(kSlotAxes);
   const auto slot_floats = [&](std::size_t s, const Volume& t) {
-    for (std::size_t k = 0; k < kN; ++k) {
+    for (std::size_t k = 0; k < kAxes; ++k) {
       slot_bounds_[k * stride + s] = float_below(t.lo[k]);
-      slot_bounds_[(kN + k) * stride + s] = float_above(t.hi[k]);
+      slot_bounds_[(kAxes + k) * stride + s] = float_above(t.hi[k]);
     }
   };
   for (std::size_t n = nodes_.size(); n-- > 0;) {
@@ -278,6 +280,7 @@ void Bvh<N>::refit(std::span<const Volume> triangle_bounds) {
 template <int N>
 void Bvh<N>::refit_wide_only(std::span<const Volume> triangle_bounds) {
   constexpr auto kN = static_cast<std::size_t>(N);
+  constexpr auto kAxes = static_cast<std::size_t>(kSlotAxes);
   const std::size_t stride = slot_stride();
   // A wide node's inner children come after it (built depth first), so one backward sweep is
   // bottom-up. A bucket lane is its triangles' union, rounded outwards; an inner lane the union of
@@ -297,8 +300,10 @@ void Bvh<N>::refit_wide_only(std::span<const Volume> triangle_bounds) {
             const Volume& t = triangle_bounds[static_cast<std::size_t>(order_[s])];
             const float tl = float_below(t.lo[k]);
             const float th = float_above(t.hi[k]);
-            slot_bounds_[k * stride + s] = tl;
-            slot_bounds_[(kN + k) * stride + s] = th;
+            if (k < kAxes) {
+              slot_bounds_[k * stride + s] = tl;
+              slot_bounds_[(kAxes + k) * stride + s] = th;
+            }
             lo = std::min(lo, tl);
             hi = std::max(hi, th);
           }

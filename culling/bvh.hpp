@@ -113,16 +113,20 @@ class Bvh {
   /// bucket_size by its two children. Children of at most bucket_size triangles are buckets.
   /// Empty when the tree is.
   [[nodiscard]] std::span<const WideBvhNode<N>> wide_nodes() const { return wide_; }
-  /// The triangles' own volumes as floats rounded outwards (as the wide nodes'), by slot of
-  /// triangle_order(), axis by axis: slot_lo(k)[s], slot_hi(k)[s] for s in [0, #triangles + 3),
-  /// the last three slots empty (+inf, −inf) so that any four consecutive slots of the tree can be
-  /// read at once. The traversals test a triangle against four of a bucket with them (a float
-  /// test that only prunes). Refit writes them.
+  /// Axes of the triangles' float volumes by slot: the three coordinate axes (all of an AABB's;
+  /// the first three of a 16-DOP's — a test on fewer axes only prunes less, and 24 bytes a
+  /// triangle instead of 64 keep `kdop` within its memory budget).
+  static constexpr int kSlotAxes = N < 3 ? N : 3;
+  /// The triangles' own volumes on the first kSlotAxes axes, as floats rounded outwards (as the
+  /// wide nodes'), by slot of triangle_order(), axis by axis: slot_lo(k)[s], slot_hi(k)[s] for
+  /// k < kSlotAxes and s in [0, #triangles + 3), the last three slots empty (+inf, −inf) so that
+  /// any four consecutive slots of the tree can be read at once. The traversals test a triangle
+  /// against four of a bucket with them (a float test that only prunes). Refit writes them.
   [[nodiscard]] const float* slot_lo(int k) const {
     return slot_bounds_.data() + static_cast<std::size_t>(k) * slot_stride();
   }
   [[nodiscard]] const float* slot_hi(int k) const {
-    return slot_bounds_.data() + static_cast<std::size_t>(N + k) * slot_stride();
+    return slot_bounds_.data() + static_cast<std::size_t>(kSlotAxes + k) * slot_stride();
   }
   /// Wide nodes on the longest path from the virtual root to a leaf, the virtual root included
   /// (1 when the tree is one leaf; 0 when empty).
@@ -143,7 +147,7 @@ class Bvh {
   std::vector<WideBvhNode<N>> wide_;
   [[nodiscard]] std::size_t slot_stride() const { return order_.size() + kSlotPadding; }
   static constexpr std::size_t kSlotPadding = 3;
-  std::vector<float> slot_bounds_;  // 2N rows of slot_stride(): lo by axis, then hi by axis
+  std::vector<float> slot_bounds_;  // 2·kSlotAxes rows of slot_stride(): lo by axis, then hi
   struct Item {
     Eigen::Vector3d centroid;
     std::int32_t id;

@@ -282,7 +282,7 @@ class Walk {
   [[nodiscard]] unsigned float_overlap_slots(std::int32_t si, std::int32_t sb) const {
 #if defined(__SSE2__)
     __m128 ok = _mm_castsi128_ps(_mm_set1_epi32(-1));
-    for (int k = 0; k < N; ++k) {
+    for (int k = 0; k < Bvh<N>::kSlotAxes; ++k) {
       const __m128 a_lo = _mm_set1_ps(a_.slot_lo(k)[to_size(si)]);
       const __m128 a_hi = _mm_set1_ps(a_.slot_hi(k)[to_size(si)]);
       ok = _mm_and_ps(ok, _mm_cmple_ps(_mm_loadu_ps(b_.slot_lo(k) + sb), a_hi));
@@ -293,7 +293,7 @@ class Walk {
     unsigned mask = 0;
     for (int c = 0; c < kWidth; ++c) {
       bool hit = true;
-      for (int k = 0; k < N; ++k) {
+      for (int k = 0; k < Bvh<N>::kSlotAxes; ++k) {
         hit = hit && b_.slot_lo(k)[to_size(sb + c)] <= a_.slot_hi(k)[to_size(si)] &&
               a_.slot_lo(k)[to_size(si)] <= b_.slot_hi(k)[to_size(sb + c)];
       }

@@ -171,7 +171,7 @@ template <int N>
 void expect_slot_volumes(
     const Bvh<N>& bvh, std::span<const Dop<N>> bounds, const std::string& what) {
   const auto order = bvh.triangle_order();
-  for (int k = 0; k < N; ++k) {
+  for (int k = 0; k < Bvh<N>::kSlotAxes; ++k) {
     for (std::size_t s = 0; s < order.size(); ++s) {
       const Dop<N>& t = bounds[static_cast<std::size_t>(order[s])];
       ASSERT_EQ(bvh.slot_lo(k)[s], float_below(t.lo[static_cast<std::size_t>(k)]))
