@@ -196,6 +196,7 @@ void dcd_tests(
     const ElementaryTests& tests,
     std::span<const std::uint8_t> certified,
     bool filter,
+    bool sorted,
     FrameResult& out) {
   assert(tests.triangles != nullptr);
   const std::size_t first = out.dcd_pairs.size();
@@ -240,7 +241,9 @@ void dcd_tests(
     ++out.counters.dcd_pairs;
     out.dcd_pairs.push_back(pairs[i]);
   }
-  std::sort(out.dcd_pairs.begin() + static_cast<std::ptrdiff_t>(first), out.dcd_pairs.end());
+  if (sorted) {
+    std::sort(out.dcd_pairs.begin() + static_cast<std::ptrdiff_t>(first), out.dcd_pairs.end());
+  }
 }
 
 }  // namespace
@@ -252,7 +255,7 @@ void run_dcd_tests(
     const ElementaryTests& tests,
     std::span<const std::uint8_t> certified,
     FrameResult& out) {
-  dcd_tests(topology, pairs, x, tests, certified, false, out);
+  dcd_tests(topology, pairs, x, tests, certified, /*filter=*/false, /*sorted=*/true, out);
 }
 
 void filter_and_run_dcd_tests(
@@ -262,7 +265,7 @@ void filter_and_run_dcd_tests(
     const ElementaryTests& tests,
     std::span<const std::uint8_t> certified,
     FrameResult& out) {
-  dcd_tests(topology, pairs, x, tests, certified, true, out);
+  dcd_tests(topology, pairs, x, tests, certified, /*filter=*/true, /*sorted=*/false, out);
 }
 
 }  // namespace skelcd::culling

@@ -113,7 +113,9 @@ void run_dcd_tests(
 
 /// dcd_filter_triangle_pairs (candidates.hpp) and run_dcd_tests in one pass: pairs that are
 /// part-excluded or duplicate faces are dropped, the others counted in candidate_pairs and tested,
-/// with each pair's shared corners looked up once (the traversing methods' blocks).
+/// with each pair's shared corners looked up once (the traversing methods' blocks). The
+/// intersecting pairs are appended in the order of `pairs`, not sorted: PairBlocks::finish sorts a
+/// query's pairs once, after its last block.
 void filter_and_run_dcd_tests(
     const FeatureTopology& topology,
     std::span<const TrianglePair> pairs,
