@@ -63,10 +63,7 @@ inline unsigned overlap_lanes(const WideBvhNode<N>& w, const WideBvhNode<N>& q, 
 #endif
 }
 
-/// One traversal over wide nodes: of one tree with itself (kSelf: a and b are the same tree) or of
-/// two trees. Entries on the stack are slot pairs whose float volumes overlap (the first entry
-/// excepted: it is the virtual roots, never tested).
-/// Bit i set when corner i (0..2) of `a` is a vertex of `b` (corners as in FanSieve::corners;
+/// Bit i set when corner i (0..2) of `a` is a vertex of `b` (corners as in SlotAdjacency::corners;
 /// negative ids never match).
 inline unsigned shared_lanes(
     const std::array<std::int32_t, 4>& a, const std::array<std::int32_t, 4>& b) {
@@ -87,6 +84,9 @@ inline unsigned shared_lanes(
 #endif
 }
 
+/// One traversal over wide nodes: of one tree with itself (kSelf: a and b are the same tree) or of
+/// two trees. Entries on the stack are slot pairs whose float volumes overlap (the first entry
+/// excepted: it is the virtual roots, never tested).
 /// kSieve: a FanSieve settles pairs instead of emitting them (self traversal only).
 template <int N, bool kSelf, bool kSieve = false>
 class Walk {
