@@ -17,6 +17,7 @@
 #include "culling/feature_topology.hpp"
 #include "tests/culling/procedural_meshes.hpp"
 #include "tests/culling/test_dual_cone_scenes.hpp"
+#include "tests/support/test_support.hpp"
 
 namespace skelcd::culling {
 namespace {
@@ -122,7 +123,7 @@ TEST(Cones, StaticNormalConesContainEveryTriangleNormalUpTheTree) {
   const auto order = bvh.triangle_order();
   int bounded_nodes = 0;
   for (std::size_t i = 0; i < nodes.size(); ++i) {
-    const DirectionCone& c = tree.node_cones()[i];
+    const DirectionCone c = tree.node_cone(bvh, static_cast<std::int32_t>(i));
     bounded_nodes += c.in_open_half_space() ? 1 : 0;
     for (std::int32_t s = nodes[i].begin; s < nodes[i].end; ++s) {
       const auto& t = features.triangle(order[static_cast<std::size_t>(s)]);
@@ -134,7 +135,7 @@ TEST(Cones, StaticNormalConesContainEveryTriangleNormalUpTheTree) {
     }
   }
   // A mildly wavy sheet: the root's normals lie in a half-space.
-  EXPECT_TRUE(tree.node_cones()[0].in_open_half_space());
+  EXPECT_TRUE(tree.node_cone(bvh, 0).in_open_half_space());
   EXPECT_EQ(bounded_nodes, static_cast<int>(nodes.size()));
 }
 
@@ -155,7 +156,7 @@ TEST(Cones, ContinuousConesContainNormalsAtEverySampledTimeAndTheControlVectors)
   const auto nodes = bvh.nodes();
   const auto order = bvh.triangle_order();
   for (std::size_t i = 0; i < nodes.size(); ++i) {
-    const DirectionCone& c = tree.node_cones()[i];
+    const DirectionCone c = tree.node_cone(bvh, static_cast<std::int32_t>(i));
     for (std::int32_t s = nodes[i].begin; s < nodes[i].end; ++s) {
       const auto& t = features.triangle(order[static_cast<std::size_t>(s)]);
       std::array<LVec, 3> p0;
@@ -177,7 +178,7 @@ TEST(Cones, ContinuousConesContainNormalsAtEverySampledTimeAndTheControlVectors)
       EXPECT_TRUE(inside(c, e11.cross(e21)));
     }
   }
-  EXPECT_TRUE(tree.node_cones()[0].in_open_half_space());
+  EXPECT_TRUE(tree.node_cone(bvh, 0).in_open_half_space());
 }
 
 TEST(Cones, FlippingTriangleMakesItsContinuousConeFull) {
@@ -194,9 +195,9 @@ TEST(Cones, FlippingTriangleMakesItsContinuousConeFull) {
   const AabbBvh bvh(features.welded_triangles(), x0);
   NormalConeTree tree;
   tree.refit(bvh, features, x0, x1);
-  EXPECT_TRUE(tree.node_cones()[0].is_full());
+  EXPECT_TRUE(tree.node_cone(bvh, 0).is_full());
   tree.refit(bvh, features, x0, x0);
-  EXPECT_TRUE(tree.node_cones()[0].in_open_half_space());
+  EXPECT_TRUE(tree.node_cone(bvh, 0).in_open_half_space());
 }
 
 TEST(Cones, DirectTestAroundTheMeanNormalProvesWhatTheCheckAllowsAndNothingElse) {
@@ -211,17 +212,19 @@ TEST(Cones, DirectTestAroundTheMeanNormalProvesWhatTheCheckAllowsAndNothingElse)
   NormalConeTree tree;
   const skinning::Positions bent = test::folded(x, 1.0, 150.0 * std::numbers::pi / 180.0);
   tree.refit(bvh, features, bent);
-  const Vec mean = tree.mean_normal(0);
+  const Vec mean = tree.mean_normal(bvh, 0);
   EXPECT_NEAR(mean.norm(), 1.0, 1e-12);
   EXPECT_TRUE(tree.normals_in_half_space(bvh, 0, mean));
   EXPECT_FALSE(tree.normals_in_half_space(bvh, 0, Vec(0, 0, 1)));  // the far half faces down
   tree.refit(bvh, features, bent, bent);                           // CCD: the same, constant
-  EXPECT_TRUE(tree.normals_in_half_space(bvh, 0, tree.mean_normal(0)));
+  EXPECT_TRUE(tree.normals_in_half_space(bvh, 0, tree.mean_normal(bvh, 0)));
   // Folded by 181°: the two halves' normals are 179° apart — still a half-space, barely; the
   // opposite direction never is.
-  tree.refit(bvh, features, test::folded(x, 1.0, 181.0 * std::numbers::pi / 180.0));
-  EXPECT_TRUE(tree.normals_in_half_space(bvh, 0, tree.mean_normal(0)));
-  EXPECT_FALSE(tree.normals_in_half_space(bvh, 0, -tree.mean_normal(0)));
+  // (The tree reads the positions at its queries: they must outlive them.)
+  const skinning::Positions x181 = test::folded(x, 1.0, 181.0 * std::numbers::pi / 180.0);
+  tree.refit(bvh, features, x181);
+  EXPECT_TRUE(tree.normals_in_half_space(bvh, 0, tree.mean_normal(bvh, 0)));
+  EXPECT_FALSE(tree.normals_in_half_space(bvh, 0, -tree.mean_normal(bvh, 0)));
   // A closed sphere: its normals cancel, no direction passes.
   const auto sphere = test::uv_sphere(6, 8);
   const auto st = test::simple_topology(sphere);
@@ -230,7 +233,7 @@ TEST(Cones, DirectTestAroundTheMeanNormalProvesWhatTheCheckAllowsAndNothingElse)
   const AabbBvh sb(sf.welded_triangles(), sx);
   NormalConeTree stree;
   stree.refit(sb, sf, sx);
-  for (const Vec& v : {Vec(0, 0, 1), Vec(1, 0, 0), Vec(0.3, -0.2, 0.9), stree.mean_normal(0)}) {
+  for (const Vec& v : {Vec(0, 0, 1), Vec(1, 0, 0), Vec(0.3, -0.2, 0.9), stree.mean_normal(sb, 0)}) {
     EXPECT_FALSE(stree.normals_in_half_space(sb, 0, v));
   }
   tree.refit(bvh, features, x);
@@ -569,6 +572,53 @@ TEST(ContourTester, FlatSheetIsSimpleAndAFoldedSheetIsNot) {
   }
   EXPECT_GT(counters.edge_pair_tests, 0);
   EXPECT_GT(counters.chain_tests, 0);
+}
+
+// The tree keeps cones and normal sums for internal nodes only, and no normal per triangle: a
+// leaf's cone and mean normal are formed on request from its triangle's normal at the refit's
+// positions, and must be exactly the triangle's cone (DCD: the cone of its one normal) and unit
+// normal, as the refit merged them.
+TEST(Cones, LeafConesAreFormedFromTheirTrianglesNormals) {
+  auto mesh = test::sheet(6, 5);
+  for (Eigen::Index v = 0; v < mesh.rest_positions.rows(); ++v) {
+    mesh.rest_positions(v, 2) = 0.2 * std::sin(2.0 * mesh.rest_positions(v, 1));
+  }
+  const auto topo = test::simple_topology(mesh);
+  const FeatureTopology features(mesh, topo);
+  const skinning::Positions x = test::welded(topo, mesh.rest_positions);
+  const AabbBvh bvh(features.welded_triangles(), x);
+  NormalConeTree tree;
+  tree.refit(bvh, features, x);
+  const auto nodes = bvh.nodes();
+  const auto order = bvh.triangle_order();
+  int leaves = 0;
+  for (std::size_t i = 0; i < nodes.size(); ++i) {
+    if (!nodes[i].is_leaf()) continue;
+    const auto& t = features.triangle(order[static_cast<std::size_t>(nodes[i].begin)]);
+    const BoundedNormal n =
+        triangle_normal(x.row(t[0]).transpose(), x.row(t[1]).transpose(), x.row(t[2]).transpose());
+    const DirectionCone want = cone_of_vector(n.n, n.error);
+    const DirectionCone got = tree.node_cone(bvh, static_cast<std::int32_t>(i));
+    ASSERT_EQ(got.kind, want.kind) << "leaf " << i;
+    EXPECT_EQ(got.axis, want.axis) << "leaf " << i;
+    EXPECT_EQ(got.cos_angle, want.cos_angle) << "leaf " << i;
+    EXPECT_EQ(got.sin_angle, want.sin_angle) << "leaf " << i;
+    EXPECT_EQ(tree.mean_normal(bvh, static_cast<std::int32_t>(i)), unit_or_zero(n.n)) << i;
+    ++leaves;
+  }
+  EXPECT_EQ(leaves, static_cast<int>(features.num_triangles()));
+  // An internal node's mean normal is the unit sum of its two children's sums.
+  const Eigen::Vector3d root_sum = [&] {
+    Eigen::Vector3d s = Eigen::Vector3d::Zero();
+    for (const std::int32_t f : order) {
+      const auto& t = features.triangle(f);
+      s +=
+          triangle_normal(x.row(t[0]).transpose(), x.row(t[1]).transpose(), x.row(t[2]).transpose())
+              .n;
+    }
+    return s;
+  }();
+  EXPECT_LT((tree.mean_normal(bvh, 0) - unit_or_zero(root_sum)).norm(), 1e-12);
 }
 
 }  // namespace
