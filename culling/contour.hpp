@@ -47,12 +47,12 @@ inline constexpr int kMaxContourLoops = 16;
 
 [[nodiscard]] const char* to_string(ContourStatus status);
 
-/// A directed contour edge: from → to as the node's triangle traverses it (welded ids).
+/// A directed contour edge: from → to as the node's triangle traverses it (welded ids). 12 bytes:
+/// the contours of all nodes hold several edges per triangle (bounded memory, docs/dual-cone.md).
 struct ContourEdge {
   std::int32_t from = -1;
   std::int32_t to = -1;
-  std::int32_t edge = -1;  ///< edge id (FeatureTopology / Topology::edges row)
-  std::int32_t part = -1;  ///< which sub-surface of the node holds its triangle (0..3)
+  std::int8_t part = -1;  ///< which sub-surface of the node holds its triangle (0..3)
 };
 
 /// A fan of the node's triangles around a pinch vertex (a vertex where the contour passes more
@@ -104,15 +104,18 @@ class NodeContours {
 
  private:
   std::vector<ContourStatus> status_;
-  // Per node n, [offset[n], offset[n + 1]) into the arrays below.
-  std::vector<std::int64_t> edge_offset_;
-  std::vector<std::int64_t> loop_offset_;
-  std::vector<std::int64_t> loop_start_offset_;
-  std::vector<std::int64_t> chain_offset_;
-  std::vector<std::int64_t> fan_offset_;
+  // Compressed rows: per node its record among the `loops` nodes (-1 for any other), per record r
+  // (node order) and one past the last, where its rows begin in the arrays below; loop_starts_
+  // has #loops + 1 entries per record, so record r's begin at loop_begin_[r] + r. 32-bit offsets,
+  // and no row for the nodes without a contour test (most of them: leaves and their parents).
+  std::vector<std::int32_t> record_;
+  std::vector<std::int32_t> edge_begin_;
+  std::vector<std::int32_t> loop_begin_;
+  std::vector<std::int32_t> chain_begin_;
+  std::vector<std::int32_t> fan_begin_;
   std::vector<ContourEdge> edges_;
-  std::vector<std::int32_t> loop_starts_;  // per node: #loops + 1 entries
-  std::vector<std::int32_t> loop_probe_;   // per node: #loops entries (indexed via loop_offset_)
+  std::vector<std::int32_t> loop_starts_;  // per record: #loops + 1 entries
+  std::vector<std::int32_t> loop_probe_;   // per record: #loops entries
   std::vector<std::int32_t> chain_starts_;
   std::vector<ContourFan> fans_;
   std::array<std::int64_t, kNumContourStatuses> status_counts_{};

@@ -409,6 +409,11 @@ TEST(NodeContours, InternalBoundaryEdgesAreOnTheContourOfInnerNodes) {
   const FeatureTopology features(mesh, topo);
   const AabbBvh bvh(features.welded_triangles(), test::welded(topo, mesh.rest_positions));
   const NodeContours contours(bvh, features);
+  std::map<std::pair<std::int32_t, std::int32_t>, std::int32_t> edge_id;
+  for (std::int32_t e = 0; e < features.num_edges(); ++e) {
+    const auto& ends = features.edge(e);
+    edge_id[{std::min(ends[0], ends[1]), std::max(ends[0], ends[1])}] = e;
+  }
   const auto nodes = bvh.nodes();
   int checked = 0;
   for (std::size_t i = 0; i < nodes.size(); ++i) {
@@ -424,7 +429,9 @@ TEST(NodeContours, InternalBoundaryEdgesAreOnTheContourOfInnerNodes) {
       if (c == 1) expected.insert(e);
     }
     std::set<std::int32_t> got;
-    for (const auto& e : contours.edges(n)) got.insert(e.edge);
+    for (const auto& e : contours.edges(n)) {
+      got.insert(edge_id.at({std::min(e.from, e.to), std::max(e.from, e.to)}));
+    }
     EXPECT_EQ(got, expected) << "node " << i;
     ++checked;
   }
@@ -619,6 +626,59 @@ TEST(Cones, LeafConesAreFormedFromTheirTrianglesNormals) {
     return s;
   }();
   EXPECT_LT((tree.mean_normal(bvh, 0) - unit_or_zero(root_sum)).norm(), 1e-12);
+}
+
+// The contours are stored as compressed rows with a record per tested node: every node's rows
+// must still be its own — loops that close on themselves, chain and loop starts that end at its
+// edge count, one probe per loop, fans whose edges meet at their vertex — and nodes without a
+// contour test must have none. On the real cloth-funnel mesh (18,484 triangles, many pinches).
+TEST(NodeContours, CompressedRowsHoldEachNodesOwnLoopsOnARealMesh) {
+  const test::OpenScene s = test::cloth_funnel_scene(test::asset("cloth-funnel/frames"));
+  const FeatureTopology features(s.mesh, s.topo);
+  const AabbBvh bvh(features.welded_triangles(), s.frames[0]);
+  const NodeContours contours(bvh, features);
+  std::int64_t edges = 0;
+  int with_loops = 0;
+  int with_fans = 0;
+  for (std::int32_t n = 0; n < static_cast<std::int32_t>(bvh.nodes().size()); ++n) {
+    const auto e = contours.edges(n);
+    const auto loops = contours.loop_starts(n);
+    const auto chains = contours.chain_starts(n);
+    const auto probes = contours.loop_probe(n);
+    const auto fans = contours.fans(n);
+    edges += static_cast<std::int64_t>(e.size());
+    if (contours.status(n) != ContourStatus::loops) {
+      EXPECT_TRUE(e.empty() && loops.empty() && chains.empty() && probes.empty() && fans.empty())
+          << "node " << n;
+      continue;
+    }
+    ++with_loops;
+    ASSERT_FALSE(e.empty()) << "node " << n;
+    ASSERT_EQ(loops.size(), probes.size() + 1) << "node " << n;
+    ASSERT_EQ(loops.front(), 0) << "node " << n;
+    ASSERT_EQ(loops.back(), static_cast<std::int32_t>(e.size())) << "node " << n;
+    ASSERT_EQ(chains.front(), 0) << "node " << n;
+    ASSERT_EQ(chains.back(), static_cast<std::int32_t>(e.size())) << "node " << n;
+    for (std::size_t l = 0; l + 1 < loops.size(); ++l) {
+      const auto b = static_cast<std::size_t>(loops[l]);
+      const auto end = static_cast<std::size_t>(loops[l + 1]);
+      for (std::size_t k = b; k < end; ++k) {
+        const std::size_t next = k + 1 < end ? k + 1 : b;
+        ASSERT_EQ(e[k].to, e[next].from) << "node " << n << " loop " << l;
+        ASSERT_GE(e[k].part, 0);
+        ASSERT_LT(e[k].part, 4);
+      }
+    }
+    with_fans += fans.empty() ? 0 : 1;
+    for (const ContourFan& f : fans) {
+      ASSERT_EQ(e[static_cast<std::size_t>(f.in_edge)].to, f.vertex) << "node " << n;
+      ASSERT_EQ(e[static_cast<std::size_t>(f.out_edge)].from, f.vertex) << "node " << n;
+    }
+  }
+  EXPECT_EQ(edges, contours.total_edges());
+  EXPECT_EQ(with_loops, contours.status_counts()[static_cast<std::size_t>(ContourStatus::loops)]);
+  EXPECT_GT(with_loops, 1000);
+  EXPECT_GT(with_fans, 0);
 }
 
 }  // namespace
