@@ -272,12 +272,42 @@ void NormalConeTree::leaf_cone(
   cone = bounded ? make_cone(axis, cos_lb, sin_ub) : DirectionCone::full_cone();
 }
 
+void NormalConeTree::combine(
+    const std::array<DirectionCone, 2>& cones,
+    const std::array<Eigen::Vector3d, 2>& sums,
+    DirectionCone& cone,
+    Eigen::Vector3d& sum) {
+  sum = sums[0] + sums[1];
+  // Axis: the node's mean normal (cheap); when that leaves a wide cone, the optimal merge axis
+  // of the two children may do better (it costs a few transcendental calls).
+  cone = enclose_around(unit_or_zero(sum), cones[0], cones[1]);
+  if (cone.is_full() || cone.cos_angle < 0.5) {
+    const DirectionCone alt = merge(cones[0], cones[1]);
+    if (!alt.is_full() && (cone.is_full() || alt.cos_angle > cone.cos_angle)) cone = alt;
+  }
+}
+
+void NormalConeTree::unstored_cone(
+    const AabbBvh& bvh, std::int32_t node, DirectionCone& cone, Eigen::Vector3d& sum) const {
+  const BvhNode& n = bvh.nodes()[static_cast<std::size_t>(node)];
+  if (n.is_leaf()) {
+    leaf_cone(bvh, node, cone, sum);
+    return;
+  }
+  // Both children are leaves: merged as the refit merges any two children.
+  std::array<DirectionCone, 2> cones;
+  std::array<Eigen::Vector3d, 2> sums;
+  leaf_cone(bvh, node + 1, cones[0], sums[0]);
+  leaf_cone(bvh, n.right, cones[1], sums[1]);
+  combine(cones, sums, cone, sum);
+}
+
 DirectionCone NormalConeTree::node_cone(const AabbBvh& bvh, std::int32_t node) const {
   const std::int32_t k = internal_index_[static_cast<std::size_t>(node)];
   if (k >= 0) return node_cones_[static_cast<std::size_t>(k)];
   DirectionCone cone;
   Eigen::Vector3d sum;
-  leaf_cone(bvh, node, cone, sum);
+  unstored_cone(bvh, node, cone, sum);
   return cone;
 }
 
@@ -286,7 +316,7 @@ Eigen::Vector3d NormalConeTree::mean_normal(const AabbBvh& bvh, std::int32_t nod
   if (k >= 0) return unit_or_zero(node_sums_[static_cast<std::size_t>(k)]);
   DirectionCone cone;
   Eigen::Vector3d sum;
-  leaf_cone(bvh, node, cone, sum);
+  unstored_cone(bvh, node, cone, sum);
   return unit_or_zero(sum);
 }
 
@@ -313,44 +343,45 @@ bool NormalConeTree::normals_in_half_space(
 
 void NormalConeTree::refit_nodes(const AabbBvh& bvh) {
   const auto nodes = bvh.nodes();
-  // Records for the internal nodes only, numbered in node order (a pass over the node ids;
+  // Records for the internal nodes with an internal child only, numbered in node order: a leaf's
+  // cone and sum, and those of a node whose children are both leaves (which no cone method
+  // tests), are formed from their one to a few triangles when needed (a pass over the node ids;
   // allocation-free once sized).
+  const auto stored = [&](std::size_t i) {
+    return !nodes[i].is_leaf() &&
+           !(nodes[i + 1].is_leaf() && nodes[static_cast<std::size_t>(nodes[i].right)].is_leaf());
+  };
   internal_index_.resize(nodes.size());
-  std::int32_t internal = 0;
+  std::int32_t records = 0;
   for (std::size_t i = 0; i < nodes.size(); ++i) {
-    internal_index_[i] = nodes[i].is_leaf() ? -1 : internal++;
+    internal_index_[i] = stored(i) ? records++ : -1;
   }
-  node_cones_.resize(static_cast<std::size_t>(internal));
-  node_sums_.resize(static_cast<std::size_t>(internal));
+  node_cones_.resize(static_cast<std::size_t>(records));
+  node_sums_.resize(static_cast<std::size_t>(records));
   // Depth-first layout: children have larger ids than their parent, so one backward sweep is
   // bottom-up.
   for (std::size_t i = nodes.size(); i-- > 0;) {
-    const BvhNode& node = nodes[i];
-    if (node.is_leaf()) continue;
-    // The children's cones and sums: an internal child's record, or a leaf's formed from its
-    // triangles (each leaf has one parent: formed once per refit, as before from the triangles).
+    const std::int32_t k = internal_index_[i];
+    if (k < 0) continue;
+    // The children's cones and sums: a stored child's record, or formed from its triangles
+    // (each node has one parent: formed once per refit, from the triangles as before).
     std::array<DirectionCone, 2> cones;
     std::array<Eigen::Vector3d, 2> sums;
     for (std::size_t side = 0; side < 2; ++side) {
-      const std::size_t c = side == 0 ? i + 1 : static_cast<std::size_t>(node.right);
-      const std::int32_t k = internal_index_[c];
-      if (k >= 0) {
-        cones[side] = node_cones_[static_cast<std::size_t>(k)];
-        sums[side] = node_sums_[static_cast<std::size_t>(k)];
+      const std::size_t c = side == 0 ? i + 1 : static_cast<std::size_t>(nodes[i].right);
+      const std::int32_t kc = internal_index_[c];
+      if (kc >= 0) {
+        cones[side] = node_cones_[static_cast<std::size_t>(kc)];
+        sums[side] = node_sums_[static_cast<std::size_t>(kc)];
       } else {
-        leaf_cone(bvh, static_cast<std::int32_t>(c), cones[side], sums[side]);
+        unstored_cone(bvh, static_cast<std::int32_t>(c), cones[side], sums[side]);
       }
     }
-    const auto k = static_cast<std::size_t>(internal_index_[i]);
-    node_sums_[k] = sums[0] + sums[1];
-    // Axis: the node's mean normal (cheap); when that leaves a wide cone, the optimal merge axis
-    // of the two children may do better (it costs a few transcendental calls).
-    DirectionCone cone = enclose_around(unit_or_zero(node_sums_[k]), cones[0], cones[1]);
-    if (cone.is_full() || cone.cos_angle < 0.5) {
-      const DirectionCone alt = merge(cones[0], cones[1]);
-      if (!alt.is_full() && (cone.is_full() || alt.cos_angle > cone.cos_angle)) cone = alt;
-    }
-    node_cones_[k] = cone;
+    combine(
+        cones,
+        sums,
+        node_cones_[static_cast<std::size_t>(k)],
+        node_sums_[static_cast<std::size_t>(k)]);
   }
 }
 

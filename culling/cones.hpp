@@ -134,8 +134,9 @@ class NormalConeTree {
 
   /// The cone of a node of the hierarchy of the last refit (node ids of AabbBvh::nodes()): it
   /// contains the (continuous) normal of each of the node's triangles.
-  /// @note Only internal nodes' cones are stored; a leaf's is formed from its triangles' stored
-  /// normals, by the same code the refit merges it with (so it is the cone the refit used).
+  /// @note Only the cones of nodes with an internal child are stored; a leaf's, or a node's whose
+  /// children are leaves, is formed from its triangles' normals by the same code the refit merges
+  /// it with (so it is the cone the refit used).
   [[nodiscard]] DirectionCone node_cone(const AabbBvh& bvh, std::int32_t node) const;
 
  private:
@@ -149,6 +150,15 @@ class NormalConeTree {
   /// A leaf's cone and normal sum.
   void leaf_cone(
       const AabbBvh& bvh, std::int32_t leaf, DirectionCone& cone, Eigen::Vector3d& sum) const;
+  /// The cone and sum of a node without a record (a leaf, or a node whose children are leaves).
+  void unstored_cone(
+      const AabbBvh& bvh, std::int32_t node, DirectionCone& cone, Eigen::Vector3d& sum) const;
+  /// A parent's cone and sum from its two children's.
+  static void combine(
+      const std::array<DirectionCone, 2>& cones,
+      const std::array<Eigen::Vector3d, 2>& sums,
+      DirectionCone& cone,
+      Eigen::Vector3d& sum);
 
   // The last refit's triangles and positions (x_t1_ null for static normals): the normals are
   // formed from them, by the same functions the refit used, whenever a query needs them.
@@ -156,8 +166,9 @@ class NormalConeTree {
   const skinning::Positions* x_t0_ = nullptr;
   const skinning::Positions* x_t1_ = nullptr;
   int vectors_per_triangle_ = 1;
-  // Per node, the index of its record among the internal nodes (-1 for a leaf), and per internal
-  // node its cone and the sum of its triangles' normals: leaves' would repeat the triangles'.
+  // Per node, the index of its record (-1 for a leaf or a node whose children are both leaves:
+  // theirs are formed from their triangles when needed), and per record the node's cone and the
+  // sum of its triangles' normals.
   std::vector<std::int32_t> internal_index_;
   std::vector<DirectionCone> node_cones_;
   std::vector<Eigen::Vector3d> node_sums_;
