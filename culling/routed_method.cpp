@@ -151,7 +151,10 @@ class AutoMethod final : public detail::MethodBase {
       const skinning::Topology& topology,
       const MethodOptions& options,
       const RoutingOptions& routing)
-      : MethodBase("auto", mesh, topology, options), blocks_(options.block_pairs) {
+      : MethodBase("auto", mesh, topology, options),
+        blocks_(
+            options.block_pairs,
+            block_reserve(options.block_pairs, options.bvh.leaf_size, topology_.num_triangles())) {
     // The plan, with each component's part taken from the mesh.
     routes_ = route_components(topology, options, routing);
     const auto components = components_of(topology);
@@ -224,17 +227,6 @@ class AutoMethod final : public detail::MethodBase {
     }
     if (open_hierarchy_ == nullptr && closed_hierarchy_ == nullptr)
       return;  // nothing traversed here
-    // Blocks for what is traversed here only (bounded memory): block_reserve's first guess of 16
-    // pairs per triangle, for the triangles of a group without a method of its own and, between
-    // the groups, for the smaller group's (each such pair has one triangle of it). A cone group's
-    // pairs go through its method's own blocks. The vectors grow if a query needs more.
-    std::size_t traversed = 0;
-    if (open_method_ == nullptr) traversed += open_triangles_.size();
-    if (closed_method_ == nullptr) traversed += closed_triangles_.size();
-    if (both) traversed += std::min(open_triangles_.size(), closed_triangles_.size());
-    reserved_pairs_ = block_reserve(
-        options.block_pairs, options.bvh.leaf_size, static_cast<std::int32_t>(traversed));
-    blocks_ = PairBlocks<3>(options.block_pairs, reserved_pairs_);
     const detail::ConeMethodBase* cone = open_cone != nullptr ? open_cone : closed_cone;
     if (cone != nullptr) {
       bounds_ = &cone->feature_bounds();
@@ -257,7 +249,6 @@ class AutoMethod final : public detail::MethodBase {
       ++(h == &open_bvh_ || h == &closed_bvh_ ? r.own_hierarchies : r.shared_hierarchies);
     }
     r.own_feature_bounds = !traverses_nothing() && bounds_ == &own_bounds_;
-    r.reserved_pairs = reserved_pairs_;
     // Feature topologies held by this method and its culling-module group methods.
     std::vector<const FeatureTopology*> held{features_.get()};
     for (const CullingMethod* m : {open_method_.get(), closed_method_.get()}) {
@@ -433,7 +424,6 @@ class AutoMethod final : public detail::MethodBase {
   const FeatureBounds<3>* bounds_ = &own_bounds_;
   TraversalScratch scratch_;
   PairBlocks<3> blocks_;
-  std::size_t reserved_pairs_ = 0;  // blocks_' reservation (RoutedStructures::reserved_pairs)
   FrameResult sub_;
 };
 

@@ -73,10 +73,6 @@ struct RoutedStructures {
   /// methods that are culling/'s own: 1 when its cone group methods share `auto`'s. (A whole-mesh
   /// closed method, `dynamic`, gets another mesh and counts apart when it is one of culling/'s.)
   std::int32_t feature_topologies = 0;
-  /// Triangle pairs `auto`'s own blocks reserve up front: block_reserve for the triangles it
-  /// traverses itself (a group without a method of its own, the smaller group's for the pairs
-  /// between the groups), 0 when it traverses nothing.
-  std::size_t reserved_pairs = 0;
 };
 
 /// The structures of an `auto` method (make_routed_method).

@@ -3,7 +3,6 @@
 // through a BVH pair traversal — and the answer is exactly `bvh`'s.
 #include <gtest/gtest.h>
 
-#include <algorithm>
 #include <set>
 #include <string>
 #include <tuple>
@@ -11,7 +10,6 @@
 
 #include "culling/method.hpp"
 #include "culling/method_registry.hpp"
-#include "culling/pair_blocks.hpp"
 #include "culling/routed_method.hpp"
 #include "skinning/errors.hpp"
 #include "skinning/load.hpp"
@@ -249,20 +247,6 @@ TEST(Routing, ReadsItsConeGroupsHierarchyAndVolumesInsteadOfCopyingThem) {
     EXPECT_EQ(got.shared_hierarchies, c.want.shared_hierarchies) << c.open << " / " << c.closed;
     EXPECT_EQ(got.own_feature_bounds, c.want.own_feature_bounds) << c.open << " / " << c.closed;
     EXPECT_EQ(got.feature_topologies, 1) << c.open << " / " << c.closed;
-    // Its blocks reserve for what it traverses itself: a `bvh` group's triangles, and the smaller
-    // group's for the pairs between the groups — not the whole mesh's (bounded memory).
-    std::int32_t open = 0;
-    std::int32_t closed = 0;
-    for (const ComponentRoute& r : routes_of(*m)) {
-      (r.closed || r.capped || r.small ? closed : open) +=
-          static_cast<std::int32_t>(r.num_triangles);
-    }
-    ASSERT_GT(open, 0);
-    ASSERT_GT(closed, 0);
-    const std::int32_t own =
-        (c.open == "bvh" ? open : 0) + (c.closed.empty() || c.closed == "bvh" ? closed : 0);
-    EXPECT_EQ(got.reserved_pairs, block_reserve(kCcdBlockPairs, 1, own + std::min(open, closed)))
-        << c.open << " / " << c.closed;
     // The shared volumes are those of the query at hand, whatever came before it: CCD, DCD (which
     // refits no edge volumes), CCD again, backwards.
     EXPECT_EQ(keys(ccd(*m, s.frames[0], s.frames[1])), keys(ccd(*b, s.frames[0], s.frames[1])))
@@ -280,7 +264,6 @@ TEST(Routing, ReadsItsConeGroupsHierarchyAndVolumesInsteadOfCopyingThem) {
   EXPECT_EQ(got.shared_hierarchies, 0);
   EXPECT_FALSE(got.own_feature_bounds);
   EXPECT_EQ(got.feature_topologies, 1);
-  EXPECT_EQ(got.reserved_pairs, 0u);
   EXPECT_THROW_MESSAGE(
       (void)routed_structures(*b), InvalidInput, "routed_structures: method 'bvh' is not auto");
 }
