@@ -248,12 +248,12 @@ NodeContours::NodeContours(const AabbBvh& bvh, const FeatureTopology& topology) 
     // 4. Store: loops rotated to start at a change of sub-surface, chains, probes, fans.
     if (status == ContourStatus::loops) {
       record_[i] = offset_of(edge_begin_.size());
-      edge_begin_.push_back(offset_of(edges_.size()));
+      edge_begin_.push_back(offset_of(from_.size()));
       loop_begin_.push_back(offset_of(loop_probe_.size()));
       chain_begin_.push_back(offset_of(chain_starts_.size()));
       fan_begin_.push_back(offset_of(fans_.size()));
       position.assign(raw.size(), -1);
-      const auto base = static_cast<std::int32_t>(edges_.size());
+      const auto base = static_cast<std::int32_t>(from_.size());
       for (const auto& loop : loops) {
         const std::size_t m = loop.size();
         std::size_t start = m;
@@ -265,22 +265,25 @@ NodeContours::NodeContours(const AabbBvh& bvh, const FeatureTopology& topology) 
         }
         const bool one_part = start == m;
         if (one_part) start = 0;
-        const auto first = static_cast<std::int32_t>(edges_.size()) - base;
+        const auto first = static_cast<std::int32_t>(from_.size()) - base;
         loop_starts_.push_back(first);
         std::int32_t probe = -1;
         for (std::size_t k = 0; k < m; ++k) {
           const std::int32_t r = loop[(start + k) % m];
           const RawEdge& c = raw[sz(r)];
-          position[sz(r)] = static_cast<std::int32_t>(edges_.size()) - base;
-          if (one_part || k == 0 || c.part != edges_.back().part) {
+          position[sz(r)] = static_cast<std::int32_t>(from_.size()) - base;
+          if (one_part || k == 0 || c.part != part_.back()) {
             chain_starts_.push_back(position[sz(r)]);
           }
           if (probe < 0 && out_count[static_cast<std::size_t>(c.from)] == 1) probe = c.from;
-          edges_.push_back({c.from, c.to, c.part});
+          // Its `to` is the next edge's `from` (the first's for the last): not stored.
+          assert(c.to == raw[sz(loop[(start + k + 1) % m])].from);
+          from_.push_back(c.from);
+          part_.push_back(c.part);
         }
         loop_probe_.push_back(probe);
       }
-      const auto total = static_cast<std::int32_t>(edges_.size()) - base;
+      const auto total = static_cast<std::int32_t>(from_.size()) - base;
       loop_starts_.push_back(total);
       chain_starts_.push_back(total);
       for (const ContourFan& f : raw_fans) {
@@ -303,7 +306,7 @@ NodeContours::NodeContours(const AabbBvh& bvh, const FeatureTopology& topology) 
     status_[i] = status;
     ++status_counts_[static_cast<std::size_t>(status)];
   }
-  edge_begin_.push_back(offset_of(edges_.size()));
+  edge_begin_.push_back(offset_of(from_.size()));
   loop_begin_.push_back(offset_of(loop_probe_.size()));
   chain_begin_.push_back(offset_of(chain_starts_.size()));
   fan_begin_.push_back(offset_of(fans_.size()));
@@ -318,15 +321,30 @@ NodeContours::NodeContours(const AabbBvh& bvh, const FeatureTopology& topology) 
         &chain_starts_}) {
     v->shrink_to_fit();
   }
-  edges_.shrink_to_fit();
+  from_.shrink_to_fit();
+  part_.shrink_to_fit();
   fans_.shrink_to_fit();
 }
 
-std::span<const ContourEdge> NodeContours::edges(std::int32_t node) const {
+void NodeContours::edges(std::int32_t node, std::vector<ContourEdge>& out) const {
+  out.clear();
   const std::int32_t r = record_[sz(node)];
-  if (r < 0) return {};
-  return std::span<const ContourEdge>(edges_).subspan(
-      sz(edge_begin_[sz(r)]), sz(edge_begin_[sz(r) + 1] - edge_begin_[sz(r)]));
+  if (r < 0) return;
+  const auto base = sz(edge_begin_[sz(r)]);
+  const auto starts = loop_starts(node);
+  for (std::size_t l = 0; l + 1 < starts.size(); ++l) {
+    const std::size_t begin = base + sz(starts[l]);
+    const std::size_t end = base + sz(starts[l + 1]);
+    for (std::size_t k = begin; k < end; ++k) {
+      out.push_back({from_[k], from_[k + 1 < end ? k + 1 : begin], part_[k]});
+    }
+  }
+}
+
+std::vector<ContourEdge> NodeContours::edges(std::int32_t node) const {
+  std::vector<ContourEdge> out;
+  edges(node, out);
+  return out;
 }
 
 std::span<const std::int32_t> NodeContours::loop_starts(std::int32_t node) const {
@@ -607,7 +625,8 @@ ContourVerdict ContourTester::run(
     ContourMode mode,
     ContourTestCounters& counters) {
   assert(nodes.status(node) == ContourStatus::loops);
-  const auto edges = nodes.edges(node);
+  nodes.edges(node, edges_);
+  const std::span<const ContourEdge> edges(edges_);
   const auto chains = nodes.chain_starts(node);
   const std::size_t m = edges.size();
   const Frames x{x_t0, x_t1};

@@ -47,8 +47,7 @@ inline constexpr int kMaxContourLoops = 16;
 
 [[nodiscard]] const char* to_string(ContourStatus status);
 
-/// A directed contour edge: from → to as the node's triangle traverses it (welded ids). 12 bytes:
-/// the contours of all nodes hold several edges per triangle (bounded memory, docs/dual-cone.md).
+/// A directed contour edge: from → to as the node's triangle traverses it (welded ids).
 struct ContourEdge {
   std::int32_t from = -1;
   std::int32_t to = -1;
@@ -81,7 +80,12 @@ class NodeContours {
   }
   /// The contour of a `loops` node (empty otherwise), loop after loop; each loop visits every
   /// vertex once and is rotated so that it starts a chain.
-  [[nodiscard]] std::span<const ContourEdge> edges(std::int32_t node) const;
+  /// @param out receives the edges (cleared first; allocation-free once its capacity suffices).
+  /// @note Stored as each edge's start vertex and sub-surface only (an edge ends where the next
+  /// edge of its loop starts): expanded here, once per contour test (bounded memory).
+  void edges(std::int32_t node, std::vector<ContourEdge>& out) const;
+  /// The same, in a new vector.
+  [[nodiscard]] std::vector<ContourEdge> edges(std::int32_t node) const;
   /// Offsets into edges(node) where each loop starts, followed by edges(node).size().
   [[nodiscard]] std::span<const std::int32_t> loop_starts(std::int32_t node) const;
   /// Offsets into edges(node) where each chain starts, followed by edges(node).size(). A chain
@@ -98,9 +102,7 @@ class NodeContours {
     return status_counts_;
   }
   /// Total contour edges stored (all nodes).
-  [[nodiscard]] std::int64_t total_edges() const {
-    return static_cast<std::int64_t>(edges_.size());
-  }
+  [[nodiscard]] std::int64_t total_edges() const { return static_cast<std::int64_t>(from_.size()); }
 
  private:
   std::vector<ContourStatus> status_;
@@ -113,7 +115,9 @@ class NodeContours {
   std::vector<std::int32_t> loop_begin_;
   std::vector<std::int32_t> chain_begin_;
   std::vector<std::int32_t> fan_begin_;
-  std::vector<ContourEdge> edges_;
+  std::vector<std::int32_t>
+      from_;  // per contour edge: where it starts (it ends at the next's start)
+  std::vector<std::int8_t> part_;          // per contour edge: the sub-surface holding its triangle
   std::vector<std::int32_t> loop_starts_;  // per record: #loops + 1 entries
   std::vector<std::int32_t> loop_probe_;   // per record: #loops entries
   std::vector<std::int32_t> chain_starts_;
@@ -198,6 +202,7 @@ class ContourTester {
   struct Box2 {
     double lo1, hi1, lo2, hi2;
   };
+  std::vector<ContourEdge> edges_;  // the node's contour, expanded (NodeContours::edges)
   std::vector<Box2> boxes_;
   std::vector<std::int32_t> chain_of_;
   std::vector<std::pair<double, std::int32_t>> sorted_;
