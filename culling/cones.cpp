@@ -187,19 +187,10 @@ DirectionCone boundary_binormal_cone(
 
 void NormalConeTree::refit(
     const AabbBvh& bvh, const FeatureTopology& topology, const skinning::Positions& x) {
-  const auto nf = static_cast<std::size_t>(topology.num_triangles());
-  triangle_cones_.resize(nf);
-  triangle_sums_.resize(nf);
-  triangle_normals_.resize(nf);
+  topology_ = &topology;
+  x_t0_ = &x;
+  x_t1_ = nullptr;
   vectors_per_triangle_ = 1;
-  for (std::int32_t f = 0; f < topology.num_triangles(); ++f) {
-    const auto& t = topology.triangle(f);
-    const BoundedNormal n =
-        triangle_normal(x.row(t[0]).transpose(), x.row(t[1]).transpose(), x.row(t[2]).transpose());
-    triangle_cones_[static_cast<std::size_t>(f)] = cone_of_vector(n.n, n.error);
-    triangle_sums_[static_cast<std::size_t>(f)] = n.n;
-    triangle_normals_[static_cast<std::size_t>(f)][0] = n;
-  }
   refit_nodes(bvh);
 }
 
@@ -208,44 +199,125 @@ void NormalConeTree::refit(
     const FeatureTopology& topology,
     const skinning::Positions& x_t0,
     const skinning::Positions& x_t1) {
-  const auto nf = static_cast<std::size_t>(topology.num_triangles());
-  triangle_cones_.resize(nf);
-  triangle_sums_.resize(nf);
-  triangle_normals_.resize(nf);
+  topology_ = &topology;
+  x_t0_ = &x_t0;
+  x_t1_ = &x_t1;
   vectors_per_triangle_ = 3;
-  for (std::int32_t f = 0; f < topology.num_triangles(); ++f) {
-    const auto& t = topology.triangle(f);
-    const auto b = continuous_normal_control_vectors(
-        x_t0.row(t[0]).transpose(),
-        x_t0.row(t[1]).transpose(),
-        x_t0.row(t[2]).transpose(),
-        x_t1.row(t[0]).transpose(),
-        x_t1.row(t[1]).transpose(),
-        x_t1.row(t[2]).transpose());
-    // The cone of the three control vectors (each within its error ball) around their mean
-    // direction; with θ < π/2 it is convex and so contains n(t) for every t in [0,1].
-    const DirectionCone c0 = cone_of_vector(b[0].n, b[0].error);
-    const DirectionCone c1 = cone_of_vector(b[1].n, b[1].error);
-    const DirectionCone c2 = cone_of_vector(b[2].n, b[2].error);
-    DirectionCone cone = DirectionCone::full_cone();
-    if (!c0.is_full() && !c1.is_full() && !c2.is_full()) {
-      const Eigen::Vector3d axis = unit_or_zero(c0.axis + c1.axis + c2.axis);
-      double cos_lb = 1.0;
-      double sin_ub = 0.0;
-      if (!axis.isZero(0.0) && extend_around(axis, c0, cos_lb, sin_ub) &&
-          extend_around(axis, c1, cos_lb, sin_ub) && extend_around(axis, c2, cos_lb, sin_ub)) {
-        cone = make_cone(axis, cos_lb, sin_ub);
-      }
-    }
-    triangle_cones_[static_cast<std::size_t>(f)] = cone;
-    triangle_sums_[static_cast<std::size_t>(f)] = b[0].n + b[1].n + b[2].n;
-    triangle_normals_[static_cast<std::size_t>(f)] = b;
-  }
   refit_nodes(bvh);
 }
 
-Eigen::Vector3d NormalConeTree::mean_normal(std::int32_t node) const {
-  return unit_or_zero(node_sums_[static_cast<std::size_t>(node)]);
+std::array<BoundedNormal, 3> NormalConeTree::triangle_normals(std::int32_t f) const {
+  const auto& t = topology_->triangle(f);
+  const skinning::Positions& x0 = *x_t0_;
+  if (x_t1_ == nullptr) {
+    return {triangle_normal(
+        x0.row(t[0]).transpose(), x0.row(t[1]).transpose(), x0.row(t[2]).transpose())};
+  }
+  const skinning::Positions& x1 = *x_t1_;
+  return continuous_normal_control_vectors(
+      x0.row(t[0]).transpose(),
+      x0.row(t[1]).transpose(),
+      x0.row(t[2]).transpose(),
+      x1.row(t[0]).transpose(),
+      x1.row(t[1]).transpose(),
+      x1.row(t[2]).transpose());
+}
+
+DirectionCone NormalConeTree::triangle_cone(const std::array<BoundedNormal, 3>& b) const {
+  if (vectors_per_triangle_ == 1) return cone_of_vector(b[0].n, b[0].error);
+  // The cone of the three control vectors (each within its error ball) around their mean
+  // direction; with θ < π/2 it is convex and so contains n(t) for every t in [0,1].
+  const DirectionCone c0 = cone_of_vector(b[0].n, b[0].error);
+  const DirectionCone c1 = cone_of_vector(b[1].n, b[1].error);
+  const DirectionCone c2 = cone_of_vector(b[2].n, b[2].error);
+  if (c0.is_full() || c1.is_full() || c2.is_full()) return DirectionCone::full_cone();
+  const Eigen::Vector3d axis = unit_or_zero(c0.axis + c1.axis + c2.axis);
+  double cos_lb = 1.0;
+  double sin_ub = 0.0;
+  if (!axis.isZero(0.0) && extend_around(axis, c0, cos_lb, sin_ub) &&
+      extend_around(axis, c1, cos_lb, sin_ub) && extend_around(axis, c2, cos_lb, sin_ub)) {
+    return make_cone(axis, cos_lb, sin_ub);
+  }
+  return DirectionCone::full_cone();
+}
+
+Eigen::Vector3d NormalConeTree::triangle_sum(const std::array<BoundedNormal, 3>& b) const {
+  if (vectors_per_triangle_ == 1) return b[0].n;
+  return b[0].n + b[1].n + b[2].n;
+}
+
+void NormalConeTree::leaf_cone(
+    const AabbBvh& bvh, std::int32_t leaf, DirectionCone& cone, Eigen::Vector3d& sum) const {
+  const BvhNode& node = bvh.nodes()[static_cast<std::size_t>(leaf)];
+  const auto order = bvh.triangle_order();
+  if (node.size() == 1) {
+    const auto normals = triangle_normals(order[static_cast<std::size_t>(node.begin)]);
+    sum = Eigen::Vector3d::Zero();
+    sum += triangle_sum(normals);
+    cone = triangle_cone(normals);
+    return;
+  }
+  sum = Eigen::Vector3d::Zero();
+  for (std::int32_t s = node.begin; s < node.end; ++s) {
+    sum += triangle_sum(triangle_normals(order[static_cast<std::size_t>(s)]));
+  }
+  const Eigen::Vector3d axis = unit_or_zero(sum);
+  double cos_lb = 1.0;
+  double sin_ub = 0.0;
+  bool bounded = !axis.isZero(0.0);
+  for (std::int32_t s = node.begin; bounded && s < node.end; ++s) {
+    bounded = extend_around(
+        axis, triangle_cone(triangle_normals(order[static_cast<std::size_t>(s)])), cos_lb, sin_ub);
+  }
+  cone = bounded ? make_cone(axis, cos_lb, sin_ub) : DirectionCone::full_cone();
+}
+
+void NormalConeTree::combine(
+    const std::array<DirectionCone, 2>& cones,
+    const std::array<Eigen::Vector3d, 2>& sums,
+    DirectionCone& cone,
+    Eigen::Vector3d& sum) {
+  sum = sums[0] + sums[1];
+  // Axis: the node's mean normal (cheap); when that leaves a wide cone, the optimal merge axis
+  // of the two children may do better (it costs a few transcendental calls).
+  cone = enclose_around(unit_or_zero(sum), cones[0], cones[1]);
+  if (cone.is_full() || cone.cos_angle < 0.5) {
+    const DirectionCone alt = merge(cones[0], cones[1]);
+    if (!alt.is_full() && (cone.is_full() || alt.cos_angle > cone.cos_angle)) cone = alt;
+  }
+}
+
+void NormalConeTree::unstored_cone(
+    const AabbBvh& bvh, std::int32_t node, DirectionCone& cone, Eigen::Vector3d& sum) const {
+  const BvhNode& n = bvh.nodes()[static_cast<std::size_t>(node)];
+  if (n.is_leaf()) {
+    leaf_cone(bvh, node, cone, sum);
+    return;
+  }
+  // Both children are leaves: merged as the refit merges any two children.
+  std::array<DirectionCone, 2> cones;
+  std::array<Eigen::Vector3d, 2> sums;
+  leaf_cone(bvh, node + 1, cones[0], sums[0]);
+  leaf_cone(bvh, n.right, cones[1], sums[1]);
+  combine(cones, sums, cone, sum);
+}
+
+DirectionCone NormalConeTree::node_cone(const AabbBvh& bvh, std::int32_t node) const {
+  const std::int32_t k = internal_index_[static_cast<std::size_t>(node)];
+  if (k >= 0) return node_cones_[static_cast<std::size_t>(k)];
+  DirectionCone cone;
+  Eigen::Vector3d sum;
+  unstored_cone(bvh, node, cone, sum);
+  return cone;
+}
+
+Eigen::Vector3d NormalConeTree::mean_normal(const AabbBvh& bvh, std::int32_t node) const {
+  const std::int32_t k = internal_index_[static_cast<std::size_t>(node)];
+  if (k >= 0) return unit_or_zero(node_sums_[static_cast<std::size_t>(k)]);
+  DirectionCone cone;
+  Eigen::Vector3d sum;
+  unstored_cone(bvh, node, cone, sum);
+  return unit_or_zero(sum);
 }
 
 bool NormalConeTree::normals_in_half_space(
@@ -255,8 +327,7 @@ bool NormalConeTree::normals_in_half_space(
   const auto order = bvh.triangle_order();
   const double vn = v.norm() * (1.0 + 4.0 * kU);
   for (std::int32_t s = n.begin; s < n.end; ++s) {
-    const auto& normals =
-        triangle_normals_[static_cast<std::size_t>(order[static_cast<std::size_t>(s)])];
+    const auto normals = triangle_normals(order[static_cast<std::size_t>(s)]);
     for (int k = 0; k < vectors_per_triangle_; ++k) {
       // The exact normal is within `error` of the computed one: n·v ≥ ñ·v − error·|v|; the dot
       // product itself is within 3u·Σ|ñ_i v_i| (4u with the bound's own rounding).
@@ -272,50 +343,45 @@ bool NormalConeTree::normals_in_half_space(
 
 void NormalConeTree::refit_nodes(const AabbBvh& bvh) {
   const auto nodes = bvh.nodes();
-  const auto order = bvh.triangle_order();
-  node_cones_.resize(nodes.size());
-  node_sums_.resize(nodes.size());
+  // Records for the internal nodes with an internal child only, numbered in node order: a leaf's
+  // cone and sum, and those of a node whose children are both leaves (which no cone method
+  // tests), are formed from their one to a few triangles when needed (a pass over the node ids;
+  // allocation-free once sized).
+  const auto stored = [&](std::size_t i) {
+    return !nodes[i].is_leaf() &&
+           !(nodes[i + 1].is_leaf() && nodes[static_cast<std::size_t>(nodes[i].right)].is_leaf());
+  };
+  internal_index_.resize(nodes.size());
+  std::int32_t records = 0;
+  for (std::size_t i = 0; i < nodes.size(); ++i) {
+    internal_index_[i] = stored(i) ? records++ : -1;
+  }
+  node_cones_.resize(static_cast<std::size_t>(records));
+  node_sums_.resize(static_cast<std::size_t>(records));
   // Depth-first layout: children have larger ids than their parent, so one backward sweep is
   // bottom-up.
   for (std::size_t i = nodes.size(); i-- > 0;) {
-    const BvhNode& node = nodes[i];
-    if (node.is_leaf()) {
-      Eigen::Vector3d sum = Eigen::Vector3d::Zero();
-      for (std::int32_t s = node.begin; s < node.end; ++s) {
-        sum += triangle_sums_[static_cast<std::size_t>(order[static_cast<std::size_t>(s)])];
+    const std::int32_t k = internal_index_[i];
+    if (k < 0) continue;
+    // The children's cones and sums: a stored child's record, or formed from its triangles
+    // (each node has one parent: formed once per refit, from the triangles as before).
+    std::array<DirectionCone, 2> cones;
+    std::array<Eigen::Vector3d, 2> sums;
+    for (std::size_t side = 0; side < 2; ++side) {
+      const std::size_t c = side == 0 ? i + 1 : static_cast<std::size_t>(nodes[i].right);
+      const std::int32_t kc = internal_index_[c];
+      if (kc >= 0) {
+        cones[side] = node_cones_[static_cast<std::size_t>(kc)];
+        sums[side] = node_sums_[static_cast<std::size_t>(kc)];
+      } else {
+        unstored_cone(bvh, static_cast<std::int32_t>(c), cones[side], sums[side]);
       }
-      node_sums_[i] = sum;
-      if (node.size() == 1) {
-        node_cones_[i] =
-            triangle_cones_[static_cast<std::size_t>(order[static_cast<std::size_t>(node.begin)])];
-        continue;
-      }
-      const Eigen::Vector3d axis = unit_or_zero(sum);
-      double cos_lb = 1.0;
-      double sin_ub = 0.0;
-      bool bounded = !axis.isZero(0.0);
-      for (std::int32_t s = node.begin; bounded && s < node.end; ++s) {
-        bounded = extend_around(
-            axis,
-            triangle_cones_[static_cast<std::size_t>(order[static_cast<std::size_t>(s)])],
-            cos_lb,
-            sin_ub);
-      }
-      node_cones_[i] = bounded ? make_cone(axis, cos_lb, sin_ub) : DirectionCone::full_cone();
-      continue;
     }
-    const std::size_t l = i + 1;
-    const auto r = static_cast<std::size_t>(node.right);
-    node_sums_[i] = node_sums_[l] + node_sums_[r];
-    // Axis: the node's mean normal (cheap); when that leaves a wide cone, the optimal merge axis
-    // of the two children may do better (it costs a few transcendental calls).
-    DirectionCone cone =
-        enclose_around(unit_or_zero(node_sums_[i]), node_cones_[l], node_cones_[r]);
-    if (cone.is_full() || cone.cos_angle < 0.5) {
-      const DirectionCone alt = merge(node_cones_[l], node_cones_[r]);
-      if (!alt.is_full() && (cone.is_full() || alt.cos_angle > cone.cos_angle)) cone = alt;
-    }
-    node_cones_[i] = cone;
+    combine(
+        cones,
+        sums,
+        node_cones_[static_cast<std::size_t>(k)],
+        node_sums_[static_cast<std::size_t>(k)]);
   }
 }
 

@@ -111,8 +111,11 @@ struct BoundedNormal {
 class NormalConeTree {
  public:
   /// Static normals at positions x (#W × 3). Allocation-free after the first call.
+  /// @note The tree keeps references to `topology` and `x` (no copy of any normal): they must
+  /// outlive the queries below until the next refit.
   void refit(const AabbBvh& bvh, const FeatureTopology& topology, const skinning::Positions& x);
   /// Continuous normals over x_t0 → x_t1 (#W × 3 each). Allocation-free after the first call.
+  /// @note As above: `topology`, `x_t0` and `x_t1` must outlive the queries until the next refit.
   void refit(
       const AabbBvh& bvh,
       const FeatureTopology& topology,
@@ -121,25 +124,52 @@ class NormalConeTree {
 
   /// The node's mean normal direction (unit; zero when its normals cancel): the sum of its
   /// triangles' normals (of their control vectors for CCD), i.e. area-weighted.
-  [[nodiscard]] Eigen::Vector3d mean_normal(std::int32_t node) const;
+  /// @param bvh the hierarchy of the last refit (a leaf's is summed from its triangles).
+  [[nodiscard]] Eigen::Vector3d mean_normal(const AabbBvh& bvh, std::int32_t node) const;
   /// True when every normal of the node's triangles (every Bernstein control vector for CCD) is
   /// proven to have a positive dot product with `v`: the surface normal test done triangle by
   /// triangle, for a node whose hierarchical cone is too loose. Stops at the first failure.
   [[nodiscard]] bool normals_in_half_space(
       const AabbBvh& bvh, std::int32_t node, const Eigen::Vector3d& v) const;
 
-  /// One cone per node of the hierarchy (node ids of AabbBvh::nodes()).
-  [[nodiscard]] std::span<const DirectionCone> node_cones() const { return node_cones_; }
-  /// One cone per triangle id.
-  [[nodiscard]] std::span<const DirectionCone> triangle_cones() const { return triangle_cones_; }
+  /// The cone of a node of the hierarchy of the last refit (node ids of AabbBvh::nodes()): it
+  /// contains the (continuous) normal of each of the node's triangles.
+  /// @note Only the cones of nodes with an internal child are stored; a leaf's, or a node's whose
+  /// children are leaves, is formed from its triangles' normals by the same code the refit merges
+  /// it with (so it is the cone the refit used).
+  [[nodiscard]] DirectionCone node_cone(const AabbBvh& bvh, std::int32_t node) const;
 
  private:
   void refit_nodes(const AabbBvh& bvh);
+  /// Triangle f's normal ([0], static) or its three Bernstein control vectors (continuous), at
+  /// the last refit's positions: formed when needed, never stored (bounded memory).
+  [[nodiscard]] std::array<BoundedNormal, 3> triangle_normals(std::int32_t f) const;
+  /// The cone and the normal sum of triangle f (of its control vectors for CCD).
+  [[nodiscard]] DirectionCone triangle_cone(const std::array<BoundedNormal, 3>& normals) const;
+  [[nodiscard]] Eigen::Vector3d triangle_sum(const std::array<BoundedNormal, 3>& normals) const;
+  /// A leaf's cone and normal sum.
+  void leaf_cone(
+      const AabbBvh& bvh, std::int32_t leaf, DirectionCone& cone, Eigen::Vector3d& sum) const;
+  /// The cone and sum of a node without a record (a leaf, or a node whose children are leaves).
+  void unstored_cone(
+      const AabbBvh& bvh, std::int32_t node, DirectionCone& cone, Eigen::Vector3d& sum) const;
+  /// A parent's cone and sum from its two children's.
+  static void combine(
+      const std::array<DirectionCone, 2>& cones,
+      const std::array<Eigen::Vector3d, 2>& sums,
+      DirectionCone& cone,
+      Eigen::Vector3d& sum);
 
-  std::vector<DirectionCone> triangle_cones_;
-  std::vector<std::array<BoundedNormal, 3>> triangle_normals_;  // [0] only for static normals
+  // The last refit's triangles and positions (x_t1_ null for static normals): the normals are
+  // formed from them, by the same functions the refit used, whenever a query needs them.
+  const FeatureTopology* topology_ = nullptr;
+  const skinning::Positions* x_t0_ = nullptr;
+  const skinning::Positions* x_t1_ = nullptr;
   int vectors_per_triangle_ = 1;
-  std::vector<Eigen::Vector3d> triangle_sums_;  // raw normal (sum of control vectors) per triangle
+  // Per node, the index of its record (-1 for a leaf or a node whose children are both leaves:
+  // theirs are formed from their triangles when needed), and per record the node's cone and the
+  // sum of its triangles' normals.
+  std::vector<std::int32_t> internal_index_;
   std::vector<DirectionCone> node_cones_;
   std::vector<Eigen::Vector3d> node_sums_;
 };

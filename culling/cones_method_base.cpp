@@ -123,14 +123,14 @@ void ConeMethodBase::ccd(const culling::Interval& query, FrameResult& out) {
 }
 
 bool ConeMethodBase::normal_test(std::int32_t n, Eigen::Vector3d& axis) {
-  const DirectionCone& snc = cones_.node_cones()[static_cast<std::size_t>(n)];
+  const DirectionCone snc = cones_.node_cone(bvh_, n);
   if (snc.in_open_half_space()) {
     axis = snc.axis;
     return true;
   }
   // Cones merged level by level grow looser than the normals they bound; a node that fails by
   // its cone may still pass triangle by triangle (early exit on the first normal that fails).
-  axis = cones_.mean_normal(n);
+  axis = cones_.mean_normal(bvh_, n);
   if (!cones_.normals_in_half_space(bvh_, n, axis)) return false;
   ++stats_.normal_direct_passes;
   return true;

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <limits>
 #include <numbers>
+#include <stdexcept>
 
 #include "culling/contour_predicates.hpp"
 
@@ -12,6 +13,23 @@ namespace skelcd::culling {
 namespace {
 
 inline std::size_t sz(std::int64_t i) { return static_cast<std::size_t>(i); }
+
+/// A contour edge while the node's loops are formed: with its edge id, which the pairing at
+/// pinch vertices walks from (the stored ContourEdge does not keep it).
+struct RawEdge {
+  std::int32_t from = -1;
+  std::int32_t to = -1;
+  std::int32_t edge = -1;  ///< edge id (FeatureTopology / Topology::edges row)
+  std::int8_t part = -1;
+};
+
+/// A 32-bit offset into the contours' arrays.
+std::int32_t offset_of(std::size_t size) {
+  if (size > static_cast<std::size_t>(std::numeric_limits<std::int32_t>::max())) {
+    throw std::length_error("culling::NodeContours: more than 2^31 contour rows");
+  }
+  return static_cast<std::int32_t>(size);
+}
 
 }  // namespace
 
@@ -59,11 +77,7 @@ NodeContours::NodeContours(const AabbBvh& bvh, const FeatureTopology& topology) 
   const auto order = bvh.triangle_order();
   const std::size_t num_nodes = nodes.size();
   status_.assign(num_nodes, ContourStatus::not_tested);
-  edge_offset_.assign(num_nodes + 1, 0);
-  loop_offset_.assign(num_nodes + 1, 0);
-  loop_start_offset_.assign(num_nodes + 1, 0);
-  chain_offset_.assign(num_nodes + 1, 0);
-  fan_offset_.assign(num_nodes + 1, 0);
+  record_.assign(num_nodes, -1);
 
   // Scratch indexed by edge and by vertex, reset through touched lists (§5.2.2 preprocessing).
   const auto ne = static_cast<std::size_t>(topology.num_edges());
@@ -82,7 +96,7 @@ NodeContours::NodeContours(const AabbBvh& bvh, const FeatureTopology& topology) 
   for (std::size_t s = 0; s < order.size(); ++s) {
     slot_of[static_cast<std::size_t>(order[s])] = static_cast<std::int32_t>(s);
   }
-  std::vector<ContourEdge> raw;
+  std::vector<RawEdge> raw;
   std::vector<std::int32_t> next;
   std::vector<std::uint8_t> used;
   std::vector<std::int32_t> stack;
@@ -91,11 +105,6 @@ NodeContours::NodeContours(const AabbBvh& bvh, const FeatureTopology& topology) 
   std::vector<std::int32_t> position;  // raw index → index in the node's ordered edges
 
   for (std::size_t i = 0; i < num_nodes; ++i) {
-    edge_offset_[i + 1] = edge_offset_[i];
-    loop_offset_[i + 1] = loop_offset_[i];
-    loop_start_offset_[i + 1] = loop_start_offset_[i];
-    chain_offset_[i + 1] = chain_offset_[i];
-    fan_offset_[i + 1] = fan_offset_[i];
     std::array<std::int32_t, 4> parts{};
     const int num_parts = sub_surfaces(bvh, static_cast<std::int32_t>(i), parts);
     const BvhNode& node = nodes[i];
@@ -141,14 +150,14 @@ NodeContours::NodeContours(const AabbBvh& bvh, const FeatureTopology& topology) 
         const auto ue = static_cast<std::size_t>(e);
         if (count[ue] != 1) continue;
         const auto& ends = topology.edge(e);
-        ContourEdge c;
+        RawEdge c;
         c.edge = e;
         c.from = direction[ue] > 0 ? ends[0] : ends[1];
         c.to = direction[ue] > 0 ? ends[1] : ends[0];
         const std::int32_t slot = slot_of[static_cast<std::size_t>(face0[ue])];
         for (int p = 0; p < num_parts; ++p) {
           const BvhNode& pn = nodes[sz(parts[static_cast<std::size_t>(p)])];
-          if (slot >= pn.begin && slot < pn.end) c.part = p;
+          if (slot >= pn.begin && slot < pn.end) c.part = static_cast<std::int8_t>(p);
         }
         assert(c.part >= 0);
         contour_index[ue] = static_cast<std::int32_t>(raw.size());
@@ -238,8 +247,13 @@ NodeContours::NodeContours(const AabbBvh& bvh, const FeatureTopology& topology) 
 
     // 4. Store: loops rotated to start at a change of sub-surface, chains, probes, fans.
     if (status == ContourStatus::loops) {
+      record_[i] = offset_of(edge_begin_.size());
+      edge_begin_.push_back(offset_of(from_.size()));
+      loop_begin_.push_back(offset_of(loop_probe_.size()));
+      chain_begin_.push_back(offset_of(chain_starts_.size()));
+      fan_begin_.push_back(offset_of(fans_.size()));
       position.assign(raw.size(), -1);
-      const auto base = static_cast<std::int32_t>(edges_.size());
+      const auto base = static_cast<std::int32_t>(from_.size());
       for (const auto& loop : loops) {
         const std::size_t m = loop.size();
         std::size_t start = m;
@@ -251,36 +265,34 @@ NodeContours::NodeContours(const AabbBvh& bvh, const FeatureTopology& topology) 
         }
         const bool one_part = start == m;
         if (one_part) start = 0;
-        const auto first = static_cast<std::int32_t>(edges_.size()) - base;
+        const auto first = static_cast<std::int32_t>(from_.size()) - base;
         loop_starts_.push_back(first);
         std::int32_t probe = -1;
         for (std::size_t k = 0; k < m; ++k) {
           const std::int32_t r = loop[(start + k) % m];
-          const ContourEdge& c = raw[sz(r)];
-          position[sz(r)] = static_cast<std::int32_t>(edges_.size()) - base;
-          if (one_part || k == 0 || c.part != edges_.back().part) {
+          const RawEdge& c = raw[sz(r)];
+          position[sz(r)] = static_cast<std::int32_t>(from_.size()) - base;
+          if (one_part || k == 0 || c.part != part_.back()) {
             chain_starts_.push_back(position[sz(r)]);
           }
           if (probe < 0 && out_count[static_cast<std::size_t>(c.from)] == 1) probe = c.from;
-          edges_.push_back(c);
+          // Its `to` is the next edge's `from` (the first's for the last): not stored.
+          assert(c.to == raw[sz(loop[(start + k + 1) % m])].from);
+          from_.push_back(c.from);
+          part_.push_back(c.part);
         }
         loop_probe_.push_back(probe);
       }
-      const auto total = static_cast<std::int32_t>(edges_.size()) - base;
+      const auto total = static_cast<std::int32_t>(from_.size()) - base;
       loop_starts_.push_back(total);
       chain_starts_.push_back(total);
       for (const ContourFan& f : raw_fans) {
         fans_.push_back({f.vertex, position[sz(f.in_edge)], position[sz(f.out_edge)]});
       }
       std::sort(
-          fans_.begin() + fan_offset_[i],
+          fans_.begin() + fan_begin_.back(),
           fans_.end(),
           [](const ContourFan& a, const ContourFan& b) { return a.vertex < b.vertex; });
-      edge_offset_[i + 1] = static_cast<std::int64_t>(edges_.size());
-      loop_offset_[i + 1] = static_cast<std::int64_t>(loop_probe_.size());
-      chain_offset_[i + 1] = static_cast<std::int64_t>(chain_starts_.size());
-      fan_offset_[i + 1] = static_cast<std::int64_t>(fans_.size());
-      loop_start_offset_[i + 1] = static_cast<std::int64_t>(loop_starts_.size());
     }
 
     for (const std::int32_t e : touched_edges) {
@@ -294,36 +306,74 @@ NodeContours::NodeContours(const AabbBvh& bvh, const FeatureTopology& topology) 
     status_[i] = status;
     ++status_counts_[static_cast<std::size_t>(status)];
   }
+  edge_begin_.push_back(offset_of(from_.size()));
+  loop_begin_.push_back(offset_of(loop_probe_.size()));
+  chain_begin_.push_back(offset_of(chain_starts_.size()));
+  fan_begin_.push_back(offset_of(fans_.size()));
+  // Kept for the method's lifetime: give back what push_back's doubling reserved beyond the rows.
+  for (auto* v :
+       {&edge_begin_,
+        &loop_begin_,
+        &chain_begin_,
+        &fan_begin_,
+        &loop_starts_,
+        &loop_probe_,
+        &chain_starts_}) {
+    v->shrink_to_fit();
+  }
+  from_.shrink_to_fit();
+  part_.shrink_to_fit();
+  fans_.shrink_to_fit();
 }
 
-std::span<const ContourEdge> NodeContours::edges(std::int32_t node) const {
-  const auto n = static_cast<std::size_t>(node);
-  return std::span<const ContourEdge>(edges_).subspan(
-      sz(edge_offset_[n]), sz(edge_offset_[n + 1] - edge_offset_[n]));
+void NodeContours::edges(std::int32_t node, std::vector<ContourEdge>& out) const {
+  out.clear();
+  const std::int32_t r = record_[sz(node)];
+  if (r < 0) return;
+  const auto base = sz(edge_begin_[sz(r)]);
+  const auto starts = loop_starts(node);
+  for (std::size_t l = 0; l + 1 < starts.size(); ++l) {
+    const std::size_t begin = base + sz(starts[l]);
+    const std::size_t end = base + sz(starts[l + 1]);
+    for (std::size_t k = begin; k < end; ++k) {
+      out.push_back({from_[k], from_[k + 1 < end ? k + 1 : begin], part_[k]});
+    }
+  }
+}
+
+std::vector<ContourEdge> NodeContours::edges(std::int32_t node) const {
+  std::vector<ContourEdge> out;
+  edges(node, out);
+  return out;
 }
 
 std::span<const std::int32_t> NodeContours::loop_starts(std::int32_t node) const {
-  const auto n = static_cast<std::size_t>(node);
+  const std::int32_t r = record_[sz(node)];
+  if (r < 0) return {};
+  // #loops + 1 entries per record before this one.
   return std::span<const std::int32_t>(loop_starts_)
-      .subspan(sz(loop_start_offset_[n]), sz(loop_start_offset_[n + 1] - loop_start_offset_[n]));
+      .subspan(sz(loop_begin_[sz(r)] + r), sz(loop_begin_[sz(r) + 1] - loop_begin_[sz(r)] + 1));
 }
 
 std::span<const std::int32_t> NodeContours::loop_probe(std::int32_t node) const {
-  const auto n = static_cast<std::size_t>(node);
+  const std::int32_t r = record_[sz(node)];
+  if (r < 0) return {};
   return std::span<const std::int32_t>(loop_probe_)
-      .subspan(sz(loop_offset_[n]), sz(loop_offset_[n + 1] - loop_offset_[n]));
+      .subspan(sz(loop_begin_[sz(r)]), sz(loop_begin_[sz(r) + 1] - loop_begin_[sz(r)]));
 }
 
 std::span<const std::int32_t> NodeContours::chain_starts(std::int32_t node) const {
-  const auto n = static_cast<std::size_t>(node);
+  const std::int32_t r = record_[sz(node)];
+  if (r < 0) return {};
   return std::span<const std::int32_t>(chain_starts_)
-      .subspan(sz(chain_offset_[n]), sz(chain_offset_[n + 1] - chain_offset_[n]));
+      .subspan(sz(chain_begin_[sz(r)]), sz(chain_begin_[sz(r) + 1] - chain_begin_[sz(r)]));
 }
 
 std::span<const ContourFan> NodeContours::fans(std::int32_t node) const {
-  const auto n = static_cast<std::size_t>(node);
+  const std::int32_t r = record_[sz(node)];
+  if (r < 0) return {};
   return std::span<const ContourFan>(fans_).subspan(
-      sz(fan_offset_[n]), sz(fan_offset_[n + 1] - fan_offset_[n]));
+      sz(fan_begin_[sz(r)]), sz(fan_begin_[sz(r) + 1] - fan_begin_[sz(r)]));
 }
 
 namespace {
@@ -575,7 +625,8 @@ ContourVerdict ContourTester::run(
     ContourMode mode,
     ContourTestCounters& counters) {
   assert(nodes.status(node) == ContourStatus::loops);
-  const auto edges = nodes.edges(node);
+  nodes.edges(node, edges_);
+  const std::span<const ContourEdge> edges(edges_);
   const auto chains = nodes.chain_starts(node);
   const std::size_t m = edges.size();
   const Frames x{x_t0, x_t1};

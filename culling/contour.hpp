@@ -51,8 +51,7 @@ inline constexpr int kMaxContourLoops = 16;
 struct ContourEdge {
   std::int32_t from = -1;
   std::int32_t to = -1;
-  std::int32_t edge = -1;  ///< edge id (FeatureTopology / Topology::edges row)
-  std::int32_t part = -1;  ///< which sub-surface of the node holds its triangle (0..3)
+  std::int8_t part = -1;  ///< which sub-surface of the node holds its triangle (0..3)
 };
 
 /// A fan of the node's triangles around a pinch vertex (a vertex where the contour passes more
@@ -81,7 +80,12 @@ class NodeContours {
   }
   /// The contour of a `loops` node (empty otherwise), loop after loop; each loop visits every
   /// vertex once and is rotated so that it starts a chain.
-  [[nodiscard]] std::span<const ContourEdge> edges(std::int32_t node) const;
+  /// @param out receives the edges (cleared first; allocation-free once its capacity suffices).
+  /// @note Stored as each edge's start vertex and sub-surface only (an edge ends where the next
+  /// edge of its loop starts): expanded here, once per contour test (bounded memory).
+  void edges(std::int32_t node, std::vector<ContourEdge>& out) const;
+  /// The same, in a new vector.
+  [[nodiscard]] std::vector<ContourEdge> edges(std::int32_t node) const;
   /// Offsets into edges(node) where each loop starts, followed by edges(node).size().
   [[nodiscard]] std::span<const std::int32_t> loop_starts(std::int32_t node) const;
   /// Offsets into edges(node) where each chain starts, followed by edges(node).size(). A chain
@@ -98,21 +102,24 @@ class NodeContours {
     return status_counts_;
   }
   /// Total contour edges stored (all nodes).
-  [[nodiscard]] std::int64_t total_edges() const {
-    return static_cast<std::int64_t>(edges_.size());
-  }
+  [[nodiscard]] std::int64_t total_edges() const { return static_cast<std::int64_t>(from_.size()); }
 
  private:
   std::vector<ContourStatus> status_;
-  // Per node n, [offset[n], offset[n + 1]) into the arrays below.
-  std::vector<std::int64_t> edge_offset_;
-  std::vector<std::int64_t> loop_offset_;
-  std::vector<std::int64_t> loop_start_offset_;
-  std::vector<std::int64_t> chain_offset_;
-  std::vector<std::int64_t> fan_offset_;
-  std::vector<ContourEdge> edges_;
-  std::vector<std::int32_t> loop_starts_;  // per node: #loops + 1 entries
-  std::vector<std::int32_t> loop_probe_;   // per node: #loops entries (indexed via loop_offset_)
+  // Compressed rows: per node its record among the `loops` nodes (-1 for any other), per record r
+  // (node order) and one past the last, where its rows begin in the arrays below; loop_starts_
+  // has #loops + 1 entries per record, so record r's begin at loop_begin_[r] + r. 32-bit offsets,
+  // and no row for the nodes without a contour test (most of them: leaves and their parents).
+  std::vector<std::int32_t> record_;
+  std::vector<std::int32_t> edge_begin_;
+  std::vector<std::int32_t> loop_begin_;
+  std::vector<std::int32_t> chain_begin_;
+  std::vector<std::int32_t> fan_begin_;
+  std::vector<std::int32_t>
+      from_;  // per contour edge: where it starts (it ends at the next's start)
+  std::vector<std::int8_t> part_;          // per contour edge: the sub-surface holding its triangle
+  std::vector<std::int32_t> loop_starts_;  // per record: #loops + 1 entries
+  std::vector<std::int32_t> loop_probe_;   // per record: #loops entries
   std::vector<std::int32_t> chain_starts_;
   std::vector<ContourFan> fans_;
   std::array<std::int64_t, kNumContourStatuses> status_counts_{};
@@ -195,6 +202,7 @@ class ContourTester {
   struct Box2 {
     double lo1, hi1, lo2, hi2;
   };
+  std::vector<ContourEdge> edges_;  // the node's contour, expanded (NodeContours::edges)
   std::vector<Box2> boxes_;
   std::vector<std::int32_t> chain_of_;
   std::vector<std::pair<double, std::int32_t>> sorted_;

@@ -83,7 +83,7 @@ class DualConeMethod final : public detail::ConeMethodBase {
   // The Dual-Cone Theorem at node n (FASTCD): θ_n < π/2 and |A_n · A_b| < cos θ_b.
   bool node_culled(std::int32_t n, const Interval& /*interval*/) override {
     ++stats_.nodes_tested;
-    const DirectionCone& snc = cones_.node_cones()[static_cast<std::size_t>(n)];
+    const DirectionCone snc = cones_.node_cone(bvh_, n);
     if (!snc.in_open_half_space()) {
       ++stats_.failed_normal_cone;
       return false;

@@ -17,6 +17,7 @@
 #include "culling/feature_topology.hpp"
 #include "tests/culling/procedural_meshes.hpp"
 #include "tests/culling/test_dual_cone_scenes.hpp"
+#include "tests/support/test_support.hpp"
 
 namespace skelcd::culling {
 namespace {
@@ -122,7 +123,7 @@ TEST(Cones, StaticNormalConesContainEveryTriangleNormalUpTheTree) {
   const auto order = bvh.triangle_order();
   int bounded_nodes = 0;
   for (std::size_t i = 0; i < nodes.size(); ++i) {
-    const DirectionCone& c = tree.node_cones()[i];
+    const DirectionCone c = tree.node_cone(bvh, static_cast<std::int32_t>(i));
     bounded_nodes += c.in_open_half_space() ? 1 : 0;
     for (std::int32_t s = nodes[i].begin; s < nodes[i].end; ++s) {
       const auto& t = features.triangle(order[static_cast<std::size_t>(s)]);
@@ -134,7 +135,7 @@ TEST(Cones, StaticNormalConesContainEveryTriangleNormalUpTheTree) {
     }
   }
   // A mildly wavy sheet: the root's normals lie in a half-space.
-  EXPECT_TRUE(tree.node_cones()[0].in_open_half_space());
+  EXPECT_TRUE(tree.node_cone(bvh, 0).in_open_half_space());
   EXPECT_EQ(bounded_nodes, static_cast<int>(nodes.size()));
 }
 
@@ -155,7 +156,7 @@ TEST(Cones, ContinuousConesContainNormalsAtEverySampledTimeAndTheControlVectors)
   const auto nodes = bvh.nodes();
   const auto order = bvh.triangle_order();
   for (std::size_t i = 0; i < nodes.size(); ++i) {
-    const DirectionCone& c = tree.node_cones()[i];
+    const DirectionCone c = tree.node_cone(bvh, static_cast<std::int32_t>(i));
     for (std::int32_t s = nodes[i].begin; s < nodes[i].end; ++s) {
       const auto& t = features.triangle(order[static_cast<std::size_t>(s)]);
       std::array<LVec, 3> p0;
@@ -177,7 +178,7 @@ TEST(Cones, ContinuousConesContainNormalsAtEverySampledTimeAndTheControlVectors)
       EXPECT_TRUE(inside(c, e11.cross(e21)));
     }
   }
-  EXPECT_TRUE(tree.node_cones()[0].in_open_half_space());
+  EXPECT_TRUE(tree.node_cone(bvh, 0).in_open_half_space());
 }
 
 TEST(Cones, FlippingTriangleMakesItsContinuousConeFull) {
@@ -194,9 +195,9 @@ TEST(Cones, FlippingTriangleMakesItsContinuousConeFull) {
   const AabbBvh bvh(features.welded_triangles(), x0);
   NormalConeTree tree;
   tree.refit(bvh, features, x0, x1);
-  EXPECT_TRUE(tree.node_cones()[0].is_full());
+  EXPECT_TRUE(tree.node_cone(bvh, 0).is_full());
   tree.refit(bvh, features, x0, x0);
-  EXPECT_TRUE(tree.node_cones()[0].in_open_half_space());
+  EXPECT_TRUE(tree.node_cone(bvh, 0).in_open_half_space());
 }
 
 TEST(Cones, DirectTestAroundTheMeanNormalProvesWhatTheCheckAllowsAndNothingElse) {
@@ -211,17 +212,19 @@ TEST(Cones, DirectTestAroundTheMeanNormalProvesWhatTheCheckAllowsAndNothingElse)
   NormalConeTree tree;
   const skinning::Positions bent = test::folded(x, 1.0, 150.0 * std::numbers::pi / 180.0);
   tree.refit(bvh, features, bent);
-  const Vec mean = tree.mean_normal(0);
+  const Vec mean = tree.mean_normal(bvh, 0);
   EXPECT_NEAR(mean.norm(), 1.0, 1e-12);
   EXPECT_TRUE(tree.normals_in_half_space(bvh, 0, mean));
   EXPECT_FALSE(tree.normals_in_half_space(bvh, 0, Vec(0, 0, 1)));  // the far half faces down
   tree.refit(bvh, features, bent, bent);                           // CCD: the same, constant
-  EXPECT_TRUE(tree.normals_in_half_space(bvh, 0, tree.mean_normal(0)));
+  EXPECT_TRUE(tree.normals_in_half_space(bvh, 0, tree.mean_normal(bvh, 0)));
   // Folded by 181°: the two halves' normals are 179° apart — still a half-space, barely; the
   // opposite direction never is.
-  tree.refit(bvh, features, test::folded(x, 1.0, 181.0 * std::numbers::pi / 180.0));
-  EXPECT_TRUE(tree.normals_in_half_space(bvh, 0, tree.mean_normal(0)));
-  EXPECT_FALSE(tree.normals_in_half_space(bvh, 0, -tree.mean_normal(0)));
+  // (The tree reads the positions at its queries: they must outlive them.)
+  const skinning::Positions x181 = test::folded(x, 1.0, 181.0 * std::numbers::pi / 180.0);
+  tree.refit(bvh, features, x181);
+  EXPECT_TRUE(tree.normals_in_half_space(bvh, 0, tree.mean_normal(bvh, 0)));
+  EXPECT_FALSE(tree.normals_in_half_space(bvh, 0, -tree.mean_normal(bvh, 0)));
   // A closed sphere: its normals cancel, no direction passes.
   const auto sphere = test::uv_sphere(6, 8);
   const auto st = test::simple_topology(sphere);
@@ -230,7 +233,7 @@ TEST(Cones, DirectTestAroundTheMeanNormalProvesWhatTheCheckAllowsAndNothingElse)
   const AabbBvh sb(sf.welded_triangles(), sx);
   NormalConeTree stree;
   stree.refit(sb, sf, sx);
-  for (const Vec& v : {Vec(0, 0, 1), Vec(1, 0, 0), Vec(0.3, -0.2, 0.9), stree.mean_normal(0)}) {
+  for (const Vec& v : {Vec(0, 0, 1), Vec(1, 0, 0), Vec(0.3, -0.2, 0.9), stree.mean_normal(sb, 0)}) {
     EXPECT_FALSE(stree.normals_in_half_space(sb, 0, v));
   }
   tree.refit(bvh, features, x);
@@ -406,6 +409,11 @@ TEST(NodeContours, InternalBoundaryEdgesAreOnTheContourOfInnerNodes) {
   const FeatureTopology features(mesh, topo);
   const AabbBvh bvh(features.welded_triangles(), test::welded(topo, mesh.rest_positions));
   const NodeContours contours(bvh, features);
+  std::map<std::pair<std::int32_t, std::int32_t>, std::int32_t> edge_id;
+  for (std::int32_t e = 0; e < features.num_edges(); ++e) {
+    const auto& ends = features.edge(e);
+    edge_id[{std::min(ends[0], ends[1]), std::max(ends[0], ends[1])}] = e;
+  }
   const auto nodes = bvh.nodes();
   int checked = 0;
   for (std::size_t i = 0; i < nodes.size(); ++i) {
@@ -421,7 +429,9 @@ TEST(NodeContours, InternalBoundaryEdgesAreOnTheContourOfInnerNodes) {
       if (c == 1) expected.insert(e);
     }
     std::set<std::int32_t> got;
-    for (const auto& e : contours.edges(n)) got.insert(e.edge);
+    for (const auto& e : contours.edges(n)) {
+      got.insert(edge_id.at({std::min(e.from, e.to), std::max(e.from, e.to)}));
+    }
     EXPECT_EQ(got, expected) << "node " << i;
     ++checked;
   }
@@ -569,6 +579,106 @@ TEST(ContourTester, FlatSheetIsSimpleAndAFoldedSheetIsNot) {
   }
   EXPECT_GT(counters.edge_pair_tests, 0);
   EXPECT_GT(counters.chain_tests, 0);
+}
+
+// The tree keeps cones and normal sums for internal nodes only, and no normal per triangle: a
+// leaf's cone and mean normal are formed on request from its triangle's normal at the refit's
+// positions, and must be exactly the triangle's cone (DCD: the cone of its one normal) and unit
+// normal, as the refit merged them.
+TEST(Cones, LeafConesAreFormedFromTheirTrianglesNormals) {
+  auto mesh = test::sheet(6, 5);
+  for (Eigen::Index v = 0; v < mesh.rest_positions.rows(); ++v) {
+    mesh.rest_positions(v, 2) = 0.2 * std::sin(2.0 * mesh.rest_positions(v, 1));
+  }
+  const auto topo = test::simple_topology(mesh);
+  const FeatureTopology features(mesh, topo);
+  const skinning::Positions x = test::welded(topo, mesh.rest_positions);
+  const AabbBvh bvh(features.welded_triangles(), x);
+  NormalConeTree tree;
+  tree.refit(bvh, features, x);
+  const auto nodes = bvh.nodes();
+  const auto order = bvh.triangle_order();
+  int leaves = 0;
+  for (std::size_t i = 0; i < nodes.size(); ++i) {
+    if (!nodes[i].is_leaf()) continue;
+    const auto& t = features.triangle(order[static_cast<std::size_t>(nodes[i].begin)]);
+    const BoundedNormal n =
+        triangle_normal(x.row(t[0]).transpose(), x.row(t[1]).transpose(), x.row(t[2]).transpose());
+    const DirectionCone want = cone_of_vector(n.n, n.error);
+    const DirectionCone got = tree.node_cone(bvh, static_cast<std::int32_t>(i));
+    ASSERT_EQ(got.kind, want.kind) << "leaf " << i;
+    EXPECT_EQ(got.axis, want.axis) << "leaf " << i;
+    EXPECT_EQ(got.cos_angle, want.cos_angle) << "leaf " << i;
+    EXPECT_EQ(got.sin_angle, want.sin_angle) << "leaf " << i;
+    EXPECT_EQ(tree.mean_normal(bvh, static_cast<std::int32_t>(i)), unit_or_zero(n.n)) << i;
+    ++leaves;
+  }
+  EXPECT_EQ(leaves, static_cast<int>(features.num_triangles()));
+  // An internal node's mean normal is the unit sum of its two children's sums.
+  const Eigen::Vector3d root_sum = [&] {
+    Eigen::Vector3d s = Eigen::Vector3d::Zero();
+    for (const std::int32_t f : order) {
+      const auto& t = features.triangle(f);
+      s +=
+          triangle_normal(x.row(t[0]).transpose(), x.row(t[1]).transpose(), x.row(t[2]).transpose())
+              .n;
+    }
+    return s;
+  }();
+  EXPECT_LT((tree.mean_normal(bvh, 0) - unit_or_zero(root_sum)).norm(), 1e-12);
+}
+
+// The contours are stored as compressed rows with a record per tested node: every node's rows
+// must still be its own — loops that close on themselves, chain and loop starts that end at its
+// edge count, one probe per loop, fans whose edges meet at their vertex — and nodes without a
+// contour test must have none. On the real cloth-funnel mesh (18,484 triangles, many pinches).
+TEST(NodeContours, CompressedRowsHoldEachNodesOwnLoopsOnARealMesh) {
+  const test::OpenScene s = test::cloth_funnel_scene(test::asset("cloth-funnel/frames"));
+  const FeatureTopology features(s.mesh, s.topo);
+  const AabbBvh bvh(features.welded_triangles(), s.frames[0]);
+  const NodeContours contours(bvh, features);
+  std::int64_t edges = 0;
+  int with_loops = 0;
+  int with_fans = 0;
+  for (std::int32_t n = 0; n < static_cast<std::int32_t>(bvh.nodes().size()); ++n) {
+    const auto e = contours.edges(n);
+    const auto loops = contours.loop_starts(n);
+    const auto chains = contours.chain_starts(n);
+    const auto probes = contours.loop_probe(n);
+    const auto fans = contours.fans(n);
+    edges += static_cast<std::int64_t>(e.size());
+    if (contours.status(n) != ContourStatus::loops) {
+      EXPECT_TRUE(e.empty() && loops.empty() && chains.empty() && probes.empty() && fans.empty())
+          << "node " << n;
+      continue;
+    }
+    ++with_loops;
+    ASSERT_FALSE(e.empty()) << "node " << n;
+    ASSERT_EQ(loops.size(), probes.size() + 1) << "node " << n;
+    ASSERT_EQ(loops.front(), 0) << "node " << n;
+    ASSERT_EQ(loops.back(), static_cast<std::int32_t>(e.size())) << "node " << n;
+    ASSERT_EQ(chains.front(), 0) << "node " << n;
+    ASSERT_EQ(chains.back(), static_cast<std::int32_t>(e.size())) << "node " << n;
+    for (std::size_t l = 0; l + 1 < loops.size(); ++l) {
+      const auto b = static_cast<std::size_t>(loops[l]);
+      const auto end = static_cast<std::size_t>(loops[l + 1]);
+      for (std::size_t k = b; k < end; ++k) {
+        const std::size_t next = k + 1 < end ? k + 1 : b;
+        ASSERT_EQ(e[k].to, e[next].from) << "node " << n << " loop " << l;
+        ASSERT_GE(e[k].part, 0);
+        ASSERT_LT(e[k].part, 4);
+      }
+    }
+    with_fans += fans.empty() ? 0 : 1;
+    for (const ContourFan& f : fans) {
+      ASSERT_EQ(e[static_cast<std::size_t>(f.in_edge)].to, f.vertex) << "node " << n;
+      ASSERT_EQ(e[static_cast<std::size_t>(f.out_edge)].from, f.vertex) << "node " << n;
+    }
+  }
+  EXPECT_EQ(edges, contours.total_edges());
+  EXPECT_EQ(with_loops, contours.status_counts()[static_cast<std::size_t>(ContourStatus::loops)]);
+  EXPECT_GT(with_loops, 1000);
+  EXPECT_GT(with_fans, 0);
 }
 
 }  // namespace
