@@ -63,15 +63,16 @@ inline int orient3d_static(
   return kUndecided;
 }
 
-/// Shewchuk's static orient2d filter applied to coordinates (i, j) of (b − a) × (c − a): the sign
-/// of (b − a)_i (c − a)_j − (b − a)_j (c − a)_i when it exceeds (3 + 16ε) ε · permanent,
-/// kUndecided otherwise (as orient3d_static).
-inline int cross_component_static(
-    const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::Vector3d& c, int i, int j) {
+/// Shewchuk's static orient2d filter on differences already taken: the sign of bx·cy − by·cx,
+/// where (bx, by) = b − a and (cx, cy) = c − a were each rounded from one subtraction, when it
+/// exceeds (3 + 16ε) ε · permanent (a bound that covers the differences' rounding), kUndecided
+/// otherwise (as orient3d_static). Callers that need many signs from the same differences (a
+/// vertex fan, culling/vertex_fans.cpp) take each difference once.
+inline int cross_sign_static(double bx, double by, double cx, double cy) {
   constexpr double kHalfUlp = std::numeric_limits<double>::epsilon() / 2.0;
   constexpr double kErrBound = (3.0 + 16.0 * kHalfUlp) * kHalfUlp;
-  const double left = (b[i] - a[i]) * (c[j] - a[j]);
-  const double right = (b[j] - a[j]) * (c[i] - a[i]);
+  const double left = bx * cy;
+  const double right = by * cx;
   const double det = left - right;
   const double permanent = std::abs(left) + std::abs(right);
   if (!(permanent > std::numeric_limits<double>::min() * 0x1p64) ||
@@ -82,6 +83,14 @@ inline int cross_component_static(
   if (det > bound) return 1;
   if (-det > bound) return -1;
   return kUndecided;
+}
+
+/// Shewchuk's static orient2d filter applied to coordinates (i, j) of (b − a) × (c − a): the sign
+/// of (b − a)_i (c − a)_j − (b − a)_j (c − a)_i when it exceeds (3 + 16ε) ε · permanent,
+/// kUndecided otherwise (as orient3d_static).
+inline int cross_component_static(
+    const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::Vector3d& c, int i, int j) {
+  return cross_sign_static(b[i] - a[i], b[j] - a[j], c[i] - a[i], c[j] - a[j]);
 }
 
 }  // namespace detail

@@ -12,32 +12,6 @@
 #include "ccd/orientation.hpp"
 
 namespace skelcd::culling {
-namespace {
-
-/// ccd::detail::cross_component_static on differences already taken: the sign of
-/// bx·cy − by·cx for (bx, by) = (b − a) and (cx, cy) = (c − a) in the two kept coordinates, rounded
-/// as that function rounds them, with its bound ((3 + 16ε) ε · permanent, which covers the
-/// differences' rounding) and its refusals. Bit for bit the same answer, without taking the same
-/// differences again for every sign of a fan.
-inline int cross_sign_static(double bx, double by, double cx, double cy) {
-  constexpr double kHalfUlp = std::numeric_limits<double>::epsilon() / 2.0;
-  constexpr double kErrBound = (3.0 + 16.0 * kHalfUlp) * kHalfUlp;
-  const double left = bx * cy;
-  const double right = by * cx;
-  const double det = left - right;
-  const double permanent = std::abs(left) + std::abs(right);
-  if (!(permanent > std::numeric_limits<double>::min() * 0x1p64) ||
-      !(permanent < std::numeric_limits<double>::infinity())) {
-    return ccd::detail::kUndecided;
-  }
-  const double bound = kErrBound * permanent;
-  if (det > bound) return 1;
-  if (-det > bound) return -1;
-  return ccd::detail::kUndecided;
-}
-
-}  // namespace
-
 VertexFans::VertexFans(
     std::span<const std::array<std::int32_t, 3>> triangles, std::int32_t num_vertices) {
   const auto nv = static_cast<std::size_t>(std::max(num_vertices, 0));
@@ -155,9 +129,9 @@ bool VertexFans::certified(const skinning::Positions& x, std::int32_t v) const {
   const std::size_t i_axis = (k + 1) % 3;
   const std::size_t j_axis = (k + 2) % 3;
   // orient(p, q) in the projection: the k-th component of (p − v) × (q − v), decided by the
-  // static filter of ccd::detail::cross_component_static on the same differences, or kUndecided.
+  // static filter ccd::detail::cross_sign_static (cross_component_static's) on these differences.
   const auto orient = [&](std::size_t p, std::size_t q) {
-    return cross_sign_static(d[p][i_axis], d[p][j_axis], d[q][i_axis], d[q][j_axis]);
+    return ccd::detail::cross_sign_static(d[p][i_axis], d[p][j_axis], d[q][i_axis], d[q][j_axis]);
   };
   int sign = 0;
   int covering = 0;
