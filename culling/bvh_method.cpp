@@ -82,7 +82,7 @@ class BvhMethod final : public MethodBase {
     }
     blocks_.drain([&](std::vector<TrianglePair>& pairs, std::size_t max_pairs) {
       return self_traverse_some<N>(
-          bvh_, bounds_.triangles, scratch_, pairs, out.counters.bv_tests, max_pairs, sieve);
+          bvh_, bounds_.triangles, scratch_, pairs, out.counters.bv_tests, max_pairs, &sieve);
     });
     blocks_.finish();
     out.counters.candidate_pairs += sieve.settled;

@@ -362,29 +362,17 @@ bool self_traverse_some(
     TraversalScratch& scratch,
     std::vector<TrianglePair>& out,
     std::int64_t& bv_tests,
-    std::size_t max_pairs) {
-  if (bvh.empty()) return true;
-  return Walk<N, true>(
-             bvh, triangle_bounds, bvh, triangle_bounds, scratch.stack, out, bv_tests, max_pairs)
-      .run();
-}
-
-template <int N>
-bool self_traverse_some(
-    const Bvh<N>& bvh,
-    std::span<const Dop<N>> triangle_bounds,
-    TraversalScratch& scratch,
-    std::vector<TrianglePair>& out,
-    std::int64_t& bv_tests,
     std::size_t max_pairs,
-    FanSieve& sieve) {
+    FanSieve* sieve) {
   if (bvh.empty()) return true;
-  assert(sieve.slots != nullptr && sieve.topology != nullptr);
-  assert(sieve.slots->corners.size() == bvh.triangle_order().size());
-  assert(sieve.certified.empty() || sieve.full.size() == sieve.slots->corners.size());
-  if (sieve.certified.empty()) {
-    return self_traverse_some(bvh, triangle_bounds, scratch, out, bv_tests, max_pairs);
+  if (sieve == nullptr || sieve->certified.empty()) {
+    return Walk<N, true>(
+               bvh, triangle_bounds, bvh, triangle_bounds, scratch.stack, out, bv_tests, max_pairs)
+        .run();
   }
+  assert(sieve->slots != nullptr && sieve->topology != nullptr);
+  assert(sieve->slots->corners.size() == bvh.triangle_order().size());
+  assert(sieve->full.size() == sieve->slots->corners.size());
   return Walk<N, true, true>(
              bvh,
              triangle_bounds,
@@ -394,7 +382,7 @@ bool self_traverse_some(
              out,
              bv_tests,
              max_pairs,
-             &sieve)
+             sieve)
       .run();
 }
 
@@ -496,22 +484,8 @@ template bool self_traverse_some<3>(
     TraversalScratch&,
     std::vector<TrianglePair>&,
     std::int64_t&,
-    std::size_t);
-template bool self_traverse_some<8>(
-    const Bvh<8>&,
-    std::span<const Dop<8>>,
-    TraversalScratch&,
-    std::vector<TrianglePair>&,
-    std::int64_t&,
-    std::size_t);
-template bool self_traverse_some<3>(
-    const Bvh<3>&,
-    std::span<const Dop<3>>,
-    TraversalScratch&,
-    std::vector<TrianglePair>&,
-    std::int64_t&,
     std::size_t,
-    FanSieve&);
+    FanSieve*);
 template bool self_traverse_some<8>(
     const Bvh<8>&,
     std::span<const Dop<8>>,
@@ -519,7 +493,7 @@ template bool self_traverse_some<8>(
     std::vector<TrianglePair>&,
     std::int64_t&,
     std::size_t,
-    FanSieve&);
+    FanSieve*);
 template void self_traverse<3>(
     const Bvh<3>&,
     std::span<const Dop<3>>,

@@ -120,6 +120,8 @@ void self_traverse(
 /// traversal is finished. Over all
 /// installments the pairs are exactly self_traverse's, each once; `scratch` must not be used for
 /// anything else in between.
+/// @param sieve (DCD) when given with certificates, the pairs it settles are counted in it instead
+/// of appended: the pairs appended plus those settled or excluded are exactly self_traverse's.
 template <int N>
 void start_self_traversal(const Bvh<N>& bvh, TraversalScratch& scratch);
 template <int N>
@@ -129,18 +131,8 @@ bool self_traverse_some(
     TraversalScratch& scratch,
     std::vector<TrianglePair>& out,
     std::int64_t& bv_tests,
-    std::size_t max_pairs);
-/// The same, the pairs `sieve` settles counted in it instead of appended (DCD). The pairs
-/// appended plus those settled or excluded are exactly self_traverse's.
-template <int N>
-bool self_traverse_some(
-    const Bvh<N>& bvh,
-    std::span<const Dop<N>> triangle_bounds,
-    TraversalScratch& scratch,
-    std::vector<TrianglePair>& out,
-    std::int64_t& bv_tests,
     std::size_t max_pairs,
-    FanSieve& sieve);
+    FanSieve* sieve = nullptr);
 
 /// Pair traversal: appends to `out` every (triangle of a, triangle of b) whose volumes overlap,
 /// each once; `TrianglePair::a` is a triangle id of `a`'s triangles, `TrianglePair::b` of `b`'s.

@@ -107,7 +107,7 @@ void check(
   std::int64_t sieved_tests = 0;
   for (bool done = false; !done;) {
     done = self_traverse_some<3>(
-        bvh, bounds.triangles, scratch, block, sieved_tests, max_pairs, sieve);
+        bvh, bounds.triangles, scratch, block, sieved_tests, max_pairs, &sieve);
     emitted.insert(emitted.end(), block.begin(), block.end());
     block.clear();
   }
