@@ -9,6 +9,8 @@
 #include <cstdint>
 #include <vector>
 
+#include "culling/pair_sort.hpp"
+
 namespace skelcd::culling {
 namespace {
 
@@ -242,7 +244,7 @@ void dcd_tests(
     out.dcd_pairs.push_back(pairs[i]);
   }
   if (sorted) {
-    std::sort(out.dcd_pairs.begin() + static_cast<std::ptrdiff_t>(first), out.dcd_pairs.end());
+    sort_pairs(std::span(out.dcd_pairs).subspan(first));
   }
 }
 

@@ -6,6 +6,7 @@
 #include <utility>
 
 #include "ccd/after_swept_aabbs.hpp"
+#include "culling/pair_sort.hpp"
 
 namespace skelcd::culling {
 namespace {
@@ -138,7 +139,7 @@ void PairBlocks<N>::finish() {
         out.contacts.end(),
         [](const CcdContact& a, const CcdContact& b) { return a.before(b); });
   } else {
-    std::sort(out.dcd_pairs.begin() + static_cast<std::ptrdiff_t>(first_), out.dcd_pairs.end());
+    sort_pairs(std::span(out.dcd_pairs).subspan(first_));
   }
   out_ = nullptr;
   fans_ = {};

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <string>
 
+#include "culling/pair_sort.hpp"
 #include "culling/vertex_bounds.hpp"
 #include "skinning/errors.hpp"
 
@@ -120,7 +121,7 @@ void PairChecker::detect_dcd(
       out.dcd_pairs.push_back(p);
     }
   }
-  std::sort(out.dcd_pairs.begin() + static_cast<std::ptrdiff_t>(first), out.dcd_pairs.end());
+  sort_pairs(std::span(out.dcd_pairs).subspan(first));
   const auto t3 = Clock::now();
   out.times.refit_us += micros(t0, t1);
   out.times.traverse_us += micros(t1, t2);

@@ -16,6 +16,7 @@
 #include "culling/method_registry.hpp"
 #include "culling/normal_cone.hpp"
 #include "culling/pair_blocks.hpp"
+#include "culling/pair_sort.hpp"
 #include "culling/traversal.hpp"
 #include "culling/vertex_bounds.hpp"
 #include "skinning/errors.hpp"
@@ -285,7 +286,7 @@ class AutoMethod final : public detail::MethodBase {
     blocks_.finish();
     const auto t2 = Clock::now();
     // Merge: sorted, each pair once.
-    std::sort(out.dcd_pairs.begin(), out.dcd_pairs.end());
+    sort_pairs(out.dcd_pairs);
     out.dcd_pairs.erase(
         std::unique(out.dcd_pairs.begin(), out.dcd_pairs.end()), out.dcd_pairs.end());
     out.counters.dcd_pairs = static_cast<std::int64_t>(out.dcd_pairs.size());
