@@ -238,6 +238,18 @@ inline Plane plane_of(const Vector3d& p0, const Vector3d& p1, const Vector3d& p2
       (m0 >= kLargeMinor) && (m1 >= kLargeMinor) && (m2 >= kLargeMinor)};
 }
 
+/// The same Plane from its cached minors and permanents (triangle_plane of the same corners).
+inline Plane plane_from(
+    const TrianglePlane& t, const Vector3d& p0, const Vector3d& p1, const Vector3d& p2) {
+  return {
+      &p0,
+      &p1,
+      &p2,
+      {t.n[0], t.n[1], t.n[2]},
+      {t.m[0], t.m[1], t.m[2]},
+      (t.m[0] >= kLargeMinor) && (t.m[1] >= kLargeMinor) && (t.m[2] >= kLargeMinor)};
+}
+
 /// Some n_k is certainly nonzero: the triangle is not degenerate. Shewchuk's orient2d bound on
 /// each component, (3 + 16 eps) eps m_k, taken as 4 eps m_k: the slack (about eps m_k) covers the
 /// two products' underflow (2^-1074) once m_k >= kMinorFloor. These are the components collinear()
@@ -556,18 +568,22 @@ bool flat_meets_beyond_shared(
 
 // --- the pair without shared corners ------------------------------------------------------------
 
-bool no_shared_corner_intersect(const TriangleTriangleQuery& q) {
+// cached_a / cached_b: the planes of a and b when the caller has them (triangle_plane), or null.
+bool no_shared_corner_intersect(
+    const TriangleTriangleQuery& q, const TrianglePlane* cached_a, const TrianglePlane* cached_b) {
   const Vector3d* a[3] = {&q.a0, &q.a1, &q.a2};
   const Vector3d* b[3] = {&q.b0, &q.b1, &q.b2};
   // Most candidate pairs are separated by one of the planes: a's corners against b's plane,
   // then b's against a's. A degenerate triangle has no plane (the edge tests below want zeros):
   // its exact sides are all 0, which the filter never contradicts, so degeneracy is settled only
   // for pairs that no plane separates.
-  const Plane pb = plane_of(q.b0, q.b1, q.b2);
+  const Plane pb =
+      cached_b != nullptr ? plane_from(*cached_b, q.b0, q.b1, q.b2) : plane_of(q.b0, q.b1, q.b2);
   int oa[3];
   sides(pb, a, oa);
   if (strictly_one_side(oa)) return false;
-  const Plane pa = plane_of(q.a0, q.a1, q.a2);
+  const Plane pa =
+      cached_a != nullptr ? plane_from(*cached_a, q.a0, q.a1, q.a2) : plane_of(q.a0, q.a1, q.a2);
   int ob[3];
   sides(pa, b, ob);
   if (strictly_one_side(ob)) return false;
@@ -632,11 +648,17 @@ inline int normals_dot_static(const Plane& pa, const Plane& pb) {
 inline int order_sign(int i, int j) { return (j - i + 3) % 3 == 1 ? 1 : -1; }
 
 bool shared_corners_intersect(
-    const TriangleTriangleQuery& q, const SharedCorners& shared_with_b, int shared_count) {
+    const TriangleTriangleQuery& q,
+    const SharedCorners& shared_with_b,
+    int shared_count,
+    const TrianglePlane* cached_a,
+    const TrianglePlane* cached_b) {
   const Vector3d* a[3] = {&q.a0, &q.a1, &q.a2};
   const Vector3d* b[3] = {&q.b0, &q.b1, &q.b2};
-  const Plane pa = plane_of(q.a0, q.a1, q.a2);
-  const Plane pb = plane_of(q.b0, q.b1, q.b2);
+  const Plane pa =
+      cached_a != nullptr ? plane_from(*cached_a, q.a0, q.a1, q.a2) : plane_of(q.a0, q.a1, q.a2);
+  const Plane pb =
+      cached_b != nullptr ? plane_from(*cached_b, q.b0, q.b1, q.b2) : plane_of(q.b0, q.b1, q.b2);
   const Triangle ta{q.a0, q.a1, q.a2, degenerate(pa)};
   const Triangle tb{q.b0, q.b1, q.b2, degenerate(pb)};
   if (ta.degenerate || tb.degenerate) return degenerate_shared_intersect(q, shared_with_b, ta, tb);
@@ -716,9 +738,12 @@ bool shared_corners_intersect(
   return orient3d(s0, s1, fa, fb) == 0;
 }
 
-}  // namespace
-
-bool triangles_intersect(const TriangleTriangleQuery& q, const SharedCorners& shared_with_b) {
+// Both entries: the planes computed here (null) or given.
+bool intersect(
+    const TriangleTriangleQuery& q,
+    const SharedCorners& shared_with_b,
+    const TrianglePlane* cached_a,
+    const TrianglePlane* cached_b) {
   int shared_count = 0;
   for (int i = 0; i < 3; ++i) {
     const int j = shared_with_b[static_cast<std::size_t>(i)];
@@ -733,9 +758,28 @@ bool triangles_intersect(const TriangleTriangleQuery& q, const SharedCorners& sh
         "a shared corner must have the same position in both triangles");
     ++shared_count;
   }
-  if (shared_count == 0) return no_shared_corner_intersect(q);
+  if (shared_count == 0) return no_shared_corner_intersect(q, cached_a, cached_b);
   if (shared_count == 3) return false;  // the same triangle: nothing beyond the shared part
-  return shared_corners_intersect(q, shared_with_b, shared_count);
+  return shared_corners_intersect(q, shared_with_b, shared_count, cached_a, cached_b);
+}
+
+}  // namespace
+
+bool triangles_intersect(const TriangleTriangleQuery& q, const SharedCorners& shared_with_b) {
+  return intersect(q, shared_with_b, nullptr, nullptr);
+}
+
+TrianglePlane triangle_plane(const Vector3d& p0, const Vector3d& p1, const Vector3d& p2) {
+  const Plane pl = plane_of(p0, p1, p2);
+  return {{pl.n[0], pl.n[1], pl.n[2]}, {pl.m[0], pl.m[1], pl.m[2]}};
+}
+
+bool triangles_intersect_with_planes(
+    const TriangleTriangleQuery& q,
+    const SharedCorners& shared_with_b,
+    const TrianglePlane& plane_a,
+    const TrianglePlane& plane_b) {
+  return intersect(q, shared_with_b, &plane_a, &plane_b);
 }
 
 }  // namespace skelcd::ccd

@@ -2,10 +2,9 @@
 // Triangle-triangle intersection at an instant (DCD), exact: filtered floating-point orientation
 // predicates with an exact rational fallback.
 
+#include <Eigen/Core>
 #include <array>
 #include <cstdint>
-
-#include <Eigen/Core>
 
 namespace skelcd::ccd {
 
@@ -23,7 +22,28 @@ inline constexpr SharedCorners kNoSharedCorners{-1, -1, -1};
 /// they share one (two triangles meeting only at a shared vertex or along a shared edge do not
 /// intersect). Exact for every input, including coplanar and degenerate triangles.
 [[nodiscard]] bool triangles_intersect(
+    const TriangleTriangleQuery& query, const SharedCorners& shared_with_b = kNoSharedCorners);
+
+/// What triangles_intersect computes of one triangle (p0, p1, p2) before anything else: its
+/// normal (p1 - p0) x (p2 - p0) in doubles and each component's permanent, which filter the
+/// triangle's degeneracy and the side of every point against its plane. A DCD computes it once
+/// per triangle and instant instead of once per tested pair.
+struct TrianglePlane {
+  double n[3];
+  double m[3];
+};
+
+/// The plane data of (p0, p1, p2), in that corner order.
+[[nodiscard]] TrianglePlane triangle_plane(
+    const Eigen::Vector3d& p0, const Eigen::Vector3d& p1, const Eigen::Vector3d& p2);
+
+/// triangles_intersect(query, shared_with_b), the same answer for every input, with the planes
+/// given instead of computed.
+/// @pre plane_a == triangle_plane(query.a0, query.a1, query.a2), plane_b likewise for b.
+[[nodiscard]] bool triangles_intersect_with_planes(
     const TriangleTriangleQuery& query,
-    const SharedCorners& shared_with_b = kNoSharedCorners);
+    const SharedCorners& shared_with_b,
+    const TrianglePlane& plane_a,
+    const TrianglePlane& plane_b);
 
 }  // namespace skelcd::ccd

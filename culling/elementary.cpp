@@ -191,21 +191,48 @@ std::span<const std::uint8_t> certify_dcd_fans(
 
 namespace {
 
+/// Prefetch distances of dcd_tests, in pairs.
+constexpr std::size_t kFar = 16;
+constexpr std::size_t kNear = 8;
+
 void dcd_tests(
     const FeatureTopology& topology,
     std::span<const TrianglePair> pairs,
     const skinning::Positions& x,
     const ElementaryTests& tests,
     std::span<const std::uint8_t> certified,
+    std::span<const ccd::TrianglePlane> planes,
     bool filter,
     bool sorted,
     FrameResult& out) {
   assert(tests.triangles != nullptr);
+  assert(
+      planes.empty() || (tests.triangles == &ccd::triangles_intersect &&
+                         planes.size() == static_cast<std::size_t>(topology.num_triangles())));
   const std::size_t first = out.dcd_pairs.size();
   // The flags are read by the workers too: a span of the caller's, not their own thread_local.
   const bool use_fans = !certified.empty();
   assert(!use_fans || certified.size() == static_cast<std::size_t>(topology.num_vertices()));
   const auto outcomes = evaluate(pairs.size(), tests, [&](std::size_t i, Outcome& o) {
+    // The pairs' triangles are scattered over the mesh: ask for a later pair's data ahead, its
+    // corner ids and planes kFar pairs on, its corners' positions kNear pairs on.
+    if (i + kFar < pairs.size()) {
+      const TrianglePair& f = pairs[i + kFar];
+      __builtin_prefetch(&topology.triangle(f.a));
+      __builtin_prefetch(&topology.triangle(f.b));
+      if (!planes.empty()) {
+        __builtin_prefetch(&planes[static_cast<std::size_t>(f.a)]);
+        __builtin_prefetch(&planes[static_cast<std::size_t>(f.a)].m[2]);
+        __builtin_prefetch(&planes[static_cast<std::size_t>(f.b)]);
+        __builtin_prefetch(&planes[static_cast<std::size_t>(f.b)].m[2]);
+      }
+    }
+    if (i + kNear < pairs.size()) {
+      const TrianglePair& f = pairs[i + kNear];
+      for (const std::int32_t t : {f.a, f.b}) {
+        for (const std::int32_t v : topology.triangle(t)) __builtin_prefetch(x.data() + 3 * v);
+      }
+    }
     const TrianglePair& p = pairs[i];
     assert(p.a < p.b);
     o.kept = true;
@@ -233,7 +260,12 @@ void dcd_tests(
     const auto& tb = topology.triangle(p.b);
     const ccd::TriangleTriangleQuery q{
         row(x, ta[0]), row(x, ta[1]), row(x, ta[2]), row(x, tb[0]), row(x, tb[1]), row(x, tb[2])};
-    o.hit = tests.triangles(q, shared);
+    o.hit = planes.empty() ? tests.triangles(q, shared)
+                           : ccd::triangles_intersect_with_planes(
+                                 q,
+                                 shared,
+                                 planes[static_cast<std::size_t>(p.a)],
+                                 planes[static_cast<std::size_t>(p.b)]);
   });
   for (std::size_t i = 0; i < outcomes.size(); ++i) {
     // Pairs settled by a fan are candidates (candidate_pairs) but not tests.
@@ -257,7 +289,7 @@ void run_dcd_tests(
     const ElementaryTests& tests,
     std::span<const std::uint8_t> certified,
     FrameResult& out) {
-  dcd_tests(topology, pairs, x, tests, certified, /*filter=*/false, /*sorted=*/true, out);
+  dcd_tests(topology, pairs, x, tests, certified, {}, /*filter=*/false, /*sorted=*/true, out);
 }
 
 void filter_and_run_dcd_tests(
@@ -266,8 +298,26 @@ void filter_and_run_dcd_tests(
     const skinning::Positions& x,
     const ElementaryTests& tests,
     std::span<const std::uint8_t> certified,
+    std::span<const ccd::TrianglePlane> planes,
     FrameResult& out) {
-  dcd_tests(topology, pairs, x, tests, certified, /*filter=*/true, /*sorted=*/false, out);
+  dcd_tests(topology, pairs, x, tests, certified, planes, /*filter=*/true, /*sorted=*/false, out);
+}
+
+void dcd_planes(
+    const FeatureTopology& topology,
+    const skinning::Positions& x,
+    const ElementaryTests& tests,
+    std::vector<ccd::TrianglePlane>& planes) {
+  if (tests.triangles != &ccd::triangles_intersect) {
+    planes.clear();
+    return;
+  }
+  planes.resize(static_cast<std::size_t>(topology.num_triangles()));
+  for (std::int32_t t = 0; t < topology.num_triangles(); ++t) {
+    const auto& c = topology.triangle(t);
+    planes[static_cast<std::size_t>(t)] =
+        ccd::triangle_plane(row(x, c[0]), row(x, c[1]), row(x, c[2]));
+  }
 }
 
 }  // namespace skelcd::culling

@@ -8,6 +8,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <span>
+#include <vector>
 
 #include "ccd/accuracy.hpp"
 #include "ccd/ccd_types.hpp"
@@ -111,17 +112,30 @@ void run_dcd_tests(
     std::span<const std::uint8_t> certified_fans,
     FrameResult& out);
 
+/// The plane of every triangle at instant x (ccd::triangle_plane of its corners in topology order)
+/// into `planes`, for filter_and_run_dcd_tests calls on blocks of that instant's pairs: each
+/// triangle's plane once instead of once per tested pair. Empties `planes` when `tests` is not
+/// the exact triangle test (the planes stand for its own computation).
+/// @param planes resized to #triangles (its capacity is kept across instants).
+void dcd_planes(
+    const FeatureTopology& topology,
+    const skinning::Positions& x,
+    const ElementaryTests& tests,
+    std::vector<ccd::TrianglePlane>& planes);
+
 /// dcd_filter_triangle_pairs (candidates.hpp) and run_dcd_tests in one pass: pairs that are
 /// part-excluded or duplicate faces are dropped, the others counted in candidate_pairs and tested,
 /// with each pair's shared corners looked up once (the traversing methods' blocks). The
 /// intersecting pairs are appended in the order of `pairs`, not sorted: PairBlocks::finish sorts a
 /// query's pairs once, after its last block.
+/// @param planes dcd_planes at x, or empty (the test computes each pair's planes).
 void filter_and_run_dcd_tests(
     const FeatureTopology& topology,
     std::span<const TrianglePair> pairs,
     const skinning::Positions& x,
     const ElementaryTests& tests,
     std::span<const std::uint8_t> certified_fans,
+    std::span<const ccd::TrianglePlane> planes,
     FrameResult& out);
 
 }  // namespace skelcd::culling

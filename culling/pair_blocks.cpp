@@ -90,6 +90,7 @@ void PairBlocks<N>::start_dcd(
   // Once per instant, for every block (valid until this thread's next certify_dcd_fans).
   const auto t0 = Clock::now();
   fans_ = certify_dcd_fans(topology, x, tests);
+  dcd_planes(topology, x, tests, planes_);
   test_us_ += micros(t0, Clock::now());
 }
 
@@ -120,7 +121,7 @@ void PairBlocks<N>::flush() {
       if (p.b < p.a) std::swap(p.a, p.b);
     }
     const auto t1 = Clock::now();
-    filter_and_run_dcd_tests(*topology_, pairs_, *x_t0_, *tests_, fans_, out);
+    filter_and_run_dcd_tests(*topology_, pairs_, *x_t0_, *tests_, fans_, planes_, out);
     feature_us_ += micros(t0, t1);
     test_us_ += micros(t1, Clock::now());
   }

@@ -58,7 +58,8 @@ class PairBlocks {
       FrameResult& out);
 
   /// Starts a DCD query at x: each block → (a, b) ordered → filter_and_run_dcd_tests (the DCD
-  /// filter and the tests in one pass) into `out`, with the vertex fans certified once here.
+  /// filter and the tests in one pass) into `out`, with the vertex fans certified and the
+  /// triangles' planes computed once here.
   void start_dcd(
       const FeatureTopology& topology,
       const skinning::Positions& x,
@@ -120,7 +121,8 @@ class PairBlocks {
   ccd::Accuracy accuracy_ = ccd::Accuracy::conservative;
   const ccd::CcdOptions* ccd_options_ = nullptr;
   std::span<const std::uint8_t> fans_;
-  std::size_t first_ = 0;  ///< out's findings before this query
+  std::vector<ccd::TrianglePlane> planes_;  ///< the DCD instant's (dcd_planes); kept across queries
+  std::size_t first_ = 0;                   ///< out's findings before this query
   std::int64_t blocks_ = 0;
   double feature_us_ = 0.0;
   double test_us_ = 0.0;

@@ -85,15 +85,25 @@ struct Tally {
   int hits = 0;
 };
 
-// Both implementations on q and on its swap; returns the answer.
+// The entry a DCD uses, with each triangle's plane computed beforehand (once per instant there).
+bool with_planes(const TriangleTriangleQuery& q, const SharedCorners& shared) {
+  return triangles_intersect_with_planes(
+      q, shared, triangle_plane(q.a0, q.a1, q.a2), triangle_plane(q.b0, q.b1, q.b2));
+}
+
+// Both implementations (and the entry with planes) on q and on its swap; returns the answer.
 bool expect_same(
     const TriangleTriangleQuery& q, const SharedCorners& shared, const char* what, int n) {
   const bool expected = triangles_intersect_reference(q, shared);
   EXPECT_EQ(triangles_intersect(q, shared), expected) << what << " case " << n;
+  EXPECT_EQ(with_planes(q, shared), expected) << what << " case " << n << " (planes given)";
   const TriangleTriangleQuery swapped{q.b0, q.b1, q.b2, q.a0, q.a1, q.a2};
   const SharedCorners inv = inverse(shared);
-  EXPECT_EQ(triangles_intersect(swapped, inv), triangles_intersect_reference(swapped, inv))
+  const bool expected_swapped = triangles_intersect_reference(swapped, inv);
+  EXPECT_EQ(triangles_intersect(swapped, inv), expected_swapped)
       << what << " case " << n << " (swapped)";
+  EXPECT_EQ(with_planes(swapped, inv), expected_swapped)
+      << what << " case " << n << " (swapped, planes given)";
   return expected;
 }
 
@@ -401,6 +411,8 @@ TEST(TriangleTriangleEquivalence, ExtremeMagnitudesMixedInOneQuery) {
     const bool truth = test::brute_intersect(q, shared);
     ASSERT_EQ(triangles_intersect(q, shared), truth) << "extreme case " << n;
     ASSERT_EQ(triangles_intersect(swapped, inv), truth) << "extreme case " << n << " (swapped)";
+    ASSERT_EQ(with_planes(q, shared), truth) << "extreme case " << n << " (planes given)";
+    ASSERT_EQ(with_planes(swapped, inv), truth) << "extreme case " << n << " (swapped, planes)";
     old_wrong += triangles_intersect_reference(q, shared) != truth ? 1 : 0;
     old_wrong += triangles_intersect_reference(swapped, inv) != truth ? 1 : 0;
     judged += 2;

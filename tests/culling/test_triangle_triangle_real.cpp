@@ -1,9 +1,9 @@
-// ccd::triangles_intersect against the implementation it replaced (tests/ccd/
-// triangle_triangle_reference.cpp) on real DCD queries: every pair `bvh`'s DCD hands to its
-// triangle test on posed frames of the bundled characters and the cloth-funnel step — each pair
-// as recorded (with the corners the two share) and with its triangles swapped. The cloth-ball step
-// lives outside the repository: bench/ccd/bm_triangle_triangle checks it (and exits 1 on a
-// difference) where ../shared/assets holds it. The synthetic cases are in tests/ccd/
+// ccd::triangles_intersect (and triangles_intersect_with_planes) against the implementation it
+// replaced (tests/ccd/triangle_triangle_reference.cpp) on real DCD queries: every pair `bvh`'s
+// DCD hands to its triangle test on posed frames of the bundled characters and the cloth-funnel
+// step — each pair as recorded (with the corners the two share) and with its triangles swapped. The
+// cloth-ball step lives outside the repository: bench/ccd/bm_triangle_triangle checks it (and exits
+// 1 on a difference) where ../shared/assets holds it. The synthetic cases are in tests/ccd/
 // test_triangle_triangle_equivalence.cpp.
 
 #include <gtest/gtest.h>
@@ -42,9 +42,16 @@ void expect_same_answers(const RealSet& set) {
       if (r.shared[k] >= 0)
         inverse[static_cast<std::size_t>(r.shared[k])] = static_cast<std::int8_t>(k);
     }
-    const bool same = ccd::triangles_intersect(q, r.shared) == expected &&
-                      ccd::triangles_intersect(swapped, inverse) ==
-                          triangles_intersect_reference(swapped, inverse);
+    const bool expected_swapped = triangles_intersect_reference(swapped, inverse);
+    // Also the entry the traversing methods' DCD calls, with planes computed once per instant.
+    const auto plane_a = ccd::triangle_plane(q.a0, q.a1, q.a2);
+    const auto plane_b = ccd::triangle_plane(q.b0, q.b1, q.b2);
+    const bool same =
+        ccd::triangles_intersect(q, r.shared) == expected &&
+        ccd::triangles_intersect_with_planes(q, r.shared, plane_a, plane_b) == expected &&
+        ccd::triangles_intersect(swapped, inverse) == expected_swapped &&
+        ccd::triangles_intersect_with_planes(swapped, inverse, plane_b, plane_a) ==
+            expected_swapped;
     if (!same && ++disagreements <= 5) ADD_FAILURE() << set.name << ": query " << i << " differs";
     hits += expected ? 1 : 0;
     unsettled += r.fan_settled ? 0 : 1;
