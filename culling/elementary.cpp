@@ -56,52 +56,64 @@ ccd::EdgeEdgeQuery edge_edge_query(
 
 namespace {
 
-/// One query's outcome, in its candidate's slot.
+/// One query's outcome, in its candidate's slot (24 bytes: the doubles first).
 struct Outcome {
-  bool hit = false;
   double toi_lower = 0;
   double toi_upper = 0;
+  bool hit = false;
   bool tested = true;  ///< false: settled without a test (DCD, a certified vertex fan)
   bool kept = true;    ///< false: dropped by the DCD filter (filter_and_run_dcd_tests)
 };
 
-/// Per calling thread, reused across calls: grows to the largest candidate list it has seen.
+/// Per calling thread, reused across calls: room for one window of outcomes
+/// (kElementaryOutcomeWindow), never more, whatever the size of the calls. A call over more
+/// queries tests them a window at a time; an unbounded buffer grew to the largest block ever seen
+/// (about 2 MB after a clip's baseline DCD) and was held for the rest of the run.
 /// The parallel loops below run isolated, so a thread waiting for them never picks up another
 /// caller's work and re-enters this function with its buffer in use.
 thread_local std::vector<Outcome> tl_outcomes;
 /// Per calling thread, likewise: which welded vertices have a certified fan at the DCD instant.
 thread_local std::vector<std::uint8_t> tl_certified_fans;
 
-/// Calls `test(i, outcome)` for i in [0, n): on this thread, or split over oneTBB workers when
-/// `threads` > 1 and n is large enough. Every outcome goes to its own slot.
-template <typename Test>
-std::span<Outcome> evaluate(std::size_t n, const ElementaryTests& tests, const Test& test) {
-  if (tl_outcomes.size() < n) tl_outcomes.resize(n);
-  const std::span<Outcome> outcomes(tl_outcomes.data(), n);
+/// Calls `test(i, outcome)` for i in [0, n), on this thread or split over oneTBB workers when
+/// `threads` > 1 and n is large enough, a window of kElementaryOutcomeWindow queries at a time;
+/// then `consume(i, outcome)` for each query of the window, in order. Every outcome goes to its
+/// own slot, so the order of `consume` calls is i's whatever the split.
+template <typename Test, typename Consume>
+void evaluate(
+    std::size_t n, const ElementaryTests& tests, const Test& test, const Consume& consume) {
+  if (n == 0) return;
+  const std::size_t window = std::min(n, kElementaryOutcomeWindow);
+  if (tl_outcomes.size() < window) tl_outcomes.resize(window);
+  Outcome* const outcomes = tl_outcomes.data();
   const auto report = [&](std::size_t done) {
     if (tests.tests_done != nullptr)
       tests.tests_done->fetch_add(static_cast<std::int64_t>(done), std::memory_order_relaxed);
   };
-  if (tests.threads > 1 && n >= kParallelElementaryThreshold) {
-    tbb::this_task_arena::isolate([&] {
-      tbb::parallel_for(
-          tbb::blocked_range<std::size_t>(0, n, 64),
-          [&](const tbb::blocked_range<std::size_t>& range) {
-            for (std::size_t i = range.begin(); i != range.end(); ++i) {
-              test(i, outcomes[i]);
-            }
-            report(range.size());
-          });
-    });
-  } else {
-    constexpr std::size_t kReportEvery = 1024;
-    for (std::size_t start = 0; start < n; start += kReportEvery) {
-      const std::size_t end = std::min(n, start + kReportEvery);
-      for (std::size_t i = start; i < end; ++i) test(i, outcomes[i]);
-      report(end - start);
+  const bool parallel = tests.threads > 1 && n >= kParallelElementaryThreshold;
+  for (std::size_t first = 0; first < n; first += window) {
+    const std::size_t count = std::min(window, n - first);
+    if (parallel) {
+      tbb::this_task_arena::isolate([&] {
+        tbb::parallel_for(
+            tbb::blocked_range<std::size_t>(0, count, 64),
+            [&](const tbb::blocked_range<std::size_t>& range) {
+              for (std::size_t i = range.begin(); i != range.end(); ++i) {
+                test(first + i, outcomes[i]);
+              }
+              report(range.size());
+            });
+      });
+    } else {
+      constexpr std::size_t kReportEvery = 1024;
+      for (std::size_t start = 0; start < count; start += kReportEvery) {
+        const std::size_t end = std::min(count, start + kReportEvery);
+        for (std::size_t i = start; i < end; ++i) test(first + i, outcomes[i]);
+        report(end - start);
+      }
     }
+    for (std::size_t i = 0; i < count; ++i) consume(first + i, outcomes[i]);
   }
-  return outcomes;
 }
 
 }  // namespace
@@ -118,46 +130,44 @@ void run_ccd_tests(
   assert(tests.vertex_face != nullptr && tests.edge_edge != nullptr);
   const std::size_t first = out.contacts.size();
   Counters& c = out.counters;
-  // Vertex-face queries: outcomes in candidate order, then the hits appended in that order.
-  {
-    const auto outcomes =
-        evaluate(candidates.vf.size(), tests, [&](std::size_t i, Outcome& o) {
-          const VertexFacePair& p = candidates.vf[i];
-          const ccd::CcdResult r = tests.vertex_face(
-              vertex_face_query(x_t0, x_t1, p.vertex, x_t0, x_t1, topology.triangle(p.face)),
-              accuracy,
-              options);
-          o = {r.hit, r.toi_lower, r.toi_upper};
-        });
-    for (std::size_t i = 0; i < outcomes.size(); ++i) {
-      ++c.vf_tests;
-      if (!outcomes[i].hit) continue;
-      ++c.vf_contacts;
-      const VertexFacePair& p = candidates.vf[i];
-      out.contacts.push_back(
-          {CcdContact::Kind::vf, p.vertex, p.face, outcomes[i].toi_lower, outcomes[i].toi_upper});
-    }
-  }
+  // Vertex-face queries: outcomes in candidate order, the hits appended in that order.
+  evaluate(
+      candidates.vf.size(),
+      tests,
+      [&](std::size_t i, Outcome& o) {
+        const VertexFacePair& p = candidates.vf[i];
+        const ccd::CcdResult r = tests.vertex_face(
+            vertex_face_query(x_t0, x_t1, p.vertex, x_t0, x_t1, topology.triangle(p.face)),
+            accuracy,
+            options);
+        o = {.toi_lower = r.toi_lower, .toi_upper = r.toi_upper, .hit = r.hit};
+      },
+      [&](std::size_t i, const Outcome& o) {
+        ++c.vf_tests;
+        if (!o.hit) return;
+        ++c.vf_contacts;
+        const VertexFacePair& p = candidates.vf[i];
+        out.contacts.push_back({CcdContact::Kind::vf, p.vertex, p.face, o.toi_lower, o.toi_upper});
+      });
   // Edge-edge queries, likewise.
-  {
-    const auto outcomes =
-        evaluate(candidates.ee.size(), tests, [&](std::size_t i, Outcome& o) {
-          const EdgeEdgePair& p = candidates.ee[i];
-          const ccd::CcdResult r = tests.edge_edge(
-              edge_edge_query(x_t0, x_t1, topology.edge(p.a), x_t0, x_t1, topology.edge(p.b)),
-              accuracy,
-              options);
-          o = {r.hit, r.toi_lower, r.toi_upper};
-        });
-    for (std::size_t i = 0; i < outcomes.size(); ++i) {
-      ++c.ee_tests;
-      if (!outcomes[i].hit) continue;
-      ++c.ee_contacts;
-      const EdgeEdgePair& p = candidates.ee[i];
-      out.contacts.push_back(
-          {CcdContact::Kind::ee, p.a, p.b, outcomes[i].toi_lower, outcomes[i].toi_upper});
-    }
-  }
+  evaluate(
+      candidates.ee.size(),
+      tests,
+      [&](std::size_t i, Outcome& o) {
+        const EdgeEdgePair& p = candidates.ee[i];
+        const ccd::CcdResult r = tests.edge_edge(
+            edge_edge_query(x_t0, x_t1, topology.edge(p.a), x_t0, x_t1, topology.edge(p.b)),
+            accuracy,
+            options);
+        o = {.toi_lower = r.toi_lower, .toi_upper = r.toi_upper, .hit = r.hit};
+      },
+      [&](std::size_t i, const Outcome& o) {
+        ++c.ee_tests;
+        if (!o.hit) return;
+        ++c.ee_contacts;
+        const EdgeEdgePair& p = candidates.ee[i];
+        out.contacts.push_back({CcdContact::Kind::ee, p.a, p.b, o.toi_lower, o.toi_upper});
+      });
   // std::sort works in place: no allocation.
   std::sort(
       out.contacts.begin() + static_cast<std::ptrdiff_t>(first),
@@ -213,68 +223,77 @@ void dcd_tests(
   // The flags are read by the workers too: a span of the caller's, not their own thread_local.
   const bool use_fans = !certified.empty();
   assert(!use_fans || certified.size() == static_cast<std::size_t>(topology.num_vertices()));
-  const auto outcomes = evaluate(pairs.size(), tests, [&](std::size_t i, Outcome& o) {
-    // The pairs' triangles are scattered over the mesh: ask for a later pair's data ahead, its
-    // corner ids and planes kFar pairs on, its corners' positions kNear pairs on.
-    if (i + kFar < pairs.size()) {
-      const TrianglePair& f = pairs[i + kFar];
-      __builtin_prefetch(&topology.triangle(f.a));
-      __builtin_prefetch(&topology.triangle(f.b));
-      if (!planes.empty()) {
-        __builtin_prefetch(&planes[static_cast<std::size_t>(f.a)]);
-        __builtin_prefetch(&planes[static_cast<std::size_t>(f.a)].m[2]);
-        __builtin_prefetch(&planes[static_cast<std::size_t>(f.b)]);
-        __builtin_prefetch(&planes[static_cast<std::size_t>(f.b)].m[2]);
-      }
-    }
-    if (i + kNear < pairs.size()) {
-      const TrianglePair& f = pairs[i + kNear];
-      for (const std::int32_t t : {f.a, f.b}) {
-        for (const std::int32_t v : topology.triangle(t)) __builtin_prefetch(x.data() + 3 * v);
-      }
-    }
-    const TrianglePair& p = pairs[i];
-    assert(p.a < p.b);
-    o.kept = true;
-    if (filter && topology.triangles_excluded(p.a, p.b)) {
-      o = Outcome{.hit = false, .tested = false, .kept = false};
-      return;
-    }
-    int count = 0;
-    const ccd::SharedCorners shared = topology.shared_corners(p.a, p.b, count);
-    if (filter && count >= 3) {  // a duplicate face on the same three vertices
-      o = Outcome{.hit = false, .tested = false, .kept = false};
-      return;
-    }
-    const auto& ta = topology.triangle(p.a);
-    if (use_fans && count > 0) {
-      for (std::size_t k = 0; k < 3; ++k) {
-        if (shared[k] >= 0 && certified[static_cast<std::size_t>(ta[k])] != 0) {
-          o.hit = false;
-          o.tested = false;
+  // Outcomes in pair order, the intersecting pairs appended in that order.
+  evaluate(
+      pairs.size(),
+      tests,
+      [&](std::size_t i, Outcome& o) {
+        // The pairs' triangles are scattered over the mesh: ask for a later pair's data ahead, its
+        // corner ids and planes kFar pairs on, its corners' positions kNear pairs on.
+        if (i + kFar < pairs.size()) {
+          const TrianglePair& f = pairs[i + kFar];
+          __builtin_prefetch(&topology.triangle(f.a));
+          __builtin_prefetch(&topology.triangle(f.b));
+          if (!planes.empty()) {
+            __builtin_prefetch(&planes[static_cast<std::size_t>(f.a)]);
+            __builtin_prefetch(&planes[static_cast<std::size_t>(f.a)].m[2]);
+            __builtin_prefetch(&planes[static_cast<std::size_t>(f.b)]);
+            __builtin_prefetch(&planes[static_cast<std::size_t>(f.b)].m[2]);
+          }
+        }
+        if (i + kNear < pairs.size()) {
+          const TrianglePair& f = pairs[i + kNear];
+          for (const std::int32_t t : {f.a, f.b}) {
+            for (const std::int32_t v : topology.triangle(t)) __builtin_prefetch(x.data() + 3 * v);
+          }
+        }
+        const TrianglePair& p = pairs[i];
+        assert(p.a < p.b);
+        o.kept = true;
+        if (filter && topology.triangles_excluded(p.a, p.b)) {
+          o = Outcome{.hit = false, .tested = false, .kept = false};
           return;
         }
-      }
-    }
-    o.tested = true;
-    const auto& tb = topology.triangle(p.b);
-    const ccd::TriangleTriangleQuery q{
-        row(x, ta[0]), row(x, ta[1]), row(x, ta[2]), row(x, tb[0]), row(x, tb[1]), row(x, tb[2])};
-    o.hit = planes.empty() ? tests.triangles(q, shared)
-                           : ccd::triangles_intersect_with_planes(
-                                 q,
-                                 shared,
-                                 planes[static_cast<std::size_t>(p.a)],
-                                 planes[static_cast<std::size_t>(p.b)]);
-  });
-  for (std::size_t i = 0; i < outcomes.size(); ++i) {
-    // Pairs settled by a fan are candidates (candidate_pairs) but not tests.
-    if (filter && outcomes[i].kept) ++out.counters.candidate_pairs;
-    if (outcomes[i].tested) ++out.counters.tt_tests;
-    if (!outcomes[i].hit) continue;
-    ++out.counters.dcd_pairs;
-    out.dcd_pairs.push_back(pairs[i]);
-  }
+        int count = 0;
+        const ccd::SharedCorners shared = topology.shared_corners(p.a, p.b, count);
+        if (filter && count >= 3) {  // a duplicate face on the same three vertices
+          o = Outcome{.hit = false, .tested = false, .kept = false};
+          return;
+        }
+        const auto& ta = topology.triangle(p.a);
+        if (use_fans && count > 0) {
+          for (std::size_t k = 0; k < 3; ++k) {
+            if (shared[k] >= 0 && certified[static_cast<std::size_t>(ta[k])] != 0) {
+              o.hit = false;
+              o.tested = false;
+              return;
+            }
+          }
+        }
+        o.tested = true;
+        const auto& tb = topology.triangle(p.b);
+        const ccd::TriangleTriangleQuery q{
+            row(x, ta[0]),
+            row(x, ta[1]),
+            row(x, ta[2]),
+            row(x, tb[0]),
+            row(x, tb[1]),
+            row(x, tb[2])};
+        o.hit = planes.empty() ? tests.triangles(q, shared)
+                               : ccd::triangles_intersect_with_planes(
+                                     q,
+                                     shared,
+                                     planes[static_cast<std::size_t>(p.a)],
+                                     planes[static_cast<std::size_t>(p.b)]);
+      },
+      [&](std::size_t i, const Outcome& o) {
+        // Pairs settled by a fan are candidates (candidate_pairs) but not tests.
+        if (filter && o.kept) ++out.counters.candidate_pairs;
+        if (o.tested) ++out.counters.tt_tests;
+        if (!o.hit) return;
+        ++out.counters.dcd_pairs;
+        out.dcd_pairs.push_back(pairs[i]);
+      });
   if (sorted) {
     sort_pairs(std::span(out.dcd_pairs).subspan(first));
   }
@@ -291,6 +310,8 @@ void run_dcd_tests(
     FrameResult& out) {
   dcd_tests(topology, pairs, x, tests, certified, {}, /*filter=*/false, /*sorted=*/true, out);
 }
+
+std::size_t elementary_outcome_capacity() { return tl_outcomes.capacity(); }
 
 void filter_and_run_dcd_tests(
     const FeatureTopology& topology,

@@ -26,6 +26,11 @@ namespace skelcd::culling {
 /// (splitting costs more than it saves).
 inline constexpr std::size_t kParallelElementaryThreshold = 512;
 
+/// Queries whose outcomes one call holds at once: a call over more tests them a window at a time,
+/// so the scratch each calling thread keeps between calls stays this size (24 bytes a query)
+/// whatever the largest call of the run.
+inline constexpr std::size_t kElementaryOutcomeWindow = 8192;
+
 /// The three elementary tests a method calls. A null member means "the ccd/ kernel".
 struct ElementaryTests {
   using VertexFaceFn =
@@ -122,6 +127,10 @@ void dcd_planes(
     const skinning::Positions& x,
     const ElementaryTests& tests,
     std::vector<ccd::TrianglePlane>& planes);
+
+/// Outcomes the calling thread's scratch has room for (kept between calls, reused by the next):
+/// at most kElementaryOutcomeWindow.
+[[nodiscard]] std::size_t elementary_outcome_capacity();
 
 /// dcd_filter_triangle_pairs (candidates.hpp) and run_dcd_tests in one pass: pairs that are
 /// part-excluded or duplicate faces are dropped, the others counted in candidate_pairs and tested,

@@ -40,9 +40,10 @@ it the same minus the findings, (peak RSS - floor - findings) / triangles, where
   beyond (they grow by doubling) stays in the figure.
 - The log writer buffers each contact once more as a detail::ContactDisk row (56 bytes) before
   HDF5 writes them. That is counted only as far as the log raised the peak: `log` is measured, the
-  peak RSS of the same command minus that of the command without `-o LOG`. The rest of `log` (HDF5's
-  own buffers and the library's pages, the input's hash: about 3-5 MiB whatever the findings, see
-  cloth-funnel's 134 contacts) is not the findings' and stays in the figure.
+  peak RSS of the same command minus that of the command without `-o LOG`. The rest of `log` (about
+  4 MiB whatever the findings, see cloth-funnel's 134 contacts: mostly libhdf5's own pages, about
+  2.8 MiB resident once a file is written, and the metadata cache's 0.5 MB index; docs/benchmarks.md
+  "Fixed costs") is not the findings' and stays in the figure.
 tests/tools/test_log.cpp checks the three sizes. On the cloth steps the heap peak is reached while
 the three in-memory copies are held (valgrind massif, docs/benchmarks.md "Real assets"); where a
 peak is reached before any contact exists, "minus findings" understates it by up to n x 144 bytes.

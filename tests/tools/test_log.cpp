@@ -9,6 +9,7 @@
 #include <fstream>
 #include <sstream>
 #include <string>
+#include <vector>
 
 #include "skinning/errors.hpp"
 #include "tests/support/test_support.hpp"
@@ -688,6 +689,59 @@ TEST(FileHash, MatchesPublishedFnv1aVectors) {
   write_text(dir / "foobar.txt", "foobar");
   EXPECT_EQ(file_content_hash(dir / "foobar.txt"), "fnv1a64:85944171f73967e8");
   EXPECT_THROW_MESSAGE((void)file_content_hash(dir / "none"), IoError, "none");
+}
+
+/// A scene log's header (sample_header with routes and two checks): every table and every
+/// header dataset the writer can make.
+LogHeader scene_header() {
+  LogHeader h = sample_header();
+  h.routes = {
+      LogRoute{.component = 0, .part = 0, .closed = true, .triangles = 10, .method = "bvh"},
+      LogRoute{.component = 1, .part = 1, .closed = false, .triangles = 4, .method = "kdop"}};
+  h.checks = {
+      LogCheck{"self body", "body", "", "ccd", "bvh", "conservative"},
+      LogCheck{"pair body hat", "body", "hat", "both", "kdop", "exact"}};
+  return h;
+}
+
+TEST(Log, EachTableCachesOneOfItsChunksNotHdf5sMegabyte) {
+  // HDF5's default chunk cache is 1 MiB per open dataset, kept until the file closes; the writer
+  // only ever writes a table's last chunk, so each table caches exactly one chunk (the cache must
+  // be at least a chunk, or HDF5 reads the chunk back for every partial write).
+  const auto path = skelcd::test::temp_dir("log-chunk-cache") / "run.h5";
+  LogWriter writer(path, scene_header());
+  for (const auto& report : sample_reports()) writer.append(report, 1);
+  const auto count = H5Fget_obj_count(H5F_OBJ_ALL, H5F_OBJ_DATASET);
+  ASSERT_GT(count, 0);
+  std::vector<hid_t> ids(static_cast<std::size_t>(count));
+  ASSERT_EQ(H5Fget_obj_ids(H5F_OBJ_ALL, H5F_OBJ_DATASET, ids.size(), ids.data()), count);
+  std::vector<std::string> tables;
+  for (const hid_t id : ids) {
+    std::string name(256, '\0');
+    name.resize(static_cast<std::size_t>(H5Iget_name(id, name.data(), name.size())));
+    const hid_t create = H5Dget_create_plist(id);
+    const hid_t access = H5Dget_access_plist(id);
+    const hid_t type = H5Dget_type(id);
+    hsize_t chunk_rows = 0;
+    std::size_t slots = 0, bytes = 0;
+    double w0 = 0;
+    ASSERT_EQ(H5Pget_chunk(create, 1, &chunk_rows), 1) << name << " is chunked";
+    ASSERT_GE(H5Pget_chunk_cache(access, &slots, &bytes, &w0), 0) << name;
+    EXPECT_EQ(bytes, chunk_rows * H5Tget_size(type)) << name;
+    EXPECT_LT(bytes, std::size_t{1} << 20) << name;
+    EXPECT_LT(slots, 521u) << name << ": fewer slots than HDF5's default";
+    H5Tclose(type);
+    H5Pclose(access);
+    H5Pclose(create);
+    tables.push_back(name);
+  }
+  std::sort(tables.begin(), tables.end());
+  EXPECT_EQ(
+      tables,
+      (std::vector<std::string>{
+          "/checksums", "/contacts", "/dcd_pairs", "/frame_check", "/frames"}));
+  writer.finish();
+  EXPECT_EQ(read_log(path).frames.size(), sample_reports().size());
 }
 
 TEST(Log, ContactRecordsHaveTheSizesBenchRealCounts) {

@@ -26,10 +26,12 @@ struct Table {
   H5Handle transfer;
 };
 
-/// Bytes of HDF5's type-conversion buffer, and of its background buffer, for our appends: HDF5
-/// converts rows to the packed file layout through them, in strips of this size. Its default is
-/// 1 MiB each, kept in its free lists for the life of the process once used: 2 MiB of every
-/// checked clip's peak, whatever its findings (docs/benchmarks.md "Real assets").
+/// Bytes of HDF5's type-conversion buffer, and of its background buffer, for every dataset write
+/// (the header's /parts, /routes and /checks as well as the appends): HDF5 converts rows to the
+/// packed file layout, and strings to variable-length ones, through them, in strips of this size.
+/// Its default is 1 MiB each, kept in its free lists for the life of the process once used: 2 MiB
+/// of every checked clip's peak, whatever its findings (docs/benchmarks.md "Real assets"). The
+/// first write with the default (/parts, before this covered the header too) was enough.
 constexpr std::size_t kConversionBufferBytes = std::size_t{64} << 10;
 
 /// Dataset transfer properties with kConversionBufferBytes buffers (invalid if HDF5 refuses them:
@@ -47,6 +49,25 @@ H5Handle transfer_properties() {
 /// Rows per chunk: small enough that the chunk rewritten at every flush stays cheap.
 constexpr hsize_t kFrameChunkRows = 64;
 constexpr hsize_t kPairChunkRows = 1024;
+
+/// Slots of each table's chunk cache (HDF5's default: 521): the appends touch one chunk at a time.
+constexpr std::size_t kChunkCacheSlots = 11;
+
+/// Dataset access properties whose chunk cache holds one chunk of `chunk_bytes` (an append only
+/// ever writes the table's last chunk, and a flush writes it out). HDF5's default is 1 MiB of
+/// chunks per open dataset, kept until the file closes: on a run with many findings, up to 1 MiB
+/// each of /contacts and /dcd_pairs chunks already on disk. Invalid if HDF5 refuses them (the
+/// table then has the default cache).
+H5Handle chunk_cache_properties(std::size_t chunk_bytes) {
+  H5Handle properties(H5Pcreate(H5P_DATASET_ACCESS), H5Pclose);
+  if (properties.valid() &&
+      H5Pset_chunk_cache(
+          properties.get(), kChunkCacheSlots, chunk_bytes, H5D_CHUNK_CACHE_W0_DEFAULT) < 0) {
+    detail::clear_hdf5_error();
+    return {};
+  }
+  return properties;
+}
 
 /// The tables are chunked but not compressed, on purpose: an uncompressed chunk keeps its size
 /// and so its place in the file, and every flush rewrites it where it is. A compressed chunk
@@ -91,10 +112,17 @@ Table create_table(
   if (!space.valid() || !properties.valid()) fail("dataspace");
   if (H5Pset_chunk(properties.get(), 1, &chunk_rows) < 0) fail("chunking");
   if (H5Pset_fill_value(properties.get(), memory_type.get(), &fill) < 0) fail("fill value");
+  const H5Handle access = chunk_cache_properties(chunk_rows * H5Tget_size(file_type.get()));
   Table table;
   table.dataset = H5Handle(
       H5Dcreate2(
-          file, name, file_type.get(), space.get(), H5P_DEFAULT, properties.get(), H5P_DEFAULT),
+          file,
+          name,
+          file_type.get(),
+          space.get(),
+          H5P_DEFAULT,
+          properties.get(),
+          access.valid() ? access.get() : H5P_DEFAULT),
       H5Dclose);
   if (!table.dataset.valid()) fail("dataset");
   table.memory_type = std::move(memory_type);
@@ -156,9 +184,15 @@ void write_parts(hid_t file, const std::vector<std::string>& names, const std::s
   std::vector<const char*> pointers;
   pointers.reserve(names.size());
   for (const auto& name : names) pointers.push_back(name.c_str());
+  const H5Handle transfer = transfer_properties();
   if (!space.valid() || !dataset.valid() ||
-      (count > 0 &&
-       H5Dwrite(dataset.get(), type.get(), H5S_ALL, H5S_ALL, H5P_DEFAULT, pointers.data()) < 0)) {
+      (count > 0 && H5Dwrite(
+                        dataset.get(),
+                        type.get(),
+                        H5S_ALL,
+                        H5S_ALL,
+                        transfer.valid() ? transfer.get() : H5P_DEFAULT,
+                        pointers.data()) < 0)) {
     throw IoError(where + ": cannot write /parts (" + detail::take_hdf5_error() + ")");
   }
 }
@@ -174,9 +208,15 @@ void write_column(
   H5Handle space(H5Screate_simple(1, &count, nullptr), H5Sclose);
   H5Handle dataset(
       H5Dcreate2(group, name, type, space.get(), H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), H5Dclose);
+  const H5Handle transfer = transfer_properties();
   if (!space.valid() || !dataset.valid() ||
-      (count > 0 &&
-       H5Dwrite(dataset.get(), type, H5S_ALL, H5S_ALL, H5P_DEFAULT, values.data()) < 0)) {
+      (count > 0 && H5Dwrite(
+                        dataset.get(),
+                        type,
+                        H5S_ALL,
+                        H5S_ALL,
+                        transfer.valid() ? transfer.get() : H5P_DEFAULT,
+                        values.data()) < 0)) {
     throw IoError(
         where + ": cannot write /routes/" + name + " (" + detail::take_hdf5_error() + ")");
   }
@@ -227,8 +267,15 @@ void write_checks(hid_t file, const std::vector<LogCheck>& checks, const std::st
         H5Dcreate2(
             group.get(), name, type.get(), space.get(), H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT),
         H5Dclose);
+    const H5Handle transfer = transfer_properties();
     if (!space.valid() || !dataset.valid() ||
-        H5Dwrite(dataset.get(), type.get(), H5S_ALL, H5S_ALL, H5P_DEFAULT, values.data()) < 0) {
+        H5Dwrite(
+            dataset.get(),
+            type.get(),
+            H5S_ALL,
+            H5S_ALL,
+            transfer.valid() ? transfer.get() : H5P_DEFAULT,
+            values.data()) < 0) {
       throw IoError(
           where + ": cannot write /checks/" + name + " (" + detail::take_hdf5_error() + ")");
     }
@@ -247,6 +294,7 @@ Table create_frame_check_table(hid_t file, const std::string& where) {
   const hsize_t chunk = kFrameChunkRows;
   H5Handle space(H5Screate_simple(1, &initial, &unlimited), H5Sclose);
   H5Handle properties(H5Pcreate(H5P_DATASET_CREATE), H5Pclose);
+  const H5Handle access = chunk_cache_properties(chunk * sizeof(std::int32_t));
   Table table;
   const std::int32_t fill = -1;  // as create_table: an unwritten row reads as -1
   if (space.valid() && properties.valid() && H5Pset_chunk(properties.get(), 1, &chunk) >= 0 &&
@@ -259,13 +307,14 @@ Table create_frame_check_table(hid_t file, const std::string& where) {
             space.get(),
             H5P_DEFAULT,
             properties.get(),
-            H5P_DEFAULT),
+            access.valid() ? access.get() : H5P_DEFAULT),
         H5Dclose);
   }
   if (!table.dataset.valid()) {
     throw IoError(where + ": cannot create /frame_check (" + detail::take_hdf5_error() + ")");
   }
   table.memory_type = H5Handle(H5Tcopy(H5T_NATIVE_INT32), H5Tclose);
+  table.transfer = transfer_properties();
   return table;
 }
 

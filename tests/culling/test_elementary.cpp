@@ -1,0 +1,146 @@
+// The elementary stage (culling/elementary.hpp) on calls larger than its outcome window: every
+// query is tested once, the hits come out in candidate order with their own times, and the
+// scratch each thread keeps between calls stays one window whatever the size of the calls.
+
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <cmath>
+#include <cstdint>
+#include <vector>
+
+#include "culling/elementary.hpp"
+#include "culling/feature_topology.hpp"
+#include "tests/culling/procedural_meshes.hpp"
+
+namespace skelcd::culling {
+namespace {
+
+/// `n` disjoint triangles, triangle i's corners at x = i: (i,0,0), (i,1,0), (i,0,1). A test
+/// function can tell from a query's coordinates which triangles or vertex it was given.
+skinning::Mesh strip(int n) {
+  skinning::Mesh mesh;
+  mesh.rest_positions.resize(3 * n, 3);
+  mesh.triangles.resize(n, 3);
+  for (int i = 0; i < n; ++i) {
+    const double x = i;
+    mesh.rest_positions.row(3 * i) << x, 0, 0;
+    mesh.rest_positions.row(3 * i + 1) << x, 1, 0;
+    mesh.rest_positions.row(3 * i + 2) << x, 0, 1;
+    mesh.triangles.row(i) << 3 * i, 3 * i + 1, 3 * i + 2;
+  }
+  mesh.face_part.assign(static_cast<std::size_t>(n), 0);
+  mesh.part_names = {"strip"};
+  return mesh;
+}
+
+std::int32_t triangle_at(const Eigen::Vector3d& corner0) {
+  return static_cast<std::int32_t>(std::lround(corner0.x()));
+}
+
+std::int32_t vertex_at(const Eigen::Vector3d& p) {
+  return 3 * triangle_at(p) + (p.y() > 0.5 ? 1 : (p.z() > 0.5 ? 2 : 0));
+}
+
+bool pair_hits(std::int32_t a, std::int32_t b) { return (31 * a + b) % 5 == 0; }
+
+bool triangles_by_index(const ccd::TriangleTriangleQuery& q, const ccd::SharedCorners&) {
+  return pair_hits(triangle_at(q.a0), triangle_at(q.b0));
+}
+
+bool vertex_face_hits(std::int32_t v, std::int32_t f) { return (v + 3 * f) % 7 == 0; }
+double vertex_face_toi(std::int32_t v, std::int32_t f) { return (v * 1000 + f) * 1e-8; }
+
+ccd::CcdResult vertex_face_by_index(
+    const ccd::VertexFaceQuery& q, ccd::Accuracy, const ccd::CcdOptions&) {
+  const std::int32_t v = vertex_at(q.v_t0);
+  const std::int32_t f = triangle_at(q.f0_t0);
+  if (!vertex_face_hits(v, f)) return {};
+  const double toi = vertex_face_toi(v, f);
+  return {.hit = true, .toi_lower = toi, .toi_upper = toi + 1e-9};
+}
+
+ccd::CcdResult edge_edge_never(const ccd::EdgeEdgeQuery&, ccd::Accuracy, const ccd::CcdOptions&) {
+  return {};
+}
+
+struct Strip {
+  skinning::Mesh mesh;
+  skinning::Topology topology;
+  skinning::Positions x;
+  FeatureTopology features;
+  explicit Strip(int n)
+      : mesh(strip(n)),
+        topology(test::simple_topology(mesh)),
+        x(test::welded(topology, mesh.rest_positions)),
+        features(mesh, topology) {}
+};
+
+TEST(Elementary, DcdCallsLargerThanTheWindowKeepEveryOutcomeAndAWindowOfScratch) {
+  const Strip s(200);
+  std::vector<TrianglePair> pairs;
+  std::vector<TrianglePair> expected;
+  for (std::int32_t a = 0; a < 200; ++a) {
+    for (std::int32_t b = a + 1; b < 200; ++b) {
+      pairs.push_back({a, b});
+      if (pair_hits(a, b)) expected.push_back({a, b});
+    }
+  }
+  // 19,900 pairs: two full windows and a part of one.
+  ASSERT_GT(pairs.size(), 2 * kElementaryOutcomeWindow);
+  ASSERT_NE(pairs.size() % kElementaryOutcomeWindow, 0u);
+  for (const std::int32_t threads : {1, 2}) {
+    std::atomic<std::int64_t> done{0};
+    const ElementaryTests tests = with_ccd_defaults(
+        {.triangles = &triangles_by_index, .threads = threads, .tests_done = &done});
+    FrameResult sorted;
+    run_dcd_tests(s.features, pairs, s.x, tests, sorted);
+    EXPECT_EQ(sorted.dcd_pairs, expected) << threads << " threads";
+    EXPECT_EQ(sorted.counters.tt_tests, static_cast<std::int64_t>(pairs.size()));
+    EXPECT_EQ(sorted.counters.dcd_pairs, static_cast<std::int64_t>(expected.size()));
+    EXPECT_EQ(done.load(), static_cast<std::int64_t>(pairs.size()));
+    // The filtering pass appends in the order of `pairs`, which is sorted here.
+    FrameResult filtered;
+    filter_and_run_dcd_tests(s.features, pairs, s.x, tests, {}, {}, filtered);
+    EXPECT_EQ(filtered.dcd_pairs, expected) << threads << " threads";
+    EXPECT_EQ(filtered.counters.candidate_pairs, static_cast<std::int64_t>(pairs.size()));
+    EXPECT_LE(elementary_outcome_capacity(), kElementaryOutcomeWindow) << threads << " threads";
+    // Then a small call: the same bound, and nothing of the big call's outcomes.
+    FrameResult small;
+    run_dcd_tests(s.features, std::span(pairs).first(10), s.x, tests, small);
+    EXPECT_EQ(small.counters.tt_tests, 10);
+    EXPECT_EQ(small.dcd_pairs, std::vector<TrianglePair>(expected.begin(), expected.begin() + 2));
+    EXPECT_LE(elementary_outcome_capacity(), kElementaryOutcomeWindow);
+  }
+}
+
+TEST(Elementary, CcdCallsLargerThanTheWindowKeepEachHitsOwnTimes) {
+  const Strip s(100);
+  FeatureCandidates candidates;
+  std::vector<CcdContact> expected;
+  for (std::int32_t v = 0; v < 300; ++v) {
+    for (std::int32_t f = 0; f < 100; ++f) {
+      if (f == v / 3) continue;
+      candidates.vf.push_back({v, f});
+      if (vertex_face_hits(v, f)) {
+        const double toi = vertex_face_toi(v, f);
+        expected.push_back({CcdContact::Kind::vf, v, f, toi, toi + 1e-9});
+      }
+    }
+  }
+  ASSERT_GT(candidates.vf.size(), kElementaryOutcomeWindow);
+  ASSERT_NE(candidates.vf.size() % kElementaryOutcomeWindow, 0u);
+  for (const std::int32_t threads : {1, 2}) {
+    const ElementaryTests tests = with_ccd_defaults(
+        {.vertex_face = &vertex_face_by_index, .edge_edge = &edge_edge_never, .threads = threads});
+    FrameResult out;
+    run_ccd_tests(s.features, candidates, s.x, s.x, tests, ccd::Accuracy::conservative, {}, out);
+    EXPECT_EQ(out.contacts, expected) << threads << " threads";
+    EXPECT_EQ(out.counters.vf_tests, static_cast<std::int64_t>(candidates.vf.size()));
+    EXPECT_EQ(out.counters.vf_contacts, static_cast<std::int64_t>(expected.size()));
+    EXPECT_LE(elementary_outcome_capacity(), kElementaryOutcomeWindow);
+  }
+}
+
+}  // namespace
+}  // namespace skelcd::culling
