@@ -282,6 +282,7 @@ void Bvh<N>::refit_wide_only(std::span<const Volume> triangle_bounds) {
   constexpr auto kN = static_cast<std::size_t>(N);
   constexpr auto kAxes = static_cast<std::size_t>(kSlotAxes);
   const std::size_t stride = slot_stride();
+  constexpr std::size_t kAhead = 16;
   // A wide node's inner children come after it (built depth first), so one backward sweep is
   // bottom-up. A bucket lane is its triangles' union, rounded outwards; an inner lane the union of
   // the lanes of its wide node, which partition its triangles. float_below and float_above are
@@ -293,6 +294,11 @@ void Bvh<N>::refit_wide_only(std::span<const Volume> triangle_bounds) {
         // A bucket: its triangles' float volumes by slot, and their union.
         const auto begin = static_cast<std::size_t>(~w.child[i]);
         const auto end = begin + static_cast<std::size_t>(w.count[i]);
+        // The sweep meets the buckets in nearly decreasing slot order, and the triangles' volumes
+        // are by id, scattered: ask for those kAhead slots below now.
+        for (std::size_t s = begin; s < end && s >= kAhead; ++s) {
+          __builtin_prefetch(&triangle_bounds[static_cast<std::size_t>(order_[s - kAhead])]);
+        }
         for (std::size_t k = 0; k < kN; ++k) {
           float lo = std::numeric_limits<float>::infinity();
           float hi = -std::numeric_limits<float>::infinity();
