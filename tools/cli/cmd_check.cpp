@@ -4,6 +4,7 @@
 // broken inputs reported at the end.
 
 #include <fnmatch.h>
+#include <malloc.h>
 
 #include <CLI/CLI.hpp>
 #include <algorithm>
@@ -539,6 +540,13 @@ void run_batch(const CheckArguments& args, const std::vector<std::string>& model
 }
 
 void run_check_command(const CheckArguments& args) {
+  // Blocks of 128 KiB or more get their own mapping, returned to the system when freed. glibc
+  // raises this threshold by itself to the largest block freed so far, after which big buffers
+  // that a check frees (the baseline DCD's hierarchy, a query's scratch) stay resident in the heap
+  // and count in the peak RSS with the next ones: on cloth-funnel's CCD check, 1-2 MiB of its
+  // ~17 MiB above the floor (docs/benchmarks.md, "Fixed costs"). Only here: `inspect` reads logs
+  // under libhdf5's own allocation pattern (tests/tools/test_log.cpp, the fuzzed logs).
+  mallopt(M_MMAP_THRESHOLD, 128 * 1024);
   if (args.models.size() == 1 && is_scene_path(args.models.front())) {  // a scene (docs/scenes.md)
     run_scene_check(
         args.models.front(),

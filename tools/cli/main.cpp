@@ -1,8 +1,6 @@
 // skelcd: self-collision detection for skeleton-driven animation. Every error reaches the user as
 // one line on stderr and a non-zero exit status.
 
-#include <malloc.h>
-
 #include <CLI/CLI.hpp>
 #include <cstdio>
 #include <exception>
@@ -12,12 +10,6 @@
 #include "tools/cli/commands.hpp"
 
 int main(int argc, char** argv) {
-  // Blocks of 128 KiB or more get their own mapping, returned to the system when freed. glibc
-  // raises this threshold by itself to the largest block freed so far, after which big buffers
-  // that a run frees (the baseline DCD's hierarchy, a query's scratch) stay resident in the heap
-  // and count in the peak RSS with the next ones: on cloth-funnel's CCD check, 1-2 MiB of its
-  // ~17 MiB above the floor (docs/benchmarks.md, "Fixed costs").
-  mallopt(M_MMAP_THRESHOLD, 128 * 1024);
   CLI::App app{"skelcd — finds self-collisions in skeleton-driven animation", "skelcd"};
   app.set_version_flag("--version", skelcd::kVersion);
   app.require_subcommand(1);
