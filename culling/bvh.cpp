@@ -15,7 +15,9 @@ Bvh<N>::Bvh(
     const skinning::Triangles& triangles,
     const skinning::Positions& positions,
     const BvhOptions& options)
-    : leaf_size_(options.leaf_size), node_volumes_(options.node_volumes) {
+    : leaf_size_(options.leaf_size),
+      node_volumes_(options.node_volumes),
+      float_node_volumes_(options.node_volumes && options.float_node_volumes) {
   order_.resize(static_cast<std::size_t>(triangles.rows()));
   std::iota(order_.begin(), order_.end(), 0);
   build(triangles, positions);
@@ -29,7 +31,8 @@ Bvh<N>::Bvh(
     const BvhOptions& options)
     : order_(subset.begin(), subset.end()),
       leaf_size_(options.leaf_size),
-      node_volumes_(options.node_volumes) {
+      node_volumes_(options.node_volumes),
+      float_node_volumes_(options.node_volumes && options.float_node_volumes) {
   for (std::size_t i = 0; i < order_.size(); ++i) {
     if (order_[i] < 0 || order_[i] >= triangles.rows()) {
       throw InvalidInput(
@@ -71,7 +74,14 @@ void Bvh<N>::build(const skinning::Triangles& triangles, const skinning::Positio
     build_range(0, static_cast<std::int32_t>(order_.size()), 0);
   }
   for (std::size_t i = 0; i < order_.size(); ++i) order_[i] = items_[i].id;
-  if (node_volumes_) node_bounds_.assign(nodes_.size(), Volume::empty());
+  if (float_node_volumes_) {
+    FloatDop<N> empty;
+    empty.lo.fill(std::numeric_limits<float>::infinity());
+    empty.hi.fill(-std::numeric_limits<float>::infinity());
+    float_node_bounds_.assign(nodes_.size(), empty);
+  } else if (node_volumes_) {
+    node_bounds_.assign(nodes_.size(), Volume::empty());
+  }
   constexpr auto kAxes = static_cast<std::size_t>(kSlotAxes);
   slot_bounds_.assign(2 * kAxes * slot_stride(), 0.0f);
   for (std::size_t k = 0; k < kAxes; ++k) {
@@ -247,6 +257,10 @@ void Bvh<N>::refit(std::span<const Volume> triangle_bounds) {
       slot_bounds_[(kAxes + k) * stride + s] = float_above(t.hi[k]);
     }
   };
+  if (float_node_volumes_) {
+    refit_float_nodes(triangle_bounds);
+    return;
+  }
   for (std::size_t n = nodes_.size(); n-- > 0;) {
     const BvhNode& node = nodes_[n];
     Volume v;
@@ -272,6 +286,54 @@ void Bvh<N>::refit(std::span<const Volume> triangle_bounds) {
       for (std::size_t k = 0; k < kN; ++k) {
         w.lo[k][i] = float_below(v.lo[k]);
         w.hi[k][i] = float_above(v.hi[k]);
+      }
+    }
+  }
+}
+
+template <int N>
+void Bvh<N>::refit_float_nodes(std::span<const Volume> triangle_bounds) {
+  constexpr auto kN = static_cast<std::size_t>(N);
+  constexpr auto kAxes = static_cast<std::size_t>(kSlotAxes);
+  const std::size_t stride = slot_stride();
+  // As refit(), bottom-up in one backward sweep, on the rounded volumes: float_below and
+  // float_above are monotone, so the union of rounded volumes is the rounded exact union, and the
+  // wide copy below gets the bits refit() gives it.
+  for (std::size_t n = nodes_.size(); n-- > 0;) {
+    const BvhNode& node = nodes_[n];
+    FloatDop<N>& v = float_node_bounds_[n];
+    if (node.is_leaf()) {
+      v.lo.fill(std::numeric_limits<float>::infinity());
+      v.hi.fill(-std::numeric_limits<float>::infinity());
+      for (auto s = static_cast<std::size_t>(node.begin); s < static_cast<std::size_t>(node.end);
+           ++s) {
+        const Volume& t = triangle_bounds[static_cast<std::size_t>(order_[s])];
+        for (std::size_t k = 0; k < kN; ++k) {
+          const float tl = float_below(t.lo[k]);
+          const float th = float_above(t.hi[k]);
+          if (k < kAxes) {
+            slot_bounds_[k * stride + s] = tl;
+            slot_bounds_[(kAxes + k) * stride + s] = th;
+          }
+          v.lo[k] = std::min(v.lo[k], tl);
+          v.hi[k] = std::max(v.hi[k], th);
+        }
+      }
+    } else {
+      const FloatDop<N>& l = float_node_bounds_[n + 1];
+      const FloatDop<N>& r = float_node_bounds_[static_cast<std::size_t>(node.right)];
+      for (std::size_t k = 0; k < kN; ++k) {
+        v.lo[k] = std::min(l.lo[k], r.lo[k]);
+        v.hi[k] = std::max(l.hi[k], r.hi[k]);
+      }
+    }
+  }
+  for (WideBvhNode<N>& w : wide_) {
+    for (int i = 0; i < w.num_children; ++i) {
+      const FloatDop<N>& v = float_node_bounds_[static_cast<std::size_t>(w.node[i])];
+      for (std::size_t k = 0; k < kN; ++k) {
+        w.lo[k][i] = v.lo[k];
+        w.hi[k][i] = v.hi[k];
       }
     }
   }

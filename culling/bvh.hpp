@@ -23,6 +23,26 @@ struct BvhOptions {
   /// only the wide copy and the triangles' volumes) refit fills the wide nodes straight from the
   /// triangles' volumes, with the same bits, and the tree holds 2·#F·sizeof(Dop<N>) bytes less.
   bool node_volumes = true;
+  /// With node_volumes: keep them as floats rounded outwards (Bvh::float_node_bounds, half the
+  /// bytes) instead of doubles. A traversal on them is conservative (volumes that overlap in
+  /// double overlap in float) and tests its triangle pairs with the triangles' exact volumes: the
+  /// cone methods, whose binary tree is their traversal's.
+  bool float_node_volumes = false;
+};
+
+/// A node volume as floats rounded outwards (BvhOptions::float_node_volumes).
+template <int N>
+struct FloatDop {
+  std::array<float, static_cast<std::size_t>(N)> lo;
+  std::array<float, static_cast<std::size_t>(N)> hi;
+  /// True when the closed volumes share a point on every axis (touching counts).
+  [[nodiscard]] bool overlaps(const FloatDop& other) const {
+    bool ok = true;
+    for (std::size_t k = 0; k < static_cast<std::size_t>(N); ++k) {
+      ok = ok & (lo[k] <= other.hi[k]) & (other.lo[k] <= hi[k]);
+    }
+    return ok;
+  }
 };
 
 struct BvhNode {
@@ -96,8 +116,14 @@ class Bvh {
   void refit(std::span<const Volume> triangle_bounds);
 
   [[nodiscard]] std::span<const BvhNode> nodes() const { return nodes_; }
-  /// The binary nodes' volumes; empty when built without them (BvhOptions::node_volumes).
+  /// The binary nodes' volumes; empty when built without them (BvhOptions::node_volumes) or
+  /// with float ones (BvhOptions::float_node_volumes).
   [[nodiscard]] std::span<const Volume> node_bounds() const { return node_bounds_; }
+  /// The binary nodes' volumes as floats rounded outwards, each containing its node's exact
+  /// volume; empty unless built with BvhOptions::float_node_volumes.
+  [[nodiscard]] std::span<const FloatDop<N>> float_node_bounds() const {
+    return float_node_bounds_;
+  }
   /// Triangle ids in leaf order; node n holds triangle_order()[n.begin .. n.end).
   [[nodiscard]] std::span<const std::int32_t> triangle_order() const { return order_; }
   [[nodiscard]] bool empty() const { return nodes_.empty(); }
@@ -140,9 +166,11 @@ class Bvh {
   std::size_t count_wide(std::int32_t node) const;
   std::int32_t build_wide_node(std::int32_t node, int depth);
   void refit_wide_only(std::span<const Volume> triangle_bounds);
+  void refit_float_nodes(std::span<const Volume> triangle_bounds);
 
   std::vector<BvhNode> nodes_;
   std::vector<Volume> node_bounds_;
+  std::vector<FloatDop<N>> float_node_bounds_;
   std::vector<std::int32_t> order_;
   std::vector<WideBvhNode<N>> wide_;
   [[nodiscard]] std::size_t slot_stride() const { return order_.size() + kSlotPadding; }
@@ -157,6 +185,7 @@ class Bvh {
   int wide_depth_ = 0;
   int leaf_size_ = 1;
   bool node_volumes_ = true;
+  bool float_node_volumes_ = false;
 };
 
 using AabbBvh = Bvh<3>;

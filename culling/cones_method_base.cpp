@@ -10,6 +10,15 @@
 namespace skelcd::culling::detail {
 namespace {
 
+/// The cone methods' hierarchy: their traversal (collide) reads the binary nodes' volumes, kept as
+/// floats rounded outwards (half the bytes); its leaves test the triangles' exact volumes.
+BvhOptions cone_bvh(const MethodOptions& options) {
+  BvhOptions bvh = options.bvh;
+  bvh.node_volumes = true;
+  bvh.float_node_volumes = true;
+  return bvh;
+}
+
 inline std::size_t sz(std::int32_t i) { return static_cast<std::size_t>(i); }
 
 /// Welded rest positions (row w = rest position of representative_vertex[w]): the hierarchy is
@@ -42,12 +51,13 @@ ConeMethodBase::ConeMethodBase(
     : MethodBase(name, mesh, topology, options, std::move(features)),
       bvh_(
           subset == nullptr
-              ? AabbBvh(topology_.welded_triangles(), welded_rest(mesh, topology), options.bvh)
+              ? AabbBvh(
+                    topology_.welded_triangles(), welded_rest(mesh, topology), cone_bvh(options))
               : AabbBvh(
                     topology_.welded_triangles(),
                     welded_rest(mesh, topology),
                     *subset,
-                    options.bvh)),
+                    cone_bvh(options))),
       descent_(descent),
       // The cone theorems say "no intersection", not "no pair within a distance": with a contact
       // distance the method culls nothing and equals `bvh` (docs/dual-cone.md).
@@ -179,7 +189,7 @@ void ConeMethodBase::traverse(const Interval& interval, std::int64_t& bv_tests) 
 void ConeMethodBase::collide(std::int32_t a, std::int32_t b, std::int64_t& bv_tests) {
   ++stats_.subtree_pairs;
   const auto nodes = bvh_.nodes();
-  const auto volumes = bvh_.node_bounds();
+  const auto volumes = bvh_.float_node_bounds();
   const auto order = bvh_.triangle_order();
   const auto& tri = bounds_.triangles;
   const bool single = bvh_.leaf_size() == 1;
@@ -193,11 +203,13 @@ void ConeMethodBase::collide(std::int32_t a, std::int32_t b, std::int64_t& bv_te
     const BvhNode& nx = nodes[sz(x)];
     const BvhNode& ny = nodes[sz(y)];
     if (nx.is_leaf() && ny.is_leaf()) {
-      if (single) {  // one-triangle leaves: the node test was the triangle test
+      if (single) {  // one-triangle leaves: the float node test only pruned; now the exact one
         const std::int32_t ta = order[sz(nx.begin)];
         const std::int32_t tb = order[sz(ny.begin)];
-        blocks_.pairs().push_back({std::min(ta, tb), std::max(ta, tb)});
-        pair_added();
+        if (tri[sz(ta)].overlaps(tri[sz(tb)])) {
+          blocks_.pairs().push_back({std::min(ta, tb), std::max(ta, tb)});
+          pair_added();
+        }
         continue;
       }
       for (std::int32_t i = nx.begin; i < nx.end; ++i) {

@@ -202,8 +202,26 @@ void check_without_node_volumes(
                             : Bvh<N>(topology.welded_triangles(), x_t0, subset, with);
   Bvh<N> b = subset.empty() ? Bvh<N>(topology.welded_triangles(), x_t0, without)
                             : Bvh<N>(topology.welded_triangles(), x_t0, subset, without);
+  // c: the cone methods' hierarchy, node volumes as floats rounded outwards.
+  const BvhOptions floats{.leaf_size = leaf_size, .float_node_volumes = true};
+  Bvh<N> c = subset.empty() ? Bvh<N>(topology.welded_triangles(), x_t0, floats)
+                            : Bvh<N>(topology.welded_triangles(), x_t0, subset, floats);
   EXPECT_FALSE(a.node_bounds().empty()) << what;
   EXPECT_TRUE(b.node_bounds().empty()) << what;
+  EXPECT_TRUE(c.node_bounds().empty()) << what;
+  EXPECT_EQ(c.float_node_bounds().size(), a.nodes().size()) << what;
+  EXPECT_TRUE(a.float_node_bounds().empty()) << what;
+  // Each float node volume is its exact volume rounded outwards, bit for bit.
+  const auto expect_rounded_nodes = [&](const std::string& when) {
+    for (std::size_t n = 0; n < a.nodes().size(); ++n) {
+      for (std::size_t k = 0; k < static_cast<std::size_t>(N); ++k) {
+        ASSERT_EQ(c.float_node_bounds()[n].lo[k], float_below(a.node_bounds()[n].lo[k]))
+            << what << when << " node " << n;
+        ASSERT_EQ(c.float_node_bounds()[n].hi[k], float_above(a.node_bounds()[n].hi[k]))
+            << what << when << " node " << n;
+      }
+    }
+  };
   // Two refits in a row (the second must not keep anything of the first): an instant, then an
   // interval with a contact distance.
   FeatureBounds<N> bounds;
@@ -211,22 +229,32 @@ void check_without_node_volumes(
   bounds.derive(topology, false);
   a.refit(bounds.triangles);
   b.refit(bounds.triangles);
+  c.refit(bounds.triangles);
   expect_same_wide_nodes(a, b, what + ", static");
+  expect_same_wide_nodes(a, c, what + ", static, float node volumes");
   expect_slot_volumes<N>(a, bounds.triangles, what + ", static, with node volumes");
   expect_slot_volumes<N>(b, bounds.triangles, what + ", static, without");
+  expect_slot_volumes<N>(c, bounds.triangles, what + ", static, float node volumes");
+  expect_rounded_nodes(", static");
   swept_vertex_bounds<N>(x_t0, x_t1, 0.005, bounds.vertices);
   bounds.derive(topology);
   a.refit(bounds.triangles);
   b.refit(bounds.triangles);
+  c.refit(bounds.triangles);
   expect_same_wide_nodes(a, b, what + ", swept");
+  expect_same_wide_nodes(a, c, what + ", swept, float node volumes");
   expect_slot_volumes<N>(a, bounds.triangles, what + ", swept, with node volumes");
   expect_slot_volumes<N>(b, bounds.triangles, what + ", swept, without");
+  expect_slot_volumes<N>(c, bounds.triangles, what + ", swept, float node volumes");
+  expect_rounded_nodes(", swept");
 }
 
 TEST(Bvh, WithoutNodeVolumesRefitGivesTheWideNodesTheSameBits) {
   // The `bvh`, `kdop` and `auto` hierarchies keep no binary node volumes (2·#F volumes less,
   // docs/culling.md "Bounded memory"): their traversals read only the wide copy, which must be
-  // what the refit through the node volumes gives, bit for bit.
+  // what the refit through the node volumes gives, bit for bit. The cone methods keep them as
+  // floats (BvhOptions::float_node_volumes): each the exact one rounded outwards, and the same
+  // wide copy.
   const Scene s = moving_tube();
   const std::vector<std::int32_t> all;
   const std::vector<std::int32_t> small{5, 9, 100, 3};
