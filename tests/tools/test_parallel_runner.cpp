@@ -179,10 +179,11 @@ TEST(ParallelRunner, IncrementalDcdRowsHoldTheFullDcdsPairsWithFewerTests) {
   }
 }
 
-// Without --block-samples the blocks are an even number of nearly equal runs (two workers finish
-// together): read from the rows, where a block's first DCD is a full one (the full run's counters)
-// and the others are updates.
-TEST(ParallelRunner, DefaultBlocksAreAnEvenNumberOfNearlyEqualRuns) {
+// Without --block-samples the blocks hold B = clamp(samples / 16, 4, 64) samples while more than
+// 4·B are left, then a quarter of what is left (at least 2), so that the last blocks a pipeline
+// hands out are small and the workers run out of work together: read from the rows, where a
+// block's first DCD is a full one (the full run's counters) and the others are updates.
+TEST(ParallelRunner, DefaultBlocksShrinkTowardsTheEndOfTheClip) {
   for (const int frames : {100, 45}) {
     SCOPED_TRACE(frames);
     const auto l = load("gen:rope?triangles=200&frames=" + std::to_string(frames));
@@ -213,11 +214,24 @@ TEST(ParallelRunner, DefaultBlocksAreAnEvenNumberOfNearlyEqualRuns) {
     starts.push_back(frames);  // one past the last block
     std::vector<std::int32_t> sizes;
     for (std::size_t b = 0; b + 1 < starts.size(); ++b) sizes.push_back(starts[b + 1] - starts[b]);
-    const auto [smallest, largest] = std::minmax_element(sizes.begin(), sizes.end());
-    EXPECT_EQ(sizes.size() % 2, 0u) << "an even number of blocks";
-    EXPECT_LE(*largest - *smallest, 1) << "sizes differ by at most one sample";
+    const std::int32_t largest = std::clamp(frames / 16, 4, 64);
+    std::int32_t left = frames;
+    for (std::size_t b = 0; b < sizes.size(); ++b) {
+      SCOPED_TRACE(b);
+      const bool last = b + 1 == sizes.size();
+      if (left > 4 * largest) {
+        EXPECT_EQ(sizes[b], largest);
+      } else if (!last) {
+        EXPECT_EQ(sizes[b], std::max((left + 3) / 4, 2)) << "a quarter of " << left;
+      } else {
+        EXPECT_GE(sizes[b], 2);  // the remainder below 2 joins the last block
+        EXPECT_LE(sizes[b], 3);
+      }
+      left -= sizes[b];
+    }
+    EXPECT_LE(sizes.back(), largest / 2);
     EXPECT_EQ(plan.blocks, static_cast<std::int32_t>(sizes.size()));
-    EXPECT_EQ(plan.block_samples, *largest);
+    EXPECT_EQ(plan.block_samples, largest);
     EXPECT_EQ(plan.threads, 2);
   }
 }

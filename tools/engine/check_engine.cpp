@@ -4,6 +4,7 @@
 #include <cctype>
 #include <cmath>
 #include <filesystem>
+#include <future>
 #include <memory>
 
 #include "culling/method.hpp"
@@ -111,14 +112,39 @@ CheckOutcome check_model(
   const auto motion =
       model.motion(skinning::MotionRequest{.clip = request.clip, .rate_hz = request.fps});
   CheckOutcome outcome;
-  outcome.radial_view = setup_radial_view(request.radial_view, model, *motion, options);
   // The baseline and the allowances, refused (a bad sample, a log of another model, an unknown
-  // part) before the log is created. The baseline's DCD builds its own `bvh` and frees it before
-  // the runner builds its method: the two would otherwise be the run's peak memory together
-  // (docs/benchmarks.md "Real assets").
-  skinning::Topology topology = skinning::build_topology(motion->mesh());
-  const auto baseline = baseline_findings(request.baseline, *motion, topology);
-  ClipRunner runner(*motion, options, std::move(topology));
+  // part) before the log is created. The baseline's DCD builds its own `bvh`. A serial run frees
+  // it before the runner builds its method: the two would otherwise be the run's peak memory
+  // together (docs/benchmarks.md "Real assets"). A parallel run computes it on a thread of its
+  // own while this one sets up the radial view and the runner builds the workers' methods: the
+  // stretch before the workers start is serial, and it caps the speed-up (docs/check.md,
+  // "Threads").
+  const bool parallel = options.threads != 1;
+  skinning::Topology topology;
+  BaselineFindings baseline;
+  std::future<void> baseline_task;  // after what it reads: waited for before they go
+  if (parallel) {
+    topology = skinning::build_topology(motion->mesh());
+    baseline_task = std::async(std::launch::async, [&baseline, &request, &motion, &topology] {
+      baseline = baseline_findings(request.baseline, *motion, topology);
+    });
+  }
+  outcome.radial_view = setup_radial_view(request.radial_view, model, *motion, options);
+  if (!parallel) {
+    topology = skinning::build_topology(motion->mesh());
+    baseline = baseline_findings(request.baseline, *motion, topology);
+  }
+  ClipRunner runner = [&] {
+    try {
+      // (A parallel run's runner gets a copy: the baseline's thread may still read this one.)
+      return ClipRunner(
+          *motion, options, parallel ? skinning::Topology(topology) : std::move(topology));
+    } catch (...) {
+      if (baseline_task.valid()) baseline_task.get();  // its refusal first, as in a serial run
+      throw;
+    }
+  }();
+  if (baseline_task.valid()) baseline_task.get();
   outcome.plan = runner.plan();
   outcome.clip = motion->name();
   outcome.fps = motion->rate_hz();

@@ -143,13 +143,14 @@ class ClipRunner {
   /// DCD updated from the CCD contacts (RunOptions::incremental_dcd).
   bool incremental_dcd_ = false;
   /// Block i's sample units [first, end) (a unit: the DCD at k, then the CCD k → k+1), whatever
-  /// the thread count: RunOptions::block_samples each, or the units split into blocks_ as equal as
-  /// can be.
+  /// the thread count: RunOptions::block_samples each, or large blocks first and smaller ones at
+  /// the end (docs/check.md, "Threads").
   [[nodiscard]] std::pair<std::int32_t, std::int32_t> block(std::int32_t i) const;
+  [[nodiscard]] std::int32_t blocks() const;
 
-  std::int32_t units_ = 0;          ///< sample units of the run, from plan_.first_sample
-  std::int32_t blocks_ = 1;         ///< blocks the units are cut into
-  std::int32_t block_samples_ = 0;  ///< RunOptions::block_samples (0: balanced blocks)
+  std::int32_t units_ = 0;  ///< sample units of the run, from plan_.first_sample
+  /// Each block's first unit (from plan_.first_sample), then units_.
+  std::vector<std::int32_t> block_starts_;
 };
 
 /// Maps welded ids (culling's numbering) back to the file's own numbering (part, index).
