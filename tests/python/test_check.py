@@ -100,7 +100,10 @@ def test_full_dcd_finds_the_same_pairs_with_more_tests():
         assert np.array_equal(getattr(incremental, name), getattr(full, name))
     dcd = incremental.rows["kind"] == 0
     assert len(incremental.dcd_pairs) > 0
-    assert incremental.rows["tt_tests"][dcd].sum() * 3 < full.rows["tt_tests"][dcd].sum()
+    # Each block of samples starts with a full DCD (docs/check.md, "Threads"), and the blocks
+    # shrink towards the end of the clip: 7 of these 21 samples are full ones, where the update
+    # saves nothing.
+    assert incremental.rows["tt_tests"][dcd].sum() * 2 < full.rows["tt_tests"][dcd].sum()
 
 
 def test_one_sample_is_dcd_only():
