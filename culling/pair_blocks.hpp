@@ -58,8 +58,9 @@ class PairBlocks {
       FrameResult& out);
 
   /// Starts a DCD query at x: each block → (a, b) ordered → filter_and_run_dcd_tests (the DCD
-  /// filter and the tests in one pass) into `out`, with the vertex fans certified and the
-  /// triangles' planes computed once here.
+  /// filter and the tests in one pass) into `out`, with the vertex fans certified once here, and
+  /// the triangles' planes computed once at the first block when it holds at least
+  /// min(block_pairs, #triangles) pairs (the planes change no answer, only the time).
   void start_dcd(
       const FeatureTopology& topology,
       const skinning::Positions& x,
@@ -122,6 +123,8 @@ class PairBlocks {
   const ccd::CcdOptions* ccd_options_ = nullptr;
   std::span<const std::uint8_t> fans_;
   std::vector<ccd::TrianglePlane> planes_;  ///< the DCD instant's (dcd_planes); kept across queries
+  bool planes_decided_ = false;             ///< the DCD query's first block has decided use_planes_
+  bool use_planes_ = false;                 ///< planes_ holds this instant's planes
   std::size_t first_ = 0;                   ///< out's findings before this query
   std::int64_t blocks_ = 0;
   double feature_us_ = 0.0;
