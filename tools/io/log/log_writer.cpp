@@ -34,8 +34,13 @@ struct Table {
 /// first write with the default (/parts, before this covered the header too) was enough.
 constexpr std::size_t kConversionBufferBytes = std::size_t{64} << 10;
 
+/// A property list of ours, or HDF5's defaults where it could not be made (invalid).
+hid_t or_default(const H5Handle& properties) {
+  return properties.valid() ? properties.get() : H5P_DEFAULT;
+}
+
 /// Dataset transfer properties with kConversionBufferBytes buffers (invalid if HDF5 refuses them:
-/// the appends then use the defaults).
+/// the writes then use the defaults).
 H5Handle transfer_properties() {
   H5Handle properties(H5Pcreate(H5P_DATASET_XFER), H5Pclose);
   if (properties.valid() &&
@@ -122,7 +127,7 @@ Table create_table(
           space.get(),
           H5P_DEFAULT,
           properties.get(),
-          access.valid() ? access.get() : H5P_DEFAULT),
+          or_default(access)),
       H5Dclose);
   if (!table.dataset.valid()) fail("dataset");
   table.memory_type = std::move(memory_type);
@@ -150,7 +155,7 @@ void append_rows(
           table.memory_type.get(),
           memory_space.get(),
           file_space.get(),
-          table.transfer.valid() ? table.transfer.get() : H5P_DEFAULT,
+          or_default(table.transfer),
           rows.data()) < 0) {
     fail();
   }
@@ -186,13 +191,10 @@ void write_parts(hid_t file, const std::vector<std::string>& names, const std::s
   for (const auto& name : names) pointers.push_back(name.c_str());
   const H5Handle transfer = transfer_properties();
   if (!space.valid() || !dataset.valid() ||
-      (count > 0 && H5Dwrite(
-                        dataset.get(),
-                        type.get(),
-                        H5S_ALL,
-                        H5S_ALL,
-                        transfer.valid() ? transfer.get() : H5P_DEFAULT,
-                        pointers.data()) < 0)) {
+      (count > 0 &&
+       H5Dwrite(
+           dataset.get(), type.get(), H5S_ALL, H5S_ALL, or_default(transfer), pointers.data()) <
+           0)) {
     throw IoError(where + ": cannot write /parts (" + detail::take_hdf5_error() + ")");
   }
 }
@@ -210,13 +212,8 @@ void write_column(
       H5Dcreate2(group, name, type, space.get(), H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), H5Dclose);
   const H5Handle transfer = transfer_properties();
   if (!space.valid() || !dataset.valid() ||
-      (count > 0 && H5Dwrite(
-                        dataset.get(),
-                        type,
-                        H5S_ALL,
-                        H5S_ALL,
-                        transfer.valid() ? transfer.get() : H5P_DEFAULT,
-                        values.data()) < 0)) {
+      (count > 0 &&
+       H5Dwrite(dataset.get(), type, H5S_ALL, H5S_ALL, or_default(transfer), values.data()) < 0)) {
     throw IoError(
         where + ": cannot write /routes/" + name + " (" + detail::take_hdf5_error() + ")");
   }
@@ -269,13 +266,8 @@ void write_checks(hid_t file, const std::vector<LogCheck>& checks, const std::st
         H5Dclose);
     const H5Handle transfer = transfer_properties();
     if (!space.valid() || !dataset.valid() ||
-        H5Dwrite(
-            dataset.get(),
-            type.get(),
-            H5S_ALL,
-            H5S_ALL,
-            transfer.valid() ? transfer.get() : H5P_DEFAULT,
-            values.data()) < 0) {
+        H5Dwrite(dataset.get(), type.get(), H5S_ALL, H5S_ALL, or_default(transfer), values.data()) <
+            0) {
       throw IoError(
           where + ": cannot write /checks/" + name + " (" + detail::take_hdf5_error() + ")");
     }
@@ -307,7 +299,7 @@ Table create_frame_check_table(hid_t file, const std::string& where) {
             space.get(),
             H5P_DEFAULT,
             properties.get(),
-            access.valid() ? access.get() : H5P_DEFAULT),
+            or_default(access)),
         H5Dclose);
   }
   if (!table.dataset.valid()) {
@@ -491,7 +483,7 @@ struct LogWriter::Impl {
                                               memory_type.get(),
                                               H5S_ALL,
                                               H5S_ALL,
-                                              transfer.valid() ? transfer.get() : H5P_DEFAULT,
+                                              or_default(transfer),
                                               rows.data()) < 0)) {
       throw IoError(where + ": cannot write /" + name + " (" + detail::take_hdf5_error() + ")");
     }
