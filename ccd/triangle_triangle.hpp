@@ -2,9 +2,10 @@
 // Triangle-triangle intersection at an instant (DCD), exact: filtered floating-point orientation
 // predicates with an exact rational fallback.
 
-#include <Eigen/Core>
 #include <array>
 #include <cstdint>
+
+#include <Eigen/Core>
 
 namespace skelcd::ccd {
 
@@ -22,7 +23,8 @@ inline constexpr SharedCorners kNoSharedCorners{-1, -1, -1};
 /// they share one (two triangles meeting only at a shared vertex or along a shared edge do not
 /// intersect). Exact for every input, including coplanar and degenerate triangles.
 [[nodiscard]] bool triangles_intersect(
-    const TriangleTriangleQuery& query, const SharedCorners& shared_with_b = kNoSharedCorners);
+    const TriangleTriangleQuery& query,
+    const SharedCorners& shared_with_b = kNoSharedCorners);
 
 /// What triangles_intersect computes of one triangle (p0, p1, p2) before anything else: its
 /// normal (p1 - p0) x (p2 - p0) in doubles and each component's permanent, which filter the

@@ -91,7 +91,6 @@ void PairBlocks<N>::start_dcd(
   const auto t0 = Clock::now();
   fans_ = certify_dcd_fans(topology, x, tests);
   test_us_ += micros(t0, Clock::now());
-  planes_decided_ = false;
   use_planes_ = false;
 }
 
@@ -122,11 +121,11 @@ void PairBlocks<N>::flush() {
       if (p.b < p.a) std::swap(p.a, p.b);
     }
     const auto t1 = Clock::now();
-    if (!planes_decided_) {
-      // Every triangle's plane costs about what a few tests save: worth it when this instant
-      // tests about as many pairs as there are triangles (a first block that is full, or as
-      // long), not for a query that tests a few pairs (CesiumMan: ~2,500 tests, 4,300 triangles).
-      planes_decided_ = true;
+    if (blocks_ == 0) {
+      // The query's first block decides. Every triangle's plane costs about what a few tests
+      // save: worth it when this instant tests about as many pairs as there are triangles (a
+      // first block that is full, or as long), not for a query that tests a few pairs (CesiumMan:
+      // ~2,500 tests, 4,300 triangles).
       use_planes_ = pairs_.size() >=
                     std::min(block_pairs_, static_cast<std::size_t>(topology_->num_triangles()));
       if (use_planes_) dcd_planes(*topology_, *x_t0_, *tests_, planes_);

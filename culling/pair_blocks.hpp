@@ -123,9 +123,8 @@ class PairBlocks {
   const ccd::CcdOptions* ccd_options_ = nullptr;
   std::span<const std::uint8_t> fans_;
   std::vector<ccd::TrianglePlane> planes_;  ///< the DCD instant's (dcd_planes); kept across queries
-  bool planes_decided_ = false;             ///< the DCD query's first block has decided use_planes_
-  bool use_planes_ = false;                 ///< planes_ holds this instant's planes
-  std::size_t first_ = 0;                   ///< out's findings before this query
+  bool use_planes_ = false;  ///< planes_ holds this instant's planes (the first block decides)
+  std::size_t first_ = 0;    ///< out's findings before this query
   std::int64_t blocks_ = 0;
   double feature_us_ = 0.0;
   double test_us_ = 0.0;
