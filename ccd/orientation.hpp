@@ -23,26 +23,29 @@ namespace detail {
 inline constexpr int kUndecided = 2;
 
 /// Shewchuk's static orient3d filter ("Adaptive precision floating-point arithmetic and fast
-/// robust geometric predicates", 1997): D = det[a − d; b − d; c − d], evaluated in double on the
-/// rounded differences, is within (7 + 56ε) ε · permanent of the exact value (ε = 2⁻⁵³) when no
-/// product underflows. A product that underflows is off by up to η/2 (η = 2⁻¹⁰⁷⁴, the smallest
-/// subnormal) more, and a 2 × 2 minor's error is then multiplied by a coordinate difference that
-/// may be huge (2⁻⁵⁴⁰ · 2⁴⁹⁵ mixed in one query): the bound adds 2η · (|adz| + |bdz| + |cdz|) + 4η,
-/// which covers the six minors' products (η each after the minor's subtraction, grown by the outer
-/// product's rounding) and the three outer products (η/2 each); sums and differences of subnormals
-/// are exact. Returns the sign of −D = (d − a) · ((b − a) × (c − a)) when |D| exceeds the bound,
-/// kUndecided otherwise (also when the permanent is too small to rule out underflow, or not
+/// robust geometric predicates", 1997) on differences already taken: D = det[a; b; c] (rows
+/// a = (adx, ady, adz), …), each component rounded from at most one subtraction of exact inputs
+/// (or exact itself), evaluated in double, is within (7 + 56ε) ε · permanent of the exact value
+/// (ε = 2⁻⁵³) when no product underflows. A product that underflows is off by up to η/2
+/// (η = 2⁻¹⁰⁷⁴, the smallest subnormal) more, and a 2 × 2 minor's error is then multiplied by a
+/// coordinate difference that may be huge (2⁻⁵⁴⁰ · 2⁴⁹⁵ mixed in one query): the bound adds
+/// 2η · (|adz| + |bdz| + |cdz|) + 4η, which covers the six minors' products (η each after the
+/// minor's subtraction, grown by the outer product's rounding) and the three outer products (η/2
+/// each); sums and differences of subnormals are exact. Returns the sign of D when |D| exceeds the
+/// bound, kUndecided otherwise (also when the permanent is too small to rule out underflow, or not
 /// finite).
-inline int orient3d_static(
-    const Eigen::Vector3d& a,
-    const Eigen::Vector3d& b,
-    const Eigen::Vector3d& c,
-    const Eigen::Vector3d& d) {
+inline int det3_sign_static(
+    double adx,
+    double ady,
+    double adz,
+    double bdx,
+    double bdy,
+    double bdz,
+    double cdx,
+    double cdy,
+    double cdz) {
   constexpr double kHalfUlp = std::numeric_limits<double>::epsilon() / 2.0;
   constexpr double kErrBound = (7.0 + 56.0 * kHalfUlp) * kHalfUlp;
-  const double adx = a.x() - d.x(), ady = a.y() - d.y(), adz = a.z() - d.z();
-  const double bdx = b.x() - d.x(), bdy = b.y() - d.y(), bdz = b.z() - d.z();
-  const double cdx = c.x() - d.x(), cdy = c.y() - d.y(), cdz = c.z() - d.z();
   const double bdxcdy = bdx * cdy, cdxbdy = cdx * bdy;
   const double cdxady = cdx * ady, adxcdy = adx * cdy;
   const double adxbdy = adx * bdy, bdxady = bdx * ady;
@@ -58,9 +61,30 @@ inline int orient3d_static(
   constexpr double kEta = std::numeric_limits<double>::denorm_min();
   const double bound = kErrBound * permanent +
                        2.0 * kEta * (std::abs(adz) + std::abs(bdz) + std::abs(cdz)) + 4.0 * kEta;
-  if (det > bound) return -1;
-  if (-det > bound) return 1;
+  if (det > bound) return 1;
+  if (-det > bound) return -1;
   return kUndecided;
+}
+
+/// Shewchuk's static orient3d filter on the points: det3_sign_static of D = det[a − d; b − d;
+/// c − d]. Returns the sign of −D = (d − a) · ((b − a) × (c − a)) when it is certain, kUndecided
+/// otherwise.
+inline int orient3d_static(
+    const Eigen::Vector3d& a,
+    const Eigen::Vector3d& b,
+    const Eigen::Vector3d& c,
+    const Eigen::Vector3d& d) {
+  const int s = det3_sign_static(
+      a.x() - d.x(),
+      a.y() - d.y(),
+      a.z() - d.z(),
+      b.x() - d.x(),
+      b.y() - d.y(),
+      b.z() - d.z(),
+      c.x() - d.x(),
+      c.y() - d.y(),
+      c.z() - d.z());
+  return s == kUndecided ? s : -s;
 }
 
 /// Shewchuk's static orient2d filter on differences already taken: the sign of bx·cy − by·cx,

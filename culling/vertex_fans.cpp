@@ -130,9 +130,25 @@ bool VertexFans::certified(const skinning::Positions& x, std::int32_t v) const {
   const std::size_t j_axis = (k + 2) % 3;
   // orient(p, q) in the projection: the k-th component of (p − v) × (q − v), decided by the
   // static filter ccd::detail::cross_sign_static (cross_component_static's) on these differences.
-  const auto orient = [&](std::size_t p, std::size_t q) {
+  const auto along_axis = [&](std::size_t p, std::size_t q) {
     return ccd::detail::cross_sign_static(d[p][i_axis], d[p][j_axis], d[q][i_axis], d[q][j_axis]);
   };
+  if (winds_once(m, closed, along_axis)) return true;
+  // A fan that no coordinate axis sees injectively (a cube's corner, a cone's tip, a crease
+  // turned away from the axes) may still be seen so along its own summed normal n: the
+  // projection onto the plane normal to n is just as sound (any direction is), and orient(p, q)
+  // is then the sign of n · ((p − v) × (q − v)) = det[p − v; q − v; n], by the static orient3d
+  // filter on these differences (n is exact as computed: a difference rounded zero times).
+  if (!(std::abs(nx) + std::abs(ny) + std::abs(nz) > 0.0)) return false;
+  const auto along_normal = [&](std::size_t p, std::size_t q) {
+    return ccd::detail::det3_sign_static(
+        d[p][0], d[p][1], d[p][2], d[q][0], d[q][1], d[q][2], nx, ny, nz);
+  };
+  return winds_once(m, closed, along_normal);
+}
+
+template <class Orient>
+bool VertexFans::winds_once(std::size_t m, bool closed, const Orient& orient) {
   int sign = 0;
   int covering = 0;
   for (std::size_t i = 0; i < m; ++i) {

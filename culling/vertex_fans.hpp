@@ -5,7 +5,8 @@
 //
 // The fan of welded vertex v is certified when v is a manifold vertex (its triangles form one
 // chain, consistently oriented, none degenerate: a cycle around a closed vertex, a path at a
-// boundary vertex) and, dropping the coordinate k where the fan's normal is largest, (1) every
+// boundary vertex) and, in a projection onto a plane — first dropping the coordinate k where the
+// fan's normal is largest, then, if that fails, along the fan's summed normal itself — (1) every
 // triangle of the fan projects with the same strict orientation and (2) the projected sectors do
 // not overlap: a closed fan winds exactly once around v (the ray from v through the first spoke
 // lies in exactly one half-open sector), an open fan never comes back to that ray. Then the
@@ -48,6 +49,12 @@ class VertexFans {
   void certify(const skinning::Positions& x, std::vector<std::uint8_t>& out) const;
 
  private:
+  /// Conditions (1) and (2) of the certificate for the m triangles of a fan, given the sign of
+  /// each projected spoke pair (orient(p, q) ∈ {−1, 1, kUndecided}; spoke m of a closed fan is
+  /// spoke 0).
+  template <class Orient>
+  static bool winds_once(std::size_t m, bool closed, const Orient& orient);
+
   std::vector<std::int32_t> offsets_{0};
   std::vector<std::int32_t> spokes_;
   std::vector<std::uint8_t> closed_;
