@@ -8,6 +8,9 @@
 // with other jobs, where a thread waits for a core, it compares two builds without the waits (the
 // figures it prints are not the wall-clock ones of the table).
 //
+// --json also gives each run's exact triangle tests (tt_tests): the pairs the traversal and the
+// vertex fans left to test.
+//
 // Method `incremental` times the DCD of a clip check at a sample after the first: the previous
 // sample's pairs updated from the CCD contacts of the interval (culling/incremental_dcd.hpp).
 //
@@ -409,7 +412,8 @@ int run(const Arguments& args) {
             "\"skelcd_ms\": %.4f, \"cgal_ms\": %.4f, \"speedup\": %.4f, \"skelcd_pairs\": %zu, "
             "\"cgal_pairs\": %zu, \"same\": %zu, \"skelcd_only\": %zu, \"cgal_only\": %zu, "
             "\"cgal_extra_at_duplicated\": %zu, \"cgal_duplicated_vertices\": %zu, "
-            "\"removed_excluded\": %zu, \"removed_duplicate_faces\": %zu, \"identical\": %s}\n",
+            "\"removed_excluded\": %zu, \"removed_duplicate_faces\": %zu, \"tt_tests\": %lld, "
+            "\"identical\": %s}\n",
             quoted(args.model).c_str(),
             k,
             static_cast<long long>(mesh.num_triangles()),
@@ -427,6 +431,7 @@ int run(const Arguments& args) {
                 cgal->welded_was_duplicated.begin(), cgal->welded_was_duplicated.end(), true)),
             c.removed_excluded,
             c.removed_duplicate_faces,
+            static_cast<long long>(result.counters.tt_tests),
             identical ? "true" : "false");
       } else {
         std::printf(
