@@ -8,6 +8,7 @@
 #include "culling/candidates.hpp"
 #include "culling/detail/method_base.hpp"
 #include "culling/pair_blocks.hpp"
+#include "culling/relative_aabb.hpp"
 #include "culling/traversal.hpp"
 #include "culling/vertex_bounds.hpp"
 #include "skinning/errors.hpp"
@@ -45,14 +46,18 @@ class BvhMethod final : public MethodBase {
       std::string_view name,
       const skinning::Mesh& mesh,
       const skinning::Topology& topology,
-      const MethodOptions& options)
+      const MethodOptions& options,
+      bool relative_pairs)
       : MethodBase(name, mesh, topology, options),
+        relative_pairs_(relative_pairs),
         bvh_(
             topology_.welded_triangles(),
             welded_rest_positions(mesh, topology),
             traversal_only(options.bvh)) {
     // Everything an interval touches is sized here; only the blocks' feature candidates and the
-    // caller's findings may still grow (with the motion), and they keep their capacity.
+    // caller's findings may still grow (with the motion), and they keep their capacity — and
+    // `kdop`'s relative boxes (#F × 120 bytes), sized by the first query whose trial keeps them:
+    // a clip that never needs them never holds them (docs/benchmarks.md, bounded memory).
     const auto num_faces = static_cast<std::size_t>(topology_.num_triangles());
     bounds_.vertices.reserve(static_cast<std::size_t>(topology_.num_vertices()));
     bounds_.triangles.reserve(num_faces);
@@ -109,9 +114,18 @@ class BvhMethod final : public MethodBase {
     // de-duplication is by ownership within each triangle pair, so blocks never repeat a test).
     blocks_.start_ccd(topology_, bounds_, x_t0, x_t1, tests_, options_.accuracy, ccd_options_, out);
     start_self_traversal<N>(bvh_, scratch_);
+    if (relative_pairs_) {
+      relative_.start(
+          RelativePairTrial::trial_pairs(options_.block_pairs, topology_.num_triangles()));
+    }
     blocks_.drain([&](std::vector<TrianglePair>& pairs, std::size_t max_pairs) {
-      return self_traverse_some<N>(
+      const std::size_t first = pairs.size();
+      const bool done = self_traverse_some<N>(
           bvh_, bounds_.triangles, scratch_, pairs, out.counters.bv_tests, max_pairs);
+      if (relative_pairs_) {
+        relative_.filter(topology_, x_t0, x_t1, 0.5 * options_.min_separation, pairs, first);
+      }
+      return done;
     });
     blocks_.finish();
     const auto t2 = Clock::now();
@@ -121,6 +135,8 @@ class BvhMethod final : public MethodBase {
   }
 
  private:
+  bool relative_pairs_;
+  RelativePairTrial relative_;
   Bvh<N> bvh_;
   SlotAdjacency slots_{topology_, bvh_.triangle_order()};
   std::vector<std::uint8_t> full_slots_;
@@ -138,13 +154,14 @@ std::unique_ptr<CullingMethod> make_bvh_method(
     std::string_view name,
     const skinning::Mesh& mesh,
     const skinning::Topology& topology,
-    const MethodOptions& options) {
-  return std::make_unique<BvhMethod<N>>(name, mesh, topology, options);
+    const MethodOptions& options,
+    bool relative_pairs) {
+  return std::make_unique<BvhMethod<N>>(name, mesh, topology, options, relative_pairs);
 }
 
 template std::unique_ptr<CullingMethod> make_bvh_method<3>(
-    std::string_view, const skinning::Mesh&, const skinning::Topology&, const MethodOptions&);
+    std::string_view, const skinning::Mesh&, const skinning::Topology&, const MethodOptions&, bool);
 template std::unique_ptr<CullingMethod> make_bvh_method<8>(
-    std::string_view, const skinning::Mesh&, const skinning::Topology&, const MethodOptions&);
+    std::string_view, const skinning::Mesh&, const skinning::Topology&, const MethodOptions&, bool);
 
 }  // namespace skelcd::culling::detail

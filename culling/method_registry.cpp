@@ -53,12 +53,13 @@ void add_culling_methods(Registry& r) {
        }});
   add(r,
       {.name = "kdop",
-       .description = "16-DOP hierarchy",
+       .description = "16-DOP hierarchy; CCD pairs through relative AABBs when that pays",
        .order = 30,
        .make = [](const skinning::Mesh& mesh,
                   const skinning::Topology& topology,
                   const MethodOptions& options) {
-         return detail::make_bvh_method<8>("kdop", mesh, topology, options);
+         return detail::make_bvh_method<8>(
+             "kdop", mesh, topology, options, /*relative_pairs=*/true);
        }});
   add(r,
       {.name = "normal-cone",

@@ -140,4 +140,40 @@ std::int64_t RelativeAabbFilter::filter(
   return removed;
 }
 
+std::size_t RelativePairTrial::trial_pairs(std::size_t block_pairs, std::int32_t num_triangles) {
+  return std::max<std::size_t>(
+      1, std::min(block_pairs, static_cast<std::size_t>(std::max(num_triangles, 0))));
+}
+
+void RelativePairTrial::start(std::size_t trial) {
+  trial_ = std::max<std::size_t>(trial, 1);
+  seen_ = 0;
+  removed_ = 0;
+  state_ = State::trial;
+}
+
+std::int64_t RelativePairTrial::filter(
+    const FeatureTopology& topology,
+    const skinning::Positions& x_t0,
+    const skinning::Positions& x_t1,
+    double half_width,
+    std::vector<TrianglePair>& pairs,
+    std::size_t first) {
+  if (state_ == State::dropped) return 0;
+  if (state_ == State::kept) return prepared_.filter(topology, half_width, pairs, first);
+  const auto seen = static_cast<std::int64_t>(pairs.size() - first);
+  const std::int64_t removed = relative_aabb_filter(topology, x_t0, x_t1, half_width, pairs, first);
+  seen_ += seen;
+  removed_ += removed;
+  if (seen_ >= static_cast<std::int64_t>(trial_)) {
+    if (static_cast<double>(removed_) >= kTrialShare * static_cast<double>(seen_)) {
+      prepared_.prepare(topology, x_t0, x_t1);
+      state_ = State::kept;
+    } else {
+      state_ = State::dropped;
+    }
+  }
+  return removed;
+}
+
 }  // namespace skelcd::culling

@@ -72,4 +72,46 @@ class RelativeAabbFilter {
   std::vector<Triangle> triangles_;
 };
 
+/// A CCD query's triangle pairs through the relative AABB filter when that pays (`kdop`,
+/// docs/culling.md "Relative boxes in `kdop`"): the filter costs about as much per pair as a few
+/// percent of what a kept pair costs in the feature and elementary stages, and removes from none (a
+/// body at rest, a slow garment) to most of the pairs (a character with root motion, a falling
+/// cloth: what moves together). Each query starts with a trial on its first pairs, filtered one by
+/// one from the positions (relative_aabb_filter: nothing held); once the trial has seen its pairs,
+/// the filter is kept for the rest of the query when it removed at least kTrialShare of them (the
+/// per-triangle boxes are then prepared: RelativeAabbFilter), else no later pair is filtered.
+/// Either way the contacts are the same: a pair the filter removes has none.
+class RelativePairTrial {
+ public:
+  /// The share of the trial's pairs the filter must remove to be kept for the query.
+  static constexpr double kTrialShare = 0.25;
+  /// Pairs of the trial: the first min(block_pairs, #triangles) pairs of the query (at least 1).
+  [[nodiscard]] static std::size_t trial_pairs(std::size_t block_pairs, std::int32_t num_triangles);
+
+  /// Starts a query whose trial is its first `trial` pairs (≥ 1).
+  void start(std::size_t trial);
+  /// Filters pairs[first..] as the query stands (trial, kept, dropped); returns how many it
+  /// removed. Decides at the end of the trial. Allocation-free but for the first prepare of a
+  /// topology.
+  std::int64_t filter(
+      const FeatureTopology& topology,
+      const skinning::Positions& x_t0,
+      const skinning::Positions& x_t1,
+      double half_width,
+      std::vector<TrianglePair>& pairs,
+      std::size_t first);
+  /// True once the trial has kept the filter for this query.
+  [[nodiscard]] bool kept() const { return state_ == State::kept; }
+  /// True while the query is still in its trial.
+  [[nodiscard]] bool in_trial() const { return state_ == State::trial; }
+
+ private:
+  enum class State : std::uint8_t { trial, kept, dropped };
+  RelativeAabbFilter prepared_;
+  std::size_t trial_ = 1;
+  std::int64_t seen_ = 0;
+  std::int64_t removed_ = 0;
+  State state_ = State::dropped;
+};
+
 }  // namespace skelcd::culling

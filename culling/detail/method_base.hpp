@@ -52,12 +52,15 @@ class MethodBase : public CullingMethod {
 [[nodiscard]] std::unique_ptr<CullingMethod> make_brute_method(
     const skinning::Mesh& mesh, const skinning::Topology& topology, const MethodOptions& options);
 
-/// `bvh` (N = 3) and `kdop` (N = 8).
+/// `bvh` (N = 3) and `kdop` (N = 8). With `relative_pairs` a CCD query also sends its triangle
+/// pairs through the relative AABB filter (culling/relative_aabb.hpp) whenever a trial on its first
+/// pairs shows that it pays (docs/culling.md "Relative boxes in `kdop`").
 template <int N>
 [[nodiscard]] std::unique_ptr<CullingMethod> make_bvh_method(
     std::string_view name,
     const skinning::Mesh& mesh,
     const skinning::Topology& topology,
-    const MethodOptions& options);
+    const MethodOptions& options,
+    bool relative_pairs = false);
 
 }  // namespace skelcd::culling::detail
