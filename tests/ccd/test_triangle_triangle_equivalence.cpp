@@ -139,6 +139,22 @@ bool expect_same(
   return expected;
 }
 
+// A copy of a query scaled by a power of two (exactly, so the same answer): against the old code,
+// or for a map that names a corner twice against the unscaled query's brute-force `answer`
+// (rationals of 2^-1000 are slow, the more so in the sanitizer build).
+void expect_same_scaled(
+    const TriangleTriangleQuery& qs,
+    const SharedCorners& shared,
+    bool answer,
+    const char* what,
+    int n) {
+  if (injective(shared)) {
+    expect_same(qs, shared, what, n);
+  } else {
+    expect_answer(qs, shared, answer, what, n);
+  }
+}
+
 // The generators. Grid coordinates are multiples of 1/8 below 4 in magnitude: scaling them by a
 // power of two in [2^-1000, 2^300] is exact, so the scaled query has the same answer.
 class Generator {
@@ -263,7 +279,7 @@ TEST(TriangleTriangleEquivalence, GridDegeneraciesEverySharedPatternEveryScale) 
           const TriangleTriangleQuery qs = scaled(q, s);
           EXPECT_EQ(triangles_intersect(qs, shared), answer)
               << "grid case " << n << " scaled by " << s;
-          expect_same(qs, shared, "grid (scaled)", n);
+          expect_same_scaled(qs, shared, answer, "grid (scaled)", n);
         }
         ++n;
         if (::testing::Test::HasFailure()) return;
@@ -291,9 +307,9 @@ TEST(TriangleTriangleEquivalence, NudgedContactsEverySharedPattern) {
         V& moved = *corners[gen.integer(0, 5)];
         moved = gen.nudged(moved);
         apply_shared(q, shared);
-        expect_same(q, shared, "nudged", n);
+        const bool answer = expect_same(q, shared, "nudged", n);
         for (const double s : {0x1p-1000, 0x1p-600, 0x1p200, 0x1p300}) {
-          expect_same(scaled(q, s), shared, "nudged (scaled)", n);
+          expect_same_scaled(scaled(q, s), shared, answer, "nudged (scaled)", n);
         }
         ++n;
         if (::testing::Test::HasFailure()) return;
@@ -579,7 +595,7 @@ TEST(TriangleTriangleEquivalence, RepeatedSharedCornersAgainstTheBruteForce) {
   int n = 0;
   int hits = 0;
   int old_wrong = 0;
-  for (int round = 0; round < 6; ++round) {
+  for (int round = 0; round < 4; ++round) {
     const bool nudged = round % 2 == 1;
     for (int b_shape = 0; b_shape < 5; ++b_shape) {
       for (int c_shape = 0; c_shape < 6; ++c_shape) {
