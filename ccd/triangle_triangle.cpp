@@ -9,7 +9,9 @@
 // {s} iff the edge of A opposite s meets B or the edge of B opposite s meets A; with a shared edge,
 // iff the triangles are coplanar and lie on the same side of it. A degenerate triangle sharing
 // corners with a solid one is decided in the solid's plane (flat_meets_beyond_shared), two
-// degenerate ones on their common line (flats_meet_beyond_shared).
+// degenerate ones on their common line (flats_meet_beyond_shared). The shared part is the hull of
+// the distinct corners of b named: a map naming one twice ({1, 1, -1}, a degenerate a repeating a
+// mesh vertex) shares a vertex, and is read as such (degenerate_shared_intersect).
 //
 // The common cases first, with the same exact answers (issue 14): each triangle's plane normal is
 // computed once in doubles, with the permanents of its components, and serves as a static filter
@@ -600,14 +602,37 @@ bool no_shared_corner_intersect(
 
 // --- pairs with shared corners -------------------------------------------------------------------
 
+// shared_with_b names some corner of b twice (two shared corners of a are one mesh vertex).
+inline bool repeats_a_corner(const SharedCorners& s) {
+  return (s[0] >= 0 && (s[0] == s[1] || s[0] == s[2])) || (s[1] >= 0 && s[1] == s[2]);
+}
+
+// shared_with_b with each corner of b named once: a later corner of a that names a corner of b
+// already named is no longer marked shared. It has that corner's position (intersect's
+// precondition), so the geometry is unchanged, and the shared set — the hull of the distinct
+// corners of b named — is too; only the count now says vertex where it said edge.
+SharedCorners without_repeats(const SharedCorners& shared_with_b) {
+  SharedCorners out = shared_with_b;
+  if (out[1] >= 0 && out[1] == out[0]) out[1] = -1;
+  if (out[2] >= 0 && (out[2] == out[0] || out[2] == shared_with_b[1])) out[2] = -1;
+  return out;
+}
+
 // At least one triangle degenerate (shared_count 1 or 2).
 [[gnu::noinline]] bool degenerate_shared_intersect(
     const TriangleTriangleQuery& q,
-    const SharedCorners& shared_with_b,
+    const SharedCorners& shared_corners,
     const Triangle& ta,
     const Triangle& tb) {
   const Vector3d* a[3] = {&q.a0, &q.a1, &q.a2};
   const Vector3d* b[3] = {&q.b0, &q.b1, &q.b2};
+  // A repeated entry names one vertex, not an edge: {1, 1, -1} shares b's corner 1 alone. Such a
+  // map only arrives here — its two corners of a have one position, so a's normal is exactly zero
+  // and a is degenerate — with two entries (intersect answers three itself: a is then within
+  // the hull of the shared corners). Counted as an edge, a degenerate a reaching into a solid b
+  // from the vertex would be answered "no" (flat_meets_beyond_shared's two-corner case).
+  const SharedCorners shared_with_b =
+      repeats_a_corner(shared_corners) ? without_repeats(shared_corners) : shared_corners;
   if (ta.degenerate != tb.degenerate) {
     return ta.degenerate ? flat_meets_beyond_shared(a, shared_with_b, tb, b)
                          : flat_meets_beyond_shared(b, inverse(shared_with_b), ta, a);
@@ -759,7 +784,9 @@ bool intersect(
     ++shared_count;
   }
   if (shared_count == 0) return no_shared_corner_intersect(q, cached_a, cached_b);
-  if (shared_count == 3) return false;  // the same triangle: nothing beyond the shared part
+  // Three entries: a's corners are all shared corners of b, so a lies within their hull (the same
+  // triangle, or with a repeated entry the shared edge or vertex): nothing beyond it.
+  if (shared_count == 3) return false;
   return shared_corners_intersect(q, shared_with_b, shared_count, cached_a, cached_b);
 }
 

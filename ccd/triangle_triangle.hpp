@@ -15,7 +15,9 @@ struct TriangleTriangleQuery {
 };
 
 /// Which corners the two triangles share as mesh vertices: shared_with_b[i] = j when corner i of
-/// a is corner j of b (the same mesh vertex), -1 otherwise.
+/// a is corner j of b (the same mesh vertex), -1 otherwise. A degenerate a may repeat a vertex
+/// and so name one corner of b twice or three times; the shared part is the hull of the distinct
+/// corners named — {1, 1, -1} shares b's corner 1 alone, {1, 1, 2} the edge (1, 2).
 using SharedCorners = std::array<std::int8_t, 3>;
 inline constexpr SharedCorners kNoSharedCorners{-1, -1, -1};
 

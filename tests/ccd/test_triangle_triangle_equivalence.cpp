@@ -3,8 +3,10 @@
 // triangles; grid triangles (exact coplanarity, collinearity, touching at a point or along an
 // edge, zero-area triangles, coincident corners); contacts built exactly and then nudged by a few
 // ulps; every SharedCorners pattern; each query also with the triangles swapped and scaled by
-// powers of two from 2^-1000 to 2^300. The real queries of posed frames are in
-// tests/culling/test_triangle_triangle_real.cpp (they need the model loaders).
+// powers of two from 2^-1000 to 2^300. Patterns that name a corner of b twice are judged by the
+// brute force (tests/ccd/triangle_triangle_brute.cpp) instead: there the old code was wrong. The
+// real queries of posed frames are in tests/culling/test_triangle_triangle_real.cpp (they need the
+// model loaders).
 //
 // Non-finite coordinates are not tested: neither implementation defines an answer for them (the
 // exact fallback converts to GMP rationals, which has none), and positions are checked for
@@ -14,6 +16,7 @@
 
 #include <Eigen/Geometry>
 #include <array>
+#include <cassert>
 #include <cmath>
 #include <iostream>
 #include <random>
@@ -91,9 +94,38 @@ bool with_planes(const TriangleTriangleQuery& q, const SharedCorners& shared) {
       q, shared, triangle_plane(q.a0, q.a1, q.a2), triangle_plane(q.b0, q.b1, q.b2));
 }
 
-// Both implementations (and the entry with planes) on q and on its swap; returns the answer.
+// The new code, both entries, on q and on its swap, answers `truth`.
+void expect_answer(
+    const TriangleTriangleQuery& q,
+    const SharedCorners& shared,
+    bool truth,
+    const char* what,
+    int n) {
+  EXPECT_EQ(triangles_intersect(q, shared), truth) << what << " case " << n;
+  EXPECT_EQ(with_planes(q, shared), truth) << what << " case " << n << " (planes given)";
+  const TriangleTriangleQuery swapped{q.b0, q.b1, q.b2, q.a0, q.a1, q.a2};
+  const SharedCorners inv = inverse(shared);
+  EXPECT_EQ(triangles_intersect(swapped, inv), truth) << what << " case " << n << " (swapped)";
+  EXPECT_EQ(with_planes(swapped, inv), truth)
+      << what << " case " << n << " (swapped, planes given)";
+}
+
+// The new code against the brute force; returns the answer.
+bool expect_brute(
+    const TriangleTriangleQuery& q, const SharedCorners& shared, const char* what, int n) {
+  const bool truth = test::brute_intersect(q, shared);
+  expect_answer(q, shared, truth, what, n);
+  return truth;
+}
+
+// Both implementations (and the entry with planes) on q and on its swap; returns the answer. A map
+// that names a corner of b twice is judged by the brute force instead: the old code read two
+// entries naming one vertex as a shared edge, and answered "no" for a degenerate a reaching into a
+// solid b from that vertex; the new code reads them as the one vertex they name, as the brute
+// force does (RepeatedSharedCornersAgainstTheBruteForce below).
 bool expect_same(
     const TriangleTriangleQuery& q, const SharedCorners& shared, const char* what, int n) {
+  if (!injective(shared)) return expect_brute(q, shared, what, n);
   const bool expected = triangles_intersect_reference(q, shared);
   EXPECT_EQ(triangles_intersect(q, shared), expected) << what << " case " << n;
   EXPECT_EQ(with_planes(q, shared), expected) << what << " case " << n << " (planes given)";
@@ -105,6 +137,22 @@ bool expect_same(
   EXPECT_EQ(with_planes(swapped, inv), expected_swapped)
       << what << " case " << n << " (swapped, planes given)";
   return expected;
+}
+
+// A copy of a query scaled by a power of two (exactly, so the same answer): against the old code,
+// or for a map that names a corner twice against the unscaled query's brute-force `answer`
+// (rationals of 2^-1000 are slow, the more so in the sanitizer build).
+void expect_same_scaled(
+    const TriangleTriangleQuery& qs,
+    const SharedCorners& shared,
+    bool answer,
+    const char* what,
+    int n) {
+  if (injective(shared)) {
+    expect_same(qs, shared, what, n);
+  } else {
+    expect_answer(qs, shared, answer, what, n);
+  }
 }
 
 // The generators. Grid coordinates are multiples of 1/8 below 4 in magnitude: scaling them by a
@@ -231,7 +279,7 @@ TEST(TriangleTriangleEquivalence, GridDegeneraciesEverySharedPatternEveryScale) 
           const TriangleTriangleQuery qs = scaled(q, s);
           EXPECT_EQ(triangles_intersect(qs, shared), answer)
               << "grid case " << n << " scaled by " << s;
-          expect_same(qs, shared, "grid (scaled)", n);
+          expect_same_scaled(qs, shared, answer, "grid (scaled)", n);
         }
         ++n;
         if (::testing::Test::HasFailure()) return;
@@ -259,9 +307,9 @@ TEST(TriangleTriangleEquivalence, NudgedContactsEverySharedPattern) {
         V& moved = *corners[gen.integer(0, 5)];
         moved = gen.nudged(moved);
         apply_shared(q, shared);
-        expect_same(q, shared, "nudged", n);
+        const bool answer = expect_same(q, shared, "nudged", n);
         for (const double s : {0x1p-1000, 0x1p-600, 0x1p200, 0x1p300}) {
-          expect_same(scaled(q, s), shared, "nudged (scaled)", n);
+          expect_same_scaled(scaled(q, s), shared, answer, "nudged (scaled)", n);
         }
         ++n;
         if (::testing::Test::HasFailure()) return;
@@ -374,11 +422,8 @@ TEST(TriangleTriangleEquivalence, CoplanarSlivers) {
 // old code is not always right: the static filter of ccd::orient3d, which it calls, can take a
 // sign from a product that underflowed (see Orient3dFilterAllowsForAnUnderflowedProduct below; the
 // filter is fixed now). So both are judged by the brute-force rational reference: the new test must
-// always be right, and may differ from the old one only where the old one is wrong. Except with a
-// repeated shared vertex (two of a's corners shared with one corner of b): the old code's answer
-// for a degenerate triangle against a solid one counts two shared corners as a shared edge even
-// when they are one vertex, which the brute force does not, and the new code keeps the old answer
-// there (the other tests check it against the old code).
+// always be right, and may differ from the old one only where the old one is wrong (which includes
+// the repeated shared vertex of RepeatedSharedCornersAgainstTheBruteForce below).
 TEST(TriangleTriangleEquivalence, ExtremeMagnitudesMixedInOneQuery) {
   Generator gen(5);
   const auto patterns = all_shared_patterns();
@@ -400,14 +445,6 @@ TEST(TriangleTriangleEquivalence, ExtremeMagnitudesMixedInOneQuery) {
     apply_shared(q, shared);
     const TriangleTriangleQuery swapped{q.b0, q.b1, q.b2, q.a0, q.a1, q.a2};
     const SharedCorners inv = inverse(shared);
-    if (!injective(shared)) {
-      // A repeated shared vertex: both implementations share a flaw there (see the note above).
-      ASSERT_EQ(triangles_intersect(q, shared), triangles_intersect_reference(q, shared))
-          << "extreme case " << n;
-      ASSERT_EQ(triangles_intersect(swapped, inv), triangles_intersect_reference(swapped, inv))
-          << "extreme case " << n << " (swapped)";
-      continue;
-    }
     const bool truth = test::brute_intersect(q, shared);
     ASSERT_EQ(triangles_intersect(q, shared), truth) << "extreme case " << n;
     ASSERT_EQ(triangles_intersect(swapped, inv), truth) << "extreme case " << n << " (swapped)";
@@ -442,17 +479,148 @@ TEST(TriangleTriangleEquivalence, Orient3dFilterAllowsForAnUnderflowedProduct) {
   EXPECT_TRUE(triangles_intersect_reference(q));
 }
 
-// The old answer kept where it is wrong: a zero-area triangle repeating the vertex it shares
-// with a solid neighbour (a0 and a1 are both b's corner 1) and reaching into the neighbour from
-// it. The old code counts the two shared corners as a shared edge and answers no; the brute force
-// says they meet beyond the vertex. Fixing it is a change of answers, left to its own commit.
-TEST(TriangleTriangleEquivalence, RepeatedSharedVertexKeepsTheOldAnswer) {
+// A zero-area triangle a that repeats the vertex it shares with a solid neighbour b (a0 and a1
+// are both b's corner 1) and reaches into b from it: they meet along [o, a2], beyond the vertex.
+// The old code counted the two entries as a shared edge and answered no.
+TEST(TriangleTriangleEquivalence, RepeatedSharedVertexReachingIntoASolidNeighbour) {
   const V o(0, 0, 0);
   const TriangleTriangleQuery q{o, o, V(0.25, 0.25, 0), V(1, 0, 0), o, V(0, 1, 0)};
   const SharedCorners shared{1, 1, -1};
   EXPECT_TRUE(test::brute_intersect(q, shared));
-  EXPECT_FALSE(triangles_intersect_reference(q, shared));
-  EXPECT_FALSE(triangles_intersect(q, shared));
+  EXPECT_FALSE(triangles_intersect_reference(q, shared));  // the old answer
+  EXPECT_TRUE(triangles_intersect(q, shared));
+  EXPECT_TRUE(with_planes(q, shared));
+  const TriangleTriangleQuery swapped{q.b0, q.b1, q.b2, q.a0, q.a1, q.a2};
+  EXPECT_TRUE(triangles_intersect(swapped, inverse(shared)));
+  // The same vertex named once, by either corner of a: the same answer.
+  EXPECT_TRUE(triangles_intersect(q, {1, -1, -1}));
+  EXPECT_TRUE(triangles_intersect(q, {-1, 1, -1}));
+  // Pointing away from b, or out of its plane, a meets b at the vertex alone.
+  for (const V& a2 : {V(-0.25, -0.25, 0), V(0.25, 0.25, 0.5)}) {
+    const TriangleTriangleQuery away{o, o, a2, q.b0, q.b1, q.b2};
+    EXPECT_FALSE(test::brute_intersect(away, shared));
+    EXPECT_FALSE(triangles_intersect(away, shared));
+  }
+  // Its far corner b's corner 0 too ({1, 1, 0}): a is b's edge (1, 0), the shared part.
+  const TriangleTriangleQuery edge{o, o, q.b0, q.b0, q.b1, q.b2};
+  EXPECT_FALSE(test::brute_intersect(edge, {1, 1, 0}));
+  EXPECT_FALSE(triangles_intersect(edge, {1, 1, 0}));
+}
+
+// A pair around the vertex v = b's corner that `shared` names twice or three times. b's shape:
+// solid, solid in a plane z = const, a corner on the segment of the others, two corners equal, a
+// point. a's free corner (if it has one): a grid point, in b's angle at v, along an edge of b from
+// v (short of, at and beyond its end), opposite b's angle, at v, or just off b's plane. a's shared
+// corners take b's positions. With `nudged`, everything moves off the dyadic grid (so that
+// differences round) and one corner moves by a few ulps: near-degenerate instead of exact.
+TriangleTriangleQuery repeated_vertex_query(
+    Generator& gen, const SharedCorners& shared, int b_shape, int c_shape, bool nudged) {
+  int j = -1;  // the corner of b named more than once
+  for (std::size_t i = 0; i < 3; ++i) {
+    for (std::size_t k = 0; k < i; ++k) {
+      if (shared[i] >= 0 && shared[i] == shared[k]) j = shared[i];
+    }
+  }
+  assert(j >= 0);
+  const auto ju = static_cast<std::size_t>(j);
+  V b[3] = {gen.grid_point(2), gen.grid_point(2), gen.grid_point(2)};
+  const std::size_t m = (ju + 1 + static_cast<std::size_t>(gen.integer(0, 1))) % 3;  // not v
+  const std::size_t other = 3 - ju - m;
+  switch (b_shape) {
+    case 0:
+      break;
+    case 1:
+      b[1].z() = b[2].z() = b[0].z();
+      break;
+    case 2:
+      b[m] = gen.on_triangle(b[ju], b[other], b[other]);
+      break;
+    case 3:
+      b[m] = gen.integer(0, 1) ? b[ju] : b[other];
+      break;
+    default:
+      b[0] = b[1] = b[2];
+      break;
+  }
+  const V& v = b[ju];
+  const V p = gen.on_triangle(b[0], b[1], b[2]);
+  const double t = 0.5 * gen.integer(1, 4);  // 1/2 .. 2
+  V c;
+  switch (c_shape) {
+    case 0:
+      c = gen.grid_point(2);
+      break;
+    case 1:
+      c = v + t * (p - v);
+      break;
+    case 2:
+      c = v + t * (b[m] - v);
+      break;
+    case 3:
+      c = v - t * (p - v);
+      break;
+    case 4:
+      c = v;
+      break;
+    default:
+      c = v + t * (p - v) + 0.125 * (b[m] - v).cross(b[other] - v);
+      break;
+  }
+  if (nudged) {
+    const V offset(0.1, 0.3, 0.7);
+    for (V& x : b) x += offset;
+    c += offset;
+    V* corners[4] = {&b[0], &b[1], &b[2], &c};
+    V& moved = *corners[gen.integer(0, 3)];
+    moved = gen.nudged(moved);
+  }
+  V a[3];
+  for (std::size_t i = 0; i < 3; ++i)
+    a[i] = shared[i] >= 0 ? b[static_cast<std::size_t>(shared[i])] : c;
+  return {a[0], a[1], a[2], b[0], b[1], b[2]};
+}
+
+// Every map that names a corner of b twice or three times (30 of the 64) on the pairs above, exact
+// and nudged, the exact ones also scaled by powers of two: the new code, both entries and both
+// orders (seen from b, the repeated vertex is named once and a is the triangle with a repeated
+// point), against the brute force. The sweep must meet the case the old code got wrong.
+TEST(TriangleTriangleEquivalence, RepeatedSharedCornersAgainstTheBruteForce) {
+  Generator gen(8);
+  std::vector<SharedCorners> repeated;
+  for (const SharedCorners& s : all_shared_patterns()) {
+    if (!injective(s)) repeated.push_back(s);
+  }
+  ASSERT_EQ(repeated.size(), 30u);
+  const double scales[] = {0x1p-1000, 0x1p-330, 0x1p-20, 0x1p40, 0x1p300};
+  int n = 0;
+  int hits = 0;
+  int old_wrong = 0;
+  for (int round = 0; round < 4; ++round) {
+    const bool nudged = round % 2 == 1;
+    for (int b_shape = 0; b_shape < 5; ++b_shape) {
+      for (int c_shape = 0; c_shape < 6; ++c_shape) {
+        for (const SharedCorners& shared : repeated) {
+          const TriangleTriangleQuery q =
+              repeated_vertex_query(gen, shared, b_shape, c_shape, nudged);
+          const bool truth = expect_brute(q, shared, "repeated", n);
+          hits += truth ? 1 : 0;
+          old_wrong += triangles_intersect_reference(q, shared) != truth ? 1 : 0;
+          if (!nudged) {
+            for (const double s : scales) {
+              expect_answer(scaled(q, s), shared, truth, "repeated (scaled)", n);
+            }
+          }
+          ++n;
+          if (::testing::Test::HasFailure()) return;
+        }
+      }
+    }
+  }
+  EXPECT_GT(hits, n / 20);
+  EXPECT_LT(hits, n / 2);
+  EXPECT_GT(old_wrong, 0);
+  std::cout << "  " << hits << " of " << n << " repeated-vertex queries intersect; the old test was"
+            << " wrong on " << old_wrong << "\n";
 }
 
 }  // namespace
