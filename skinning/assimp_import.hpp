@@ -77,6 +77,7 @@ struct ImportedRig {
 ///         weights, indices out of range (also when assimp reports it dropped such faces), no
 ///         triangle at all, a node hierarchy with a cycle. A clip with unusable keys (out of
 ///         order, non-finite) does not throw: it is refused alone (ImportedRig::refused_clips).
-[[nodiscard]] ImportedRig import_rig(const std::filesystem::path& file, const ImportOptions& options = {});
+[[nodiscard]] ImportedRig import_rig(
+    const std::filesystem::path& file, const ImportOptions& options = {});
 
 }  // namespace skelcd::skinning
