@@ -26,6 +26,7 @@
 
 #include "skinning/detail/collada_bind_shape.hpp"
 #include "skinning/detail/import_guard.hpp"
+#include "skinning/detail/imported_rig_stream.hpp"
 #include "skinning/errors.hpp"
 #include "skinning/frame_sequence.hpp"
 
@@ -1162,15 +1163,19 @@ ImportedRig import_rig(const std::filesystem::path& file, const ImportOptions& o
   if (std::filesystem::file_size(file, ec) == 0 && !ec) throw IoError(name + ": empty file");
   detail::check_declared_counts(file);
 
-  std::lock_guard lock(import_mutex());
-  if (options.isolate) {
-    // A crash, a loop or a runaway allocation inside assimp ends the child, not this process.
+  std::unique_lock lock(import_mutex());
+  try {
+    if (!options.isolate) return import_locked(file, options);
+    // A crash, a loop or a runaway allocation inside assimp ends the child, not this process. The
+    // child's import is the only one: it sends the rig back, and this process decodes it.
     const detail::ImportLimits limits{
         .memory_bytes = options.memory_limit_bytes, .time_s = options.time_limit_s};
-    detail::run_isolated(file, limits, [&] { (void)import_locked(file, options); });
-  }
-  try {
-    return import_locked(file, options);
+    detail::ChildAnswer answer =
+        detail::run_isolated_with_answer(file, limits, [&](const detail::AnswerSink& send) {
+          detail::write_imported_rig(import_locked(file, options), send);
+        });
+    lock.unlock();  // decoding touches neither assimp nor its logger
+    return detail::read_imported_rig(answer, name);
   } catch (const std::bad_alloc&) {
     throw InvalidInput(name + ": ran out of memory importing it");
   }
