@@ -43,6 +43,8 @@ struct RefusedClip {
   std::string reason;
 };
 
+/// What import_rig returns. A field added here must also cross from the import's child process to
+/// its parent: skinning/detail/imported_rig_stream.cpp, and the comparison in its test.
 struct ImportedRig {
   Rig rig;
   /// Clips left out of rig.clips because their data are unusable (each also has a line in
