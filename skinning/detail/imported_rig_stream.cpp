@@ -269,7 +269,8 @@ SkinWeights read_weights(Reader& r) {
   r.bytes(W.innerIndexPtr(), nonzeros * sizeof(Index));
   r.bytes(W.valuePtr(), nonzeros * sizeof(double));
   // Eigen trusts this layout: row starts from 0 to #nonzeros, never decreasing; within a row,
-  // columns in range and increasing.
+  // columns in range and increasing. Every start is checked before any is used as an index: a
+  // start beyond #nonzeros followed by a smaller one would otherwise be read through first.
   const Index* start = W.outerIndexPtr();
   const Index* column = W.innerIndexPtr();
   if (start[0] != 0 || static_cast<std::size_t>(start[rows]) != nonzeros)
@@ -277,6 +278,8 @@ SkinWeights read_weights(Reader& r) {
   for (std::size_t v = 0; v < rows; ++v) {
     if (start[v + 1] < start[v])
       r.damaged("weight row " + std::to_string(v) + " ends before it starts");
+  }
+  for (std::size_t v = 0; v < rows; ++v) {
     for (Index k = start[v]; k < start[v + 1]; ++k) {
       if (column[k] < 0 || static_cast<std::uint64_t>(column[k]) >= cols ||
           (k > start[v] && column[k] <= column[k - 1]))
