@@ -1,6 +1,7 @@
 #include "skinning/detail/import_guard.hpp"
 
 #include <fcntl.h>
+#include <malloc.h>
 #include <poll.h>
 #include <sys/resource.h>
 #include <sys/wait.h>
@@ -709,7 +710,11 @@ class AnswerWriter {
     asan_limit_bytes = static_cast<long long>(limits.memory_bytes);
     __sanitizer_install_malloc_and_free_hooks(asan_on_malloc, asan_on_free);
 #else
-    const rlim_t cap = static_cast<rlim_t>(mapped_bytes() + limits.memory_bytes);
+    // Heap the parent freed but still maps is room the probe allocates in without adding address
+    // space: it counts against the limit (a process that has imported a few models holds a few
+    // MB of it, as much as a small limit). The probe may still use `memory_bytes` in all.
+    const std::size_t reusable = std::min(::mallinfo2().fordblks, limits.memory_bytes);
+    const rlim_t cap = static_cast<rlim_t>(mapped_bytes() + limits.memory_bytes - reusable);
     const rlimit limit{cap, cap};
     setrlimit(RLIMIT_AS, &limit);
 #endif

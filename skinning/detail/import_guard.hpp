@@ -13,7 +13,8 @@
 namespace skelcd::skinning::detail {
 
 struct ImportLimits {
-  /// Address space the probe may add to what the process already maps, bytes.
+  /// Memory the probe may take, bytes: address space it may add to what the process already
+  /// maps, less the heap the process freed but still maps (which the probe allocates in first).
   std::size_t memory_bytes = 0;
   /// Wall-clock time the probe may take, seconds (<= 0: no limit).
   double time_s = 0.0;
