@@ -26,6 +26,7 @@
 
 #include "skinning/detail/collada_bind_shape.hpp"
 #include "skinning/detail/import_guard.hpp"
+#include "skinning/detail/imported_rig_stream.hpp"
 #include "skinning/errors.hpp"
 #include "skinning/frame_sequence.hpp"
 
@@ -65,7 +66,8 @@ class CollectingStream final : public Assimp::LogStream {
   void write(const char* message) override {
     std::string line(message);
     // DefaultLogger prefixes "Warn,  T0: " and appends a newline.
-    if (const auto colon = line.find(": "); colon != std::string::npos && colon < 16) line.erase(0, colon + 2);
+    if (const auto colon = line.find(": "); colon != std::string::npos && colon < 16)
+      line.erase(0, colon + 2);
     while (!line.empty() && (line.back() == '\n' || line.back() == '\r')) line.pop_back();
     lines.push_back(std::move(line));
   }
@@ -78,11 +80,13 @@ class ScopedLogCapture {
     if (Assimp::DefaultLogger::isNullLogger()) {
       Assimp::DefaultLogger::create("", Assimp::Logger::NORMAL, 0);  // no file, no console
     }
-    Assimp::DefaultLogger::get()->attachStream(&stream_, Assimp::Logger::Warn | Assimp::Logger::Err);
+    Assimp::DefaultLogger::get()->attachStream(
+        &stream_, Assimp::Logger::Warn | Assimp::Logger::Err);
   }
   ~ScopedLogCapture() {
     // Detaching hands ownership of the stream back to us (assimp does not delete it).
-    Assimp::DefaultLogger::get()->detachStream(&stream_, Assimp::Logger::Warn | Assimp::Logger::Err);
+    Assimp::DefaultLogger::get()->detachStream(
+        &stream_, Assimp::Logger::Warn | Assimp::Logger::Err);
   }
   ScopedLogCapture(const ScopedLogCapture&) = delete;
   ScopedLogCapture& operator=(const ScopedLogCapture&) = delete;
@@ -157,7 +161,9 @@ class ScopedStdCapture {
 };
 
 std::string lower(std::string s) {
-  std::transform(s.begin(), s.end(), s.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  std::transform(s.begin(), s.end(), s.begin(), [](unsigned char c) {
+    return static_cast<char>(std::tolower(c));
+  });
   return s;
 }
 
@@ -172,7 +178,9 @@ struct Context {
   std::map<std::string, Eigen::Affine3d> bind_shapes;
   /// Frames per second the file declares for its clips (file_frame_rate), 0 when it declares none.
   double frame_rate_hz = 0.0;
-  [[noreturn]] void invalid(const std::string& fault) const { throw InvalidInput(file + ": " + fault); }
+  [[noreturn]] void invalid(const std::string& fault) const {
+    throw InvalidInput(file + ": " + fault);
+  }
 };
 
 Eigen::Affine3d to_affine(const aiMatrix4x4& m, const Context& ctx, const std::string& what) {
@@ -209,7 +217,9 @@ double file_unit_scale(const aiScene* scene, Context& ctx) {
   const aiMetadata* meta = scene->mMetaData;
   if (meta == nullptr) return 1.0;
   aiString format;
-  if (!meta->Get("SourceAsset_Format", format) || lower(format.C_Str()).find("fbx") == std::string::npos) return 1.0;
+  if (!meta->Get("SourceAsset_Format", format) ||
+      lower(format.C_Str()).find("fbx") == std::string::npos)
+    return 1.0;
   double factor = 0.0;
   float factor_f = 0.0f;
   if (!meta->Get("UnitScaleFactor", factor)) {
@@ -217,7 +227,8 @@ double file_unit_scale(const aiScene* scene, Context& ctx) {
     factor = static_cast<double>(factor_f);
   }
   if (!std::isfinite(factor) || factor <= 0) {
-    ctx.problems.push_back("FBX UnitScaleFactor " + std::to_string(factor) + " is not positive; unit scale ignored");
+    ctx.problems.push_back(
+        "FBX UnitScaleFactor " + std::to_string(factor) + " is not positive; unit scale ignored");
     return 1.0;
   }
   return factor / 100.0;  // FBX units are centimetres times UnitScaleFactor
@@ -315,8 +326,8 @@ std::map<std::string, Eigen::Affine3d>::const_iterator find_bind_shape(
 // loader bug) could still make a node reachable twice, which would be a cycle for us.
 
 struct Hierarchy {
-  std::vector<const aiNode*> nodes;                  // pre-order
-  std::vector<Eigen::Affine3d> scene_global;          // without the unit scale
+  std::vector<const aiNode*> nodes;           // pre-order
+  std::vector<Eigen::Affine3d> scene_global;  // without the unit scale
   std::unordered_map<std::string, std::vector<std::int32_t>> by_name;
 };
 
@@ -329,17 +340,21 @@ Hierarchy read_hierarchy(const aiScene* scene, Skeleton& skeleton, Context& ctx)
   while (!stack.empty()) {
     const auto [node, parent] = stack.back();
     stack.pop_back();
-    if (!seen.insert(node).second) ctx.invalid(node_label(node) + " is reached twice in the node hierarchy (a cycle)");
+    if (!seen.insert(node).second)
+      ctx.invalid(node_label(node) + " is reached twice in the node hierarchy (a cycle)");
     const auto index = static_cast<std::int32_t>(h.nodes.size());
     h.nodes.push_back(node);
     SkeletonNode sn;
     sn.name = node->mName.C_Str();
     sn.parent = parent;
     sn.rest_local = to_affine(node->mTransformation, ctx, node_label(node));
-    h.scene_global.push_back(parent < 0 ? sn.rest_local : h.scene_global[static_cast<std::size_t>(parent)] * sn.rest_local);
+    h.scene_global.push_back(
+        parent < 0 ? sn.rest_local
+                   : h.scene_global[static_cast<std::size_t>(parent)] * sn.rest_local);
     h.by_name[sn.name].push_back(index);
     skeleton.nodes.push_back(std::move(sn));
-    if (node->mNumChildren > 0 && node->mChildren == nullptr) ctx.invalid(node_label(node) + " lists children it does not have");
+    if (node->mNumChildren > 0 && node->mChildren == nullptr)
+      ctx.invalid(node_label(node) + " lists children it does not have");
     for (unsigned c = node->mNumChildren; c-- > 0;) {
       if (node->mChildren[c] == nullptr) ctx.invalid(node_label(node) + " has a null child");
       stack.emplace_back(node->mChildren[c], index);
@@ -368,7 +383,8 @@ std::int32_t resolve_node(
     return -1;
   };
   std::int32_t chosen = -1;
-  if (hosts_bone != nullptr) chosen = pick([&](std::int32_t c) { return (*hosts_bone)[static_cast<std::size_t>(c)]; });
+  if (hosts_bone != nullptr)
+    chosen = pick([&](std::int32_t c) { return (*hosts_bone)[static_cast<std::size_t>(c)]; });
   if (chosen < 0) {
     chosen = pick([&](std::int32_t c) {
       const aiNode* n = h.nodes[static_cast<std::size_t>(c)];
@@ -383,7 +399,11 @@ std::int32_t resolve_node(
 
 // A root node with a fixed transform, for a bone the hierarchy lacks. Its global (scene space)
 // transform is `scene_global`; it has no aiNode.
-std::int32_t add_static_node(Skeleton& skeleton, Hierarchy& h, const std::string& name, const Eigen::Affine3d& scene_global) {
+std::int32_t add_static_node(
+    Skeleton& skeleton,
+    Hierarchy& h,
+    const std::string& name,
+    const Eigen::Affine3d& scene_global) {
   const auto index = static_cast<std::int32_t>(skeleton.nodes.size());
   SkeletonNode sn;
   sn.name = name;
@@ -409,7 +429,8 @@ struct PendingBone {
 constexpr double kSameBindTolerance = 1e-12;
 
 bool same_transform(const Eigen::Affine3d& a, const Eigen::Affine3d& b) {
-  const double scale = 1.0 + std::max(a.matrix().cwiseAbs().maxCoeff(), b.matrix().cwiseAbs().maxCoeff());
+  const double scale =
+      1.0 + std::max(a.matrix().cwiseAbs().maxCoeff(), b.matrix().cwiseAbs().maxCoeff());
   return (a.matrix() - b.matrix()).cwiseAbs().maxCoeff() <= kSameBindTolerance * scale;
 }
 
@@ -431,7 +452,9 @@ void add_part(
     Rig& rig,
     MeshBuild& build,
     Context& ctx) {
-  const std::string mesh_name = am->mName.length > 0 ? am->mName.C_Str() : h.nodes[static_cast<std::size_t>(node)]->mName.C_Str();
+  const std::string mesh_name = am->mName.length > 0
+                                    ? am->mName.C_Str()
+                                    : h.nodes[static_cast<std::size_t>(node)]->mName.C_Str();
   const std::string label = "mesh '" + mesh_name + "'";
   (void)scene;
   if (am->mNumVertices > 0 && am->mVertices == nullptr) ctx.invalid(label + " has no vertex array");
@@ -441,28 +464,41 @@ void add_part(
   std::size_t points = 0, lines = 0, triangles = 0;
   for (unsigned f = 0; f < am->mNumFaces; ++f) {
     const aiFace& face = am->mFaces[f];
-    if (face.mNumIndices > 0 && face.mIndices == nullptr) ctx.invalid(label + ", face " + std::to_string(f) + " has no indices");
+    if (face.mNumIndices > 0 && face.mIndices == nullptr)
+      ctx.invalid(label + ", face " + std::to_string(f) + " has no indices");
     for (unsigned k = 0; k < face.mNumIndices; ++k) {
       if (face.mIndices[k] >= am->mNumVertices) {
-        ctx.invalid(label + ", face " + std::to_string(f) + " has vertex index " + std::to_string(face.mIndices[k]) +
-                    " out of range [0, " + std::to_string(am->mNumVertices) + ")");
+        ctx.invalid(
+            label + ", face " + std::to_string(f) + " has vertex index " +
+            std::to_string(face.mIndices[k]) + " out of range [0, " +
+            std::to_string(am->mNumVertices) + ")");
       }
     }
-    if (face.mNumIndices == 3) ++triangles;
-    else if (face.mNumIndices == 2) ++lines;
-    else if (face.mNumIndices == 1) ++points;
-    else ctx.invalid(label + ", face " + std::to_string(f) + " has " + std::to_string(face.mNumIndices) + " indices after triangulation");
+    if (face.mNumIndices == 3)
+      ++triangles;
+    else if (face.mNumIndices == 2)
+      ++lines;
+    else if (face.mNumIndices == 1)
+      ++points;
+    else
+      ctx.invalid(
+          label + ", face " + std::to_string(f) + " has " + std::to_string(face.mNumIndices) +
+          " indices after triangulation");
   }
   if (triangles == 0) {
-    ctx.problems.push_back(label + " has no triangles (" + std::to_string(points) + " points, " + std::to_string(lines) +
-                           " lines): skipped");
+    ctx.problems.push_back(
+        label + " has no triangles (" + std::to_string(points) + " points, " +
+        std::to_string(lines) + " lines): skipped");
     return;
   }
   if (points + lines > 0) {
-    ctx.problems.push_back(label + ": dropped " + std::to_string(points) + " points and " + std::to_string(lines) + " lines");
+    ctx.problems.push_back(
+        label + ": dropped " + std::to_string(points) + " points and " + std::to_string(lines) +
+        " lines");
   }
   if (am->mNumAnimMeshes > 0) {
-    ctx.problems.push_back(label + ": " + std::to_string(am->mNumAnimMeshes) + " morph targets ignored");
+    ctx.problems.push_back(
+        label + ": " + std::to_string(am->mNumAnimMeshes) + " morph targets ignored");
   }
   for (unsigned v = 0; v < am->mNumVertices; ++v) {
     if (!to_vector(am->mVertices[v]).allFinite()) {
@@ -510,19 +546,25 @@ void add_part(
       offset[b] =
           to_affine(bone->mOffsetMatrix, ctx, label + ", bone '" + bone_name + "' offset matrix") *
           shape.inverse();
-      if (bone->mNumWeights > 0 && bone->mWeights == nullptr) ctx.invalid(label + ", bone '" + bone_name + "' has no weight array");
+      if (bone->mNumWeights > 0 && bone->mWeights == nullptr)
+        ctx.invalid(label + ", bone '" + bone_name + "' has no weight array");
       const bool placed = bone_node[b] >= 0;  // a bone without a node says nothing about B
-      const Eigen::Affine3d at_rest = placed ? Eigen::Affine3d(h.scene_global[static_cast<std::size_t>(bone_node[b])] * offset[b]) : Eigen::Affine3d::Identity();
+      const Eigen::Affine3d at_rest =
+          placed
+              ? Eigen::Affine3d(h.scene_global[static_cast<std::size_t>(bone_node[b])] * offset[b])
+              : Eigen::Affine3d::Identity();
       for (unsigned k = 0; k < bone->mNumWeights; ++k) {
         const auto& vw = bone->mWeights[k];
         const double w = static_cast<double>(vw.mWeight);
         if (vw.mVertexId >= am->mNumVertices) {
-          ctx.invalid(label + ", bone '" + bone_name + "' weights vertex " + std::to_string(vw.mVertexId) +
-                      " out of range [0, " + std::to_string(am->mNumVertices) + ")");
+          ctx.invalid(
+              label + ", bone '" + bone_name + "' weights vertex " + std::to_string(vw.mVertexId) +
+              " out of range [0, " + std::to_string(am->mNumVertices) + ")");
         }
         if (!std::isfinite(w) || w < 0) {
-          ctx.invalid(label + ", bone '" + bone_name + "' has weight " + std::to_string(w) + " for vertex " +
-                      std::to_string(vw.mVertexId) + " (must be finite and >= 0)");
+          ctx.invalid(
+              label + ", bone '" + bone_name + "' has weight " + std::to_string(w) +
+              " for vertex " + std::to_string(vw.mVertexId) + " (must be finite and >= 0)");
         }
         if (w == 0 || !placed) continue;
         skinned[vw.mVertexId] += w * (at_rest * local[vw.mVertexId]);
@@ -544,7 +586,8 @@ void add_part(
     // otherwise: the scene frame reproduces the rest pose to within the file's precision and
     // the mesh frame does not.
     const double extent = (hi - lo).allFinite() ? (hi - lo).norm() : 0.0;
-    if (dev_scene < dev_mesh && dev_scene <= kBindFrameEvidence * extent) bind_frame = Eigen::Affine3d::Identity();
+    if (dev_scene < dev_mesh && dev_scene <= kBindFrameEvidence * extent)
+      bind_frame = Eigen::Affine3d::Identity();
     const double dev_chosen = bind_frame.matrix() == mesh_global.matrix() ? dev_mesh : dev_scene;
     // A bone whose node is missing (anim_test.x binds 'joint3', which no frame defines) can only
     // stay where the bind pose puts it: a static node of its own at the bind transform
@@ -553,7 +596,9 @@ void add_part(
       if (bone_node[b] >= 0) continue;
       const std::string bone_name = am->mBones[b]->mName.C_Str();
       bone_node[b] = add_static_node(rig.skeleton, h, bone_name, bind_frame * offset[b].inverse());
-      ctx.problems.push_back(label + ": bone '" + bone_name + "' names no node of the hierarchy; it stays in its bind pose");
+      ctx.problems.push_back(
+          label + ": bone '" + bone_name +
+          "' names no node of the hierarchy; it stays in its bind pose");
     }
     const double unit_scale = unit.linear()(0, 0);
     build.rest_pose_deviation = std::max(build.rest_pose_deviation, unit_scale * dev_chosen);
@@ -569,8 +614,10 @@ void add_part(
   for (unsigned f = 0; f < am->mNumFaces; ++f) {
     const aiFace& face = am->mFaces[f];
     if (face.mNumIndices != 3) continue;
-    build.triangles.push_back({base + static_cast<std::int32_t>(face.mIndices[0]), base + static_cast<std::int32_t>(face.mIndices[1]),
-                               base + static_cast<std::int32_t>(face.mIndices[2])});
+    build.triangles.push_back(
+        {base + static_cast<std::int32_t>(face.mIndices[0]),
+         base + static_cast<std::int32_t>(face.mIndices[1]),
+         base + static_cast<std::int32_t>(face.mIndices[2])});
     rig.mesh.face_part.push_back(part);
     rig.mesh.face_index_in_part.push_back(static_cast<std::int32_t>(f));
   }
@@ -590,16 +637,21 @@ void add_part(
     const Eigen::Affine3d inverse_bind = offset[b] * to_file;
     std::int32_t index = -1;
     for (std::size_t k = 0; k < build.bones.size(); ++k) {
-      if (build.bones[k].node == bone_node[b] && same_transform(build.bones[k].inverse_bind, inverse_bind)) {
+      if (build.bones[k].node == bone_node[b] &&
+          same_transform(build.bones[k].inverse_bind, inverse_bind)) {
         index = static_cast<std::int32_t>(k);
         break;
       }
     }
     if (index < 0) {
-      const bool node_taken = std::any_of(build.bones.begin(), build.bones.end(), [&](const PendingBone& p) { return p.node == bone_node[b]; });
+      const bool node_taken =
+          std::any_of(build.bones.begin(), build.bones.end(), [&](const PendingBone& p) {
+            return p.node == bone_node[b];
+          });
       if (node_taken) {
-        ctx.problems.push_back(label + ": bone '" + std::string(bone->mName.C_Str()) +
-                               "' has a different bind matrix than in another mesh; kept as a separate bone");
+        ctx.problems.push_back(
+            label + ": bone '" + std::string(bone->mName.C_Str()) +
+            "' has a different bind matrix than in another mesh; kept as a separate bone");
       }
       index = static_cast<std::int32_t>(build.bones.size());
       build.bones.push_back({bone_node[b], inverse_bind, bone->mName.C_Str()});
@@ -607,16 +659,19 @@ void add_part(
     for (unsigned k = 0; k < bone->mNumWeights; ++k) {
       const auto& vw = bone->mWeights[k];
       if (vw.mWeight > 0) {
-        build.weights.emplace_back(base + static_cast<int>(vw.mVertexId), index, static_cast<double>(vw.mWeight));
+        build.weights.emplace_back(
+            base + static_cast<int>(vw.mVertexId), index, static_cast<double>(vw.mWeight));
         weighted[vw.mVertexId] = true;
       }
     }
   }
   if (am->mNumBones > 0) {
-    const auto unweighted = static_cast<std::size_t>(std::count(weighted.begin(), weighted.end(), false));
+    const auto unweighted =
+        static_cast<std::size_t>(std::count(weighted.begin(), weighted.end(), false));
     if (unweighted > 0) {
-      ctx.problems.push_back(label + ": " + std::to_string(unweighted) +
-                             " vertices have no skin weight; they follow the mesh node rigidly");
+      ctx.problems.push_back(
+          label + ": " + std::to_string(unweighted) +
+          " vertices have no skin weight; they follow the mesh node rigidly");
     }
   }
 }
@@ -626,7 +681,8 @@ void finish_skin(MeshBuild& build, const Hierarchy& h, Rig& rig, Context& ctx) {
   std::vector<std::int32_t> order(build.bones.size());
   for (std::size_t i = 0; i < order.size(); ++i) order[i] = static_cast<std::int32_t>(i);
   std::stable_sort(order.begin(), order.end(), [&](std::int32_t a, std::int32_t b) {
-    return build.bones[static_cast<std::size_t>(a)].node < build.bones[static_cast<std::size_t>(b)].node;
+    return build.bones[static_cast<std::size_t>(a)].node <
+           build.bones[static_cast<std::size_t>(b)].node;
   });
   std::vector<std::int32_t> new_index(order.size());
   auto& bones = rig.skeleton.bones;
@@ -647,7 +703,8 @@ void finish_skin(MeshBuild& build, const Hierarchy& h, Rig& rig, Context& ctx) {
     if (slot < 0) slot = static_cast<std::int32_t>(b);
   }
   for (auto& bone : bones) {
-    for (auto n = rig.skeleton.nodes[static_cast<std::size_t>(bone.node)].parent; n >= 0; n = rig.skeleton.nodes[static_cast<std::size_t>(n)].parent) {
+    for (auto n = rig.skeleton.nodes[static_cast<std::size_t>(bone.node)].parent; n >= 0;
+         n = rig.skeleton.nodes[static_cast<std::size_t>(n)].parent) {
       if (bone_of_node[static_cast<std::size_t>(n)] >= 0) {
         bone.parent = bone_of_node[static_cast<std::size_t>(n)];
         break;
@@ -657,7 +714,8 @@ void finish_skin(MeshBuild& build, const Hierarchy& h, Rig& rig, Context& ctx) {
 
   // Weights: #V × #B, each non-empty row scaled to sum 1.
   const auto nv = static_cast<Eigen::Index>(build.positions.size());
-  for (auto& t : build.weights) t = Eigen::Triplet<double>(t.row(), new_index[static_cast<std::size_t>(t.col())], t.value());
+  for (auto& t : build.weights)
+    t = Eigen::Triplet<double>(t.row(), new_index[static_cast<std::size_t>(t.col())], t.value());
   rig.weights.resize(nv, static_cast<Eigen::Index>(bones.size()));
   rig.weights.setFromTriplets(build.weights.begin(), build.weights.end());
   rig.weights.makeCompressed();
@@ -675,8 +733,9 @@ void finish_skin(MeshBuild& build, const Hierarchy& h, Rig& rig, Context& ctx) {
     for (SkinWeights::InnerIterator it(rig.weights, v); it; ++it) it.valueRef() /= sum;
   }
   if (off > 0) {
-    ctx.problems.push_back("skin weights of " + std::to_string(off) + " vertices did not sum to 1 (from " +
-                           std::to_string(lowest) + " to " + std::to_string(highest) + "); normalised");
+    ctx.problems.push_back(
+        "skin weights of " + std::to_string(off) + " vertices did not sum to 1 (from " +
+        std::to_string(lowest) + " to " + std::to_string(highest) + "); normalised");
   }
 
   // Rest segments: head at the bone's joint in the bind pose; tail at the mean of its child
@@ -720,12 +779,16 @@ void finish_skin(MeshBuild& build, const Hierarchy& h, Rig& rig, Context& ctx) {
     if ((tail - bones[b].rest_head).norm() == 0.0) {
       double length = 0.05 * extent;
       if (bones[b].parent >= 0) {
-        const double to_parent = (bones[b].rest_head - bones[static_cast<std::size_t>(bones[b].parent)].rest_head).norm();
+        const double to_parent =
+            (bones[b].rest_head - bones[static_cast<std::size_t>(bones[b].parent)].rest_head)
+                .norm();
         if (to_parent > 0) length = 0.5 * to_parent;
       }
       const Eigen::Vector3d axis = bind_global[b].linear().col(1);
       const double axis_norm = axis.norm();
-      tail = bones[b].rest_head + (axis_norm > 0 ? Eigen::Vector3d(axis / axis_norm) : Eigen::Vector3d::UnitY()) * length;
+      tail =
+          bones[b].rest_head +
+          (axis_norm > 0 ? Eigen::Vector3d(axis / axis_norm) : Eigen::Vector3d::UnitY()) * length;
     }
     bones[b].rest_tail = tail;
   }
@@ -908,7 +971,8 @@ void check_raw_numbers(const aiScene* scene, const Context& ctx) {
   for (unsigned m = 0; m < scene->mNumMeshes; ++m) {
     const aiMesh* am = scene->mMeshes[m];
     if (am == nullptr) continue;
-    const std::string label = am->mName.length > 0 ? "mesh '" + std::string(am->mName.C_Str()) + "'" : "mesh " + std::to_string(m);
+    const std::string label = am->mName.length > 0 ? "mesh '" + std::string(am->mName.C_Str()) + "'"
+                                                   : "mesh " + std::to_string(m);
     for (unsigned v = 0; am->mVertices != nullptr && v < am->mNumVertices; ++v) {
       if (to_vector(am->mVertices[v]).allFinite()) continue;
       // assimp numbers an OBJ's vertices by face corner, not as the file does: our own reader of
@@ -919,9 +983,11 @@ void check_raw_numbers(const aiScene* scene, const Context& ctx) {
     }
     for (unsigned b = 0; am->mBones != nullptr && b < am->mNumBones; ++b) {
       const aiBone* bone = am->mBones[b];
-      for (unsigned k = 0; bone != nullptr && bone->mWeights != nullptr && k < bone->mNumWeights; ++k) {
+      for (unsigned k = 0; bone != nullptr && bone->mWeights != nullptr && k < bone->mNumWeights;
+           ++k) {
         if (!std::isfinite(bone->mWeights[k].mWeight)) {
-          ctx.invalid(label + ", bone '" + std::string(bone->mName.C_Str()) + "' has a non-finite weight");
+          ctx.invalid(
+              label + ", bone '" + std::string(bone->mName.C_Str()) + "' has a non-finite weight");
         }
       }
     }
@@ -957,14 +1023,19 @@ ImportedRig import_locked(const std::filesystem::path& file, const ImportOptions
   std::vector<std::string> warnings;
   for (const auto& line : log.lines()) {
     const auto l = lower(line);
-    if (l.find("out-of-range") != std::string::npos || l.find("out of range") != std::string::npos) {
+    if (l.find("out-of-range") != std::string::npos ||
+        l.find("out of range") != std::string::npos) {
       throw InvalidInput(ctx.file + ": " + line);
     }
-    if (l.find("bone weight sum") != std::string::npos) continue;  // we normalise and report it ourselves
-    if (std::find(warnings.begin(), warnings.end(), line) == warnings.end()) warnings.push_back(line);
+    if (l.find("bone weight sum") != std::string::npos)
+      continue;  // we normalise and report it ourselves
+    if (std::find(warnings.begin(), warnings.end(), line) == warnings.end())
+      warnings.push_back(line);
   }
-  if ((scene->mFlags & AI_SCENE_FLAGS_INCOMPLETE) != 0) throw InvalidInput(ctx.file + ": assimp marked the scene incomplete");
-  if (scene->mNumMeshes > 0 && scene->mMeshes == nullptr) ctx.invalid("the scene lists meshes it does not have");
+  if ((scene->mFlags & AI_SCENE_FLAGS_INCOMPLETE) != 0)
+    throw InvalidInput(ctx.file + ": assimp marked the scene incomplete");
+  if (scene->mNumMeshes > 0 && scene->mMeshes == nullptr)
+    ctx.invalid("the scene lists meshes it does not have");
 
   ImportedRig out;
   Rig& rig = out.rig;
@@ -987,45 +1058,61 @@ ImportedRig import_locked(const std::filesystem::path& file, const ImportOptions
   for (std::size_t n = 0; n < h.nodes.size(); ++n) {
     const aiNode* node = h.nodes[n];
     if (node == nullptr) continue;  // a static node added for a bone the file lacks
-    if (node->mNumMeshes > 0 && node->mMeshes == nullptr) ctx.invalid(node_label(node) + " lists meshes it does not have");
+    if (node->mNumMeshes > 0 && node->mMeshes == nullptr)
+      ctx.invalid(node_label(node) + " lists meshes it does not have");
     for (unsigned k = 0; k < node->mNumMeshes; ++k) {
       const auto mi = node->mMeshes[k];
       if (mi >= scene->mNumMeshes || scene->mMeshes[mi] == nullptr) {
-        ctx.invalid(node_label(node) + " refers to mesh " + std::to_string(mi) + " out of range [0, " + std::to_string(scene->mNumMeshes) + ")");
+        ctx.invalid(
+            node_label(node) + " refers to mesh " + std::to_string(mi) + " out of range [0, " +
+            std::to_string(scene->mNumMeshes) + ")");
       }
       add_part(scene, scene->mMeshes[mi], static_cast<std::int32_t>(n), h, unit, rig, build, ctx);
     }
   }
   if (build.triangles.empty()) ctx.invalid("no triangles in the file");
-  if (build.positions.size() > static_cast<std::size_t>(INT32_MAX)) ctx.invalid("too many vertices");
+  if (build.positions.size() > static_cast<std::size_t>(INT32_MAX))
+    ctx.invalid("too many vertices");
 
   rig.mesh.rest_positions.resize(static_cast<Eigen::Index>(build.positions.size()), 3);
-  for (std::size_t v = 0; v < build.positions.size(); ++v) rig.mesh.rest_positions.row(static_cast<Eigen::Index>(v)) = build.positions[v];
+  for (std::size_t v = 0; v < build.positions.size(); ++v)
+    rig.mesh.rest_positions.row(static_cast<Eigen::Index>(v)) = build.positions[v];
   rig.mesh.triangles.resize(static_cast<Eigen::Index>(build.triangles.size()), 3);
   for (std::size_t f = 0; f < build.triangles.size(); ++f) {
-    for (int k = 0; k < 3; ++k) rig.mesh.triangles(static_cast<Eigen::Index>(f), k) = build.triangles[f][static_cast<std::size_t>(k)];
+    for (int k = 0; k < 3; ++k)
+      rig.mesh.triangles(static_cast<Eigen::Index>(f), k) =
+          build.triangles[f][static_cast<std::size_t>(k)];
   }
   finish_skin(build, h, rig, ctx);
   out.rest_pose_deviation = build.rest_pose_deviation;
   read_clips(scene, h, rig, out.refused_clips, ctx);
 
   if (rig.mesh.num_vertices() > 0) {
-    const double size = (rig.mesh.rest_positions.colwise().maxCoeff() - rig.mesh.rest_positions.colwise().minCoeff()).norm();
+    const double size = (rig.mesh.rest_positions.colwise().maxCoeff() -
+                         rig.mesh.rest_positions.colwise().minCoeff())
+                            .norm();
     if (out.rest_pose_deviation > kBindFrameEvidence * size) {
-      ctx.problems.push_back("the node hierarchy's rest pose is not the skin's bind pose: skinned vertices move by up to " +
-                             std::to_string(out.rest_pose_deviation) + " (" +
-                             std::to_string(100.0 * out.rest_pose_deviation / size) + "% of the model's size) between them");
+      ctx.problems.push_back(
+          "the node hierarchy's rest pose is not the skin's bind pose: skinned vertices move by up "
+          "to " +
+          std::to_string(out.rest_pose_deviation) + " (" +
+          std::to_string(100.0 * out.rest_pose_deviation / size) +
+          "% of the model's size) between them");
     }
   }
   if (!ctx.shared_names.empty()) {
     std::string names;
-    for (const auto& [name, count] : ctx.shared_names) names += (names.empty() ? "'" : ", '") + name + "' (" + std::to_string(count) + ")";
-    ctx.problems.push_back("node names shared by several nodes: " + names +
-                           "; bones and channels bind to the namesake that hosts a bone, else has no mesh, else comes first");
+    for (const auto& [name, count] : ctx.shared_names)
+      names += (names.empty() ? "'" : ", '") + name + "' (" + std::to_string(count) + ")";
+    ctx.problems.push_back(
+        "node names shared by several nodes: " + names +
+        "; bones and channels bind to the namesake that hosts a bone, else has no mesh, else comes "
+        "first");
   }
   if (!ctx.clips_with_mesh_channels.empty()) {
-    ctx.problems.push_back(std::to_string(ctx.clips_with_mesh_channels.size()) +
-                           " clips also animate meshes or morph targets; ignored (only node transforms are animated)");
+    ctx.problems.push_back(
+        std::to_string(ctx.clips_with_mesh_channels.size()) +
+        " clips also animate meshes or morph targets; ignored (only node transforms are animated)");
   }
   // assimp's own remarks, after ours: warnings that differ only in their numbers are one line.
   std::vector<std::pair<std::string, std::size_t>> groups;  // (first instance, count)
@@ -1033,8 +1120,10 @@ ImportedRig import_locked(const std::filesystem::path& file, const ImportOptions
   for (const auto& w : warnings) {
     std::string pattern;
     for (char c : w) {
-      if (std::isdigit(static_cast<unsigned char>(c)) == 0) pattern += c;
-      else if (pattern.empty() || pattern.back() != '#') pattern += '#';
+      if (std::isdigit(static_cast<unsigned char>(c)) == 0)
+        pattern += c;
+      else if (pattern.empty() || pattern.back() != '#')
+        pattern += '#';
     }
     const auto it = std::find(patterns.begin(), patterns.end(), pattern);
     if (it == patterns.end()) {
@@ -1046,15 +1135,19 @@ ImportedRig import_locked(const std::filesystem::path& file, const ImportOptions
   }
   for (std::size_t i = 0; i < groups.size() && i < kMaxForwardedWarnings; ++i) {
     const auto& [first, count] = groups[i];
-    ctx.problems.push_back("assimp: " + first + (count > 1 ? " (and " + std::to_string(count - 1) + " similar)" : ""));
+    ctx.problems.push_back(
+        "assimp: " + first + (count > 1 ? " (and " + std::to_string(count - 1) + " similar)" : ""));
   }
   if (groups.size() > kMaxForwardedWarnings) {
-    ctx.problems.push_back("assimp: " + std::to_string(groups.size() - kMaxForwardedWarnings) + " more kinds of warning");
+    ctx.problems.push_back(
+        "assimp: " + std::to_string(groups.size() - kMaxForwardedWarnings) +
+        " more kinds of warning");
   }
   validate_rig(rig);
   // One line per distinct remark, in order of first appearance.
   for (auto& p : ctx.problems) {
-    if (std::find(out.problems.begin(), out.problems.end(), p) == out.problems.end()) out.problems.push_back(std::move(p));
+    if (std::find(out.problems.begin(), out.problems.end(), p) == out.problems.end())
+      out.problems.push_back(std::move(p));
   }
   return out;
 }
@@ -1070,15 +1163,19 @@ ImportedRig import_rig(const std::filesystem::path& file, const ImportOptions& o
   if (std::filesystem::file_size(file, ec) == 0 && !ec) throw IoError(name + ": empty file");
   detail::check_declared_counts(file);
 
-  std::lock_guard lock(import_mutex());
-  if (options.isolate) {
-    // A crash, a loop or a runaway allocation inside assimp ends the child, not this process.
+  std::unique_lock lock(import_mutex());
+  try {
+    if (!options.isolate) return import_locked(file, options);
+    // A crash, a loop or a runaway allocation inside assimp ends the child, not this process. The
+    // child's import is the only one: it sends the rig back, and this process decodes it.
     const detail::ImportLimits limits{
         .memory_bytes = options.memory_limit_bytes, .time_s = options.time_limit_s};
-    detail::run_isolated(file, limits, [&] { (void)import_locked(file, options); });
-  }
-  try {
-    return import_locked(file, options);
+    detail::ChildAnswer answer =
+        detail::run_isolated_with_answer(file, limits, [&](const detail::AnswerSink& send) {
+          detail::write_imported_rig(import_locked(file, options), send);
+        });
+    lock.unlock();  // decoding touches neither assimp nor its logger
+    return detail::read_imported_rig(answer, name);
   } catch (const std::bad_alloc&) {
     throw InvalidInput(name + ": ran out of memory importing it");
   }

@@ -24,9 +24,10 @@ struct ImportOptions {
   /// (FBX: GlobalSettings UnitScaleFactor, in centimetres). glTF is in metres by definition and
   /// assimp applies Collada's <unit>; other formats carry no unit and are taken as they are.
   bool convert_to_metres = true;
-  /// Read the file once in a child process before importing it here, so that a file on which
+  /// Import the file in a child process, which sends the result back, so that a file on which
   /// assimp crashes, loops or allocates without bound costs one line, not the process
-  /// (skinning/detail/import_guard.hpp). Off only for fuzzing the importer in-process.
+  /// (skinning/detail/import_guard.hpp, imported_rig_stream.hpp). The file is read once either
+  /// way. Off only for fuzzing the importer in-process.
   bool isolate = true;
   /// Address space that importing one file may use, bytes (checked in the child process).
   std::size_t memory_limit_bytes = kDefaultImportMemoryLimit;
@@ -42,6 +43,8 @@ struct RefusedClip {
   std::string reason;
 };
 
+/// What import_rig returns. A field added here must also cross from the import's child process to
+/// its parent: skinning/detail/imported_rig_stream.cpp, and the comparison in its test.
 struct ImportedRig {
   Rig rig;
   /// Clips left out of rig.clips because their data are unusable (each also has a line in
@@ -70,13 +73,15 @@ struct ImportedRig {
 ///
 /// @throws IoError when the file is missing, unreadable or assimp cannot parse it (the message
 ///         names the file and repeats assimp's reason), or when assimp crashed or exceeded
-///         `time_limit_s` reading it in the child process.
+///         `time_limit_s` reading it in the child process, or when the rig the child sent back
+///         arrives damaged (it never does but for a bug: every count is checked on arrival).
 /// @throws InvalidInput also when the file declares more elements than its size can hold, or
 ///         importing it needs more than `memory_limit_bytes`.
 /// @throws InvalidInput when the data are unusable: non-finite coordinates, transforms or
 ///         weights, indices out of range (also when assimp reports it dropped such faces), no
 ///         triangle at all, a node hierarchy with a cycle. A clip with unusable keys (out of
 ///         order, non-finite) does not throw: it is refused alone (ImportedRig::refused_clips).
-[[nodiscard]] ImportedRig import_rig(const std::filesystem::path& file, const ImportOptions& options = {});
+[[nodiscard]] ImportedRig import_rig(
+    const std::filesystem::path& file, const ImportOptions& options = {});
 
 }  // namespace skelcd::skinning

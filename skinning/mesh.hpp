@@ -1,13 +1,14 @@
 #pragma once
 // The triangle mesh every stage works on, as imported: file vertices (not welded) and triangles,
 // with the map back to the file's own numbering (part and index) for reporting.
+// A field added to Mesh must also cross from the import's child process to its parent:
+// skinning/detail/imported_rig_stream.cpp, and the comparison in its test.
 
+#include <Eigen/Core>
 #include <cstdint>
 #include <string>
 #include <utility>
 #include <vector>
-
-#include <Eigen/Core>
 
 namespace skelcd::skinning {
 

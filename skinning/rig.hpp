@@ -1,14 +1,15 @@
 #pragma once
 // A rigged character: mesh + skeleton (node hierarchy with bones) + skin weights + clips.
 // Importers (assimp) and generators fill it; linear blend skinning and RigMotion read it.
-
-#include <cstdint>
-#include <string>
-#include <vector>
+// A field added to a struct here must also cross from the import's child process to its parent:
+// skinning/detail/imported_rig_stream.cpp, and the comparison in its test.
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 #include <Eigen/SparseCore>
+#include <cstdint>
+#include <string>
+#include <vector>
 
 #include "skinning/mesh.hpp"
 
@@ -18,14 +19,14 @@ namespace skelcd::skinning {
 /// non-bone nodes between them whose animation still moves the bones below.
 struct SkeletonNode {
   std::string name;
-  std::int32_t parent = -1;           ///< index into Skeleton::nodes; parents precede children
+  std::int32_t parent = -1;  ///< index into Skeleton::nodes; parents precede children
   Eigen::Affine3d rest_local = Eigen::Affine3d::Identity();  ///< static local transform
 };
 
 struct Bone {
   std::string name;
-  std::int32_t node = -1;         ///< the node that moves this bone
-  std::int32_t parent = -1;       ///< nearest ancestor that is a bone, -1 for a root bone
+  std::int32_t node = -1;    ///< the node that moves this bone
+  std::int32_t parent = -1;  ///< nearest ancestor that is a bone, -1 for a root bone
   /// Object space (rest mesh) → bone space at bind time (assimp's offset matrix, with the mesh
   /// node's transform and the unit scale folded in so that rest positions are object space).
   Eigen::Affine3d inverse_bind = Eigen::Affine3d::Identity();

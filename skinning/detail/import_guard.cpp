@@ -1,6 +1,7 @@
 #include "skinning/detail/import_guard.hpp"
 
 #include <fcntl.h>
+#include <malloc.h>
 #include <poll.h>
 #include <sys/resource.h>
 #include <sys/wait.h>
@@ -624,16 +625,19 @@ std::size_t mapped_bytes() {
 }
 #endif
 
-// What the child tells its parent: one status byte, then the message.
+// What the child tells its parent: one status byte, then the message (or, after kOk, the probe's
+// answer).
 constexpr char kOk = 'O';
 constexpr char kInvalidInput = 'I';
 constexpr char kIoError = 'E';
 constexpr char kOutOfMemory = 'M';
 constexpr char kOther = 'X';
 
-void write_all(int fd, const std::string& data) {
-  const char* p = data.data();
-  std::size_t left = data.size();
+// Exit status of a child whose probe failed after part of its answer was already on its way (no
+// report can follow it: the parent reads an incomplete answer).
+constexpr int kBrokenAnswerExit = 76;
+
+void write_all(int fd, const char* p, std::size_t left) {
   while (left > 0) {
     const ssize_t n = ::write(fd, p, left);
     if (n < 0 && errno == EINTR) continue;
@@ -643,7 +647,54 @@ void write_all(int fd, const std::string& data) {
   }
 }
 
-[[noreturn]] void child(int fd, const ImportLimits& limits, const std::function<void()>& probe) {
+void write_all(int fd, const std::string& data) { write_all(fd, data.data(), data.size()); }
+
+// The child's answer on its way to the parent: kOk, then what the probe sends, a block at a time.
+// Nothing reaches the pipe before the first block is full, so a probe that fails before it has
+// sent that much still reports its failure instead.
+class AnswerWriter {
+ public:
+  explicit AnswerWriter(int fd) : fd_(fd), block_(kBlockBytes) {}
+
+  void write(const void* data, std::size_t n) {
+    const char* p = static_cast<const char*>(data);
+    if (n >= kBlockBytes) {  // a large array: straight through
+      flush();
+      write_all(fd_, p, n);
+      return;
+    }
+    while (n > 0) {
+      const std::size_t take = std::min(n, kBlockBytes - used_);
+      std::memcpy(block_.data() + used_, p, take);
+      used_ += take;
+      p += take;
+      n -= take;
+      if (used_ == kBlockBytes) flush();
+    }
+  }
+
+  // Sends kOk and whatever is buffered (also when the probe sent nothing).
+  void flush() {
+    if (!started_) {
+      write_all(fd_, &kOk, 1);
+      started_ = true;
+    }
+    write_all(fd_, block_.data(), used_);
+    used_ = 0;
+  }
+
+  [[nodiscard]] bool started() const { return started_; }
+
+ private:
+  static constexpr std::size_t kBlockBytes = std::size_t{64} << 10;
+  int fd_;
+  std::vector<char> block_;
+  std::size_t used_ = 0;
+  bool started_ = false;
+};
+
+[[noreturn]] void child(
+    int fd, const ImportLimits& limits, const std::function<void(const AnswerSink&)>& probe) {
 #if defined(SKELCD_UNDER_ASAN)
   // Under the sanitizers a library's memory error in the child is caught by ASan, which prints a
   // report of dozens of lines and exits 1 instead of dying by a signal: the user's stderr keeps
@@ -653,20 +704,27 @@ void write_all(int fd, const std::string& data) {
     ::close(null);
   }
 #endif
+  AnswerWriter answer(fd);  // its buffer before the limit, which is the probe's
   if (limits.memory_bytes > 0) {
 #if defined(SKELCD_UNDER_ASAN)
     asan_limit_bytes = static_cast<long long>(limits.memory_bytes);
     __sanitizer_install_malloc_and_free_hooks(asan_on_malloc, asan_on_free);
 #else
-    const rlim_t cap = static_cast<rlim_t>(mapped_bytes() + limits.memory_bytes);
+    // Heap the parent freed but still maps is room the probe allocates in without adding address
+    // space: it counts against the limit (a process that has imported a few models holds a few
+    // MB of it, as much as a small limit). The probe may still use `memory_bytes` in all.
+    const std::size_t reusable = std::min(::mallinfo2().fordblks, limits.memory_bytes);
+    const rlim_t cap = static_cast<rlim_t>(mapped_bytes() + limits.memory_bytes - reusable);
     const rlimit limit{cap, cap};
     setrlimit(RLIMIT_AS, &limit);
 #endif
   }
   std::string report;
   try {
-    probe();
-    report = kOk;
+    probe([&answer](const void* data, std::size_t size) { answer.write(data, size); });
+    answer.flush();
+    ::close(fd);
+    _exit(0);  // no atexit handlers, no stdio flush: the parent owns those
   } catch (const std::bad_alloc&) {
     report = kOutOfMemory;
   } catch (const InvalidInput& e) {
@@ -680,9 +738,10 @@ void write_all(int fd, const std::string& data) {
   } catch (...) {
     report = std::string(1, kOther) + "unknown exception";
   }
+  if (answer.started()) _exit(kBrokenAnswerExit);
   write_all(fd, report);
   ::close(fd);
-  _exit(0);  // no atexit handlers, no stdio flush: the parent owns those
+  _exit(0);
 }
 
 std::string signal_name(int sig) {
@@ -716,10 +775,42 @@ void check_declared_counts(const std::filesystem::path& file) {
   if (ext == ".md5mesh") check_md5mesh(file);
 }
 
+void ChildAnswer::append(std::vector<char> piece) {
+  if (piece.empty()) return;
+  size_ += piece.size();
+  pieces_.push_back(std::move(piece));
+}
+
+bool ChildAnswer::read(void* out, std::size_t n) {
+  if (n > size_) return false;
+  char* to = static_cast<char*>(out);
+  while (n > 0) {
+    const std::vector<char>& front = pieces_.front();
+    const std::size_t take = std::min(n, front.size() - offset_);
+    std::memcpy(to, front.data() + offset_, take);
+    to += take;
+    n -= take;
+    offset_ += take;
+    size_ -= take;
+    if (offset_ == front.size()) {  // read through: released
+      pieces_.pop_front();
+      offset_ = 0;
+    }
+  }
+  return true;
+}
+
 void run_isolated(
     const std::filesystem::path& file,
     const ImportLimits& limits,
     const std::function<void()>& probe) {
+  (void)run_isolated_with_answer(file, limits, [&probe](const AnswerSink&) { probe(); });
+}
+
+ChildAnswer run_isolated_with_answer(
+    const std::filesystem::path& file,
+    const ImportLimits& limits,
+    const std::function<void(const AnswerSink& send)>& probe) {
   const std::string name = file.string();
   int fds[2];
   if (::pipe(fds) != 0)
@@ -738,10 +829,18 @@ void run_isolated(
   }
   ::close(fds[1]);
 
-  // Read the child's report until it closes the pipe, within the time limit.
-  std::string report;
+  // Read the child's report until it closes the pipe, within the time limit, while it writes (a
+  // pipe holds 64 KiB: a child waiting for room would wait for ever). Pieces grow from 64 KiB to
+  // 4 MiB: small reports stay small, large answers take few allocations.
+  constexpr std::size_t kFirstPieceBytes = std::size_t{64} << 10;
+  constexpr std::size_t kLargestPieceBytes = std::size_t{4} << 20;
+  ChildAnswer answer;
+  std::vector<char> piece;
+  std::size_t filled = 0;
+  std::size_t received = 0;
   const auto start = std::chrono::steady_clock::now();
   bool timed_out = false;
+  bool too_large = false;
   for (;;) {
     int wait_ms = -1;
     if (limits.time_s > 0) {
@@ -758,14 +857,29 @@ void run_isolated(
     const int ready = ::poll(&p, 1, wait_ms);
     if (ready < 0 && errno == EINTR) continue;
     if (ready == 0) continue;  // the deadline is checked above
-    char buffer[4096];
-    const ssize_t n = ::read(fds[0], buffer, sizeof buffer);
+    if (filled == piece.size()) {
+      const std::size_t next =
+          piece.empty() ? kFirstPieceBytes : std::min(2 * piece.size(), kLargestPieceBytes);
+      answer.append(std::move(piece));
+      piece = std::vector<char>(next);
+      filled = 0;
+    }
+    const ssize_t n = ::read(fds[0], piece.data() + filled, piece.size() - filled);
     if (n < 0 && errno == EINTR) continue;
     if (n <= 0) break;
-    report.append(buffer, static_cast<std::size_t>(n));
+    filled += static_cast<std::size_t>(n);
+    received += static_cast<std::size_t>(n);
+    // An answer is what the child held in memory, written out: more than its limit is a child
+    // gone wrong, and this process would hold it all.
+    if (limits.memory_bytes > 0 && received > limits.memory_bytes) {
+      too_large = true;
+      break;
+    }
   }
+  piece.resize(filled);
+  answer.append(std::move(piece));
   ::close(fds[0]);
-  if (timed_out) ::kill(pid, SIGKILL);
+  if (timed_out || too_large) ::kill(pid, SIGKILL);
   int status = 0;
   while (::waitpid(pid, &status, 0) < 0 && errno == EINTR) {
   }
@@ -776,6 +890,9 @@ void run_isolated(
   }
   const std::string limit_text =
       "the import memory limit of " + mib(static_cast<double>(limits.memory_bytes));
+  const std::string over_memory =
+      name + ": importing it needs more memory than " + limit_text + " (--import-memory raises it)";
+  if (too_large) throw InvalidInput(over_memory);
   if (WIFSIGNALED(status)) {
     const int sig = WTERMSIG(status);
     if (sig == SIGKILL)
@@ -785,25 +902,31 @@ void run_isolated(
         name + ": " + limits.reader + " crashed reading it (" + signal_name(sig) +
         "); the file is damaged or uses a feature it cannot read");
   }
-  if (report.empty() && WIFEXITED(status) && WEXITSTATUS(status) == kOverMemoryExit)
-    report = kOutOfMemory;
-  if (report.empty()) {
+  const int exit_status = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  char kind = 0;
+  const bool answered = answer.read(&kind, 1);
+  if ((!answered || kind == kOk) && exit_status == kOverMemoryExit) throw InvalidInput(over_memory);
+  if (!answered) {
     throw IoError(
         name + ": " + limits.reader + " ended without an answer (exit status " +
-        std::to_string(WIFEXITED(status) ? WEXITSTATUS(status) : -1) + ")");
+        std::to_string(exit_status) + ")");
   }
-  const std::string message = report.substr(1);
-  switch (report.front()) {
-    case kOk:
-      return;
+  if (kind == kOk) {
+    if (exit_status != 0)
+      throw IoError(
+          name + ": " + limits.reader + " ended without completing its answer (exit status " +
+          std::to_string(exit_status) + ")");
+    return answer;
+  }
+  std::string message(answer.size(), '\0');
+  (void)answer.read(message.data(), message.size());
+  switch (kind) {
     case kInvalidInput:
       throw InvalidInput(message);
     case kIoError:
       throw IoError(message);
     case kOutOfMemory:
-      throw InvalidInput(
-          name + ": importing it needs more memory than " + limit_text +
-          " (--import-memory raises it)");
+      throw InvalidInput(over_memory);
     default:
       throw IoError(name + ": " + message);
   }

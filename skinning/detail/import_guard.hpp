@@ -5,13 +5,16 @@
 // files; skelcd must answer every input with a result or one line.
 
 #include <cstddef>
+#include <deque>
 #include <filesystem>
 #include <functional>
+#include <vector>
 
 namespace skelcd::skinning::detail {
 
 struct ImportLimits {
-  /// Address space the probe may add to what the process already maps, bytes.
+  /// Memory the probe may take, bytes: address space it may add to what the process already
+  /// maps, less the heap the process freed but still maps (which the probe allocates in first).
   std::size_t memory_bytes = 0;
   /// Wall-clock time the probe may take, seconds (<= 0: no limit).
   double time_s = 0.0;
@@ -25,6 +28,30 @@ struct ImportLimits {
 /// @throws InvalidInput "<file>: declares … but its N bytes hold at most …".
 void check_declared_counts(const std::filesystem::path& file);
 
+/// Where a probe run by run_isolated_with_answer sends its answer: bytes written in order reach the
+/// parent in that order (buffered in the child; the parent drains the pipe while the child writes,
+/// so an answer of any size goes through).
+using AnswerSink = std::function<void(const void* data, std::size_t size)>;
+
+/// The bytes a child process answered with, in the pieces they arrived in. Reading releases each
+/// piece once it has been read through, so that decoding the answer into its own structures does
+/// not hold the whole answer twice.
+class ChildAnswer {
+ public:
+  /// Appends `piece` after the bytes already held.
+  void append(std::vector<char> piece);
+  /// Bytes not yet read.
+  [[nodiscard]] std::size_t size() const { return size_; }
+  /// Copies the next `n` bytes into `out` and returns true; returns false and reads nothing when
+  /// fewer than `n` bytes are left.
+  [[nodiscard]] bool read(void* out, std::size_t n);
+
+ private:
+  std::deque<std::vector<char>> pieces_;
+  std::size_t offset_ = 0;  // into pieces_.front()
+  std::size_t size_ = 0;
+};
+
 /// Runs `probe` in a child process under `limits` (POSIX fork; the address-space limit is
 /// RLIMIT_AS, skipped under AddressSanitizer, whose own allocator limit applies there) and
 /// returns when it succeeded. The child's outcome becomes the parent's:
@@ -36,5 +63,17 @@ void run_isolated(
     const std::filesystem::path& file,
     const ImportLimits& limits,
     const std::function<void()>& probe);
+
+/// run_isolated for a probe that also answers: what `probe` writes to its sink comes back here
+/// (the child's own import is then the only one). Every outcome but success is reported as by
+/// run_isolated; besides, an answer larger than `limits.memory_bytes` (when set) is refused as
+/// over the memory limit, and a child that exits without completing its answer is an IoError.
+/// @note The answer is the child's bytes as sent: the caller decodes and validates them (a
+///       truncated answer, e.g. from a child killed while writing, is the caller's to detect when
+///       the child's exit does not already say so).
+[[nodiscard]] ChildAnswer run_isolated_with_answer(
+    const std::filesystem::path& file,
+    const ImportLimits& limits,
+    const std::function<void(const AnswerSink& send)>& probe);
 
 }  // namespace skelcd::skinning::detail

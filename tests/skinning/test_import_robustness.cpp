@@ -259,6 +259,80 @@ TEST(ImportGuard, AChildThatTakesTooLongIsStopped) {
   EXPECT_LT(std::chrono::steady_clock::now() - start, std::chrono::seconds(10));
 }
 
+// A probe's answer: `blocks` times the same 64 KiB of a pattern, sent as they are made.
+void send_blocks(const detail::AnswerSink& send, int blocks) {
+  std::vector<char> block(std::size_t{64} << 10);
+  for (std::size_t i = 0; i < block.size(); ++i) block[i] = static_cast<char>(i * 31 % 251);
+  for (int b = 0; b < blocks; ++b) send(block.data(), block.size());
+}
+
+TEST(ImportGuard, AnAnswerFarLargerThanThePipeArrivesWhole) {
+  // 32 MiB against a pipe of 64 KiB: the parent reads while the child writes (no deadlock).
+  const detail::ImportLimits limits{.memory_bytes = std::size_t{1} << 30, .time_s = 60};
+  auto answer = detail::run_isolated_with_answer(
+      "model.glb", limits, [](const detail::AnswerSink& send) { send_blocks(send, 512); });
+  ASSERT_EQ(answer.size(), std::size_t{32} << 20);
+  std::vector<char> block(std::size_t{64} << 10);
+  bool same = true;
+  for (int b = 0; b < 512; ++b) {
+    ASSERT_TRUE(answer.read(block.data(), block.size()));
+    for (std::size_t i = 0; i < block.size(); ++i)
+      same = same && block[i] == static_cast<char>(i * 31 % 251);
+  }
+  EXPECT_TRUE(same);
+  EXPECT_EQ(answer.size(), 0u);
+}
+
+TEST(ImportGuard, AFailureBeforeTheAnswerIsSentIsReportedAsBefore) {
+  // Less than a block sent, then a throw: the answer never left the child, the error does.
+  const detail::ImportLimits limits{.memory_bytes = std::size_t{1} << 30, .time_s = 60};
+  EXPECT_THROW_MESSAGE(
+      (void)detail::run_isolated_with_answer(
+          "model.glb",
+          limits,
+          [](const detail::AnswerSink& send) {
+            send("abc", 3);
+            throw InvalidInput("model.glb: vertex 3 is bad");
+          }),
+      InvalidInput,
+      "model.glb: vertex 3 is bad");
+}
+
+TEST(ImportGuard, AChildThatCrashesOrFailsWhileAnsweringIsReported) {
+  const detail::ImportLimits limits{.memory_bytes = std::size_t{1} << 30, .time_s = 60};
+  EXPECT_THROW_MESSAGE(
+      (void)detail::run_isolated_with_answer(
+          "model.glb",
+          limits,
+          [](const detail::AnswerSink& send) {
+            send_blocks(send, 16);
+            std::abort();
+          }),
+      IoError,
+      "model.glb: the importer (assimp) crashed reading it (SIGABRT)");
+  EXPECT_THROW_MESSAGE(
+      (void)detail::run_isolated_with_answer(
+          "model.glb",
+          limits,
+          [](const detail::AnswerSink& send) {
+            send_blocks(send, 16);
+            throw IoError("model.glb: too late to say so");
+          }),
+      IoError,
+      "model.glb: the importer (assimp) ended without completing its answer");
+}
+
+TEST(ImportGuard, AnAnswerLargerThanTheMemoryLimitIsRefused) {
+  // The child's answer is what it held: more than its limit is a child gone wrong, and the
+  // parent stops reading there instead of holding it all.
+  const detail::ImportLimits limits{.memory_bytes = std::size_t{1} << 20, .time_s = 60};
+  EXPECT_THROW_MESSAGE(
+      (void)detail::run_isolated_with_answer(
+          "model.glb", limits, [](const detail::AnswerSink& send) { send_blocks(send, 1 << 20); }),
+      InvalidInput,
+      "model.glb: importing it needs more memory than the import memory limit of 1 MiB");
+}
+
 TEST(ImportRobustness, ATinyImportMemoryLimitRefusesARealCharacter) {
   ImportOptions options;
   options.memory_limit_bytes = std::size_t{1} << 20;  // 1 MiB: CesiumMan needs more

@@ -18,7 +18,7 @@ void add_model_options(CLI::App& command, skinning::LoadOptions& options) {
       "--package-path",
       options.package_path,
       "robots: folder searched for package:// meshes (repeatable)");
-  // Memory that importing one model file may take, MiB; the import runs in a child process first,
+  // Memory that importing one model file may take, MiB; the import runs in a child process,
   // so a file that asks for more costs one line (docs/cli.md, "Broken files").
   command
       .add_option_function<double>(
