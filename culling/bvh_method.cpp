@@ -115,8 +115,7 @@ class BvhMethod final : public MethodBase {
     blocks_.start_ccd(topology_, bounds_, x_t0, x_t1, tests_, options_.accuracy, ccd_options_, out);
     start_self_traversal<N>(bvh_, scratch_);
     if (relative_pairs_) {
-      relative_.start(
-          RelativePairTrial::trial_pairs(options_.block_pairs, topology_.num_triangles()));
+      relative_.start(RelativePairTrial::trial_pairs(topology_.num_triangles()));
     }
     blocks_.drain([&](std::vector<TrianglePair>& pairs, std::size_t max_pairs) {
       const std::size_t first = pairs.size();

@@ -140,9 +140,9 @@ std::int64_t RelativeAabbFilter::filter(
   return removed;
 }
 
-std::size_t RelativePairTrial::trial_pairs(std::size_t block_pairs, std::int32_t num_triangles) {
-  return std::max<std::size_t>(
-      1, std::min(block_pairs, static_cast<std::size_t>(std::max(num_triangles, 0))));
+std::size_t RelativePairTrial::trial_pairs(std::int32_t num_triangles) {
+  return std::clamp<std::size_t>(
+      static_cast<std::size_t>(std::max(num_triangles, 0)), 1, kMaxTrial);
 }
 
 void RelativePairTrial::start(std::size_t trial) {
@@ -159,20 +159,33 @@ std::int64_t RelativePairTrial::filter(
     double half_width,
     std::vector<TrianglePair>& pairs,
     std::size_t first) {
-  if (state_ == State::dropped) return 0;
-  if (state_ == State::kept) return prepared_.filter(topology, half_width, pairs, first);
-  const auto seen = static_cast<std::int64_t>(pairs.size() - first);
-  const std::int64_t removed = relative_aabb_filter(topology, x_t0, x_t1, half_width, pairs, first);
-  seen_ += seen;
-  removed_ += removed;
-  if (seen_ >= static_cast<std::int64_t>(trial_)) {
-    if (static_cast<double>(removed_) >= kTrialShare * static_cast<double>(seen_)) {
-      prepared_.prepare(topology, x_t0, x_t1);
-      state_ = State::kept;
-    } else {
-      state_ = State::dropped;
+  assert(first <= pairs.size());
+  std::int64_t removed = 0;
+  if (state_ == State::trial) {
+    // Exactly the query's first trial_ pairs, from the positions, whatever the installments:
+    // the decision, and so every counter, is the same for any block size.
+    const std::size_t k = std::min(pairs.size() - first, trial_ - static_cast<std::size_t>(seen_));
+    const auto from = pairs.begin() + static_cast<std::ptrdiff_t>(first);
+    const auto to = from + static_cast<std::ptrdiff_t>(k);
+    const auto kept = std::remove_if(from, to, [&](const TrianglePair& p) {
+      if (shares_vertex(topology.triangle(p.a), topology.triangle(p.b))) return false;
+      return !relative_boxes_overlap(topology, p, x_t0, x_t1, half_width);
+    });
+    removed = static_cast<std::int64_t>(to - kept);
+    pairs.erase(kept, to);
+    seen_ += static_cast<std::int64_t>(k);
+    removed_ += removed;
+    first += k - static_cast<std::size_t>(removed);
+    if (seen_ >= static_cast<std::int64_t>(trial_)) {
+      if (static_cast<double>(removed_) >= kTrialShare * static_cast<double>(seen_)) {
+        prepared_.prepare(topology, x_t0, x_t1);
+        state_ = State::kept;
+      } else {
+        state_ = State::dropped;
+      }
     }
   }
+  if (state_ == State::kept) removed += prepared_.filter(topology, half_width, pairs, first);
   return removed;
 }
 

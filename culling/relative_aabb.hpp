@@ -77,16 +77,20 @@ class RelativeAabbFilter {
 /// percent of what a kept pair costs in the feature and elementary stages, and removes from none (a
 /// body at rest, a slow garment) to most of the pairs (a character with root motion, a falling
 /// cloth: what moves together). Each query starts with a trial on its first pairs, filtered one by
-/// one from the positions (relative_aabb_filter: nothing held); once the trial has seen its pairs,
-/// the filter is kept for the rest of the query when it removed at least kTrialShare of them (the
-/// per-triangle boxes are then prepared: RelativeAabbFilter), else no later pair is filtered.
+/// one from the positions (relative_boxes_overlap: nothing held); once the trial has seen its
+/// pairs, the filter is kept for the rest of the query when it removed at least kTrialShare of
+/// them (the per-triangle boxes are then prepared: RelativeAabbFilter), else no later pair is
+/// filtered. The trial is the query's first trial_pairs pairs in traversal order, which
+/// installments do not change, so the decision and every counter are the same for any block size.
 /// Either way the contacts are the same: a pair the filter removes has none.
 class RelativePairTrial {
  public:
   /// The share of the trial's pairs the filter must remove to be kept for the query.
   static constexpr double kTrialShare = 0.25;
-  /// Pairs of the trial: the first min(block_pairs, #triangles) pairs of the query (at least 1).
-  [[nodiscard]] static std::size_t trial_pairs(std::size_t block_pairs, std::int32_t num_triangles);
+  /// The longest trial, in pairs.
+  static constexpr std::size_t kMaxTrial = std::size_t{1} << 15;
+  /// Pairs of the trial: the query's first min(#triangles, kMaxTrial) pairs (at least 1).
+  [[nodiscard]] static std::size_t trial_pairs(std::int32_t num_triangles);
 
   /// Starts a query whose trial is its first `trial` pairs (≥ 1).
   void start(std::size_t trial);

@@ -49,13 +49,14 @@ struct Model {
 // A body carried along rigidly, far over one interval: the swept boxes of every pair overlap its
 // neighbours' along the whole path, the relative boxes are the body's own. The trial keeps the
 // filter, which removes most pairs; the contacts stay exactly those of the same 16-DOP hierarchy
-// without it and of `bvh` (none: the body is the rest pose, carried), also with blocks of 64 pairs
-// (the trial then spans many installments).
+// without it and of `bvh` (none: the body is the rest pose, carried), and the counters are the
+// same with blocks of 64 pairs (the trial then spans many installments) as in one piece.
 TEST(RelativePairs, ABodyCarriedFarKeepsTheFilterAndTheContacts) {
   const Model m("CesiumMan.glb");
   skinning::Positions far = m.rest;
   far.col(0).array() += 3.0;
   far.col(2).array() -= 1.0;
+  std::int64_t one_piece = -1;
   for (const std::size_t block : {std::size_t{1} << 15, std::size_t{64}}) {
     const MethodOptions options{.block_pairs = block};
     auto kdop = make_method("kdop", *m.loaded.mesh, m.topology, options);
@@ -67,6 +68,8 @@ TEST(RelativePairs, ABodyCarriedFarKeepsTheFilterAndTheContacts) {
     EXPECT_EQ(a.contacts, b.contacts) << block;
     EXPECT_EQ(a.contacts, c.contacts) << block;
     EXPECT_LT(a.candidate_pairs * 4, b.candidate_pairs) << block << ": most pairs removed";
+    if (one_piece < 0) one_piece = a.candidate_pairs;
+    EXPECT_EQ(a.candidate_pairs, one_piece) << block;
   }
 }
 
@@ -120,10 +123,10 @@ TEST(RelativePairs, TheTrialKeepsTheFilterOnlyWhenItRemovesAQuarterOfItsPairs) {
   const FeatureTopology ft(*m.loaded.mesh, m.topology);
   skinning::Positions far = m.rest;
   far.col(0).array() += 3.0;
-  const std::size_t trial =
-      RelativePairTrial::trial_pairs(std::size_t{1} << 15, ft.num_triangles());
+  const std::size_t trial = RelativePairTrial::trial_pairs(ft.num_triangles());
   EXPECT_EQ(trial, static_cast<std::size_t>(ft.num_triangles()));
-  EXPECT_EQ(RelativePairTrial::trial_pairs(64, ft.num_triangles()), 64u);
+  EXPECT_EQ(RelativePairTrial::trial_pairs(100'000), RelativePairTrial::kMaxTrial);
+  EXPECT_EQ(RelativePairTrial::trial_pairs(0), 1u);
 
   RelativePairTrial t;
   const auto moving = swept_pairs(ft, m.rest, far);
