@@ -65,6 +65,25 @@ bool relative_boxes_overlap(
   return a.overlaps(b);
 }
 
+namespace {
+
+/// Removes, in place (order kept), the pairs of [from, to) without a shared vertex whose relative
+/// boxes are apart; returns the new end of the range (the caller erases the rest of it).
+std::vector<TrianglePair>::iterator remove_apart(
+    const FeatureTopology& topology,
+    const skinning::Positions& x_t0,
+    const skinning::Positions& x_t1,
+    double half_width,
+    std::vector<TrianglePair>::iterator from,
+    std::vector<TrianglePair>::iterator to) {
+  return std::remove_if(from, to, [&](const TrianglePair& p) {
+    if (shares_vertex(topology.triangle(p.a), topology.triangle(p.b))) return false;
+    return !relative_boxes_overlap(topology, p, x_t0, x_t1, half_width);
+  });
+}
+
+}  // namespace
+
 std::int64_t relative_aabb_filter(
     const FeatureTopology& topology,
     const skinning::Positions& x_t0,
@@ -74,10 +93,7 @@ std::int64_t relative_aabb_filter(
     std::size_t first) {
   assert(first <= pairs.size());
   const auto from = pairs.begin() + static_cast<std::ptrdiff_t>(first);
-  const auto kept = std::remove_if(from, pairs.end(), [&](const TrianglePair& p) {
-    if (shares_vertex(topology.triangle(p.a), topology.triangle(p.b))) return false;
-    return !relative_boxes_overlap(topology, p, x_t0, x_t1, half_width);
-  });
+  const auto kept = remove_apart(topology, x_t0, x_t1, half_width, from, pairs.end());
   const auto removed = static_cast<std::int64_t>(pairs.end() - kept);
   pairs.erase(kept, pairs.end());
   return removed;
@@ -167,10 +183,7 @@ std::int64_t RelativePairTrial::filter(
     const std::size_t k = std::min(pairs.size() - first, trial_ - static_cast<std::size_t>(seen_));
     const auto from = pairs.begin() + static_cast<std::ptrdiff_t>(first);
     const auto to = from + static_cast<std::ptrdiff_t>(k);
-    const auto kept = std::remove_if(from, to, [&](const TrianglePair& p) {
-      if (shares_vertex(topology.triangle(p.a), topology.triangle(p.b))) return false;
-      return !relative_boxes_overlap(topology, p, x_t0, x_t1, half_width);
-    });
+    const auto kept = remove_apart(topology, x_t0, x_t1, half_width, from, to);
     removed = static_cast<std::int64_t>(to - kept);
     pairs.erase(kept, to);
     seen_ += static_cast<std::int64_t>(k);
