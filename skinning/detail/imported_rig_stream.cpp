@@ -138,9 +138,13 @@ class Reader {
 
 void write_mesh(Writer& w, const Mesh& mesh) {
   w.count(static_cast<std::size_t>(mesh.rest_positions.rows()));
-  w.block(mesh.rest_positions.data(), static_cast<std::size_t>(mesh.rest_positions.size()) * 8);
+  w.block(
+      mesh.rest_positions.data(),
+      static_cast<std::size_t>(mesh.rest_positions.size()) * sizeof(double));
   w.count(static_cast<std::size_t>(mesh.triangles.rows()));
-  w.block(mesh.triangles.data(), static_cast<std::size_t>(mesh.triangles.size()) * 4);
+  w.block(
+      mesh.triangles.data(),
+      static_cast<std::size_t>(mesh.triangles.size()) * sizeof(std::int32_t));
   w.array(mesh.face_part);
   w.array(mesh.face_index_in_part);
   w.array(mesh.vertex_part);
