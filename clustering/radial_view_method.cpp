@@ -807,6 +807,11 @@ void RadialViewMethod::ccd(const culling::Interval& interval, culling::FrameResu
   const double half_width = 0.5 * method_options_.min_separation;
   culling::swept_vertex_bounds<3>(x_t0, x_t1, half_width, bounds_.vertices);
   bounds_.derive(topology_);
+  // The unmasked pair traversals test node pairs in the relative motion too when the interval
+  // moves enough for it to prune (docs/culling.md "Relative boxes at the nodes").
+  const bool node_relative =
+      options_.relative_aabb &&
+      culling::motion_scale(topology_, x_t0, x_t1) >= culling::kNodeRelativeMotion;
   for (std::int32_t a = 0; a < clusters_.num_atomic(); ++a) {
     auto& local = clusters_.local_bvh(a);
     if (local.empty()) {
@@ -814,6 +819,9 @@ void RadialViewMethod::ccd(const culling::Interval& interval, culling::FrameResu
       continue;
     }
     local.refit(bounds_.triangles);
+    if (node_relative) {
+      local.refit_end_boxes(topology_.welded_triangles(), x_t0, x_t1, half_width);
+    }
     cluster_bounds_[at(a)] = local.node_bounds()[0];
   }
   clusters_.global_bvh().refit(cluster_bounds_);

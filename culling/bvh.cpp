@@ -243,6 +243,7 @@ std::int32_t Bvh<N>::build_range(std::int32_t begin, std::int32_t end, int depth
 template <int N>
 void Bvh<N>::refit(std::span<const Volume> triangle_bounds) {
   constexpr auto kN = static_cast<std::size_t>(N);
+  end_boxes_ready_ = false;  // they were of another interval
   if (!node_volumes_) {
     refit_wide_only(triangle_bounds);
     return;
@@ -393,6 +394,81 @@ void Bvh<N>::refit_wide_only(std::span<const Volume> triangle_bounds) {
       }
     }
   }
+}
+
+template <int N>
+void Bvh<N>::refit_end_boxes(
+    const skinning::Triangles& triangles,
+    const skinning::Positions& x_t0,
+    const skinning::Positions& x_t1,
+    double half_width) {
+  end_boxes_.resize(wide_.size());
+  constexpr float kInf = std::numeric_limits<float>::infinity();
+  // Lower and upper ends of a corner coordinate grown by half_width, rounded outwards.
+  const auto below = [half_width](double x) {
+    return float_below(half_width > 0.0 ? next_down(x - half_width) : x);
+  };
+  const auto above = [half_width](double x) {
+    return float_above(half_width > 0.0 ? next_up(x + half_width) : x);
+  };
+  // As refit_wide_only: children after their parent, so one backward sweep is bottom-up; a bucket
+  // lane from its triangles' corners, an inner lane the union of its wide node's lanes (the min
+  // of rounded ends is the rounded min).
+  for (std::size_t n = wide_.size(); n-- > 0;) {
+    const WideBvhNode<N>& w = wide_[n];
+    WideEndBoxes& e = end_boxes_[n];
+    for (std::size_t k = 0; k < 3; ++k) {
+      for (std::size_t i = 0; i < 4; ++i) {
+        e.lo0[k][i] = e.lo1[k][i] = kInf;
+        e.hi0[k][i] = e.hi1[k][i] = -kInf;
+      }
+    }
+    for (int lane = 0; lane < w.num_children; ++lane) {
+      const auto i = static_cast<std::size_t>(lane);
+      if (w.child[i] < 0) {
+        const auto begin = static_cast<std::size_t>(~w.child[i]);
+        const auto end = begin + static_cast<std::size_t>(w.count[i]);
+        std::array<double, 3> lo0, hi0, lo1, hi1;
+        lo0.fill(std::numeric_limits<double>::infinity());
+        lo1 = lo0;
+        hi0.fill(-std::numeric_limits<double>::infinity());
+        hi1 = hi0;
+        for (std::size_t s = begin; s < end; ++s) {
+          const auto f = static_cast<Eigen::Index>(order_[s]);
+          for (Eigen::Index j = 0; j < 3; ++j) {
+            const Eigen::Index v = triangles(f, j);
+            const double* p0 = x_t0.data() + 3 * v;  // row-major #W × 3
+            const double* p1 = x_t1.data() + 3 * v;
+            for (std::size_t k = 0; k < 3; ++k) {
+              lo0[k] = std::min(lo0[k], p0[k]);
+              hi0[k] = std::max(hi0[k], p0[k]);
+              lo1[k] = std::min(lo1[k], p1[k]);
+              hi1[k] = std::max(hi1[k], p1[k]);
+            }
+          }
+        }
+        for (std::size_t k = 0; k < 3; ++k) {
+          e.lo0[k][i] = below(lo0[k]);
+          e.hi0[k][i] = above(hi0[k]);
+          e.lo1[k][i] = below(lo1[k]);
+          e.hi1[k][i] = above(hi1[k]);
+        }
+      } else {
+        const WideBvhNode<N>& cw = wide_[static_cast<std::size_t>(w.child[i])];
+        const WideEndBoxes& ce = end_boxes_[static_cast<std::size_t>(w.child[i])];
+        for (std::size_t k = 0; k < 3; ++k) {
+          for (int j = 0; j < cw.num_children; ++j) {
+            const auto l = static_cast<std::size_t>(j);
+            e.lo0[k][i] = std::min(e.lo0[k][i], ce.lo0[k][l]);
+            e.hi0[k][i] = std::max(e.hi0[k][i], ce.hi0[k][l]);
+            e.lo1[k][i] = std::min(e.lo1[k][i], ce.lo1[k][l]);
+            e.hi1[k][i] = std::max(e.hi1[k][i], ce.hi1[k][l]);
+          }
+        }
+      }
+    }
+  }
+  end_boxes_ready_ = true;
 }
 
 template class Bvh<3>;

@@ -81,6 +81,18 @@ struct alignas(16) WideBvhNode {
   std::int32_t num_children;   ///< lanes in use, 1..4 (lanes 0 .. num_children − 1)
 };
 
+/// The lanes of one wide node as boxes at the two ends of an interval (Bvh::refit_end_boxes): the
+/// box of the lane's triangles' corners at t = 0 (lo0, hi0) and at t = 1 (lo1, hi1), grown by a
+/// half width, as floats rounded outwards, axis by axis four lanes side by side like
+/// WideBvhNode's (unused lanes empty). A traversal tests two lanes' boxes in the motion relative
+/// to a common velocity (culling/traversal.hpp, docs/culling.md "Relative boxes at the nodes").
+struct alignas(16) WideEndBoxes {
+  float lo0[3][4];
+  float hi0[3][4];
+  float lo1[3][4];
+  float hi1[3][4];
+};
+
 /// Hierarchy of Dop<N> volumes (Dop<3>: AABB, Dop<8>: 16-DOP) over a set of triangles.
 template <int N>
 class Bvh {
@@ -154,6 +166,21 @@ class Bvh {
   [[nodiscard]] const float* slot_hi(int k) const {
     return slot_bounds_.data() + static_cast<std::size_t>(kSlotAxes + k) * slot_stride();
   }
+  /// Fills end_boxes() for the interval x_t0 → x_t1 (welded positions, rows indexed by the
+  /// vertex ids of `triangles`, the triangles the tree was built from), each box grown by
+  /// half_width. Valid until the next refit() (which drops them), so that a traversal never
+  /// reads boxes of another interval. Allocates once (#wide nodes × 192 bytes).
+  void refit_end_boxes(
+      const skinning::Triangles& triangles,
+      const skinning::Positions& x_t0,
+      const skinning::Positions& x_t1,
+      double half_width);
+  /// The wide nodes' end boxes (WideEndBoxes), by wide node; empty unless refit_end_boxes ran
+  /// after the last refit().
+  [[nodiscard]] std::span<const WideEndBoxes> end_boxes() const {
+    return end_boxes_ready_ ? std::span<const WideEndBoxes>(end_boxes_)
+                            : std::span<const WideEndBoxes>();
+  }
   /// Wide nodes on the longest path from the virtual root to a leaf, the virtual root included
   /// (1 when the tree is one leaf; 0 when empty).
   [[nodiscard]] int wide_depth() const { return wide_depth_; }
@@ -173,6 +200,8 @@ class Bvh {
   std::vector<FloatDop<N>> float_node_bounds_;
   std::vector<std::int32_t> order_;
   std::vector<WideBvhNode<N>> wide_;
+  std::vector<WideEndBoxes> end_boxes_;
+  bool end_boxes_ready_ = false;
   [[nodiscard]] std::size_t slot_stride() const { return order_.size() + kSlotPadding; }
   static constexpr std::size_t kSlotPadding = 3;
   std::vector<float> slot_bounds_;  // 2·kSlotAxes rows of slot_stride(): lo by axis, then hi

@@ -108,6 +108,11 @@ class BvhMethod final : public MethodBase {
     swept_vertex_bounds<N>(x_t0, x_t1, 0.5 * options_.min_separation, bounds_.vertices);
     bounds_.derive(topology_, /*with_edges=*/false);
     bvh_.refit(bounds_.triangles);
+    // `kdop`: node pairs tested in the relative motion too when the interval moves enough for it
+    // to prune (docs/culling.md "Relative boxes at the nodes").
+    if (relative_pairs_ && motion_scale(topology_, x_t0, x_t1) >= kNodeRelativeMotion) {
+      bvh_.refit_end_boxes(topology_.welded_triangles(), x_t0, x_t1, 0.5 * options_.min_separation);
+    }
     const auto t1 = Clock::now();
     // Self traversal → triangle pairs → de-duplicated feature pairs → tests, in blocks of
     // block_pairs triangle pairs: the candidates held at once stay bounded on any motion (the

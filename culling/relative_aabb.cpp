@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <cassert>
+#include <cmath>
 
 #include "culling/dop.hpp"
 
@@ -154,6 +155,40 @@ std::int64_t RelativeAabbFilter::filter(
   const auto removed = static_cast<std::int64_t>(pairs.end() - kept);
   pairs.erase(kept, pairs.end());
   return removed;
+}
+
+double motion_scale(
+    const FeatureTopology& topology,
+    const skinning::Positions& x_t0,
+    const skinning::Positions& x_t1) {
+  const Eigen::Index num_vertices = std::min(x_t0.rows(), x_t1.rows());
+  const std::int32_t num_triangles = topology.num_triangles();
+  if (num_vertices == 0 || num_triangles == 0) return 0.0;
+  double moved = 0.0;
+  for (Eigen::Index v = 0; v < num_vertices; ++v) {
+    moved += std::max(
+        {std::abs(x_t1(v, 0) - x_t0(v, 0)),
+         std::abs(x_t1(v, 1) - x_t0(v, 1)),
+         std::abs(x_t1(v, 2) - x_t0(v, 2))});
+  }
+  double size = 0.0;
+  for (std::int32_t f = 0; f < num_triangles; ++f) {
+    const auto& t = topology.triangle(f);
+    const auto a = static_cast<Eigen::Index>(t[0]);
+    const auto b = static_cast<Eigen::Index>(t[1]);
+    const auto c = static_cast<Eigen::Index>(t[2]);
+    double side = 0.0;
+    for (Eigen::Index k = 0; k < 3; ++k) {
+      side = std::max(
+          side,
+          std::max({x_t0(a, k), x_t0(b, k), x_t0(c, k)}) -
+              std::min({x_t0(a, k), x_t0(b, k), x_t0(c, k)}));
+    }
+    size += side;
+  }
+  const double scale =
+      (moved / static_cast<double>(num_vertices)) / (size / static_cast<double>(num_triangles));
+  return std::isfinite(scale) ? scale : 0.0;
 }
 
 std::size_t RelativePairTrial::trial_pairs(std::int32_t num_triangles) {

@@ -72,6 +72,22 @@ class RelativeAabbFilter {
   std::vector<Triangle> triangles_;
 };
 
+/// How far an interval moves its vertices against the size of its triangles: the mean over the
+/// vertices of their largest coordinate displacement, over the mean over the triangles of the
+/// longest side of their box at t = 0 (0 when either mean is 0 or not finite). The hierarchy
+/// methods test node pairs in the relative motion as well (Bvh::refit_end_boxes) from
+/// kNodeRelativeMotion on: below it the swept boxes are barely larger than the still ones and
+/// the relative test cannot prune what the swept one keeps (docs/culling.md "Relative boxes at
+/// the nodes"). O(#W + #F).
+/// @param x_t0,x_t1 #W × 3 welded positions.
+[[nodiscard]] double motion_scale(
+    const FeatureTopology& topology,
+    const skinning::Positions& x_t0,
+    const skinning::Positions& x_t1);
+
+/// The motion_scale from which node pairs are tested in the relative motion too.
+inline constexpr double kNodeRelativeMotion = 0.3;
+
 /// A CCD query's triangle pairs through the relative AABB filter when that pays (`kdop`,
 /// docs/culling.md "Relative boxes in `kdop`"): the filter costs about as much per pair as a few
 /// percent of what a kept pair costs in the feature and elementary stages, and removes from none (a

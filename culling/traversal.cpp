@@ -4,6 +4,7 @@
 #include <array>
 #include <bit>
 #include <cassert>
+#include <cmath>
 #include <cstdint>
 #include <limits>
 
@@ -63,6 +64,77 @@ inline unsigned overlap_lanes(const WideBvhNode<N>& w, const WideBvhNode<N>& q, 
 #endif
 }
 
+}  // namespace
+
+unsigned end_boxes_meet(const WideEndBoxes& w, const WideEndBoxes& q, int lane) {
+#if defined(__SSE2__)
+  const __m128 sign = _mm_set1_ps(-0.0f);
+  const __m128 scale = _mm_set1_ps(0x1p-22f);
+  const __m128 tiny = _mm_set1_ps(std::numeric_limits<float>::min());
+  const __m128 largest = _mm_set1_ps(std::numeric_limits<float>::max());
+  const __m128 quarter = _mm_set1_ps(0.25f);
+  // The margin that puts fl(x) below (above) every value it may have rounded.
+  const auto margin = [&](__m128 x) {
+    return _mm_add_ps(_mm_mul_ps(_mm_andnot_ps(sign, x), scale), tiny);
+  };
+  __m128 ok = _mm_castsi128_ps(_mm_set1_epi32(-1));
+  for (int k = 0; k < 3; ++k) {
+    const __m128 w_lo0 = _mm_load_ps(w.lo0[k]);
+    const __m128 w_hi0 = _mm_load_ps(w.hi0[k]);
+    const __m128 w_lo1 = _mm_load_ps(w.lo1[k]);
+    const __m128 w_hi1 = _mm_load_ps(w.hi1[k]);
+    const __m128 q_lo0 = _mm_set1_ps(q.lo0[k][lane]);
+    const __m128 q_hi0 = _mm_set1_ps(q.hi0[k][lane]);
+    const __m128 q_lo1 = _mm_set1_ps(q.lo1[k][lane]);
+    const __m128 q_hi1 = _mm_set1_ps(q.hi1[k][lane]);
+    // u = ((centre₁ − centre₀) of w's lane + that of q's lane) / 2, twice-centres halved twice.
+    const __m128 dw = _mm_sub_ps(_mm_add_ps(w_lo1, w_hi1), _mm_add_ps(w_lo0, w_hi0));
+    const __m128 dq = _mm_sub_ps(_mm_add_ps(q_lo1, q_hi1), _mm_add_ps(q_lo0, q_hi0));
+    __m128 u = _mm_mul_ps(_mm_add_ps(dw, dq), quarter);
+    u = _mm_and_ps(u, _mm_cmple_ps(_mm_andnot_ps(sign, u), largest));  // NaN, ±inf → 0
+    const __m128 w_lo = _mm_sub_ps(w_lo1, u);
+    const __m128 w_hi = _mm_sub_ps(w_hi1, u);
+    const __m128 q_lo = _mm_sub_ps(q_lo1, u);
+    const __m128 q_hi = _mm_sub_ps(q_hi1, u);
+    const __m128 w_rlo = _mm_min_ps(w_lo0, _mm_sub_ps(w_lo, margin(w_lo)));
+    const __m128 w_rhi = _mm_max_ps(w_hi0, _mm_add_ps(w_hi, margin(w_hi)));
+    const __m128 q_rlo = _mm_min_ps(q_lo0, _mm_sub_ps(q_lo, margin(q_lo)));
+    const __m128 q_rhi = _mm_max_ps(q_hi0, _mm_add_ps(q_hi, margin(q_hi)));
+    ok = _mm_and_ps(ok, _mm_cmple_ps(w_rlo, q_rhi));
+    ok = _mm_and_ps(ok, _mm_cmple_ps(q_rlo, w_rhi));
+  }
+  return static_cast<unsigned>(_mm_movemask_ps(ok));
+#else
+  constexpr float kLargest = std::numeric_limits<float>::max();
+  const auto margin = [](float x) {
+    return std::abs(x) * 0x1p-22f + std::numeric_limits<float>::min();
+  };
+  unsigned mask = 0;
+  for (int i = 0; i < kWidth; ++i) {
+    bool hit = true;
+    for (int k = 0; k < 3; ++k) {
+      const float dw = (w.lo1[k][i] + w.hi1[k][i]) - (w.lo0[k][i] + w.hi0[k][i]);
+      const float dq = (q.lo1[k][lane] + q.hi1[k][lane]) - (q.lo0[k][lane] + q.hi0[k][lane]);
+      float u = (dw + dq) * 0.25f;
+      if (!(std::abs(u) <= kLargest)) u = 0.0f;
+      const float w_lo = w.lo1[k][i] - u;
+      const float w_hi = w.hi1[k][i] - u;
+      const float q_lo = q.lo1[k][lane] - u;
+      const float q_hi = q.hi1[k][lane] - u;
+      const float w_rlo = std::min(w.lo0[k][i], w_lo - margin(w_lo));
+      const float w_rhi = std::max(w.hi0[k][i], w_hi + margin(w_hi));
+      const float q_rlo = std::min(q.lo0[k][lane], q_lo - margin(q_lo));
+      const float q_rhi = std::max(q.hi0[k][lane], q_hi + margin(q_hi));
+      hit = hit && w_rlo <= q_rhi && q_rlo <= w_rhi;
+    }
+    mask |= static_cast<unsigned>(hit) << i;
+  }
+  return mask;
+#endif
+}
+
+namespace {
+
 /// Bit i set when corner i (0..2) of `a` is a vertex of `b` (corners as in SlotAdjacency::corners;
 /// negative ids never match).
 inline unsigned shared_lanes(
@@ -110,6 +182,9 @@ class Walk {
         order_b_(b.triangle_order()),
         bounds_a_(bounds_a),
         bounds_b_(bounds_b),
+        ends_a_(a.end_boxes()),
+        ends_b_(b.end_boxes()),
+        relative_(!ends_a_.empty() && !ends_b_.empty()),
         stack_(stack),
         out_(out),
         bv_tests_(bv_tests),
@@ -150,6 +225,8 @@ class Walk {
     for (int i = 0; i + 1 < m; ++i) {
       // Children i < j: lanes above i.
       unsigned mask = overlap_lanes<N>(w, w, i) & ~((2u << i) - 1u);
+      if (relative_ && mask != 0)
+        mask &= end_boxes_meet(ends_a_[to_size(c)], ends_a_[to_size(c)], i);
       bv_tests_ += m - 1 - i;
       while (mask != 0) {
         const int j = std::countr_zero(mask);
@@ -180,6 +257,9 @@ class Walk {
     if (cb < 0 || (ca >= 0 && pa.count[la] >= pb.count[lb])) {
       const WideBvhNode<N>& w = wide_a_[to_size(ca)];
       unsigned mask = overlap_lanes<N>(w, pb, lb);
+      if (relative_ && mask != 0) {
+        mask &= end_boxes_meet(ends_a_[to_size(ca)], ends_b_[node_of(sb)], lb);
+      }
       bv_tests_ += w.num_children;
       while (mask != 0) {
         const int i = std::countr_zero(mask);
@@ -193,6 +273,9 @@ class Walk {
     } else {
       const WideBvhNode<N>& w = wide_b_[to_size(cb)];
       unsigned mask = overlap_lanes<N>(w, pa, la);
+      if (relative_ && mask != 0) {
+        mask &= end_boxes_meet(ends_b_[to_size(cb)], ends_a_[node_of(sa)], la);
+      }
       bv_tests_ += w.num_children;
       while (mask != 0) {
         const int j = std::countr_zero(mask);
@@ -338,6 +421,11 @@ class Walk {
   std::span<const std::int32_t> order_b_;
   std::span<const Dop<N>> bounds_a_;
   std::span<const Dop<N>> bounds_b_;
+  // The wide nodes' end boxes when both trees have them for this interval: node pairs are then
+  // also tested in the relative motion (end_boxes_meet).
+  std::span<const WideEndBoxes> ends_a_;
+  std::span<const WideEndBoxes> ends_b_;
+  bool relative_;
   std::vector<Entry>& stack_;
   std::vector<TrianglePair>& out_;
   std::int64_t& bv_tests_;

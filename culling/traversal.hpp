@@ -59,6 +59,18 @@ void certified_slots(
     std::span<const std::uint8_t> certified,
     std::vector<std::uint8_t>& full);
 
+/// Bit i set when child i of wide node `w` (its lane i) and lane `lane` of wide node `q` may come
+/// within reach of each other over the interval, judged by their end boxes (Bvh::end_boxes) in
+/// the motion relative to a common velocity u (docs/culling.md "Relative boxes at the nodes"). A
+/// point x(t) = (1 − t) x₀ + t x₁ of a lane's triangles, minus t u, stays in the hull of the lane's
+/// box at t = 0 and its box at t = 1 shifted by −u; two points within reach of each other stay so
+/// when both lose the same t u. Any u is sound: u is half the sum of the two lanes' box-centre
+/// displacements (the pair's mean motion), 0 where that is not finite. The shifted ends are
+/// rounded outwards by a margin: x − (fl(|x|·2⁻²²) + FLT_MIN), rounded, is below every value
+/// that rounds to x, for any float x (and above for +). Bits of unused lanes are 0. The self and
+/// pair traversals apply it to every node pair when both trees have end boxes.
+[[nodiscard]] unsigned end_boxes_meet(const WideEndBoxes& w, const WideEndBoxes& q, int lane);
+
 /// Caller-owned scratch of a traversal: the stack of pending node pairs. Reserve it once for the
 /// hierarchies it will traverse; a traversal then allocates nothing. One per thread when
 /// traversals run in parallel (a stack seeded with a frontier of node pairs is the unit to split).

@@ -1,0 +1,228 @@
+// Relative boxes at the nodes (Bvh::refit_end_boxes, end_boxes_meet; docs/culling.md "Relative
+// boxes at the nodes"): the wide nodes' boxes at both ends of an interval hold every corner of
+// their triangles, a refit drops them, two lanes that meet in the relative motion are never told
+// apart, and on a body carried far while it moves the traversal prunes most node pairs while
+// `kdop` keeps exactly `bvh`'s contacts (`dynamic`'s: tests/clustering, the real clips).
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "culling/bvh.hpp"
+#include "culling/candidates.hpp"
+#include "culling/feature_topology.hpp"
+#include "culling/method.hpp"
+#include "culling/relative_aabb.hpp"
+#include "culling/traversal.hpp"
+#include "culling/vertex_bounds.hpp"
+#include "skinning/load.hpp"
+#include "skinning/topology.hpp"
+#include "tests/support/test_support.hpp"
+
+namespace skelcd::culling {
+namespace {
+
+struct Model {
+  explicit Model(const std::string& file)
+      : loaded(skinning::load_model(test::asset("characters/" + file))),
+        topology(skinning::build_topology(*loaded.mesh)) {
+    skinning::gather_welded(topology, loaded.mesh->rest_positions, rest);
+  }
+  skinning::LoadedModel loaded;
+  skinning::Topology topology;
+  skinning::Positions rest;
+};
+
+/// The welded positions of sample k of the model's first clip.
+skinning::Positions sample(const Model& m, int k) {
+  skinning::Positions posed, welded;
+  m.loaded.motion()->positions(k, posed);
+  skinning::gather_welded(m.topology, posed, welded);
+  return welded;
+}
+
+/// The triangle pairs of a self traversal of `bvh` refit over x0 → x1, with or without its end
+/// boxes, and its volume tests.
+struct Traversed {
+  std::vector<TrianglePair> pairs;
+  std::int64_t bv_tests = 0;
+};
+Traversed traverse(
+    Bvh<3>& bvh,
+    const FeatureTopology& ft,
+    const skinning::Positions& x0,
+    const skinning::Positions& x1,
+    bool end_boxes) {
+  FeatureBounds<3> bounds;
+  swept_vertex_bounds<3>(x0, x1, 0.0, bounds.vertices);
+  bounds.derive(ft, /*with_edges=*/false);
+  bvh.refit(bounds.triangles);
+  if (end_boxes) bvh.refit_end_boxes(ft.welded_triangles(), x0, x1, 0.0);
+  EXPECT_EQ(bvh.end_boxes().empty(), !end_boxes);
+  TraversalScratch scratch;
+  Traversed t;
+  self_traverse<3>(bvh, bounds.triangles, scratch, t.pairs, t.bv_tests);
+  std::sort(t.pairs.begin(), t.pairs.end());
+  return t;
+}
+
+// Every lane's boxes hold its triangles' corners at t = 0 and t = 1, grown by the half width;
+// the next refit drops them (a traversal of another interval must not read them).
+TEST(NodeRelative, EndBoxesHoldEveryCornerAndARefitDropsThem) {
+  const Model m("CesiumMan.glb");
+  const FeatureTopology ft(*m.loaded.mesh, m.topology);
+  const skinning::Positions x0 = sample(m, 0);
+  const skinning::Positions x1 = sample(m, 20);
+  Bvh<3> bvh(ft.welded_triangles(), m.rest);
+  FeatureBounds<3> bounds;
+  swept_vertex_bounds<3>(x0, x1, 0.0, bounds.vertices);
+  bounds.derive(ft, /*with_edges=*/false);
+  bvh.refit(bounds.triangles);
+  EXPECT_TRUE(bvh.end_boxes().empty());
+  const double half_width = 1e-3;
+  bvh.refit_end_boxes(ft.welded_triangles(), x0, x1, half_width);
+  const auto ends = bvh.end_boxes();
+  ASSERT_EQ(ends.size(), bvh.wide_nodes().size());
+  const auto order = bvh.triangle_order();
+  std::int64_t checked = 0;
+  for (std::size_t n = 0; n < ends.size(); ++n) {
+    const auto& w = bvh.wide_nodes()[n];
+    for (int i = 0; i < w.num_children; ++i) {
+      const BvhNode& node = bvh.nodes()[static_cast<std::size_t>(w.node[i])];
+      float tight[3][4];  // the tightest float box of the lane at t = 0 on each axis: lo, hi
+      for (auto& row : tight) {
+        row[0] = row[2] = std::numeric_limits<float>::infinity();
+        row[1] = row[3] = -std::numeric_limits<float>::infinity();
+      }
+      for (std::int32_t s = node.begin; s < node.end; ++s) {
+        for (const std::int32_t v : ft.triangle(order[static_cast<std::size_t>(s)])) {
+          for (int k = 0; k < 3; ++k) {
+            const double p0 = x0(v, k);
+            const double p1 = x1(v, k);
+            EXPECT_LE(ends[n].lo0[k][i], p0 - half_width);
+            EXPECT_GE(ends[n].hi0[k][i], p0 + half_width);
+            EXPECT_LE(ends[n].lo1[k][i], p1 - half_width);
+            EXPECT_GE(ends[n].hi1[k][i], p1 + half_width);
+            ++checked;
+          }
+        }
+      }
+    }
+    for (int i = w.num_children; i < 4; ++i) {
+      EXPECT_GT(ends[n].lo0[0][i], ends[n].hi0[0][i]) << "an unused lane is empty";
+    }
+  }
+  EXPECT_GT(checked, 3 * 3 * ft.num_triangles());
+  bvh.refit(bounds.triangles);
+  EXPECT_TRUE(bvh.end_boxes().empty());
+}
+
+// Two points that meet at t = 1/2, each the only content of a lane, on top of a common motion of
+// up to 2^20 and with coordinates from 2^-30 to 2^20 (all sums exact in double): their lanes
+// always meet (the rounding of the shifted ends is outwards), whatever the common motion and which
+// side is the vector. A point carried with one of them, 4 away on every axis, is told apart
+// from it, though their swept boxes overlap whenever the motion exceeds 4: the test prunes.
+TEST(NodeRelative, LanesThatMeetInTheRelativeMotionAreNeverToldApart) {
+  std::mt19937_64 rng(14);
+  std::uniform_int_distribution<int> exponent(-10, 20);
+  std::uniform_int_distribution<std::int64_t> mantissa(-(1 << 20), 1 << 20);
+  // A dyadic number m · 2^(e − 20), |m| ≤ 2^20: a multiple of 2^-30 of magnitude ≤ 2^20.
+  const auto dyadic = [&](int e) { return std::ldexp(static_cast<double>(mantissa(rng)), e - 20); };
+  const auto point_lane = [](WideEndBoxes& b, int lane, const double p0[3], const double p1[3]) {
+    for (int k = 0; k < 3; ++k) {
+      b.lo0[k][lane] = float_below(p0[k]);
+      b.hi0[k][lane] = float_above(p0[k]);
+      b.lo1[k][lane] = float_below(p1[k]);
+      b.hi1[k][lane] = float_above(p1[k]);
+    }
+  };
+  const auto empty = [] {
+    WideEndBoxes b;
+    for (int k = 0; k < 3; ++k) {
+      for (int i = 0; i < 4; ++i) {
+        b.lo0[k][i] = b.lo1[k][i] = std::numeric_limits<float>::infinity();
+        b.hi0[k][i] = b.hi1[k][i] = -std::numeric_limits<float>::infinity();
+      }
+    }
+    return b;
+  };
+  int met = 0;
+  int apart = 0;
+  for (int trial = 0; trial < 100'000; ++trial) {
+    // a(t) = a0 + t da, b(t) = b0 + t db with a(1/2) = b(1/2) = c; both carried by T.
+    double a0[3], a1[3], b0[3], b1[3], c0[3], c1[3];
+    for (int k = 0; k < 3; ++k) {
+      const double c = dyadic(exponent(rng));
+      const double da = dyadic(exponent(rng));
+      const double db = dyadic(exponent(rng));
+      const double carry = dyadic(exponent(rng));
+      a0[k] = c - da;
+      a1[k] = c + da + carry;
+      b0[k] = c - db;
+      b1[k] = c + db + carry;
+      // A third point carried with a, 4 away.
+      c0[k] = a0[k] + 4.0;
+      c1[k] = a1[k] + 4.0;
+    }
+    WideEndBoxes w = empty();
+    WideEndBoxes q = empty();
+    const int lane = trial % 4;
+    point_lane(w, lane, a0, a1);
+    point_lane(q, 3 - lane, b0, b1);
+    EXPECT_EQ(end_boxes_meet(w, q, 3 - lane), 1u << lane) << trial;
+    EXPECT_EQ(end_boxes_meet(q, w, lane), 1u << (3 - lane)) << trial;
+    met += end_boxes_meet(w, q, 3 - lane) == (1u << lane);
+    WideEndBoxes r = empty();
+    point_lane(r, 0, c0, c1);
+    apart += end_boxes_meet(w, r, 0) == 0u;
+  }
+  EXPECT_EQ(met, 100'000);
+  EXPECT_EQ(apart, 100'000);
+}
+
+// A body carried far over one interval while it moves (CesiumMan between two samples of its
+// clip, the second shifted by 3 m): the pairs with end boxes are a subset of the pairs without,
+// far fewer, with fewer volume tests; `kdop` (which tests node pairs in the relative motion at
+// this motion) reports exactly `bvh`'s contacts, some.
+TEST(NodeRelative, ABodyCarriedFarWhileItMovesKeepsItsContactsWithFarFewerPairs) {
+  const Model m("CesiumMan.glb");
+  const FeatureTopology ft(*m.loaded.mesh, m.topology);
+  const skinning::Positions x0 = sample(m, 5);
+  skinning::Positions x1 = sample(m, 25);
+  x1.col(0).array() += 3.0;
+  x1.col(1).array() -= 0.5;
+  EXPECT_GE(motion_scale(ft, x0, x1), kNodeRelativeMotion);
+  EXPECT_LT(motion_scale(ft, x0, x0), kNodeRelativeMotion);
+
+  Bvh<3> bvh(ft.welded_triangles(), m.rest);
+  const Traversed plain = traverse(bvh, ft, x0, x1, false);
+  const Traversed relative = traverse(bvh, ft, x0, x1, true);
+  EXPECT_TRUE(std::includes(
+      plain.pairs.begin(), plain.pairs.end(), relative.pairs.begin(), relative.pairs.end()));
+  EXPECT_LT(relative.pairs.size() * 4, plain.pairs.size());
+  EXPECT_LT(relative.bv_tests * 2, plain.bv_tests);
+  // At rest the end boxes are the swept boxes: nothing is pruned.
+  const Traversed still = traverse(bvh, ft, x0, x0, false);
+  EXPECT_EQ(traverse(bvh, ft, x0, x0, true).pairs, still.pairs);
+
+  std::vector<CcdContact> reference;
+  for (const std::string name : {"bvh", "kdop"}) {
+    auto method = make_method(name, *m.loaded.mesh, m.topology);
+    FrameResult r;
+    method->detect_ccd(x0, x1, r);
+    if (name == "bvh") {
+      reference = r.contacts;
+      EXPECT_GT(reference.size(), 0u);
+    } else {
+      EXPECT_EQ(r.contacts, reference) << name;
+    }
+  }
+}
+
+}  // namespace
+}  // namespace skelcd::culling
