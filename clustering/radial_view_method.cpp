@@ -812,6 +812,7 @@ void RadialViewMethod::ccd(const culling::Interval& interval, culling::FrameResu
   const bool node_relative =
       options_.relative_aabb &&
       culling::motion_scale(topology_, x_t0, x_t1) >= culling::kNodeRelativeMotion;
+  if (node_relative) culling::vertex_end_boxes(x_t0, x_t1, half_width, vertex_ends_);
   for (std::int32_t a = 0; a < clusters_.num_atomic(); ++a) {
     auto& local = clusters_.local_bvh(a);
     if (local.empty()) {
@@ -820,7 +821,7 @@ void RadialViewMethod::ccd(const culling::Interval& interval, culling::FrameResu
     }
     local.refit(bounds_.triangles);
     if (node_relative) {
-      local.refit_end_boxes(topology_.welded_triangles(), x_t0, x_t1, half_width);
+      local.refit_end_boxes(topology_.welded_triangles(), vertex_ends_);
     }
     cluster_bounds_[at(a)] = local.node_bounds()[0];
   }

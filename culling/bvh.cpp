@@ -8,6 +8,10 @@
 
 #include "skinning/errors.hpp"
 
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
+
 namespace skelcd::culling {
 
 template <int N>
@@ -396,24 +400,89 @@ void Bvh<N>::refit_wide_only(std::span<const Volume> triangle_bounds) {
   }
 }
 
-template <int N>
-void Bvh<N>::refit_end_boxes(
-    const skinning::Triangles& triangles,
+namespace {
+
+/// a ∪= b, the end boxes of two sets (four slots at once).
+inline void merge_ends(NodeEndBoxes& a, const NodeEndBoxes& b) {
+#if defined(__SSE2__)
+  _mm_store_ps(a.lo0, _mm_min_ps(_mm_load_ps(a.lo0), _mm_load_ps(b.lo0)));
+  _mm_store_ps(a.hi0, _mm_max_ps(_mm_load_ps(a.hi0), _mm_load_ps(b.hi0)));
+  _mm_store_ps(a.lo1, _mm_min_ps(_mm_load_ps(a.lo1), _mm_load_ps(b.lo1)));
+  _mm_store_ps(a.hi1, _mm_max_ps(_mm_load_ps(a.hi1), _mm_load_ps(b.hi1)));
+#else
+  for (std::size_t k = 0; k < 4; ++k) {
+    a.lo0[k] = std::min(a.lo0[k], b.lo0[k]);
+    a.hi0[k] = std::max(a.hi0[k], b.hi0[k]);
+    a.lo1[k] = std::min(a.lo1[k], b.lo1[k]);
+    a.hi1[k] = std::max(a.hi1[k], b.hi1[k]);
+  }
+#endif
+}
+
+}  // namespace
+
+void vertex_end_boxes(
     const skinning::Positions& x_t0,
     const skinning::Positions& x_t1,
-    double half_width) {
-  end_boxes_.resize(wide_.size());
-  constexpr float kInf = std::numeric_limits<float>::infinity();
-  // Lower and upper ends of a corner coordinate grown by half_width, rounded outwards.
+    double half_width,
+    std::vector<NodeEndBoxes>& out) {
+  // Lower and upper ends of a coordinate grown by half_width, rounded outwards.
   const auto below = [half_width](double x) {
     return float_below(half_width > 0.0 ? next_down(x - half_width) : x);
   };
   const auto above = [half_width](double x) {
     return float_above(half_width > 0.0 ? next_up(x + half_width) : x);
   };
-  // As refit_wide_only: children after their parent, so one backward sweep is bottom-up; a bucket
-  // lane from its triangles' corners, an inner lane the union of its wide node's lanes (the min
-  // of rounded ends is the rounded min).
+  const auto rows = static_cast<std::size_t>(std::min(x_t0.rows(), x_t1.rows()));
+  out.resize(rows);
+  for (std::size_t v = 0; v < rows; ++v) {
+    const double* p0 = x_t0.data() + 3 * v;  // row-major #W × 3
+    const double* p1 = x_t1.data() + 3 * v;
+    NodeEndBoxes& e = out[v];
+    for (std::size_t k = 0; k < 3; ++k) {
+      e.lo0[k] = below(p0[k]);
+      e.hi0[k] = above(p0[k]);
+      e.lo1[k] = below(p1[k]);
+      e.hi1[k] = above(p1[k]);
+    }
+    e.lo0[3] = e.hi0[3] = e.lo1[3] = e.hi1[3] = 0.0f;
+  }
+}
+
+template <int N>
+void Bvh<N>::refit_end_boxes(
+    const skinning::Triangles& triangles, std::span<const NodeEndBoxes> vertex_ends) {
+  constexpr float kInf = std::numeric_limits<float>::infinity();
+  // The union of the triangles' corners' end boxes in slots [begin, end): float_below and
+  // float_above are monotone, so it is the rounding of the exact union.
+  const auto slot_boxes = [&](std::size_t begin, std::size_t end, NodeEndBoxes& out) {
+    out = vertex_ends[static_cast<std::size_t>(triangles(order_[begin], 0))];
+    for (std::size_t s = begin; s < end; ++s) {
+      const auto f = static_cast<Eigen::Index>(order_[s]);
+      for (Eigen::Index j = s == begin ? 1 : 0; j < 3; ++j) {
+        merge_ends(out, vertex_ends[static_cast<std::size_t>(triangles(f, j))]);
+      }
+    }
+  };
+  if (node_volumes_) {
+    // The binary nodes bottom-up (children after their parent), then each wide lane a copy of its
+    // binary node's.
+    node_end_boxes_.resize(nodes_.size());
+    for (std::size_t n = nodes_.size(); n-- > 0;) {
+      const BvhNode& node = nodes_[n];
+      NodeEndBoxes& e = node_end_boxes_[n];
+      if (node.is_leaf()) {
+        slot_boxes(static_cast<std::size_t>(node.begin), static_cast<std::size_t>(node.end), e);
+      } else {
+        e = node_end_boxes_[n + 1];
+        merge_ends(e, node_end_boxes_[static_cast<std::size_t>(node.right)]);
+      }
+    }
+  }
+  end_boxes_.resize(wide_.size());
+  // As refit_wide_only: children after their parent, so one backward sweep is bottom-up; a lane is
+  // its binary node's boxes, or else a bucket's from its triangles' corners and an inner lane the
+  // union of its wide node's lanes.
   for (std::size_t n = wide_.size(); n-- > 0;) {
     const WideBvhNode<N>& w = wide_[n];
     WideEndBoxes& e = end_boxes_[n];
@@ -425,46 +494,32 @@ void Bvh<N>::refit_end_boxes(
     }
     for (int lane = 0; lane < w.num_children; ++lane) {
       const auto i = static_cast<std::size_t>(lane);
-      if (w.child[i] < 0) {
+      NodeEndBoxes lane_boxes;
+      if (node_volumes_) {
+        lane_boxes = node_end_boxes_[static_cast<std::size_t>(w.node[i])];
+      } else if (w.child[i] < 0) {
         const auto begin = static_cast<std::size_t>(~w.child[i]);
-        const auto end = begin + static_cast<std::size_t>(w.count[i]);
-        std::array<double, 3> lo0, hi0, lo1, hi1;
-        lo0.fill(std::numeric_limits<double>::infinity());
-        lo1 = lo0;
-        hi0.fill(-std::numeric_limits<double>::infinity());
-        hi1 = hi0;
-        for (std::size_t s = begin; s < end; ++s) {
-          const auto f = static_cast<Eigen::Index>(order_[s]);
-          for (Eigen::Index j = 0; j < 3; ++j) {
-            const Eigen::Index v = triangles(f, j);
-            const double* p0 = x_t0.data() + 3 * v;  // row-major #W × 3
-            const double* p1 = x_t1.data() + 3 * v;
-            for (std::size_t k = 0; k < 3; ++k) {
-              lo0[k] = std::min(lo0[k], p0[k]);
-              hi0[k] = std::max(hi0[k], p0[k]);
-              lo1[k] = std::min(lo1[k], p1[k]);
-              hi1[k] = std::max(hi1[k], p1[k]);
-            }
-          }
-        }
-        for (std::size_t k = 0; k < 3; ++k) {
-          e.lo0[k][i] = below(lo0[k]);
-          e.hi0[k][i] = above(hi0[k]);
-          e.lo1[k][i] = below(lo1[k]);
-          e.hi1[k][i] = above(hi1[k]);
-        }
+        slot_boxes(begin, begin + static_cast<std::size_t>(w.count[i]), lane_boxes);
       } else {
         const WideBvhNode<N>& cw = wide_[static_cast<std::size_t>(w.child[i])];
         const WideEndBoxes& ce = end_boxes_[static_cast<std::size_t>(w.child[i])];
         for (std::size_t k = 0; k < 3; ++k) {
+          lane_boxes.lo0[k] = lane_boxes.lo1[k] = kInf;
+          lane_boxes.hi0[k] = lane_boxes.hi1[k] = -kInf;
           for (int j = 0; j < cw.num_children; ++j) {
             const auto l = static_cast<std::size_t>(j);
-            e.lo0[k][i] = std::min(e.lo0[k][i], ce.lo0[k][l]);
-            e.hi0[k][i] = std::max(e.hi0[k][i], ce.hi0[k][l]);
-            e.lo1[k][i] = std::min(e.lo1[k][i], ce.lo1[k][l]);
-            e.hi1[k][i] = std::max(e.hi1[k][i], ce.hi1[k][l]);
+            lane_boxes.lo0[k] = std::min(lane_boxes.lo0[k], ce.lo0[k][l]);
+            lane_boxes.hi0[k] = std::max(lane_boxes.hi0[k], ce.hi0[k][l]);
+            lane_boxes.lo1[k] = std::min(lane_boxes.lo1[k], ce.lo1[k][l]);
+            lane_boxes.hi1[k] = std::max(lane_boxes.hi1[k], ce.hi1[k][l]);
           }
         }
+      }
+      for (std::size_t k = 0; k < 3; ++k) {
+        e.lo0[k][i] = lane_boxes.lo0[k];
+        e.hi0[k][i] = lane_boxes.hi0[k];
+        e.lo1[k][i] = lane_boxes.lo1[k];
+        e.hi1[k][i] = lane_boxes.hi1[k];
       }
     }
   }

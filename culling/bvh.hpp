@@ -93,6 +93,25 @@ struct alignas(16) WideEndBoxes {
   float hi1[3][4];
 };
 
+/// One binary node's boxes at the two ends of an interval (Bvh::node_end_boxes), as floats rounded
+/// outwards: lo0[k], hi0[k] at t = 0 and lo1[k], hi1[k] at t = 1 on axis k < 3; the fourth slot
+/// of each is 0 (so that four axes are tested at once, the fourth always meeting).
+struct alignas(16) NodeEndBoxes {
+  float lo0[4];
+  float hi0[4];
+  float lo1[4];
+  float hi1[4];
+};
+
+/// Every vertex's end boxes over x_t0 → x_t1 (#W × 3 each): its position at t = 0 and at t = 1
+/// grown by half_width, rounded outwards to floats, into `out` (resized to #W), for
+/// Bvh::refit_end_boxes. Computed once per interval for all the trees over one mesh.
+void vertex_end_boxes(
+    const skinning::Positions& x_t0,
+    const skinning::Positions& x_t1,
+    double half_width,
+    std::vector<NodeEndBoxes>& out);
+
 /// Hierarchy of Dop<N> volumes (Dop<3>: AABB, Dop<8>: 16-DOP) over a set of triangles.
 template <int N>
 class Bvh {
@@ -166,15 +185,21 @@ class Bvh {
   [[nodiscard]] const float* slot_hi(int k) const {
     return slot_bounds_.data() + static_cast<std::size_t>(kSlotAxes + k) * slot_stride();
   }
-  /// Fills end_boxes() for the interval x_t0 → x_t1 (welded positions, rows indexed by the
-  /// vertex ids of `triangles`, the triangles the tree was built from), each box grown by
-  /// half_width. Valid until the next refit() (which drops them), so that a traversal never
-  /// reads boxes of another interval. Allocates once (#wide nodes × 192 bytes).
+  /// Fills end_boxes() for an interval from its vertices' end boxes (vertex_end_boxes, indexed by
+  /// the vertex ids of `triangles`, the triangles the tree was built from); with binary node
+  /// volumes also node_end_boxes(). Valid until the next refit()
+  /// (which drops them), so that a traversal never reads boxes of another interval. Allocates
+  /// once (#wide nodes × 192 bytes, and #nodes × 64 with binary node volumes).
   void refit_end_boxes(
-      const skinning::Triangles& triangles,
-      const skinning::Positions& x_t0,
-      const skinning::Positions& x_t1,
-      double half_width);
+      const skinning::Triangles& triangles, std::span<const NodeEndBoxes> vertex_ends);
+  /// The binary nodes' end boxes (NodeEndBoxes), by node of nodes(); filled by refit_end_boxes
+  /// when the tree keeps its binary node volumes (BvhOptions::node_volumes: the masked
+  /// traversals walk the binary nodes), else empty; empty too unless refit_end_boxes ran after
+  /// the last refit().
+  [[nodiscard]] std::span<const NodeEndBoxes> node_end_boxes() const {
+    return end_boxes_ready_ ? std::span<const NodeEndBoxes>(node_end_boxes_)
+                            : std::span<const NodeEndBoxes>();
+  }
   /// The wide nodes' end boxes (WideEndBoxes), by wide node; empty unless refit_end_boxes ran
   /// after the last refit().
   [[nodiscard]] std::span<const WideEndBoxes> end_boxes() const {
@@ -201,6 +226,7 @@ class Bvh {
   std::vector<std::int32_t> order_;
   std::vector<WideBvhNode<N>> wide_;
   std::vector<WideEndBoxes> end_boxes_;
+  std::vector<NodeEndBoxes> node_end_boxes_;
   bool end_boxes_ready_ = false;
   [[nodiscard]] std::size_t slot_stride() const { return order_.size() + kSlotPadding; }
   static constexpr std::size_t kSlotPadding = 3;

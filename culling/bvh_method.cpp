@@ -111,7 +111,8 @@ class BvhMethod final : public MethodBase {
     // `kdop`: node pairs tested in the relative motion too when the interval moves enough for it
     // to prune (docs/culling.md "Relative boxes at the nodes").
     if (relative_pairs_ && motion_scale(topology_, x_t0, x_t1) >= kNodeRelativeMotion) {
-      bvh_.refit_end_boxes(topology_.welded_triangles(), x_t0, x_t1, 0.5 * options_.min_separation);
+      vertex_end_boxes(x_t0, x_t1, 0.5 * options_.min_separation, vertex_ends_);
+      bvh_.refit_end_boxes(topology_.welded_triangles(), vertex_ends_);
     }
     const auto t1 = Clock::now();
     // Self traversal → triangle pairs → de-duplicated feature pairs → tests, in blocks of
@@ -144,6 +145,7 @@ class BvhMethod final : public MethodBase {
   Bvh<N> bvh_;
   SlotAdjacency slots_{topology_, bvh_.triangle_order()};
   std::vector<std::uint8_t> full_slots_;
+  std::vector<NodeEndBoxes> vertex_ends_;  // sized by the first interval that moves enough
   FeatureBounds<N> bounds_;
   TraversalScratch scratch_;
   PairBlocks<N> blocks_{

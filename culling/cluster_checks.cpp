@@ -118,6 +118,9 @@ bool masked_self_traverse_some(
   const auto nodes = bvh.nodes();
   const auto bounds = bvh.node_bounds();
   const auto order = bvh.triangle_order();
+  // With end boxes for this interval, node pairs are also tested in the relative motion
+  // (node_end_boxes_meet; docs/culling.md "Relative boxes at the nodes").
+  const auto ends = bvh.node_end_boxes();
   auto& stack = scratch.stack;
   while (!stack.empty()) {
     if (out.size() >= max_pairs) return false;
@@ -142,6 +145,7 @@ bool masked_self_traverse_some(
     }
     ++bv_tests;
     if (!bounds[at(e.a)].overlaps(bounds[at(e.b)])) continue;
+    if (!ends.empty() && !node_end_boxes_meet(ends[at(e.a)], ends[at(e.b)])) continue;
     const BvhNode& nb = nodes[at(e.b)];
     if (na.is_leaf() && nb.is_leaf()) {
       leaf_pairs<N>(na, order, nb, order, false, triangle_bounds, triangle_mask, which, out,
@@ -199,6 +203,9 @@ bool masked_pair_traverse_some(
   if (a.empty() || b.empty()) return true;
   const auto nodes_a = a.nodes();
   const auto nodes_b = b.nodes();
+  const auto ends_a = a.node_end_boxes();
+  const auto ends_b = b.node_end_boxes();
+  const bool relative = !ends_a.empty() && !ends_b.empty();
   auto& stack = scratch.stack;
   while (!stack.empty()) {
     if (out.size() >= max_pairs) return false;
@@ -207,6 +214,7 @@ bool masked_pair_traverse_some(
     if (!node_pair_wanted(node_mask_a[at(e.a)], node_mask_b[at(e.b)], which)) continue;
     ++bv_tests;
     if (!a.node_bounds()[at(e.a)].overlaps(b.node_bounds()[at(e.b)])) continue;
+    if (relative && !node_end_boxes_meet(ends_a[at(e.a)], ends_b[at(e.b)])) continue;
     const BvhNode& na = nodes_a[at(e.a)];
     const BvhNode& nb = nodes_b[at(e.b)];
     if (na.is_leaf() && nb.is_leaf()) {

@@ -86,7 +86,7 @@ class RelativeAabbFilter {
     const skinning::Positions& x_t1);
 
 /// The motion_scale from which node pairs are tested in the relative motion too.
-inline constexpr double kNodeRelativeMotion = 0.3;
+inline constexpr double kNodeRelativeMotion = 0.4;
 
 /// A CCD query's triangle pairs through the relative AABB filter when that pays (`kdop`,
 /// docs/culling.md "Relative boxes in `kdop`"): the filter costs about as much per pair as a few

@@ -15,6 +15,7 @@
 
 #include "culling/bvh.hpp"
 #include "culling/candidates.hpp"
+#include "culling/cluster_checks.hpp"
 #include "culling/feature_topology.hpp"
 #include "culling/method.hpp"
 #include "culling/relative_aabb.hpp"
@@ -62,7 +63,11 @@ Traversed traverse(
   swept_vertex_bounds<3>(x0, x1, 0.0, bounds.vertices);
   bounds.derive(ft, /*with_edges=*/false);
   bvh.refit(bounds.triangles);
-  if (end_boxes) bvh.refit_end_boxes(ft.welded_triangles(), x0, x1, 0.0);
+  if (end_boxes) {
+    std::vector<NodeEndBoxes> vertices;
+    vertex_end_boxes(x0, x1, 0.0, vertices);
+    bvh.refit_end_boxes(ft.welded_triangles(), vertices);
+  }
   EXPECT_EQ(bvh.end_boxes().empty(), !end_boxes);
   TraversalScratch scratch;
   Traversed t;
@@ -85,7 +90,9 @@ TEST(NodeRelative, EndBoxesHoldEveryCornerAndARefitDropsThem) {
   bvh.refit(bounds.triangles);
   EXPECT_TRUE(bvh.end_boxes().empty());
   const double half_width = 1e-3;
-  bvh.refit_end_boxes(ft.welded_triangles(), x0, x1, half_width);
+  std::vector<NodeEndBoxes> vertices;
+  vertex_end_boxes(x0, x1, half_width, vertices);
+  bvh.refit_end_boxes(ft.welded_triangles(), vertices);
   const auto ends = bvh.end_boxes();
   ASSERT_EQ(ends.size(), bvh.wide_nodes().size());
   const auto order = bvh.triangle_order();
@@ -118,8 +125,31 @@ TEST(NodeRelative, EndBoxesHoldEveryCornerAndARefitDropsThem) {
     }
   }
   EXPECT_GT(checked, 3 * 3 * ft.num_triangles());
+  // The binary nodes' (the tree keeps its node volumes): every node's triangles, both ends.
+  const auto node_ends = bvh.node_end_boxes();
+  ASSERT_EQ(node_ends.size(), bvh.nodes().size());
+  for (std::size_t n = 0; n < node_ends.size(); ++n) {
+    const BvhNode& node = bvh.nodes()[n];
+    for (std::int32_t s = node.begin; s < node.end; ++s) {
+      for (const std::int32_t v : ft.triangle(order[static_cast<std::size_t>(s)])) {
+        for (int k = 0; k < 3; ++k) {
+          EXPECT_LE(node_ends[n].lo0[k], x0(v, k) - half_width);
+          EXPECT_GE(node_ends[n].hi0[k], x0(v, k) + half_width);
+          EXPECT_LE(node_ends[n].lo1[k], x1(v, k) - half_width);
+          EXPECT_GE(node_ends[n].hi1[k], x1(v, k) + half_width);
+        }
+      }
+    }
+  }
   bvh.refit(bounds.triangles);
   EXPECT_TRUE(bvh.end_boxes().empty());
+  EXPECT_TRUE(bvh.node_end_boxes().empty());
+  // A traversal-only tree (`kdop`'s) has no binary ones.
+  Bvh<3> wide_only(ft.welded_triangles(), m.rest, BvhOptions{.node_volumes = false});
+  wide_only.refit(bounds.triangles);
+  wide_only.refit_end_boxes(ft.welded_triangles(), vertices);
+  EXPECT_EQ(wide_only.end_boxes().size(), wide_only.wide_nodes().size());
+  EXPECT_TRUE(wide_only.node_end_boxes().empty());
 }
 
 // Two points that meet at t = 1/2, each the only content of a lane, on top of a common motion of
@@ -151,6 +181,15 @@ TEST(NodeRelative, LanesThatMeetInTheRelativeMotionAreNeverToldApart) {
     }
     return b;
   };
+  const auto node_of = [](NodeEndBoxes& b, const double p0[3], const double p1[3]) {
+    for (int k = 0; k < 3; ++k) {
+      b.lo0[k] = float_below(p0[k]);
+      b.hi0[k] = float_above(p0[k]);
+      b.lo1[k] = float_below(p1[k]);
+      b.hi1[k] = float_above(p1[k]);
+    }
+    b.lo0[3] = b.hi0[3] = b.lo1[3] = b.hi1[3] = 0.0f;
+  };
   int met = 0;
   int apart = 0;
   for (int trial = 0; trial < 100'000; ++trial) {
@@ -176,19 +215,27 @@ TEST(NodeRelative, LanesThatMeetInTheRelativeMotionAreNeverToldApart) {
     point_lane(q, 3 - lane, b0, b1);
     EXPECT_EQ(end_boxes_meet(w, q, 3 - lane), 1u << lane) << trial;
     EXPECT_EQ(end_boxes_meet(q, w, lane), 1u << (3 - lane)) << trial;
-    met += end_boxes_meet(w, q, 3 - lane) == (1u << lane);
+    // The binary nodes' test, the same points as single nodes.
+    NodeEndBoxes na, nb, nc;
+    node_of(na, a0, a1);
+    node_of(nb, b0, b1);
+    node_of(nc, c0, c1);
+    met += end_boxes_meet(w, q, 3 - lane) == (1u << lane) && node_end_boxes_meet(na, nb) &&
+           node_end_boxes_meet(nb, na);
+    apart += !node_end_boxes_meet(na, nc);
     WideEndBoxes r = empty();
     point_lane(r, 0, c0, c1);
     apart += end_boxes_meet(w, r, 0) == 0u;
   }
   EXPECT_EQ(met, 100'000);
-  EXPECT_EQ(apart, 100'000);
+  EXPECT_EQ(apart, 2 * 100'000);
 }
 
 // A body carried far over one interval while it moves (CesiumMan between two samples of its
-// clip, the second shifted by 3 m): the pairs with end boxes are a subset of the pairs without,
-// far fewer, with fewer volume tests; `kdop` (which tests node pairs in the relative motion at
-// this motion) reports exactly `bvh`'s contacts, some.
+// clip, the second shifted by 3 m): `kdop` (which tests node pairs in the relative motion at this
+// motion) reports exactly `bvh`'s contacts, some; the pairs of the wide and of the masked binary
+// traversals with end boxes are subsets of those without, far fewer, and hold the triangle pair
+// of every one of those contacts.
 TEST(NodeRelative, ABodyCarriedFarWhileItMovesKeepsItsContactsWithFarFewerPairs) {
   const Model m("CesiumMan.glb");
   const FeatureTopology ft(*m.loaded.mesh, m.topology);
@@ -198,17 +245,6 @@ TEST(NodeRelative, ABodyCarriedFarWhileItMovesKeepsItsContactsWithFarFewerPairs)
   x1.col(1).array() -= 0.5;
   EXPECT_GE(motion_scale(ft, x0, x1), kNodeRelativeMotion);
   EXPECT_LT(motion_scale(ft, x0, x0), kNodeRelativeMotion);
-
-  Bvh<3> bvh(ft.welded_triangles(), m.rest);
-  const Traversed plain = traverse(bvh, ft, x0, x1, false);
-  const Traversed relative = traverse(bvh, ft, x0, x1, true);
-  EXPECT_TRUE(std::includes(
-      plain.pairs.begin(), plain.pairs.end(), relative.pairs.begin(), relative.pairs.end()));
-  EXPECT_LT(relative.pairs.size() * 4, plain.pairs.size());
-  EXPECT_LT(relative.bv_tests * 2, plain.bv_tests);
-  // At rest the end boxes are the swept boxes: nothing is pruned.
-  const Traversed still = traverse(bvh, ft, x0, x0, false);
-  EXPECT_EQ(traverse(bvh, ft, x0, x0, true).pairs, still.pairs);
 
   std::vector<CcdContact> reference;
   for (const std::string name : {"bvh", "kdop"}) {
@@ -222,6 +258,59 @@ TEST(NodeRelative, ABodyCarriedFarWhileItMovesKeepsItsContactsWithFarFewerPairs)
       EXPECT_EQ(r.contacts, reference) << name;
     }
   }
+  // The triangle pair each of `bvh`'s contacts comes from (the owners of its two features, as
+  // the feature stage derives them): a sound traversal emits every one of them.
+  std::vector<TrianglePair> needed;
+  for (const CcdContact& c : reference) {
+    const std::int32_t ta =
+        c.kind == CcdContact::Kind::vf ? ft.vertex_owner(c.a) : ft.edge_owner(c.a);
+    const std::int32_t tb = c.kind == CcdContact::Kind::vf ? c.b : ft.edge_owner(c.b);
+    needed.push_back({std::min(ta, tb), std::max(ta, tb)});
+  }
+  std::sort(needed.begin(), needed.end());
+  needed.erase(std::unique(needed.begin(), needed.end()), needed.end());
+  Bvh<3> bvh(ft.welded_triangles(), m.rest);
+  const Traversed plain = traverse(bvh, ft, x0, x1, false);
+  const Traversed relative = traverse(bvh, ft, x0, x1, true);
+  EXPECT_TRUE(std::includes(
+      plain.pairs.begin(), plain.pairs.end(), relative.pairs.begin(), relative.pairs.end()));
+  EXPECT_LT(relative.pairs.size() * 4, plain.pairs.size());
+  EXPECT_TRUE(
+      std::includes(relative.pairs.begin(), relative.pairs.end(), needed.begin(), needed.end()));
+  EXPECT_LT(relative.bv_tests * 2, plain.bv_tests);
+  // The masked traversal over the binary nodes (radial view's intra- and inter-cluster checks),
+  // every triangle "other" (nothing skipped by masks): the same subset, as few.
+  {
+    std::vector<std::uint8_t> tri_mask(static_cast<std::size_t>(ft.num_triangles()), kMaskOther);
+    std::vector<std::uint8_t> node_mask;
+    node_class_masks<3>(bvh, tri_mask, node_mask);
+    FeatureBounds<3> bounds;
+    swept_vertex_bounds<3>(x0, x1, 0.0, bounds.vertices);
+    bounds.derive(ft, /*with_edges=*/false);
+    std::vector<TrianglePair> masked[2];
+    for (const bool with_ends : {false, true}) {
+      bvh.refit(bounds.triangles);
+      if (with_ends) {
+        std::vector<NodeEndBoxes> vertices;
+        vertex_end_boxes(x0, x1, 0.0, vertices);
+        bvh.refit_end_boxes(ft.welded_triangles(), vertices);
+      }
+      TraversalScratch scratch;
+      std::int64_t tests = 0;
+      auto& out = masked[with_ends ? 1 : 0];
+      masked_self_traverse<3>(
+          bvh, bounds.triangles, node_mask, tri_mask, MaskedPairs::tested, scratch, out, tests);
+      std::sort(out.begin(), out.end());
+    }
+    EXPECT_EQ(masked[0], plain.pairs);
+    EXPECT_TRUE(
+        std::includes(masked[0].begin(), masked[0].end(), masked[1].begin(), masked[1].end()));
+    EXPECT_LT(masked[1].size() * 4, masked[0].size());
+    EXPECT_TRUE(std::includes(masked[1].begin(), masked[1].end(), needed.begin(), needed.end()));
+  }
+  // At rest the end boxes are the swept boxes: nothing is pruned.
+  const Traversed still = traverse(bvh, ft, x0, x0, false);
+  EXPECT_EQ(traverse(bvh, ft, x0, x0, true).pairs, still.pairs);
 }
 
 }  // namespace
