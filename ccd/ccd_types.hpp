@@ -20,6 +20,12 @@ struct CcdOptions {
   /// extent is the largest coordinate difference between the query's points at t = 0 or t = 1.
   /// Unitless. Smaller values give fewer false positives on near misses and cost more boxes.
   double relative_distance_tolerance = 1e-10;
+  /// Conservative only: after the coplanarity stage, reject queries whose relative boxes are apart
+  /// (the points minus their mean motion; docs/ccd.md, "Relative boxes"). It only removes queries
+  /// that never come within min_separation — never a contact — and pays where features move
+  /// together and lie close to coplanar (cloth layers). Off by default, so that the kernel alone
+  /// answers as it always has; the culling methods turn it on.
+  bool relative_boxes = false;
 };
 
 enum class CcdStatus : std::uint8_t {
@@ -44,6 +50,8 @@ struct CcdStats {
   std::int64_t queries = 0;               ///< queries answered
   std::int64_t aabb_rejected = 0;         ///< removed by the swept-AABB filter
   std::int64_t coplanarity_rejected = 0;  ///< removed by the deforming non-penetration filter
+  std::int64_t relative_rejected =
+      0;  ///< removed by the relative boxes (CcdOptions::relative_boxes)
   std::int64_t algebraic_rejected = 0;    ///< proven separated by the algebraic filter
   std::int64_t algebraic_hits = 0;        ///< proven in contact by the algebraic filter
   std::int64_t solver_runs = 0;           ///< queries the filters left to the inclusion solver
@@ -56,6 +64,7 @@ struct CcdStats {
     queries += other.queries;
     aabb_rejected += other.aabb_rejected;
     coplanarity_rejected += other.coplanarity_rejected;
+    relative_rejected += other.relative_rejected;
     algebraic_rejected += other.algebraic_rejected;
     algebraic_hits += other.algebraic_hits;
     solver_runs += other.solver_runs;

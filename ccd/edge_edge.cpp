@@ -7,6 +7,7 @@
 #include "ccd/after_swept_aabbs.hpp"
 #include "ccd/detail/conservative_pipeline.hpp"
 #include "ccd/detail/fast_ccd.hpp"
+#include "ccd/detail/relative_boxes.hpp"
 #include "ccd/exact_ccd.hpp"
 #include "ccd/filters.hpp"
 
@@ -46,7 +47,14 @@ CcdResult conservative_after_aabbs(
     p.triangle_domain = false;
     return p;
   };
-  return detail::conservative_pipeline(t0, t1, quartic_inputs, problem, options, stats);
+  const auto relative_apart = [&] {
+    return detail::relative_boxes_apart<2>(
+        {&q.ea0_t0, &q.ea1_t0, &q.eb0_t0, &q.eb1_t0},
+        {&q.ea0_t1, &q.ea1_t1, &q.eb0_t1, &q.eb1_t1},
+        0.5 * options.min_separation);
+  };
+  return detail::conservative_pipeline(
+      t0, t1, quartic_inputs, problem, relative_apart, options, stats);
 }
 
 // conservative: swept AABBs, then the rest of the pipeline.

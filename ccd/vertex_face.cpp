@@ -7,6 +7,7 @@
 #include "ccd/after_swept_aabbs.hpp"
 #include "ccd/detail/conservative_pipeline.hpp"
 #include "ccd/detail/fast_ccd.hpp"
+#include "ccd/detail/relative_boxes.hpp"
 #include "ccd/exact_ccd.hpp"
 #include "ccd/filters.hpp"
 
@@ -47,7 +48,14 @@ CcdResult conservative_after_aabbs(
     p.triangle_domain = true;
     return p;
   };
-  return detail::conservative_pipeline(t0, t1, quartic_inputs, problem, options, stats);
+  const auto relative_apart = [&] {
+    return detail::relative_boxes_apart<1>(
+        {&q.v_t0, &q.f0_t0, &q.f1_t0, &q.f2_t0},
+        {&q.v_t1, &q.f0_t1, &q.f1_t1, &q.f2_t1},
+        0.5 * options.min_separation);
+  };
+  return detail::conservative_pipeline(
+      t0, t1, quartic_inputs, problem, relative_apart, options, stats);
 }
 
 // conservative: swept AABBs, then the rest of the pipeline.

@@ -207,6 +207,7 @@ RadialViewMethod::RadialViewMethod(
               topology_.num_triangles())) {
   num_bones_ = num_bones;
   ccd_options_.min_separation = method_options.min_separation;
+  ccd_options_.relative_boxes = true;  // docs/ccd.md, "Relative boxes"
   const auto num_faces = at(topology_.num_triangles());
   const auto num_atomic = at(clusters_.num_atomic());
   const auto num_components = at(clusters_.num_components());

@@ -46,6 +46,8 @@ MethodBase::MethodBase(
     throw InvalidInput("culling::make_method: block_pairs must be >= 1, got 0");
   }
   ccd_options_.min_separation = options.min_separation;
+  // The kernels reject queries whose relative boxes are apart (docs/ccd.md, "Relative boxes").
+  ccd_options_.relative_boxes = true;
 }
 
 void MethodBase::check_positions(

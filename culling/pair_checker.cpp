@@ -58,6 +58,7 @@ PairChecker::PairChecker(
     throw InvalidInput("culling::PairChecker: the exact accuracy supports only min_separation 0");
   }
   ccd_options_.min_separation = options.min_separation;
+  ccd_options_.relative_boxes = true;  // docs/ccd.md, "Relative boxes"
   bvh_a_ = AabbBvh(topology_a_.welded_triangles(), welded_rest(mesh_a, topology_a), options.bvh);
   bvh_b_ = AabbBvh(topology_b_.welded_triangles(), welded_rest(mesh_b, topology_b), options.bvh);
   scratch_.reserve_pair(bvh_a_, bvh_b_);

@@ -1,7 +1,8 @@
 #pragma once
 // The conservative CCD pipeline shared by vertex-face and edge-edge, after the swept-AABB test
 // (docs/ccd.md, "Conservative pipeline"):
-//   1. coplanarity filter — the cubic c(t) (with min_separation: |c| > s |n|) certified away from 0;
+//   1. coplanarity filter — the cubic c(t) (with min_separation: |c| > s |n|) certified away from
+//   0; 1½. with CcdOptions::relative_boxes, the relative boxes (ccd/detail/relative_boxes.hpp);
 //   2. algebraic filter — certified decisions on intervals (with min_separation: widened by it);
 //   3. inclusion solver — whatever is left, from the first time the filters could not exclude.
 
@@ -58,12 +59,15 @@ inline constexpr double kQuarticScreenMagnitude = 0x1p190;
 /// when min_separation is 0 (they are not needed).
 /// @param make_problem returns the solver's InclusionProblem (only the few queries that reach it
 /// pay for it).
-template <typename MakeQuarticInputs, typename MakeProblem>
+/// @param relative_apart returns relative_boxes_apart for the query (asked only with
+/// CcdOptions::relative_boxes, of the queries the coplanarity stage leaves).
+template <typename MakeQuarticInputs, typename MakeProblem, typename RelativeApart>
 CcdResult conservative_pipeline(
     const DifferenceTriple& coplanarity_t0,
     const DifferenceTriple& coplanarity_t1,
     MakeQuarticInputs&& make_quartic_inputs,
     MakeProblem&& make_problem,
+    RelativeApart&& relative_apart,
     const CcdOptions& options,
     CcdStats& stats) {
   const double s = options.min_separation;
@@ -82,6 +86,13 @@ CcdResult conservative_pipeline(
   if (certified_sign(
           screen.coefficients, s > 0.0 ? add_up(screen.error_upper, margin) : screen.error_upper)) {
     ++stats.coplanarity_rejected;
+    return {};
+  }
+  // Stage 1½, the relative boxes: after the cheap coplanarity screen, so that the queries it
+  // rejects cost nothing more, and before the exact coplanarity bound, its subdivisions and the
+  // quartics, which the queries it removes would reach.
+  if (options.relative_boxes && relative_apart()) {
+    ++stats.relative_rejected;
     return {};
   }
   BernsteinCubic c{screen.coefficients, trilinear_error(coplanarity_t0, coplanarity_t1)};

@@ -1,0 +1,132 @@
+// The relative-box stage of the conservative kernels (CcdOptions::relative_boxes,
+// ccd/detail/relative_boxes.hpp; docs/ccd.md "Relative boxes"): it only turns answers from hit to
+// no hit, only where the exact kernel finds no contact, and never on the ground-truthed
+// cloth-funnel contacts; features that move together close to coplanar — which the coplanarity
+// stage cannot reject — are rejected by it; contact distance widens the boxes.
+
+#include <gtest/gtest.h>
+
+#include <iostream>
+#include <string>
+
+#include "ccd/edge_edge.hpp"
+#include "ccd/exact_ccd.hpp"
+#include "ccd/vertex_face.hpp"
+#include "tests/ccd/cloth_funnel.hpp"
+#include "tests/ccd/random_queries.hpp"
+
+namespace skelcd::ccd {
+namespace {
+
+CcdOptions with_relative(bool on, double min_separation = 0.0) {
+  CcdOptions o;
+  o.min_separation = min_separation;
+  o.relative_boxes = on;
+  return o;
+}
+
+// Random and near-degenerate queries (contacts built on purpose, grids, common planes, scaled
+// 10^-6 … 10^6): with the stage, a hit is a hit without it, and a hit it removes is no contact
+// for the exact kernel.
+TEST(RelativeBoxes, OnlyRemovesHitsThatAreNoContact) {
+  test::RandomQueryGenerator gen(2611);
+  int removed_hits = 0;
+  int hits = 0;
+  CcdStats stats;
+  for (int i = 0; i < 40'000; ++i) {
+    const test::RandomQuery q = gen.next();
+    CcdStats off_stats;
+    const CcdResult off =
+        q.vertex_face
+            ? vertex_face_ccd(q.vf(), Accuracy::conservative, with_relative(false), off_stats)
+            : edge_edge_ccd(q.ee(), Accuracy::conservative, with_relative(false), off_stats);
+    const CcdResult on =
+        q.vertex_face ? vertex_face_ccd(q.vf(), Accuracy::conservative, with_relative(true), stats)
+                      : edge_edge_ccd(q.ee(), Accuracy::conservative, with_relative(true), stats);
+    hits += off.hit ? 1 : 0;
+    if (on.hit) {
+      ASSERT_TRUE(off.hit) << q.kind << " query " << i;
+      EXPECT_EQ(on.toi_lower, off.toi_lower) << q.kind << " query " << i;
+      continue;
+    }
+    if (!off.hit) continue;
+    ++removed_hits;
+    const bool exact = q.vertex_face ? vertex_face_ccd(q.vf(), Accuracy::exact).hit
+                                     : edge_edge_ccd(q.ee(), Accuracy::exact).hit;
+    EXPECT_FALSE(exact) << q.kind << " query " << i << ": a contact removed";
+  }
+  EXPECT_GT(hits, 1000);
+  EXPECT_GT(stats.relative_rejected, 0);
+  // Every query the stage rejected left the coplanarity stage undecided: the counters add up.
+  EXPECT_EQ(
+      stats.aabb_rejected + stats.coplanarity_rejected + stats.relative_rejected +
+          stats.algebraic_rejected + stats.algebraic_hits + stats.solver_runs,
+      stats.queries);
+  std::cout << "  relative boxes: " << stats.relative_rejected << " of " << stats.queries
+            << " rejected, " << removed_hits << " conservative false positives removed\n";
+}
+
+// The published cloth-funnel step: every contact of its ground truth stays a hit.
+TEST(RelativeBoxes, KeepsEveryClothFunnelContact) {
+  for (const std::string kind : {"vf", "ee"}) {
+    const auto queries = test::load_cloth_funnel(kind);
+    int contacts = 0;
+    for (std::size_t i = 0; i < queries.size(); ++i) {
+      const auto& q = queries[i];
+      const CcdResult r = q.vertex_face
+                              ? vertex_face_ccd(q.vf(), Accuracy::conservative, with_relative(true))
+                              : edge_edge_ccd(q.ee(), Accuracy::conservative, with_relative(true));
+      if (!q.truth) continue;
+      ++contacts;
+      EXPECT_TRUE(r.hit) << kind << " query " << i;
+    }
+    EXPECT_EQ(contacts, kind == "vf" ? 27 : 107);
+  }
+}
+
+// Two parallel edges in one plane, 1 apart, carried together by 10 in that plane: the coplanarity
+// cubic is 0 throughout (nothing for that stage to reject) and their swept boxes overlap; their
+// relative boxes are 1 apart. With contact distance 0.9 they are still rejected; with 1.1 (and the
+// same motion) they are within reach all along and stay a hit.
+TEST(RelativeBoxes, RejectsCoplanarFeaturesThatMoveTogether) {
+  const Eigen::Vector3d carry(10.0, 3.0, 0.0);
+  EdgeEdgeQuery q;
+  q.ea0_t0 = {0.0, 0.0, 0.0};
+  q.ea1_t0 = {2.0, 0.0, 0.0};
+  q.eb0_t0 = {0.0, 1.0, 0.0};
+  q.eb1_t0 = {2.0, 1.0, 0.0};
+  q.ea0_t1 = q.ea0_t0 + carry;
+  q.ea1_t1 = q.ea1_t0 + carry;
+  q.eb0_t1 = q.eb0_t0 + carry;
+  q.eb1_t1 = q.eb1_t0 + carry;
+  CcdStats on, off;
+  EXPECT_FALSE(edge_edge_ccd(q, Accuracy::conservative, with_relative(true), on).hit);
+  EXPECT_EQ(on.relative_rejected, 1);
+  EXPECT_FALSE(edge_edge_ccd(q, Accuracy::conservative, with_relative(false), off).hit);
+  EXPECT_EQ(off.relative_rejected, 0);
+  EXPECT_EQ(off.coplanarity_rejected, 0) << "the coplanarity stage cannot decide it";
+  CcdStats near;
+  EXPECT_FALSE(edge_edge_ccd(q, Accuracy::conservative, with_relative(true, 0.9), near).hit);
+  EXPECT_EQ(near.relative_rejected, 1);
+  CcdStats within;
+  EXPECT_TRUE(edge_edge_ccd(q, Accuracy::conservative, with_relative(true, 1.1), within).hit);
+  EXPECT_EQ(within.relative_rejected, 0);
+  // The vertex-face form: a vertex in the face's plane, 1 beside the face, carried along.
+  VertexFaceQuery v;
+  v.v_t0 = {-1.0, 0.5, 0.0};
+  v.f0_t0 = {0.0, 0.0, 0.0};
+  v.f1_t0 = {2.0, 0.0, 0.0};
+  v.f2_t0 = {0.0, 2.0, 0.0};
+  v.v_t1 = v.v_t0 + carry;
+  v.f0_t1 = v.f0_t0 + carry;
+  v.f1_t1 = v.f1_t0 + carry;
+  v.f2_t1 = v.f2_t0 + carry;
+  CcdStats vf;
+  EXPECT_FALSE(vertex_face_ccd(v, Accuracy::conservative, with_relative(true), vf).hit);
+  EXPECT_EQ(vf.relative_rejected, 1);
+  CcdStats vf_within;
+  EXPECT_TRUE(vertex_face_ccd(v, Accuracy::conservative, with_relative(true, 1.1), vf_within).hit);
+}
+
+}  // namespace
+}  // namespace skelcd::ccd
