@@ -133,8 +133,16 @@ inline bool relative_meet(
 
 }  // namespace
 
-unsigned end_boxes_meet(const WideEndBoxes& w, const WideEndBoxes& q, int lane) {
+unsigned end_boxes_meet(const WideEndBoxes& w, const WideEndBoxes& q, int lane, unsigned wanted) {
 #if defined(__SSE2__)
+  // Lanes whose boxes overlap at t = 0 overlap in any relative motion (each relative box holds its
+  // box at t = 0): when that settles every wanted lane — little moves — u is not computed.
+  __m128 still = _mm_castsi128_ps(_mm_set1_epi32(-1));
+  for (int k = 0; k < 3; ++k) {
+    still = _mm_and_ps(still, _mm_cmple_ps(_mm_load_ps(w.lo0[k]), _mm_set1_ps(q.hi0[k][lane])));
+    still = _mm_and_ps(still, _mm_cmple_ps(_mm_set1_ps(q.lo0[k][lane]), _mm_load_ps(w.hi0[k])));
+  }
+  if ((static_cast<unsigned>(_mm_movemask_ps(still)) & wanted) == wanted) return wanted;
   __m128 ok = _mm_castsi128_ps(_mm_set1_epi32(-1));
   for (int k = 0; k < 3; ++k) {
     ok = _mm_and_ps(
@@ -149,7 +157,7 @@ unsigned end_boxes_meet(const WideEndBoxes& w, const WideEndBoxes& q, int lane) 
             _mm_set1_ps(q.lo1[k][lane]),
             _mm_set1_ps(q.hi1[k][lane])));
   }
-  return static_cast<unsigned>(_mm_movemask_ps(ok));
+  return static_cast<unsigned>(_mm_movemask_ps(ok)) & wanted;
 #else
   unsigned mask = 0;
   for (int i = 0; i < kWidth; ++i) {
@@ -167,12 +175,21 @@ unsigned end_boxes_meet(const WideEndBoxes& w, const WideEndBoxes& q, int lane) 
     }
     mask |= static_cast<unsigned>(hit) << i;
   }
-  return mask;
+  return mask & wanted;
 #endif
 }
 
 bool node_end_boxes_meet(const NodeEndBoxes& a, const NodeEndBoxes& b) {
 #if defined(__SSE2__)
+  // Boxes that overlap at t = 0 overlap in any relative motion (each relative box holds its box at
+  // t = 0): the common case where little moves, settled without computing u.
+  const __m128 a_lo0 = _mm_load_ps(a.lo0);
+  const __m128 a_hi0 = _mm_load_ps(a.hi0);
+  const __m128 b_lo0 = _mm_load_ps(b.lo0);
+  const __m128 b_hi0 = _mm_load_ps(b.hi0);
+  if (_mm_movemask_ps(_mm_and_ps(_mm_cmple_ps(a_lo0, b_hi0), _mm_cmple_ps(b_lo0, a_hi0))) == 0xf) {
+    return true;
+  }
   // The three axes and the padding slot (all 0: always meeting) at once.
   const __m128 ok = relative_meet(
       _mm_load_ps(a.lo0),
@@ -288,7 +305,7 @@ class Walk {
       // Children i < j: lanes above i.
       unsigned mask = overlap_lanes<N>(w, w, i) & ~((2u << i) - 1u);
       if (relative_ && mask != 0)
-        mask &= end_boxes_meet(ends_a_[to_size(c)], ends_a_[to_size(c)], i);
+        mask = end_boxes_meet(ends_a_[to_size(c)], ends_a_[to_size(c)], i, mask);
       bv_tests_ += m - 1 - i;
       while (mask != 0) {
         const int j = std::countr_zero(mask);
@@ -320,7 +337,7 @@ class Walk {
       const WideBvhNode<N>& w = wide_a_[to_size(ca)];
       unsigned mask = overlap_lanes<N>(w, pb, lb);
       if (relative_ && mask != 0) {
-        mask &= end_boxes_meet(ends_a_[to_size(ca)], ends_b_[node_of(sb)], lb);
+        mask = end_boxes_meet(ends_a_[to_size(ca)], ends_b_[node_of(sb)], lb, mask);
       }
       bv_tests_ += w.num_children;
       while (mask != 0) {
@@ -336,7 +353,7 @@ class Walk {
       const WideBvhNode<N>& w = wide_b_[to_size(cb)];
       unsigned mask = overlap_lanes<N>(w, pa, la);
       if (relative_ && mask != 0) {
-        mask &= end_boxes_meet(ends_b_[to_size(cb)], ends_a_[node_of(sa)], la);
+        mask = end_boxes_meet(ends_b_[to_size(cb)], ends_a_[node_of(sa)], la, mask);
       }
       bv_tests_ += w.num_children;
       while (mask != 0) {

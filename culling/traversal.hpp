@@ -69,7 +69,11 @@ void certified_slots(
 /// rounded outwards by a margin: x − (fl(|x|·2⁻²²) + FLT_MIN), rounded, is below every value
 /// that rounds to x, for any float x (and above for +). Bits of unused lanes are 0. The self and
 /// pair traversals apply it to every node pair when both trees have end boxes.
-[[nodiscard]] unsigned end_boxes_meet(const WideEndBoxes& w, const WideEndBoxes& q, int lane);
+/// Only the lanes in `wanted` are looked at (the others' bits are 0); lanes whose boxes overlap
+/// at t = 0 are kept without computing u, and when that settles all of `wanted` nothing else is
+/// computed.
+[[nodiscard]] unsigned end_boxes_meet(
+    const WideEndBoxes& w, const WideEndBoxes& q, int lane, unsigned wanted = 0xfu);
 
 /// end_boxes_meet for two binary nodes' end boxes (Bvh::node_end_boxes), the masked traversals'
 /// test (culling/cluster_checks.hpp): true when the nodes may come within reach of each other.
