@@ -23,29 +23,12 @@
 #include "culling/vertex_bounds.hpp"
 #include "skinning/load.hpp"
 #include "skinning/topology.hpp"
-#include "tests/support/test_support.hpp"
+#include "tests/culling/welded_character.hpp"
 
 namespace skelcd::culling {
 namespace {
 
-struct Model {
-  explicit Model(const std::string& file)
-      : loaded(skinning::load_model(test::asset("characters/" + file))),
-        topology(skinning::build_topology(*loaded.mesh)) {
-    skinning::gather_welded(topology, loaded.mesh->rest_positions, rest);
-  }
-  skinning::LoadedModel loaded;
-  skinning::Topology topology;
-  skinning::Positions rest;
-};
-
-/// The welded positions of sample k of the model's first clip.
-skinning::Positions sample(const Model& m, int k) {
-  skinning::Positions posed, welded;
-  m.loaded.motion()->positions(k, posed);
-  skinning::gather_welded(m.topology, posed, welded);
-  return welded;
-}
+using Model = test::WeldedCharacter;
 
 /// The triangle pairs of a self traversal of `bvh` refit over x0 → x1, with or without its end
 /// boxes, and its volume tests.
@@ -81,8 +64,8 @@ Traversed traverse(
 TEST(NodeRelative, EndBoxesHoldEveryCornerAndARefitDropsThem) {
   const Model m("CesiumMan.glb");
   const FeatureTopology ft(*m.loaded.mesh, m.topology);
-  const skinning::Positions x0 = sample(m, 0);
-  const skinning::Positions x1 = sample(m, 20);
+  const skinning::Positions x0 = m.sample(0);
+  const skinning::Positions x1 = m.sample(20);
   Bvh<3> bvh(ft.welded_triangles(), m.rest);
   FeatureBounds<3> bounds;
   swept_vertex_bounds<3>(x0, x1, 0.0, bounds.vertices);
@@ -239,8 +222,8 @@ TEST(NodeRelative, LanesThatMeetInTheRelativeMotionAreNeverToldApart) {
 TEST(NodeRelative, ABodyCarriedFarWhileItMovesKeepsItsContactsWithFarFewerPairs) {
   const Model m("CesiumMan.glb");
   const FeatureTopology ft(*m.loaded.mesh, m.topology);
-  const skinning::Positions x0 = sample(m, 5);
-  skinning::Positions x1 = sample(m, 25);
+  const skinning::Positions x0 = m.sample(5);
+  skinning::Positions x1 = m.sample(25);
   x1.col(0).array() += 3.0;
   x1.col(1).array() -= 0.5;
   EXPECT_GE(motion_scale(ft, x0, x1), kNodeRelativeMotion);

@@ -18,7 +18,7 @@
 #include "culling/vertex_bounds.hpp"
 #include "skinning/load.hpp"
 #include "skinning/topology.hpp"
-#include "tests/support/test_support.hpp"
+#include "tests/culling/welded_character.hpp"
 
 namespace skelcd::culling {
 namespace {
@@ -34,17 +34,7 @@ Outcome ccd(CullingMethod& method, const skinning::Positions& x0, const skinning
   return {r.contacts, r.counters.candidate_pairs};
 }
 
-/// The welded rest pose of a bundled character and its topology.
-struct Model {
-  explicit Model(const std::string& file)
-      : loaded(skinning::load_model(test::asset("characters/" + file))),
-        topology(skinning::build_topology(*loaded.mesh)) {
-    skinning::gather_welded(topology, loaded.mesh->rest_positions, rest);
-  }
-  skinning::LoadedModel loaded;
-  skinning::Topology topology;
-  skinning::Positions rest;
-};
+using Model = test::WeldedCharacter;
 
 // A body carried along rigidly, far over one interval: the swept boxes of every pair overlap its
 // neighbours' along the whole path, the relative boxes are the body's own. The trial keeps the
