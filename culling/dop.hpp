@@ -17,20 +17,14 @@
 #include <cstdint>
 #include <limits>
 
+#include "ccd/detail/float_bounds.hpp"
+
 namespace skelcd::culling {
 
-/// Smallest double greater than `x` (x finite, not the largest double). Inline bit arithmetic
-/// without branches (std::nextafter is an out-of-line libm call, and a branch on the sign is
-/// mispredicted often in the per-pair relative AABB filter): adding 0.0 turns −0 into +0; then one
-/// step towards +∞ is +1 on the bits of a non-negative double, −1 on those of a negative one
-/// (sign-magnitude: the bits read as int64 are negative exactly for the negative doubles).
-[[nodiscard]] inline double next_up(double x) {
-  const auto bits = std::bit_cast<std::int64_t>(x + 0.0);
-  return std::bit_cast<double>(bits + ((bits >> 63) | 1));
-}
-
-/// Largest double smaller than `x` (x finite, not the lowest double).
-[[nodiscard]] inline double next_down(double x) { return -next_up(-x); }
+/// Smallest double greater than `x`, largest smaller (x finite; bit arithmetic without branches):
+/// the one copy in ccd/detail/float_bounds.hpp, which the CCD kernels' relative boxes use too.
+using ccd::detail::next_down;
+using ccd::detail::next_up;
 
 /// The largest float not above `x` (x finite): bounds rounded outwards for the traversal's float
 /// volumes (culling/bvh.hpp). Never a subnormal, so that the bound holds also where the CPU

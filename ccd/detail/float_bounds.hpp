@@ -67,4 +67,18 @@ template <int K>
 /// a + b rounded so that the result is >= the exact a + b (a, b >= 0).
 [[nodiscard]] inline double add_up(double a, double b) { return (a + b) * kRoundUp; }
 
+/// Smallest double greater than `x` (x finite, not the largest double; ±0 → the smallest positive
+/// subnormal). Inline bit arithmetic without branches (std::nextafter is an out-of-line libm call,
+/// and a branch on the sign is mispredicted often in per-pair filters): adding 0.0 turns −0 into
+/// +0; then one step towards +∞ is +1 on the bits of a non-negative double, −1 on those of a
+/// negative one (sign-magnitude: the bits read as int64 are negative exactly for the negative
+/// doubles). The one copy for ccd/ and culling/ (culling/dop.hpp).
+[[nodiscard]] inline double next_up(double x) {
+  const auto bits = std::bit_cast<std::int64_t>(x + 0.0);
+  return std::bit_cast<double>(bits + ((bits >> 63) | 1));
+}
+
+/// Largest double smaller than `x` (x finite, not the lowest double).
+[[nodiscard]] inline double next_down(double x) { return -next_up(-x); }
+
 }  // namespace skelcd::ccd::detail

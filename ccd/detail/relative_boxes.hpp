@@ -17,14 +17,9 @@
 #include <cstdint>
 #include <limits>
 
-namespace skelcd::ccd::detail {
+#include "ccd/detail/float_bounds.hpp"
 
-/// The double above / below a finite x (±0 → the smallest subnormal of the sign asked for).
-[[nodiscard]] inline double step_up(double x) {
-  const auto bits = std::bit_cast<std::int64_t>(x + 0.0);
-  return std::bit_cast<double>(bits + ((bits >> 63) | 1));
-}
-[[nodiscard]] inline double step_down(double x) { return -step_up(-x); }
+namespace skelcd::ccd::detail {
 
 /// True when the relative boxes of the features (a: the first NA points, b: the other 4 − NA)
 /// prove that they never come within 2·half_width over the interval. `t0` and `t1` list the four
@@ -53,15 +48,15 @@ template <std::size_t NA>
         const double p0 = (*t0[i])[k];
         const double p1 = (*t1[i])[k] - u[k];
         finite = finite && std::abs(p0) <= kMax && std::abs(p1) <= kMax;
-        l = std::min({l, p0, step_down(p1)});
-        h = std::max({h, p0, step_up(p1)});
+        l = std::min({l, p0, next_down(p1)});
+        h = std::max({h, p0, next_up(p1)});
       }
       if (half_width > 0.0) {
         l -= half_width;
         h += half_width;
         finite = finite && std::abs(l) <= kMax && std::abs(h) <= kMax;
-        l = step_down(l);
-        h = step_up(h);
+        l = next_down(l);
+        h = next_up(h);
       }
       lo[side] = l;
       hi[side] = h;
