@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <bit>
 #include <random>
 #include <set>
 #include <string>
@@ -123,6 +124,79 @@ std::vector<std::uint8_t> random_flags(std::int32_t n, std::uint32_t seed, doubl
   std::vector<std::uint8_t> out(static_cast<std::size_t>(n));
   for (auto& f : out) f = coin(rng) ? 1 : 0;
   return out;
+}
+
+/// SlotAdjacency's corners and windows against their definition, slot pair by slot pair: bit d of
+/// window[s] set exactly when slot o = s + d − kReach (o ≠ s) holds a triangle sharing one or two
+/// vertices with slot s's, neither degenerate, their parts not excluded.
+void check_windows(const std::string& name, const FeatureTopology& ft, const Bvh<3>& bvh) {
+  SCOPED_TRACE(name);
+  const auto order = bvh.triangle_order();
+  const SlotAdjacency slots(ft, order);
+  ASSERT_EQ(slots.corners.size(), order.size());
+  ASSERT_EQ(slots.window.size(), order.size());
+  const auto degenerate = [](const std::array<std::int32_t, 3>& t) {
+    return t[0] == t[1] || t[1] == t[2] || t[0] == t[2];
+  };
+  const auto n = static_cast<std::int32_t>(order.size());
+  std::int64_t bits = 0;
+  for (std::int32_t s = 0; s < n; ++s) {
+    const auto& a = ft.triangle(order[static_cast<std::size_t>(s)]);
+    const std::array<std::int32_t, 4> corners =
+        degenerate(a) ? std::array<std::int32_t, 4>{-1, -1, -1, -1}
+                      : std::array<std::int32_t, 4>{a[0], a[1], a[2], -1};
+    ASSERT_EQ(slots.corners[static_cast<std::size_t>(s)], corners) << "slot " << s;
+    std::uint64_t expected = 0;
+    for (std::int32_t d = 0; d < 2 * SlotAdjacency::kReach; ++d) {
+      const std::int32_t o = s + d - SlotAdjacency::kReach;
+      if (o == s || o < 0 || o >= n) continue;
+      const auto& b = ft.triangle(order[static_cast<std::size_t>(o)]);
+      if (degenerate(a) || degenerate(b)) continue;
+      const auto shared = std::count_if(a.begin(), a.end(), [&](std::int32_t v) {
+        return std::find(b.begin(), b.end(), v) != b.end();
+      });
+      if (shared == 0 || shared == 3) continue;
+      if (ft.triangles_excluded(
+              order[static_cast<std::size_t>(s)], order[static_cast<std::size_t>(o)])) {
+        continue;
+      }
+      expected |= std::uint64_t{1} << d;
+    }
+    ASSERT_EQ(slots.window[static_cast<std::size_t>(s)], expected) << "slot " << s;
+    bits += std::popcount(expected);
+  }
+  EXPECT_GT(bits, n) << "most slots have neighbours in their window";
+}
+
+TEST(FanSieve, SlotWindowsHoldExactlyTheNeighboursSharingOneOrTwoVertices) {
+  for (const char* asset :
+       {"characters/CesiumMan.glb", "characters/stormtrooper/stormtrooper.dae"}) {
+    const auto model = skinning::load_model(test::asset(asset));
+    const skinning::Topology topo = skinning::build_topology(*model.mesh);
+    const FeatureTopology ft(*model.mesh, topo);
+    const skinning::Positions x = test::welded(topo, model.mesh->rest_positions);
+    check_windows(asset, ft, Bvh<3>(ft.welded_triangles(), x));
+  }
+  // Parts never checked against each other, a duplicate face and a degenerate one.
+  skinning::Mesh m = test::tube(12, 16, 0.5, 3.0);
+  const auto f = static_cast<Eigen::Index>(m.triangles.rows());
+  m.triangles.conservativeResize(f + 2, 3);
+  m.triangles.row(f) << m.triangles(0, 0), m.triangles(0, 2), m.triangles(0, 1);
+  m.triangles.row(f + 1) << m.triangles(1, 0), m.triangles(1, 1), m.triangles(1, 1);
+  m.part_names = {"even", "odd"};
+  m.face_part.resize(static_cast<std::size_t>(f + 2));
+  m.face_index_in_part.resize(static_cast<std::size_t>(f + 2));
+  std::array<std::int32_t, 2> in_part{0, 0};
+  for (Eigen::Index i = 0; i < f + 2; ++i) {
+    const std::int32_t part = i % 3 == 0 ? 1 : 0;  // neighbours in both parts, and in one
+    m.face_part[static_cast<std::size_t>(i)] = part;
+    m.face_index_in_part[static_cast<std::size_t>(i)] = in_part[static_cast<std::size_t>(part)]++;
+  }
+  m.excluded_part_pairs = {{0, 1}};
+  const skinning::Topology topo = test::simple_topology(m);
+  const FeatureTopology ft(m, topo);
+  check_windows(
+      "tube with parts", ft, Bvh<3>(ft.welded_triangles(), test::welded(topo, m.rest_positions)));
 }
 
 TEST(FanSieve, SettlesExactlyThePairsSharingACertifiedVertexOnARealCharacter) {
