@@ -126,6 +126,28 @@ std::vector<std::uint8_t> random_flags(std::int32_t n, std::uint32_t seed, doubl
   return out;
 }
 
+/// A tube with a duplicate of face 0 (reversed) and a degenerate face on an edge of face 1, its
+/// faces in two parts never checked against each other: face i in part 1 when every_other, else
+/// when i % 3 == 0 (so that some neighbours share a part and some do not).
+skinning::Mesh tube_with_parts(bool every_other) {
+  skinning::Mesh m = test::tube(12, 16, 0.5, 3.0);
+  const auto f = static_cast<Eigen::Index>(m.triangles.rows());
+  m.triangles.conservativeResize(f + 2, 3);
+  m.triangles.row(f) << m.triangles(0, 0), m.triangles(0, 2), m.triangles(0, 1);
+  m.triangles.row(f + 1) << m.triangles(1, 0), m.triangles(1, 1), m.triangles(1, 1);
+  m.part_names = {"first", "second"};
+  m.face_part.resize(static_cast<std::size_t>(f + 2));
+  m.face_index_in_part.resize(static_cast<std::size_t>(f + 2));
+  std::array<std::int32_t, 2> in_part{0, 0};
+  for (Eigen::Index i = 0; i < f + 2; ++i) {
+    const std::int32_t part = every_other ? static_cast<std::int32_t>(i % 2) : (i % 3 == 0 ? 1 : 0);
+    m.face_part[static_cast<std::size_t>(i)] = part;
+    m.face_index_in_part[static_cast<std::size_t>(i)] = in_part[static_cast<std::size_t>(part)]++;
+  }
+  m.excluded_part_pairs = {{0, 1}};
+  return m;
+}
+
 /// SlotAdjacency's corners and windows against their definition, slot pair by slot pair: bit d of
 /// window[s] set exactly when slot o = s + d − kReach (o ≠ s) holds a triangle sharing one or two
 /// vertices with slot s's, neither degenerate, their parts not excluded.
@@ -178,21 +200,7 @@ TEST(FanSieve, SlotWindowsHoldExactlyTheNeighboursSharingOneOrTwoVertices) {
     check_windows(asset, ft, Bvh<3>(ft.welded_triangles(), x));
   }
   // Parts never checked against each other, a duplicate face and a degenerate one.
-  skinning::Mesh m = test::tube(12, 16, 0.5, 3.0);
-  const auto f = static_cast<Eigen::Index>(m.triangles.rows());
-  m.triangles.conservativeResize(f + 2, 3);
-  m.triangles.row(f) << m.triangles(0, 0), m.triangles(0, 2), m.triangles(0, 1);
-  m.triangles.row(f + 1) << m.triangles(1, 0), m.triangles(1, 1), m.triangles(1, 1);
-  m.part_names = {"even", "odd"};
-  m.face_part.resize(static_cast<std::size_t>(f + 2));
-  m.face_index_in_part.resize(static_cast<std::size_t>(f + 2));
-  std::array<std::int32_t, 2> in_part{0, 0};
-  for (Eigen::Index i = 0; i < f + 2; ++i) {
-    const std::int32_t part = i % 3 == 0 ? 1 : 0;  // neighbours in both parts, and in one
-    m.face_part[static_cast<std::size_t>(i)] = part;
-    m.face_index_in_part[static_cast<std::size_t>(i)] = in_part[static_cast<std::size_t>(part)]++;
-  }
-  m.excluded_part_pairs = {{0, 1}};
+  const skinning::Mesh m = tube_with_parts(/*every_other=*/false);
   const skinning::Topology topo = test::simple_topology(m);
   const FeatureTopology ft(m, topo);
   check_windows(
@@ -228,21 +236,8 @@ TEST(FanSieve, SettlesExactlyThePairsSharingACertifiedVertexOnARealCharacter) {
 }
 
 TEST(FanSieve, LeavesExcludedDegenerateAndDuplicatePairsToTheFilter) {
-  skinning::Mesh m = test::tube(12, 16, 0.5, 3.0);
-  const auto f = static_cast<Eigen::Index>(m.triangles.rows());
-  // A duplicate of face 0 (reversed) and a degenerate face on an edge of face 1.
-  m.triangles.conservativeResize(f + 2, 3);
-  m.triangles.row(f) << m.triangles(0, 0), m.triangles(0, 2), m.triangles(0, 1);
-  m.triangles.row(f + 1) << m.triangles(1, 0), m.triangles(1, 1), m.triangles(1, 1);
   // Two parts, every other face, never checked against each other.
-  m.part_names = {"even", "odd"};
-  m.face_part.resize(static_cast<std::size_t>(f + 2));
-  m.face_index_in_part.resize(static_cast<std::size_t>(f + 2));
-  for (Eigen::Index i = 0; i < f + 2; ++i) {
-    m.face_part[static_cast<std::size_t>(i)] = static_cast<std::int32_t>(i % 2);
-    m.face_index_in_part[static_cast<std::size_t>(i)] = static_cast<std::int32_t>(i / 2);
-  }
-  m.excluded_part_pairs = {{0, 1}};
+  const skinning::Mesh m = tube_with_parts(/*every_other=*/true);
   const skinning::Topology topo = test::simple_topology(m);
   const FeatureTopology ft(m, topo);
   const skinning::Positions x = test::welded(topo, m.rest_positions);
