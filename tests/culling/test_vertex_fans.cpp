@@ -3,6 +3,7 @@
 // that DCD with fans reports exactly the pairs it reports testing every pair, on real characters.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <numbers>
@@ -110,6 +111,62 @@ TEST(VertexFans, ClosedOpenAndNoFan) {
   std::vector<Tri> bow_tie{{0, 1, 2}, {0, 2, 3}, {0, 3, 1}, {0, 4, 5}, {0, 5, 6}, {0, 6, 4}};
   EXPECT_TRUE(VertexFans(bow_tie, 7).spokes(0).empty());
   EXPECT_FALSE(VertexFans(bow_tie, 7).spokes(4).empty());
+}
+
+TEST(VertexFans, ChainsFansOfAnySizeFromShuffledTriangles) {
+  // Fans of 1 to 40 triangles, their triangles shuffled and their spokes relabelled at random: a
+  // closed fan's spokes start at its smallest label and follow the triangles' orientation, an open
+  // one's at its free start; and a flipped triangle, a duplicate face or a second fan through the
+  // vertex leaves no fan.
+  std::mt19937 rng(5);
+  for (int m = 1; m <= 40; ++m) {
+    for (const bool closed : {false, true}) {
+      if (closed && m < 3) continue;
+      // Spoke i (1 … m, or m + 1 open) gets label labels[i]; vertex 0 stays 0.
+      const int spokes = closed ? m : m + 1;
+      std::vector<std::int32_t> labels(static_cast<std::size_t>(spokes) + 1);
+      for (int i = 0; i <= spokes; ++i) labels[static_cast<std::size_t>(i)] = i;
+      std::shuffle(labels.begin() + 1, labels.end(), rng);
+      std::vector<Tri> tris;
+      for (int i = 1; i <= m; ++i) {
+        const int j = i == spokes ? 1 : i + 1;  // closed: spoke m back to spoke 1
+        tris.push_back(
+            {0, labels[static_cast<std::size_t>(i)], labels[static_cast<std::size_t>(j)]});
+      }
+      std::shuffle(tris.begin(), tris.end(), rng);
+      const auto name = std::to_string(m) + (closed ? " closed" : " open");
+      SCOPED_TRACE(name);
+      const VertexFans fans(tris, spokes + 1);
+      ASSERT_EQ(fans.closed(0), closed);
+      const auto got = fans.spokes(0);
+      ASSERT_EQ(got.size(), static_cast<std::size_t>(spokes));
+      // Expected: rotate the cycle to its smallest label; a path from spoke 1.
+      std::size_t first = 1;
+      if (closed) {
+        for (int i = 1; i <= spokes; ++i) {
+          if (labels[static_cast<std::size_t>(i)] < labels[first])
+            first = static_cast<std::size_t>(i);
+        }
+      }
+      for (int k = 0; k < spokes; ++k) {
+        const std::size_t i =
+            (first - 1 + static_cast<std::size_t>(k)) % static_cast<std::size_t>(spokes) + 1;
+        EXPECT_EQ(got[static_cast<std::size_t>(k)], labels[i]) << "spoke " << k;
+      }
+      if (m >= 2) {
+        auto flipped = tris;
+        std::swap(flipped[0][1], flipped[0][2]);
+        EXPECT_TRUE(VertexFans(flipped, spokes + 1).spokes(0).empty()) << "flipped";
+      }
+      auto duplicate = tris;
+      duplicate.push_back(tris[0]);
+      EXPECT_TRUE(VertexFans(duplicate, spokes + 1).spokes(0).empty()) << "duplicate";
+      // A second closed fan of three through vertex 0, on spokes of its own.
+      auto bow_tie = tris;
+      for (int i = 0; i < 3; ++i) bow_tie.push_back({0, spokes + 1 + i, spokes + 1 + (i + 1) % 3});
+      EXPECT_TRUE(VertexFans(bow_tie, spokes + 4).spokes(0).empty()) << "bow tie";
+    }
+  }
 }
 
 TEST(VertexFans, CertifiesFlatAndBumpyFansAndRefusesOnesThatWindTwice) {
