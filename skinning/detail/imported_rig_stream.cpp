@@ -8,6 +8,7 @@
 #include <utility>
 #include <vector>
 
+#include "skinning/detail/answer_stream.hpp"
 #include "skinning/errors.hpp"
 
 namespace skelcd::skinning::detail {
@@ -27,7 +28,7 @@ static_assert(sizeof(Eigen::Affine3d) == 16 * sizeof(double));
 
 // Bytes each element takes at least in the stream: a count of N elements must leave N times this
 // in the bytes still to read, which bounds every allocation by what was actually received.
-constexpr std::size_t kCountBytes = sizeof(std::uint64_t);
+constexpr std::size_t kCountBytes = kAnswerCountBytes;
 constexpr std::size_t kAffineBytes = 16 * sizeof(double);
 constexpr std::size_t kStringMin = kCountBytes;
 constexpr std::size_t kNodeMin = kStringMin + sizeof(std::int32_t) + kAffineBytes;
@@ -39,73 +40,17 @@ constexpr std::size_t kClipMin =
 constexpr std::size_t kAttachmentMin = sizeof(std::int32_t) + kAffineBytes;
 constexpr std::size_t kRefusedClipMin = 2 * kStringMin;
 
-class Writer {
+// The rig's transforms and points go as blocks of doubles.
+class Writer : public AnswerWriter {
  public:
-  explicit Writer(const AnswerSink& send) : send_(send) {}
-
-  template <class T>
-  void scalar(T value) {
-    static_assert(std::is_arithmetic_v<T>);
-    send_(&value, sizeof value);
-  }
-  void count(std::size_t n) { scalar(static_cast<std::uint64_t>(n)); }
-  void string(const std::string& s) {
-    count(s.size());
-    send_(s.data(), s.size());
-  }
-  void block(const void* data, std::size_t size) { send_(data, size); }
-  void affine(const Eigen::Affine3d& t) { send_(t.matrix().data(), kAffineBytes); }
-  void vector3(const Eigen::Vector3d& v) { send_(v.data(), sizeof v); }
-  // A vector of scalars or of fixed-size Eigen objects, as one block.
-  template <class T>
-  void array(const std::vector<T>& values) {
-    count(values.size());
-    send_(values.data(), values.size() * sizeof(T));
-  }
-  void strings(const std::vector<std::string>& values) {
-    count(values.size());
-    for (const auto& s : values) string(s);
-  }
-
- private:
-  const AnswerSink& send_;
+  using AnswerWriter::AnswerWriter;
+  void affine(const Eigen::Affine3d& t) { block(t.matrix().data(), kAffineBytes); }
+  void vector3(const Eigen::Vector3d& v) { block(v.data(), sizeof v); }
 };
 
-class Reader {
+class Reader : public AnswerReader {
  public:
-  Reader(ChildAnswer& in, const std::string& file) : in_(in), file_(file) {}
-
-  [[noreturn]] void damaged(const std::string& what) const {
-    throw IoError(file_ + ": the import's answer from its child process is damaged (" + what + ")");
-  }
-
-  void bytes(void* out, std::size_t n) {
-    if (!in_.read(out, n))
-      damaged(
-          "it ends " + std::to_string(n - in_.size()) + " bytes short of " + std::to_string(n) +
-          " more");
-  }
-  template <class T>
-  T scalar() {
-    static_assert(std::is_arithmetic_v<T>);
-    T value;
-    bytes(&value, sizeof value);
-    return value;
-  }
-  // A count of elements taking at least `min_bytes` each, bounded by the bytes left.
-  std::size_t count(std::size_t min_bytes, const char* what) {
-    const auto n = scalar<std::uint64_t>();
-    if (n > in_.size() / min_bytes)
-      damaged(
-          std::to_string(n) + " " + what + " announced, but only " + std::to_string(in_.size()) +
-          " bytes follow");
-    return static_cast<std::size_t>(n);
-  }
-  std::string string(const char* what) {
-    std::string s(count(1, what), '\0');
-    bytes(s.data(), s.size());
-    return s;
-  }
+  Reader(ChildAnswer& in, const std::string& file) : AnswerReader(in, file, "the import's") {}
   Eigen::Affine3d affine() {
     Eigen::Affine3d t;
     bytes(t.matrix().data(), kAffineBytes);
@@ -116,22 +61,6 @@ class Reader {
     bytes(v.data(), sizeof v);
     return v;
   }
-  template <class T>
-  std::vector<T> array(const char* what) {
-    std::vector<T> values(count(sizeof(T), what));
-    bytes(values.data(), values.size() * sizeof(T));
-    return values;
-  }
-  std::vector<std::string> strings(const char* what) {
-    std::vector<std::string> values(count(kStringMin, what));
-    for (auto& s : values) s = string(what);
-    return values;
-  }
-  [[nodiscard]] std::size_t left() const { return in_.size(); }
-
- private:
-  ChildAnswer& in_;
-  const std::string& file_;
 };
 
 // --- writing, field by field in the order of the structs (skinning/rig.hpp, mesh.hpp) ---------
