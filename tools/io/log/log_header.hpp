@@ -24,6 +24,7 @@ struct LogRoute {
   bool closed = false;          ///< no boundary and no non-manifold edge
   std::int32_t triangles = 0;
   std::string method;  ///< the method that tested its pairs
+  friend bool operator==(const LogRoute&, const LogRoute&) = default;
 };
 
 /// One check of a scene (docs/scenes.md): stored as the /checks group, one row per check; the
@@ -35,6 +36,7 @@ struct LogCheck {
   std::string query;     ///< "dcd" | "ccd" | "both"
   std::string method;
   std::string accuracy;
+  friend bool operator==(const LogCheck&, const LogCheck&) = default;
 };
 
 struct LogHeader {

@@ -12,6 +12,7 @@
 #include "skinning/detail/import_guard.hpp"
 #include "skinning/errors.hpp"
 #include "tools/io/log/detail/hdf5_schema.hpp"
+#include "tools/io/log/detail/log_answer.hpp"
 
 namespace skelcd::tools {
 
@@ -632,11 +633,18 @@ LogData read_log(const std::filesystem::path& path, const ReadLogOptions& option
   if (options.isolate) {
     std::error_code exists_ec;
     if (std::filesystem::is_regular_file(path, exists_ec)) {
+      // The child's read is the only one: it sends the log back, and this process never hands
+      // the file to libhdf5, whose faults on a malformed file (some only now and then, as a read
+      // after free) stay in the child.
       ReadLogOptions inside = options;
       inside.isolate = false;
       const skinning::detail::ImportLimits limits{
           .memory_bytes = std::size_t{4} << 30, .time_s = 120.0, .reader = "HDF5"};
-      skinning::detail::run_isolated(path, limits, [&] { (void)read_log(path, inside); });
+      auto answer = skinning::detail::run_isolated_with_answer(
+          path, limits, [&](const skinning::detail::AnswerSink& send) {
+            detail::write_log_answer(read_log(path, inside), send);
+          });
+      return detail::read_log_answer(answer, path.string());
     }
   }
   detail::silence_hdf5_errors();

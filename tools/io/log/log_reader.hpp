@@ -39,9 +39,10 @@ struct LogData {
 struct ReadLogOptions {
   /// Also read /contacts and /dcd_pairs (a batch summary needs only the header and /frames).
   bool findings = true;
-  /// Read the file once in a child process first: HDF5 itself crashes, loops or allocates without
-  /// bound on some malformed files (fuzz/crashes/hdf5/), which then costs one line, not the
-  /// process. Off only for fuzzing the reader in-process.
+  /// Read the file in a child process, which sends the log back: HDF5 itself crashes, loops or
+  /// allocates without bound on some malformed files (fuzz/crashes/hdf5/), which then costs one
+  /// line, not the process, and this process never opens the file with HDF5. Off only for fuzzing
+  /// the reader in-process.
   bool isolate = true;
 };
 
