@@ -18,13 +18,16 @@ inline bool shares_vertex(const std::array<std::int32_t, 3>& a, const std::array
 }
 
 /// The swept box of one triangle in the relative motion: its corners at t = 0 (exact) and at
-/// t = 1 minus the common displacement `w`, each rounded result bracketed by its neighbours
-/// (round-to-nearest is within one ulp of the exact difference).
+/// t = 1 minus the common displacement `w`. With `bracket`, each rounded difference is bracketed
+/// by its neighbours (round-to-nearest is within one ulp of the exact difference); without, the
+/// box holds the rounded differences themselves, which is enough for a test without width
+/// (RelativeAabbFilter's class comment says why).
 Aabb relative_box(
     const std::array<std::int32_t, 3>& t,
     const skinning::Positions& x_t0,
     const skinning::Positions& x_t1,
-    const Eigen::Vector3d& w) {
+    const Eigen::Vector3d& w,
+    bool bracket) {
   Aabb box = Aabb::empty();
   for (const std::int32_t v : t) {
     const auto i = static_cast<Eigen::Index>(v);
@@ -32,8 +35,8 @@ Aabb relative_box(
       const auto c = static_cast<Eigen::Index>(k);
       const double p0 = x_t0(i, c);
       const double p1 = x_t1(i, c) - w[c];
-      box.lo[k] = std::min({box.lo[k], p0, next_down(p1)});
-      box.hi[k] = std::max({box.hi[k], p0, next_up(p1)});
+      box.lo[k] = std::min({box.lo[k], p0, bracket ? next_down(p1) : p1});
+      box.hi[k] = std::max({box.hi[k], p0, bracket ? next_up(p1) : p1});
     }
   }
   return box;
@@ -59,8 +62,9 @@ bool relative_boxes_overlap(
     }
   }
   w /= 6.0;
-  Aabb a = relative_box(ta, x_t0, x_t1, w);
-  Aabb b = relative_box(tb, x_t0, x_t1, w);
+  const bool bracket = half_width > 0.0;
+  Aabb a = relative_box(ta, x_t0, x_t1, w, bracket);
+  Aabb b = relative_box(tb, x_t0, x_t1, w, bracket);
   a.inflate(half_width);
   b.inflate(half_width);
   return a.overlaps(b);
@@ -118,8 +122,9 @@ void RelativeAabbFilter::prepare(
       t.hi0[k] = std::max({x_t0(v0, c), x_t0(v1, c), x_t0(v2, c)});
       t.lo1[k] = std::min({x_t1(v0, c), x_t1(v1, c), x_t1(v2, c)});
       t.hi1[k] = std::max({x_t1(v0, c), x_t1(v1, c), x_t1(v2, c)});
-      t.displacement[k] =
-          ((x_t1(v0, c) - x_t0(v0, c)) + (x_t1(v1, c) - x_t0(v1, c))) + (x_t1(v2, c) - x_t0(v2, c));
+      t.sixth_displacement[k] = (((x_t1(v0, c) - x_t0(v0, c)) + (x_t1(v1, c) - x_t0(v1, c))) +
+                                 (x_t1(v2, c) - x_t0(v2, c))) /
+                                6.0;
     }
   }
 }
@@ -128,9 +133,25 @@ bool RelativeAabbFilter::overlap(const TrianglePair& pair, double half_width) co
   assert(half_width >= 0.0);
   const Triangle& a = triangles_[static_cast<std::size_t>(pair.a)];
   const Triangle& b = triangles_[static_cast<std::size_t>(pair.b)];
+  if (half_width == 0.0) {
+    // Apart on an axis when one box's lower end is above the other's upper end. Every end is a
+    // double of the input (lo0, hi0) or a rounded fl(y - w) with the pair's one w, and rounding
+    // is monotone: fl(y - w) > fl(z - w) implies y > z, fl(y - w) > c implies y - w > c for a
+    // double c, and likewise the other way round. So a strict inequality between the rounded ends
+    // holds between the exact ones: no bracketing, and no box to build.
+    for (std::size_t k = 0; k < 3; ++k) {
+      const double w = a.sixth_displacement[k] + b.sixth_displacement[k];
+      const double a_lo = std::min(a.lo0[k], a.lo1[k] - w);
+      const double a_hi = std::max(a.hi0[k], a.hi1[k] - w);
+      const double b_lo = std::min(b.lo0[k], b.lo1[k] - w);
+      const double b_hi = std::max(b.hi0[k], b.hi1[k] - w);
+      if (a_lo > b_hi || b_lo > a_hi) return false;
+    }
+    return true;
+  }
   Aabb ra, rb;
   for (std::size_t k = 0; k < 3; ++k) {
-    const double w = (a.displacement[k] + b.displacement[k]) / 6.0;
+    const double w = a.sixth_displacement[k] + b.sixth_displacement[k];
     ra.lo[k] = std::min(a.lo0[k], next_down(a.lo1[k] - w));
     ra.hi[k] = std::max(a.hi0[k], next_up(a.hi1[k] - w));
     rb.lo[k] = std::min(b.lo0[k], next_down(b.lo1[k] - w));

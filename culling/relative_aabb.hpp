@@ -4,7 +4,8 @@
 // vertices changes no distance between points of the two triangles at any instant, so if the swept
 // boxes of the *relative* motion are apart, the triangles are apart over the whole interval. The
 // common velocity is the mean of the six (any vector would be sound; the mean makes the boxes
-// small). Rounding is outward: each relative end position is bracketed by the doubles around it.
+// small). Rounding is outward: each relative end position is bracketed by the doubles around it
+// (with a width; without one, monotone rounding is enough: RelativeAabbFilter).
 
 #include <array>
 #include <cstddef>
@@ -41,15 +42,19 @@ std::int64_t relative_aabb_filter(
     std::size_t first = 0);
 
 /// The same filter with what each triangle contributes computed once per interval (prepare):
-/// its corners' box at t = 0, at t = 1, and the sum of its corners' displacements, so that a pair
-/// costs two box translations instead of twelve corner lookups. The relative box of a triangle is
-/// [min(lo₀, ↓(lo₁ − w)), max(hi₀, ↑(hi₁ − w))] per axis: the rounded min of the corners' x₁ − w
-/// is the rounded (min x₁) − w (rounding is monotone), bracketed outwards as above; w, the mean of
-/// the six displacements, is summed triangle by triangle (another rounding of the mean: any common
-/// vector is sound). Tested against relative_boxes_overlap (tests/culling/test_cluster_checks.cpp).
+/// its corners' box at t = 0, at t = 1, and a sixth of the sum of its corners' displacements, so
+/// that a pair costs two box translations instead of twelve corner lookups. The relative box of a
+/// triangle is [min(lo₀, ↓(lo₁ − w)), max(hi₀, ↑(hi₁ − w))] per axis: the rounded min of the
+/// corners' x₁ − w is the rounded (min x₁) − w (rounding is monotone), bracketed outwards as above;
+/// w, the mean of the six displacements, is the sum of the two triangles' sixths (another rounding
+/// of the mean: any common vector is sound). Without width (`half_width` 0, as the radial-view
+/// methods run) no end is bracketed: the boxes are apart only when a rounded end lies strictly
+/// beyond another, and since each end is an input double or fl(y − w) with the pair's one w,
+/// monotone rounding makes the exact ends lie so too. Tested against relative_boxes_overlap and
+/// exact arithmetic (tests/culling/test_cluster_checks.cpp).
 class RelativeAabbFilter {
  public:
-  /// Per-triangle boxes and displacement sums of the interval x_t0 → x_t1 (#W × 3 each).
+  /// Per-triangle boxes and displacements of the interval x_t0 → x_t1 (#W × 3 each).
   /// Allocation-free once sized for the topology.
   void prepare(
       const FeatureTopology& topology,
@@ -67,7 +72,7 @@ class RelativeAabbFilter {
 
  private:
   struct Triangle {
-    std::array<double, 3> lo0, hi0, lo1, hi1, displacement;
+    std::array<double, 3> lo0, hi0, lo1, hi1, sixth_displacement;
   };
   std::vector<Triangle> triangles_;
 };

@@ -3,11 +3,14 @@
 // `skipped` split the overlapping pairs between them. The relative AABB filter never removes a
 // pair whose triangles touch (checked with the CCD of ccd/), and removes pairs
 // that move together. (The conservative CCD accuracy is used: its "no hit" is a proof.)
+#include <gtest/gtest.h>
+
 #include <algorithm>
+#include <array>
+#include <cmath>
+#include <limits>
 #include <random>
 #include <set>
-
-#include <gtest/gtest.h>
 
 #include "ccd/edge_edge.hpp"
 #include "ccd/vertex_face.hpp"
@@ -266,6 +269,71 @@ TEST(ClusterChecks, RelativeBoxesOfARigidTranslation) {
   EXPECT_TRUE(relative_boxes_overlap(ft, {0, 1}, x0, x2, 0.0));
   prepared.prepare(ft, x0, x2);
   EXPECT_TRUE(prepared.overlap({0, 1}, 0.0));
+}
+
+TEST(ClusterChecks, RelativeBoxesWithoutWidthAreApartOnlyWhenTheExactOnesAre) {
+  // Without width neither filter brackets the rounded ends fl(x₁ − w) (relative_aabb.hpp). Here
+  // every coordinate lies in [1, 2) on a grid of a few ulps, so ends tie and cross at the last bit,
+  // and w, the common displacement ~0.1, is computed as each filter computes it; x₁ − w is then
+  // exact in long double (at most 57 significant bits). Every pair a filter calls apart must have
+  // exactly separated relative boxes.
+  static_assert(std::numeric_limits<long double>::digits >= 64);
+  constexpr double kUlp = 0x1p-52;
+  std::mt19937 rng(20261127);
+  std::uniform_int_distribution<int> grid(-6, 6);
+  std::uniform_int_distribution<int> low_bits(0, 64);
+  skinning::Positions x0(6, 3), x1(6, 3);
+  x0 << 0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1, 1, 0, 1, 0, 1, 1;  // six distinct vertices at rest
+  skinning::Mesh mesh =
+      test::single_part_mesh(x0, (skinning::Triangles(2, 3) << 0, 1, 2, 3, 4, 5).finished());
+  const auto topo = test::simple_topology(mesh);
+  const FeatureTopology ft(mesh, topo);
+  ASSERT_EQ(ft.triangle(0), (std::array<std::int32_t, 3>{0, 1, 2}));
+  ASSERT_EQ(ft.triangle(1), (std::array<std::int32_t, 3>{3, 4, 5}));
+  // Exact separation of the relative boxes for the common displacement w.
+  const auto exactly_apart = [&](const Eigen::Vector3d& w) {
+    for (Eigen::Index k = 0; k < 3; ++k) {
+      std::array<long double, 2> lo{INFINITY, INFINITY}, hi{-INFINITY, -INFINITY};
+      for (Eigen::Index v = 0; v < 6; ++v) {
+        const std::size_t side = v < 3 ? 0 : 1;
+        const long double end = static_cast<long double>(x1(v, k)) - static_cast<long double>(w[k]);
+        lo[side] = std::min({lo[side], static_cast<long double>(x0(v, k)), end});
+        hi[side] = std::max({hi[side], static_cast<long double>(x0(v, k)), end});
+      }
+      if (lo[0] > hi[1] || lo[1] > hi[0]) return true;
+    }
+    return false;
+  };
+  int prepared_apart = 0, unprepared_apart = 0;
+  RelativeAabbFilter prepared;
+  for (int trial = 0; trial < 200000; ++trial) {
+    for (Eigen::Index v = 0; v < 6; ++v) {
+      for (Eigen::Index k = 0; k < 3; ++k) {
+        x0(v, k) = 1.5 + grid(rng) * kUlp;
+        x1(v, k) = x0(v, k) + (0.1 + low_bits(rng) * 0x1p-56);
+      }
+    }
+    // w as each filter forms it: the prepared one adds each triangle's summed displacement over
+    // 6; relative_boxes_overlap sums the six displacements in order and divides once.
+    Eigen::Vector3d w_prepared, w_unprepared;
+    for (Eigen::Index k = 0; k < 3; ++k) {
+      const auto d = [&](Eigen::Index v) { return x1(v, k) - x0(v, k); };
+      w_prepared[k] = ((d(0) + d(1)) + d(2)) / 6.0 + ((d(3) + d(4)) + d(5)) / 6.0;
+      w_unprepared[k] = (((((d(0) + d(1)) + d(2)) + d(3)) + d(4)) + d(5)) / 6.0;
+    }
+    prepared.prepare(ft, x0, x1);
+    if (!prepared.overlap({0, 1}, 0.0)) {
+      ++prepared_apart;
+      ASSERT_TRUE(exactly_apart(w_prepared)) << "trial " << trial;
+    }
+    if (!relative_boxes_overlap(ft, {0, 1}, x0, x1, 0.0)) {
+      ++unprepared_apart;
+      ASSERT_TRUE(exactly_apart(w_unprepared)) << "trial " << trial;
+    }
+  }
+  // Enough separated pairs for the check to mean something.
+  EXPECT_GT(prepared_apart, 1000);
+  EXPECT_GT(unprepared_apart, 1000);
 }
 
 }  // namespace
