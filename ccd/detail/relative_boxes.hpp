@@ -5,8 +5,12 @@
 // p₁ moves, less t·u, inside the box of p₀ and p₁ − u. So when the boxes of the two features'
 // relative ends, each grown by half of min_separation, are apart on some axis, the features never
 // come within min_separation of each other over [0, 1]. Any u is sound; u is the mean displacement
-// of the query's four points. Each p₁ − u is bracketed by the doubles around its rounded value
-// (round-to-nearest is within half an ulp), so the boxes hold the exact relative ends.
+// of the query's four points. With a contact distance each p₁ − u is bracketed by the doubles
+// around its rounded value (round-to-nearest is within half an ulp), so the boxes hold the exact
+// relative ends. Without one the boxes need not hold them: every end compared is an input
+// coordinate or fl(p₁ − u) with the query's one u, and rounding is monotone (fl(x − u) < fl(y − u)
+// implies x < y, fl(x − u) < c implies x − u < c for a double c, and the same the other way), so a
+// strict gap between the rounded ends is a gap between the exact ones.
 
 #include <Eigen/Core>
 #include <algorithm>
@@ -21,12 +25,9 @@
 
 namespace skelcd::ccd::detail {
 
-/// True when the relative boxes of the features (a: the first NA points, b: the other 4 − NA)
-/// prove that they never come within 2·half_width over the interval. `t0` and `t1` list the four
-/// points, a's first. False whenever a value on the way is not finite (a non-finite coordinate, an
-/// overflowing difference): the stage then leaves the query to the rest of the pipeline.
-template <std::size_t NA>
-[[nodiscard]] bool relative_boxes_apart(
+/// relative_boxes_apart with (kWidth: half_width > 0) or without a contact distance.
+template <std::size_t NA, bool kWidth>
+[[nodiscard]] bool relative_boxes_apart_as(
     const std::array<const Eigen::Vector3d*, 4>& t0,
     const std::array<const Eigen::Vector3d*, 4>& t1,
     double half_width) {
@@ -48,10 +49,10 @@ template <std::size_t NA>
         const double p0 = (*t0[i])[k];
         const double p1 = (*t1[i])[k] - u[k];
         finite = finite && std::abs(p0) <= kMax && std::abs(p1) <= kMax;
-        l = std::min({l, p0, next_down(p1)});
-        h = std::max({h, p0, next_up(p1)});
+        l = std::min({l, p0, kWidth ? next_down(p1) : p1});
+        h = std::max({h, p0, kWidth ? next_up(p1) : p1});
       }
-      if (half_width > 0.0) {
+      if constexpr (kWidth) {
         l -= half_width;
         h += half_width;
         finite = finite && std::abs(l) <= kMax && std::abs(h) <= kMax;
@@ -65,6 +66,20 @@ template <std::size_t NA>
     if (finite && (hi[0] < lo[1] || hi[1] < lo[0])) return true;
   }
   return false;
+}
+
+/// True when the relative boxes of the features (a: the first NA points, b: the other 4 − NA)
+/// prove that they never come within 2·half_width over the interval. `t0` and `t1` list the four
+/// points, a's first. False whenever a value on the way is not finite (a non-finite coordinate, an
+/// overflowing difference): the stage then leaves the query to the rest of the pipeline.
+/// @pre half_width >= 0.
+template <std::size_t NA>
+[[nodiscard]] bool relative_boxes_apart(
+    const std::array<const Eigen::Vector3d*, 4>& t0,
+    const std::array<const Eigen::Vector3d*, 4>& t1,
+    double half_width) {
+  return half_width > 0.0 ? relative_boxes_apart_as<NA, true>(t0, t1, half_width)
+                          : relative_boxes_apart_as<NA, false>(t0, t1, half_width);
 }
 
 }  // namespace skelcd::ccd::detail

@@ -6,9 +6,16 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdint>
 #include <iostream>
+#include <limits>
+#include <random>
 #include <string>
 
+#include "ccd/detail/relative_boxes.hpp"
 #include "ccd/edge_edge.hpp"
 #include "ccd/exact_ccd.hpp"
 #include "ccd/vertex_face.hpp"
@@ -126,6 +133,54 @@ TEST(RelativeBoxes, RejectsCoplanarFeaturesThatMoveTogether) {
   EXPECT_EQ(vf.relative_rejected, 1);
   CcdStats vf_within;
   EXPECT_TRUE(vertex_face_ccd(v, Accuracy::conservative, with_relative(true, 1.1), vf_within).hit);
+}
+
+// Without contact distance the stage compares rounded ends fl(p₁ − u) unbracketed
+// (relative_boxes.hpp). Every coordinate here lies in [1, 2) on a grid of a few ulps, so ends tie
+// and cross at the last bit; u is formed as the stage forms it, and p₁ − u is exact in long double
+// (at most 57 significant bits). Every query the stage calls apart, for a vertex and a face (NA =
+// 1) and for two edges (NA = 2), must have exactly separated relative boxes.
+template <std::size_t NA>
+void expect_apart_only_when_exactly_apart(std::uint32_t seed) {
+  static_assert(std::numeric_limits<long double>::digits >= 64);
+  constexpr double kUlp = 0x1p-52;
+  std::mt19937 rng(seed);
+  std::uniform_int_distribution<int> grid(-6, 6);
+  std::uniform_int_distribution<int> low_bits(0, 64);
+  std::array<Eigen::Vector3d, 4> p0, p1;
+  const std::array<const Eigen::Vector3d*, 4> t0{&p0[0], &p0[1], &p0[2], &p0[3]};
+  const std::array<const Eigen::Vector3d*, 4> t1{&p1[0], &p1[1], &p1[2], &p1[3]};
+  int apart = 0;
+  for (int trial = 0; trial < 200000; ++trial) {
+    for (std::size_t i = 0; i < 4; ++i) {
+      for (Eigen::Index k = 0; k < 3; ++k) {
+        p0[i][k] = 1.5 + grid(rng) * kUlp;
+        p1[i][k] = p0[i][k] + (0.1 + low_bits(rng) * 0x1p-56);
+      }
+    }
+    if (!detail::relative_boxes_apart<NA>(t0, t1, 0.0)) continue;
+    ++apart;
+    const Eigen::Vector3d u =
+        0.25 * (((p1[0] - p0[0]) + (p1[1] - p0[1])) + ((p1[2] - p0[2]) + (p1[3] - p0[3])));
+    bool exactly_apart = false;
+    for (Eigen::Index k = 0; k < 3; ++k) {
+      std::array<long double, 2> lo{INFINITY, INFINITY}, hi{-INFINITY, -INFINITY};
+      for (std::size_t i = 0; i < 4; ++i) {
+        const std::size_t side = i < NA ? 0 : 1;
+        const long double end = static_cast<long double>(p1[i][k]) - static_cast<long double>(u[k]);
+        lo[side] = std::min({lo[side], static_cast<long double>(p0[i][k]), end});
+        hi[side] = std::max({hi[side], static_cast<long double>(p0[i][k]), end});
+      }
+      exactly_apart = exactly_apart || hi[0] < lo[1] || hi[1] < lo[0];
+    }
+    ASSERT_TRUE(exactly_apart) << "trial " << trial;
+  }
+  EXPECT_GT(apart, 1000);  // enough separated queries for the check to mean something
+}
+
+TEST(RelativeBoxes, WithoutContactDistanceApartOnlyWhenTheExactBoxesAre) {
+  expect_apart_only_when_exactly_apart<1>(20261127);
+  expect_apart_only_when_exactly_apart<2>(20261128);
 }
 
 }  // namespace
