@@ -151,6 +151,9 @@ template <class Orient>
 bool VertexFans::winds_once(std::size_t m, bool closed, const Orient& orient) {
   int sign = 0;
   int covering = 0;
+  // orient(0, i) of the sector before (decided: an undecided sign has returned). orient(i, 0) is
+  // its negation: a decided sign is the exact one, and the exact one is antisymmetric.
+  int to_spoke_i = 0;
   for (std::size_t i = 0; i < m; ++i) {
     const int o = orient(i, i + 1);
     if (o == ccd::detail::kUndecided) return false;
@@ -161,11 +164,13 @@ bool VertexFans::winds_once(std::size_t m, bool closed, const Orient& orient) {
     // (each sector is narrower than a half-turn, so both signs equal to the fan's mean inside).
     if (i == 0) {
       ++covering;
+      to_spoke_i = o;  // orient(0, 1)
     } else if (!closed || i + 1 < m) {
-      const int o1 = orient(i, 0);
+      const int o1 = -to_spoke_i;  // orient(i, 0)
       const int o2 = orient(0, i + 1);
-      if (o1 == ccd::detail::kUndecided || o2 == ccd::detail::kUndecided) return false;
+      if (o2 == ccd::detail::kUndecided) return false;
       if (o1 == sign && o2 == sign) ++covering;
+      to_spoke_i = o2;
     }
   }
   // Closed: the fan winds exactly once. Open: no sector after the first reaches the ray again
