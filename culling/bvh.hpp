@@ -145,6 +145,14 @@ class Bvh {
   /// union, bit for bit.
   /// @param triangle_bounds indexed by triangle id (#F of the `triangles` built from).
   void refit(std::span<const Volume> triangle_bounds);
+  /// refit() of the wide nodes and the slot volumes only — the bits refit() gives them — for a
+  /// caller that reads nothing else until the next refit(): the binary node volumes, when kept,
+  /// stay those of the last refit() (`auto`'s DCD on a cone group's tree, which traverses the wide
+  /// copy). Allocation-free.
+  void refit_wide(std::span<const Volume> triangle_bounds) {
+    end_boxes_ready_ = false;
+    refit_wide_only(triangle_bounds);
+  }
 
   [[nodiscard]] std::span<const BvhNode> nodes() const { return nodes_; }
   /// The binary nodes' volumes; empty when built without them (BvhOptions::node_volumes) or

@@ -7,6 +7,7 @@
 #include "culling/bvh.hpp"
 #include "culling/candidates.hpp"
 #include "culling/detail/method_base.hpp"
+#include "culling/detail/sieved_dcd.hpp"
 #include "culling/pair_blocks.hpp"
 #include "culling/relative_aabb.hpp"
 #include "culling/traversal.hpp"
@@ -78,19 +79,9 @@ class BvhMethod final : public MethodBase {
     // (bounded memory), the vertex fans certified once for the instant.
     // Pairs sharing a certified vertex are settled where the traversal finds them (FanSieve).
     blocks_.start_dcd(topology_, x, tests_, out);
-    start_self_traversal<N>(bvh_, scratch_);
-    FanSieve sieve{
-        .slots = &slots_, .certified = blocks_.fans(), .full = {}, .topology = &topology_};
-    if (!sieve.certified.empty()) {
-      certified_slots(slots_, sieve.certified, full_slots_);
-      sieve.full = full_slots_;
-    }
-    blocks_.drain([&](std::vector<TrianglePair>& pairs, std::size_t max_pairs) {
-      return self_traverse_some<N>(
-          bvh_, bounds_.triangles, scratch_, pairs, out.counters.bv_tests, max_pairs, &sieve);
-    });
+    sieved_self_dcd<N>(
+        bvh_, bounds_.triangles, topology_, slots_, full_slots_, scratch_, blocks_, out);
     blocks_.finish();
-    out.counters.candidate_pairs += sieve.settled;
     const auto t2 = Clock::now();
     out.times.refit_us += micros(t0, t1);
     out.times.traverse_us += micros(t1, t2) - blocks_.test_us();

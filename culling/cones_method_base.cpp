@@ -101,6 +101,36 @@ void ConeMethodBase::dcd(const Instant& at, FrameResult& out) {
   out.times.elementary_us += blocks_.test_us();
 }
 
+void ConeMethodBase::refit_static(const skinning::Positions& x) {
+  check_positions(x, "detect_dcd", "x");
+  static_vertex_bounds<3>(x, bounds_.vertices);
+  bounds_.derive(topology_, /*with_edges=*/false);
+  bvh_.refit_wide(bounds_.triangles);
+}
+
+std::int64_t ConeMethodBase::count_dcd_pairs(const skinning::Positions& x, std::int64_t cap) {
+  check_positions(x, "detect_dcd", "x");
+  stats_ = {};
+  stats_.culling_disabled = !cull_enabled_;
+  static_vertex_bounds<3>(x, bounds_.vertices);
+  bounds_.derive(topology_, /*with_edges=*/false);
+  bvh_.refit(bounds_.triangles);
+  const Interval interval{&x, &x, false};
+  if (cull_enabled_) {
+    cones_.refit(bvh_, topology_, x);
+    refit_extra(interval);
+  }
+  blocks_.pairs().clear();
+  counting_ = true;
+  counted_ = 0;
+  count_cap_ = cap;
+  std::int64_t bv_tests = 0;
+  traverse(interval, bv_tests);
+  pair_added();
+  counting_ = false;
+  return counted_;
+}
+
 void ConeMethodBase::ccd(const culling::Interval& query, FrameResult& out) {
   const skinning::Positions& x_t0 = query.x_t0;
   const skinning::Positions& x_t1 = query.x_t1;
@@ -151,7 +181,7 @@ void ConeMethodBase::traverse(const Interval& interval, std::int64_t& bv_tests) 
   const auto nodes = bvh_.nodes();
   self_stack_.clear();
   self_stack_.push_back(0);
-  while (!self_stack_.empty()) {
+  while (!self_stack_.empty() && !counted_enough()) {
     const std::int32_t n = self_stack_.back();
     self_stack_.pop_back();
     const BvhNode& node = nodes[sz(n)];
@@ -195,7 +225,7 @@ void ConeMethodBase::collide(std::int32_t a, std::int32_t b, std::int64_t& bv_te
   const bool single = bvh_.leaf_size() == 1;
   pair_stack_.clear();
   pair_stack_.emplace_back(a, b);
-  while (!pair_stack_.empty()) {
+  while (!pair_stack_.empty() && !counted_enough()) {
     const auto [x, y] = pair_stack_.back();
     pair_stack_.pop_back();
     ++bv_tests;

@@ -37,6 +37,16 @@ class ConeMethodBase : public MethodBase, public ConeStatistics {
   /// pairs between its groups on these rather than on copies (docs/culling.md "Bounded memory").
   [[nodiscard]] const AabbBvh& hierarchy() const { return bvh_; }
   [[nodiscard]] const FeatureBounds<3>& feature_bounds() const { return bounds_; }
+  /// Refits feature_bounds() and the wide copy of hierarchy() (Bvh::refit_wide: not its binary
+  /// node volumes, nor the cones) to the static volumes of instant x: what `auto` asks before it
+  /// traverses this hierarchy for a DCD itself, sieved as `bvh` does, instead of this method's
+  /// cone-culled DCD (docs/dual-cone.md "`auto`'s DCD"). This method's own queries refit all.
+  void refit_static(const skinning::Positions& x);
+  /// The triangle pairs this method's cone-culled DCD traversal produces at x (everything refit
+  /// to x first), counted without testing them; the count stops at `cap` (the result is then cap
+  /// or a leaf's pairs more). For `auto`'s choice, which only needs to know whether the count
+  /// stays under a bound. Allocation-free.
+  [[nodiscard]] std::int64_t count_dcd_pairs(const skinning::Positions& x, std::int64_t cap);
 
  protected:
   /// Where a self-test descends when its node is not culled.
@@ -92,7 +102,17 @@ class ConeMethodBase : public MethodBase, public ConeStatistics {
   void leaf_self(std::int32_t leaf, std::int64_t& bv_tests);
 
   /// Tests the pairs gathered so far (a block) once block_pairs are waiting: DCD and CCD alike.
-  void pair_added() { blocks_.flush_if_full(); }
+  /// While counting (count_dcd_pairs), counts and drops them instead.
+  void pair_added() {
+    if (counting_) {
+      counted_ += static_cast<std::int64_t>(blocks_.pairs().size());
+      blocks_.pairs().clear();
+      return;
+    }
+    blocks_.flush_if_full();
+  }
+  /// count_dcd_pairs has counted up to its cap: the traversal stops.
+  [[nodiscard]] bool counted_enough() const { return counting_ && counted_ >= count_cap_; }
 
   Descent descent_;
   bool cull_enabled_;
@@ -100,6 +120,9 @@ class ConeMethodBase : public MethodBase, public ConeStatistics {
   std::vector<std::int32_t> self_stack_;
   std::vector<std::pair<std::int32_t, std::int32_t>> pair_stack_;
   PairBlocks<3> blocks_;
+  bool counting_ = false;  ///< count_dcd_pairs is running
+  std::int64_t counted_ = 0;
+  std::int64_t count_cap_ = 0;
 };
 
 }  // namespace skelcd::culling::detail

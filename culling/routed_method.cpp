@@ -5,12 +5,14 @@
 #include "culling/routed_method.hpp"
 
 #include <algorithm>
+#include <array>
 #include <numeric>
 
 #include "culling/bvh.hpp"
 #include "culling/candidates.hpp"
 #include "culling/cones_method_base.hpp"
 #include "culling/detail/method_base.hpp"
+#include "culling/detail/sieved_dcd.hpp"
 #include "culling/dual_cone.hpp"
 #include "culling/enhanced_dual_cone.hpp"
 #include "culling/method_registry.hpp"
@@ -156,6 +158,11 @@ class AutoMethod final : public detail::MethodBase {
         blocks_(
             options.block_pairs,
             block_reserve(options.block_pairs, options.bvh.leaf_size, topology_.num_triangles())) {
+    if (routing.dcd_cone_share < 0) {
+      throw InvalidInput(
+          "culling::make_method(auto): dcd_cone_share must be 0 (never the cones) or more (got " +
+          std::to_string(routing.dcd_cone_share) + ")");
+    }
     // The plan, with each component's part taken from the mesh.
     routes_ = route_components(topology, options, routing);
     const auto components = components_of(topology);
@@ -206,8 +213,11 @@ class AutoMethod final : public detail::MethodBase {
     // (bounded memory, docs/culling.md). Hierarchies built here are traversed on their wide copy
     // only (culling/traversal.hpp): no binary node volumes.
     const bool both = !open_triangles_.empty() && !closed_triangles_.empty();
-    const auto* open_cone = dynamic_cast<const detail::ConeMethodBase*>(open_method_.get());
-    const auto* closed_cone = dynamic_cast<const detail::ConeMethodBase*>(closed_method_.get());
+    open_cone_ = dynamic_cast<detail::ConeMethodBase*>(open_method_.get());
+    closed_cone_ = dynamic_cast<detail::ConeMethodBase*>(closed_method_.get());
+    choose_dcd_traversals(rest, routing.dcd_cone_share);
+    const detail::ConeMethodBase* open_cone = open_cone_;
+    const detail::ConeMethodBase* closed_cone = closed_cone_;
     BvhOptions own_bvh = options.bvh;
     own_bvh.node_volumes = false;
     if (!open_triangles_.empty() && (open_method_ == nullptr || both)) {
@@ -242,6 +252,35 @@ class AutoMethod final : public detail::MethodBase {
     scratch_.reserve(static_cast<std::size_t>(4 * depth + 8));
   }
 
+  /// The DCD traversal of each cone group, chosen at rest (RoutingOptions::dcd_cone_share): the
+  /// cones' when their traversal produces fewer than 1/share of the pairs whose volumes overlap
+  /// (what the sieved traversal produces, emitted or settled). At rest, not at a query: the
+  /// choice, and so every counter, is then the same whichever worker meets which instant first.
+  void choose_dcd_traversals(const skinning::Positions& rest, std::int64_t share) {
+    std::vector<TrianglePair> pairs;
+    for (std::size_t g = 0; g < 2; ++g) {
+      detail::ConeMethodBase* cone = g == 0 ? open_cone_ : closed_cone_;
+      if (cone == nullptr || cone->hierarchy().empty() || share == 0) continue;
+      cone->refit_static(rest);
+      const AabbBvh& h = cone->hierarchy();
+      const std::span<const Aabb> tri(cone->feature_bounds().triangles);
+      constexpr std::size_t kInstallment = 4096;
+      const auto bucket = static_cast<std::size_t>(bucket_size(h.leaf_size()));
+      pairs.reserve(kInstallment + bucket * bucket);  // an installment passes by a bucket pair's
+      start_self_traversal<3>(h, scratch_);
+      std::int64_t overlapping = 0;
+      std::int64_t bv_tests = 0;
+      for (bool done = false; !done;) {
+        pairs.clear();
+        done = self_traverse_some<3>(h, tri, scratch_, pairs, bv_tests, kInstallment);
+        overlapping += static_cast<std::int64_t>(pairs.size());
+      }
+      // cones < overlapping / share  <=>  cones < ceil(overlapping / share) (integers).
+      const std::int64_t cap = overlapping / share + (overlapping % share != 0 ? 1 : 0);
+      dcd_by_cones_[g] = cone->count_dcd_pairs(rest, cap) < cap;
+    }
+  }
+
   /// What this method holds for its own traversal (routed_structures).
   [[nodiscard]] RoutedStructures structures() const {
     RoutedStructures r;
@@ -270,19 +309,72 @@ class AutoMethod final : public detail::MethodBase {
   void dcd(const Instant& at, FrameResult& out) override {
     const skinning::Positions& x = at.x;
     check_positions(x, "detect_dcd", "x");
-    run_groups([&](CullingMethod& m, FrameResult& r) { m.detect_dcd(at, r); }, out);
-    if (traverses_nothing()) return;  // one group, its own method's answer
+    // A whole-mesh closed method (`dynamic`) answers for its group on its own structures.
+    if (closed_method_ != nullptr && closed_cone_ == nullptr) {
+      run_group(
+          *closed_method_, [&](CullingMethod& m, FrameResult& r) { m.detect_dcd(at, r); }, out);
+    }
+    // A cone group takes the DCD traversal chosen at rest (choose_dcd_traversals; docs/dual-cone.md
+    // "`auto`'s DCD"): its method's cone-culled DCD, or the sieved traversal of `bvh` on its
+    // hierarchy. Either way the cone's hierarchy and feature volumes end refit to x.
+    std::array<bool, 2> by_cones{};
+    for (std::size_t g = 0; g < 2; ++g) {
+      detail::ConeMethodBase* cone = g == 0 ? open_cone_ : closed_cone_;
+      if (cone == nullptr) continue;
+      by_cones[g] = dcd_by_cones_[g];
+      if (by_cones[g]) {
+        run_group(
+            *cone, [&](CullingMethod& m, FrameResult& r) { m.detect_dcd(at, r); }, out);
+      } else {
+        cone->refit_static(x);
+      }
+    }
+    std::array<const AabbBvh*, 2> groups{dcd_group(0), dcd_group(1)};
+    for (std::size_t g = 0; g < 2; ++g) {
+      if (by_cones[g]) groups[g] = nullptr;
+    }
+    const bool between = open_hierarchy_ != nullptr && closed_hierarchy_ != nullptr &&
+                         !open_hierarchy_->empty() && !closed_hierarchy_->empty();
+    if (groups[0] == nullptr && groups[1] == nullptr && !between) return;
     const auto t0 = Clock::now();
-    if (bounds_ == &own_bounds_) {
+    if (bounds_ == &own_bounds_ && !traverses_nothing()) {
       static_vertex_bounds<3>(x, own_bounds_.vertices);
       own_bounds_.derive(topology_, /*with_edges=*/false);
     }
     refit_groups();
     const auto t1 = Clock::now();
-    // The `bvh` groups' own pairs and the pairs between the groups, tested in blocks of
+    // Each group's own pairs (sieved), then the pairs between the groups, tested in blocks of
     // block_pairs (bounded memory).
     blocks_.start_dcd(topology_, x, tests_, out);
-    traverse_own(out.counters.bv_tests);
+    for (std::size_t g = 0; g < groups.size(); ++g) {
+      const AabbBvh* h = groups[g];
+      if (h == nullptr || h->empty()) continue;
+      const detail::ConeMethodBase* cone = g == 0 ? open_cone_ : closed_cone_;
+      const std::span<const Aabb> tri(
+          cone != nullptr ? cone->feature_bounds().triangles : bounds_->triangles);
+      // The slots' corners and windows: built by the first DCD (a CCD-only check never holds
+      // them; #F x 24 bytes).
+      SlotAdjacency& slots = dcd_slots_[g];
+      if (slots.corners.size() != h->triangle_order().size()) {
+        slots = SlotAdjacency(topology_, h->triangle_order());
+      }
+      detail::sieved_self_dcd<3>(*h, tri, topology_, slots, full_slots_, scratch_, blocks_, out);
+    }
+    if (between) {
+      const std::span<const Aabb> tri(bounds_->triangles);
+      start_pair_traversal<3>(*open_hierarchy_, *closed_hierarchy_, scratch_);
+      blocks_.drain([&](std::vector<TrianglePair>& pairs, std::size_t max_pairs) {
+        return pair_traverse_some<3>(
+            *open_hierarchy_,
+            tri,
+            *closed_hierarchy_,
+            tri,
+            scratch_,
+            pairs,
+            out.counters.bv_tests,
+            max_pairs);
+      });
+    }
     blocks_.finish();
     const auto t2 = Clock::now();
     // Merge: sorted, each pair once.
@@ -366,14 +458,30 @@ class AutoMethod final : public detail::MethodBase {
   template <class Call>
   void run_groups(Call call, FrameResult& out) {
     for (CullingMethod* m : {open_method_.get(), closed_method_.get()}) {
-      if (m == nullptr) continue;
-      sub_.clear();
-      call(*m, sub_);
-      out.counters += sub_.counters;
-      out.times += sub_.times;
-      out.contacts.insert(out.contacts.end(), sub_.contacts.begin(), sub_.contacts.end());
-      out.dcd_pairs.insert(out.dcd_pairs.end(), sub_.dcd_pairs.begin(), sub_.dcd_pairs.end());
+      if (m != nullptr) run_group(*m, call, out);
     }
+  }
+
+  /// One group method's query, its findings and counters added to out.
+  template <class Call>
+  void run_group(CullingMethod& m, Call call, FrameResult& out) {
+    sub_.clear();
+    call(m, sub_);
+    out.counters += sub_.counters;
+    out.times += sub_.times;
+    out.contacts.insert(out.contacts.end(), sub_.contacts.begin(), sub_.contacts.end());
+    out.dcd_pairs.insert(out.dcd_pairs.end(), sub_.dcd_pairs.begin(), sub_.dcd_pairs.end());
+  }
+
+  /// The hierarchy whose own pairs a DCD traverses here for group g (0 open, 1 closed): a cone
+  /// method's, or the one built here when `bvh` tests the group; null for a whole-mesh method's
+  /// group (it answers itself) or an empty group.
+  [[nodiscard]] const AabbBvh* dcd_group(std::size_t g) const {
+    const detail::ConeMethodBase* cone = g == 0 ? open_cone_ : closed_cone_;
+    if (cone != nullptr) return &cone->hierarchy();
+    const bool own = g == 0 ? open_method_ == nullptr : closed_method_ == nullptr;
+    const bool any = !(g == 0 ? open_triangles_ : closed_triangles_).empty();
+    return own && any ? (g == 0 ? open_hierarchy_ : closed_hierarchy_) : nullptr;
   }
 
   [[nodiscard]] bool traverses_nothing() const {
@@ -417,6 +525,17 @@ class AutoMethod final : public detail::MethodBase {
   AabbBvh closed_bvh_;
   std::unique_ptr<CullingMethod> open_method_;
   std::unique_ptr<CullingMethod> closed_method_;
+  /// The group methods that are cone methods (null otherwise): their hierarchies are traversed
+  /// here for a DCD (dcd).
+  detail::ConeMethodBase* open_cone_ = nullptr;
+  detail::ConeMethodBase* closed_cone_ = nullptr;
+  /// Per group (open, closed), SlotAdjacency of the hierarchy a DCD traverses here, built by the
+  /// first DCD; and the sieve's per-slot buffer.
+  std::array<SlotAdjacency, 2> dcd_slots_;
+  std::vector<std::uint8_t> full_slots_;
+  /// Per group (open, closed): a cone group's DCD takes its method's cone-culled traversal
+  /// (choose_dcd_traversals).
+  std::array<bool, 2> dcd_by_cones_{};
   /// The groups' hierarchies this method traverses (null: not traversed here): its own, or a
   /// cone group method's.
   const AabbBvh* open_hierarchy_ = nullptr;

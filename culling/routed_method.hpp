@@ -34,6 +34,11 @@ struct RoutingOptions {
   /// cone methods have nothing to gain on a small open part, and a group of its own costs `auto`
   /// the group's hierarchies and the traversal between the groups (docs/dual-cone.md, "Routing").
   std::int32_t min_open_triangles = 256;
+  /// A cone group's DCD takes either its method's cone-culled traversal or the sieved traversal
+  /// of `bvh` on the group's hierarchy — the same pairs either way (docs/dual-cone.md "`auto`'s
+  /// DCD"). Chosen once, at rest: the cones when their traversal produces fewer than
+  /// 1/dcd_cone_share of the pairs whose volumes overlap; 0: never the cones.
+  std::int64_t dcd_cone_share = 8;
 };
 
 /// The methods `auto` uses for the open and the closed components under `options`: {open, closed}.

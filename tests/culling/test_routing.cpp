@@ -6,6 +6,7 @@
 #include <set>
 #include <string>
 #include <tuple>
+#include <utility>
 #include <vector>
 
 #include "culling/method.hpp"
@@ -118,6 +119,48 @@ TEST(Routing, AutoFindsExactlyWhatBvhAndBruteFind) {
   for (const auto& p : dcd(*a, s.frames[1]).dcd_pairs)
     across |= (p.a < body_faces) != (p.b < body_faces);
   EXPECT_TRUE(across);
+}
+
+// `auto`'s DCD of a cone group takes the traversal chosen at rest (docs/dual-cone.md "`auto`'s
+// DCD"): the sieved traversal of `bvh` on the group's hierarchy — which tests and settles exactly
+// what `bvh` does — on the cloth funnel, whose cone traversal produces 3/4 of the pairs whose
+// volumes overlap at rest; the cones on the skirt, whose cone traversal produces none — fewer tests
+// than `bvh` — unless dcd_cone_share is 0. The pairs are `bvh`'s every time, and a query repeated
+// gives the same counters.
+TEST(Routing, DcdOfAConeGroupTakesTheTraversalChosenAtRest) {
+  const OpenScene funnel = test::cloth_funnel_scene(test::asset("cloth-funnel/frames"));
+  const OpenScene skirt = test::skirt_body_scene(9, 14, 16, 10, {0.3, 0.5});
+  RoutingOptions never;
+  never.dcd_cone_share = 0;
+  for (const auto& [s, routing, cones] :
+       {std::tuple{&funnel, RoutingOptions{}, false},
+        std::tuple{&skirt, RoutingOptions{}, true},
+        std::tuple{&skirt, never, false}}) {
+    auto a = make_routed_method(s->mesh, s->topo, {}, routing);
+    auto b = make_method("bvh", s->mesh, s->topo);
+    int cone_groups = 0;
+    for (const auto& r : routes_of(*a)) cone_groups += r.method == "enhanced-dual-cone" ? 1 : 0;
+    EXPECT_EQ(cone_groups, s == &funnel ? 2 : 1);
+    for (const auto& x : s->frames) {
+      const FrameResult want = dcd(*b, x);
+      EXPECT_FALSE(want.dcd_pairs.empty());
+      const FrameResult first = dcd(*a, x);
+      for (const FrameResult& got : {first, dcd(*a, x)}) {
+        EXPECT_EQ(got.dcd_pairs, want.dcd_pairs);
+        EXPECT_EQ(got.counters.dcd_pairs, want.counters.dcd_pairs);
+        EXPECT_EQ(got.counters.bv_tests, first.counters.bv_tests);
+        if (cones) {
+          EXPECT_LT(got.counters.tt_tests, want.counters.tt_tests);
+        } else {
+          EXPECT_EQ(got.counters.tt_tests, want.counters.tt_tests);
+          EXPECT_EQ(got.counters.candidate_pairs, want.counters.candidate_pairs);
+        }
+      }
+    }
+  }
+  RoutingOptions bad;
+  bad.dcd_cone_share = -1;
+  EXPECT_THROW((void)make_routed_method(skirt.mesh, skirt.topo, {}, bad), InvalidInput);
 }
 
 TEST(Routing, ClothFunnelRoutesThreeClothPartsAndTheFunnelAndMatchesBvh) {
