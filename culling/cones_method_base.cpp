@@ -108,6 +108,14 @@ void ConeMethodBase::refit_static(const skinning::Positions& x) {
   bvh_.refit_wide(bounds_.triangles);
 }
 
+void ConeMethodBase::refit_swept(const skinning::Positions& x_t0, const skinning::Positions& x_t1) {
+  check_positions(x_t0, "detect_ccd", "x_t0");
+  check_positions(x_t1, "detect_ccd", "x_t1");
+  swept_vertex_bounds<3>(x_t0, x_t1, 0.5 * options_.min_separation, bounds_.vertices);
+  bounds_.derive(topology_, /*with_edges=*/false);
+  bvh_.refit_wide(bounds_.triangles);
+}
+
 std::int64_t ConeMethodBase::count_dcd_pairs(const skinning::Positions& x, std::int64_t cap) {
   check_positions(x, "detect_dcd", "x");
   stats_ = {};

@@ -42,6 +42,10 @@ class ConeMethodBase : public MethodBase, public ConeStatistics {
   /// traverses this hierarchy for a DCD itself, sieved as `bvh` does, instead of this method's
   /// cone-culled DCD (docs/dual-cone.md "`auto`'s DCD"). This method's own queries refit all.
   void refit_static(const skinning::Positions& x);
+  /// The same for the interval x_t0 → x_t1: its swept volumes (grown by half the contact distance,
+  /// as this method's CCD grows them), for `auto`'s CCD on this hierarchy without the cones
+  /// (docs/dual-cone.md "`auto`'s CCD").
+  void refit_swept(const skinning::Positions& x_t0, const skinning::Positions& x_t1);
   /// The triangle pairs this method's cone-culled DCD traversal produces at x (everything refit
   /// to x first), counted without testing them; the count stops at `cap` (the result is then cap
   /// or a leaf's pairs more). For `auto`'s choice, which only needs to know whether the count

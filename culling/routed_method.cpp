@@ -158,10 +158,12 @@ class AutoMethod final : public detail::MethodBase {
         blocks_(
             options.block_pairs,
             block_reserve(options.block_pairs, options.bvh.leaf_size, topology_.num_triangles())) {
-    if (routing.dcd_cone_share < 0) {
+    if (routing.dcd_cone_share < 0 || routing.ccd_cone_share < 0) {
       throw InvalidInput(
-          "culling::make_method(auto): dcd_cone_share must be 0 (never the cones) or more (got " +
-          std::to_string(routing.dcd_cone_share) + ")");
+          "culling::make_method(auto): dcd_cone_share and ccd_cone_share must be 0 (never the "
+          "cones) or more (got " +
+          std::to_string(routing.dcd_cone_share) + " and " +
+          std::to_string(routing.ccd_cone_share) + ")");
     }
     // The plan, with each component's part taken from the mesh.
     routes_ = route_components(topology, options, routing);
@@ -206,16 +208,17 @@ class AutoMethod final : public detail::MethodBase {
         closed_method_ = make_group_method(closed_name, mesh, topology, options, closed_triangles_);
       }
     }
-    // A group's hierarchy is traversed here when `bvh` tests its pairs (no method of its own), or
-    // for the pairs between the two groups. A cone method's group already has one, over the same
-    // triangles, split at the same rest pose, refit by that method's own query just before ours
-    // (run_groups), and the volumes of every feature of the mesh: those are read, not copied
-    // (bounded memory, docs/culling.md). Hierarchies built here are traversed on their wide copy
-    // only (culling/traversal.hpp): no binary node volumes.
+    // A group's hierarchy is traversed here when `bvh` tests its pairs (no method of its own), for
+    // the pairs between the two groups, or for a cone group's query that its cones do not answer
+    // (choose_traversals). A cone method's group already has one, over the same triangles, split
+    // at the same rest pose, refit by that method's own query just before ours or by its
+    // refit_static / refit_swept, and the volumes of every feature of the mesh: those are read, not
+    // copied (bounded memory, docs/culling.md). Hierarchies built here are traversed on their wide
+    // copy only (culling/traversal.hpp): no binary node volumes.
     const bool both = !open_triangles_.empty() && !closed_triangles_.empty();
     open_cone_ = dynamic_cast<detail::ConeMethodBase*>(open_method_.get());
     closed_cone_ = dynamic_cast<detail::ConeMethodBase*>(closed_method_.get());
-    choose_dcd_traversals(rest, routing.dcd_cone_share);
+    choose_traversals(rest, routing);
     const detail::ConeMethodBase* open_cone = open_cone_;
     const detail::ConeMethodBase* closed_cone = closed_cone_;
     BvhOptions own_bvh = options.bvh;
@@ -236,12 +239,13 @@ class AutoMethod final : public detail::MethodBase {
         closed_hierarchy_ = &closed_bvh_;
       }
     }
-    if (open_hierarchy_ == nullptr && closed_hierarchy_ == nullptr)
-      return;  // nothing traversed here
+    // The volumes every traversal here reads: a cone group's, refit by its query or by
+    // refit_static / refit_swept (a cone group traversed here without its cones), else our own.
     const detail::ConeMethodBase* cone = open_cone != nullptr ? open_cone : closed_cone;
-    if (cone != nullptr) {
-      bounds_ = &cone->feature_bounds();
-    } else {
+    if (cone != nullptr) bounds_ = &cone->feature_bounds();
+    if (open_hierarchy_ == nullptr && closed_hierarchy_ == nullptr)
+      return;  // nothing traversed here but maybe a cone group without its cones
+    if (cone == nullptr) {
       own_bounds_.vertices.reserve(static_cast<std::size_t>(topology_.num_vertices()));
       own_bounds_.triangles.reserve(nf);
       bounds_ = &own_bounds_;
@@ -252,15 +256,17 @@ class AutoMethod final : public detail::MethodBase {
     scratch_.reserve(static_cast<std::size_t>(4 * depth + 8));
   }
 
-  /// The DCD traversal of each cone group, chosen at rest (RoutingOptions::dcd_cone_share): the
-  /// cones' when their traversal produces fewer than 1/share of the pairs whose volumes overlap
-  /// (what the sieved traversal produces, emitted or settled). At rest, not at a query: the
-  /// choice, and so every counter, is then the same whichever worker meets which instant first.
-  void choose_dcd_traversals(const skinning::Positions& rest, std::int64_t share) {
+  /// The traversals of each cone group, chosen at rest (RoutingOptions::dcd_cone_share,
+  /// ccd_cone_share): the cones' for a query when their traversal produces fewer than 1/share of
+  /// the pairs whose volumes overlap (what the plain traversal of `bvh` produces; for DCD emitted
+  /// or settled). At rest, not at a query: the choice, and so every counter, is then the same
+  /// whichever worker meets which instant first.
+  void choose_traversals(const skinning::Positions& rest, const RoutingOptions& routing) {
     std::vector<TrianglePair> pairs;
     for (std::size_t g = 0; g < 2; ++g) {
       detail::ConeMethodBase* cone = g == 0 ? open_cone_ : closed_cone_;
-      if (cone == nullptr || cone->hierarchy().empty() || share == 0) continue;
+      if (cone == nullptr || cone->hierarchy().empty()) continue;
+      if (routing.dcd_cone_share == 0 && routing.ccd_cone_share == 0) continue;
       cone->refit_static(rest);
       const AabbBvh& h = cone->hierarchy();
       const std::span<const Aabb> tri(cone->feature_bounds().triangles);
@@ -275,9 +281,16 @@ class AutoMethod final : public detail::MethodBase {
         done = self_traverse_some<3>(h, tri, scratch_, pairs, bv_tests, kInstallment);
         overlapping += static_cast<std::int64_t>(pairs.size());
       }
-      // cones < overlapping / share  <=>  cones < ceil(overlapping / share) (integers).
-      const std::int64_t cap = overlapping / share + (overlapping % share != 0 ? 1 : 0);
-      dcd_by_cones_[g] = cone->count_dcd_pairs(rest, cap) < cap;
+      // cones < overlapping / share  <=>  cones < ceil(overlapping / share) (integers); 0 for a
+      // share of 0 (never).
+      const auto cap_of = [overlapping](std::int64_t share) -> std::int64_t {
+        return share == 0 ? 0 : overlapping / share + (overlapping % share != 0 ? 1 : 0);
+      };
+      const std::int64_t dcd_cap = cap_of(routing.dcd_cone_share);
+      const std::int64_t ccd_cap = cap_of(routing.ccd_cone_share);
+      const std::int64_t cones = cone->count_dcd_pairs(rest, std::max(dcd_cap, ccd_cap));
+      dcd_by_cones_[g] = cones < dcd_cap;
+      ccd_by_cones_[g] = cones < ccd_cap;
     }
   }
 
@@ -314,7 +327,7 @@ class AutoMethod final : public detail::MethodBase {
       run_group(
           *closed_method_, [&](CullingMethod& m, FrameResult& r) { m.detect_dcd(at, r); }, out);
     }
-    // A cone group takes the DCD traversal chosen at rest (choose_dcd_traversals; docs/dual-cone.md
+    // A cone group takes the DCD traversal chosen at rest (choose_traversals; docs/dual-cone.md
     // "`auto`'s DCD"): its method's cone-culled DCD, or the sieved traversal of `bvh` on its
     // hierarchy. Either way the cone's hierarchy and feature volumes end refit to x.
     std::array<bool, 2> by_cones{};
@@ -360,21 +373,7 @@ class AutoMethod final : public detail::MethodBase {
       }
       detail::sieved_self_dcd<3>(*h, tri, topology_, slots, full_slots_, scratch_, blocks_, out);
     }
-    if (between) {
-      const std::span<const Aabb> tri(bounds_->triangles);
-      start_pair_traversal<3>(*open_hierarchy_, *closed_hierarchy_, scratch_);
-      blocks_.drain([&](std::vector<TrianglePair>& pairs, std::size_t max_pairs) {
-        return pair_traverse_some<3>(
-            *open_hierarchy_,
-            tri,
-            *closed_hierarchy_,
-            tri,
-            scratch_,
-            pairs,
-            out.counters.bv_tests,
-            max_pairs);
-      });
-    }
+    if (between) traverse_between(out.counters.bv_tests);
     blocks_.finish();
     const auto t2 = Clock::now();
     // Merge: sorted, each pair once.
@@ -392,8 +391,30 @@ class AutoMethod final : public detail::MethodBase {
     const skinning::Positions& x_t1 = interval.x_t1;
     check_positions(x_t0, "detect_ccd", "x_t0");
     check_positions(x_t1, "detect_ccd", "x_t1");
-    run_groups([&](CullingMethod& m, FrameResult& r) { m.detect_ccd(interval, r); }, out);
-    if (traverses_nothing()) return;  // one group, its own method's answer
+    // A whole-mesh closed method (`dynamic`) answers for its group; a cone group with its cones
+    // when chosen at rest (choose_traversals; docs/dual-cone.md "`auto`'s CCD"), else traversed
+    // here as `bvh` traverses, its hierarchy and volumes refit to the interval's swept ones.
+    if (closed_method_ != nullptr && closed_cone_ == nullptr) {
+      run_group(
+          *closed_method_,
+          [&](CullingMethod& m, FrameResult& r) { m.detect_ccd(interval, r); },
+          out);
+    }
+    std::array<const AabbBvh*, 2> groups{dcd_group(0), dcd_group(1)};
+    for (std::size_t g = 0; g < 2; ++g) {
+      detail::ConeMethodBase* cone = g == 0 ? open_cone_ : closed_cone_;
+      if (cone == nullptr) continue;
+      if (ccd_by_cones_[g]) {
+        groups[g] = nullptr;
+        run_group(
+            *cone, [&](CullingMethod& m, FrameResult& r) { m.detect_ccd(interval, r); }, out);
+      } else {
+        cone->refit_swept(x_t0, x_t1);
+      }
+    }
+    const bool between = open_hierarchy_ != nullptr && closed_hierarchy_ != nullptr &&
+                         !open_hierarchy_->empty() && !closed_hierarchy_->empty();
+    if (groups[0] == nullptr && groups[1] == nullptr && !between) return;
     const auto t0 = Clock::now();
     if (bounds_ == &own_bounds_) {
       swept_vertex_bounds<3>(x_t0, x_t1, 0.5 * options_.min_separation, own_bounds_.vertices);
@@ -401,11 +422,19 @@ class AutoMethod final : public detail::MethodBase {
     }
     refit_groups();
     const auto t1 = Clock::now();
-    // The `bvh` groups' own pairs and the pairs between the groups, tested in blocks of
-    // block_pairs (bounded memory).
+    // Each group's own pairs, then the pairs between the groups, tested in blocks of block_pairs
+    // (bounded memory).
     blocks_.start_ccd(
         topology_, *bounds_, x_t0, x_t1, tests_, options_.accuracy, ccd_options_, out);
-    traverse_own(out.counters.bv_tests);
+    const std::span<const Aabb> tri(bounds_->triangles);
+    for (const AabbBvh* h : groups) {
+      if (h == nullptr || h->empty()) continue;
+      start_self_traversal<3>(*h, scratch_);
+      blocks_.drain([&](std::vector<TrianglePair>& pairs, std::size_t max_pairs) {
+        return self_traverse_some<3>(*h, tri, scratch_, pairs, out.counters.bv_tests, max_pairs);
+      });
+    }
+    if (between) traverse_between(out.counters.bv_tests);
     blocks_.finish();
     const auto t2 = Clock::now();
     // Merge: canonical order, each pair once (a vertex shared by an open and a closed component
@@ -452,14 +481,7 @@ class AutoMethod final : public detail::MethodBase {
     if (name == "dual-cone") {
       return make_dual_cone_method(mesh, topology, options, triangles, features_);
     }
-    return nullptr;  // `bvh`: traversed here (traverse_own)
-  }
-
-  template <class Call>
-  void run_groups(Call call, FrameResult& out) {
-    for (CullingMethod* m : {open_method_.get(), closed_method_.get()}) {
-      if (m != nullptr) run_group(*m, call, out);
-    }
+    return nullptr;  // `bvh`: traversed here
   }
 
   /// One group method's query, its findings and counters added to out.
@@ -473,9 +495,9 @@ class AutoMethod final : public detail::MethodBase {
     out.dcd_pairs.insert(out.dcd_pairs.end(), sub_.dcd_pairs.begin(), sub_.dcd_pairs.end());
   }
 
-  /// The hierarchy whose own pairs a DCD traverses here for group g (0 open, 1 closed): a cone
-  /// method's, or the one built here when `bvh` tests the group; null for a whole-mesh method's
-  /// group (it answers itself) or an empty group.
+  /// The hierarchy whose own pairs a query traverses here for group g (0 open, 1 closed) unless
+  /// the group's cones answer: a cone method's, or the one built here when `bvh` tests the group;
+  /// null for a whole-mesh method's group (it answers itself) or an empty group.
   [[nodiscard]] const AabbBvh* dcd_group(std::size_t g) const {
     const detail::ConeMethodBase* cone = g == 0 ? open_cone_ : closed_cone_;
     if (cone != nullptr) return &cone->hierarchy();
@@ -494,28 +516,14 @@ class AutoMethod final : public detail::MethodBase {
     if (!closed_bvh_.empty()) closed_bvh_.refit(bounds_->triangles);
   }
 
-  /// The `bvh` groups' self pairs and the pairs between the groups, into blocks_ in
-  /// installments.
-  void traverse_own(std::int64_t& bv_tests) {
+  /// The pairs between the two groups (both hierarchies refit), into blocks_ in installments.
+  void traverse_between(std::int64_t& bv_tests) {
     const std::span<const Aabb> tri(bounds_->triangles);
-    for (const AabbBvh* group : {open_hierarchy_, closed_hierarchy_}) {
-      if (group == nullptr) continue;
-      const bool own =
-          group == open_hierarchy_ ? open_method_ == nullptr : closed_method_ == nullptr;
-      if (group->empty() || !own) continue;
-      start_self_traversal<3>(*group, scratch_);
-      blocks_.drain([&](std::vector<TrianglePair>& pairs, std::size_t max_pairs) {
-        return self_traverse_some<3>(*group, tri, scratch_, pairs, bv_tests, max_pairs);
-      });
-    }
-    if (open_hierarchy_ != nullptr && closed_hierarchy_ != nullptr && !open_hierarchy_->empty() &&
-        !closed_hierarchy_->empty()) {
-      start_pair_traversal<3>(*open_hierarchy_, *closed_hierarchy_, scratch_);
-      blocks_.drain([&](std::vector<TrianglePair>& pairs, std::size_t max_pairs) {
-        return pair_traverse_some<3>(
-            *open_hierarchy_, tri, *closed_hierarchy_, tri, scratch_, pairs, bv_tests, max_pairs);
-      });
-    }
+    start_pair_traversal<3>(*open_hierarchy_, *closed_hierarchy_, scratch_);
+    blocks_.drain([&](std::vector<TrianglePair>& pairs, std::size_t max_pairs) {
+      return pair_traverse_some<3>(
+          *open_hierarchy_, tri, *closed_hierarchy_, tri, scratch_, pairs, bv_tests, max_pairs);
+    });
   }
 
   std::vector<ComponentRoute> routes_;
@@ -533,9 +541,10 @@ class AutoMethod final : public detail::MethodBase {
   /// first DCD; and the sieve's per-slot buffer.
   std::array<SlotAdjacency, 2> dcd_slots_;
   std::vector<std::uint8_t> full_slots_;
-  /// Per group (open, closed): a cone group's DCD takes its method's cone-culled traversal
-  /// (choose_dcd_traversals).
+  /// Per group (open, closed): a cone group's DCD, CCD takes its method's cone-culled traversal
+  /// (choose_traversals).
   std::array<bool, 2> dcd_by_cones_{};
+  std::array<bool, 2> ccd_by_cones_{};
   /// The groups' hierarchies this method traverses (null: not traversed here): its own, or a
   /// cone group method's.
   const AabbBvh* open_hierarchy_ = nullptr;

@@ -39,6 +39,10 @@ struct RoutingOptions {
   /// DCD"). Chosen once, at rest: the cones when their traversal produces fewer than
   /// 1/dcd_cone_share of the pairs whose volumes overlap; 0: never the cones.
   std::int64_t dcd_cone_share = 8;
+  /// The same choice for CCD (docs/dual-cone.md "`auto`'s CCD"), whose pairs each cost more (the
+  /// feature stage, the conservative kernels), so that the cones pay at a smaller cull: the
+  /// cones' traversal, or the plain one of `bvh` on the group's hierarchy.
+  std::int64_t ccd_cone_share = 2;
 };
 
 /// The methods `auto` uses for the open and the closed components under `options`: {open, closed}.

@@ -121,17 +121,18 @@ TEST(Routing, AutoFindsExactlyWhatBvhAndBruteFind) {
   EXPECT_TRUE(across);
 }
 
-// `auto`'s DCD of a cone group takes the traversal chosen at rest (docs/dual-cone.md "`auto`'s
-// DCD"): the sieved traversal of `bvh` on the group's hierarchy — which tests and settles exactly
-// what `bvh` does — on the cloth funnel, whose cone traversal produces 3/4 of the pairs whose
-// volumes overlap at rest; the cones on the skirt, whose cone traversal produces none — fewer tests
-// than `bvh` — unless dcd_cone_share is 0. The pairs are `bvh`'s every time, and a query repeated
-// gives the same counters.
-TEST(Routing, DcdOfAConeGroupTakesTheTraversalChosenAtRest) {
+// A cone group's DCD and CCD take the traversals chosen at rest (docs/dual-cone.md "`auto`'s
+// DCD"): the plain ones of `bvh` on the group's hierarchy (the DCD's sieved) — which test (and
+// settle) exactly what `bvh` does — on the cloth funnel, whose cone traversal produces 3/4 of the
+// pairs whose volumes overlap at rest; the cones on the skirt, whose cone traversal produces none
+// there — fewer tests than `bvh` — unless dcd_cone_share and ccd_cone_share are 0. The pairs and
+// contacts are `bvh`'s every time, and a query repeated gives the same counters.
+TEST(Routing, ConeGroupsTakeTheTraversalsChosenAtRest) {
   const OpenScene funnel = test::cloth_funnel_scene(test::asset("cloth-funnel/frames"));
   const OpenScene skirt = test::skirt_body_scene(9, 14, 16, 10, {0.3, 0.5});
   RoutingOptions never;
   never.dcd_cone_share = 0;
+  never.ccd_cone_share = 0;
   for (const auto& [s, routing, cones] :
        {std::tuple{&funnel, RoutingOptions{}, false},
         std::tuple{&skirt, RoutingOptions{}, true},
@@ -157,10 +158,29 @@ TEST(Routing, DcdOfAConeGroupTakesTheTraversalChosenAtRest) {
         }
       }
     }
+    const FrameResult want = ccd(*b, s->frames.front(), s->frames.back());
+    EXPECT_FALSE(want.contacts.empty());
+    const FrameResult first = ccd(*a, s->frames.front(), s->frames.back());
+    for (const FrameResult& got : {first, ccd(*a, s->frames.front(), s->frames.back())}) {
+      EXPECT_EQ(keys(got), keys(want));
+      EXPECT_EQ(got.counters.bv_tests, first.counters.bv_tests);
+      const auto tests = [](const FrameResult& r) {
+        return r.counters.vf_tests + r.counters.ee_tests;
+      };
+      if (cones) {
+        EXPECT_LT(got.counters.candidate_pairs, want.counters.candidate_pairs);
+      } else {
+        EXPECT_EQ(got.counters.candidate_pairs, want.counters.candidate_pairs);
+        EXPECT_EQ(tests(got), tests(want));
+      }
+    }
   }
-  RoutingOptions bad;
-  bad.dcd_cone_share = -1;
-  EXPECT_THROW((void)make_routed_method(skirt.mesh, skirt.topo, {}, bad), InvalidInput);
+  for (const auto& [dcd_share, ccd_share] : {std::pair{-1, 2}, std::pair{8, -1}}) {
+    RoutingOptions bad;
+    bad.dcd_cone_share = dcd_share;
+    bad.ccd_cone_share = ccd_share;
+    EXPECT_THROW((void)make_routed_method(skirt.mesh, skirt.topo, {}, bad), InvalidInput);
+  }
 }
 
 TEST(Routing, ClothFunnelRoutesThreeClothPartsAndTheFunnelAndMatchesBvh) {
