@@ -80,15 +80,7 @@ void ConeMethodBase::dcd(const Instant& at, FrameResult& out) {
   stats_ = {};
   stats_.culling_disabled = !cull_enabled_;
   const auto t0 = Clock::now();
-  // Refit: static volumes, the hierarchy, the normal cones of the instant.
-  static_vertex_bounds<3>(x, bounds_.vertices);
-  bounds_.derive(topology_, /*with_edges=*/false);
-  bvh_.refit(bounds_.triangles);
-  const Interval interval{&x, &x, false};
-  if (cull_enabled_) {
-    cones_.refit(bvh_, topology_, x);
-    refit_extra(interval);
-  }
+  const Interval interval = refit_instant(x);
   const auto t1 = Clock::now();
   // Cone-culled self traversal → triangle pairs → the DCD rules → tests, in blocks of
   // block_pairs pairs (bounded memory), the vertex fans certified once for the instant.
@@ -116,10 +108,8 @@ void ConeMethodBase::refit_swept(const skinning::Positions& x_t0, const skinning
   bvh_.refit_wide(bounds_.triangles);
 }
 
-std::int64_t ConeMethodBase::count_dcd_pairs(const skinning::Positions& x, std::int64_t cap) {
-  check_positions(x, "detect_dcd", "x");
-  stats_ = {};
-  stats_.culling_disabled = !cull_enabled_;
+ConeMethodBase::Interval ConeMethodBase::refit_instant(const skinning::Positions& x) {
+  // Static volumes, the hierarchy, the normal cones of the instant.
   static_vertex_bounds<3>(x, bounds_.vertices);
   bounds_.derive(topology_, /*with_edges=*/false);
   bvh_.refit(bounds_.triangles);
@@ -128,6 +118,14 @@ std::int64_t ConeMethodBase::count_dcd_pairs(const skinning::Positions& x, std::
     cones_.refit(bvh_, topology_, x);
     refit_extra(interval);
   }
+  return interval;
+}
+
+std::int64_t ConeMethodBase::count_dcd_pairs(const skinning::Positions& x, std::int64_t cap) {
+  check_positions(x, "detect_dcd", "x");
+  stats_ = {};
+  stats_.culling_disabled = !cull_enabled_;
+  const Interval interval = refit_instant(x);
   blocks_.pairs().clear();
   counting_ = true;
   counted_ = 0;

@@ -98,6 +98,9 @@ class ConeMethodBase : public MethodBase, public ConeStatistics {
   ConeCullingStats stats_;
 
  private:
+  /// Refits everything a cone-culled DCD at x reads (static volumes, the hierarchy with its binary
+  /// node volumes, the cones); returns the instant as the node tests see it.
+  Interval refit_instant(const skinning::Positions& x);
   void traverse(const Interval& interval, std::int64_t& bv_tests);
   /// Collide(a, b) of Algorithm 3: every triangle pair (one under a, one under b) whose volumes
   /// overlap, as (min, max); the node with more triangles is split first.
