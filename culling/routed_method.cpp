@@ -322,35 +322,17 @@ class AutoMethod final : public detail::MethodBase {
   void dcd(const Instant& at, FrameResult& out) override {
     const skinning::Positions& x = at.x;
     check_positions(x, "detect_dcd", "x");
-    // A whole-mesh closed method (`dynamic`) answers for its group on its own structures.
-    if (closed_method_ != nullptr && closed_cone_ == nullptr) {
-      run_group(
-          *closed_method_, [&](CullingMethod& m, FrameResult& r) { m.detect_dcd(at, r); }, out);
-    }
-    // A cone group takes the DCD traversal chosen at rest (choose_traversals; docs/dual-cone.md
-    // "`auto`'s DCD"): its method's cone-culled DCD, or the sieved traversal of `bvh` on its
-    // hierarchy. Either way the cone's hierarchy and feature volumes end refit to x.
-    std::array<bool, 2> by_cones{};
-    for (std::size_t g = 0; g < 2; ++g) {
-      detail::ConeMethodBase* cone = g == 0 ? open_cone_ : closed_cone_;
-      if (cone == nullptr) continue;
-      by_cones[g] = dcd_by_cones_[g];
-      if (by_cones[g]) {
-        run_group(
-            *cone, [&](CullingMethod& m, FrameResult& r) { m.detect_dcd(at, r); }, out);
-      } else {
-        cone->refit_static(x);
-      }
-    }
-    std::array<const AabbBvh*, 2> groups{dcd_group(0), dcd_group(1)};
-    for (std::size_t g = 0; g < 2; ++g) {
-      if (by_cones[g]) groups[g] = nullptr;
-    }
-    const bool between = open_hierarchy_ != nullptr && closed_hierarchy_ != nullptr &&
-                         !open_hierarchy_->empty() && !closed_hierarchy_->empty();
+    // The groups that answer themselves; a cone group that does not (its DCD traversal chosen at
+    // rest: docs/dual-cone.md "`auto`'s DCD") refit to x for the sieved traversal of `bvh`.
+    const std::array<const AabbBvh*, 2> groups = answer_groups(
+        dcd_by_cones_,
+        [&](CullingMethod& m, FrameResult& r) { m.detect_dcd(at, r); },
+        [&](detail::ConeMethodBase& cone) { cone.refit_static(x); },
+        out);
+    const bool between = traverses_between();
     if (groups[0] == nullptr && groups[1] == nullptr && !between) return;
     const auto t0 = Clock::now();
-    if (bounds_ == &own_bounds_ && !traverses_nothing()) {
+    if (bounds_ == &own_bounds_) {
       static_vertex_bounds<3>(x, own_bounds_.vertices);
       own_bounds_.derive(topology_, /*with_edges=*/false);
     }
@@ -359,12 +341,11 @@ class AutoMethod final : public detail::MethodBase {
     // Each group's own pairs (sieved), then the pairs between the groups, tested in blocks of
     // block_pairs (bounded memory).
     blocks_.start_dcd(topology_, x, tests_, out);
+    // Every cone group's volumes equal bounds_' (the whole mesh's, refit to x).
+    const std::span<const Aabb> tri(bounds_->triangles);
     for (std::size_t g = 0; g < groups.size(); ++g) {
       const AabbBvh* h = groups[g];
       if (h == nullptr || h->empty()) continue;
-      const detail::ConeMethodBase* cone = g == 0 ? open_cone_ : closed_cone_;
-      const std::span<const Aabb> tri(
-          cone != nullptr ? cone->feature_bounds().triangles : bounds_->triangles);
       // The slots' corners and windows: built by the first DCD (a CCD-only check never holds
       // them; #F x 24 bytes).
       SlotAdjacency& slots = dcd_slots_[g];
@@ -391,29 +372,15 @@ class AutoMethod final : public detail::MethodBase {
     const skinning::Positions& x_t1 = interval.x_t1;
     check_positions(x_t0, "detect_ccd", "x_t0");
     check_positions(x_t1, "detect_ccd", "x_t1");
-    // A whole-mesh closed method (`dynamic`) answers for its group; a cone group with its cones
-    // when chosen at rest (choose_traversals; docs/dual-cone.md "`auto`'s CCD"), else traversed
-    // here as `bvh` traverses, its hierarchy and volumes refit to the interval's swept ones.
-    if (closed_method_ != nullptr && closed_cone_ == nullptr) {
-      run_group(
-          *closed_method_,
-          [&](CullingMethod& m, FrameResult& r) { m.detect_ccd(interval, r); },
-          out);
-    }
-    std::array<const AabbBvh*, 2> groups{dcd_group(0), dcd_group(1)};
-    for (std::size_t g = 0; g < 2; ++g) {
-      detail::ConeMethodBase* cone = g == 0 ? open_cone_ : closed_cone_;
-      if (cone == nullptr) continue;
-      if (ccd_by_cones_[g]) {
-        groups[g] = nullptr;
-        run_group(
-            *cone, [&](CullingMethod& m, FrameResult& r) { m.detect_ccd(interval, r); }, out);
-      } else {
-        cone->refit_swept(x_t0, x_t1);
-      }
-    }
-    const bool between = open_hierarchy_ != nullptr && closed_hierarchy_ != nullptr &&
-                         !open_hierarchy_->empty() && !closed_hierarchy_->empty();
+    // The groups that answer themselves; a cone group that does not (its CCD traversal chosen at
+    // rest: docs/dual-cone.md "`auto`'s CCD") refit to the interval's swept volumes for the plain
+    // traversal of `bvh`.
+    const std::array<const AabbBvh*, 2> groups = answer_groups(
+        ccd_by_cones_,
+        [&](CullingMethod& m, FrameResult& r) { m.detect_ccd(interval, r); },
+        [&](detail::ConeMethodBase& cone) { cone.refit_swept(x_t0, x_t1); },
+        out);
+    const bool between = traverses_between();
     if (groups[0] == nullptr && groups[1] == nullptr && !between) return;
     const auto t0 = Clock::now();
     if (bounds_ == &own_bounds_) {
@@ -495,15 +462,35 @@ class AutoMethod final : public detail::MethodBase {
     out.dcd_pairs.insert(out.dcd_pairs.end(), sub_.dcd_pairs.begin(), sub_.dcd_pairs.end());
   }
 
-  /// The hierarchy whose own pairs a query traverses here for group g (0 open, 1 closed) unless
-  /// the group's cones answer: a cone method's, or the one built here when `bvh` tests the group;
-  /// null for a whole-mesh method's group (it answers itself) or an empty group.
-  [[nodiscard]] const AabbBvh* dcd_group(std::size_t g) const {
-    const detail::ConeMethodBase* cone = g == 0 ? open_cone_ : closed_cone_;
-    if (cone != nullptr) return &cone->hierarchy();
-    const bool own = g == 0 ? open_method_ == nullptr : closed_method_ == nullptr;
-    const bool any = !(g == 0 ? open_triangles_ : closed_triangles_).empty();
-    return own && any ? (g == 0 ? open_hierarchy_ : closed_hierarchy_) : nullptr;
+  /// Runs the query `call` of the groups that answer for themselves — a whole-mesh closed method
+  /// (`dynamic`), a cone group whose cones were chosen for this query (`by_cones`) — adding their
+  /// findings to out, and refits (`refit`) the other cone groups. Returns per group (open, closed)
+  /// the hierarchy whose own pairs this method traverses: such a cone group's, or the one built
+  /// here when `bvh` tests the group; null otherwise.
+  template <class Call, class Refit>
+  std::array<const AabbBvh*, 2> answer_groups(
+      const std::array<bool, 2>& by_cones, Call call, Refit refit, FrameResult& out) {
+    if (closed_method_ != nullptr && closed_cone_ == nullptr) run_group(*closed_method_, call, out);
+    std::array<const AabbBvh*, 2> groups{};
+    for (std::size_t g = 0; g < 2; ++g) {
+      detail::ConeMethodBase* cone = g == 0 ? open_cone_ : closed_cone_;
+      const bool own = (g == 0 ? open_method_ : closed_method_) == nullptr;
+      if (cone != nullptr && by_cones[g]) {
+        run_group(*cone, call, out);
+      } else if (cone != nullptr) {
+        refit(*cone);
+        groups[g] = &cone->hierarchy();
+      } else if (own) {
+        groups[g] = g == 0 ? open_hierarchy_ : closed_hierarchy_;  // null for an empty group
+      }
+    }
+    return groups;
+  }
+
+  /// The two groups are both here with triangles: their pairs are traversed here.
+  [[nodiscard]] bool traverses_between() const {
+    return open_hierarchy_ != nullptr && closed_hierarchy_ != nullptr &&
+           !open_hierarchy_->empty() && !closed_hierarchy_->empty();
   }
 
   [[nodiscard]] bool traverses_nothing() const {
