@@ -3,6 +3,7 @@
 // reference the hierarchy methods must match exactly.
 #include "culling/candidates.hpp"
 #include "culling/detail/method_base.hpp"
+#include "culling/elementary.hpp"
 #include "culling/vertex_bounds.hpp"
 
 namespace skelcd::culling::detail {
@@ -49,7 +50,15 @@ class BruteMethod final : public MethodBase {
     bounds_.derive(topology_);
     const auto t1 = Clock::now();
     features_.clear();
-    ccd_candidates_brute_force<3>(topology_, bounds_, features_, out.counters);
+    // The hierarchy methods' fan rule (pair_blocks.cpp), decided here for every vertex.
+    const bool fans = ccd_uses_fans(topology_, tests_, ccd_options_);
+    if (fans) topology_.fans().certify_over(x_t0, x_t1, fans_);
+    ccd_candidates_brute_force<3>(
+        topology_,
+        bounds_,
+        features_,
+        out.counters,
+        fans ? std::span<const std::uint8_t>(fans_) : std::span<const std::uint8_t>{});
     const auto t2 = Clock::now();
     run_ccd_tests(topology_, features_, x_t0, x_t1, tests_, options_.accuracy, ccd_options_, out);
     const auto t3 = Clock::now();
@@ -62,6 +71,7 @@ class BruteMethod final : public MethodBase {
   FeatureBounds<3> bounds_;
   std::vector<TrianglePair> pairs_;
   FeatureCandidates features_;
+  std::vector<std::uint8_t> fans_;  ///< VertexFans::certify_over of the last CCD query
 };
 
 }  // namespace

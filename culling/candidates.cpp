@@ -63,11 +63,12 @@ constexpr std::size_t kChunkPairs = 64;
 /// false). Reads one OwnedFeatures record per triangle instead of the owned bits, corners, side
 /// edges and their endpoints from four arrays; the pairs, the rules and the order of what is
 /// appended are those of the bit-by-bit loop.
-template <int N, bool kExclusions>
+template <int N, bool kExclusions, bool kFans>
 void owned_feature_pairs(
     const FeatureTopology& topology,
     std::span<const TrianglePair> pairs,
     const FeatureBounds<N>& bounds,
+    std::span<const std::uint8_t> fans,
     FeatureCandidates& out,
     std::int64_t& feature_bv_tests,
     std::int64_t& candidate_pairs) {
@@ -111,6 +112,16 @@ void owned_feature_pairs(
     ++candidate_pairs;
     const Owned& a = topology.owned_features(p.a);
     const Owned& b = topology.owned_features(p.b);
+    if constexpr (kFans) {
+      // A corner both share whose fan is certified over the interval: the two triangles never
+      // meet beyond what they share, so no feature pair they own can touch (a candidate pair, as
+      // a DCD pair a fan settles, with no feature pairs).
+      bool settled = false;
+      for (const std::int32_t v : a.corners) {
+        settled |= is_corner(v, b.corners) & (fans[at(v)] == 1);
+      }
+      if (settled) continue;
+    }
     // VF: the vertices each triangle owns against the other triangle's face.
     vertices_vs_face(a, b, p.b);
     vertices_vs_face(b, a, p.a);
@@ -150,13 +161,18 @@ void ccd_candidates_from_triangle_pairs(
     std::span<const TrianglePair> pairs,
     const FeatureBounds<N>& bounds,
     FeatureCandidates& out,
-    Counters& counters) {
+    Counters& counters,
+    std::span<const std::uint8_t> fans) {
   std::int64_t feature_bv_tests = 0;
   std::int64_t candidate_pairs = 0;
+  const auto run = [&]<bool kExclusions, bool kFans>() {
+    owned_feature_pairs<N, kExclusions, kFans>(
+        topology, pairs, bounds, fans, out, feature_bv_tests, candidate_pairs);
+  };
   if (topology.has_exclusions()) {
-    owned_feature_pairs<N, true>(topology, pairs, bounds, out, feature_bv_tests, candidate_pairs);
+    fans.empty() ? run.template operator()<true, false>() : run.template operator()<true, true>();
   } else {
-    owned_feature_pairs<N, false>(topology, pairs, bounds, out, feature_bv_tests, candidate_pairs);
+    fans.empty() ? run.template operator()<false, false>() : run.template operator()<false, true>();
   }
   counters.feature_bv_tests += feature_bv_tests;
   counters.candidate_pairs += candidate_pairs;
@@ -167,17 +183,29 @@ void ccd_candidates_brute_force(
     const FeatureTopology& topology,
     const FeatureBounds<N>& bounds,
     FeatureCandidates& out,
-    Counters& counters) {
+    Counters& counters,
+    std::span<const std::uint8_t> fans) {
   const std::int32_t num_faces = topology.num_triangles();
   const std::int32_t num_vertices = topology.num_vertices();
   const std::int32_t num_edges = topology.num_edges();
   std::int64_t tests = 0;
+  // The fan rule of ccd_candidates_from_triangle_pairs, on the pair of owners a hierarchy would
+  // have formed the feature pair from.
+  const auto settled = [&](std::int32_t a, std::int32_t b) {
+    if (fans.empty()) return false;
+    const auto& tb = topology.triangle(b);
+    for (const std::int32_t v : topology.triangle(a)) {
+      if (is_corner(v, tb) && fans[at(v)] == 1) return true;
+    }
+    return false;
+  };
   // Every vertex that lies on a triangle against every face it is not a corner of.
   for (std::int32_t v = 0; v < num_vertices; ++v) {
     if (topology.vertex_owner(v) < 0) continue;
     const Dop<N>& bv = bounds.vertices[at(v)];
     for (std::int32_t f = 0; f < num_faces; ++f) {
       if (is_corner(v, topology.triangle(f)) || topology.vertex_face_excluded(v, f)) continue;
+      if (settled(topology.vertex_owner(v), f)) continue;
       ++tests;
       if (bv.overlaps(bounds.triangles[at(f)])) out.vf.push_back({v, f});
     }
@@ -188,6 +216,7 @@ void ccd_candidates_brute_force(
     const auto& ends_a = topology.edge(a);
     for (std::int32_t b = a + 1; b < num_edges; ++b) {
       if (share_endpoint(ends_a, topology.edge(b)) || topology.edges_excluded(a, b)) continue;
+      if (settled(topology.edge_owner(a), topology.edge_owner(b))) continue;
       ++tests;
       if (ba.overlaps(bounds.edges[at(b)])) out.ee.push_back({a, b});
     }
@@ -233,17 +262,27 @@ template void ccd_candidates_from_triangle_pairs<3>(
     std::span<const TrianglePair>,
     const FeatureBounds<3>&,
     FeatureCandidates&,
-    Counters&);
+    Counters&,
+    std::span<const std::uint8_t>);
 template void ccd_candidates_from_triangle_pairs<8>(
     const FeatureTopology&,
     std::span<const TrianglePair>,
     const FeatureBounds<8>&,
     FeatureCandidates&,
-    Counters&);
+    Counters&,
+    std::span<const std::uint8_t>);
 template void ccd_candidates_brute_force<3>(
-    const FeatureTopology&, const FeatureBounds<3>&, FeatureCandidates&, Counters&);
+    const FeatureTopology&,
+    const FeatureBounds<3>&,
+    FeatureCandidates&,
+    Counters&,
+    std::span<const std::uint8_t>);
 template void ccd_candidates_brute_force<8>(
-    const FeatureTopology&, const FeatureBounds<8>&, FeatureCandidates&, Counters&);
+    const FeatureTopology&,
+    const FeatureBounds<8>&,
+    FeatureCandidates&,
+    Counters&,
+    std::span<const std::uint8_t>);
 template void dcd_candidates_brute_force<3>(
     const FeatureTopology&, std::span<const Dop<3>>, std::vector<TrianglePair>&, Counters&);
 template void dcd_candidates_brute_force<8>(

@@ -77,24 +77,31 @@ inline constexpr std::size_t kCcdBlockPairs = std::size_t{1} << 15;
 /// so the caller need not hold #E edge volumes.
 /// Counts counters.candidate_pairs (triangle pairs not wholly part-excluded) and
 /// counters.feature_bv_tests.
+/// `fans`: when not empty, VertexFans::certify_over of the interval (1 per welded vertex): a
+/// triangle pair sharing a certified corner is a candidate with no feature pairs — none of them
+/// can come into contact (docs/culling.md, "Vertex fans over an interval").
 template <int N>
 void ccd_candidates_from_triangle_pairs(
     const FeatureTopology& topology,
     std::span<const TrianglePair> pairs,
     const FeatureBounds<N>& bounds,
     FeatureCandidates& out,
-    Counters& counters);
+    Counters& counters,
+    std::span<const std::uint8_t> fans = {});
 
 /// CCD brute force: appends every VF pair (vertex on some triangle × triangle) and EE pair
 /// (a < b) that passes the rules above — O(#W·#F + #E²) volume tests, no hierarchy.
 /// Counts counters.feature_bv_tests; sets counters.candidate_pairs to #F·(#F−1)/2 (every
 /// triangle pair is a candidate of brute force).
+/// `fans` as for ccd_candidates_from_triangle_pairs: a feature pair whose owners (vertex_owner,
+/// edge_owner) share a certified corner is skipped, as the hierarchy methods skip their pair.
 template <int N>
 void ccd_candidates_brute_force(
     const FeatureTopology& topology,
     const FeatureBounds<N>& bounds,
     FeatureCandidates& out,
-    Counters& counters);
+    Counters& counters,
+    std::span<const std::uint8_t> fans = {});
 
 /// The DCD rules for one triangle pair: not part-excluded, not a duplicate face (the same three
 /// welded vertices). Pairs sharing one or two vertices are checked: the exact test handles them.

@@ -190,6 +190,13 @@ void run_dcd_tests(
       out);
 }
 
+bool ccd_uses_fans(
+    const FeatureTopology& topology, const ElementaryTests& tests, const ccd::CcdOptions& options) {
+  return options.min_separation == 0.0 && topology.fans().num_fans() > 0 &&
+         tests.vertex_face == static_cast<ElementaryTests::VertexFaceFn>(&ccd::vertex_face_ccd) &&
+         tests.edge_edge == static_cast<ElementaryTests::EdgeEdgeFn>(&ccd::edge_edge_ccd);
+}
+
 std::span<const std::uint8_t> certify_dcd_fans(
     const FeatureTopology& topology, const skinning::Positions& x, const ElementaryTests& tests) {
   // Certified vertex fans settle pairs that share a corner without a test — only for the exact

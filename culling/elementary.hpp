@@ -102,6 +102,13 @@ void run_dcd_tests(
     const ElementaryTests& tests,
     FrameResult& out);
 
+/// Whether a CCD query may settle triangle pairs by vertex fans certified over its interval
+/// (VertexFans::certified_over): the mesh has fans, `options` asks for contact itself
+/// (min_separation 0: a contact is then a common point of two triangles), and `tests` are the
+/// product's kernels (a substituted test sees every pair).
+[[nodiscard]] bool ccd_uses_fans(
+    const FeatureTopology& topology, const ElementaryTests& tests, const ccd::CcdOptions& options);
+
 /// The certified vertex fans at instant x (culling/vertex_fans.hpp), one flag per welded vertex,
 /// for run_dcd_tests calls on blocks of one instant's pairs; empty when `tests` is not the exact
 /// triangle test (fans stand for that test only). Valid until the calling thread's next call.

@@ -178,6 +178,90 @@ bool VertexFans::winds_once(std::size_t m, bool closed, const Orient& orient) {
   return covering == 1;
 }
 
+bool VertexFans::certified_over(
+    const skinning::Positions& x_t0, const skinning::Positions& x_t1, std::int32_t v) const {
+  const std::span<const std::int32_t> s = spokes(v);
+  // Closed fans only: with every sector strictly oriented throughout, a closed fan's winding
+  // number is an integer that varies continuously, hence constant; an open fan's total angle
+  // could grow past a full turn between the ends without any sector flattening.
+  if (closed_[static_cast<std::size_t>(v)] == 0 || s.size() < 3) return false;
+  const std::size_t m = s.size();
+  constexpr std::size_t kStackSpokes = 32;
+  std::array<std::array<double, 3>, kStackSpokes + 1> stack0;
+  std::array<std::array<double, 3>, kStackSpokes + 1> stack1;
+  thread_local std::vector<std::array<double, 3>> heap0;
+  thread_local std::vector<std::array<double, 3>> heap1;
+  if (m > kStackSpokes && heap0.size() < m + 1) {
+    heap0.resize(m + 1);
+    heap1.resize(m + 1);
+  }
+  const std::span<std::array<double, 3>> d0 =
+      m > kStackSpokes ? std::span<std::array<double, 3>>(heap0) : stack0;
+  const std::span<std::array<double, 3>> d1 =
+      m > kStackSpokes ? std::span<std::array<double, 3>>(heap1) : stack1;
+  // Spoke i relative to v at either end: p(t) = (1 − t) d0[i] + t d1[i], each component of d0 and
+  // d1 rounded from one subtraction of input coordinates (what the static filters allow for).
+  for (std::size_t i = 0; i < m; ++i) {
+    for (int k = 0; k < 3; ++k) {
+      d0[i][static_cast<std::size_t>(k)] = x_t0(s[i], k) - x_t0(v, k);
+      d1[i][static_cast<std::size_t>(k)] = x_t1(s[i], k) - x_t1(v, k);
+    }
+  }
+  d0[m] = d0[0];
+  d1[m] = d1[0];
+  double nx = 0.0, ny = 0.0, nz = 0.0;  // the summed normal at both ends: any direction is sound
+  for (const auto* d : {&d0, &d1}) {
+    for (std::size_t i = 0; i < m; ++i) {
+      const auto& a = (*d)[i];
+      const auto& b = (*d)[i + 1];
+      nx += a[1] * b[2] - a[2] * b[1];
+      ny += a[2] * b[0] - a[0] * b[2];
+      nz += a[0] * b[1] - a[1] * b[0];
+    }
+  }
+  // In a fixed projection, sector i's orientation at t is that of the cross product of
+  // (1 − t) p0 + t p1 and (1 − t) q0 + t q1 (p, q its spokes): (1 − t)² ⟨p0, q0⟩ +
+  // t (1 − t) (⟨p0, q1⟩ + ⟨p1, q0⟩) + t² ⟨p1, q1⟩. The four signs equal make it strict on [0, 1].
+  // The closed fan winds once at t = 0 (winds_once, in the same projection); it keeps doing so.
+  const auto holds = [&](const auto& sign) {
+    const auto at_start = [&](std::size_t p, std::size_t q) { return sign(d0[p], d0[q]); };
+    if (!winds_once(m, true, at_start)) return false;
+    const int o = at_start(0, 1);
+    for (std::size_t i = 0; i < m; ++i) {
+      if (sign(d0[i], d1[i + 1]) != o || sign(d1[i], d0[i + 1]) != o ||
+          sign(d1[i], d1[i + 1]) != o) {
+        return false;
+      }
+    }
+    return true;
+  };
+  std::size_t k = 0;
+  if (std::abs(ny) > std::abs(nx)) k = 1;
+  if (std::abs(nz) > std::abs(k == 0 ? nx : ny)) k = 2;
+  const std::size_t i_axis = (k + 1) % 3;
+  const std::size_t j_axis = (k + 2) % 3;
+  const auto along_axis = [&](const std::array<double, 3>& p, const std::array<double, 3>& q) {
+    return ccd::detail::cross_sign_static(p[i_axis], p[j_axis], q[i_axis], q[j_axis]);
+  };
+  if (holds(along_axis)) return true;
+  if (!(std::abs(nx) + std::abs(ny) + std::abs(nz) > 0.0)) return false;
+  const auto along_normal = [&](const std::array<double, 3>& p, const std::array<double, 3>& q) {
+    return ccd::detail::det3_sign_static(p[0], p[1], p[2], q[0], q[1], q[2], nx, ny, nz);
+  };
+  return holds(along_normal);
+}
+
+void VertexFans::certify_over(
+    const skinning::Positions& x_t0,
+    const skinning::Positions& x_t1,
+    std::vector<std::uint8_t>& out) const {
+  const std::size_t nv = closed_.size();
+  out.resize(nv);
+  for (std::size_t v = 0; v < nv; ++v) {
+    out[v] = certified_over(x_t0, x_t1, static_cast<std::int32_t>(v)) ? 1 : 0;
+  }
+}
+
 void VertexFans::certify(const skinning::Positions& x, std::vector<std::uint8_t>& out) const {
   const std::size_t nv = closed_.size();
   out.resize(nv);

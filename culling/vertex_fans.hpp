@@ -48,6 +48,19 @@ class VertexFans {
   /// certified(x, v) for every v, into out (resized to #W; 1 = certified).
   void certify(const skinning::Positions& x, std::vector<std::uint8_t>& out) const;
 
+  /// Whether v's fan is certified at every instant of the interval x_t0 → x_t1 (each vertex
+  /// moving on a straight line): a closed fan, certified at x_t0 in some fixed projection, whose
+  /// every triangle keeps its strict projected orientation throughout (docs/culling.md, "Vertex
+  /// fans over an interval"). Then no two triangles of the fan meet beyond their shared vertex or
+  /// edge at any instant, and no feature pair they own can come into contact.
+  [[nodiscard]] bool certified_over(
+      const skinning::Positions& x_t0, const skinning::Positions& x_t1, std::int32_t v) const;
+  /// certified_over(x_t0, x_t1, v) for every v, into out (resized to #W; 1 = certified).
+  void certify_over(
+      const skinning::Positions& x_t0,
+      const skinning::Positions& x_t1,
+      std::vector<std::uint8_t>& out) const;
+
  private:
   /// Conditions (1) and (2) of the certificate for the m triangles of a fan, given the sign of
   /// each projected spoke pair (orient(p, q) ∈ {−1, 1, kUndecided}; spoke m of a closed fan is

@@ -18,6 +18,7 @@
 #include "culling/vertex_fans.hpp"
 #include "skinning/load.hpp"
 #include "skinning/topology.hpp"
+#include "tests/culling/procedural_meshes.hpp"
 #include "tests/support/test_support.hpp"
 
 namespace skelcd::culling {
@@ -431,6 +432,177 @@ TEST(VertexFans, DcdOnRealCharactersIsUnchangedAndTestsFewerPairs) {
     }
     EXPECT_GT(pairs, 0) << file;
     EXPECT_LT(tests_with * 2, tests_without) << file << ": fans settle most pairs";
+  }
+}
+
+/// The product's CCD kernels under other names: the culling stages settle pairs by fans only for
+/// ccd::vertex_face_ccd / ccd::edge_edge_ccd themselves, so these see every feature pair.
+ccd::CcdResult every_vf(
+    const ccd::VertexFaceQuery& q, ccd::Accuracy accuracy, const ccd::CcdOptions& options) {
+  return ccd::vertex_face_ccd(q, accuracy, options);
+}
+ccd::CcdResult every_ee(
+    const ccd::EdgeEdgeQuery& q, ccd::Accuracy accuracy, const ccd::CcdOptions& options) {
+  return ccd::edge_edge_ccd(q, accuracy, options);
+}
+
+/// The positions at t of the straight-line motion x0 → x1.
+skinning::Positions lerp(const skinning::Positions& x0, const skinning::Positions& x1, double t) {
+  return (1.0 - t) * x0 + t * x1;
+}
+
+/// The exact CCD contacts of a mesh over x0 → x1 with every feature pair tested (brute force).
+std::vector<CcdContact> every_contact(
+    const skinning::Mesh& mesh,
+    const skinning::Topology& topo,
+    const skinning::Positions& x0,
+    const skinning::Positions& x1) {
+  auto brute = make_method(
+      "brute",
+      mesh,
+      topo,
+      {.accuracy = ccd::Accuracy::exact,
+       .elementary = {.vertex_face = &every_vf, .edge_edge = &every_ee}});
+  FrameResult r;
+  brute->detect_ccd(x0, x1, r);
+  return r.contacts;
+}
+
+TEST(VertexFans, CertifiedOverAnIntervalOnlyWhileEverySectorKeepsItsOrientation) {
+  const auto tris = fan(5, true);
+  const VertexFans fans(tris, 6);
+  const double step = 2.0 * std::numbers::pi / 5.0;
+  const auto x0 =
+      positions(star({0, step, 2 * step, 3 * step, 4 * step}, {0.3, -0.3, 0.3, -0.3, 0}));
+  // Turned by 20° and moved: certified throughout.
+  const Eigen::Matrix3d r = Eigen::AngleAxisd(0.35, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  skinning::Positions x1 = x0;
+  for (Eigen::Index i = 0; i < x1.rows(); ++i) {
+    x1.row(i) =
+        (r * Eigen::Vector3d(x0.row(i).transpose())).transpose() + Eigen::RowVector3d(2, 1, 0);
+  }
+  EXPECT_TRUE(fans.certified_over(x0, x1, 0));
+  // Turned by a half-turn about v on straight lines: certified at both ends, yet every spoke
+  // passes through v at t = 1/2 — refused.
+  const skinning::Positions half = -x0;
+  EXPECT_TRUE(fans.certified(x0, 0));
+  EXPECT_TRUE(fans.certified(half, 0));
+  EXPECT_FALSE(fans.certified_over(x0, half, 0));
+  // An umbrella turned inside out (v from above the ring to below it): the fan passes through
+  // flat but never meets itself — certified, and no pair meets at any instant sampled.
+  const auto up =
+      positions(star({0, step, 2 * step, 3 * step, 4 * step}, {-0.5, -0.5, -0.5, -0.5, -0.5}));
+  const auto down =
+      positions(star({0, step, 2 * step, 3 * step, 4 * step}, {0.5, 0.5, 0.5, 0.5, 0.5}));
+  EXPECT_TRUE(fans.certified_over(up, down, 0));
+  for (int k = 0; k <= 10; ++k) EXPECT_FALSE(some_pair_intersects(tris, lerp(up, down, k / 10.0)));
+  // Open fans are never certified over an interval.
+  const auto open_tris = fan(5, false);
+  const auto xo = positions(star({0, 0.5, 1.0, 1.5, 2.0}, {0, 0, 0, 0, 0}));
+  EXPECT_TRUE(VertexFans(open_tris, 6).certified(xo, 0));
+  EXPECT_FALSE(VertexFans(open_tris, 6).certified_over(xo, xo, 0));
+}
+
+// Random closed fans on random straight-line motions, from gentle to wild: a fan certified over
+// the interval has no intersecting pair at any sampled instant and no contact by the exact CCD of
+// every feature pair; both outcomes occur often, and refused fans with contacts do too.
+TEST(VertexFans, FansCertifiedOverAnIntervalHaveNoContacts) {
+  std::mt19937_64 rng(4321);
+  std::uniform_real_distribution<double> unit(-1.0, 1.0);
+  std::uniform_int_distribution<int> spokes(3, 9);
+  int certified = 0, refused = 0, refused_with_contacts = 0;
+  for (int n = 0; n < 400; ++n) {
+    const int m = spokes(rng);
+    const auto tris = fan(m, true);
+    skinning::Triangles f(m, 3);
+    for (int i = 0; i < m; ++i) f.row(i) << tris[i][0], tris[i][1], tris[i][2];
+    std::vector<Eigen::Vector3d> p{Eigen::Vector3d::Zero()};
+    double angle = 0;
+    for (int i = 0; i < m; ++i) {
+      const double radius = 0.3 + std::abs(unit(rng));
+      p.emplace_back(radius * std::cos(angle), radius * std::sin(angle), 0.4 * unit(rng));
+      angle += 2.0 * std::numbers::pi / m * (0.7 + 0.3 * std::abs(unit(rng)));
+    }
+    const auto x0 = positions(p);
+    // Each point moves by up to `reach`: small motions keep the fan, large ones fold it.
+    const double reach = (n % 4 + 1) * 0.35;
+    skinning::Positions x1 = x0;
+    for (Eigen::Index i = 0; i < x1.rows(); ++i) {
+      x1.row(i) += reach * Eigen::RowVector3d(unit(rng), unit(rng), unit(rng));
+    }
+    const VertexFans fans(tris, m + 1);
+    const auto mesh = test::single_part_mesh(x0, f);
+    const auto topo = test::simple_topology(mesh);
+    const auto contacts = every_contact(mesh, topo, x0, x1);
+    if (fans.certified_over(x0, x1, 0)) {
+      ++certified;
+      ASSERT_TRUE(contacts.empty()) << "case " << n;
+      for (int k = 0; k <= 8; ++k) {
+        ASSERT_FALSE(some_pair_intersects(tris, lerp(x0, x1, k / 8.0))) << "case " << n;
+      }
+    } else {
+      ++refused;
+      refused_with_contacts += contacts.empty() ? 0 : 1;
+    }
+  }
+  EXPECT_GT(certified, 60);
+  EXPECT_GT(refused, 60);
+  EXPECT_GT(refused_with_contacts, 20);
+}
+
+// The half-turn fan through its vertex has contacts at t = 1/2 although its fan is certified at
+// both ends: every method still reports each of them (a rule that looked at the ends only would
+// drop them all).
+TEST(VertexFans, FanTurnedThroughItsVertexKeepsItsContacts) {
+  const auto tris = fan(6, true);
+  skinning::Triangles f(6, 3);
+  for (int i = 0; i < 6; ++i) f.row(i) << tris[i][0], tris[i][1], tris[i][2];
+  const double step = std::numbers::pi / 3.0;
+  const auto x0 = positions(
+      star({0, step, 2 * step, 3 * step, 4 * step, 5 * step}, {0.2, -0.2, 0.2, -0.2, 0.2, -0.2}));
+  const skinning::Positions x1 = -x0;
+  const auto mesh = test::single_part_mesh(x0, f);
+  const auto topo = test::simple_topology(mesh);
+  const auto reference = every_contact(mesh, topo, x0, x1);
+  ASSERT_FALSE(reference.empty());
+  for (const std::string name : {"brute", "bvh", "kdop", "enhanced-dual-cone", "auto"}) {
+    auto method = make_method(name, mesh, topo, {.accuracy = ccd::Accuracy::exact});
+    FrameResult r;
+    method->detect_ccd(x0, x1, r);
+    EXPECT_EQ(r.contacts, reference) << name;
+  }
+}
+
+// On real characters over their clips: the same contacts with and without the fans over each
+// interval, and fewer elementary tests with them.
+TEST(VertexFans, CcdOnRealCharactersIsUnchangedAndTestsFewerPairs) {
+  for (const std::string file : {"CesiumMan.glb", "stormtrooper/stormtrooper.dae"}) {
+    const auto model = skinning::load_model(test::asset("characters/" + file));
+    const skinning::Mesh& mesh = *model.mesh;
+    const skinning::Topology topo = skinning::build_topology(mesh);
+    const auto motion = model.motion();
+    auto with_fans = make_method("bvh", mesh, topo);
+    auto without = make_method(
+        "bvh", mesh, topo, {.elementary = {.vertex_face = &every_vf, .edge_edge = &every_ee}});
+    skinning::Positions posed, x0, x1;
+    std::int64_t tests_with = 0, tests_without = 0, contacts = 0;
+    const int n = motion->num_samples();
+    for (int k = 0; k + 1 < n; k += std::max(1, n / 12)) {
+      motion->positions(k, posed);
+      skinning::gather_welded(topo, posed, x0);
+      motion->positions(k + 1, posed);
+      skinning::gather_welded(topo, posed, x1);
+      FrameResult a, b;
+      with_fans->detect_ccd(x0, x1, a);
+      without->detect_ccd(x0, x1, b);
+      ASSERT_EQ(a.contacts, b.contacts) << file << " interval " << k;
+      EXPECT_EQ(a.counters.candidate_pairs, b.counters.candidate_pairs);
+      tests_with += a.counters.vf_tests + a.counters.ee_tests;
+      tests_without += b.counters.vf_tests + b.counters.ee_tests;
+      contacts += static_cast<std::int64_t>(a.contacts.size());
+    }
+    EXPECT_GT(contacts, 0) << file;
+    EXPECT_LT(tests_with, tests_without) << file;
   }
 }
 
