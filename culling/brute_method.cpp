@@ -50,15 +50,11 @@ class BruteMethod final : public MethodBase {
     bounds_.derive(topology_);
     const auto t1 = Clock::now();
     features_.clear();
-    // The hierarchy methods' fan rule (pair_blocks.cpp), decided here for every vertex.
+    // The hierarchy methods' fan rule (pair_blocks.cpp).
     const bool fans = ccd_uses_fans(topology_, tests_, ccd_options_);
-    if (fans) topology_.fans().certify_over(x_t0, x_t1, fans_);
+    if (fans) fans_.start(topology_.fans(), x_t0, x_t1, topology_.num_vertices());
     ccd_candidates_brute_force<3>(
-        topology_,
-        bounds_,
-        features_,
-        out.counters,
-        fans ? std::span<const std::uint8_t>(fans_) : std::span<const std::uint8_t>{});
+        topology_, bounds_, features_, out.counters, fans ? &fans_ : nullptr);
     const auto t2 = Clock::now();
     run_ccd_tests(topology_, features_, x_t0, x_t1, tests_, options_.accuracy, ccd_options_, out);
     const auto t3 = Clock::now();
@@ -71,7 +67,7 @@ class BruteMethod final : public MethodBase {
   FeatureBounds<3> bounds_;
   std::vector<TrianglePair> pairs_;
   FeatureCandidates features_;
-  std::vector<std::uint8_t> fans_;  ///< VertexFans::certify_over of the last CCD query
+  IntervalFans fans_;  ///< the CCD query's fans over its interval
 };
 
 }  // namespace

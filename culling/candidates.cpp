@@ -68,7 +68,7 @@ void owned_feature_pairs(
     const FeatureTopology& topology,
     std::span<const TrianglePair> pairs,
     const FeatureBounds<N>& bounds,
-    std::span<const std::uint8_t> fans,
+    IntervalFans* fans,
     FeatureCandidates& out,
     std::int64_t& feature_bv_tests,
     std::int64_t& candidate_pairs) {
@@ -118,7 +118,10 @@ void owned_feature_pairs(
       // a DCD pair a fan settles, with no feature pairs).
       bool settled = false;
       for (const std::int32_t v : a.corners) {
-        settled |= is_corner(v, b.corners) & (fans[at(v)] == 1);
+        if (is_corner(v, b.corners) && fans->certified(v)) {
+          settled = true;
+          break;
+        }
       }
       if (settled) continue;
     }
@@ -162,7 +165,7 @@ void ccd_candidates_from_triangle_pairs(
     const FeatureBounds<N>& bounds,
     FeatureCandidates& out,
     Counters& counters,
-    std::span<const std::uint8_t> fans) {
+    IntervalFans* fans) {
   std::int64_t feature_bv_tests = 0;
   std::int64_t candidate_pairs = 0;
   const auto run = [&]<bool kExclusions, bool kFans>() {
@@ -170,9 +173,11 @@ void ccd_candidates_from_triangle_pairs(
         topology, pairs, bounds, fans, out, feature_bv_tests, candidate_pairs);
   };
   if (topology.has_exclusions()) {
-    fans.empty() ? run.template operator()<true, false>() : run.template operator()<true, true>();
+    fans == nullptr ? run.template operator()<true, false>()
+                    : run.template operator()<true, true>();
   } else {
-    fans.empty() ? run.template operator()<false, false>() : run.template operator()<false, true>();
+    fans == nullptr ? run.template operator()<false, false>()
+                    : run.template operator()<false, true>();
   }
   counters.feature_bv_tests += feature_bv_tests;
   counters.candidate_pairs += candidate_pairs;
@@ -184,7 +189,7 @@ void ccd_candidates_brute_force(
     const FeatureBounds<N>& bounds,
     FeatureCandidates& out,
     Counters& counters,
-    std::span<const std::uint8_t> fans) {
+    IntervalFans* fans) {
   const std::int32_t num_faces = topology.num_triangles();
   const std::int32_t num_vertices = topology.num_vertices();
   const std::int32_t num_edges = topology.num_edges();
@@ -192,10 +197,10 @@ void ccd_candidates_brute_force(
   // The fan rule of ccd_candidates_from_triangle_pairs, on the pair of owners a hierarchy would
   // have formed the feature pair from.
   const auto settled = [&](std::int32_t a, std::int32_t b) {
-    if (fans.empty()) return false;
+    if (fans == nullptr) return false;
     const auto& tb = topology.triangle(b);
     for (const std::int32_t v : topology.triangle(a)) {
-      if (is_corner(v, tb) && fans[at(v)] == 1) return true;
+      if (is_corner(v, tb) && fans->certified(v)) return true;
     }
     return false;
   };
@@ -263,26 +268,18 @@ template void ccd_candidates_from_triangle_pairs<3>(
     const FeatureBounds<3>&,
     FeatureCandidates&,
     Counters&,
-    std::span<const std::uint8_t>);
+    IntervalFans*);
 template void ccd_candidates_from_triangle_pairs<8>(
     const FeatureTopology&,
     std::span<const TrianglePair>,
     const FeatureBounds<8>&,
     FeatureCandidates&,
     Counters&,
-    std::span<const std::uint8_t>);
+    IntervalFans*);
 template void ccd_candidates_brute_force<3>(
-    const FeatureTopology&,
-    const FeatureBounds<3>&,
-    FeatureCandidates&,
-    Counters&,
-    std::span<const std::uint8_t>);
+    const FeatureTopology&, const FeatureBounds<3>&, FeatureCandidates&, Counters&, IntervalFans*);
 template void ccd_candidates_brute_force<8>(
-    const FeatureTopology&,
-    const FeatureBounds<8>&,
-    FeatureCandidates&,
-    Counters&,
-    std::span<const std::uint8_t>);
+    const FeatureTopology&, const FeatureBounds<8>&, FeatureCandidates&, Counters&, IntervalFans*);
 template void dcd_candidates_brute_force<3>(
     const FeatureTopology&, std::span<const Dop<3>>, std::vector<TrianglePair>&, Counters&);
 template void dcd_candidates_brute_force<8>(

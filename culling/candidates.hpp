@@ -22,6 +22,7 @@
 #include "culling/dop.hpp"
 #include "culling/feature_topology.hpp"
 #include "culling/frame_result.hpp"
+#include "skinning/mesh.hpp"
 
 namespace skelcd::culling {
 
@@ -64,6 +65,31 @@ struct FeatureBounds {
   void derive(const FeatureTopology& topology, bool with_edges = true);
 };
 
+/// Vertex fans over one CCD query's interval (VertexFans::certified_over), each decided the first
+/// time a pair asks (a query may bring few pairs). Reused across queries: start() clears.
+struct IntervalFans {
+  const VertexFans* fans = nullptr;
+  const skinning::Positions* x_t0 = nullptr;
+  const skinning::Positions* x_t1 = nullptr;
+  std::vector<std::uint8_t> state;  ///< per welded vertex: 0 undecided, 1 certified, 2 refused
+
+  void start(
+      const VertexFans& of,
+      const skinning::Positions& from,
+      const skinning::Positions& to,
+      std::int32_t num_vertices) {
+    fans = &of;
+    x_t0 = &from;
+    x_t1 = &to;
+    state.assign(static_cast<std::size_t>(num_vertices), 0);
+  }
+  [[nodiscard]] bool certified(std::int32_t v) {
+    std::uint8_t& s = state[static_cast<std::size_t>(v)];
+    if (s == 0) s = fans->certified_over(*x_t0, *x_t1, v) ? 1 : 2;
+    return s == 1;
+  }
+};
+
 /// Triangle pairs per CCD block: the hierarchy methods turn their traversal's pairs into feature
 /// candidates and test them a block at a time, so that what they hold at once (pairs, at most 15
 /// feature candidates each, the tests' outcomes: a few MB) is bounded whatever the motion, and a
@@ -77,9 +103,9 @@ inline constexpr std::size_t kCcdBlockPairs = std::size_t{1} << 15;
 /// so the caller need not hold #E edge volumes.
 /// Counts counters.candidate_pairs (triangle pairs not wholly part-excluded) and
 /// counters.feature_bv_tests.
-/// `fans`: when not empty, VertexFans::certify_over of the interval (1 per welded vertex): a
-/// triangle pair sharing a certified corner is a candidate with no feature pairs — none of them
-/// can come into contact (docs/culling.md, "Vertex fans over an interval").
+/// `fans`: when not null, the query's fans over its interval: a triangle pair sharing a certified
+/// corner is a candidate with no feature pairs — none of them can come into contact
+/// (docs/culling.md, "Vertex fans over an interval").
 template <int N>
 void ccd_candidates_from_triangle_pairs(
     const FeatureTopology& topology,
@@ -87,7 +113,7 @@ void ccd_candidates_from_triangle_pairs(
     const FeatureBounds<N>& bounds,
     FeatureCandidates& out,
     Counters& counters,
-    std::span<const std::uint8_t> fans = {});
+    IntervalFans* fans = nullptr);
 
 /// CCD brute force: appends every VF pair (vertex on some triangle × triangle) and EE pair
 /// (a < b) that passes the rules above — O(#W·#F + #E²) volume tests, no hierarchy.
@@ -101,7 +127,7 @@ void ccd_candidates_brute_force(
     const FeatureBounds<N>& bounds,
     FeatureCandidates& out,
     Counters& counters,
-    std::span<const std::uint8_t> fans = {});
+    IntervalFans* fans = nullptr);
 
 /// The DCD rules for one triangle pair: not part-excluded, not a duplicate face (the same three
 /// welded vertices). Pairs sharing one or two vertices are checked: the exact test handles them.

@@ -75,25 +75,9 @@ void PairBlocks<N>::start_ccd(
   ccd_options_ = &options;
   first_ = out.contacts.size();
   // Vertex fans over the interval settle triangle pairs that share a certified corner
-  // (ccd_uses_fans says when). Certified on demand, for the corners shared by the pairs that come:
-  // a query may have few.
+  // (ccd_uses_fans says when), each decided when a pair first shares it: a query may have few.
   use_fans_ = ccd_uses_fans(topology, tests, options);
-  if (use_fans_) interval_fans_.assign(static_cast<std::size_t>(topology.num_vertices()), 0);
-}
-
-template <int N>
-void PairBlocks<N>::certify_shared_corners() {
-  const VertexFans& fans = topology_->fans();
-  for (const TrianglePair& p : pairs_) {
-    const auto& a = topology_->triangle(p.a);
-    const auto& b = topology_->triangle(p.b);
-    for (const std::int32_t v : a) {
-      auto& state = interval_fans_[static_cast<std::size_t>(v)];
-      if (state == 0 && (v == b[0] || v == b[1] || v == b[2])) {
-        state = fans.certified_over(*x_t0_, *x_t1_, v) ? kFanCertified : kFanRefused;
-      }
-    }
-  }
+  if (use_fans_) interval_fans_.start(topology.fans(), x_t0, x_t1, topology.num_vertices());
 }
 
 template <int N>
@@ -122,15 +106,13 @@ void PairBlocks<N>::flush() {
   const auto t0 = Clock::now();
   if (continuous_) {
     features_.clear();
-    if (use_fans_) certify_shared_corners();
     ccd_candidates_from_triangle_pairs<N>(
         *topology_,
         pairs_,
         *bounds_,
         features_,
         out.counters,
-        use_fans_ ? std::span<const std::uint8_t>(interval_fans_)
-                  : std::span<const std::uint8_t>{});
+        use_fans_ ? &interval_fans_ : nullptr);
     const auto t1 = Clock::now();
     run_ccd_tests(
         *topology_,

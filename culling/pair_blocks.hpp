@@ -107,9 +107,6 @@ class PairBlocks {
 
  private:
   void start(const FeatureTopology& topology, const ElementaryTests& tests, FrameResult& out);
-  /// CCD: decides VertexFans::certified_over for each corner shared by a pair of the block that
-  /// is not decided yet this query.
-  void certify_shared_corners();
 
   std::size_t block_pairs_;
   std::vector<TrianglePair> pairs_;
@@ -125,12 +122,8 @@ class PairBlocks {
   ccd::Accuracy accuracy_ = ccd::Accuracy::conservative;
   const ccd::CcdOptions* ccd_options_ = nullptr;
   std::span<const std::uint8_t> fans_;
-  // CCD: per welded vertex, its fan over the query's interval — 0 not decided yet, else
-  // kFanCertified or kFanRefused (ccd_candidates_from_triangle_pairs reads 1 as certified).
-  static constexpr std::uint8_t kFanCertified = 1;
-  static constexpr std::uint8_t kFanRefused = 2;
-  bool use_fans_ = false;
-  std::vector<std::uint8_t> interval_fans_;
+  bool use_fans_ = false;                   ///< CCD: ccd_uses_fans for this query
+  IntervalFans interval_fans_;              ///< CCD: the query's fans, decided on demand
   std::vector<ccd::TrianglePlane> planes_;  ///< the DCD instant's (dcd_planes); kept across queries
   bool use_planes_ = false;  ///< planes_ holds this instant's planes (the first block decides)
   std::size_t first_ = 0;    ///< out's findings before this query

@@ -251,17 +251,6 @@ bool VertexFans::certified_over(
   return holds(along_normal);
 }
 
-void VertexFans::certify_over(
-    const skinning::Positions& x_t0,
-    const skinning::Positions& x_t1,
-    std::vector<std::uint8_t>& out) const {
-  const std::size_t nv = closed_.size();
-  out.resize(nv);
-  for (std::size_t v = 0; v < nv; ++v) {
-    out[v] = certified_over(x_t0, x_t1, static_cast<std::int32_t>(v)) ? 1 : 0;
-  }
-}
-
 void VertexFans::certify(const skinning::Positions& x, std::vector<std::uint8_t>& out) const {
   const std::size_t nv = closed_.size();
   out.resize(nv);

@@ -55,11 +55,6 @@ class VertexFans {
   /// edge at any instant, and no feature pair they own can come into contact.
   [[nodiscard]] bool certified_over(
       const skinning::Positions& x_t0, const skinning::Positions& x_t1, std::int32_t v) const;
-  /// certified_over(x_t0, x_t1, v) for every v, into out (resized to #W; 1 = certified).
-  void certify_over(
-      const skinning::Positions& x_t0,
-      const skinning::Positions& x_t1,
-      std::vector<std::uint8_t>& out) const;
 
  private:
   /// Conditions (1) and (2) of the certificate for the m triangles of a fan, given the sign of
