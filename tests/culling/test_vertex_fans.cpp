@@ -515,7 +515,10 @@ TEST(VertexFans, FansCertifiedOverAnIntervalHaveNoContacts) {
     const int m = spokes(rng);
     const auto tris = fan(m, true);
     skinning::Triangles f(m, 3);
-    for (int i = 0; i < m; ++i) f.row(i) << tris[i][0], tris[i][1], tris[i][2];
+    for (int i = 0; i < m; ++i) {
+      const Tri& t = tris[static_cast<std::size_t>(i)];
+      f.row(i) << t[0], t[1], t[2];
+    }
     std::vector<Eigen::Vector3d> p{Eigen::Vector3d::Zero()};
     double angle = 0;
     for (int i = 0; i < m; ++i) {
@@ -556,7 +559,10 @@ TEST(VertexFans, FansCertifiedOverAnIntervalHaveNoContacts) {
 TEST(VertexFans, FanTurnedThroughItsVertexKeepsItsContacts) {
   const auto tris = fan(6, true);
   skinning::Triangles f(6, 3);
-  for (int i = 0; i < 6; ++i) f.row(i) << tris[i][0], tris[i][1], tris[i][2];
+  for (int i = 0; i < 6; ++i) {
+    const Tri& t = tris[static_cast<std::size_t>(i)];
+    f.row(i) << t[0], t[1], t[2];
+  }
   const double step = std::numbers::pi / 3.0;
   const auto x0 = positions(
       star({0, step, 2 * step, 3 * step, 4 * step, 5 * step}, {0.2, -0.2, 0.2, -0.2, 0.2, -0.2}));
