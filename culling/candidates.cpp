@@ -13,6 +13,17 @@ inline bool is_corner(std::int32_t v, const std::array<std::int32_t, 3>& t) {
   return v == t[0] || v == t[1] || v == t[2];
 }
 
+/// Triangles with corners a and b share a corner whose fan is certified over the interval.
+inline bool share_certified_corner(
+    const std::array<std::int32_t, 3>& a,
+    const std::array<std::int32_t, 3>& b,
+    IntervalFans& fans) {
+  for (const std::int32_t v : a) {
+    if (is_corner(v, b) && fans.certified(v)) return true;
+  }
+  return false;
+}
+
 inline bool share_endpoint(
     const std::array<std::int32_t, 2>& a, const std::array<std::int32_t, 2>& b) {
   return a[0] == b[0] || a[0] == b[1] || a[1] == b[0] || a[1] == b[1];
@@ -116,14 +127,7 @@ void owned_feature_pairs(
       // A corner both share whose fan is certified over the interval: the two triangles never
       // meet beyond what they share, so no feature pair they own can touch (a candidate pair, as
       // a DCD pair a fan settles, with no feature pairs).
-      bool settled = false;
-      for (const std::int32_t v : a.corners) {
-        if (is_corner(v, b.corners) && fans->certified(v)) {
-          settled = true;
-          break;
-        }
-      }
-      if (settled) continue;
+      if (share_certified_corner(a.corners, b.corners, *fans)) continue;
     }
     // VF: the vertices each triangle owns against the other triangle's face.
     vertices_vs_face(a, b, p.b);
@@ -197,12 +201,8 @@ void ccd_candidates_brute_force(
   // The fan rule of ccd_candidates_from_triangle_pairs, on the pair of owners a hierarchy would
   // have formed the feature pair from.
   const auto settled = [&](std::int32_t a, std::int32_t b) {
-    if (fans == nullptr) return false;
-    const auto& tb = topology.triangle(b);
-    for (const std::int32_t v : topology.triangle(a)) {
-      if (is_corner(v, tb) && fans->certified(v)) return true;
-    }
-    return false;
+    return fans != nullptr &&
+           share_certified_corner(topology.triangle(a), topology.triangle(b), *fans);
   };
   // Every vertex that lies on a triangle against every face it is not a corner of.
   for (std::int32_t v = 0; v < num_vertices; ++v) {

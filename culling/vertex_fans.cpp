@@ -93,58 +93,89 @@ VertexFans::VertexFans(
   }
 }
 
+namespace {
+
+using Spoke = std::array<double, 3>;
+
+/// Room for n spoke differences: on the stack for fans of up to 32 spokes (`stack`), else in this
+/// thread's buffer (kept).
+template <std::size_t kStack>
+std::span<Spoke> spoke_room(std::size_t n, std::array<Spoke, kStack>& stack) {
+  thread_local std::vector<Spoke> heap;
+  if (n <= kStack) return {stack.data(), n};
+  if (heap.size() < n) heap.resize(n);
+  return {heap.data(), n};
+}
+
+/// d[i] = spoke i − v at x for the spokes s, and d[s.size()] = d[0] (spoke m of a closed fan is
+/// spoke 0): every sign of a certificate is a function of these differences, each rounded from one
+/// subtraction of input coordinates (what the static filters allow for), taken once.
+[[gnu::always_inline]] inline void spoke_differences(
+    const skinning::Positions& x,
+    std::int32_t v,
+    std::span<const std::int32_t> s,
+    std::span<Spoke> d) {
+  const double cx = x(v, 0), cy = x(v, 1), cz = x(v, 2);
+  for (std::size_t i = 0; i < s.size(); ++i) {
+    d[i] = {x(s[i], 0) - cx, x(s[i], 1) - cy, x(s[i], 2) - cz};
+  }
+  d[s.size()] = d[0];
+}
+
+/// Adds the (approximate) normals of the m sectors (d[i], d[i + 1]) to n.
+[[gnu::always_inline]] inline void add_normal(std::span<const Spoke> d, std::size_t m, Spoke& n) {
+  for (std::size_t i = 0; i < m; ++i) {
+    const Spoke& a = d[i];
+    const Spoke& b = d[i + 1];
+    n[0] += a[1] * b[2] - a[2] * b[1];
+    n[1] += a[2] * b[0] - a[0] * b[2];
+    n[2] += a[0] * b[1] - a[1] * b[0];
+  }
+}
+
+/// `holds(sign)` in a projection, sign(p, q) the orientation of spoke differences p, q there:
+/// first the coordinate projection that drops the axis where n is largest (any choice is sound;
+/// this one makes the certificate likely), the sign the k-th component of p × q by the static
+/// filter ccd::detail::cross_sign_static; then, if that fails, the projection along n itself — a
+/// fan that no coordinate axis sees injectively (a cube's corner, a cone's tip, a crease turned
+/// away from the axes) may still be seen so — the sign n · (p × q) = det[p; q; n] by the static
+/// orient3d filter (n is exact as computed: a difference rounded zero times).
+template <class Holds>
+bool holds_in_a_projection(const Spoke& n, const Holds& holds) {
+  std::size_t k = 0;
+  if (std::abs(n[1]) > std::abs(n[0])) k = 1;
+  if (std::abs(n[2]) > std::abs(n[k])) k = 2;
+  const std::size_t i_axis = (k + 1) % 3;
+  const std::size_t j_axis = (k + 2) % 3;
+  const auto along_axis = [&](const Spoke& p, const Spoke& q) {
+    return ccd::detail::cross_sign_static(p[i_axis], p[j_axis], q[i_axis], q[j_axis]);
+  };
+  if (holds(along_axis)) return true;
+  if (!(std::abs(n[0]) + std::abs(n[1]) + std::abs(n[2]) > 0.0)) return false;
+  const auto along_normal = [&](const Spoke& p, const Spoke& q) {
+    return ccd::detail::det3_sign_static(p[0], p[1], p[2], q[0], q[1], q[2], n[0], n[1], n[2]);
+  };
+  return holds(along_normal);
+}
+
+constexpr std::size_t kStackSpokes = 32;
+
+}  // namespace
+
 bool VertexFans::certified(const skinning::Positions& x, std::int32_t v) const {
   const std::span<const std::int32_t> s = spokes(v);
   const bool closed = closed_[static_cast<std::size_t>(v)] != 0;
   // m triangles: (v, s[i], s[i + 1]), the last one wrapping around when the fan is closed.
   const std::size_t m = closed ? s.size() : (s.empty() ? 0 : s.size() - 1);
   if (m < (closed ? 3u : 1u)) return false;
-  // The spokes relative to v, once: every sign below is a function of these differences (the
-  // static filter would round the same subtractions each time it needs them).
-  // On the stack for fans of up to 32 spokes, else in this thread's buffer (kept).
-  constexpr std::size_t kStackSpokes = 32;
-  std::array<std::array<double, 3>, kStackSpokes + 1> on_stack;
-  thread_local std::vector<std::array<double, 3>> on_heap;
-  if (s.size() > kStackSpokes && on_heap.size() < s.size() + 1) on_heap.resize(s.size() + 1);
-  const std::span<std::array<double, 3>> d =
-      s.size() > kStackSpokes ? std::span<std::array<double, 3>>(on_heap) : on_stack;
-  const double cx = x(v, 0), cy = x(v, 1), cz = x(v, 2);
-  for (std::size_t i = 0; i < s.size(); ++i) {
-    d[i] = {x(s[i], 0) - cx, x(s[i], 1) - cy, x(s[i], 2) - cz};
-  }
-  d[s.size()] = d[0];  // spoke m of a closed fan is spoke 0
-  // The projection: drop the axis where the fan's (approximate) normal is largest. Any choice is
-  // sound; this one makes the certificate likely.
-  double nx = 0.0, ny = 0.0, nz = 0.0;
-  for (std::size_t i = 0; i < m; ++i) {
-    const auto& a = d[i];
-    const auto& b = d[i + 1];
-    nx += a[1] * b[2] - a[2] * b[1];
-    ny += a[2] * b[0] - a[0] * b[2];
-    nz += a[0] * b[1] - a[1] * b[0];
-  }
-  std::size_t k = 0;
-  if (std::abs(ny) > std::abs(nx)) k = 1;
-  if (std::abs(nz) > std::abs(k == 0 ? nx : ny)) k = 2;
-  const std::size_t i_axis = (k + 1) % 3;
-  const std::size_t j_axis = (k + 2) % 3;
-  // orient(p, q) in the projection: the k-th component of (p − v) × (q − v), decided by the
-  // static filter ccd::detail::cross_sign_static (cross_component_static's) on these differences.
-  const auto along_axis = [&](std::size_t p, std::size_t q) {
-    return ccd::detail::cross_sign_static(d[p][i_axis], d[p][j_axis], d[q][i_axis], d[q][j_axis]);
-  };
-  if (winds_once(m, closed, along_axis)) return true;
-  // A fan that no coordinate axis sees injectively (a cube's corner, a cone's tip, a crease
-  // turned away from the axes) may still be seen so along its own summed normal n: the
-  // projection onto the plane normal to n is just as sound (any direction is), and orient(p, q)
-  // is then the sign of n · ((p − v) × (q − v)) = det[p − v; q − v; n], by the static orient3d
-  // filter on these differences (n is exact as computed: a difference rounded zero times).
-  if (!(std::abs(nx) + std::abs(ny) + std::abs(nz) > 0.0)) return false;
-  const auto along_normal = [&](std::size_t p, std::size_t q) {
-    return ccd::detail::det3_sign_static(
-        d[p][0], d[p][1], d[p][2], d[q][0], d[q][1], d[q][2], nx, ny, nz);
-  };
-  return winds_once(m, closed, along_normal);
+  std::array<Spoke, kStackSpokes + 1> stack;
+  const std::span<Spoke> d = spoke_room(s.size() + 1, stack);
+  spoke_differences(x, v, s, d);
+  Spoke n{0.0, 0.0, 0.0};
+  add_normal(d, m, n);
+  return holds_in_a_projection(n, [&](const auto& sign) {
+    return winds_once(m, closed, [&](std::size_t p, std::size_t q) { return sign(d[p], d[q]); });
+  });
 }
 
 template <class Orient>
@@ -186,44 +217,21 @@ bool VertexFans::certified_over(
   // could grow past a full turn between the ends without any sector flattening.
   if (closed_[static_cast<std::size_t>(v)] == 0 || s.size() < 3) return false;
   const std::size_t m = s.size();
-  constexpr std::size_t kStackSpokes = 32;
-  std::array<std::array<double, 3>, kStackSpokes + 1> stack0;
-  std::array<std::array<double, 3>, kStackSpokes + 1> stack1;
-  thread_local std::vector<std::array<double, 3>> heap0;
-  thread_local std::vector<std::array<double, 3>> heap1;
-  if (m > kStackSpokes && heap0.size() < m + 1) {
-    heap0.resize(m + 1);
-    heap1.resize(m + 1);
-  }
-  const std::span<std::array<double, 3>> d0 =
-      m > kStackSpokes ? std::span<std::array<double, 3>>(heap0) : stack0;
-  const std::span<std::array<double, 3>> d1 =
-      m > kStackSpokes ? std::span<std::array<double, 3>>(heap1) : stack1;
-  // Spoke i relative to v at either end: p(t) = (1 − t) d0[i] + t d1[i], each component of d0 and
-  // d1 rounded from one subtraction of input coordinates (what the static filters allow for).
-  for (std::size_t i = 0; i < m; ++i) {
-    for (int k = 0; k < 3; ++k) {
-      d0[i][static_cast<std::size_t>(k)] = x_t0(s[i], k) - x_t0(v, k);
-      d1[i][static_cast<std::size_t>(k)] = x_t1(s[i], k) - x_t1(v, k);
-    }
-  }
-  d0[m] = d0[0];
-  d1[m] = d1[0];
-  double nx = 0.0, ny = 0.0, nz = 0.0;  // the summed normal at both ends: any direction is sound
-  for (const auto* d : {&d0, &d1}) {
-    for (std::size_t i = 0; i < m; ++i) {
-      const auto& a = (*d)[i];
-      const auto& b = (*d)[i + 1];
-      nx += a[1] * b[2] - a[2] * b[1];
-      ny += a[2] * b[0] - a[0] * b[2];
-      nz += a[0] * b[1] - a[1] * b[0];
-    }
-  }
+  // Spoke i relative to v on the straight-line motion: p(t) = (1 − t) d0[i] + t d1[i].
+  std::array<Spoke, 2 * (kStackSpokes + 1)> stack;
+  const std::span<Spoke> room = spoke_room(2 * (m + 1), stack);
+  const std::span<Spoke> d0 = room.first(m + 1);
+  const std::span<Spoke> d1 = room.subspan(m + 1);
+  spoke_differences(x_t0, v, s, d0);
+  spoke_differences(x_t1, v, s, d1);
+  Spoke n{0.0, 0.0, 0.0};  // the summed normal at both ends: any direction is sound
+  add_normal(d0, m, n);
+  add_normal(d1, m, n);
   // In a fixed projection, sector i's orientation at t is that of the cross product of
   // (1 − t) p0 + t p1 and (1 − t) q0 + t q1 (p, q its spokes): (1 − t)² ⟨p0, q0⟩ +
   // t (1 − t) (⟨p0, q1⟩ + ⟨p1, q0⟩) + t² ⟨p1, q1⟩. The four signs equal make it strict on [0, 1].
   // The closed fan winds once at t = 0 (winds_once, in the same projection); it keeps doing so.
-  const auto holds = [&](const auto& sign) {
+  return holds_in_a_projection(n, [&](const auto& sign) {
     const auto at_start = [&](std::size_t p, std::size_t q) { return sign(d0[p], d0[q]); };
     if (!winds_once(m, true, at_start)) return false;
     const int o = at_start(0, 1);
@@ -234,21 +242,7 @@ bool VertexFans::certified_over(
       }
     }
     return true;
-  };
-  std::size_t k = 0;
-  if (std::abs(ny) > std::abs(nx)) k = 1;
-  if (std::abs(nz) > std::abs(k == 0 ? nx : ny)) k = 2;
-  const std::size_t i_axis = (k + 1) % 3;
-  const std::size_t j_axis = (k + 2) % 3;
-  const auto along_axis = [&](const std::array<double, 3>& p, const std::array<double, 3>& q) {
-    return ccd::detail::cross_sign_static(p[i_axis], p[j_axis], q[i_axis], q[j_axis]);
-  };
-  if (holds(along_axis)) return true;
-  if (!(std::abs(nx) + std::abs(ny) + std::abs(nz) > 0.0)) return false;
-  const auto along_normal = [&](const std::array<double, 3>& p, const std::array<double, 3>& q) {
-    return ccd::detail::det3_sign_static(p[0], p[1], p[2], q[0], q[1], q[2], nx, ny, nz);
-  };
-  return holds(along_normal);
+  });
 }
 
 void VertexFans::certify(const skinning::Positions& x, std::vector<std::uint8_t>& out) const {

@@ -446,6 +446,15 @@ ccd::CcdResult every_ee(
   return ccd::edge_edge_ccd(q, accuracy, options);
 }
 
+/// The triangles as a mesh's index rows.
+skinning::Triangles as_triangles(const std::vector<Tri>& tris) {
+  skinning::Triangles f(static_cast<Eigen::Index>(tris.size()), 3);
+  for (std::size_t i = 0; i < tris.size(); ++i) {
+    f.row(static_cast<Eigen::Index>(i)) << tris[i][0], tris[i][1], tris[i][2];
+  }
+  return f;
+}
+
 /// The positions at t of the straight-line motion x0 → x1.
 skinning::Positions lerp(const skinning::Positions& x0, const skinning::Positions& x1, double t) {
   return (1.0 - t) * x0 + t * x1;
@@ -514,11 +523,7 @@ TEST(VertexFans, FansCertifiedOverAnIntervalHaveNoContacts) {
   for (int n = 0; n < 400; ++n) {
     const int m = spokes(rng);
     const auto tris = fan(m, true);
-    skinning::Triangles f(m, 3);
-    for (int i = 0; i < m; ++i) {
-      const Tri& t = tris[static_cast<std::size_t>(i)];
-      f.row(i) << t[0], t[1], t[2];
-    }
+    const skinning::Triangles f = as_triangles(tris);
     std::vector<Eigen::Vector3d> p{Eigen::Vector3d::Zero()};
     double angle = 0;
     for (int i = 0; i < m; ++i) {
@@ -558,11 +563,7 @@ TEST(VertexFans, FansCertifiedOverAnIntervalHaveNoContacts) {
 // drop them all).
 TEST(VertexFans, FanTurnedThroughItsVertexKeepsItsContacts) {
   const auto tris = fan(6, true);
-  skinning::Triangles f(6, 3);
-  for (int i = 0; i < 6; ++i) {
-    const Tri& t = tris[static_cast<std::size_t>(i)];
-    f.row(i) << t[0], t[1], t[2];
-  }
+  const skinning::Triangles f = as_triangles(tris);
   const double step = std::numbers::pi / 3.0;
   const auto x0 = positions(
       star({0, step, 2 * step, 3 * step, 4 * step, 5 * step}, {0.2, -0.2, 0.2, -0.2, 0.2, -0.2}));
