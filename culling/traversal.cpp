@@ -267,7 +267,21 @@ class Walk {
         stack_(stack),
         out_(out),
         bv_tests_(bv_tests),
-        max_pairs_(max_pairs) {}
+        max_pairs_(max_pairs) {
+    for (std::size_t k = 0; k < kAxes; ++k) {
+      const auto axis = static_cast<int>(k);
+      a_lo_[k] = a.slot_lo(axis);
+      a_hi_[k] = a.slot_hi(axis);
+      b_lo_[k] = b.slot_lo(axis);
+      b_hi_[k] = b.slot_hi(axis);
+    }
+    if (sieve != nullptr) {
+      corners_ = sieve->slots->corners.data();
+      window_ = sieve->slots->window.data();
+      full_ = sieve->full.data();
+      certified_ = sieve->certified.data();
+    }
+  }
 
   /// Runs until the stack is empty (true) or `out` holds max_pairs (false).
   bool run() {
@@ -389,7 +403,9 @@ class Walk {
   }
 
   /// The triangle pairs of two bucket slots (one bucket's own pairs when they are the same),
-  /// each tested with the exact double volumes.
+  /// each tested with the exact double volumes. Everything it reads comes through the pointers
+  /// the constructor cached: a store to `out` could otherwise alias the trees' and the sieve's
+  /// members, and the compiler would load them again for every four slots.
   void leaf_pairs(std::int32_t sa, std::int32_t sb) {
     const WideBvhNode<N>& pa = wide_a_[node_of(sa)];
     const WideBvhNode<N>& pb = wide_b_[node_of(sb)];
@@ -399,71 +415,128 @@ class Walk {
     const std::int32_t end_b = begin_b + pb.count[lane_of(sb)];
     const bool same = kSelf && sa == sb;
     std::int64_t tests = 0;
-    for (std::int32_t i = begin_a; i < end_a; ++i) {
-      const std::int32_t ti = order_a_[to_size(i)];
-      for (std::int32_t j0 = same ? i + 1 : begin_b; j0 < end_b; j0 += kWidth) {
-        const std::int32_t n = std::min(kWidth, end_b - j0);
-        // Four slots of b at once in float (the slots past the tree's last are empty), which only
-        // prunes; then the pairs left, one by one.
-        unsigned mask = float_overlap_slots(i, j0) & ((1u << n) - 1u);
-        tests += n;
-        if constexpr (kSieve) {
-          // Every corner of slot i certified: its window settles the neighbours it shares a
-          // vertex with, four at a time (a pair that shares one overlaps: its bit is in mask).
-          const std::int32_t d = j0 - i + SlotAdjacency::kReach;
-          if (sieve_->full[to_size(i)] != 0 && d >= 0 && d <= 2 * SlotAdjacency::kReach - 4) {
-            const auto settled =
-                static_cast<unsigned>(sieve_->slots->window[to_size(i)] >> d) & mask;
-            sieve_->settled += kBitsIn4[settled];
-            mask &= ~settled;
-          }
-        }
-        while (mask != 0) {
-          const std::int32_t sj = j0 + std::countr_zero(mask);
-          const std::int32_t tj = order_b_[to_size(sj)];
-          mask &= mask - 1;
-          // Two triangles that share a vertex always overlap (both volumes hold it): a settled
-          // pair needs no exact volume test.
+    std::int64_t settled = 0;
+#if defined(__SSE2__)
+    // Two buckets of at most four: b's four slots are loaded once for all of a's.
+    const bool one_group = !same && end_b - begin_b <= kWidth;
+    const Group b_group = one_group ? load_group(begin_b) : Group{};
+#endif
+    // Four slots of a at a time; across two buckets only those within b's bucket box, which holds
+    // every slot box of b (one test of four slots instead of four of b's).
+    for (std::int32_t i0 = begin_a; i0 < end_a; i0 += kWidth) {
+      const std::int32_t m = std::min(kWidth, end_a - i0);
+      unsigned a_mask = (1u << m) - 1u;
+#if defined(__SSE2__)
+      if (!same) {
+        a_mask &= group_within_lane(i0, pb, lane_of(sb));
+        tests += m;
+      }
+#endif
+      while (a_mask != 0) {
+        const std::int32_t i = i0 + std::countr_zero(a_mask);
+        a_mask &= a_mask - 1;
+        const std::int32_t ti = order_a_[to_size(i)];
+        for (std::int32_t j0 = same ? i + 1 : begin_b; j0 < end_b; j0 += kWidth) {
+          const std::int32_t n = std::min(kWidth, end_b - j0);
+          // Four slots of b at once in float (the slots past the tree's last are empty), which only
+          // prunes; then the pairs left, one by one.
+#if defined(__SSE2__)
+          unsigned mask =
+              float_overlap_group(i, one_group ? b_group : load_group(j0)) & ((1u << n) - 1u);
+#else
+          unsigned mask = float_overlap_slots(i, j0) & ((1u << n) - 1u);
+#endif
+          tests += n;
           if constexpr (kSieve) {
-            if (settles(i, sj, ti, tj)) continue;
+            // Every corner of slot i certified: its window settles the neighbours it shares a
+            // vertex with, four at a time (a pair that shares one overlaps: its bit is in mask).
+            const std::int32_t d = j0 - i + SlotAdjacency::kReach;
+            if (full_[i] != 0 && d >= 0 && d <= 2 * SlotAdjacency::kReach - 4) {
+              const auto window_settled = static_cast<unsigned>(window_[i] >> d) & mask;
+              settled += kBitsIn4[window_settled];
+              mask &= ~window_settled;
+            }
           }
-          if (!overlap(bounds_a_[to_size(ti)], bounds_b_[to_size(tj)])) continue;
-          // Ordered a < b within one tree (a select, not a branch), as given across two.
-          if constexpr (kSelf) {
-            out_.push_back({std::min(ti, tj), std::max(ti, tj)});
-          } else {
-            out_.push_back({ti, tj});
+          while (mask != 0) {
+            const std::int32_t sj = j0 + std::countr_zero(mask);
+            const std::int32_t tj = order_b_[to_size(sj)];
+            mask &= mask - 1;
+            // Two triangles that share a vertex always overlap (both volumes hold it): a settled
+            // pair needs no exact volume test.
+            if constexpr (kSieve) {
+              if (settles(i, sj, ti, tj, settled)) continue;
+            }
+            if (!overlap(bounds_a_[to_size(ti)], bounds_b_[to_size(tj)])) continue;
+            // Ordered a < b within one tree (a select, not a branch), as given across two.
+            if constexpr (kSelf) {
+              out_.push_back({std::min(ti, tj), std::max(ti, tj)});
+            } else {
+              out_.push_back({ti, tj});
+            }
           }
         }
       }
     }
     bv_tests_ += tests;
+    if constexpr (kSieve) sieve_->settled += settled;
   }
 
-  /// Bit c set when the float volume of slot si of a overlaps that of slot sb + c of b, c < 4.
-  [[nodiscard]] unsigned float_overlap_slots(std::int32_t si, std::int32_t sb) const {
+  static constexpr int kSlotAxes = Bvh<N>::kSlotAxes;
+  static constexpr auto kAxes = static_cast<std::size_t>(kSlotAxes);
+
 #if defined(__SSE2__)
+  /// The float volumes of four consecutive slots of b, by axis.
+  struct Group {
+    __m128 lo[kAxes];
+    __m128 hi[kAxes];
+  };
+
+  /// Slots sb … sb + 3 of b.
+  [[nodiscard]] Group load_group(std::int32_t sb) const {
+    Group g{};
+    for (std::size_t k = 0; k < kAxes; ++k) {
+      g.lo[k] = _mm_loadu_ps(b_lo_[k] + sb);
+      g.hi[k] = _mm_loadu_ps(b_hi_[k] + sb);
+    }
+    return g;
+  }
+
+  /// Bit c set when the float volume of slot sa + c of a (c < 4) overlaps lane `lane` of b's wide
+  /// node `w` on the slot axes.
+  [[nodiscard]] unsigned group_within_lane(
+      std::int32_t sa, const WideBvhNode<N>& w, int lane) const {
     __m128 ok = _mm_castsi128_ps(_mm_set1_epi32(-1));
-    for (int k = 0; k < Bvh<N>::kSlotAxes; ++k) {
-      const __m128 a_lo = _mm_set1_ps(a_.slot_lo(k)[to_size(si)]);
-      const __m128 a_hi = _mm_set1_ps(a_.slot_hi(k)[to_size(si)]);
-      ok = _mm_and_ps(ok, _mm_cmple_ps(_mm_loadu_ps(b_.slot_lo(k) + sb), a_hi));
-      ok = _mm_and_ps(ok, _mm_cmple_ps(a_lo, _mm_loadu_ps(b_.slot_hi(k) + sb)));
+    const auto l = static_cast<std::size_t>(lane);
+    for (std::size_t k = 0; k < kAxes; ++k) {
+      ok = _mm_and_ps(ok, _mm_cmple_ps(_mm_loadu_ps(a_lo_[k] + sa), _mm_set1_ps(w.hi[k][l])));
+      ok = _mm_and_ps(ok, _mm_cmple_ps(_mm_set1_ps(w.lo[k][l]), _mm_loadu_ps(a_hi_[k] + sa)));
     }
     return static_cast<unsigned>(_mm_movemask_ps(ok));
+  }
+
+  /// Bit c set when the float volume of slot si of a overlaps lane c of a group of b's slots.
+  [[nodiscard]] unsigned float_overlap_group(std::int32_t si, const Group& g) const {
+    __m128 ok = _mm_castsi128_ps(_mm_set1_epi32(-1));
+    for (std::size_t k = 0; k < kAxes; ++k) {
+      ok = _mm_and_ps(ok, _mm_cmple_ps(g.lo[k], _mm_set1_ps(a_hi_[k][si])));
+      ok = _mm_and_ps(ok, _mm_cmple_ps(_mm_set1_ps(a_lo_[k][si]), g.hi[k]));
+    }
+    return static_cast<unsigned>(_mm_movemask_ps(ok));
+  }
 #else
+  /// Bit c set when the float volume of slot si of a overlaps that of slot sb + c of b, c < 4.
+  [[nodiscard]] unsigned float_overlap_slots(std::int32_t si, std::int32_t sb) const {
     unsigned mask = 0;
     for (int c = 0; c < kWidth; ++c) {
       bool hit = true;
-      for (int k = 0; k < Bvh<N>::kSlotAxes; ++k) {
-        hit = hit && b_.slot_lo(k)[to_size(sb + c)] <= a_.slot_hi(k)[to_size(si)] &&
-              a_.slot_lo(k)[to_size(si)] <= b_.slot_hi(k)[to_size(sb + c)];
+      for (std::size_t k = 0; k < kAxes; ++k) {
+        hit = hit && b_lo_[k][sb + c] <= a_hi_[k][si] && a_lo_[k][si] <= b_hi_[k][sb + c];
       }
       mask |= static_cast<unsigned>(hit) << c;
     }
     return mask;
-#endif
   }
+#endif
 
   /// The exact (double) volume test of a triangle pair.
   [[nodiscard]] static bool overlap(const Dop<N>& a, const Dop<N>& b) {
@@ -475,15 +548,16 @@ class Walk {
   }
 
   /// The pair of slots (si, sj) holding (ti, tj) shares a certified vertex (and not three
-  /// vertices): count it in the sieve unless its parts are excluded, and drop it.
-  bool settles(std::int32_t si, std::int32_t sj, std::int32_t ti, std::int32_t tj) {
-    const auto& ci = sieve_->slots->corners[to_size(si)];
-    const unsigned shared = shared_lanes(ci, sieve_->slots->corners[to_size(sj)]);
+  /// vertices): count it in `settled` unless its parts are excluded, and drop it.
+  bool settles(
+      std::int32_t si, std::int32_t sj, std::int32_t ti, std::int32_t tj, std::int64_t& settled) {
+    const auto& ci = corners_[si];
+    const unsigned shared = shared_lanes(ci, corners_[sj]);
     if (shared == 0 || shared == 7u) return false;
     for (unsigned m = shared; m != 0; m &= m - 1) {
-      if (sieve_->certified[to_size(ci[static_cast<std::size_t>(std::countr_zero(m))])] != 0) {
+      if (certified_[ci[static_cast<std::size_t>(std::countr_zero(m))]] != 0) {
         if (!sieve_->topology->triangles_excluded(std::min(ti, tj), std::max(ti, tj))) {
-          ++sieve_->settled;
+          ++settled;
         }
         return true;
       }
@@ -511,6 +585,15 @@ class Walk {
   std::size_t max_pairs_;
   std::array<Entry, 6> deferred_{};  // at most one per pair of four children
   std::size_t num_deferred_ = 0;
+  // Cached for leaf_pairs: the slots' float volumes of both trees by axis, and the sieve's arrays.
+  std::array<const float*, kAxes> a_lo_{};
+  std::array<const float*, kAxes> a_hi_{};
+  std::array<const float*, kAxes> b_lo_{};
+  std::array<const float*, kAxes> b_hi_{};
+  const std::array<std::int32_t, 4>* corners_ = nullptr;
+  const std::uint64_t* window_ = nullptr;
+  const std::uint8_t* full_ = nullptr;
+  const std::uint8_t* certified_ = nullptr;
 };
 
 }  // namespace
