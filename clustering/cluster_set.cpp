@@ -207,7 +207,8 @@ ClusterSet::ClusterSet(
     if (!tris.empty()) centroids.row(c) /= 3.0 * static_cast<double>(tris.size());
     items.row(c).setConstant(c);
   }
-  global_ = culling::AabbBvh(items, centroids, culling::BvhOptions{.leaf_size = 1});
+  global_ = culling::AabbBvh(
+      items, centroids, culling::BvhOptions{.leaf_size = 1, .split = culling::BvhSplit::median});
 }
 
 }  // namespace skelcd::clustering

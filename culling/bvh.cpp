@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cmath>
 #include <limits>
 #include <numeric>
 #include <string>
@@ -21,7 +22,8 @@ Bvh<N>::Bvh(
     const BvhOptions& options)
     : leaf_size_(options.leaf_size),
       node_volumes_(options.node_volumes),
-      float_node_volumes_(options.node_volumes && options.float_node_volumes) {
+      float_node_volumes_(options.node_volumes && options.float_node_volumes),
+      split_(options.split) {
   order_.resize(static_cast<std::size_t>(triangles.rows()));
   std::iota(order_.begin(), order_.end(), 0);
   build(triangles, positions);
@@ -36,7 +38,8 @@ Bvh<N>::Bvh(
     : order_(subset.begin(), subset.end()),
       leaf_size_(options.leaf_size),
       node_volumes_(options.node_volumes),
-      float_node_volumes_(options.node_volumes && options.float_node_volumes) {
+      float_node_volumes_(options.node_volumes && options.float_node_volumes),
+      split_(options.split) {
   for (std::size_t i = 0; i < order_.size(); ++i) {
     if (order_[i] < 0 || order_[i] >= triangles.rows()) {
       throw InvalidInput(
@@ -58,6 +61,8 @@ void Bvh<N>::build(const skinning::Triangles& triangles, const skinning::Positio
   for (std::size_t i = 0; i < order_.size(); ++i) {
     const auto f = static_cast<Eigen::Index>(order_[i]);
     Eigen::Vector3d c = Eigen::Vector3d::Zero();
+    Eigen::Vector3d lo = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
+    Eigen::Vector3d hi = -lo;
     for (Eigen::Index k = 0; k < 3; ++k) {
       const std::int32_t v = triangles(f, k);
       if (v < 0 || v >= positions.rows()) {
@@ -66,9 +71,12 @@ void Bvh<N>::build(const skinning::Triangles& triangles, const skinning::Positio
             " is vertex " + std::to_string(v) + ", outside [0, " +
             std::to_string(positions.rows()) + ")");
       }
-      c += positions.row(v).transpose();
+      const Eigen::Vector3d p = positions.row(v).transpose();
+      c += p;
+      lo = lo.cwiseMin(p);
+      hi = hi.cwiseMax(p);
     }
-    items_[i] = {c, order_[i]};
+    items_[i] = {c, lo, hi, order_[i]};
   }
   nodes_.clear();
   depth_ = 0;
@@ -227,21 +235,105 @@ std::int32_t Bvh<N>::build_range(std::int32_t begin, std::int32_t end, int depth
   Eigen::Index axis = 0;
   (hi - lo).maxCoeff(&axis);
 
-  // Median split by count: the lower half of centroids along the axis goes left. Ties are broken
-  // by triangle id so the tree depends only on the input, not on the library's nth_element.
-  const std::int32_t mid = begin + (end - begin) / 2;
-  const auto before = [axis](const Item& s, const Item& t) {
-    const double cs = s.centroid[axis];
-    const double ct = t.centroid[axis];
-    if (cs != ct) return cs < ct;
-    return s.id < t.id;
-  };
-  std::nth_element(items_.begin() + begin, items_.begin() + mid, items_.begin() + end, before);
+  // The surface-area heuristic's split where it finds one (down to kMaxSahDepth, which bounds
+  // the recursion and the tree's depth on any input), else the median split by count along the
+  // longest axis: the lower half of centroids goes left. Ties are broken by triangle id so the
+  // tree depends only on the input, not on the library's nth_element.
+  constexpr int kMaxSahDepth = 48;
+  std::int32_t mid =
+      split_ == BvhSplit::surface_area && depth < kMaxSahDepth ? sah_split(begin, end, lo, hi) : -1;
+  if (mid < 0) {
+    mid = begin + (end - begin) / 2;
+    const auto before = [axis](const Item& s, const Item& t) {
+      const double cs = s.centroid[axis];
+      const double ct = t.centroid[axis];
+      if (cs != ct) return cs < ct;
+      return s.id < t.id;
+    };
+    std::nth_element(items_.begin() + begin, items_.begin() + mid, items_.begin() + end, before);
+  }
 
   build_range(begin, mid, depth + 1);
   const std::int32_t right = build_range(mid, end, depth + 1);
   nodes_[static_cast<std::size_t>(index)].right = right;
   return index;
+}
+
+template <int N>
+std::int32_t Bvh<N>::sah_split(
+    std::int32_t begin, std::int32_t end, const Eigen::Vector3d& lo, const Eigen::Vector3d& hi) {
+  // Binned (Wald 2007): the centroids in kBins equal slabs per axis, each bin's count and box;
+  // the cost of the split after bin j is area(left) · #left + area(right) · #right, the expected
+  // work of a query that meets the parent's box meeting each child's.
+  constexpr int kBins = 16;
+  struct Bin {
+    std::int32_t count = 0;
+    Eigen::Vector3d lo = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
+    Eigen::Vector3d hi = Eigen::Vector3d::Constant(-std::numeric_limits<double>::infinity());
+  };
+  const auto area = [](const Eigen::Vector3d& l, const Eigen::Vector3d& h) {
+    const Eigen::Vector3d d = (h - l).cwiseMax(0.0);
+    return d.x() * d.y() + d.y() * d.z() + d.z() * d.x();
+  };
+  const auto bin_of = [&](const Item& item, Eigen::Index axis, double scale) {
+    const double t = (item.centroid[axis] - lo[axis]) * scale;
+    return t >= 1.0 ? static_cast<int>(std::min(t, kBins - 1.0)) : 0;  // NaN: bin 0
+  };
+  double best_cost = std::numeric_limits<double>::infinity();
+  std::int32_t best_imbalance = std::numeric_limits<std::int32_t>::max();
+  Eigen::Index best_axis = -1;
+  int best_bin = -1;
+  double best_scale = 0.0;
+  for (Eigen::Index axis = 0; axis < 3; ++axis) {
+    const double extent = hi[axis] - lo[axis];
+    if (!(extent > 0.0) || !std::isfinite(extent)) continue;
+    const double scale = kBins / extent;
+    std::array<Bin, kBins> bins{};
+    for (std::int32_t i = begin; i < end; ++i) {
+      const Item& item = items_[static_cast<std::size_t>(i)];
+      Bin& b = bins[static_cast<std::size_t>(bin_of(item, axis, scale))];
+      ++b.count;
+      b.lo = b.lo.cwiseMin(item.lo);
+      b.hi = b.hi.cwiseMax(item.hi);
+    }
+    // Right sides (bins j + 1 ..) swept from the end, then the left sides from the start.
+    std::array<double, kBins> right_cost{};
+    Bin right;
+    for (int j = kBins - 1; j > 0; --j) {
+      const Bin& b = bins[static_cast<std::size_t>(j)];
+      right.count += b.count;
+      right.lo = right.lo.cwiseMin(b.lo);
+      right.hi = right.hi.cwiseMax(b.hi);
+      right_cost[static_cast<std::size_t>(j - 1)] =
+          right.count > 0 ? area(right.lo, right.hi) * right.count : -1.0;
+    }
+    Bin left;
+    for (int j = 0; j + 1 < kBins; ++j) {
+      const Bin& b = bins[static_cast<std::size_t>(j)];
+      left.count += b.count;
+      left.lo = left.lo.cwiseMin(b.lo);
+      left.hi = left.hi.cwiseMax(b.hi);
+      const double rc = right_cost[static_cast<std::size_t>(j)];
+      if (left.count == 0 || rc < 0.0) continue;
+      const double cost = area(left.lo, left.hi) * left.count + rc;
+      // Equal costs (boxes of no area: points, a flat strip): the more balanced split.
+      const std::int32_t imbalance = std::abs(2 * left.count - (end - begin));
+      if (cost < best_cost || (cost == best_cost && imbalance < best_imbalance)) {
+        best_cost = cost;
+        best_imbalance = imbalance;
+        best_axis = axis;
+        best_bin = j;
+        best_scale = scale;
+      }
+    }
+  }
+  if (best_axis < 0) return -1;
+  // Stable: the order within each side is the input's, so the tree depends only on the input.
+  const auto middle =
+      std::stable_partition(items_.begin() + begin, items_.begin() + end, [&](const Item& item) {
+        return bin_of(item, best_axis, best_scale) <= best_bin;
+      });
+  return static_cast<std::int32_t>(middle - items_.begin());
 }
 
 template <int N>

@@ -14,6 +14,17 @@
 
 namespace skelcd::culling {
 
+/// How Bvh splits a range of triangles in two (at the build positions).
+enum class BvhSplit {
+  /// The surface-area heuristic, binned (docs/culling.md "The hierarchy"): the split that
+  /// minimises area(left) · #left + area(right) · #right over 16 slabs per axis, the median below
+  /// when none separates the centroids. Fewer overlapping siblings on real meshes.
+  surface_area,
+  /// At the median by count along the longest axis of the centroids: balanced, depth
+  /// ⌈log₂(#F / leaf_size)⌉. The cone methods' hierarchy (paper 000's figures were taken on it).
+  median,
+};
+
 struct BvhOptions {
   /// Most triangles in a leaf (>= 1). Larger leaves: fewer nodes to refit and visit, more
   /// triangle-box tests inside leaf pairs (bench/culling measures the trade).
@@ -28,6 +39,7 @@ struct BvhOptions {
   /// double overlap in float) and tests its triangle pairs with the triangles' exact volumes: the
   /// cone methods, whose binary tree is their traversal's.
   bool float_node_volumes = false;
+  BvhSplit split = BvhSplit::surface_area;
 };
 
 /// A node volume as floats rounded outwards (BvhOptions::float_node_volumes).
@@ -120,8 +132,8 @@ class Bvh {
 
   Bvh() = default;
 
-  /// Builds over every triangle: median split (by count) along the longest axis of the
-  /// triangles' centroids, recursively, until a range holds at most leaf_size triangles.
+  /// Builds over every triangle: each range split in two (BvhOptions::split), recursively, until
+  /// it holds at most leaf_size triangles.
   /// @param triangles #F × 3 vertex ids into positions.
   /// @param positions #W × 3 positions the split is computed from (rest pose, usually).
   /// @throws InvalidInput when leaf_size < 1 or a vertex id is out of range (naming the triangle).
@@ -240,15 +252,22 @@ class Bvh {
   static constexpr std::size_t kSlotPadding = 3;
   std::vector<float> slot_bounds_;  // 2·kSlotAxes rows of slot_stride(): lo by axis, then hi
   struct Item {
-    Eigen::Vector3d centroid;
+    Eigen::Vector3d centroid;  // three times the centroid (the split only compares them)
+    Eigen::Vector3d lo;        // the triangle's box at the build positions
+    Eigen::Vector3d hi;
     std::int32_t id;
   };
+  /// The surface-area split of [begin, end) (docs/culling.md "The hierarchy"), or −1 when the
+  /// centroids fall in one bin on every axis; partitions items_ when it finds one.
+  std::int32_t sah_split(
+      std::int32_t begin, std::int32_t end, const Eigen::Vector3d& lo, const Eigen::Vector3d& hi);
   std::vector<Item> items_;  // build-time only, by slot; freed after the build
   int depth_ = 0;
   int wide_depth_ = 0;
   int leaf_size_ = 1;
   bool node_volumes_ = true;
   bool float_node_volumes_ = false;
+  BvhSplit split_ = BvhSplit::surface_area;
 };
 
 using AabbBvh = Bvh<3>;

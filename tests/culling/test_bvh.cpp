@@ -13,8 +13,11 @@
 
 #include "culling/bvh.hpp"
 #include "culling/candidates.hpp"
+#include "culling/method.hpp"
 #include "culling/vertex_bounds.hpp"
 #include "skinning/errors.hpp"
+#include "skinning/load.hpp"
+#include "skinning/topology.hpp"
 #include "tests/culling/exact_dop.hpp"
 #include "tests/culling/procedural_meshes.hpp"
 #include "tests/support/test_support.hpp"
@@ -39,13 +42,25 @@ Scene moving_tube() {
 }
 
 template <int N>
-void check_structure(const Bvh<N>& bvh, std::int32_t num_triangles, int leaf_size) {
+void check_structure(
+    const Bvh<N>& bvh,
+    const skinning::Triangles& triangles,
+    const skinning::Positions& at,
+    int leaf_size,
+    BvhSplit split) {
+  const auto num_triangles = static_cast<std::int32_t>(triangles.rows());
   // triangle_order is a permutation of the triangles.
   std::vector<std::int32_t> order(bvh.triangle_order().begin(), bvh.triangle_order().end());
   std::sort(order.begin(), order.end());
   std::vector<std::int32_t> all(static_cast<std::size_t>(num_triangles));
   std::iota(all.begin(), all.end(), 0);
   ASSERT_EQ(order, all);
+  const auto centroid = [&](std::int32_t slot) {
+    const std::int32_t f = bvh.triangle_order()[static_cast<std::size_t>(slot)];
+    Eigen::Vector3d c = Eigen::Vector3d::Zero();
+    for (Eigen::Index k = 0; k < 3; ++k) c += at.row(triangles(f, k)).transpose();
+    return c;
+  };
   const auto nodes = bvh.nodes();
   ASSERT_FALSE(nodes.empty());
   EXPECT_EQ(nodes[0].begin, 0);
@@ -62,24 +77,43 @@ void check_structure(const Bvh<N>& bvh, std::int32_t num_triangles, int leaf_siz
     EXPECT_GT(n.size(), leaf_size);
     const BvhNode& l = nodes[i + 1];
     const BvhNode& r = nodes[static_cast<std::size_t>(n.right)];
-    // The children split the parent's range at its median.
+    // The children split the parent's range in two non-empty parts...
     EXPECT_EQ(l.begin, n.begin);
     EXPECT_EQ(l.end, r.begin);
     EXPECT_EQ(r.end, n.end);
-    EXPECT_EQ(l.size(), n.size() / 2);
+    EXPECT_GT(l.size(), 0);
+    EXPECT_GT(r.size(), 0);
+    // ...at its median by count, or (the surface-area split, or its median fallback) by a plane
+    // across one axis: no left centroid beyond a right one on it.
+    if (split == BvhSplit::median) {
+      EXPECT_EQ(l.size(), n.size() / 2);
+    }
+    bool separated = false;
+    for (Eigen::Index k = 0; k < 3 && !separated; ++k) {
+      double left_max = -std::numeric_limits<double>::infinity();
+      double right_min = std::numeric_limits<double>::infinity();
+      for (std::int32_t s = l.begin; s < l.end; ++s) left_max = std::max(left_max, centroid(s)[k]);
+      for (std::int32_t s = r.begin; s < r.end; ++s)
+        right_min = std::min(right_min, centroid(s)[k]);
+      separated = left_max <= right_min;
+    }
+    EXPECT_TRUE(separated) << "node " << i;
   }
   EXPECT_EQ(leaves_total, num_triangles);
-  // A median split is balanced: depth <= ceil(log2(#F / leaf_size)) + 1.
-  EXPECT_LE(
-      bvh.depth(),
-      static_cast<int>(std::ceil(std::log2(static_cast<double>(num_triangles) / leaf_size))) + 1);
+  // A median split is balanced: depth <= ceil(log2(#F / leaf_size)) + 1. The surface-area split
+  // stops at depth 48 and continues at the median.
+  const int balanced =
+      static_cast<int>(std::ceil(std::log2(static_cast<double>(num_triangles) / leaf_size))) + 1;
+  EXPECT_LE(bvh.depth(), split == BvhSplit::median ? balanced : 48 + balanced);
 }
 
 template <int N>
-void check_refit(const Scene& s, int leaf_size, double min_separation) {
+void check_refit(
+    const Scene& s, int leaf_size, double min_separation, BvhSplit split = BvhSplit::surface_area) {
   const FeatureTopology topology(s.mesh, s.topology);
-  Bvh<N> bvh(topology.welded_triangles(), s.x_t0, BvhOptions{leaf_size});
-  check_structure(bvh, topology.num_triangles(), leaf_size);
+  Bvh<N> bvh(
+      topology.welded_triangles(), s.x_t0, BvhOptions{.leaf_size = leaf_size, .split = split});
+  check_structure(bvh, topology.welded_triangles(), s.x_t0, leaf_size, split);
 
   FeatureBounds<N> bounds;
   swept_vertex_bounds<N>(s.x_t0, s.x_t1, 0.5 * min_separation, bounds.vertices);
@@ -111,14 +145,18 @@ void check_refit(const Scene& s, int leaf_size, double min_separation) {
 
 TEST(Bvh, AabbRefitContainsTrianglesAtBothEndsAndParentsContainChildren) {
   const Scene s = moving_tube();
-  for (const int leaf : {1, 2, 5}) check_refit<3>(s, leaf, 0.0);
-  check_refit<3>(s, 1, 0.01);
+  for (const BvhSplit split : {BvhSplit::surface_area, BvhSplit::median}) {
+    for (const int leaf : {1, 2, 5}) check_refit<3>(s, leaf, 0.0, split);
+    check_refit<3>(s, 1, 0.01, split);
+  }
 }
 
 TEST(Bvh, KdopRefitContainsTrianglesAtBothEndsAndParentsContainChildren) {
   const Scene s = moving_tube();
-  for (const int leaf : {1, 2, 5}) check_refit<8>(s, leaf, 0.0);
-  check_refit<8>(s, 3, 0.01);
+  for (const BvhSplit split : {BvhSplit::surface_area, BvhSplit::median}) {
+    for (const int leaf : {1, 2, 5}) check_refit<8>(s, leaf, 0.0, split);
+    check_refit<8>(s, 3, 0.01, split);
+  }
 }
 
 TEST(Bvh, RefitIsExactForVerticesFarFromTheOrigin) {
@@ -128,6 +166,44 @@ TEST(Bvh, RefitIsExactForVerticesFarFromTheOrigin) {
   s.x_t1 = test::translated(s.x_t1 * 1e3, Eigen::Vector3d(1e6 + 0.1, -1e6, 3e5));
   check_refit<8>(s, 1, 0.0);
   check_refit<3>(s, 1, 0.0);
+  check_refit<3>(s, 1, 0.0, BvhSplit::median);
+}
+
+TEST(Bvh, SurfaceAreaSplitFindsTheSamePairsWithFewerVolumeTestsOnRealCharacters) {
+  // The same DCD pairs and triangle tests and the same CCD contacts as the median tree — the
+  // split changes which volumes are compared, never the answer — with fewer volume tests: the
+  // siblings of a real character overlap less.
+  for (const std::string file : {"CesiumMan.glb", "stormtrooper/stormtrooper.dae"}) {
+    const auto model = skinning::load_model(test::asset("characters/" + file));
+    const skinning::Mesh& mesh = *model.mesh;
+    const skinning::Topology topo = skinning::build_topology(mesh);
+    const auto motion = model.motion();
+    auto sah = make_method("bvh", mesh, topo);
+    auto median = make_method("bvh", mesh, topo, {.bvh = {.split = BvhSplit::median}});
+    skinning::Positions posed, x0, x1;
+    std::int64_t bv_sah = 0, bv_median = 0, pairs = 0;
+    const int n = motion->num_samples();
+    for (int k = 0; k + 1 < n; k += std::max(1, n / 6)) {
+      motion->positions(k, posed);
+      skinning::gather_welded(topo, posed, x0);
+      motion->positions(k + 1, posed);
+      skinning::gather_welded(topo, posed, x1);
+      FrameResult a, b;
+      sah->detect_dcd(x0, a);
+      median->detect_dcd(x0, b);
+      ASSERT_EQ(a.dcd_pairs, b.dcd_pairs) << file << " sample " << k;
+      EXPECT_EQ(a.counters.tt_tests, b.counters.tt_tests) << file << " sample " << k;
+      FrameResult c, d;
+      sah->detect_ccd(x0, x1, c);
+      median->detect_ccd(x0, x1, d);
+      ASSERT_EQ(c.contacts, d.contacts) << file << " interval " << k;
+      bv_sah += a.counters.bv_tests + c.counters.bv_tests;
+      bv_median += b.counters.bv_tests + d.counters.bv_tests;
+      pairs += static_cast<std::int64_t>(a.dcd_pairs.size() + c.contacts.size());
+    }
+    EXPECT_GT(pairs, 0) << file;
+    EXPECT_LT(bv_sah, bv_median) << file;
+  }
 }
 
 TEST(Bvh, SubsetBuildHoldsOnlyTheSubset) {
