@@ -349,9 +349,12 @@ void Bvh<N>::refit(std::span<const Volume> triangle_bounds) {
   const std::size_t stride = slot_stride();
   constexpr auto kAxes = static_cast<std::size_t>(kSlotAxes);
   const auto slot_floats = [&](std::size_t s, const Volume& t) {
+    std::array<float, kN> lo;
+    std::array<float, kN> hi;
+    round_outwards(t, lo, hi);
     for (std::size_t k = 0; k < kAxes; ++k) {
-      slot_bounds_[k * stride + s] = float_below(t.lo[k]);
-      slot_bounds_[(kAxes + k) * stride + s] = float_above(t.hi[k]);
+      slot_bounds_[k * stride + s] = lo[k];
+      slot_bounds_[(kAxes + k) * stride + s] = hi[k];
     }
   };
   if (float_node_volumes_) {
@@ -379,10 +382,12 @@ void Bvh<N>::refit(std::span<const Volume> triangle_bounds) {
   // The wide copy: each lane's binary node volume, rounded outwards to floats.
   for (WideBvhNode<N>& w : wide_) {
     for (int i = 0; i < w.num_children; ++i) {
-      const Volume& v = node_bounds_[static_cast<std::size_t>(w.node[i])];
+      std::array<float, kN> lo;
+      std::array<float, kN> hi;
+      round_outwards(node_bounds_[static_cast<std::size_t>(w.node[i])], lo, hi);
       for (std::size_t k = 0; k < kN; ++k) {
-        w.lo[k][i] = float_below(v.lo[k]);
-        w.hi[k][i] = float_above(v.hi[k]);
+        w.lo[k][i] = lo[k];
+        w.hi[k][i] = hi[k];
       }
     }
   }
@@ -404,16 +409,16 @@ void Bvh<N>::refit_float_nodes(std::span<const Volume> triangle_bounds) {
       v.hi.fill(-std::numeric_limits<float>::infinity());
       for (auto s = static_cast<std::size_t>(node.begin); s < static_cast<std::size_t>(node.end);
            ++s) {
-        const Volume& t = triangle_bounds[static_cast<std::size_t>(order_[s])];
+        std::array<float, kN> tl;
+        std::array<float, kN> th;
+        round_outwards(triangle_bounds[static_cast<std::size_t>(order_[s])], tl, th);
         for (std::size_t k = 0; k < kN; ++k) {
-          const float tl = float_below(t.lo[k]);
-          const float th = float_above(t.hi[k]);
           if (k < kAxes) {
-            slot_bounds_[k * stride + s] = tl;
-            slot_bounds_[(kAxes + k) * stride + s] = th;
+            slot_bounds_[k * stride + s] = tl[k];
+            slot_bounds_[(kAxes + k) * stride + s] = th[k];
           }
-          v.lo[k] = std::min(v.lo[k], tl);
-          v.hi[k] = std::max(v.hi[k], th);
+          v.lo[k] = std::min(v.lo[k], tl[k]);
+          v.hi[k] = std::max(v.hi[k], th[k]);
         }
       }
     } else {
@@ -458,22 +463,26 @@ void Bvh<N>::refit_wide_only(std::span<const Volume> triangle_bounds) {
         for (std::size_t s = begin; s < end && s >= kAhead; ++s) {
           __builtin_prefetch(&triangle_bounds[static_cast<std::size_t>(order_[s - kAhead])]);
         }
-        for (std::size_t k = 0; k < kN; ++k) {
-          float lo = std::numeric_limits<float>::infinity();
-          float hi = -std::numeric_limits<float>::infinity();
-          for (std::size_t s = begin; s < end; ++s) {
-            const Volume& t = triangle_bounds[static_cast<std::size_t>(order_[s])];
-            const float tl = float_below(t.lo[k]);
-            const float th = float_above(t.hi[k]);
+        std::array<float, kN> lo;
+        std::array<float, kN> hi;
+        lo.fill(std::numeric_limits<float>::infinity());
+        hi.fill(-std::numeric_limits<float>::infinity());
+        for (std::size_t s = begin; s < end; ++s) {
+          std::array<float, kN> tl;
+          std::array<float, kN> th;
+          round_outwards(triangle_bounds[static_cast<std::size_t>(order_[s])], tl, th);
+          for (std::size_t k = 0; k < kN; ++k) {
             if (k < kAxes) {
-              slot_bounds_[k * stride + s] = tl;
-              slot_bounds_[(kAxes + k) * stride + s] = th;
+              slot_bounds_[k * stride + s] = tl[k];
+              slot_bounds_[(kAxes + k) * stride + s] = th[k];
             }
-            lo = std::min(lo, tl);
-            hi = std::max(hi, th);
+            lo[k] = std::min(lo[k], tl[k]);
+            hi[k] = std::max(hi[k], th[k]);
           }
-          w.lo[k][i] = lo;
-          w.hi[k][i] = hi;
+        }
+        for (std::size_t k = 0; k < kN; ++k) {
+          w.lo[k][i] = lo[k];
+          w.hi[k][i] = hi[k];
         }
       } else {
         const WideBvhNode<N>& c = wide_[static_cast<std::size_t>(w.child[i])];

@@ -19,6 +19,10 @@
 
 #include "ccd/detail/float_bounds.hpp"
 
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
+
 namespace skelcd::culling {
 
 /// Smallest double greater than `x`, largest smaller (x finite; bit arithmetic without branches):
@@ -173,6 +177,69 @@ void Dop<N>::inflate(double half_width) {
     lo[k] = next_down(lo[k] - grow);
     hi[k] = next_up(hi[k] + grow);
   }
+}
+
+#if defined(__SSE2__)
+namespace detail {
+
+/// float_below of four doubles (x01: lanes 0, 1; x23: lanes 2, 3), bit for bit: the same steps on
+/// SSE2 lanes — the nearest float, one step down where rounding went up, subnormals replaced.
+inline __m128 float_below4(__m128d x01, __m128d x23) {
+  const __m128 sign = _mm_set1_ps(-0.0f);
+  const __m128 f = _mm_movelh_ps(_mm_cvtpd_ps(x01), _mm_cvtpd_ps(x23));
+  // Four 64-bit masks to four 32-bit lanes.
+  const auto pack = [](__m128d m01, __m128d m23) {
+    return _mm_shuffle_ps(_mm_castpd_ps(m01), _mm_castpd_ps(m23), _MM_SHUFFLE(2, 0, 2, 0));
+  };
+  const __m128 went_up = pack(
+      _mm_cmpgt_pd(_mm_cvtps_pd(f), x01), _mm_cmpgt_pd(_mm_cvtps_pd(_mm_movehl_ps(f, f)), x23));
+  __m128i bits = _mm_castps_si128(_mm_add_ps(_mm_xor_ps(f, sign), _mm_setzero_ps()));  // −f + 0
+  bits = _mm_add_epi32(bits, _mm_or_si128(_mm_srai_epi32(bits, 31), _mm_set1_epi32(1)));
+  const __m128 below = _mm_xor_ps(_mm_castsi128_ps(bits), sign);
+  const __m128 r = _mm_or_ps(_mm_and_ps(went_up, below), _mm_andnot_ps(went_up, f));
+  const __m128 k_min = _mm_set1_ps(std::numeric_limits<float>::min());
+  const __m128 tiny = _mm_and_ps(_mm_cmpgt_ps(r, _mm_xor_ps(k_min, sign)), _mm_cmplt_ps(r, k_min));
+  const __m128 non_negative =
+      pack(_mm_cmpge_pd(x01, _mm_setzero_pd()), _mm_cmpge_pd(x23, _mm_setzero_pd()));
+  const __m128 replacement = _mm_andnot_ps(non_negative, _mm_xor_ps(k_min, sign));  // 0 or −min
+  return _mm_or_ps(_mm_and_ps(tiny, replacement), _mm_andnot_ps(tiny, r));
+}
+
+}  // namespace detail
+#endif
+
+/// The volume v rounded outwards to floats, bit for bit float_below(v.lo[k]) and
+/// float_above(v.hi[k]) — four at a time where SSE2 is there (a refit converts every triangle's).
+template <int N>
+inline void round_outwards(
+    const Dop<N>& v,
+    std::array<float, static_cast<std::size_t>(N)>& lo,
+    std::array<float, static_cast<std::size_t>(N)>& hi) {
+  constexpr auto kN = static_cast<std::size_t>(N);
+#if defined(__SSE2__)
+  // lo, then −hi (float_above(h) = −float_below(−h)), in groups of four; the last one padded.
+  constexpr std::size_t kGroups = (2 * kN + 3) / 4;
+  alignas(16) std::array<double, 4 * kGroups> in{};
+  alignas(16) std::array<float, 4 * kGroups> out{};
+  for (std::size_t k = 0; k < kN; ++k) {
+    in[k] = v.lo[k];
+    in[kN + k] = -v.hi[k];
+  }
+  for (std::size_t g = 0; g < kGroups; ++g) {
+    _mm_store_ps(
+        out.data() + 4 * g,
+        detail::float_below4(_mm_load_pd(in.data() + 4 * g), _mm_load_pd(in.data() + 4 * g + 2)));
+  }
+  for (std::size_t k = 0; k < kN; ++k) {
+    lo[k] = out[k];
+    hi[k] = -out[kN + k];
+  }
+#else
+  for (std::size_t k = 0; k < kN; ++k) {
+    lo[k] = float_below(v.lo[k]);
+    hi[k] = float_above(v.hi[k]);
+  }
+#endif
 }
 
 }  // namespace skelcd::culling

@@ -1,7 +1,9 @@
 // Dop<N> (AABB, 16-DOP): outward rounding proven against exact rationals, inflation, overlap.
 #include <gtest/gtest.h>
 
+#include <bit>
 #include <cmath>
+#include <cstdint>
 #include <limits>
 #include <random>
 #include <vector>
@@ -39,9 +41,9 @@ TEST(NextUpDown, MatchNextafterAcrossSignsAndMagnitudes) {
   }
 }
 
-// The traversals' float volumes (culling/bvh.hpp) round each bound outwards to the nearest float
-// that is not subnormal: below x for a low end, above for a high end, and no farther than needed.
-TEST(FloatBounds, RoundOutwardsToTheNearestNormalFloat) {
+/// Bounds to round: zeros, float and double subnormals, the float range's ends and beyond, and
+/// 20,000 random values over 280 binary orders of magnitude.
+std::vector<double> bounds_to_round() {
   const float fmax = std::numeric_limits<float>::max();
   const float fmin = std::numeric_limits<float>::min();
   std::vector<double> values = {
@@ -72,6 +74,15 @@ TEST(FloatBounds, RoundOutwardsToTheNearestNormalFloat) {
   std::uniform_real_distribution<double> mantissa(-1.0, 1.0);
   std::uniform_int_distribution<int> exponent(-140, 140);
   for (int i = 0; i < 20000; ++i) values.push_back(std::ldexp(mantissa(rng), exponent(rng)));
+  return values;
+}
+
+// The traversals' float volumes (culling/bvh.hpp) round each bound outwards to the nearest float
+// that is not subnormal: below x for a low end, above for a high end, and no farther than needed.
+TEST(FloatBounds, RoundOutwardsToTheNearestNormalFloat) {
+  const float fmax = std::numeric_limits<float>::max();
+  const float fmin = std::numeric_limits<float>::min();
+  const std::vector<double> values = bounds_to_round();
   for (const double x : values) {
     const float lo = float_below(x);
     const float hi = float_above(x);
@@ -98,6 +109,37 @@ TEST(FloatBounds, RoundOutwardsToTheNearestNormalFloat) {
   EXPECT_EQ(float_above(1e-310), fmin);
   EXPECT_EQ(float_below(1e-310), 0.0f);
   EXPECT_EQ(float_below(-1e-310), -fmin);
+}
+
+// A refit rounds whole volumes four bounds at a time (round_outwards, SSE2 where there): the same
+// bits as float_below and float_above one by one, for AABBs and 16-DOPs.
+template <int N>
+void check_round_outwards(const std::vector<double>& values) {
+  constexpr auto kN = static_cast<std::size_t>(N);
+  for (std::size_t i = 0; i + 2 * kN <= values.size(); i += 2 * kN - 1) {
+    Dop<N> v;
+    for (std::size_t k = 0; k < kN; ++k) {
+      v.lo[k] = values[i + k];
+      v.hi[k] = values[i + kN + k];
+    }
+    std::array<float, kN> lo;
+    std::array<float, kN> hi;
+    round_outwards(v, lo, hi);
+    for (std::size_t k = 0; k < kN; ++k) {
+      ASSERT_EQ(
+          std::bit_cast<std::uint32_t>(lo[k]), std::bit_cast<std::uint32_t>(float_below(v.lo[k])))
+          << v.lo[k];
+      ASSERT_EQ(
+          std::bit_cast<std::uint32_t>(hi[k]), std::bit_cast<std::uint32_t>(float_above(v.hi[k])))
+          << v.hi[k];
+    }
+  }
+}
+
+TEST(FloatBounds, RoundingAWholeVolumeGivesTheSameBitsAsOneBoundAtATime) {
+  const std::vector<double> values = bounds_to_round();
+  check_round_outwards<3>(values);
+  check_round_outwards<8>(values);
 }
 
 TEST(Dop, AabbOfPointIsThePointExactly) {
