@@ -16,10 +16,9 @@
 #include "culling/method.hpp"
 #include "culling/vertex_bounds.hpp"
 #include "skinning/errors.hpp"
-#include "skinning/load.hpp"
-#include "skinning/topology.hpp"
 #include "tests/culling/exact_dop.hpp"
 #include "tests/culling/procedural_meshes.hpp"
+#include "tests/culling/welded_character.hpp"
 #include "tests/support/test_support.hpp"
 
 namespace skelcd::culling {
@@ -174,20 +173,16 @@ TEST(Bvh, SurfaceAreaSplitFindsTheSamePairsWithFewerVolumeTestsOnRealCharacters)
   // split changes which volumes are compared, never the answer — with fewer volume tests: the
   // siblings of a real character overlap less.
   for (const std::string file : {"CesiumMan.glb", "stormtrooper/stormtrooper.dae"}) {
-    const auto model = skinning::load_model(test::asset("characters/" + file));
-    const skinning::Mesh& mesh = *model.mesh;
-    const skinning::Topology topo = skinning::build_topology(mesh);
-    const auto motion = model.motion();
-    auto sah = make_method("bvh", mesh, topo);
-    auto median = make_method("bvh", mesh, topo, {.bvh = {.split = BvhSplit::median}});
-    skinning::Positions posed, x0, x1;
+    const test::WeldedCharacter character(file);
+    const skinning::Mesh& mesh = *character.loaded.mesh;
+    auto sah = make_method("bvh", mesh, character.topology);
+    auto median =
+        make_method("bvh", mesh, character.topology, {.bvh = {.split = BvhSplit::median}});
     std::int64_t bv_sah = 0, bv_median = 0, pairs = 0;
-    const int n = motion->num_samples();
+    const int n = character.loaded.motion()->num_samples();
     for (int k = 0; k + 1 < n; k += std::max(1, n / 6)) {
-      motion->positions(k, posed);
-      skinning::gather_welded(topo, posed, x0);
-      motion->positions(k + 1, posed);
-      skinning::gather_welded(topo, posed, x1);
+      const skinning::Positions x0 = character.sample(k);
+      const skinning::Positions x1 = character.sample(k + 1);
       FrameResult a, b;
       sah->detect_dcd(x0, a);
       median->detect_dcd(x0, b);

@@ -19,6 +19,7 @@
 #include "skinning/load.hpp"
 #include "skinning/topology.hpp"
 #include "tests/culling/procedural_meshes.hpp"
+#include "tests/culling/welded_character.hpp"
 #include "tests/support/test_support.hpp"
 
 namespace skelcd::culling {
@@ -584,21 +585,19 @@ TEST(VertexFans, FanTurnedThroughItsVertexKeepsItsContacts) {
 // interval, and fewer elementary tests with them.
 TEST(VertexFans, CcdOnRealCharactersIsUnchangedAndTestsFewerPairs) {
   for (const std::string file : {"CesiumMan.glb", "stormtrooper/stormtrooper.dae"}) {
-    const auto model = skinning::load_model(test::asset("characters/" + file));
-    const skinning::Mesh& mesh = *model.mesh;
-    const skinning::Topology topo = skinning::build_topology(mesh);
-    const auto motion = model.motion();
-    auto with_fans = make_method("bvh", mesh, topo);
+    const test::WeldedCharacter character(file);
+    const skinning::Mesh& mesh = *character.loaded.mesh;
+    auto with_fans = make_method("bvh", mesh, character.topology);
     auto without = make_method(
-        "bvh", mesh, topo, {.elementary = {.vertex_face = &every_vf, .edge_edge = &every_ee}});
-    skinning::Positions posed, x0, x1;
+        "bvh",
+        mesh,
+        character.topology,
+        {.elementary = {.vertex_face = &every_vf, .edge_edge = &every_ee}});
     std::int64_t tests_with = 0, tests_without = 0, contacts = 0;
-    const int n = motion->num_samples();
+    const int n = character.loaded.motion()->num_samples();
     for (int k = 0; k + 1 < n; k += std::max(1, n / 12)) {
-      motion->positions(k, posed);
-      skinning::gather_welded(topo, posed, x0);
-      motion->positions(k + 1, posed);
-      skinning::gather_welded(topo, posed, x1);
+      const skinning::Positions x0 = character.sample(k);
+      const skinning::Positions x1 = character.sample(k + 1);
       FrameResult a, b;
       with_fans->detect_ccd(x0, x1, a);
       without->detect_ccd(x0, x1, b);
