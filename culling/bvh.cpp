@@ -236,12 +236,15 @@ std::int32_t Bvh<N>::build_range(std::int32_t begin, std::int32_t end, int depth
   (hi - lo).maxCoeff(&axis);
 
   // The surface-area heuristic's split where it finds one (down to kMaxSahDepth, which bounds
-  // the recursion and the tree's depth on any input), else the median split by count along the
-  // longest axis: the lower half of centroids goes left. Ties are broken by triangle id so the
-  // tree depends only on the input, not on the library's nth_element.
+  // the recursion and the tree's depth on any input, and above the buckets: inside one the split
+  // orders only its slots, which the traversals test as a whole, and most calls would be there),
+  // else the median split by count along the longest axis: the lower half of centroids goes left.
+  // Ties are broken by triangle id so the tree depends only on the input, not on the library's
+  // nth_element.
   constexpr int kMaxSahDepth = 48;
-  std::int32_t mid =
-      split_ == BvhSplit::surface_area && depth < kMaxSahDepth ? sah_split(begin, end, lo, hi) : -1;
+  const bool surface_area = split_ == BvhSplit::surface_area && depth < kMaxSahDepth &&
+                            end - begin > bucket_size(leaf_size_);
+  std::int32_t mid = surface_area ? sah_split(begin, end, lo, hi) : -1;
   if (mid < 0) {
     mid = begin + (end - begin) / 2;
     const auto before = [axis](const Item& s, const Item& t) {
@@ -277,30 +280,43 @@ std::int32_t Bvh<N>::sah_split(
   };
   const auto bin_of = [&](const Item& item, Eigen::Index axis, double scale) {
     const double t = (item.centroid[axis] - lo[axis]) * scale;
-    return t >= 1.0 ? static_cast<int>(std::min(t, kBins - 1.0)) : 0;  // NaN: bin 0
+    return static_cast<int>(std::max(0.0, std::min(t, kBins - 1.0)));  // NaN: bin 0; no branch
   };
+  // One pass over the range bins it on every axis (the items are streamed once, not three times).
+  std::array<double, 3> scale{};
+  std::array<bool, 3> usable{};
+  for (Eigen::Index axis = 0; axis < 3; ++axis) {
+    const double extent = hi[axis] - lo[axis];
+    const auto a = static_cast<std::size_t>(axis);
+    usable[a] = extent > 0.0 && std::isfinite(extent);
+    scale[a] = usable[a] ? kBins / extent : 0.0;
+  }
+  std::array<std::array<Bin, kBins>, 3> bins{};
+  for (std::int32_t i = begin; i < end; ++i) {
+    const Item& item = items_[static_cast<std::size_t>(i)];
+    for (Eigen::Index axis = 0; axis < 3; ++axis) {
+      const auto a = static_cast<std::size_t>(axis);
+      Bin& b = bins[a][static_cast<std::size_t>(bin_of(item, axis, scale[a]))];
+      ++b.count;
+      for (Eigen::Index k = 0; k < 3; ++k) {  // plain min / max: Eigen's temporaries cost 3x
+        b.lo[k] = std::min(b.lo[k], item.lo[k]);
+        b.hi[k] = std::max(b.hi[k], item.hi[k]);
+      }
+    }
+  }
   double best_cost = std::numeric_limits<double>::infinity();
   std::int32_t best_imbalance = std::numeric_limits<std::int32_t>::max();
   Eigen::Index best_axis = -1;
   int best_bin = -1;
   double best_scale = 0.0;
   for (Eigen::Index axis = 0; axis < 3; ++axis) {
-    const double extent = hi[axis] - lo[axis];
-    if (!(extent > 0.0) || !std::isfinite(extent)) continue;
-    const double scale = kBins / extent;
-    std::array<Bin, kBins> bins{};
-    for (std::int32_t i = begin; i < end; ++i) {
-      const Item& item = items_[static_cast<std::size_t>(i)];
-      Bin& b = bins[static_cast<std::size_t>(bin_of(item, axis, scale))];
-      ++b.count;
-      b.lo = b.lo.cwiseMin(item.lo);
-      b.hi = b.hi.cwiseMax(item.hi);
-    }
+    const auto a = static_cast<std::size_t>(axis);
+    if (!usable[a]) continue;
     // Right sides (bins j + 1 ..) swept from the end, then the left sides from the start.
     std::array<double, kBins> right_cost{};
     Bin right;
     for (int j = kBins - 1; j > 0; --j) {
-      const Bin& b = bins[static_cast<std::size_t>(j)];
+      const Bin& b = bins[a][static_cast<std::size_t>(j)];
       right.count += b.count;
       right.lo = right.lo.cwiseMin(b.lo);
       right.hi = right.hi.cwiseMax(b.hi);
@@ -309,7 +325,7 @@ std::int32_t Bvh<N>::sah_split(
     }
     Bin left;
     for (int j = 0; j + 1 < kBins; ++j) {
-      const Bin& b = bins[static_cast<std::size_t>(j)];
+      const Bin& b = bins[a][static_cast<std::size_t>(j)];
       left.count += b.count;
       left.lo = left.lo.cwiseMin(b.lo);
       left.hi = left.hi.cwiseMax(b.hi);
@@ -323,7 +339,7 @@ std::int32_t Bvh<N>::sah_split(
         best_imbalance = imbalance;
         best_axis = axis;
         best_bin = j;
-        best_scale = scale;
+        best_scale = scale[a];
       }
     }
   }
