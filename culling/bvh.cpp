@@ -362,16 +362,10 @@ void Bvh<N>::refit(std::span<const Volume> triangle_bounds) {
   }
   // Depth-first order puts every child after its parent, so one backward sweep is bottom-up. A
   // leaf also writes its triangles' float volumes by slot.
-  const std::size_t stride = slot_stride();
-  constexpr auto kAxes = static_cast<std::size_t>(kSlotAxes);
   const auto slot_floats = [&](std::size_t s, const Volume& t) {
-    std::array<float, kN> lo;
-    std::array<float, kN> hi;
-    round_outwards(t, lo, hi);
-    for (std::size_t k = 0; k < kAxes; ++k) {
-      slot_bounds_[k * stride + s] = lo[k];
-      slot_bounds_[(kAxes + k) * stride + s] = hi[k];
-    }
+    FloatBounds lo;
+    FloatBounds hi;
+    round_slot(s, t, lo, hi);
   };
   if (float_node_volumes_) {
     refit_float_nodes(triangle_bounds);
@@ -410,10 +404,19 @@ void Bvh<N>::refit(std::span<const Volume> triangle_bounds) {
 }
 
 template <int N>
-void Bvh<N>::refit_float_nodes(std::span<const Volume> triangle_bounds) {
-  constexpr auto kN = static_cast<std::size_t>(N);
+void Bvh<N>::round_slot(std::size_t s, const Volume& t, FloatBounds& lo, FloatBounds& hi) {
   constexpr auto kAxes = static_cast<std::size_t>(kSlotAxes);
   const std::size_t stride = slot_stride();
+  round_outwards(t, lo, hi);
+  for (std::size_t k = 0; k < kAxes; ++k) {
+    slot_bounds_[k * stride + s] = lo[k];
+    slot_bounds_[(kAxes + k) * stride + s] = hi[k];
+  }
+}
+
+template <int N>
+void Bvh<N>::refit_float_nodes(std::span<const Volume> triangle_bounds) {
+  constexpr auto kN = static_cast<std::size_t>(N);
   // As refit(), bottom-up in one backward sweep, on the rounded volumes: float_below and
   // float_above are monotone, so the union of rounded volumes is the rounded exact union, and the
   // wide copy below gets the bits refit() gives it.
@@ -425,14 +428,10 @@ void Bvh<N>::refit_float_nodes(std::span<const Volume> triangle_bounds) {
       v.hi.fill(-std::numeric_limits<float>::infinity());
       for (auto s = static_cast<std::size_t>(node.begin); s < static_cast<std::size_t>(node.end);
            ++s) {
-        std::array<float, kN> tl;
-        std::array<float, kN> th;
-        round_outwards(triangle_bounds[static_cast<std::size_t>(order_[s])], tl, th);
+        FloatBounds tl;
+        FloatBounds th;
+        round_slot(s, triangle_bounds[static_cast<std::size_t>(order_[s])], tl, th);
         for (std::size_t k = 0; k < kN; ++k) {
-          if (k < kAxes) {
-            slot_bounds_[k * stride + s] = tl[k];
-            slot_bounds_[(kAxes + k) * stride + s] = th[k];
-          }
           v.lo[k] = std::min(v.lo[k], tl[k]);
           v.hi[k] = std::max(v.hi[k], th[k]);
         }
@@ -460,8 +459,6 @@ void Bvh<N>::refit_float_nodes(std::span<const Volume> triangle_bounds) {
 template <int N>
 void Bvh<N>::refit_wide_only(std::span<const Volume> triangle_bounds) {
   constexpr auto kN = static_cast<std::size_t>(N);
-  constexpr auto kAxes = static_cast<std::size_t>(kSlotAxes);
-  const std::size_t stride = slot_stride();
   constexpr std::size_t kAhead = 16;
   // A wide node's inner children come after it (built depth first), so one backward sweep is
   // bottom-up. A bucket lane is its triangles' union, rounded outwards; an inner lane the union of
@@ -479,19 +476,15 @@ void Bvh<N>::refit_wide_only(std::span<const Volume> triangle_bounds) {
         for (std::size_t s = begin; s < end && s >= kAhead; ++s) {
           __builtin_prefetch(&triangle_bounds[static_cast<std::size_t>(order_[s - kAhead])]);
         }
-        std::array<float, kN> lo;
-        std::array<float, kN> hi;
+        FloatBounds lo;
+        FloatBounds hi;
         lo.fill(std::numeric_limits<float>::infinity());
         hi.fill(-std::numeric_limits<float>::infinity());
         for (std::size_t s = begin; s < end; ++s) {
-          std::array<float, kN> tl;
-          std::array<float, kN> th;
-          round_outwards(triangle_bounds[static_cast<std::size_t>(order_[s])], tl, th);
+          FloatBounds tl;
+          FloatBounds th;
+          round_slot(s, triangle_bounds[static_cast<std::size_t>(order_[s])], tl, th);
           for (std::size_t k = 0; k < kN; ++k) {
-            if (k < kAxes) {
-              slot_bounds_[k * stride + s] = tl[k];
-              slot_bounds_[(kAxes + k) * stride + s] = th[k];
-            }
             lo[k] = std::min(lo[k], tl[k]);
             hi[k] = std::max(hi[k], th[k]);
           }

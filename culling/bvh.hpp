@@ -239,6 +239,10 @@ class Bvh {
   std::int32_t build_wide_node(std::int32_t node, int depth);
   void refit_wide_only(std::span<const Volume> triangle_bounds);
   void refit_float_nodes(std::span<const Volume> triangle_bounds);
+  using FloatBounds = std::array<float, static_cast<std::size_t>(N)>;
+  /// The volume t of the triangle in slot s rounded outwards into (lo, hi), its slot volume
+  /// (slot_lo / slot_hi) written.
+  void round_slot(std::size_t s, const Volume& t, FloatBounds& lo, FloatBounds& hi);
 
   std::vector<BvhNode> nodes_;
   std::vector<Volume> node_bounds_;
