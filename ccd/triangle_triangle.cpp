@@ -237,7 +237,7 @@ inline Plane plane_of(const Vector3d& p0, const Vector3d& p1, const Vector3d& p2
       &p2,
       {yz - zy, zx - xz, xy - yx},
       {m0, m1, m2},
-      (m0 >= kLargeMinor) && (m1 >= kLargeMinor) && (m2 >= kLargeMinor)};
+      static_cast<bool>((m0 >= kLargeMinor) & (m1 >= kLargeMinor) & (m2 >= kLargeMinor))};
 }
 
 /// The same Plane from its cached minors and permanents (triangle_plane of the same corners).
@@ -249,7 +249,8 @@ inline Plane plane_from(
       &p2,
       {t.n[0], t.n[1], t.n[2]},
       {t.m[0], t.m[1], t.m[2]},
-      (t.m[0] >= kLargeMinor) && (t.m[1] >= kLargeMinor) && (t.m[2] >= kLargeMinor)};
+      static_cast<bool>(
+          (t.m[0] >= kLargeMinor) & (t.m[1] >= kLargeMinor) & (t.m[2] >= kLargeMinor))};
 }
 
 /// Some n_k is certainly nonzero: the triangle is not degenerate. Shewchuk's orient2d bound on
