@@ -133,29 +133,51 @@ std::span<Spoke> spoke_room(std::size_t n, std::array<Spoke, kStack>& stack) {
   }
 }
 
-/// `holds(sign)` in a projection, sign(p, q) the orientation of spoke differences p, q there:
+/// `holds(sign, axes)` in a projection, sign(p, q) the orientation of spoke differences p, q there:
 /// first the coordinate projection that drops the axis where n is largest (any choice is sound;
 /// this one makes the certificate likely), the sign the k-th component of p × q by the static
-/// filter ccd::detail::cross_sign_static; then, if that fails, the projection along n itself — a
-/// fan that no coordinate axis sees injectively (a cube's corner, a cone's tip, a crease turned
-/// away from the axes) may still be seen so — the sign n · (p × q) = det[p; q; n] by the static
-/// orient3d filter (n is exact as computed: a difference rounded zero times).
+/// filter ccd::detail::cross_sign_static, and `axes` the two coordinates kept (i, j); then, if that
+/// fails, the projection along n itself — a fan that no coordinate axis sees injectively (a cube's
+/// corner, a cone's tip, a crease turned away from the axes) may still be seen so — the sign
+/// n · (p × q) = det[p; q; n] by the static orient3d filter (n is exact as computed: a difference
+/// rounded zero times), and `axes` null.
 template <class Holds>
 bool holds_in_a_projection(const Spoke& n, const Holds& holds) {
   std::size_t k = 0;
   if (std::abs(n[1]) > std::abs(n[0])) k = 1;
   if (std::abs(n[2]) > std::abs(n[k])) k = 2;
-  const std::size_t i_axis = (k + 1) % 3;
-  const std::size_t j_axis = (k + 2) % 3;
+  const std::array<std::size_t, 2> axes{(k + 1) % 3, (k + 2) % 3};
   const auto along_axis = [&](const Spoke& p, const Spoke& q) {
-    return ccd::detail::cross_sign_static(p[i_axis], p[j_axis], q[i_axis], q[j_axis]);
+    return ccd::detail::cross_sign_static(p[axes[0]], p[axes[1]], q[axes[0]], q[axes[1]]);
   };
-  if (holds(along_axis)) return true;
+  if (holds(along_axis, &axes)) return true;
   if (!(std::abs(n[0]) + std::abs(n[1]) + std::abs(n[2]) > 0.0)) return false;
   const auto along_normal = [&](const Spoke& p, const Spoke& q) {
     return ccd::detail::det3_sign_static(p[0], p[1], p[2], q[0], q[1], q[2], n[0], n[1], n[2]);
   };
-  return holds(along_normal);
+  return holds(along_normal, static_cast<const std::array<std::size_t, 2>*>(nullptr));
+}
+
+/// Conditions (1) and (2) of the certificate for a closed fan of m sectors (d[m] = d[0]) in the
+/// coordinate projection onto `axes` (i, j), `sign` its filtered orientations. Every sector
+/// strictly of one orientation s, the fan winds w times around v and every direction lies in
+/// exactly w of the half-open sectors [d_i, d_i+1); for the direction e = (1, 0) that is
+/// s·orient(d_i, e) = −s·d_i[j] >= 0 and s·orient(e, d_i+1) = s·d_i+1[j] > 0 (a sector narrower
+/// than a half-turn). These are signs of coordinate differences, exact as rounded: so condition
+/// (2) costs no orientation test, where winds_once needs m − 2 more.
+template <class Sign>
+bool closed_winds_once_in_axes(
+    std::span<const Spoke> d, std::size_t m, std::size_t j, const Sign& sign) {
+  const int s = sign(d[0], d[1]);
+  if (s == ccd::detail::kUndecided) return false;
+  int covering = 0;
+  for (std::size_t i = 0; i < m; ++i) {
+    if (i > 0 && sign(d[i], d[i + 1]) != s) return false;  // undecided or of the other sign
+    const double from = s > 0 ? -d[i][j] : d[i][j];
+    const double to = s > 0 ? d[i + 1][j] : -d[i + 1][j];
+    covering += static_cast<int>((from >= 0.0) & (to > 0.0));
+  }
+  return covering == 1;
 }
 
 constexpr std::size_t kStackSpokes = 32;
@@ -173,7 +195,8 @@ bool VertexFans::certified(const skinning::Positions& x, std::int32_t v) const {
   spoke_differences(x, v, s, d);
   Spoke n{0.0, 0.0, 0.0};
   add_normal(d, m, n);
-  return holds_in_a_projection(n, [&](const auto& sign) {
+  return holds_in_a_projection(n, [&](const auto& sign, const std::array<std::size_t, 2>* axes) {
+    if (closed && axes != nullptr) return closed_winds_once_in_axes(d, m, (*axes)[1], sign);
     return winds_once(m, closed, [&](std::size_t p, std::size_t q) { return sign(d[p], d[q]); });
   });
 }
@@ -231,9 +254,12 @@ bool VertexFans::certified_over(
   // (1 − t) p0 + t p1 and (1 − t) q0 + t q1 (p, q its spokes): (1 − t)² ⟨p0, q0⟩ +
   // t (1 − t) (⟨p0, q1⟩ + ⟨p1, q0⟩) + t² ⟨p1, q1⟩. The four signs equal make it strict on [0, 1].
   // The closed fan winds once at t = 0 (winds_once, in the same projection); it keeps doing so.
-  return holds_in_a_projection(n, [&](const auto& sign) {
+  return holds_in_a_projection(n, [&](const auto& sign, const std::array<std::size_t, 2>* axes) {
     const auto at_start = [&](std::size_t p, std::size_t q) { return sign(d0[p], d0[q]); };
-    if (!winds_once(m, true, at_start)) return false;
+    if (axes != nullptr ? !closed_winds_once_in_axes(d0, m, (*axes)[1], sign)
+                        : !winds_once(m, true, at_start)) {
+      return false;
+    }
     const int o = at_start(0, 1);
     for (std::size_t i = 0; i < m; ++i) {
       if (sign(d0[i], d1[i + 1]) != o || sign(d1[i], d0[i + 1]) != o ||

@@ -200,6 +200,31 @@ TEST(VertexFans, CertifiesFlatAndBumpyFansAndRefusesOnesThatWindTwice) {
   EXPECT_TRUE(VertexFans(open4, 6).certified(x4, 0));
 }
 
+// A closed fan's winding is counted on the direction (1, 0) of its coordinate projection, from
+// coordinate signs: spokes exactly opposite each other (orient = 0, which the first spoke's ray
+// could not decide) or exactly on that direction are certified when the fan winds once, and a
+// fan winding twice with a spoke on it is still refused.
+TEST(VertexFans, ClosedFansWithSpokesOnTheCountingDirectionAreDecidedExactly) {
+  const VertexFans square(fan(4, true), 5);
+  // A flat quad-grid vertex: spokes at 0°, 90°, 180°, 270° (exact coordinates), and a bumpy one.
+  const std::vector<Eigen::Vector3d> flat{{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {-1, 0, 0}, {0, -1, 0}};
+  const std::vector<Eigen::Vector3d> bumpy{
+      {0, 0, 0}, {1, 0, 0.25}, {0, 1, -0.25}, {-1, 0, 0.25}, {0, -1, -0.25}};
+  for (const auto& p : {flat, bumpy}) {
+    const auto x = positions(p);
+    EXPECT_TRUE(square.certified(x, 0));
+    EXPECT_FALSE(some_pair_intersects(fan(4, true), x));
+    EXPECT_TRUE(square.certified_over(x, x, 0));
+  }
+  // Six flat spokes, (1, 0), (-1, 1), (-1, -1) and twice as far the same way round: every sector
+  // strictly oriented, the fan winding twice, spokes 1 and 4 on (1, 0).
+  const VertexFans six(fan(6, true), 7);
+  const auto twice = positions(
+      {{0, 0, 0}, {1, 0, 0}, {-1, 1, 0}, {-1, -1, 0}, {2, 0, 0}, {-2, 2, 0}, {-2, -2, 0}});
+  EXPECT_FALSE(six.certified(twice, 0));
+  EXPECT_TRUE(some_pair_intersects(fan(6, true), twice));
+}
+
 // Random fans, closed and open, from nearly flat to wildly folded: a certified one never has an
 // intersecting pair (the exact test decides), and both outcomes occur often.
 TEST(VertexFans, CertifiedFansNeverIntersectThemselves) {
