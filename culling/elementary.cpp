@@ -211,6 +211,12 @@ namespace {
 /// Prefetch distances of dcd_tests, in pairs.
 constexpr std::size_t kFar = 16;
 constexpr std::size_t kNear = 8;
+/// dcd_tests prefetches from this many triangles on. Below it, the planes, corner ids and
+/// positions a test reads (about 72 bytes per triangle) stay in the caches and the prefetches are
+/// only instructions: without them the DCD is 2-4 % faster on the bundled characters and the
+/// 18k-triangle cloth-funnel step, with them 5 % faster on the 92k-triangle cloth-ball step
+/// (bench/real/ab_dcd.py, 2026-11-28).
+constexpr std::int32_t kPrefetchFrom = 32768;
 
 void dcd_tests(
     const FeatureTopology& topology,
@@ -230,6 +236,7 @@ void dcd_tests(
   // The flags are read by the workers too: a span of the caller's, not their own thread_local.
   const bool use_fans = !certified.empty();
   assert(!use_fans || certified.size() == static_cast<std::size_t>(topology.num_vertices()));
+  const bool prefetch = topology.num_triangles() >= kPrefetchFrom;
   // Outcomes in pair order, the intersecting pairs appended in that order.
   evaluate(
       pairs.size(),
@@ -237,7 +244,7 @@ void dcd_tests(
       [&](std::size_t i, Outcome& o) {
         // The pairs' triangles are scattered over the mesh: ask for a later pair's data ahead, its
         // corner ids and planes kFar pairs on, its corners' positions kNear pairs on.
-        if (i + kFar < pairs.size()) {
+        if (prefetch && i + kFar < pairs.size()) {
           const TrianglePair& f = pairs[i + kFar];
           __builtin_prefetch(&topology.triangle(f.a));
           __builtin_prefetch(&topology.triangle(f.b));
@@ -248,7 +255,7 @@ void dcd_tests(
             __builtin_prefetch(&planes[static_cast<std::size_t>(f.b)].m[2]);
           }
         }
-        if (i + kNear < pairs.size()) {
+        if (prefetch && i + kNear < pairs.size()) {
           const TrianglePair& f = pairs[i + kNear];
           for (const std::int32_t t : {f.a, f.b}) {
             for (const std::int32_t v : topology.triangle(t)) __builtin_prefetch(x.data() + 3 * v);
