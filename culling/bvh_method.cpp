@@ -70,9 +70,8 @@ class BvhMethod final : public MethodBase {
     const skinning::Positions& x = at.x;
     check_positions(x, "detect_dcd", "x");
     const auto t0 = Clock::now();
-    // Refit over the static volumes of the instant.
-    static_vertex_bounds<N>(x, bounds_.vertices);
-    bounds_.derive(topology_, /*with_edges=*/false);
+    // Refit over the static volumes of the instant (the triangles' only).
+    bounds_.static_triangles(topology_, x);
     bvh_.refit(bounds_.triangles);
     const auto t1 = Clock::now();
     // Self traversal → overlapping triangle pairs → the DCD rules → tests, in blocks as the CCD

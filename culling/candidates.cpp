@@ -52,6 +52,25 @@ void FeatureBounds<N>::derive(const FeatureTopology& topology, bool with_edges) 
   }
 }
 
+template <int N>
+void FeatureBounds<N>::static_triangles(
+    const FeatureTopology& topology, const skinning::Positions& x) {
+  vertices.clear();
+  const auto num_faces = static_cast<std::size_t>(topology.num_triangles());
+  triangles.resize(num_faces);
+  const double* const p = x.data();  // row-major: vertex v at p + 3 v
+  for (std::size_t f = 0; f < num_faces; ++f) {
+    const auto& t = topology.triangle(static_cast<std::int32_t>(f));
+    const double* c = p + 3 * at(t[0]);
+    Dop<N> d = Dop<N>::of_point(c[0], c[1], c[2]);
+    for (std::size_t k = 1; k < 3; ++k) {
+      c = p + 3 * at(t[k]);
+      d.merge(Dop<N>::of_point(c[0], c[1], c[2]));
+    }
+    triangles[f] = d;
+  }
+}
+
 namespace {
 
 /// Overlap of two closed volumes as one bit, without branches: about half the feature pairs of a

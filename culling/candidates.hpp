@@ -63,6 +63,10 @@ struct FeatureBounds {
   /// force and the radial view's pair checks read them. Allocation-free once the vectors have
   /// their sizes.
   void derive(const FeatureTopology& topology, bool with_edges = true);
+  /// triangles = each triangle's static volume at x, bit for bit what static_vertex_bounds(x,
+  /// vertices) then derive(topology, false) give, read from the corners' positions directly: the
+  /// DCD needs no vertex volumes. `vertices` is cleared (its capacity kept).
+  void static_triangles(const FeatureTopology& topology, const skinning::Positions& x);
 };
 
 /// Vertex fans over one CCD query's interval (VertexFans::certified_over), each decided the first

@@ -333,8 +333,7 @@ class AutoMethod final : public detail::MethodBase {
     if (groups[0] == nullptr && groups[1] == nullptr && !between) return;
     const auto t0 = Clock::now();
     if (bounds_ == &own_bounds_) {
-      static_vertex_bounds<3>(x, own_bounds_.vertices);
-      own_bounds_.derive(topology_, /*with_edges=*/false);
+      own_bounds_.static_triangles(topology_, x);
     }
     refit_groups();
     const auto t1 = Clock::now();
