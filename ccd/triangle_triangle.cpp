@@ -302,15 +302,17 @@ inline int side(const Plane& pl, const Vector3d& p) {
 /// The filter of side_static on three points without branches; bit i of the result is set where
 /// o[i] is not certain. With every m_k >= 2^-900 a minor's underflow (2^-1074) is under 2^-174
 /// m_k, so the guard reduces to P >= 2^-969 (for the three outer products, and a normal bound).
+/// On raw coordinates (p0: the plane's first corner), so that a caller without a Plane can ask.
 template <bool kLargeMinors>
-inline unsigned sides_static(const Plane& pl, const Vector3d* const p[3], int o[3]) {
+inline unsigned sides_static(
+    const double n[3], const double m[3], const double* p0, const double* const p[3], int o[3]) {
   unsigned undecided = 0;
   for (int i = 0; i < 3; ++i) {
-    const Vector3d& x = *p[i];
-    const double wx = x.x() - pl.p0->x(), wy = x.y() - pl.p0->y(), wz = x.z() - pl.p0->z();
-    const double det = pl.n[0] * wx + pl.n[1] * wy + pl.n[2] * wz;
+    const double* x = p[i];
+    const double wx = x[0] - p0[0], wy = x[1] - p0[1], wz = x[2] - p0[2];
+    const double det = n[0] * wx + n[1] * wy + n[2] * wz;
     const double ax = std::abs(wx), ay = std::abs(wy), az = std::abs(wz);
-    const double permanent = pl.m[0] * ax + pl.m[1] * ay + pl.m[2] * az;
+    const double permanent = m[0] * ax + m[1] * ay + m[2] * az;
     bool guarded;
     if constexpr (kLargeMinors) {
       guarded = (permanent >= 0x1p-969) & (permanent < std::numeric_limits<double>::infinity());
@@ -326,6 +328,13 @@ inline unsigned sides_static(const Plane& pl, const Vector3d* const p[3], int o[
   return undecided;
 }
 
+/// sides_static of a Plane: bit i set where o[i] is not certain.
+inline unsigned sides_static(const Plane& pl, const Vector3d* const p[3], int o[3]) {
+  const double* const q[3] = {p[0]->data(), p[1]->data(), p[2]->data()};
+  return pl.large_minors ? sides_static<true>(pl.n, pl.m, pl.p0->data(), q, o)
+                         : sides_static<false>(pl.n, pl.m, pl.p0->data(), q, o);
+}
+
 /// o[i] = the exact orient3d where sides_static left it undecided (rare: out of line).
 [[gnu::noinline]] void settle_sides(
     const Plane& pl, const Vector3d* const p[3], unsigned undecided, int o[3]) {
@@ -336,8 +345,7 @@ inline unsigned sides_static(const Plane& pl, const Vector3d* const p[3], int o[
 
 /// The three sides(pl, *p[i]), exact.
 inline void sides(const Plane& pl, const Vector3d* const p[3], int o[3]) {
-  const unsigned undecided =
-      pl.large_minors ? sides_static<true>(pl, p, o) : sides_static<false>(pl, p, o);
+  const unsigned undecided = sides_static(pl, p, o);
   if (undecided != 0) settle_sides(pl, p, undecided, o);
 }
 
@@ -572,8 +580,13 @@ bool flat_meets_beyond_shared(
 // --- the pair without shared corners ------------------------------------------------------------
 
 // cached_a / cached_b: the planes of a and b when the caller has them (triangle_plane), or null.
+// first: the filter's sides of a's corners against b's plane when the caller has them (then
+// cached_b is given too), or null.
 bool no_shared_corner_intersect(
-    const TriangleTriangleQuery& q, const TrianglePlane* cached_a, const TrianglePlane* cached_b) {
+    const TriangleTriangleQuery& q,
+    const TrianglePlane* cached_a,
+    const TrianglePlane* cached_b,
+    const FirstSides* first = nullptr) {
   const Vector3d* a[3] = {&q.a0, &q.a1, &q.a2};
   const Vector3d* b[3] = {&q.b0, &q.b1, &q.b2};
   // Most candidate pairs are separated by one of the planes: a's corners against b's plane,
@@ -583,7 +596,14 @@ bool no_shared_corner_intersect(
   const Plane pb =
       cached_b != nullptr ? plane_from(*cached_b, q.b0, q.b1, q.b2) : plane_of(q.b0, q.b1, q.b2);
   int oa[3];
-  sides(pb, a, oa);
+  if (first != nullptr) {
+    oa[0] = first->o[0];
+    oa[1] = first->o[1];
+    oa[2] = first->o[2];
+    if (first->undecided != 0) settle_sides(pb, a, first->undecided, oa);
+  } else {
+    sides(pb, a, oa);
+  }
   if (strictly_one_side(oa)) return false;
   const Plane pa =
       cached_a != nullptr ? plane_from(*cached_a, q.a0, q.a1, q.a2) : plane_of(q.a0, q.a1, q.a2);
@@ -808,6 +828,31 @@ bool triangles_intersect_with_planes(
     const TrianglePlane& plane_a,
     const TrianglePlane& plane_b) {
   return intersect(q, shared_with_b, &plane_a, &plane_b);
+}
+
+bool first_sides_separate(
+    const double* a0,
+    const double* a1,
+    const double* a2,
+    const double* b0,
+    const TrianglePlane& plane_b,
+    FirstSides& out) {
+  const double* const a[3] = {a0, a1, a2};
+  const bool large = static_cast<bool>(
+      (plane_b.m[0] >= kLargeMinor) & (plane_b.m[1] >= kLargeMinor) &
+      (plane_b.m[2] >= kLargeMinor));
+  out.undecided = large ? sides_static<true>(plane_b.n, plane_b.m, b0, a, out.o)
+                        : sides_static<false>(plane_b.n, plane_b.m, b0, a, out.o);
+  // Decided signs are exact: all three strictly on one side separates the pair.
+  return out.undecided == 0 && strictly_one_side(out.o);
+}
+
+bool triangles_intersect_after_first_sides(
+    const TriangleTriangleQuery& q,
+    const TrianglePlane& plane_a,
+    const TrianglePlane& plane_b,
+    const FirstSides& first) {
+  return no_shared_corner_intersect(q, &plane_a, &plane_b, &first);
 }
 
 }  // namespace skelcd::ccd

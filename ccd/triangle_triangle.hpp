@@ -50,4 +50,35 @@ struct TrianglePlane {
     const TrianglePlane& plane_a,
     const TrianglePlane& plane_b);
 
+/// The first step of the test of a pair without shared corners, for a caller that gathers its
+/// pairs' corners itself (the DCD): the sides of a's corners against b's plane by the static
+/// filter alone. About half of a real mesh's tested pairs stop here, before their six corners are
+/// copied into a query.
+struct FirstSides {
+  int o[3];            ///< orient3d(b0, b1, b2, a_i) where decided
+  unsigned undecided;  ///< bit i set: o[i] left to the exact predicate
+};
+
+/// True when the filter proves a's corners (a_i: three coordinates each) strictly on one side of
+/// b's plane: the closed triangles do not meet, as triangles_intersect would answer. Otherwise
+/// `out` holds what it decided, for triangles_intersect_after_first_sides.
+/// @pre plane_b == triangle_plane(b0, b1, b2); b0: b's first corner.
+[[nodiscard]] bool first_sides_separate(
+    const double* a0,
+    const double* a1,
+    const double* a2,
+    const double* b0,
+    const TrianglePlane& plane_b,
+    FirstSides& out);
+
+/// triangles_intersect(query) for a pair without shared corners whose first_sides_separate was
+/// false, finishing from `first` (the same answer for every input).
+/// @pre the planes as for triangles_intersect_with_planes; `first` from first_sides_separate on
+/// the query's corners and plane_b.
+[[nodiscard]] bool triangles_intersect_after_first_sides(
+    const TriangleTriangleQuery& query,
+    const TrianglePlane& plane_a,
+    const TrianglePlane& plane_b,
+    const FirstSides& first);
+
 }  // namespace skelcd::ccd

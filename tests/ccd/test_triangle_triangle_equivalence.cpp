@@ -88,10 +88,23 @@ struct Tally {
   int hits = 0;
 };
 
-// The entry a DCD uses, with each triangle's plane computed beforehand (once per instant there).
+// The entry a DCD uses, with each triangle's plane computed beforehand (once per instant there);
+// for a pair without shared corners also the DCD's split of it (the first plane's filter from the
+// raw coordinates, then the rest from what it decided), which must give the same answer.
 bool with_planes(const TriangleTriangleQuery& q, const SharedCorners& shared) {
-  return triangles_intersect_with_planes(
-      q, shared, triangle_plane(q.a0, q.a1, q.a2), triangle_plane(q.b0, q.b1, q.b2));
+  const TrianglePlane plane_a = triangle_plane(q.a0, q.a1, q.a2);
+  const TrianglePlane plane_b = triangle_plane(q.b0, q.b1, q.b2);
+  const bool answer = triangles_intersect_with_planes(q, shared, plane_a, plane_b);
+  if (shared == kNoSharedCorners) {
+    FirstSides first{};
+    const bool separated =
+        first_sides_separate(q.a0.data(), q.a1.data(), q.a2.data(), q.b0.data(), plane_b, first);
+    EXPECT_FALSE(separated && answer) << "the first plane's filter separated a meeting pair";
+    if (!separated) {
+      EXPECT_EQ(triangles_intersect_after_first_sides(q, plane_a, plane_b, first), answer);
+    }
+  }
+  return answer;
 }
 
 // The new code, both entries, on q and on its swap, answers `truth`.
