@@ -253,7 +253,8 @@ bool VertexFans::certified_over(
   // In a fixed projection, sector i's orientation at t is that of the cross product of
   // (1 − t) p0 + t p1 and (1 − t) q0 + t q1 (p, q its spokes): (1 − t)² ⟨p0, q0⟩ +
   // t (1 − t) (⟨p0, q1⟩ + ⟨p1, q0⟩) + t² ⟨p1, q1⟩. The four signs equal make it strict on [0, 1].
-  // The closed fan winds once at t = 0 (winds_once, in the same projection); it keeps doing so.
+  // The closed fan winds once at t = 0 in the same projection (closed_winds_once_in_axes, or
+  // winds_once along the normal); it keeps doing so.
   return holds_in_a_projection(n, [&](const auto& sign, const std::array<std::size_t, 2>* axes) {
     const auto at_start = [&](std::size_t p, std::size_t q) { return sign(d0[p], d0[q]); };
     if (axes != nullptr ? !closed_winds_once_in_axes(d0, m, (*axes)[1], sign)
