@@ -7,6 +7,7 @@
 #include <atomic>
 #include <cmath>
 #include <cstdint>
+#include <thread>
 #include <vector>
 
 #include "culling/elementary.hpp"
@@ -112,6 +113,29 @@ TEST(Elementary, DcdCallsLargerThanTheWindowKeepEveryOutcomeAndAWindowOfScratch)
     EXPECT_EQ(small.dcd_pairs, std::vector<TrianglePair>(expected.begin(), expected.begin() + 2));
     EXPECT_LE(elementary_outcome_capacity(), kElementaryOutcomeWindow);
   }
+}
+
+// The thread's outcome buffer grown in two steps — a call of 13/16 of a window, then one larger
+// than a window — is still one window: a vector's own growth would have doubled 6,656 to 13,312
+// (what a test process running a DCD before these tests showed).
+TEST(Elementary, ScratchGrownInTwoStepsStaysOneWindow) {
+  const Strip s(200);
+  std::vector<TrianglePair> pairs;
+  for (std::int32_t a = 0; a < 200; ++a) {
+    for (std::int32_t b = a + 1; b < 200; ++b) pairs.push_back({a, b});
+  }
+  ASSERT_GT(pairs.size(), kElementaryOutcomeWindow);
+  const ElementaryTests tests = with_ccd_defaults({.triangles = &triangles_by_index, .threads = 1});
+  // A fresh thread: this one's buffer may have grown in an earlier test of the same process.
+  std::thread([&] {
+    FrameResult first;
+    run_dcd_tests(
+        s.features, std::span(pairs).first(kElementaryOutcomeWindow / 16 * 13), s.x, tests, first);
+    FrameResult second;
+    run_dcd_tests(s.features, pairs, s.x, tests, second);
+    EXPECT_EQ(second.counters.tt_tests, static_cast<std::int64_t>(pairs.size()));
+    EXPECT_LE(elementary_outcome_capacity(), kElementaryOutcomeWindow);
+  }).join();
 }
 
 TEST(Elementary, CcdCallsLargerThanTheWindowKeepEachHitsOwnTimes) {
