@@ -212,6 +212,11 @@ constexpr double kMinorFloor = 0x1p-960;
 /// comparison (see sides).
 constexpr double kLargeMinor = 0x1p-900;
 
+/// Every permanent m_k >= kLargeMinor (three compares, no branches: the flag is asked per pair).
+inline bool large_minors(double m0, double m1, double m2) {
+  return static_cast<bool>((m0 >= kLargeMinor) & (m1 >= kLargeMinor) & (m2 >= kLargeMinor));
+}
+
 struct Plane {
   const Vector3d* p0;
   const Vector3d* p1;
@@ -231,13 +236,7 @@ inline Plane plane_of(const Vector3d& p0, const Vector3d& p1, const Vector3d& p2
   const double m0 = std::abs(yz) + std::abs(zy);
   const double m1 = std::abs(zx) + std::abs(xz);
   const double m2 = std::abs(xy) + std::abs(yx);
-  return {
-      &p0,
-      &p1,
-      &p2,
-      {yz - zy, zx - xz, xy - yx},
-      {m0, m1, m2},
-      static_cast<bool>((m0 >= kLargeMinor) & (m1 >= kLargeMinor) & (m2 >= kLargeMinor))};
+  return {&p0, &p1, &p2, {yz - zy, zx - xz, xy - yx}, {m0, m1, m2}, large_minors(m0, m1, m2)};
 }
 
 /// The same Plane from its cached minors and permanents (triangle_plane of the same corners).
@@ -249,8 +248,7 @@ inline Plane plane_from(
       &p2,
       {t.n[0], t.n[1], t.n[2]},
       {t.m[0], t.m[1], t.m[2]},
-      static_cast<bool>(
-          (t.m[0] >= kLargeMinor) & (t.m[1] >= kLargeMinor) & (t.m[2] >= kLargeMinor))};
+      large_minors(t.m[0], t.m[1], t.m[2])};
 }
 
 /// Some n_k is certainly nonzero: the triangle is not degenerate. Shewchuk's orient2d bound on
@@ -838,11 +836,9 @@ bool first_sides_separate(
     const TrianglePlane& plane_b,
     FirstSides& out) {
   const double* const a[3] = {a0, a1, a2};
-  const bool large = static_cast<bool>(
-      (plane_b.m[0] >= kLargeMinor) & (plane_b.m[1] >= kLargeMinor) &
-      (plane_b.m[2] >= kLargeMinor));
-  out.undecided = large ? sides_static<true>(plane_b.n, plane_b.m, b0, a, out.o)
-                        : sides_static<false>(plane_b.n, plane_b.m, b0, a, out.o);
+  out.undecided = large_minors(plane_b.m[0], plane_b.m[1], plane_b.m[2])
+                      ? sides_static<true>(plane_b.n, plane_b.m, b0, a, out.o)
+                      : sides_static<false>(plane_b.n, plane_b.m, b0, a, out.o);
   // Decided signs are exact: all three strictly on one side separates the pair.
   return out.undecided == 0 && strictly_one_side(out.o);
 }
