@@ -1,0 +1,130 @@
+// Cost of building the hierarchy (culling::Bvh, the surface-area split) on real meshes: what
+// every method pays once per check before its first query, on the serial start of a parallel
+// check (docs/benchmarks.md, "parallel"). One iteration = one Bvh<3> built over every welded
+// triangle at the first sample, as `bvh`, `dynamic` and `auto` build it (no binary node volumes);
+// Bvh<8> as `kdop` builds it.
+//
+//   build/bench/culling/bm_bvh_build [MODEL …] [--benchmark_* flags]
+//
+// Without MODEL: the bundled characters and, when present, the cloth steps of
+// ../shared/assets/cloth. Each row's label gives the triangles and a hash of the tree (the node
+// ranges and the triangle order): two builds of skelcd that label a model alike build the same
+// tree, so a faster build can be checked to change nothing else.
+
+#include <benchmark/benchmark.h>
+
+#include <cstdint>
+#include <cstdio>
+#include <filesystem>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "culling/bvh.hpp"
+#include "skinning/load.hpp"
+#include "skinning/topology.hpp"
+
+namespace {
+
+using namespace skelcd;
+
+struct Input {
+  std::string name;
+  skinning::Triangles triangles;
+  skinning::Positions welded;
+};
+
+/// FNV-1a over the node ranges and the triangle order.
+template <int N>
+std::uint64_t tree_hash(const culling::Bvh<N>& bvh) {
+  std::uint64_t h = 1469598103934665603ull;
+  const auto mix = [&h](std::int32_t v) {
+    for (int b = 0; b < 4; ++b) {
+      h ^= static_cast<std::uint64_t>((static_cast<std::uint32_t>(v) >> (8 * b)) & 0xffu);
+      h *= 1099511628211ull;
+    }
+  };
+  for (const culling::BvhNode& n : bvh.nodes()) {
+    mix(n.begin);
+    mix(n.end);
+    mix(n.right);
+  }
+  for (const std::int32_t t : bvh.triangle_order()) mix(t);
+  return h;
+}
+
+template <int N>
+void bm_build(benchmark::State& state, const Input* input) {
+  culling::BvhOptions options;
+  options.node_volumes = false;
+  for (auto _ : state) {
+    culling::Bvh<N> bvh(input->triangles, input->welded, options);
+    benchmark::DoNotOptimize(bvh.nodes().data());
+  }
+  const std::uint64_t hash = tree_hash(culling::Bvh<N>(input->triangles, input->welded, options));
+  char label[96];
+  std::snprintf(
+      label,
+      sizeof label,
+      "%lld triangles, tree %016llx",
+      static_cast<long long>(input->triangles.rows()),
+      static_cast<unsigned long long>(hash));
+  state.SetLabel(label);
+  state.SetItemsProcessed(state.iterations() * input->triangles.rows());
+}
+
+std::vector<std::string> default_models() {
+  const std::filesystem::path source(SKELCD_SOURCE_DIR);
+  std::vector<std::string> models;
+  for (const char* m :
+       {"assets/characters/CesiumMan.glb",
+        "assets/characters/RobotExpressive.glb",
+        "assets/characters/ninja/ninja.mesh",
+        "assets/characters/stormtrooper/stormtrooper.dae"}) {
+    if (std::filesystem::exists(source / m)) models.push_back((source / m).string());
+  }
+  for (const char* c : {"cloth-funnel", "cloth-ball"}) {
+    const auto frames = source.parent_path() / "shared/assets/cloth" / c / "frames";
+    if (std::filesystem::is_directory(frames)) models.push_back(frames.string());
+  }
+  return models;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  benchmark::Initialize(&argc, argv);
+  std::vector<std::string> models;
+  for (int i = 1; i < argc; ++i) models.emplace_back(argv[i]);
+  if (models.empty()) models = default_models();
+  std::vector<std::unique_ptr<Input>> inputs;
+  for (const auto& path : models) {
+    try {
+      const skinning::LoadedModel model = skinning::load_model(path);
+      const auto motion = model.motion({});
+      const skinning::Topology topology = skinning::build_topology(motion->mesh());
+      skinning::Positions posed;
+      motion->positions(0, posed);
+      auto input = std::make_unique<Input>();
+      input->name = std::filesystem::path(path).filename().string();
+      if (input->name == "frames") {
+        input->name = std::filesystem::path(path).parent_path().filename().string();
+      }
+      input->triangles = topology.welded_triangles;
+      skinning::gather_welded(topology, posed, input->welded);
+      inputs.push_back(std::move(input));
+    } catch (const std::exception& e) {
+      std::fprintf(stderr, "bm_bvh_build: %s\n", e.what());
+      return 1;
+    }
+  }
+  for (const auto& input : inputs) {
+    benchmark::RegisterBenchmark(("BM_build_aabb/" + input->name).c_str(), bm_build<3>, input.get())
+        ->Unit(benchmark::kMillisecond);
+    benchmark::RegisterBenchmark(("BM_build_kdop/" + input->name).c_str(), bm_build<8>, input.get())
+        ->Unit(benchmark::kMillisecond);
+  }
+  benchmark::RunSpecifiedBenchmarks();
+  benchmark::Shutdown();
+  return 0;
+}
