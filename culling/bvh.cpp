@@ -83,6 +83,7 @@ void Bvh<N>::build(const skinning::Triangles& triangles, const skinning::Positio
   if (!order_.empty()) {
     // A binary tree with #F leaves at most has 2·#F − 1 nodes.
     nodes_.reserve(2 * order_.size() - 1);
+    if (split_ == BvhSplit::surface_area) spill_.resize(order_.size() / 2);
     build_range(0, static_cast<std::int32_t>(order_.size()), 0);
   }
   for (std::size_t i = 0; i < order_.size(); ++i) order_[i] = items_[i].id;
@@ -102,7 +103,8 @@ void Bvh<N>::build(const skinning::Triangles& triangles, const skinning::Positio
     std::fill(lo, lo + slot_stride(), std::numeric_limits<float>::infinity());
     std::fill(hi, hi + slot_stride(), -std::numeric_limits<float>::infinity());
   }
-  std::vector<Item>().swap(items_);  // free it: `items_ = {}` would keep the capacity
+  std::vector<Item>().swap(items_);  // free them: `items_ = {}` would keep the capacity
+  std::vector<Item>().swap(spill_);
   build_wide();
 }
 
@@ -269,14 +271,17 @@ std::int32_t Bvh<N>::sah_split(
   // the cost of the split after bin j is area(left) · #left + area(right) · #right, the expected
   // work of a query that meets the parent's box meeting each child's.
   constexpr int kBins = 16;
-  struct Bin {
-    std::int32_t count = 0;
-    Eigen::Vector3d lo = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
-    Eigen::Vector3d hi = Eigen::Vector3d::Constant(-std::numeric_limits<double>::infinity());
+  // A bin's box as x, y, z and a pad, so that two lanes of SSE2 update it (min / max pick the
+  // same operand as std::min / std::max, so the boxes are those of a scalar loop, bit for bit).
+  struct alignas(16) BinBox {
+    double lo[4];
+    double hi[4];
   };
-  const auto area = [](const Eigen::Vector3d& l, const Eigen::Vector3d& h) {
-    const Eigen::Vector3d d = (h - l).cwiseMax(0.0);
-    return d.x() * d.y() + d.y() * d.z() + d.z() * d.x();
+  const auto area = [](const double* l, const double* h) {
+    const double dx = std::max(h[0] - l[0], 0.0);
+    const double dy = std::max(h[1] - l[1], 0.0);
+    const double dz = std::max(h[2] - l[2], 0.0);
+    return dx * dy + dy * dz + dz * dx;
   };
   const auto bin_of = [&](const Item& item, Eigen::Index axis, double scale) {
     const double t = (item.centroid[axis] - lo[axis]) * scale;
@@ -291,52 +296,103 @@ std::int32_t Bvh<N>::sah_split(
     usable[a] = extent > 0.0 && std::isfinite(extent);
     scale[a] = usable[a] ? kBins / extent : 0.0;
   }
-  std::array<std::array<Bin, kBins>, 3> bins{};
+  constexpr double kInf = std::numeric_limits<double>::infinity();
+  std::array<std::array<std::int32_t, kBins>, 3> counts{};
+  std::array<std::array<BinBox, kBins>, 3> boxes;
+  for (auto& axis_boxes : boxes) {
+    for (BinBox& b : axis_boxes) {
+#if defined(__SSE2__)
+      const __m128d up = _mm_set1_pd(kInf);
+      const __m128d down = _mm_set1_pd(-kInf);
+      _mm_store_pd(b.lo, up);
+      _mm_store_pd(b.lo + 2, up);
+      _mm_store_pd(b.hi, down);
+      _mm_store_pd(b.hi + 2, down);
+#else
+      for (int k = 0; k < 4; ++k) {
+        b.lo[k] = kInf;
+        b.hi[k] = -kInf;
+      }
+#endif
+    }
+  }
   for (std::int32_t i = begin; i < end; ++i) {
     const Item& item = items_[static_cast<std::size_t>(i)];
+#if defined(__SSE2__)
+    const __m128d lo01 = _mm_loadu_pd(item.lo.data());
+    const __m128d lo2 = _mm_load_sd(item.lo.data() + 2);
+    const __m128d hi01 = _mm_loadu_pd(item.hi.data());
+    const __m128d hi2 = _mm_load_sd(item.hi.data() + 2);
+#endif
     for (Eigen::Index axis = 0; axis < 3; ++axis) {
       const auto a = static_cast<std::size_t>(axis);
-      Bin& b = bins[a][static_cast<std::size_t>(bin_of(item, axis, scale[a]))];
-      ++b.count;
-      for (Eigen::Index k = 0; k < 3; ++k) {  // plain min / max: Eigen's temporaries cost 3x
+      const auto j = static_cast<std::size_t>(bin_of(item, axis, scale[a]));
+      ++counts[a][j];
+      BinBox& b = boxes[a][j];
+#if defined(__SSE2__)
+      // _mm_min_pd(x, y) is x < y ? x : y: std::min(y, x), as the scalar loop below.
+      _mm_store_pd(b.lo, _mm_min_pd(lo01, _mm_load_pd(b.lo)));
+      _mm_store_pd(b.lo + 2, _mm_min_pd(lo2, _mm_load_pd(b.lo + 2)));
+      _mm_store_pd(b.hi, _mm_max_pd(hi01, _mm_load_pd(b.hi)));
+      _mm_store_pd(b.hi + 2, _mm_max_pd(hi2, _mm_load_pd(b.hi + 2)));
+#else
+      for (Eigen::Index k = 0; k < 3; ++k) {
         b.lo[k] = std::min(b.lo[k], item.lo[k]);
         b.hi[k] = std::max(b.hi[k], item.hi[k]);
       }
+#endif
     }
   }
-  double best_cost = std::numeric_limits<double>::infinity();
+  double best_cost = kInf;
   std::int32_t best_imbalance = std::numeric_limits<std::int32_t>::max();
+  std::int32_t best_left = 0;
   Eigen::Index best_axis = -1;
   int best_bin = -1;
   double best_scale = 0.0;
   for (Eigen::Index axis = 0; axis < 3; ++axis) {
     const auto a = static_cast<std::size_t>(axis);
     if (!usable[a]) continue;
-    // Right sides (bins j + 1 ..) swept from the end, then the left sides from the start.
-    std::array<double, kBins> right_cost{};
-    Bin right;
-    for (int j = kBins - 1; j > 0; --j) {
-      const Bin& b = bins[a][static_cast<std::size_t>(j)];
-      right.count += b.count;
-      right.lo = right.lo.cwiseMin(b.lo);
-      right.hi = right.hi.cwiseMax(b.hi);
-      right_cost[static_cast<std::size_t>(j - 1)] =
-          right.count > 0 ? area(right.lo, right.hi) * right.count : -1.0;
+    // The splits after the nonempty bins only: a split after an empty bin j cuts the items as
+    // the split after the last nonempty bin before j does, with the same boxes (an empty bin's is
+    // the identity of min / max), so the same cost and balance; of equal candidates the first in
+    // bin order is kept, which is that nonempty bin's. (Small ranges leave most bins empty.)
+    std::array<int, kBins> used;  // the first num_used are set
+    int num_used = 0;
+    for (int j = 0; j < kBins; ++j) {
+      if (counts[a][static_cast<std::size_t>(j)] > 0)
+        used[static_cast<std::size_t>(num_used++)] = j;
     }
-    Bin left;
-    for (int j = 0; j + 1 < kBins; ++j) {
-      const Bin& b = bins[a][static_cast<std::size_t>(j)];
-      left.count += b.count;
-      left.lo = left.lo.cwiseMin(b.lo);
-      left.hi = left.hi.cwiseMax(b.hi);
-      const double rc = right_cost[static_cast<std::size_t>(j)];
-      if (left.count == 0 || rc < 0.0) continue;
-      const double cost = area(left.lo, left.hi) * left.count + rc;
+    if (num_used < 2) continue;
+    // Right sides (the used bins after the i-th) swept from the end, then the left sides.
+    std::array<double, kBins> right_cost;  // the first num_used − 1 are set
+    BinBox side{{kInf, kInf, kInf, kInf}, {-kInf, -kInf, -kInf, -kInf}};
+    std::int32_t count = 0;
+    for (int i = num_used - 1; i > 0; --i) {
+      const auto b = static_cast<std::size_t>(used[static_cast<std::size_t>(i)]);
+      count += counts[a][b];
+      for (int k = 0; k < 3; ++k) {
+        side.lo[k] = std::min(side.lo[k], boxes[a][b].lo[k]);
+        side.hi[k] = std::max(side.hi[k], boxes[a][b].hi[k]);
+      }
+      right_cost[static_cast<std::size_t>(i - 1)] = area(side.lo, side.hi) * count;
+    }
+    side = BinBox{{kInf, kInf, kInf, kInf}, {-kInf, -kInf, -kInf, -kInf}};
+    count = 0;
+    for (int i = 0; i + 1 < num_used; ++i) {
+      const int j = used[static_cast<std::size_t>(i)];
+      const auto b = static_cast<std::size_t>(j);
+      count += counts[a][b];
+      for (int k = 0; k < 3; ++k) {
+        side.lo[k] = std::min(side.lo[k], boxes[a][b].lo[k]);
+        side.hi[k] = std::max(side.hi[k], boxes[a][b].hi[k]);
+      }
+      const double cost = area(side.lo, side.hi) * count + right_cost[static_cast<std::size_t>(i)];
       // Equal costs (boxes of no area: points, a flat strip): the more balanced split.
-      const std::int32_t imbalance = std::abs(2 * left.count - (end - begin));
+      const std::int32_t imbalance = std::abs(2 * count - (end - begin));
       if (cost < best_cost || (cost == best_cost && imbalance < best_imbalance)) {
         best_cost = cost;
         best_imbalance = imbalance;
+        best_left = count;
         best_axis = axis;
         best_bin = j;
         best_scale = scale[a];
@@ -345,11 +401,37 @@ std::int32_t Bvh<N>::sah_split(
   }
   if (best_axis < 0) return -1;
   // Stable: the order within each side is the input's, so the tree depends only on the input.
-  const auto middle =
-      std::stable_partition(items_.begin() + begin, items_.begin() + end, [&](const Item& item) {
-        return bin_of(item, best_axis, best_scale) <= best_bin;
-      });
-  return static_cast<std::int32_t>(middle - items_.begin());
+  // The smaller side goes to spill_ (at most half the items: allocated once per build) while the
+  // larger one slides together in place, then it comes back behind or before it.
+  const auto goes_left = [&](const Item& item) {
+    return bin_of(item, best_axis, best_scale) <= best_bin;
+  };
+  Item* const first = items_.data() + begin;
+  Item* const last = items_.data() + end;
+  Item* const spill = spill_.data();
+  std::size_t spilled = 0;
+  if (best_left <= end - begin - best_left) {
+    Item* write = last;  // the rights, from the back; never ahead of the read
+    for (Item* read = last; read-- != first;) {
+      if (goes_left(*read)) {
+        spill[spilled++] = *read;
+      } else {
+        *--write = *read;
+      }
+    }
+    for (std::size_t k = 0; k < spilled; ++k) first[k] = spill[spilled - 1 - k];
+  } else {
+    Item* write = first;  // the lefts, from the front; never ahead of the read
+    for (Item* read = first; read != last; ++read) {
+      if (goes_left(*read)) {
+        *write++ = *read;
+      } else {
+        spill[spilled++] = *read;
+      }
+    }
+    std::copy(spill, spill + spilled, write);
+  }
+  return begin + best_left;
 }
 
 template <int N>

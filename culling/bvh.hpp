@@ -268,6 +268,7 @@ class Bvh {
   std::int32_t sah_split(
       std::int32_t begin, std::int32_t end, const Eigen::Vector3d& lo, const Eigen::Vector3d& hi);
   std::vector<Item> items_;  // build-time only, by slot; freed after the build
+  std::vector<Item> spill_;  // build-time only: the smaller side of a split while partitioning
   int depth_ = 0;
   int wide_depth_ = 0;
   int leaf_size_ = 1;
