@@ -2,7 +2,7 @@
 // every method pays once per check before its first query, on the serial start of a parallel
 // check (docs/benchmarks.md, "parallel"). One iteration = one Bvh<3> built over every welded
 // triangle at the first sample, as `bvh`, `dynamic` and `auto` build it (no binary node volumes);
-// Bvh<8> as `kdop` builds it.
+// Bvh<8> as `kdop` builds it; BM_features: the mesh's culling::FeatureTopology.
 //
 //   build/bench/culling/bm_bvh_build [MODEL …] [--benchmark_* flags]
 //
@@ -21,6 +21,7 @@
 #include <vector>
 
 #include "culling/bvh.hpp"
+#include "culling/feature_topology.hpp"
 #include "skinning/load.hpp"
 #include "skinning/topology.hpp"
 
@@ -32,6 +33,8 @@ struct Input {
   std::string name;
   skinning::Triangles triangles;
   skinning::Positions welded;
+  std::shared_ptr<const skinning::Mesh> mesh;
+  skinning::Topology topology;
 };
 
 /// FNV-1a over the node ranges and the triangle order.
@@ -73,6 +76,16 @@ void bm_build(benchmark::State& state, const Input* input) {
   state.SetItemsProcessed(state.iterations() * input->triangles.rows());
 }
 
+/// The mesh's FeatureTopology (with its vertex fans): what every method, the baseline and each
+/// incremental-DCD updater build before their first query.
+void bm_features(benchmark::State& state, const Input* input) {
+  for (auto _ : state) {
+    const culling::FeatureTopology features(*input->mesh, input->topology);
+    benchmark::DoNotOptimize(&features);
+  }
+  state.SetLabel(std::to_string(input->triangles.rows()) + " triangles");
+}
+
 std::vector<std::string> default_models() {
   const std::filesystem::path source(SKELCD_SOURCE_DIR);
   std::vector<std::string> models;
@@ -111,6 +124,8 @@ int main(int argc, char** argv) {
         input->name = std::filesystem::path(path).parent_path().filename().string();
       }
       input->triangles = topology.welded_triangles;
+      input->mesh = std::make_shared<const skinning::Mesh>(motion->mesh());
+      input->topology = topology;
       skinning::gather_welded(topology, posed, input->welded);
       inputs.push_back(std::move(input));
     } catch (const std::exception& e) {
@@ -122,6 +137,8 @@ int main(int argc, char** argv) {
     benchmark::RegisterBenchmark(("BM_build_aabb/" + input->name).c_str(), bm_build<3>, input.get())
         ->Unit(benchmark::kMillisecond);
     benchmark::RegisterBenchmark(("BM_build_kdop/" + input->name).c_str(), bm_build<8>, input.get())
+        ->Unit(benchmark::kMillisecond);
+    benchmark::RegisterBenchmark(("BM_features/" + input->name).c_str(), bm_features, input.get())
         ->Unit(benchmark::kMillisecond);
   }
   benchmark::RunSpecifiedBenchmarks();
