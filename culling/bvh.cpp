@@ -301,19 +301,10 @@ std::int32_t Bvh<N>::sah_split(
   std::array<std::array<BinBox, kBins>, 3> boxes;
   for (auto& axis_boxes : boxes) {
     for (BinBox& b : axis_boxes) {
-#if defined(__SSE2__)
-      const __m128d up = _mm_set1_pd(kInf);
-      const __m128d down = _mm_set1_pd(-kInf);
-      _mm_store_pd(b.lo, up);
-      _mm_store_pd(b.lo + 2, up);
-      _mm_store_pd(b.hi, down);
-      _mm_store_pd(b.hi + 2, down);
-#else
       for (int k = 0; k < 4; ++k) {
         b.lo[k] = kInf;
         b.hi[k] = -kInf;
       }
-#endif
     }
   }
   for (std::int32_t i = begin; i < end; ++i) {

@@ -20,7 +20,7 @@ enum class BvhSplit {
   /// minimises area(left) · #left + area(right) · #right over 16 slabs per axis. The median split
   /// below is taken instead where the centroids fall into one slab on every axis, below depth 48
   /// (which bounds the depth on any input) and inside a bucket. Fewer overlapping siblings on real
-  /// meshes, at about four times the median build's cost, paid once per hierarchy.
+  /// meshes, at a few times the median build's cost, paid once per hierarchy.
   surface_area,
   /// At the median by count along the longest axis of the centroids: balanced, depth
   /// ⌈log₂(#F / leaf_size)⌉. The cone methods' hierarchy (paper 000's figures were taken on it).

@@ -31,8 +31,7 @@ using namespace skelcd;
 
 struct Input {
   std::string name;
-  skinning::Triangles triangles;
-  skinning::Positions welded;
+  skinning::Positions welded;  // at the first sample
   std::shared_ptr<const skinning::Mesh> mesh;
   skinning::Topology topology;
 };
@@ -61,19 +60,20 @@ void bm_build(benchmark::State& state, const Input* input) {
   culling::BvhOptions options;
   options.node_volumes = false;
   for (auto _ : state) {
-    culling::Bvh<N> bvh(input->triangles, input->welded, options);
+    culling::Bvh<N> bvh(input->topology.welded_triangles, input->welded, options);
     benchmark::DoNotOptimize(bvh.nodes().data());
   }
-  const std::uint64_t hash = tree_hash(culling::Bvh<N>(input->triangles, input->welded, options));
+  const std::uint64_t hash =
+      tree_hash(culling::Bvh<N>(input->topology.welded_triangles, input->welded, options));
   char label[96];
   std::snprintf(
       label,
       sizeof label,
       "%lld triangles, tree %016llx",
-      static_cast<long long>(input->triangles.rows()),
+      static_cast<long long>(input->topology.welded_triangles.rows()),
       static_cast<unsigned long long>(hash));
   state.SetLabel(label);
-  state.SetItemsProcessed(state.iterations() * input->triangles.rows());
+  state.SetItemsProcessed(state.iterations() * input->topology.welded_triangles.rows());
 }
 
 /// The mesh's FeatureTopology (with its vertex fans): what every method, the baseline and each
@@ -83,7 +83,7 @@ void bm_features(benchmark::State& state, const Input* input) {
     const culling::FeatureTopology features(*input->mesh, input->topology);
     benchmark::DoNotOptimize(&features);
   }
-  state.SetLabel(std::to_string(input->triangles.rows()) + " triangles");
+  state.SetLabel(std::to_string(input->topology.welded_triangles.rows()) + " triangles");
 }
 
 std::vector<std::string> default_models() {
@@ -123,7 +123,6 @@ int main(int argc, char** argv) {
       if (input->name == "frames") {
         input->name = std::filesystem::path(path).parent_path().filename().string();
       }
-      input->triangles = topology.welded_triangles;
       input->mesh = std::make_shared<const skinning::Mesh>(motion->mesh());
       input->topology = topology;
       skinning::gather_welded(topology, posed, input->welded);
