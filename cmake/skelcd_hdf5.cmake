@@ -8,8 +8,8 @@
 # which need libsz (libaec-dev, a dependency of libhdf5-dev), zlib, libdl and libm. A shared
 # object (the Python extension) cannot hold the archive's non-PIC code and links libhdf5.so.
 # Every target that uses HDF5 links this target, never HDF5::HDF5 directly, so that no program
-# holds both copies. SKELCD_STATIC_HDF5=OFF, or no archive found, links the shared library
-# everywhere.
+# holds both copies. SKELCD_STATIC_HDF5=OFF, SKELCD_FUZZ=ON, or no archive found, links the shared
+# library everywhere.
 option(SKELCD_STATIC_HDF5 "Link executables with HDF5's static archive (faster process start)" ON)
 
 add_library(skelcd_hdf5 INTERFACE)
@@ -17,8 +17,13 @@ add_library(skelcd::hdf5 ALIAS skelcd_hdf5)
 target_include_directories(skelcd_hdf5 SYSTEM INTERFACE ${HDF5_C_INCLUDE_DIRS} ${HDF5_INCLUDE_DIRS})
 target_compile_definitions(skelcd_hdf5 INTERFACE ${HDF5_C_DEFINITIONS} ${HDF5_DEFINITIONS})
 
+# The fuzz build (make fuzz) keeps the shared library: its leak suppressions (fuzz/lsan.supp) and
+# scripts/fuzz.sh's sorting of crashes tell libhdf5's own faults from ours by the name of its
+# shared object, which a static copy inside the harness does not carry.
 set(_skelcd_hdf5_archive "")
-if(SKELCD_STATIC_HDF5)
+if(SKELCD_STATIC_HDF5 AND SKELCD_FUZZ)
+  message(STATUS "skelcd: the fuzz build links libhdf5.so (SKELCD_STATIC_HDF5 ignored)")
+elseif(SKELCD_STATIC_HDF5)
   set(_skelcd_hdf5_dirs "")
   foreach(_lib IN LISTS HDF5_C_LIBRARIES)
     if(_lib MATCHES "hdf5[^/]*\\.so$")
