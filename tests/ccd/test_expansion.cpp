@@ -133,5 +133,54 @@ TEST(Expansion, ProductsNearUnderflowOrOverflowAreFlagged) {
       1);
 }
 
+// orient3d_exact (ccd/orientation.cpp), the fallback of every DCD filter, against rationals on the
+// inputs that reach it on real meshes: flat fans and coplanar grids at mesh scale (exact zeros),
+// near-coplanar points nudged by one ulp, the same grids from 2^-200 to 2^200, and coordinates of
+// both signs whose differences round.
+TEST(Expansion, ExactOrient3dAgreesWithRationalsOnEveryPath) {
+  std::mt19937_64 rng(29);
+  std::uniform_real_distribution<double> mesh(0.4, 0.7);  // one sign, within 2x: exact differences
+  std::uniform_real_distribution<double> unit(-1.0, 1.0);
+  std::uniform_int_distribution<int> grid(-5, 5);
+  std::uniform_int_distribution<int> scale_exp(-200, 200);
+  int zeros = 0, nonzeros = 0;
+  for (int n = 0; n < 40000; ++n) {
+    Eigen::Vector3d p[4];
+    const int kind = n % 5;
+    const double s = std::ldexp(1.0, kind == 3 ? scale_exp(rng) : 0);
+    for (auto& v : p) {
+      switch (kind) {
+        case 0:  // an axis-aligned flat fan at mesh scale: exact zeros through exact differences
+          v = Eigen::Vector3d(mesh(rng), mesh(rng), 0.5);
+          break;
+        case 1:  // coplanar points of a tilted grid at mesh scale
+        case 3:  // the same grid from 2^-200 to 2^200: some differences leave the fast range
+          v = s * (Eigen::Vector3d(0.5, 0.5, 0.5) +
+                   0x1p-8 * (grid(rng) * Eigen::Vector3d(1.0, 0.0, 0.25) +
+                             grid(rng) * Eigen::Vector3d(0.0, 1.0, -0.5)));
+          break;
+        case 2:  // generic points at mesh scale
+          v = Eigen::Vector3d(mesh(rng), mesh(rng), mesh(rng));
+          break;
+        default:  // both signs, one near 0: differences that round
+          v = Eigen::Vector3d(unit(rng), 1e-9 * unit(rng), unit(rng));
+          break;
+      }
+    }
+    if (kind == 2 || kind == 4) p[3] = p[0] + (p[1] - p[0]) * 0.375 + (p[2] - p[0]) * 0.25;
+    if (n % 3 == 0) {
+      double& c = p[n % 4][(n / 3) % 3];
+      c = std::nextafter(c, n % 2 ? 10.0 : -10.0);
+    }
+    const int expected = rational_sign_of(orient<mpq_class>(p[0], p[1], p[2], p[3]));
+    ASSERT_EQ(orient3d_exact(p[0], p[1], p[2], p[3]), expected) << "case " << n;
+    // Antisymmetric under an odd permutation, on whichever path that order takes.
+    ASSERT_EQ(orient3d_exact(p[1], p[0], p[2], p[3]), -expected) << "case " << n;
+    (expected == 0 ? zeros : nonzeros) += 1;
+  }
+  EXPECT_GT(zeros, 8000);
+  EXPECT_GT(nonzeros, 15000);
+}
+
 }  // namespace
 }  // namespace skelcd::ccd::detail
