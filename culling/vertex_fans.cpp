@@ -97,11 +97,11 @@ namespace {
 
 using Spoke = std::array<double, 3>;
 
-/// Room for n spoke differences: on the stack for fans of up to 32 spokes (`stack`), else in this
-/// thread's buffer (kept).
-template <std::size_t kStack>
-std::span<Spoke> spoke_room(std::size_t n, std::array<Spoke, kStack>& stack) {
-  thread_local std::vector<Spoke> heap;
+/// Room for n spoke differences (or sectors): on the stack for fans of up to 32 spokes (`stack`),
+/// else in this thread's buffer (kept).
+template <class T, std::size_t kStack>
+std::span<T> spoke_room(std::size_t n, std::array<T, kStack>& stack) {
+  thread_local std::vector<T> heap;
   if (n <= kStack) return {stack.data(), n};
   if (heap.size() < n) heap.resize(n);
   return {heap.data(), n};
@@ -182,6 +182,26 @@ bool closed_winds_once_in_axes(
 
 constexpr std::size_t kStackSpokes = 32;
 
+/// det3_sign_static of the columns (a, b, n) — the sign along n of sector (a, b), the same
+/// determinant as the rows — from the components of a × b (det3_sign_static_minors): `certify` is
+/// 1.3–1.5× faster on the fans that reach the normal than with det3_sign_static on the rows
+/// (docs/culling.md, "Closed fans along the normal, cheaper").
+inline int sector_sign_along(const Spoke& a, const Spoke& b, const Spoke& n) {
+  const double l0 = a[1] * b[2], r0 = a[2] * b[1];
+  const double l1 = a[2] * b[0], r1 = a[0] * b[2];
+  const double l2 = a[0] * b[1], r2 = a[1] * b[0];
+  return ccd::detail::det3_sign_static_minors(
+      l0 - r0,
+      l1 - r1,
+      l2 - r2,
+      std::abs(l0) + std::abs(r0),
+      std::abs(l1) + std::abs(r1),
+      std::abs(l2) + std::abs(r2),
+      n[0],
+      n[1],
+      n[2]);
+}
+
 }  // namespace
 
 bool VertexFans::certified(const skinning::Positions& x, std::int32_t v) const {
@@ -196,8 +216,53 @@ bool VertexFans::certified(const skinning::Positions& x, std::int32_t v) const {
   Spoke n{0.0, 0.0, 0.0};
   add_normal(d, m, n);
   return holds_in_a_projection(n, [&](const auto& sign, const std::array<std::size_t, 2>* axes) {
-    if (closed && axes != nullptr) return closed_winds_once_in_axes(d, m, (*axes)[1], sign);
+    if (closed) {
+      return axes != nullptr ? closed_winds_once_in_axes(d, m, (*axes)[1], sign)
+                             : closed_along_normal(d, m, n);
+    }
     return winds_once(m, closed, [&](std::size_t p, std::size_t q) { return sign(d[p], d[q]); });
+  });
+}
+
+bool VertexFans::closed_along_normal(std::span<const Spoke> d, std::size_t m, const Spoke& n) {
+  // (1) every sector's det[d_i; d_i+1; n] of one strict sign s (sector_sign_along). (2) The fan
+  // winds once: every direction of the plane lies in exactly w half-open sectors, w the winding
+  // number, as in the coordinate projection; take the direction e of axis a (where |n| is
+  // smallest, so that e is not along n) projected onto the plane. The sign along n of (p, e) is
+  // det[p; e; n] = det[p; u_a; n] = (n × p)_a (e − u_a is parallel to n), a 2 × 2 minor of n and
+  // p: one filtered sign per spoke, where winds_once needs one determinant per spoke from spoke
+  // 0. Sector [d_i, d_i+1) holds e when s·(n × d_i)_a >= 0 and −s·(n × d_i+1)_a > 0, which needs
+  // exact zeros: a spoke whose sign the filter leaves open (a spoke in the plane of n and u_a —
+  // the corner of an axis-aligned box) hands the covering to winds_once.
+  if (!(std::abs(n[0]) + std::abs(n[1]) + std::abs(n[2]) > 0.0)) return false;
+  const int sign = sector_sign_along(d[0], d[1], n);
+  if (sign == ccd::detail::kUndecided) return false;
+  for (std::size_t i = 1; i < m; ++i) {
+    if (sector_sign_along(d[i], d[i + 1], n) != sign) return false;
+  }
+  std::size_t a = 0;
+  if (std::abs(n[1]) < std::abs(n[0])) a = 1;
+  if (std::abs(n[2]) < std::abs(n[a])) a = 2;
+  const std::size_t b = (a + 1) % 3;
+  const std::size_t c = (a + 2) % 3;
+  const auto toward_e = [&](const Spoke& p) {  // sign of (n × p)_a = n_b p_c − n_c p_b
+    return ccd::detail::cross_sign_static(n[b], n[c], p[b], p[c]);
+  };
+  int covering = 0;
+  int t_i = toward_e(d[0]);
+  const int t_0 = t_i;
+  bool decided = t_i != ccd::detail::kUndecided;
+  for (std::size_t i = 0; i < m && decided; ++i) {
+    const int t_next = i + 1 < m ? toward_e(d[i + 1]) : t_0;
+    decided = t_next != ccd::detail::kUndecided;
+    covering += static_cast<int>((sign * t_i >= 0) & (-sign * t_next > 0));
+    t_i = t_next;
+  }
+  if (decided) return covering == 1;
+  return winds_once(m, true, [&](std::size_t p, std::size_t q) {
+    if (q == p + 1) return sector_sign_along(d[p], d[q], n);
+    return ccd::detail::det3_sign_static(
+        d[p][0], d[p][1], d[p][2], d[q][0], d[q][1], d[q][2], n[0], n[1], n[2]);
   });
 }
 

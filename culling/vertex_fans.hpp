@@ -16,6 +16,7 @@
 // floating-point filter with a proven bound (ccd/orientation.hpp); a sign it cannot decide leaves
 // the vertex uncertified, so the certificate is exact and costs no rational arithmetic.
 
+#include <array>
 #include <cstdint>
 #include <span>
 #include <vector>
@@ -57,6 +58,10 @@ class VertexFans {
       const skinning::Positions& x_t0, const skinning::Positions& x_t1, std::int32_t v) const;
 
  private:
+  /// certified()'s second try for a closed fan of m ≥ 3 sectors: along its summed normal n, d its
+  /// m spoke differences and d[m] = d[0].
+  static bool closed_along_normal(
+      std::span<const std::array<double, 3>> d, std::size_t m, const std::array<double, 3>& n);
   /// Conditions (1) and (2) of the certificate for the m triangles of a fan, given the sign of
   /// each projected spoke pair (orient(p, q) ∈ {−1, 1, kUndecided}; spoke m of a closed fan is
   /// spoke 0).

@@ -2,7 +2,9 @@
 // every method pays once per check before its first query, on the serial start of a parallel
 // check (docs/benchmarks.md, "parallel"). One iteration = one Bvh<3> built over every welded
 // triangle at the first sample, as `bvh`, `dynamic` and `auto` build it (no binary node volumes);
-// Bvh<8> as `kdop` builds it; BM_features: the mesh's culling::FeatureTopology.
+// Bvh<8> as `kdop` builds it; BM_features: the mesh's culling::FeatureTopology; BM_certify: its
+// vertex fans certified at that sample (VertexFans::certify, once per DCD instant), labelled with
+// how many are certified and a hash of which.
 //
 //   build/bench/culling/bm_bvh_build [MODEL …] [--benchmark_* flags]
 //
@@ -86,6 +88,32 @@ void bm_features(benchmark::State& state, const Input* input) {
   state.SetLabel(std::to_string(input->topology.welded_triangles.rows()) + " triangles");
 }
 
+/// The vertex fans certified at the first sample: what every DCD instant pays before its traversal.
+void bm_certify(benchmark::State& state, const Input* input) {
+  const culling::FeatureTopology features(*input->mesh, input->topology);
+  std::vector<std::uint8_t> certified;
+  for (auto _ : state) {
+    features.fans().certify(input->welded, certified);
+    benchmark::DoNotOptimize(certified.data());
+  }
+  std::uint64_t h = 1469598103934665603ull;
+  std::size_t count = 0;
+  for (const std::uint8_t c : certified) {
+    h = (h ^ c) * 1099511628211ull;
+    count += c;
+  }
+  char label[96];
+  std::snprintf(
+      label,
+      sizeof label,
+      "%zu of %zu certified, %016llx",
+      count,
+      certified.size(),
+      static_cast<unsigned long long>(h));
+  state.SetLabel(label);
+  state.SetItemsProcessed(state.iterations() * static_cast<std::int64_t>(certified.size()));
+}
+
 std::vector<std::string> default_models() {
   const std::filesystem::path source(SKELCD_SOURCE_DIR);
   std::vector<std::string> models;
@@ -139,6 +167,8 @@ int main(int argc, char** argv) {
         ->Unit(benchmark::kMillisecond);
     benchmark::RegisterBenchmark(("BM_features/" + input->name).c_str(), bm_features, input.get())
         ->Unit(benchmark::kMillisecond);
+    benchmark::RegisterBenchmark(("BM_certify/" + input->name).c_str(), bm_certify, input.get())
+        ->Unit(benchmark::kMicrosecond);
   }
   benchmark::RunSpecifiedBenchmarks();
   benchmark::Shutdown();
