@@ -46,7 +46,11 @@ class VertexFans {
 
   /// Whether v's fan is certified at positions x (#W × 3 welded).
   [[nodiscard]] bool certified(const skinning::Positions& x, std::int32_t v) const;
-  /// certified(x, v) for every v, into out (resized to #W; 1 = certified).
+  /// Every vertex's certificate at x, into out (resized to #W; 1 = certified): each closed fan
+  /// first in the coordinate projection that certified(x, v − 1) chose (a vertex's predecessor in
+  /// a mesh is mostly a neighbour, its normal along the same axis; no normal to sum), then as
+  /// certified(x, v). Every projection is sound: out[v] is 1 wherever certified(x, v) is, and for
+  /// a few fans more.
   void certify(const skinning::Positions& x, std::vector<std::uint8_t>& out) const;
 
   /// Whether v's fan is certified at every instant of the interval x_t0 → x_t1 (each vertex
@@ -58,6 +62,9 @@ class VertexFans {
       const skinning::Positions& x_t0, const skinning::Positions& x_t1, std::int32_t v) const;
 
  private:
+  /// certified(x, v), and in `axis` the coordinate axis its first projection drops (that along
+  /// which the fan's summed normal is largest).
+  bool certified(const skinning::Positions& x, std::int32_t v, std::size_t& axis) const;
   /// certified()'s second try for a closed fan of m ≥ 3 sectors: along its summed normal n, d its
   /// m spoke differences and d[m] = d[0].
   static bool closed_along_normal(
