@@ -97,11 +97,11 @@ namespace {
 
 using Spoke = std::array<double, 3>;
 
-/// Room for n spoke differences (or sectors): on the stack for fans of up to 32 spokes (`stack`),
-/// else in this thread's buffer (kept).
-template <class T, std::size_t kStack>
-std::span<T> spoke_room(std::size_t n, std::array<T, kStack>& stack) {
-  thread_local std::vector<T> heap;
+/// Room for n spoke differences: on the stack for fans of up to 32 spokes (`stack`), else in this
+/// thread's buffer (kept).
+template <std::size_t kStack>
+std::span<Spoke> spoke_room(std::size_t n, std::array<Spoke, kStack>& stack) {
+  thread_local std::vector<Spoke> heap;
   if (n <= kStack) return {stack.data(), n};
   if (heap.size() < n) heap.resize(n);
   return {heap.data(), n};
@@ -133,14 +133,6 @@ std::span<T> spoke_room(std::size_t n, std::array<T, kStack>& stack) {
   }
 }
 
-/// `holds(sign, axes)` in a projection, sign(p, q) the orientation of spoke differences p, q there:
-/// first the coordinate projection that drops the axis where n is largest (any choice is sound;
-/// this one makes the certificate likely), the sign the k-th component of p × q by the static
-/// filter ccd::detail::cross_sign_static, and `axes` the two coordinates kept (i, j); then, if that
-/// fails, the projection along n itself — a fan that no coordinate axis sees injectively (a cube's
-/// corner, a cone's tip, a crease turned away from the axes) may still be seen so — the sign
-/// n · (p × q) = det[p; q; n] by the static orient3d filter (n is exact as computed: a difference
-/// rounded zero times), and `axes` null.
 /// The axis along which n is largest (the first of equals).
 inline std::size_t largest_axis(const Spoke& n) {
   std::size_t k = 0;
@@ -149,6 +141,14 @@ inline std::size_t largest_axis(const Spoke& n) {
   return k;
 }
 
+/// `holds(sign, axes)` in a projection, sign(p, q) the orientation of spoke differences p, q there:
+/// first the coordinate projection that drops the axis where n is largest (any choice is sound;
+/// this one makes the certificate likely), the sign the k-th component of p × q by the static
+/// filter ccd::detail::cross_sign_static, and `axes` the two coordinates kept (i, j); then, if that
+/// fails, the projection along n itself — a fan that no coordinate axis sees injectively (a cube's
+/// corner, a cone's tip, a crease turned away from the axes) may still be seen so — the sign
+/// n · (p × q) = det[p; q; n] by the static orient3d filter (n is exact as computed: a difference
+/// rounded zero times), and `axes` null.
 template <class Holds>
 bool holds_in_a_projection(const Spoke& n, const Holds& holds) {
   const std::size_t k = largest_axis(n);
