@@ -16,14 +16,24 @@ REPEAT=${REPEAT:-3}
 METHODS=${METHODS:-"bvh dynamic"}
 ARGS=${ARGS:-}
 
-# measure METHOD THREADS: "wall cpu" in seconds of one check (bash's `time`: real, user + sys of
-# the process and the children it waited for).
+# measure METHOD THREADS: one check; sets WALL and CPU, in seconds (bash's `time`: real, and user +
+# sys of the process and the children it waited for). A failing check stops the script with its
+# messages.
+ERRORS=$(mktemp)
+trap 'rm -f "$ERRORS"' EXIT
 measure() {
-  local times
+  local times status=0
   TIMEFORMAT='%R %U %S'
   # shellcheck disable=SC2086
-  times=$({ time "$SKELCD" check "$MODEL" --method "$1" --threads "$2" $ARGS > /dev/null; } 2>&1)
-  awk '{ printf "%.3f %.3f", $1, $2 + $3 }' <<< "$times"
+  times=$({ time "$SKELCD" check "$MODEL" --method "$1" --threads "$2" $ARGS > /dev/null 2> "$ERRORS"; } 2>&1) ||
+    status=$?
+  if [ "$status" -ne 0 ]; then
+    echo "bench_parallel.sh: $SKELCD check $MODEL --method $1 --threads $2 failed (exit $status):" >&2
+    cat "$ERRORS" >&2
+    exit 1
+  fi
+  read -r WALL user sys <<< "$times"
+  CPU=$(awk -v u="$user" -v s="$sys" 'BEGIN { printf "%.3f", u + s }')
 }
 min() { awk -v a="$1" -v b="$2" 'BEGIN { print (a == "" || b < a) ? b : a }'; }
 
@@ -34,12 +44,12 @@ printf '%-10s %12s %12s %9s %12s %12s %9s\n' method "threads 1 s" "threads $THRE
 for method in $METHODS; do
   serial="" parallel="" serial_cpu="" parallel_cpu=""
   for ((i = 0; i < REPEAT; i++)); do
-    read -r wall cpu <<< "$(measure "$method" 1)"
-    serial=$(min "$serial" "$wall")
-    serial_cpu=$(min "$serial_cpu" "$cpu")
-    read -r wall cpu <<< "$(measure "$method" "$THREADS")"
-    parallel=$(min "$parallel" "$wall")
-    parallel_cpu=$(min "$parallel_cpu" "$cpu")
+    measure "$method" 1
+    serial=$(min "$serial" "$WALL")
+    serial_cpu=$(min "$serial_cpu" "$CPU")
+    measure "$method" "$THREADS"
+    parallel=$(min "$parallel" "$WALL")
+    parallel_cpu=$(min "$parallel_cpu" "$CPU")
   done
   printf '%-10s %12s %12s %9s %12s %12s %9s\n' "$method" "$serial" "$parallel" \
     "$(awk -v s="$serial" -v p="$parallel" 'BEGIN { printf "%.2fx", s / p }')" \
