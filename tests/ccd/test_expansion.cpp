@@ -107,10 +107,10 @@ TEST(Expansion, StaticOrient3dFilterIsRightWithUnderflowedProducts) {
   EXPECT_GT(decided, 50000);
 }
 
-// det3_sign_static_minors (ccd/orientation.hpp) from the cross product a × b that a vertex fan
-// takes per sector: the same verdict as det3_sign_static on the transposed rows for every input —
-// mesh-like differences, one-ulp nudges onto a plane, and the underflow mix above — and every
-// decided sign is that of the rational det[a; b; z].
+// det3_sign_static_minors (ccd/orientation.hpp, det3_sign_static's own verdict) from the cross
+// product a × b that a vertex fan takes per sector: the same verdict as det3_sign_static on the
+// transposed rows for every input — mesh-like differences, one-ulp nudges onto a plane, and the
+// underflow mix above — and every decided sign is that of the rational det[a; b; z].
 TEST(Expansion, StaticDeterminantFromMinorsIsTheTransposedFilter) {
   std::mt19937_64 rng(77);
   std::uniform_real_distribution<double> mantissa(-1.0, 1.0);
