@@ -221,24 +221,13 @@ bool closed_winds_once_dropping(
   return covering == 1;
 }
 
-/// det3_sign_static of the columns (a, b, n) — the sign along n of sector (a, b), the same
-/// determinant as the rows — from the components of a × b (det3_sign_static_minors): `certify` is
-/// 1.3–1.5× faster on the fans that reach the normal than with det3_sign_static on the rows
-/// (docs/culling.md, "Closed fans along the normal, cheaper").
+/// The sign along n of sector (a, b): det[a; b; n] by the static orient3d filter on the transposed
+/// rows (a_x, b_x, n_x), (a_y, b_y, n_y), (a_z, b_z, n_z) — the same determinant, whose 2 × 2
+/// minors are then the components of a × b. `certify` is 1.3–1.5× faster on the fans that reach
+/// the normal than with the rows (a, b, n) (docs/culling.md, "Closed fans along the normal,
+/// cheaper").
 inline int sector_sign_along(const Spoke& a, const Spoke& b, const Spoke& n) {
-  const double l0 = a[1] * b[2], r0 = a[2] * b[1];
-  const double l1 = a[2] * b[0], r1 = a[0] * b[2];
-  const double l2 = a[0] * b[1], r2 = a[1] * b[0];
-  return ccd::detail::det3_sign_static_minors(
-      l0 - r0,
-      l1 - r1,
-      l2 - r2,
-      std::abs(l0) + std::abs(r0),
-      std::abs(l1) + std::abs(r1),
-      std::abs(l2) + std::abs(r2),
-      n[0],
-      n[1],
-      n[2]);
+  return ccd::detail::det3_sign_static(a[0], b[0], n[0], a[1], b[1], n[1], a[2], b[2], n[2]);
 }
 
 }  // namespace

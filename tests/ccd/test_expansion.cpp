@@ -107,54 +107,6 @@ TEST(Expansion, StaticOrient3dFilterIsRightWithUnderflowedProducts) {
   EXPECT_GT(decided, 50000);
 }
 
-// det3_sign_static_minors (ccd/orientation.hpp, det3_sign_static's own verdict) from the cross
-// product a × b that a vertex fan takes per sector: the same verdict as det3_sign_static on the
-// transposed rows for every input — mesh-like differences, one-ulp nudges onto a plane, and the
-// underflow mix above — and every decided sign is that of the rational det[a; b; z].
-TEST(Expansion, StaticDeterminantFromMinorsIsTheTransposedFilter) {
-  std::mt19937_64 rng(77);
-  std::uniform_real_distribution<double> mantissa(-1.0, 1.0);
-  std::uniform_int_distribution<int> pick(0, 11);
-  const int exponents[] = {-1074, -1060, -1022, -700, -540, -401, -100, 0, 100, 300, 495, 0};
-  int decided = 0, undecided = 0;
-  for (int n = 0; n < 200000; ++n) {
-    Eigen::Vector3d a, b, z;
-    if (n % 2 == 0) {  // the underflow mix
-      for (Eigen::Vector3d* v : {&a, &b, &z}) {
-        for (int k = 0; k < 3; ++k) {
-          (*v)[k] = pick(rng) < 3 ? 0.0 : std::ldexp(mantissa(rng), exponents[pick(rng)]);
-        }
-      }
-    } else {  // spokes of a fan and its normal at mesh scale; z nearly in the plane of a, b
-      a = Eigen::Vector3d(mantissa(rng), mantissa(rng), mantissa(rng)) * 0.01;
-      b = Eigen::Vector3d(mantissa(rng), mantissa(rng), mantissa(rng)) * 0.01;
-      z = n % 4 == 1 ? Eigen::Vector3d(a + 0.5 * b)
-                     : Eigen::Vector3d(mantissa(rng), mantissa(rng), mantissa(rng));
-      if (n % 3 == 0) z[n % 3] = std::nextafter(z[n % 3], n % 5 ? 1.0 : -1.0);
-    }
-    double c[3], permanent[3];
-    for (int k = 0; k < 3; ++k) {
-      const double left = a[(k + 1) % 3] * b[(k + 2) % 3];
-      const double right = a[(k + 2) % 3] * b[(k + 1) % 3];
-      c[k] = left - right;
-      permanent[k] = std::abs(left) + std::abs(right);
-    }
-    const int s = det3_sign_static_minors(
-        c[0], c[1], c[2], permanent[0], permanent[1], permanent[2], z[0], z[1], z[2]);
-    ASSERT_EQ(s, det3_sign_static(a[0], b[0], z[0], a[1], b[1], z[1], a[2], b[2], z[2]))
-        << "case " << n;
-    if (s == kUndecided) {
-      ++undecided;
-      continue;
-    }
-    ++decided;
-    const mpq_class det = dot(cross(lift<mpq_class>(a), lift<mpq_class>(b)), lift<mpq_class>(z));
-    ASSERT_EQ(s, rational_sign_of(det)) << "case " << n;
-  }
-  EXPECT_GT(decided, 100000);
-  EXPECT_GT(undecided, 10000);
-}
-
 TEST(Expansion, ProductsNearUnderflowOrOverflowAreFlagged) {
   // Leaves outside [2^-300, 2^300] and products outside the exact range of two-product are flagged,
   // so that exact_sign falls back to rationals.
