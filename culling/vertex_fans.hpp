@@ -47,10 +47,10 @@ class VertexFans {
   /// Whether v's fan is certified at positions x (#W × 3 welded).
   [[nodiscard]] bool certified(const skinning::Positions& x, std::int32_t v) const;
   /// Every vertex's certificate at x, into out (resized to #W; 1 = certified): each closed fan
-  /// first in the coordinate projection that certified(x, v − 1) chose (a vertex's predecessor in
-  /// a mesh is mostly a neighbour, its normal along the same axis; no normal to sum), then as
-  /// certified(x, v). Every projection is sound: out[v] is 1 wherever certified(x, v) is, and for
-  /// a few fans more.
+  /// first in the coordinate projection that certified() last chose for a vertex before it (a
+  /// vertex's predecessors in a mesh are mostly neighbours, their normals along the same axis; no
+  /// normal to sum), then as certified(x, v). Every projection is sound: out[v] is 1 wherever
+  /// certified(x, v) is, and for a few fans more.
   void certify(const skinning::Positions& x, std::vector<std::uint8_t>& out) const;
 
   /// Whether v's fan is certified at every instant of the interval x_t0 → x_t1 (each vertex
@@ -63,7 +63,8 @@ class VertexFans {
 
  private:
   /// certified(x, v), and in `axis` the coordinate axis its first projection drops (that along
-  /// which the fan's summed normal is largest).
+  /// which the fan's summed normal is largest); `axis` is left as it was for a vertex without a
+  /// fan of enough triangles (no normal is summed).
   bool certified(const skinning::Positions& x, std::int32_t v, std::size_t& axis) const;
   /// certified()'s second try for a closed fan of m ≥ 3 sectors: along its summed normal n, d its
   /// m spoke differences and d[m] = d[0].
