@@ -62,9 +62,9 @@ class VertexFans {
       const skinning::Positions& x_t0, const skinning::Positions& x_t1, std::int32_t v) const;
 
  private:
-  /// certified(x, v), and in `axis` the coordinate axis its first projection drops (that along
-  /// which the fan's summed normal is largest); `axis` is left as it was for a vertex without a
-  /// fan of enough triangles (no normal is summed).
+  /// certified(x, v), a closed fan tried first in the coordinate projection that drops `axis`
+  /// when axis < 3. When a normal is summed, `axis` becomes the axis along which it is largest
+  /// (the projection certified() chose); else it is left as it was.
   bool certified(const skinning::Positions& x, std::int32_t v, std::size_t& axis) const;
   /// certified()'s second try for a closed fan of m ≥ 3 sectors: along its summed normal n, d its
   /// m spoke differences and d[m] = d[0].

@@ -38,14 +38,21 @@ struct Input {
   skinning::Topology topology;
 };
 
+constexpr std::uint64_t kFnvBasis = 1469598103934665603ull;
+
+/// One byte into an FNV-1a hash.
+inline void fnv_byte(std::uint64_t& h, std::uint8_t byte) {
+  h ^= byte;
+  h *= 1099511628211ull;
+}
+
 /// FNV-1a over the node ranges and the triangle order.
 template <int N>
 std::uint64_t tree_hash(const culling::Bvh<N>& bvh) {
-  std::uint64_t h = 1469598103934665603ull;
+  std::uint64_t h = kFnvBasis;
   const auto mix = [&h](std::int32_t v) {
     for (int b = 0; b < 4; ++b) {
-      h ^= static_cast<std::uint64_t>((static_cast<std::uint32_t>(v) >> (8 * b)) & 0xffu);
-      h *= 1099511628211ull;
+      fnv_byte(h, static_cast<std::uint8_t>(static_cast<std::uint32_t>(v) >> (8 * b)));
     }
   };
   for (const culling::BvhNode& n : bvh.nodes()) {
@@ -96,10 +103,10 @@ void bm_certify(benchmark::State& state, const Input* input) {
     features.fans().certify(input->welded, certified);
     benchmark::DoNotOptimize(certified.data());
   }
-  std::uint64_t h = 1469598103934665603ull;
+  std::uint64_t h = kFnvBasis;
   std::size_t count = 0;
   for (const std::uint8_t c : certified) {
-    h = (h ^ c) * 1099511628211ull;
+    fnv_byte(h, c);
     count += c;
   }
   char label[96];

@@ -478,16 +478,12 @@ TEST(VertexFans, CertifyTriesThePredecessorsProjectionAndStaysSound) {
   std::int64_t extra = 0;
   for (const std::string file :
        {"CesiumMan.glb", "RobotExpressive.glb", "stormtrooper/stormtrooper.dae"}) {
-    const auto model = skinning::load_model(test::asset("characters/" + file));
-    const skinning::Topology topo = skinning::build_topology(*model.mesh);
-    const FeatureTopology ft(*model.mesh, topo);
-    const auto motion = model.motion();
-    skinning::Positions posed, welded;
-    for (const int k : {0, motion->num_samples() / 2}) {
-      motion->positions(k, posed);
-      skinning::gather_welded(topo, posed, welded);
+    const test::WeldedCharacter character(file);
+    const FeatureTopology ft(*character.loaded.mesh, character.topology);
+    for (const int k : {0, character.loaded.motion()->num_samples() / 2}) {
+      const skinning::Positions welded = character.sample(k);
       ft.fans().certify(welded, batch);
-      for (std::int32_t v = 0; v < topo.num_welded_vertices(); ++v) {
+      for (std::int32_t v = 0; v < character.topology.num_welded_vertices(); ++v) {
         const bool single = ft.fans().certified(welded, v);
         const bool many = batch[static_cast<std::size_t>(v)] != 0;
         if (single) {
