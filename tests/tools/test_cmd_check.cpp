@@ -194,19 +194,35 @@ TEST(CmdCheck, KilledRunLeavesALogWithEveryCompletedFrame) {
             "-o", log_path.c_str(), static_cast<char*>(nullptr));
     ::_exit(127);
   }
-  // Poll the log (the writer takes no file lock) until a few rows are on disk, then kill.
+  // Poll the log until a few rows are on disk, then kill. The run is stopped (SIGSTOP) while the
+  // log is read: the writer flushes twice per row, every few ms, and a read racing it fails
+  // (the writer takes no file lock); polling a running writer saw no rows before the end of the
+  // whole run in about half the runs on a loaded 2-core machine. Stopped mid-flush, the read
+  // fails and the run goes on to the next poll; the kill comes while it is stopped, at a state
+  // the read saw whole.
   std::size_t seen = 0;
+  int status = 0;
+  bool ended = false;
   const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
   while (seen < 5 && std::chrono::steady_clock::now() < deadline) {
     std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    ASSERT_EQ(::kill(pid, SIGSTOP), 0);
+    ASSERT_EQ(::waitpid(pid, &status, WUNTRACED), pid);
+    if (!WIFSTOPPED(status)) {
+      ended = true;
+      break;
+    }
     try {
       seen = read_log(log_path, ReadLogOptions{.findings = false}).frames.size();
     } catch (const std::exception&) {
-      // not created yet, or caught mid-write: poll again
+      // not created yet, or stopped mid-write: poll again
+    }
+    if (seen < 5) {
+      ASSERT_EQ(::kill(pid, SIGCONT), 0);
     }
   }
-  ASSERT_EQ(::kill(pid, SIGKILL), 0);
-  int status = 0;
+  ASSERT_FALSE(ended) << "the run ended before it was killed";
+  ASSERT_EQ(::kill(pid, SIGKILL), 0);  // stopped or not, it dies
   ASSERT_EQ(::waitpid(pid, &status, 0), pid);
   ASSERT_TRUE(WIFSIGNALED(status)) << "the run ended before it was killed";
   ASSERT_GE(seen, 5u) << "no rows appeared within 60 s";
