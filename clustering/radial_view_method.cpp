@@ -125,6 +125,22 @@ const skinning::Topology& used_topology(
   return ghosts ? ghosts->topology : real;
 }
 
+/// The FeatureTopology of the method's DCD (its `bvh` and its updater): `offered` (the method
+/// options') when built from these very objects, else a new one.
+std::shared_ptr<const culling::FeatureTopology> dcd_features(
+    const std::shared_ptr<const culling::FeatureTopology>& offered,
+    const skinning::Mesh& mesh,
+    const skinning::Topology& topology) {
+  if (offered != nullptr && offered->built_from(mesh, topology)) return offered;
+  return std::make_shared<const culling::FeatureTopology>(mesh, topology);
+}
+
+culling::MethodOptions with_features(
+    culling::MethodOptions options, std::shared_ptr<const culling::FeatureTopology> features) {
+  options.features = std::move(features);
+  return options;
+}
+
 /// Patches smaller than this are not classified (their triangles are tested as Hᵘ): a ray costs
 /// a pass over the component, and a few triangles skipped save less than that.
 constexpr std::int32_t kMinPatch = 8;
@@ -189,13 +205,17 @@ RadialViewMethod::RadialViewMethod(
       method_options_(method_options),
       options_(options),
       tests_(culling::with_ccd_defaults(method_options.elementary)),
+      dcd_features_(dcd_features(
+          method_options.features,
+          used_mesh(ghosts_, real_mesh),
+          used_topology(ghosts_, real_topology))),
       // The bvh method checks the method options (min_separation, accuracy) as every method does.
       bvh_(culling::make_method(
           "bvh",
           used_mesh(ghosts_, real_mesh),
           used_topology(ghosts_, real_topology),
-          method_options_)),
-      updater_(used_mesh(ghosts_, real_mesh), used_topology(ghosts_, real_topology)),
+          with_features(method_options_, dcd_features_))),
+      updater_(used_mesh(ghosts_, real_mesh), used_topology(ghosts_, real_topology), dcd_features_),
       builder_(clusters_, options.clusters),
       edge_face_offsets_(used_topology(ghosts_, real_topology).edge_face_offsets),
       edge_faces_(used_topology(ghosts_, real_topology).edge_faces),

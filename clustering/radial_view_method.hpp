@@ -185,6 +185,9 @@ class RadialViewMethod final : public culling::CullingMethod {
   RadialViewOptions options_;
   culling::ElementaryTests tests_;
   ccd::CcdOptions ccd_options_;
+  // The DCD's FeatureTopology (triangle order), shared by bvh_ and updater_: the method options'
+  // when built from the mesh used here, else built once for both.
+  std::shared_ptr<const culling::FeatureTopology> dcd_features_;
   std::unique_ptr<culling::CullingMethod> bvh_;  // DCD
   culling::DcdUpdater updater_;                  // the intersecting pairs from one end to the next
   MegaClusterBuilder builder_;

@@ -37,7 +37,11 @@ FeatureTopology::FeatureTopology(
     const skinning::Mesh& mesh,
     const skinning::Topology& topology,
     std::span<const std::int32_t> owner_order)
-    : welded_triangles_(topology.welded_triangles), num_vertices_(topology.num_welded_vertices()) {
+    : mesh_(&mesh),
+      topology_(&topology),
+      triangle_order_(owner_order.empty()),
+      welded_triangles_(topology.welded_triangles),
+      num_vertices_(topology.num_welded_vertices()) {
   const auto num_faces = static_cast<std::size_t>(topology.welded_triangles.rows());
   const auto num_edges = static_cast<std::size_t>(topology.edges.rows());
   const auto num_vertices = static_cast<std::size_t>(num_vertices_);

@@ -37,6 +37,14 @@ class FeatureTopology {
       const skinning::Topology& topology,
       std::span<const std::int32_t> owner_order = {});
 
+  /// True when this was built from these very objects (by address) in triangle order (no
+  /// owner_order): what a method may take instead of building its own (MethodOptions::features).
+  /// A mesh of other parts or exclusions can have the same triangles, so the counts do not say it.
+  [[nodiscard]] bool built_from(
+      const skinning::Mesh& mesh, const skinning::Topology& topology) const {
+    return mesh_ == &mesh && topology_ == &topology && triangle_order_;
+  }
+
   [[nodiscard]] std::int32_t num_vertices() const { return num_vertices_; }
   [[nodiscard]] std::int32_t num_triangles() const {
     return static_cast<std::int32_t>(triangles_.size());
@@ -133,6 +141,10 @@ class FeatureTopology {
   [[nodiscard]] bool all_excluded(
       std::span<const std::int32_t> parts_a, std::span<const std::int32_t> parts_b) const;
 
+  // Provenance, for built_from: the objects given to the constructor (never read through).
+  const skinning::Mesh* mesh_ = nullptr;
+  const skinning::Topology* topology_ = nullptr;
+  bool triangle_order_ = true;
   skinning::Triangles welded_triangles_;
   std::int32_t num_vertices_ = 0;
   std::vector<std::array<std::int32_t, 3>> triangles_;

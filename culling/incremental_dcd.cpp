@@ -13,8 +13,15 @@ inline std::size_t at(std::int32_t i) { return static_cast<std::size_t>(i); }
 
 }  // namespace
 
-DcdUpdater::DcdUpdater(const skinning::Mesh& mesh, const skinning::Topology& topology)
-    : features_(mesh, topology),
+DcdUpdater::DcdUpdater(
+    const skinning::Mesh& mesh,
+    const skinning::Topology& topology,
+    std::shared_ptr<const FeatureTopology> features)
+    : shared_(
+          features != nullptr && features->built_from(mesh, topology)
+              ? std::move(features)
+              : std::make_shared<const FeatureTopology>(mesh, topology)),
+      features_(*shared_),
       edge_face_offsets_(topology.edge_face_offsets),
       edge_faces_(topology.edge_faces) {
   const std::int32_t num_vertices = features_.num_vertices();

@@ -12,6 +12,7 @@
 // (tests/culling/test_incremental_dcd.cpp compares them sample by sample).
 
 #include <cstdint>
+#include <memory>
 #include <span>
 #include <vector>
 
@@ -28,8 +29,14 @@ class DcdUpdater {
  public:
   /// Builds the incidences (vertex → triangles, edge → triangles) and the DCD rules of `mesh`
   /// (excluded parts, duplicate faces) for its welded `topology`.
+  /// @param features the mesh's FeatureTopology when the caller has one built from these very
+  ///        objects (FeatureTopology::built_from; the runner's, shared by its methods): used, not
+  ///        built again. Null or built from other objects: one is built here.
   /// @throws InvalidInput as FeatureTopology's constructor.
-  DcdUpdater(const skinning::Mesh& mesh, const skinning::Topology& topology);
+  DcdUpdater(
+      const skinning::Mesh& mesh,
+      const skinning::Topology& topology,
+      std::shared_ptr<const FeatureTopology> features = {});
 
   /// The triangle pairs (a < b, sorted, each once) that hold the features of some contact in
   /// `contacts` and that the DCD checks (not part-excluded, not a duplicate face): a VF contact
@@ -51,9 +58,14 @@ class DcdUpdater {
       FrameResult& out);
 
   [[nodiscard]] const FeatureTopology& features() const { return features_; }
+  /// The FeatureTopology it uses (built here or lent), for a method to share.
+  [[nodiscard]] const std::shared_ptr<const FeatureTopology>& shared_features() const {
+    return shared_;
+  }
 
  private:
-  FeatureTopology features_;
+  std::shared_ptr<const FeatureTopology> shared_;
+  const FeatureTopology& features_;                // *shared_
   std::vector<std::int32_t> vertex_face_offsets_;  // CSR welded vertex → triangles
   std::vector<std::int32_t> vertex_faces_;
   std::vector<std::int32_t> edge_face_offsets_;  // CSR edge → triangles (Topology's)

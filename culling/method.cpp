@@ -13,6 +13,18 @@
 namespace skelcd::culling {
 namespace detail {
 
+std::shared_ptr<const FeatureTopology> shared_or_built(
+    std::shared_ptr<const FeatureTopology> lent,
+    const MethodOptions& options,
+    const skinning::Mesh& mesh,
+    const skinning::Topology& topology) {
+  if (lent != nullptr) return lent;
+  if (options.features != nullptr && options.features->built_from(mesh, topology)) {
+    return options.features;
+  }
+  return std::make_shared<const FeatureTopology>(mesh, topology);
+}
+
 MethodBase::MethodBase(
     std::string_view name,
     const skinning::Mesh& mesh,
@@ -20,9 +32,7 @@ MethodBase::MethodBase(
     const MethodOptions& options,
     std::shared_ptr<const FeatureTopology> features)
     : name_(name),
-      features_(
-          features != nullptr ? std::move(features)
-                              : std::make_shared<const FeatureTopology>(mesh, topology)),
+      features_(shared_or_built(std::move(features), options, mesh, topology)),
       topology_(*features_),
       options_(options),
       tests_(with_ccd_defaults(options.elementary)) {

@@ -53,6 +53,11 @@ struct MethodOptions {
   /// memory"): what a query holds at once grows with it, not with the motion. The findings do not
   /// depend on it; tests make it small to cut a query into many blocks. ≥ 1.
   std::size_t block_pairs = kCcdBlockPairs;
+  /// The mesh's FeatureTopology, when the caller built one to share (the runner: one for all its
+  /// methods, their DCD updaters and its threads; docs/culling.md "Bounded memory"). A method
+  /// takes it only when it was built from the very mesh and topology objects it is given
+  /// (FeatureTopology::built_from); otherwise, and when null, it builds its own.
+  std::shared_ptr<const FeatureTopology> features{};
 };
 
 /// Where one connected component (Topology::components) goes under `auto` (routed_method.hpp).

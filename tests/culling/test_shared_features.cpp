@@ -1,0 +1,115 @@
+// MethodOptions::features: the runner builds one FeatureTopology and its methods and DCD updaters
+// take it instead of building their own — but only one built from the very mesh and topology they
+// are given. A mesh with the same triangles and other part exclusions (what `auto` hands its
+// closed group) must not take it: its findings would follow the other mesh's exclusions.
+#include <gtest/gtest.h>
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "culling/detail/method_base.hpp"
+#include "culling/incremental_dcd.hpp"
+#include "culling/method.hpp"
+#include "tests/culling/procedural_meshes.hpp"
+
+namespace skelcd::culling {
+namespace {
+
+/// Two parts: a sheet in z = 0 and a sheet standing across it (the plane y = 1.03), which cut
+/// each other along a line.
+skinning::Mesh crossing_sheets() {
+  const skinning::Mesh flat = test::sheet(6, 6, 2.0, 2.0);
+  skinning::Mesh standing = test::sheet(6, 6, 2.0, 2.0);
+  for (Eigen::Index v = 0; v < standing.rest_positions.rows(); ++v) {
+    const double x = standing.rest_positions(v, 0);
+    const double y = standing.rest_positions(v, 1);
+    standing.rest_positions.row(v) << x + 0.1, 1.03, y - 0.97;
+  }
+  return test::combine(flat, standing);
+}
+
+const FeatureTopology* features_of(const CullingMethod& m) {
+  const auto* base = dynamic_cast<const detail::MethodBase*>(&m);
+  return base == nullptr ? nullptr : base->feature_topology().get();
+}
+
+TEST(SharedFeatures, MethodsTakeTheOptionsFeaturesOnlyWhenBuiltFromTheirMeshAndTopology) {
+  const skinning::Mesh mesh = crossing_sheets();
+  skinning::Mesh excluded = mesh;  // the same triangles; the two parts may not collide
+  excluded.excluded_part_pairs = {{0, 1}};
+  const auto topology = test::simple_topology(mesh);
+  const auto x = test::welded(topology, mesh.rest_positions);
+  skinning::Positions raised = mesh.rest_positions;  // the standing sheet 0.4 higher
+  for (Eigen::Index v = 0; v < raised.rows(); ++v) {
+    if (mesh.vertex_part[static_cast<std::size_t>(v)] == 1) raised(v, 2) += 0.4;
+  }
+  const auto x_t0 = test::welded(topology, raised);
+
+  MethodOptions options;
+  options.features = std::make_shared<const FeatureTopology>(mesh, topology);
+  ASSERT_TRUE(options.features->built_from(mesh, topology));
+  EXPECT_FALSE(options.features->built_from(excluded, topology));
+  const skinning::Topology copy = topology;
+  EXPECT_FALSE(options.features->built_from(mesh, copy));
+  std::vector<std::int32_t> reversed;
+  for (auto f = static_cast<std::int32_t>(topology.welded_triangles.rows()) - 1; f >= 0; --f) {
+    reversed.push_back(f);
+  }
+  EXPECT_FALSE(FeatureTopology(mesh, topology, reversed).built_from(mesh, topology));
+
+  for (const std::string name : {"brute", "bvh", "kdop", "auto"}) {
+    SCOPED_TRACE(name);
+    const auto own = make_method(name, mesh, topology);
+    const auto shared = make_method(name, mesh, topology, options);
+    const auto other = make_method(name, excluded, topology, options);
+    EXPECT_EQ(features_of(*shared), options.features.get());
+    EXPECT_NE(features_of(*own), options.features.get());
+    EXPECT_NE(features_of(*other), options.features.get());
+
+    FrameResult a, b, c;
+    own->detect_dcd(x, a);
+    shared->detect_dcd(x, b);
+    other->detect_dcd(x, c);
+    EXPECT_FALSE(a.dcd_pairs.empty());  // the sheets cut each other
+    EXPECT_EQ(b.dcd_pairs, a.dcd_pairs);
+    EXPECT_TRUE(c.dcd_pairs.empty());  // the excluded mesh's rule, not the shared topology's
+
+    // The standing sheet's motion down through the flat one: contacts, none where excluded.
+    FrameResult ca, cb, cc;
+    own->detect_ccd(x_t0, x, ca);
+    shared->detect_ccd(x_t0, x, cb);
+    other->detect_ccd(x_t0, x, cc);
+    EXPECT_FALSE(ca.contacts.empty());
+    EXPECT_EQ(cb.contacts.size(), ca.contacts.size());
+    EXPECT_LT(cc.contacts.size(), ca.contacts.size());
+  }
+}
+
+TEST(SharedFeatures, DcdUpdaterTakesTheFeaturesOnlyWhenBuiltFromItsMeshAndTopology) {
+  const skinning::Mesh mesh = crossing_sheets();
+  skinning::Mesh excluded = mesh;
+  excluded.excluded_part_pairs = {{0, 1}};
+  const auto topology = test::simple_topology(mesh);
+  const auto features = std::make_shared<const FeatureTopology>(mesh, topology);
+
+  const DcdUpdater shared(mesh, topology, features);
+  EXPECT_EQ(shared.shared_features(), features);
+  const DcdUpdater other(excluded, topology, features);
+  EXPECT_NE(other.shared_features(), features);
+  // Every pair of one triangle of each sheet, as the updater's rules see it.
+  std::vector<CcdContact> contacts;
+  CcdContact c;
+  c.kind = CcdContact::Kind::vf;
+  c.a = topology.welded_triangles(0, 0);
+  c.b = static_cast<std::int32_t>(topology.welded_triangles.rows()) - 1;
+  contacts.push_back(c);
+  std::vector<TrianglePair> with_shared, with_other;
+  shared.affected_pairs(contacts, with_shared);
+  other.affected_pairs(contacts, with_other);
+  EXPECT_FALSE(with_shared.empty());
+  EXPECT_TRUE(with_other.empty());  // the excluded mesh's rule
+}
+
+}  // namespace
+}  // namespace skelcd::culling
