@@ -125,16 +125,6 @@ const skinning::Topology& used_topology(
   return ghosts ? ghosts->topology : real;
 }
 
-/// The FeatureTopology of the method's DCD (its `bvh` and its updater): `offered` (the method
-/// options') when built from these very objects, else a new one.
-std::shared_ptr<const culling::FeatureTopology> dcd_features(
-    const std::shared_ptr<const culling::FeatureTopology>& offered,
-    const skinning::Mesh& mesh,
-    const skinning::Topology& topology) {
-  if (offered != nullptr && offered->built_from(mesh, topology)) return offered;
-  return std::make_shared<const culling::FeatureTopology>(mesh, topology);
-}
-
 culling::MethodOptions with_features(
     culling::MethodOptions options, std::shared_ptr<const culling::FeatureTopology> features) {
   options.features = std::move(features);
@@ -205,7 +195,7 @@ RadialViewMethod::RadialViewMethod(
       method_options_(method_options),
       options_(options),
       tests_(culling::with_ccd_defaults(method_options.elementary)),
-      dcd_features_(dcd_features(
+      dcd_features_(culling::shared_or_built(
           method_options.features,
           used_mesh(ghosts_, real_mesh),
           used_topology(ghosts_, real_topology))),

@@ -264,4 +264,12 @@ ccd::SharedCorners FeatureTopology::shared_corners(
   return shared;
 }
 
+std::shared_ptr<const FeatureTopology> shared_or_built(
+    std::shared_ptr<const FeatureTopology> offered,
+    const skinning::Mesh& mesh,
+    const skinning::Topology& topology) {
+  if (offered != nullptr && offered->built_from(mesh, topology)) return offered;
+  return std::make_shared<const FeatureTopology>(mesh, topology);
+}
+
 }  // namespace skelcd::culling

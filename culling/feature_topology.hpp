@@ -7,6 +7,7 @@
 
 #include <array>
 #include <cstdint>
+#include <memory>
 #include <span>
 #include <vector>
 
@@ -166,5 +167,13 @@ class FeatureTopology {
   bool has_exclusions_ = false;
   VertexFans fans_;
 };
+
+/// `offered` when it was built from these very objects in triangle order (built_from), else a new
+/// FeatureTopology(mesh, topology): how a method or a DCD updater takes the one its caller shares
+/// (MethodOptions::features) without ever taking one of another mesh.
+[[nodiscard]] std::shared_ptr<const FeatureTopology> shared_or_built(
+    std::shared_ptr<const FeatureTopology> offered,
+    const skinning::Mesh& mesh,
+    const skinning::Topology& topology);
 
 }  // namespace skelcd::culling

@@ -17,10 +17,7 @@ DcdUpdater::DcdUpdater(
     const skinning::Mesh& mesh,
     const skinning::Topology& topology,
     std::shared_ptr<const FeatureTopology> features)
-    : shared_(
-          features != nullptr && features->built_from(mesh, topology)
-              ? std::move(features)
-              : std::make_shared<const FeatureTopology>(mesh, topology)),
+    : shared_(shared_or_built(std::move(features), mesh, topology)),
       features_(*shared_),
       edge_face_offsets_(topology.edge_face_offsets),
       edge_faces_(topology.edge_faces) {

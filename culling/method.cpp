@@ -13,18 +13,6 @@
 namespace skelcd::culling {
 namespace detail {
 
-std::shared_ptr<const FeatureTopology> shared_or_built(
-    std::shared_ptr<const FeatureTopology> lent,
-    const MethodOptions& options,
-    const skinning::Mesh& mesh,
-    const skinning::Topology& topology) {
-  if (lent != nullptr) return lent;
-  if (options.features != nullptr && options.features->built_from(mesh, topology)) {
-    return options.features;
-  }
-  return std::make_shared<const FeatureTopology>(mesh, topology);
-}
-
 MethodBase::MethodBase(
     std::string_view name,
     const skinning::Mesh& mesh,
@@ -32,7 +20,9 @@ MethodBase::MethodBase(
     const MethodOptions& options,
     std::shared_ptr<const FeatureTopology> features)
     : name_(name),
-      features_(shared_or_built(std::move(features), options, mesh, topology)),
+      features_(
+          features != nullptr ? std::move(features)
+                              : shared_or_built(options.features, mesh, topology)),
       topology_(*features_),
       options_(options),
       tests_(with_ccd_defaults(options.elementary)) {

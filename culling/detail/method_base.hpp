@@ -12,14 +12,6 @@
 
 namespace skelcd::culling::detail {
 
-/// `lent` when not null; else options.features when it was built from these very objects
-/// (FeatureTopology::built_from); else a new FeatureTopology(mesh, topology).
-[[nodiscard]] std::shared_ptr<const FeatureTopology> shared_or_built(
-    std::shared_ptr<const FeatureTopology> lent,
-    const MethodOptions& options,
-    const skinning::Mesh& mesh,
-    const skinning::Topology& topology);
-
 class MethodBase : public CullingMethod {
  public:
   [[nodiscard]] std::string_view name() const override { return name_; }
@@ -32,7 +24,7 @@ class MethodBase : public CullingMethod {
 
  protected:
   /// @param features when not null, a FeatureTopology(mesh, topology) another method built, used
-  ///        instead of building another one; when null, shared_or_built's choice.
+  ///        instead of building another one; when null, shared_or_built(options.features, …).
   /// @throws InvalidInput for bad options, or features of another triangle count.
   MethodBase(
       std::string_view name,

@@ -57,6 +57,12 @@ TEST(SharedFeatures, MethodsTakeTheOptionsFeaturesOnlyWhenBuiltFromTheirMeshAndT
     reversed.push_back(f);
   }
   EXPECT_FALSE(FeatureTopology(mesh, topology, reversed).built_from(mesh, topology));
+  EXPECT_EQ(shared_or_built(options.features, mesh, topology), options.features);
+  const auto built = shared_or_built(options.features, excluded, topology);
+  ASSERT_NE(built, nullptr);
+  EXPECT_NE(built, options.features);
+  EXPECT_TRUE(built->built_from(excluded, topology));
+  EXPECT_TRUE(shared_or_built(nullptr, mesh, topology)->built_from(mesh, topology));
 
   for (const std::string name : {"brute", "bvh", "kdop", "auto"}) {
     SCOPED_TRACE(name);
