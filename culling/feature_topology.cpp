@@ -38,7 +38,7 @@ FeatureTopology::FeatureTopology(
     const skinning::Topology& topology,
     std::span<const std::int32_t> owner_order)
     : mesh_(&mesh),
-      topology_(&topology),
+      topology_(identity(topology)),
       triangle_order_(owner_order.empty()),
       welded_triangles_(topology.welded_triangles),
       num_vertices_(topology.num_welded_vertices()) {

@@ -38,12 +38,15 @@ class FeatureTopology {
       const skinning::Topology& topology,
       std::span<const std::int32_t> owner_order = {});
 
-  /// True when this was built from these very objects (by address) in triangle order (no
-  /// owner_order): what a method may take instead of building its own (MethodOptions::features).
-  /// A mesh of other parts or exclusions can have the same triangles, so the counts do not say it.
+  /// True when this was built from these very objects in triangle order (no owner_order): what a
+  /// method may take instead of building its own (MethodOptions::features). A mesh of other parts
+  /// or exclusions can have the same triangles, so the counts do not say it. The mesh by address;
+  /// the topology by the address of its welded-triangle array, which a move of the Topology keeps
+  /// and a copy does not (so that a caller may build this, then move the topology into its owner),
+  /// and by its own address when that array is empty.
   [[nodiscard]] bool built_from(
       const skinning::Mesh& mesh, const skinning::Topology& topology) const {
-    return mesh_ == &mesh && topology_ == &topology && triangle_order_;
+    return triangle_order_ && mesh_ == &mesh && topology_ == identity(topology);
   }
 
   [[nodiscard]] std::int32_t num_vertices() const { return num_vertices_; }
@@ -142,9 +145,15 @@ class FeatureTopology {
   [[nodiscard]] bool all_excluded(
       std::span<const std::int32_t> parts_a, std::span<const std::int32_t> parts_b) const;
 
-  // Provenance, for built_from: the objects given to the constructor (never read through).
+  /// What built_from compares a topology by (never read through).
+  [[nodiscard]] static const void* identity(const skinning::Topology& topology) {
+    const void* triangles = topology.welded_triangles.data();
+    return triangles != nullptr ? triangles : static_cast<const void*>(&topology);
+  }
+
+  // Provenance, for built_from: the mesh given to the constructor and identity(topology).
   const skinning::Mesh* mesh_ = nullptr;
-  const skinning::Topology* topology_ = nullptr;
+  const void* topology_ = nullptr;
   bool triangle_order_ = true;
   skinning::Triangles welded_triangles_;
   std::int32_t num_vertices_ = 0;

@@ -50,8 +50,13 @@ TEST(SharedFeatures, MethodsTakeTheOptionsFeaturesOnlyWhenBuiltFromTheirMeshAndT
   options.features = std::make_shared<const FeatureTopology>(mesh, topology);
   ASSERT_TRUE(options.features->built_from(mesh, topology));
   EXPECT_FALSE(options.features->built_from(excluded, topology));
-  const skinning::Topology copy = topology;
+  skinning::Topology copy = topology;
   EXPECT_FALSE(options.features->built_from(mesh, copy));
+  // A topology moved into its owner after the build (what a serial check does) is still the one.
+  const auto of_copy = std::make_shared<const FeatureTopology>(mesh, copy);
+  const skinning::Topology moved = std::move(copy);
+  EXPECT_TRUE(of_copy->built_from(mesh, moved));
+  EXPECT_FALSE(of_copy->built_from(mesh, topology));
   std::vector<std::int32_t> reversed;
   for (auto f = static_cast<std::int32_t>(topology.welded_triangles.rows()) - 1; f >= 0; --f) {
     reversed.push_back(f);

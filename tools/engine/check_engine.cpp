@@ -130,15 +130,23 @@ CheckOutcome check_model(
     });
   }
   outcome.radial_view = setup_radial_view(request.radial_view, model, *motion, options);
+  // A serial run builds the mesh's FeatureTopology once for the baseline's `bvh` and the runner
+  // (which takes the topology by move: FeatureTopology::built_from still holds there).
+  std::shared_ptr<const culling::FeatureTopology> features;
   if (!parallel) {
     topology = skinning::build_topology(motion->mesh());
-    baseline = baseline_findings(request.baseline, *motion, topology);
+    features = std::make_shared<const culling::FeatureTopology>(motion->mesh(), topology);
+    baseline = baseline_findings(request.baseline, *motion, topology, features);
   }
   ClipRunner runner = [&] {
     try {
       // (A parallel run's runner gets a copy: the baseline's thread may still read this one.)
       return ClipRunner(
-          *motion, options, parallel ? skinning::Topology(topology) : std::move(topology));
+          *motion,
+          options,
+          parallel ? skinning::Topology(topology) : std::move(topology),
+          {},
+          std::move(features));
     } catch (...) {
       if (baseline_task.valid()) baseline_task.get();  // its refusal first, as in a serial run
       throw;

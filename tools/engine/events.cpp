@@ -895,13 +895,18 @@ BaselineFindings baseline_findings(
 }
 
 BaselineFindings baseline_findings(
-    const BaselineSpec& spec, const skinning::Motion& motion, const skinning::Topology& topology) {
+    const BaselineSpec& spec,
+    const skinning::Motion& motion,
+    const skinning::Topology& topology,
+    std::shared_ptr<const culling::FeatureTopology> features) {
   const skinning::Mesh& mesh = motion.mesh();
   const auto positions_at = [&motion](std::int32_t sample, skinning::Positions& out) {
     motion.positions(sample, out);
   };
   const auto dcd = [&](const skinning::Positions& x) {
-    const auto method = culling::make_method("bvh", mesh, topology);
+    culling::MethodOptions options;
+    options.features = features;
+    const auto method = culling::make_method("bvh", mesh, topology, options);
     skinning::Positions welded;
     skinning::gather_welded(topology, x, welded);
     culling::FrameResult found;

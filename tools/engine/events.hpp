@@ -17,6 +17,10 @@
 #include "tools/io/event_record.hpp"
 #include "tools/io/frame_report.hpp"
 
+namespace skelcd::culling {
+class FeatureTopology;
+}
+
 namespace skelcd::tools {
 
 /// What a check compares its findings with (`--baseline`, a scene's `baseline` key).
@@ -108,10 +112,15 @@ class EventTracker {
         std::vector<std::pair<std::int32_t, std::int32_t>>(const skinning::Positions&)>& dcd);
 
 /// The baseline findings of `spec` for `motion`: DCD (`bvh`, exact) at the rest pose or at a
-/// sample of the motion, nothing for none, a log's findings. `topology` is the motion mesh's.
+/// sample of the motion, nothing for none, a log's findings. `topology` is the motion mesh's;
+/// `features`, when given and built from the two (culling::FeatureTopology::built_from), is the
+/// `bvh`'s instead of one of its own (a serial check shares it with its runner).
 /// @throws as above.
 [[nodiscard]] BaselineFindings baseline_findings(
-    const BaselineSpec& spec, const skinning::Motion& motion, const skinning::Topology& topology);
+    const BaselineSpec& spec,
+    const skinning::Motion& motion,
+    const skinning::Topology& topology,
+    std::shared_ptr<const culling::FeatureTopology> features = {});
 
 /// Length of the segment along which triangles (p0, p1, p2) and (q0, q1, q2) intersect (0 when
 /// they do not, or are coplanar): the depth measure of an event.

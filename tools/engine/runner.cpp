@@ -404,7 +404,8 @@ ClipRunner::ClipRunner(
     const skinning::Motion& motion,
     const RunOptions& options,
     skinning::Topology topology,
-    MethodFactory factory)
+    MethodFactory factory,
+    std::shared_ptr<const culling::FeatureTopology> features)
     : motion_(motion),
       options_(options),
       factory_(std::move(factory)),
@@ -457,8 +458,9 @@ ClipRunner::ClipRunner(
   // One FeatureTopology of the mesh, in triangle order, for every thread's method (and what they
   // build over the same mesh) and the DCD updaters: the same for all, where each used to build
   // its own (`dynamic` on one thread: its `bvh`, its updater and the runner's updater, three).
+  // The caller's, when built from the mesh and the topology moved in here.
   method_options_.features =
-      std::make_shared<const culling::FeatureTopology>(motion_.mesh(), topology_);
+      culling::shared_or_built(std::move(features), motion_.mesh(), topology_);
 
   // The method; in a parallel run, the other workers' methods at the same time on threads of
   // their own, so that every worker starts checking with the first block instead of one waiting

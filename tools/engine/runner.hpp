@@ -101,13 +101,17 @@ class ClipRunner {
   ClipRunner(const skinning::Motion& motion, const RunOptions& options, MethodFactory factory = {});
   /// The same on a topology the caller built (skinning::build_topology(motion.mesh())), so that
   /// what it computes on the topology first — the baseline DCD with its own `bvh` — is freed
-  /// before this runner builds its method, and the two never hold memory at once.
+  /// before this runner builds its method, and the two never hold memory at once. `features`,
+  /// when the caller built it from motion.mesh() and this topology before moving the topology in
+  /// (culling::FeatureTopology::built_from still holds), is the one the runner's methods share
+  /// instead of a new one (a serial check's baseline `bvh` used it first).
   /// @pre topology == skinning::build_topology(motion.mesh()).
   ClipRunner(
       const skinning::Motion& motion,
       const RunOptions& options,
       skinning::Topology topology,
-      MethodFactory factory = {});
+      MethodFactory factory = {},
+      std::shared_ptr<const culling::FeatureTopology> features = {});
 
   [[nodiscard]] const RunPlan& plan() const { return plan_; }
   [[nodiscard]] const skinning::Topology& topology() const { return topology_; }
