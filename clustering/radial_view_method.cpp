@@ -195,17 +195,16 @@ RadialViewMethod::RadialViewMethod(
       method_options_(method_options),
       options_(options),
       tests_(culling::with_ccd_defaults(method_options.elementary)),
-      dcd_features_(culling::shared_or_built(
-          method_options.features,
+      updater_(
           used_mesh(ghosts_, real_mesh),
-          used_topology(ghosts_, real_topology))),
+          used_topology(ghosts_, real_topology),
+          method_options.features),
       // The bvh method checks the method options (min_separation, accuracy) as every method does.
       bvh_(culling::make_method(
           "bvh",
           used_mesh(ghosts_, real_mesh),
           used_topology(ghosts_, real_topology),
-          with_features(method_options_, dcd_features_))),
-      updater_(used_mesh(ghosts_, real_mesh), used_topology(ghosts_, real_topology), dcd_features_),
+          with_features(method_options_, updater_.shared_features()))),
       builder_(clusters_, options.clusters),
       edge_face_offsets_(used_topology(ghosts_, real_topology).edge_face_offsets),
       edge_faces_(used_topology(ghosts_, real_topology).edge_faces),

@@ -185,11 +185,10 @@ class RadialViewMethod final : public culling::CullingMethod {
   RadialViewOptions options_;
   culling::ElementaryTests tests_;
   ccd::CcdOptions ccd_options_;
-  // The DCD's FeatureTopology (triangle order), shared by bvh_ and updater_: the method options'
-  // when built from the mesh used here, else built once for both.
-  std::shared_ptr<const culling::FeatureTopology> dcd_features_;
+  // The intersecting pairs from one end to the next; built before bvh_, which takes its
+  // FeatureTopology (the method options' when built from the mesh used here, else its own).
+  culling::DcdUpdater updater_;
   std::unique_ptr<culling::CullingMethod> bvh_;  // DCD
-  culling::DcdUpdater updater_;                  // the intersecting pairs from one end to the next
   MegaClusterBuilder builder_;
   std::vector<std::int32_t> edge_face_offsets_, edge_faces_;
   std::vector<std::int32_t> component_offsets_, component_triangles_;  // CSR component → triangles

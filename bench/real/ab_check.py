@@ -32,13 +32,15 @@ def run(exe, args):
         start = time.perf_counter()
         p = subprocess.Popen(
             [exe, "check", *args, "--json"], stdout=subprocess.PIPE, stderr=err, text=True)
-        out = p.stdout.read()
+        with p.stdout:
+            out = p.stdout.read()
         _, status, usage = os.wait4(p.pid, 0)
         wall = time.perf_counter() - start
-        p.returncode = os.waitstatus_to_exitcode(status)
-        if p.returncode != 0:
+        code = os.waitstatus_to_exitcode(status)
+        p.returncode = code  # reaped by wait4: Popen must not wait for it again
+        if code != 0:
             err.seek(0)
-            sys.exit(f"ab_check.py: {exe} check {' '.join(args)} failed ({p.returncode}): "
+            sys.exit(f"ab_check.py: {exe} check {' '.join(args)} failed ({code}): "
                      f"{err.read().strip()}")
     return wall, usage.ru_utime + usage.ru_stime, usage.ru_maxrss, json.loads(out)
 
