@@ -1,7 +1,6 @@
 #include "clustering/ghost_caps.hpp"
 
 #include <algorithm>
-#include <map>
 #include <utility>
 
 namespace skelcd::clustering {
@@ -88,18 +87,19 @@ std::unique_ptr<GhostCaps> cap_small_loops(
       return nullptr;
     }
   }
-  // Edge ids: the capped topology numbers its edges its own way.
-  std::map<std::pair<std::int32_t, std::int32_t>, std::int32_t> real;
-  for (std::int32_t e = 0; e < topology.num_edges(); ++e) {
-    const auto a = topology.edges(e, 0), b = topology.edges(e, 1);
-    real.emplace(std::minmax(a, b), e);
-  }
+  // Edge ids: both topologies list their edges sorted by (smaller, larger) welded vertex, and
+  // every edge between two real vertices of the capped mesh is a real edge (the ghosts add only
+  // edges to their centres): one merge of the two sorted lists pairs them.
   caps->real_edge.assign(at(t.num_edges()), -1);
+  const auto key = [](const skinning::Topology& topo, std::int32_t e) {
+    return std::minmax(topo.edges(e, 0), topo.edges(e, 1));
+  };
+  std::int32_t r = 0;
   for (std::int32_t e = 0; e < t.num_edges(); ++e) {
-    const auto a = t.edges(e, 0), b = t.edges(e, 1);
-    if (a >= num_welded || b >= num_welded) continue;
-    const auto it = real.find(std::minmax(a, b));
-    if (it != real.end()) caps->real_edge[at(e)] = it->second;
+    const auto k = key(t, e);
+    if (k.second >= num_welded) continue;
+    while (r < topology.num_edges() && key(topology, r) < k) ++r;
+    if (r < topology.num_edges() && key(topology, r) == k) caps->real_edge[at(e)] = r;
   }
   return caps;
 }

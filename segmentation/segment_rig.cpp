@@ -3,6 +3,7 @@
 
 #include <chrono>
 #include <limits>
+#include <stdexcept>
 #include <string>
 
 #include "segmentation/segmentation.hpp"
@@ -58,16 +59,32 @@ Eigen::MatrixXd welded_rig_weights(const skinning::Rig& rig, const skinning::Top
   return W;
 }
 
-}  // namespace
-
-Segmentation segment(const skinning::Rig& rig, const SegmentationOptions& options) {
+/// The refusals that come before the mesh is welded.
+void require_segmentable(const skinning::Rig& rig) {
   if (rig.skeleton.bones.empty()) {
     throw InvalidInput(rig.source + ": cannot segment: the skeleton has no bones");
   }
   if (rig.mesh.num_triangles() == 0) {
     throw InvalidInput(rig.source + ": cannot segment: the mesh has no triangles");
   }
-  const auto topology = skinning::build_topology(rig.mesh);
+}
+
+}  // namespace
+
+Segmentation segment(const skinning::Rig& rig, const SegmentationOptions& options) {
+  require_segmentable(rig);
+  return segment(rig, options, skinning::build_topology(rig.mesh));
+}
+
+Segmentation segment(
+    const skinning::Rig& rig,
+    const SegmentationOptions& options,
+    const skinning::Topology& topology) {
+  require_segmentable(rig);
+  if (topology.welded_of_vertex.size() != static_cast<std::size_t>(rig.mesh.num_vertices()) ||
+      topology.welded_triangles.rows() != rig.mesh.num_triangles()) {
+    throw std::invalid_argument("segment: the topology is not the rig mesh's");
+  }
   skinning::Positions welded;
   skinning::gather_welded(topology, rig.mesh.rest_positions, welded);
   const auto bones = bone_segments(rig.skeleton);

@@ -28,7 +28,8 @@ struct Topology {
   std::vector<std::int32_t> representative_vertex;
   /// #F × 3 triangles in welded ids (same order and orientation as Mesh::triangles).
   Triangles welded_triangles;
-  /// #E × 2 unique edges in welded ids.
+  /// #E × 2 unique edges in welded ids: edges(e, 0) < edges(e, 1), sorted by that pair (ghost
+  /// caps pair the edges of two topologies by merging the two lists).
   Edges edges;
   /// #F × 3: face_edges(f, k) is the edge from corner k to corner (k+1) % 3.
   Triangles face_edges;

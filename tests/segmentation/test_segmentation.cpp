@@ -2,15 +2,17 @@
 // triangle in exactly one edge-connected cluster, segments on their own bones, refinement never
 // worse, determinism, both weight sources, bad input.
 
+#include <gtest/gtest.h>
+
+#include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
 #include <memory>
 #include <numbers>
 #include <numeric>
 #include <set>
-
-#include <Eigen/Geometry>
-#include <gtest/gtest.h>
+#include <stdexcept>
+#include <tuple>
 
 #include "segmentation/atomic_clusters.hpp"
 #include "segmentation/face_graph.hpp"
@@ -330,6 +332,29 @@ TEST_P(RealCharacters, HeatAndRigWeightsBothPartitionTheMesh) {
               << " weights " << seg.stats.weights_s << " s decomposition "
               << seg.stats.decomposition_ms << " ms\n";
   }
+}
+
+// A check welds the mesh once and hands that topology to the segmentation: the same clusters,
+// observers and counts as welding it here; a topology of another mesh is refused.
+TEST_P(RealCharacters, TheCallersTopologyGivesTheSameSegmentation) {
+  const auto model = skelcd::skinning::load_model(character_path(GetParam()));
+  ASSERT_TRUE(model.rig);
+  const Rig& rig = *model.rig;
+  SegmentationOptions options;
+  options.weights = WeightSource::rig;
+  const auto own = segment(rig, options);
+  const auto given = segment(rig, options, skelcd::skinning::build_topology(rig.mesh));
+  EXPECT_EQ(given.triangle_cluster, own.triangle_cluster);
+  ASSERT_EQ(given.clusters.size(), own.clusters.size());
+  for (std::size_t c = 0; c < own.clusters.size(); ++c) {
+    EXPECT_EQ(given.clusters[c].bone, own.clusters[c].bone) << c;
+    EXPECT_EQ(given.clusters[c].triangles, own.clusters[c].triangles) << c;
+    EXPECT_EQ(given.clusters[c].observer.kind, own.clusters[c].observer.kind) << c;
+  }
+  EXPECT_EQ(given.stats.h_minus, own.stats.h_minus);
+  EXPECT_EQ(given.stats.h_uncertain, own.stats.h_uncertain);
+  const auto other = skelcd::skinning::build_topology(skelcd::test::capsule_chain(2).mesh);
+  EXPECT_THROW(std::ignore = segment(rig, options, other), std::invalid_argument);
 }
 
 INSTANTIATE_TEST_SUITE_P(Models, RealCharacters,

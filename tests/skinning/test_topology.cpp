@@ -1,16 +1,16 @@
 // Topology on meshes whose answers are known by construction: cube, seamed cube, sheet,
 // non-manifold fan, degenerate triangles.
 
-#include "skinning/topology.hpp"
+#include <gtest/gtest.h>
 
 #include <cmath>
 #include <limits>
 #include <set>
-
-#include <gtest/gtest.h>
+#include <utility>
 
 #include "skinning/detail/exact_collinear.hpp"
 #include "skinning/errors.hpp"
+#include "skinning/topology.hpp"
 #include "tests/skinning/mini_meshes.hpp"
 #include "tests/support/test_support.hpp"
 
@@ -19,9 +19,19 @@ namespace {
 
 using test::make_mesh;
 
-// Every edge lists its faces, every face side its edge, and the two agree.
+// Every edge lists its faces, every face side its edge, and the two agree; the edges are
+// (smaller, larger) pairs in increasing order (what ghost caps' edge merge relies on).
 void expect_consistent(const Mesh& mesh, const Topology& topo) {
   ASSERT_EQ(topo.face_edges.rows(), mesh.num_triangles());
+  for (std::int32_t e = 0; e < topo.num_edges(); ++e) {
+    EXPECT_LT(topo.edges(e, 0), topo.edges(e, 1)) << "edge " << e;
+    if (e > 0) {
+      EXPECT_LT(
+          std::make_pair(topo.edges(e - 1, 0), topo.edges(e - 1, 1)),
+          std::make_pair(topo.edges(e, 0), topo.edges(e, 1)))
+          << "edge " << e;
+    }
+  }
   for (Eigen::Index f = 0; f < mesh.num_triangles(); ++f) {
     for (int k = 0; k < 3; ++k) {
       const auto e = topo.face_edges(f, k);

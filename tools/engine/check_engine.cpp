@@ -120,21 +120,20 @@ CheckOutcome check_model(
   // stretch before the workers start is serial, and it caps the speed-up (docs/check.md,
   // "Threads").
   const bool parallel = options.threads != 1;
-  skinning::Topology topology;
+  // Welded once, for the segmentation, the baseline and the runner.
+  skinning::Topology topology = skinning::build_topology(motion->mesh());
   BaselineFindings baseline;
   std::future<void> baseline_task;  // after what it reads: waited for before they go
   if (parallel) {
-    topology = skinning::build_topology(motion->mesh());
     baseline_task = std::async(std::launch::async, [&baseline, &request, &motion, &topology] {
       baseline = baseline_findings(request.baseline, *motion, topology);
     });
   }
-  outcome.radial_view = setup_radial_view(request.radial_view, model, *motion, options);
+  outcome.radial_view = setup_radial_view(request.radial_view, model, *motion, options, &topology);
   // A serial run builds the mesh's FeatureTopology once for the baseline's `bvh` and the runner
   // (which takes the topology by move: FeatureTopology::built_from still holds there).
   std::shared_ptr<const culling::FeatureTopology> features;
   if (!parallel) {
-    topology = skinning::build_topology(motion->mesh());
     features = std::make_shared<const culling::FeatureTopology>(motion->mesh(), topology);
     baseline = baseline_findings(request.baseline, *motion, topology, features);
   }

@@ -16,7 +16,8 @@ RadialViewSetup setup_radial_view(
     const RadialViewArguments& args,
     const skinning::LoadedModel& model,
     const skinning::Motion& motion,
-    RunOptions& options) {
+    RunOptions& options,
+    const skinning::Topology* topology) {
   RadialViewSetup setup;
   const std::string method = options.method;
   // Which methods of this run need a segmentation: the method itself, or `auto`'s choices once a
@@ -81,7 +82,11 @@ RadialViewSetup setup_radial_view(
     segmentation::SegmentationOptions o;
     o.weights = model.rig->weights.nonZeros() > 0 ? segmentation::WeightSource::rig
                                                   : segmentation::WeightSource::heat;
-    seg = std::make_shared<const segmentation::Segmentation>(segmentation::segment(*model.rig, o));
+    // The caller's weld of the mesh when it is the rig's own (a rig's clip moves rig.mesh).
+    const bool rig_mesh = topology != nullptr && &motion.mesh() == &model.rig->mesh;
+    seg = std::make_shared<const segmentation::Segmentation>(
+        rig_mesh ? segmentation::segment(*model.rig, o, *topology)
+                 : segmentation::segment(*model.rig, o));
     setup.segmentation_source = o.weights == segmentation::WeightSource::rig
                                     ? "computed (rig weights)"
                                     : "computed (heat weights)";

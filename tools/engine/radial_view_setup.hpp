@@ -37,6 +37,9 @@ struct RadialViewSetup {
 /// does and `auto`'s closed parts go to its `bvh` fallback. Does nothing and returns an empty
 /// setup for any other method.
 /// @param motion the motion the runner will check (a rig's clip: Motion::num_bones() > 0).
+/// @param topology when given, `skinning::build_topology(motion.mesh())`: the segmentation
+///   computed here uses it instead of welding the rig's mesh again (when the motion moves that
+///   very mesh).
 /// @throws InvalidInput when the model has no rig, the motion is not a rig's, γ is outside
 ///   [0, 1], or the segmentation file was made from another model (hash mismatch); IoError when
 ///   the segmentation file cannot be read.
@@ -44,6 +47,7 @@ struct RadialViewSetup {
     const RadialViewArguments& args,
     const skinning::LoadedModel& model,
     const skinning::Motion& motion,
-    RunOptions& options);
+    RunOptions& options,
+    const skinning::Topology* topology = nullptr);
 
 }  // namespace skelcd::tools
