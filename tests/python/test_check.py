@@ -28,7 +28,7 @@ CASES = {
 }
 
 # Summary keys that are wall times (or the log's path); every other key must be equal.
-TIMING_KEYS = {"ms_per_interval", "total_ms", "stages_ms", "log"}
+TIMING_KEYS = {"ms_per_interval", "total_ms", "stages_ms", "setup_ms", "log"}
 
 
 def counts(summary):

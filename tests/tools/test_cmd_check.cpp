@@ -54,6 +54,40 @@ std::vector<std::tuple<int, int, int, int, int>> pair_keys(const LogData& log) {
   return keys;
 }
 
+// setup_ms: the phases before the first row, each measured on its own. A serial check runs them
+// one after the other, so they fit in the total; a parallel one computes the baseline beside the
+// others (only the rest must fit).
+TEST(CmdCheck, SetupTimesFitInTheTimeBeforeTheFirstRow) {
+  for (const char* threads : {"1", "2"}) {
+    const auto r = run_skelcd(
+        {"check",
+         kModel,
+         "--method",
+         "dynamic",
+         "--frames",
+         "0:2",
+         "--threads",
+         threads,
+         "--json"});
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    const auto j = nlohmann::json::parse(r.out);
+    ASSERT_TRUE(j.contains("setup_ms")) << r.out;
+    const auto& s = j["setup_ms"];
+    double parts = 0;
+    for (const char* phase : {"topology", "segmentation", "baseline", "methods"}) {
+      ASSERT_TRUE(s.contains(phase)) << phase;
+      EXPECT_GT(s[phase].get<double>(), 0.0) << phase << " (" << threads << " threads)";
+      if (std::string(threads) == "1" || std::string(phase) != "baseline") {
+        parts += s[phase].get<double>();
+      }
+    }
+    EXPECT_LE(parts, s["total"].get<double>()) << threads << " threads: " << s.dump();
+  }
+  const auto text = run_skelcd({"check", kModel, "--method", "bvh", "--frames", "0:1"});
+  ASSERT_EQ(text.exit_code, 0) << text.err;
+  EXPECT_NE(text.out.find("\nset-up    "), std::string::npos) << text.out;
+}
+
 TEST(CmdCheck, JsonSummaryMatchesTheLogItWrote) {
   const auto dir = skelcd::test::temp_dir("check-json");
   const auto log_path = (dir / "bcn.h5").string();

@@ -359,6 +359,21 @@ CheckedClip check_clip(
   print_events(text, motion->mesh(), outcome, options);
   print_text_summary(
       text, model, *motion, options, outcome.plan, outcome.fps, outcome.summary, log_path);
+  {
+    const SetupTimes& t = outcome.setup;
+    char line[200];
+    std::snprintf(
+        line,
+        sizeof line,
+        "set-up    %.1f ms before the first row (topology %.1f, segmentation %.1f, baseline "
+        "%.1f, methods %.1f)\n",
+        t.total,
+        t.topology,
+        t.segmentation,
+        t.baseline,
+        t.methods);
+    text << line;
+  }
   if (!outcome.radial_view.segmentation_source.empty()) {
     text << "segmentation: " << outcome.radial_view.segmentation_source << "\n";
   }
@@ -370,6 +385,7 @@ CheckedClip check_clip(
   if (!outcome.radial_view.segmentation_source.empty()) {
     checked.json["segmentation"] = outcome.radial_view.segmentation_source;
   }
+  checked.json["setup_ms"] = setup_json(outcome.setup);
   return checked;
 }
 

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cctype>
+#include <chrono>
 #include <cmath>
 #include <filesystem>
 #include <future>
@@ -108,6 +109,11 @@ std::vector<std::string> check_method_names() { return scene_method_names(); }
 
 CheckOutcome check_model(
     const skinning::LoadedModel& model, const CheckRequest& request, const FrameCallback& on_row) {
+  const auto start = std::chrono::steady_clock::now();
+  const auto ms_since = [](std::chrono::steady_clock::time_point from) {
+    return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - from)
+        .count();
+  };
   RunOptions options = run_options(request);
   const auto motion =
       model.motion(skinning::MotionRequest{.clip = request.clip, .rate_hz = request.fps});
@@ -121,22 +127,32 @@ CheckOutcome check_model(
   // "Threads").
   const bool parallel = options.threads != 1;
   // Welded once, for the segmentation, the baseline and the runner.
+  auto phase = std::chrono::steady_clock::now();
   skinning::Topology topology = skinning::build_topology(motion->mesh());
+  outcome.setup.topology = ms_since(phase);
   BaselineFindings baseline;
   std::future<void> baseline_task;  // after what it reads: waited for before they go
   if (parallel) {
-    baseline_task = std::async(std::launch::async, [&baseline, &request, &motion, &topology] {
-      baseline = baseline_findings(request.baseline, *motion, topology);
-    });
+    baseline_task = std::async(
+        std::launch::async, [&baseline, &request, &motion, &topology, &outcome, &ms_since] {
+          const auto began = std::chrono::steady_clock::now();
+          baseline = baseline_findings(request.baseline, *motion, topology);
+          outcome.setup.baseline = ms_since(began);
+        });
   }
+  phase = std::chrono::steady_clock::now();
   outcome.radial_view = setup_radial_view(request.radial_view, model, *motion, options, &topology);
+  outcome.setup.segmentation = ms_since(phase);
   // A serial run builds the mesh's FeatureTopology once for the baseline's `bvh` and the runner
   // (which takes the topology by move: FeatureTopology::built_from still holds there).
   std::shared_ptr<const culling::FeatureTopology> features;
   if (!parallel) {
+    phase = std::chrono::steady_clock::now();
     features = std::make_shared<const culling::FeatureTopology>(motion->mesh(), topology);
     baseline = baseline_findings(request.baseline, *motion, topology, features);
+    outcome.setup.baseline = ms_since(phase);
   }
+  phase = std::chrono::steady_clock::now();
   ClipRunner runner = [&] {
     try {
       // (A parallel run's runner gets a copy: the baseline's thread may still read this one.)
@@ -151,6 +167,7 @@ CheckOutcome check_model(
       throw;
     }
   }();
+  outcome.setup.methods = ms_since(phase);
   if (baseline_task.valid()) baseline_task.get();
   outcome.plan = runner.plan();
   outcome.clip = motion->name();
@@ -201,6 +218,7 @@ CheckOutcome check_model(
   }
 
   outcome.rows.reserve(static_cast<std::size_t>(outcome.plan.rows));
+  outcome.setup.total = ms_since(start);
   if (request.on_plan) request.on_plan(outcome.plan);
   const auto emit = [&](std::vector<FrameReport> ready) {
     for (const auto& report : ready) {

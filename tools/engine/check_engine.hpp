@@ -65,6 +65,7 @@ struct CheckOutcome {
   std::string baseline;             ///< describe(request.baseline)
   std::int64_t baseline_pairs = 0;  ///< intersecting pairs (and contacts) of the baseline
   std::vector<EventRecord> events;  ///< the new findings' events, by id
+  SetupTimes setup;                 ///< where the time before the first row went
 };
 
 /// Checks one clip of `model`: one FrameReport per DCD sample and CCD interval, in order, passed

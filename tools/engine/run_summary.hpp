@@ -85,4 +85,15 @@ struct RunLabels {
 /// one's include), by id.
 [[nodiscard]] std::vector<const EventRecord*> root_events(const std::vector<EventRecord>& events);
 
+/// Wall times, in ms, of what a check does before its first row (after the model is loaded: its
+/// import is the caller's). In a parallel run the baseline's DCD runs on a thread of its own beside
+/// the segmentation and the methods' builds, so the parts may add up to more than `total`.
+struct SetupTimes {
+  double topology = 0;      ///< welding the mesh (shared by the segmentation, baseline, methods)
+  double segmentation = 0;  ///< the radial view's segmentation, computed or read (0: none)
+  double baseline = 0;      ///< the baseline's findings (its DCD)
+  double methods = 0;       ///< building the runner: every worker's culling method
+  double total = 0;         ///< check_model's start to its first row (log creation included)
+};
+
 }  // namespace skelcd::tools

@@ -15,6 +15,16 @@ nlohmann::json stages_json(const RunSummary& s) {
       {"other", s.other_ms}};
 }
 
+nlohmann::json setup_json(const SetupTimes& setup) {
+  return nlohmann::json{
+      {"topology", setup.topology},
+      {"segmentation", setup.segmentation},
+      {"baseline", setup.baseline},
+      {"methods", setup.methods},
+      {"total", setup.total},
+  };
+}
+
 nlohmann::json events_json(
     const std::vector<EventRecord>& events, const std::vector<std::string>& part_names) {
   auto list = nlohmann::json::array();

@@ -15,6 +15,9 @@ namespace skelcd::tools {
 /// {"ms_per_interval", "skin", "refit", …} → per-stage ms object used by `check --json`.
 [[nodiscard]] nlohmann::json stages_json(const RunSummary& summary);
 
+/// {"topology", "segmentation", "baseline", "methods", "total"}: `check --json`'s setup_ms.
+[[nodiscard]] nlohmann::json setup_json(const SetupTimes& setup);
+
 /// The events of `check --json`: root events, each with the ids merged into it.
 [[nodiscard]] nlohmann::json events_json(
     const std::vector<EventRecord>& events, const std::vector<std::string>& part_names);
