@@ -12,6 +12,7 @@
 #include <memory>
 #include <sstream>
 
+#include "culling/feature_topology.hpp"
 #include "culling/method_registry.hpp"
 #include "culling/pair_checker.hpp"
 #include "skinning/errors.hpp"
@@ -549,10 +550,14 @@ SceneRunResult run_scene(const Scene& scene, const SceneRunOptions& options) {
     ro.min_separation = scene.min_separation;
     ro.threads = options.threads;
     try {
+      // The object's weld, copied: the runner keeps it (FeatureTopology::built_from follows this
+      // copy into it), and the segmentation uses it instead of welding the mesh again.
+      skinning::Topology topology = lo.topology;
       // Methods that need a segmentation get one (none for DCD only: they answer as `bvh`).
       if (plan.objects[at(c.object_a)].segmentation ||
           culling::method_needs(c.method).segmentation) {
-        const auto setup = setup_radial_view(RadialViewArguments{}, *lo.model, *lo.motion, ro);
+        const auto setup =
+            setup_radial_view(RadialViewArguments{}, *lo.model, *lo.motion, ro, &topology);
         if (setup.gamma) gamma = setup.gamma;
         if (setup.seed) seed = setup.seed;
         if (!setup.segmentation_source.empty()) {
@@ -561,10 +566,11 @@ SceneRunResult run_scene(const Scene& scene, const SceneRunOptions& options) {
         }
       }
       // The baseline's DCD (its own `bvh`, freed on return) before the runner builds its method,
-      // so that the two do not hold memory at once (as check_model).
-      skinning::Topology topology = skinning::build_topology(lo.motion->mesh());
-      const auto baseline = baseline_findings(so.baseline, *lo.motion, topology);
-      runners[k] = std::make_unique<ClipRunner>(*lo.motion, ro, std::move(topology));
+      // so that the two do not hold memory at once (as check_model); one FeatureTopology for both.
+      auto features = std::make_shared<const culling::FeatureTopology>(lo.motion->mesh(), topology);
+      const auto baseline = baseline_findings(so.baseline, *lo.motion, topology, features);
+      runners[k] = std::make_unique<ClipRunner>(
+          *lo.motion, ro, std::move(topology), MethodFactory{}, std::move(features));
       // The labels and events of this self check (docs/events.md).
       const auto& mesh = lo.motion->mesh();
       const skinning::Rig* rig =
