@@ -1,12 +1,12 @@
 #include "segmentation/observer.hpp"
 
+#include <Eigen/Geometry>
 #include <algorithm>
 #include <array>
+#include <cassert>
 #include <cmath>
 #include <limits>
 #include <vector>
-
-#include <Eigen/Geometry>
 
 #include "ccd/orientation.hpp"
 
@@ -25,14 +25,27 @@ Orientation orientation(const Observer& observer, const Eigen::Vector3d& a,
   return s > 0 ? Orientation::positive : (s < 0 ? Orientation::negative : Orientation::uncertain);
 }
 
-ObserverChoice choose_observer(const skinning::Positions& V, const skinning::Triangles& F,
-                               std::span<const std::int32_t> triangles, const BoneSegment& bone,
-                               const Eigen::MatrixXd& W, std::span<const std::int32_t> subtree,
-                               double theta_rad) {
-  ObserverChoice out;
-  if (triangles.empty()) return out;
+namespace {
 
-  // The cluster's vertices, each once, and its triangles in that local numbering.
+/// The test poses: identity, then ±θ about x, y, z, all about the bone's head joint.
+constexpr int kPoses = 7;
+
+}  // namespace
+
+void positive_counts(
+    const skinning::Positions& V,
+    const skinning::Triangles& F,
+    std::span<const std::int32_t> triangles,
+    const BoneSegment& bone,
+    const Eigen::MatrixXd& W,
+    std::span<const std::int32_t> subtree,
+    double theta_rad,
+    std::span<PositiveCounts> out) {
+  assert(out.size() == triangles.size());
+  std::fill(out.begin(), out.end(), PositiveCounts{});
+  if (triangles.empty()) return;
+
+  // The triangles' vertices, each once, and the triangles in that local numbering.
   std::vector<std::int32_t> vertices;
   vertices.reserve(triangles.size() * 3);
   for (const auto f : triangles) {
@@ -55,7 +68,6 @@ ObserverChoice choose_observer(const skinning::Positions& V, const skinning::Tri
     follow[k] = std::min(1.0, s);
   }
 
-  // The test poses: identity, then ±θ about x, y, z, all about the bone's head joint.
   std::vector<Eigen::Matrix3d> rotations = {Eigen::Matrix3d::Identity()};
   for (int axis = 0; axis < 3; ++axis) {
     for (const double sign : {1.0, -1.0}) {
@@ -63,9 +75,8 @@ ObserverChoice choose_observer(const skinning::Positions& V, const skinning::Tri
           Eigen::AngleAxisd(sign * theta_rad, Eigen::Vector3d::Unit(axis)).toRotationMatrix());
     }
   }
+  assert(static_cast<int>(rotations.size()) == kPoses);
   const Eigen::Vector3d q1 = bone.head;
-  std::int64_t positive_point = 0;
-  std::int64_t positive_line = 0;
   std::vector<Eigen::Vector3d> posed(vertices.size());
   for (std::size_t r = 0; r < rotations.size(); ++r) {
     const Eigen::Matrix3d& R = rotations[r];
@@ -78,15 +89,22 @@ ObserverChoice choose_observer(const skinning::Positions& V, const skinning::Tri
       // The rest pose bit for bit; otherwise the LBS blend of R and the identity about q1.
       posed[k] = r == 0 ? x : Eigen::Vector3d(q1 + follow[k] * (R * (x - q1)) + (1.0 - follow[k]) * (x - q1));
     }
-    for (const auto& t : local_triangles) {
+    for (std::size_t i = 0; i < local_triangles.size(); ++i) {
+      const auto& t = local_triangles[i];
       const auto& a = posed[t[0]];
       const auto& b = posed[t[1]];
       const auto& c = posed[t[2]];
-      positive_point += orientation(point, a, b, c) == Orientation::positive;
-      positive_line += orientation(line, a, b, c) == Orientation::positive;
+      out[i].point = static_cast<std::uint8_t>(
+          out[i].point + (orientation(point, a, b, c) == Orientation::positive));
+      out[i].line = static_cast<std::uint8_t>(
+          out[i].line + (orientation(line, a, b, c) == Orientation::positive));
     }
   }
-  out.poses = static_cast<int>(rotations.size());
+}
+
+ObserverChoice observer_choice(std::int64_t positive_point, std::int64_t positive_line) {
+  ObserverChoice out;
+  out.poses = kPoses;
   out.mean_positive_point = static_cast<double>(positive_point) / out.poses;
   out.mean_positive_line = static_cast<double>(positive_line) / out.poses;
   // §4.2: the point when it keeps more triangles positive on average, else the line. On a tie
@@ -96,6 +114,26 @@ ObserverChoice choose_observer(const skinning::Positions& V, const skinning::Tri
   out.kind = out.mean_positive_point >= out.mean_positive_line ? ObserverKind::point
                                                                 : ObserverKind::line;
   return out;
+}
+
+ObserverChoice choose_observer(
+    const skinning::Positions& V,
+    const skinning::Triangles& F,
+    std::span<const std::int32_t> triangles,
+    const BoneSegment& bone,
+    const Eigen::MatrixXd& W,
+    std::span<const std::int32_t> subtree,
+    double theta_rad) {
+  if (triangles.empty()) return ObserverChoice{};
+  std::vector<PositiveCounts> counts(triangles.size());
+  positive_counts(V, F, triangles, bone, W, subtree, theta_rad, counts);
+  std::int64_t point = 0;
+  std::int64_t line = 0;
+  for (const auto& c : counts) {
+    point += c.point;
+    line += c.line;
+  }
+  return observer_choice(point, line);
 }
 
 }  // namespace skelcd::segmentation

@@ -84,4 +84,29 @@ struct ObserverChoice {
     std::span<const std::int32_t> subtree,
     double theta_rad);
 
+/// For one triangle, how many of choose_observer's test poses leave it positively oriented to the
+/// point observer and to the line observer (0 … 7 each).
+struct PositiveCounts {
+  std::uint8_t point = 0;
+  std::uint8_t line = 0;
+};
+
+/// choose_observer's work per triangle: out[i] for triangles[i]. A triangle's counts depend on
+/// the triangle and the bone alone (its corners' poses follow their own weights), not on the
+/// cluster it is in, so a segmentation reuses them when a triangle is observed from the same bone
+/// again. @param out as many entries as `triangles`.
+void positive_counts(
+    const skinning::Positions& V,
+    const skinning::Triangles& F,
+    std::span<const std::int32_t> triangles,
+    const BoneSegment& bone,
+    const Eigen::MatrixXd& W,
+    std::span<const std::int32_t> subtree,
+    double theta_rad,
+    std::span<PositiveCounts> out);
+
+/// The choice from counts summed over a cluster's triangles: choose_observer's answer.
+[[nodiscard]] ObserverChoice observer_choice(
+    std::int64_t positive_point, std::int64_t positive_line);
+
 }  // namespace skelcd::segmentation

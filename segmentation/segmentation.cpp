@@ -90,7 +90,12 @@ Segmentation segment_mesh(const skinning::Positions& V, const skinning::Triangle
   // 1. Each triangle to the bone of its largest summed weight (§4.1).
   std::vector<std::int32_t> labels = largest_weight_bones(W, F);
 
-  // 2. Observers of those per-bone clusters (§4.2), then refinement against them (§4.1).
+  // 2. Observers of those per-bone clusters (§4.2), then refinement against them (§4.1). Each
+  // triangle's positive counts under its bone's test poses are kept: step 4 observes most
+  // triangles from the same bone again (refinement moves few), and the counts do not depend on
+  // the cluster (positive_counts).
+  std::vector<PositiveCounts> counts(static_cast<std::size_t>(F.rows()));
+  std::vector<std::int32_t> counted_bone(static_cast<std::size_t>(F.rows()), -1);
   if (options.refine) {
     std::vector<std::vector<std::int32_t>> per_bone(static_cast<std::size_t>(nb));
     for (std::int32_t f = 0; f < F.rows(); ++f) {
@@ -101,7 +106,19 @@ Segmentation segment_mesh(const skinning::Positions& V, const skinning::Triangle
       const auto& tris = per_bone[b];
       observers[b].segment = bones[b];
       if (tris.empty()) return;
-      observers[b].kind = choose_observer(V, F, tris, bones[b], W, subtree[b], theta).kind;
+      // The bones' clusters are disjoint: each writes its own triangles' counts.
+      std::vector<PositiveCounts> mine(tris.size());
+      positive_counts(V, F, tris, bones[b], W, subtree[b], theta, mine);
+      std::int64_t point = 0;
+      std::int64_t line = 0;
+      for (std::size_t i = 0; i < tris.size(); ++i) {
+        const auto f = static_cast<std::size_t>(tris[i]);
+        counts[f] = mine[i];
+        counted_bone[f] = static_cast<std::int32_t>(b);
+        point += mine[i].point;
+        line += mine[i].line;
+      }
+      observers[b].kind = observer_choice(point, line).kind;
     });
     stats.refinement = refine_labels(V, F, graph, observers, W, labels);
   }
@@ -122,7 +139,26 @@ Segmentation segment_mesh(const skinning::Positions& V, const skinning::Triangle
   for_each_index(out.clusters.size(), static_cast<std::size_t>(F.rows()), [&](std::size_t c) {
     auto& cluster = out.clusters[c];
     const auto b = static_cast<std::size_t>(cluster.bone);
-    const auto choice = choose_observer(V, F, cluster.triangles, bones[b], W, subtree[b], theta);
+    // Counts from step 2 where the triangle was observed from this bone; the others now (the
+    // clusters are disjoint: each fills its own triangles).
+    std::vector<std::int32_t> missing;
+    for (const auto f : cluster.triangles) {
+      if (counted_bone[static_cast<std::size_t>(f)] != cluster.bone) missing.push_back(f);
+    }
+    if (!missing.empty()) {
+      std::vector<PositiveCounts> fresh(missing.size());
+      positive_counts(V, F, missing, bones[b], W, subtree[b], theta, fresh);
+      for (std::size_t i = 0; i < missing.size(); ++i) {
+        counts[static_cast<std::size_t>(missing[i])] = fresh[i];
+      }
+    }
+    std::int64_t point = 0;
+    std::int64_t line = 0;
+    for (const auto f : cluster.triangles) {
+      point += counts[static_cast<std::size_t>(f)].point;
+      line += counts[static_cast<std::size_t>(f)].line;
+    }
+    const auto choice = observer_choice(point, line);
     cluster.observer = Observer{choice.kind, bones[b]};
     cluster.mean_positive_point = choice.mean_positive_point;
     cluster.mean_positive_line = choice.mean_positive_line;

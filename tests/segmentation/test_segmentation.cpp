@@ -239,6 +239,54 @@ TEST(Observer, LineWinsOnACorrugatedTubeAndTiesGoToThePoint) {
   EXPECT_EQ(plain.kind, ObserverKind::point);
 }
 
+// A triangle's positive counts depend on it and the bone, not on the other triangles of the
+// cluster (what segment_mesh's reuse of step 2's counts in step 4 relies on), and summed they are
+// choose_observer's answer. Weights that vary along the tube make the test poses non-rigid.
+TEST(Observer, PositiveCountsDoNotDependOnTheCluster) {
+  auto tube = skelcd::test::closed_tube(1.0, 0.3, 16, 12, 0.1);
+  for (Eigen::Index v = 0; v < tube.V.rows() - 2; ++v) {
+    if ((v / 12) % 3 == 1) tube.V.row(v).tail<2>() *= 0.5;
+  }
+  const BoneSegment bone{Eigen::Vector3d(0.3, 0, 0), Eigen::Vector3d(1, 0, 0)};
+  Eigen::MatrixXd W(tube.V.rows(), 1);
+  for (Eigen::Index v = 0; v < tube.V.rows(); ++v) W(v, 0) = std::clamp(tube.V(v, 0), 0.0, 1.0);
+  const std::vector<std::int32_t> subtree = {0};
+  const double theta = 40.0 * std::numbers::pi / 180.0;
+  std::vector<std::int32_t> all(static_cast<std::size_t>(tube.F.rows()));
+  std::iota(all.begin(), all.end(), 0);
+  std::vector<PositiveCounts> whole(all.size());
+  positive_counts(tube.V, tube.F, all, bone, W, subtree, theta, whole);
+  std::int64_t point = 0, line = 0;
+  std::set<int> seen;
+  for (const auto& c : whole) {
+    EXPECT_LE(c.point, 7);
+    EXPECT_LE(c.line, 7);
+    point += c.point;
+    line += c.line;
+    seen.insert(c.point);
+  }
+  EXPECT_GT(seen.size(), 1u) << "every triangle counted alike: the poses test nothing";
+  const auto chosen = choose_observer(tube.V, tube.F, all, bone, W, subtree, theta);
+  const auto summed = observer_choice(point, line);
+  EXPECT_EQ(chosen.kind, summed.kind);
+  EXPECT_EQ(chosen.mean_positive_point, summed.mean_positive_point);
+  EXPECT_EQ(chosen.mean_positive_line, summed.mean_positive_line);
+  // Every third triangle, and the others: the counts of the whole, triangle by triangle.
+  for (const int part : {0, 1}) {
+    std::vector<std::int32_t> some;
+    for (const auto f : all) {
+      if ((f % 3 == 0) == (part == 0)) some.push_back(f);
+    }
+    std::vector<PositiveCounts> counts(some.size());
+    positive_counts(tube.V, tube.F, some, bone, W, subtree, theta, counts);
+    for (std::size_t i = 0; i < some.size(); ++i) {
+      const auto& expected = whole[static_cast<std::size_t>(some[i])];
+      EXPECT_EQ(counts[i].point, expected.point) << some[i];
+      EXPECT_EQ(counts[i].line, expected.line) << some[i];
+    }
+  }
+}
+
 TEST(Segmentation, DeterministicAndIndependentOfThreads) {
   const Rig rig = bent_chain(4, 2, 120.0, 0.15);
   SegmentationOptions serial;
