@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "skinning/mesh.hpp"
+#include "skinning/topology.hpp"
 
 namespace skelcd::segmentation {
 
@@ -26,5 +27,9 @@ struct FaceGraph {
 /// Builds the face graph of F (#F × 3 welded vertex indices). Repeated-index triangles contribute
 /// only their proper edges.
 [[nodiscard]] FaceGraph face_graph(const skinning::Triangles& F);
+
+/// The same graph as face_graph(topology.welded_triangles), from the edge lists the topology
+/// already has (its edges are sorted the same way, their faces ascending, a folded triangle once).
+[[nodiscard]] FaceGraph face_graph(const skinning::Topology& topology);
 
 }  // namespace skelcd::segmentation

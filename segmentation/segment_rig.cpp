@@ -112,7 +112,7 @@ Segmentation segment(
 
   Segmentation out;
   try {
-    out = segment_mesh(welded, topology.welded_triangles, bones, W, options);
+    out = segment_mesh(welded, topology.welded_triangles, bones, W, options, &topology);
   } catch (const InvalidInput& e) {
     throw InvalidInput(rig.source + ": " + e.what());
   }

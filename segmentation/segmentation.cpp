@@ -43,9 +43,13 @@ void for_each_index(std::size_t n, std::size_t work, Body&& body) {
 
 }  // namespace
 
-Segmentation segment_mesh(const skinning::Positions& V, const skinning::Triangles& F,
-                          const std::vector<BoneSegment>& bones, const Eigen::MatrixXd& W,
-                          const SegmentationOptions& options) {
+Segmentation segment_mesh(
+    const skinning::Positions& V,
+    const skinning::Triangles& F,
+    const std::vector<BoneSegment>& bones,
+    const Eigen::MatrixXd& W,
+    const SegmentationOptions& options,
+    const skinning::Topology* topology) {
   if (bones.empty()) throw InvalidInput("segment_mesh: the skeleton has no bones");
   if (F.rows() == 0) throw InvalidInput("segment_mesh: the mesh has no triangles");
   if (W.rows() != V.rows() || W.cols() != static_cast<Eigen::Index>(bones.size())) {
@@ -84,7 +88,9 @@ Segmentation segment_mesh(const skinning::Positions& V, const skinning::Triangle
   stats.vertices = V.rows();
   stats.bones = nb;
 
-  const auto graph = face_graph(F);
+  const auto graph = topology != nullptr && &topology->welded_triangles == &F
+                         ? face_graph(*topology)
+                         : face_graph(F);
   const auto subtree = subtrees(bones);
 
   // 1. Each triangle to the bone of its largest summed weight (§4.1).

@@ -85,13 +85,16 @@ struct Segmentation {
 /// Segments the welded mesh (V, F) given per-vertex weights.
 /// @param V #W × 3 rest positions (welded); @param F #F × 3 welded triangles.
 /// @param bones #B rest segments with parents; @param W #W × #B weights (rows sum to 1).
+/// @param topology when given and F is its welded_triangles (the very matrix), the face graph
+///   starts from its edge lists instead of sorting F's sides again (the same graph).
 /// @throws InvalidInput on empty bones or triangles, or shapes that do not match.
 [[nodiscard]] Segmentation segment_mesh(
     const skinning::Positions& V,
     const skinning::Triangles& F,
     const std::vector<BoneSegment>& bones,
     const Eigen::MatrixXd& W,
-    const SegmentationOptions& options = {});
+    const SegmentationOptions& options = {},
+    const skinning::Topology* topology = nullptr);
 
 /// Segments a rig: welds its mesh, computes or reads its weights, then segment_mesh.
 /// @throws InvalidInput naming rig.source: no bones, no triangles, `rig` weights requested but

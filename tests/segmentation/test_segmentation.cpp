@@ -21,6 +21,7 @@
 #include "skinning/generators.hpp"
 #include "skinning/load.hpp"
 #include "skinning/topology.hpp"
+#include "tests/culling/procedural_meshes.hpp"
 #include "tests/segmentation/mini_rigs.hpp"
 #include "tests/support/test_support.hpp"
 
@@ -287,6 +288,27 @@ TEST(Observer, PositiveCountsDoNotDependOnTheCluster) {
   }
 }
 
+// The same on a mesh with a folded triangle (a, a, b), a non-manifold edge (three faces) and
+// a boundary.
+TEST(FaceGraph, FromTheTopologyWithFoldedAndNonManifoldFaces) {
+  skelcd::skinning::Positions x(6, 3);
+  x << 0, 0, 0, 1, 0, 0, 1, 1, 0, 0, 1, 0, 2, 0, 0, 1, 0, 1;
+  skelcd::skinning::Triangles f(5, 3);
+  f << 0, 1, 2, 0, 2, 3, 2, 1, 4, 0, 0, 1, 1, 2, 5;
+  const auto topology =
+      skelcd::skinning::build_topology(skelcd::test::single_part_mesh(std::move(x), std::move(f)));
+  const auto expected = face_graph(topology.welded_triangles);
+  const auto given = face_graph(topology);
+  EXPECT_EQ(given.edge_offsets, expected.edge_offsets);
+  EXPECT_EQ(given.edge_faces, expected.edge_faces);
+  EXPECT_EQ(given.offsets, expected.offsets);
+  EXPECT_EQ(given.neighbours, expected.neighbours);
+  // Face 0 meets faces 1 (edge 0-2), 2 and 4 (edge 1-2, non-manifold) and 3 (edge 0-1).
+  const std::vector<std::int32_t> of_0(
+      given.neighbours.begin() + given.offsets[0], given.neighbours.begin() + given.offsets[1]);
+  EXPECT_EQ(of_0, (std::vector<std::int32_t>{1, 2, 3, 4}));
+}
+
 TEST(Segmentation, DeterministicAndIndependentOfThreads) {
   const Rig rig = bent_chain(4, 2, 120.0, 0.15);
   SegmentationOptions serial;
@@ -403,6 +425,19 @@ TEST_P(RealCharacters, TheCallersTopologyGivesTheSameSegmentation) {
   EXPECT_EQ(given.stats.h_uncertain, own.stats.h_uncertain);
   const auto other = skelcd::skinning::build_topology(skelcd::test::capsule_chain(2).mesh);
   EXPECT_THROW(std::ignore = segment(rig, options, other), std::invalid_argument);
+}
+
+// The face graph from a topology's edge lists is the one from sorting the triangles' sides.
+TEST_P(RealCharacters, TheFaceGraphFromTheTopologyIsTheFaceGraph) {
+  const auto model = skelcd::skinning::load_model(character_path(GetParam()));
+  const auto topology = skelcd::skinning::build_topology(*model.mesh);
+  const auto expected = face_graph(topology.welded_triangles);
+  const auto given = face_graph(topology);
+  EXPECT_EQ(given.edge_offsets, expected.edge_offsets);
+  EXPECT_EQ(given.edge_faces, expected.edge_faces);
+  EXPECT_EQ(given.offsets, expected.offsets);
+  EXPECT_EQ(given.neighbours, expected.neighbours);
+  EXPECT_GT(given.neighbours.size(), 0u);
 }
 
 INSTANTIATE_TEST_SUITE_P(Models, RealCharacters,
