@@ -385,13 +385,7 @@ py::dict check(
   if (!outcome->radial_view.segmentation_source.empty()) {
     summary["segmentation"] = outcome->radial_view.segmentation_source;
   }
-  py::dict setup;
-  setup["topology"] = outcome->setup.topology;
-  setup["segmentation"] = outcome->setup.segmentation;
-  setup["baseline"] = outcome->setup.baseline;
-  setup["methods"] = outcome->setup.methods;
-  setup["total"] = outcome->setup.total;
-  summary["setup_ms"] = setup;
+  summary["setup_ms"] = to_python(tools::setup_json(outcome->setup));
   py::dict plan;
   plan["first_sample"] = outcome->plan.first_sample;
   plan["last_sample"] = outcome->plan.last_sample;

@@ -288,6 +288,14 @@ TEST(Observer, PositiveCountsDoNotDependOnTheCluster) {
   }
 }
 
+// Every list of two face graphs equal.
+void expect_same_graph(const FaceGraph& given, const FaceGraph& expected) {
+  EXPECT_EQ(given.edge_offsets, expected.edge_offsets);
+  EXPECT_EQ(given.edge_faces, expected.edge_faces);
+  EXPECT_EQ(given.offsets, expected.offsets);
+  EXPECT_EQ(given.neighbours, expected.neighbours);
+}
+
 // The same on a mesh with a folded triangle (a, a, b), a non-manifold edge (three faces) and
 // a boundary.
 TEST(FaceGraph, FromTheTopologyWithFoldedAndNonManifoldFaces) {
@@ -299,10 +307,7 @@ TEST(FaceGraph, FromTheTopologyWithFoldedAndNonManifoldFaces) {
       skelcd::skinning::build_topology(skelcd::test::single_part_mesh(std::move(x), std::move(f)));
   const auto expected = face_graph(topology.welded_triangles);
   const auto given = face_graph(topology);
-  EXPECT_EQ(given.edge_offsets, expected.edge_offsets);
-  EXPECT_EQ(given.edge_faces, expected.edge_faces);
-  EXPECT_EQ(given.offsets, expected.offsets);
-  EXPECT_EQ(given.neighbours, expected.neighbours);
+  expect_same_graph(given, expected);
   // Face 0 meets faces 1 (edge 0-2), 2 and 4 (edge 1-2, non-manifold) and 3 (edge 0-1).
   const std::vector<std::int32_t> of_0(
       given.neighbours.begin() + given.offsets[0], given.neighbours.begin() + given.offsets[1]);
@@ -433,10 +438,7 @@ TEST_P(RealCharacters, TheFaceGraphFromTheTopologyIsTheFaceGraph) {
   const auto topology = skelcd::skinning::build_topology(*model.mesh);
   const auto expected = face_graph(topology.welded_triangles);
   const auto given = face_graph(topology);
-  EXPECT_EQ(given.edge_offsets, expected.edge_offsets);
-  EXPECT_EQ(given.edge_faces, expected.edge_faces);
-  EXPECT_EQ(given.offsets, expected.offsets);
-  EXPECT_EQ(given.neighbours, expected.neighbours);
+  expect_same_graph(given, expected);
   EXPECT_GT(given.neighbours.size(), 0u);
 }
 
