@@ -475,5 +475,67 @@ TEST(RealCharacterAllowances, AdjacentBonesIncludeRigidPartsHangingFromABone) {
       p.new_dcd_pairs + p.baseline_dcd_pairs);
 }
 
+// The tracker alone, on rows made by hand: two events, a region joining both (the older takes the
+// younger), a gap long enough to end them, then the same place again (a new event) beside a
+// third pair. Steps reuse their scratch arrays; nothing of an earlier step may leak into a later.
+TEST(EventTracking, EventsMergeEndAfterAGapAndStartAgain) {
+  skinning::Mesh mesh;
+  for (int k = 0; k < 5; ++k) add_cube(mesh, {3.0 * k, 0, 0}, k);
+  mesh.part_names = {"A", "B", "C", "D", "E"};
+  const auto topology = skinning::build_topology(mesh);
+  EventTracker tracker(mesh, topology, nullptr, BaselineFindings{}, Allowances{}, 2, {});
+  const auto tri = [](std::int32_t part, std::int32_t index) {
+    return FeatureId{.part = part, .index = index, .side = -1};
+  };
+  const double dt = 1.0 / 30;
+  std::vector<FrameReport> out;
+  const auto push = [&](std::int32_t sample, std::vector<std::pair<FeatureId, FeatureId>> pairs) {
+    FrameReport r;
+    r.row.kind = QueryKind::dcd;
+    r.row.sample = sample;
+    r.row.t0 = r.row.t1 = sample * dt;
+    for (const auto& [a, b] : pairs) {
+      r.dcd_pairs.push_back(DcdPairRow{.frame = sample, .a = a, .b = b, .label = kLabelNone});
+    }
+    for (auto& labelled : tracker.push(std::move(r))) out.push_back(std::move(labelled));
+  };
+  push(0, {{tri(0, 0), tri(1, 0)}, {tri(2, 0), tri(3, 0)}});
+  push(1, {{tri(1, 1), tri(2, 1)}});  // B's and C's neighbours of sample 0's triangles
+  for (std::int32_t s = 2; s < 10; ++s) push(s, {});
+  push(10, {{tri(0, 0), tri(1, 0)}});
+  push(11, {{tri(0, 0), tri(1, 0)}, {tri(3, 5), tri(4, 5)}});
+  for (auto& labelled : tracker.flush()) out.push_back(std::move(labelled));
+
+  ASSERT_EQ(out.size(), 12u);
+  const auto labels = [&](std::size_t row) {
+    std::vector<std::int32_t> l;
+    for (const auto& p : out[row].dcd_pairs) l.push_back(p.label);
+    return l;
+  };
+  EXPECT_EQ(labels(0), (std::vector<std::int32_t>{0, 1}));
+  EXPECT_EQ(labels(1), (std::vector<std::int32_t>{0}));
+  EXPECT_EQ(labels(10), (std::vector<std::int32_t>{2}));
+  EXPECT_EQ(labels(11), (std::vector<std::int32_t>{2, 3}));
+  for (const auto& r : out) EXPECT_EQ(r.row.counters.new_dcd_pairs, std::ssize(r.dcd_pairs));
+
+  const auto& events = tracker.events();
+  ASSERT_EQ(events.size(), 4u);
+  EXPECT_EQ(events[1].merged_into, 0);
+  for (const std::size_t e : {0u, 2u, 3u}) EXPECT_EQ(events[e].merged_into, -1);
+  EXPECT_EQ(events[0].first_sample, 0);
+  EXPECT_EQ(events[0].last_sample, 1);
+  EXPECT_EQ(events[0].dcd_pairs, 3);
+  EXPECT_EQ(events[0].peak_pairs, 1);  // one pair at each of its two samples
+  EXPECT_EQ(events[0].peak_sample, 0);
+  EXPECT_EQ(events[0].parts, (std::vector<std::int32_t>{0, 1, 2, 3}));
+  EXPECT_EQ(events[2].first_sample, 10);
+  EXPECT_EQ(events[2].last_sample, 11);
+  EXPECT_EQ(events[2].dcd_pairs, 2);
+  EXPECT_EQ(events[2].parts, (std::vector<std::int32_t>{0, 1}));
+  EXPECT_EQ(events[3].first_sample, 11);
+  EXPECT_EQ(events[3].dcd_pairs, 1);
+  EXPECT_EQ(events[3].parts, (std::vector<std::int32_t>{3, 4}));
+}
+
 }  // namespace
 }  // namespace skelcd::tools

@@ -7,7 +7,6 @@
 #include <map>
 #include <numeric>
 #include <optional>
-#include <unordered_map>
 #include <utility>
 
 #include "culling/method.hpp"
@@ -29,6 +28,11 @@ class DisjointSets {
     const auto old = parent_.size();
     parent_.resize(n);
     for (std::size_t i = old; i < n; ++i) parent_[i] = static_cast<std::int32_t>(i);
+  }
+  /// n singletons again, keeping the capacity.
+  void reset(std::size_t n) {
+    parent_.resize(n);
+    std::iota(parent_.begin(), parent_.end(), 0);
   }
   std::int32_t find(std::int32_t x) {
     while (parent_[static_cast<std::size_t>(x)] != x) {
@@ -484,14 +488,43 @@ struct EventTracker::Impl {
     std::int32_t b = -1;
     bool dcd = true;
     std::int32_t* label = nullptr;
-    double toi = 1;                   ///< CCD: toi_lower
-    std::vector<std::int32_t> faces;  ///< every triangle it touches
+    double toi = 1;  ///< CCD: toi_lower
+    /// Every triangle it touches: step.finding_faces[first_face, end_face), `a` first.
+    std::uint32_t first_face = 0;
+    std::uint32_t end_face = 0;
   };
 
-  void process(FrameReport* ccd, FrameReport* dcd) {
+  /// What one step works with, kept between steps so that a step allocates nothing once the
+  /// largest has been seen. The per-triangle and per-vertex arrays are -1 between steps (each
+  /// step puts back what it set), so a step costs what its findings touch, not the mesh's size.
+  struct StepScratch {
     std::vector<NewFinding> fresh;
-    std::vector<std::int32_t> fa;
-    std::vector<std::int32_t> fb;
+    std::vector<std::int32_t> finding_faces;
+    std::vector<std::int32_t> fa, fb;
+    std::vector<std::int32_t> local_of_face;     ///< triangle → local id of this step
+    std::vector<std::int32_t> local_of_vertex;   ///< welded vertex → a local id touching it
+    std::vector<std::int32_t> previous_of_face;  ///< triangle → linkable event (the oldest)
+    std::vector<std::int32_t> footprint_mark;    ///< triangle → the event whose footprint has it
+    std::vector<std::int32_t> faces;             ///< local id → triangle
+    DisjointSets sets;
+    std::vector<std::pair<std::int32_t, std::int32_t>> links;  ///< (region root, event)
+    std::vector<std::int32_t> region_event;                    ///< by region root; -1: none yet
+    std::vector<std::uint8_t> region_has_ccd;
+    std::vector<double> region_toi;
+    std::vector<std::int32_t> roots;  ///< region roots in the order their events are settled
+    std::vector<std::int32_t> owners;
+    std::vector<std::int64_t> pairs_now;  ///< by event: this step's new DCD pairs
+    std::vector<double> length_now;       ///< by event: this step's intersection length
+    std::vector<std::uint8_t> has_length;
+    std::vector<std::pair<std::int32_t, std::int32_t>> by_event;  ///< (event, local id)
+  };
+  StepScratch step;
+
+  void process(FrameReport* ccd, FrameReport* dcd) {
+    auto& fresh = step.fresh;
+    auto& ff = step.finding_faces;
+    fresh.clear();
+    ff.clear();
     if (dcd != nullptr) {
       auto& c = dcd->row.counters;
       c.new_dcd_pairs = c.baseline_dcd_pairs = c.allowed_dcd_pairs = 0;
@@ -508,14 +541,24 @@ struct EventTracker::Impl {
           ++c.baseline_dcd_pairs;
         } else {
           ++c.new_dcd_pairs;
-          fresh.push_back(
-              NewFinding{.a = a, .b = b, .dcd = true, .label = &p.label, .faces = {a, b}});
+          const auto first = static_cast<std::uint32_t>(ff.size());
+          ff.push_back(a);
+          ff.push_back(b);
+          fresh.push_back(NewFinding{
+              .a = a,
+              .b = b,
+              .dcd = true,
+              .label = &p.label,
+              .first_face = first,
+              .end_face = first + 2});
         }
       }
     }
     if (ccd != nullptr) {
       auto& c = ccd->row.counters;
       c.new_ccd_contacts = c.baseline_ccd_contacts = c.allowed_ccd_contacts = 0;
+      auto& fa = step.fa;
+      auto& fb = step.fb;
       for (auto& contact : ccd->contacts) {
         const bool vf = contact.kind == culling::CcdContact::Kind::vf;
         feature_faces(contact.a, vf, fa);
@@ -530,15 +573,17 @@ struct EventTracker::Impl {
           ++c.baseline_ccd_contacts;
         } else {
           ++c.new_ccd_contacts;
-          NewFinding n{
+          const auto first = static_cast<std::uint32_t>(ff.size());
+          ff.insert(ff.end(), fa.begin(), fa.end());
+          ff.insert(ff.end(), fb.begin(), fb.end());
+          fresh.push_back(NewFinding{
               .a = fa.front(),
               .b = fb.front(),
               .dcd = false,
               .label = &contact.label,
               .toi = contact.toi_lower,
-              .faces = fa};
-          n.faces.insert(n.faces.end(), fb.begin(), fb.end());
-          fresh.push_back(std::move(n));
+              .first_face = first,
+              .end_face = static_cast<std::uint32_t>(ff.size())});
         }
       }
     }
@@ -549,88 +594,128 @@ struct EventTracker::Impl {
              t_sample - entry.second.time > kEventGapSeconds;
     });
     if (fresh.empty()) return;
-    std::unordered_map<std::int32_t, std::int32_t> previous_owner;  // triangle → linkable event
+    const auto nf = static_cast<std::size_t>(mesh.num_triangles());
+    if (step.local_of_face.size() != nf) {
+      step.local_of_face.assign(nf, -1);
+      step.previous_of_face.assign(nf, -1);
+      step.footprint_mark.assign(nf, -1);
+      step.local_of_vertex.assign(static_cast<std::size_t>(topology.num_welded_vertices()), -1);
+    }
+    // Triangle → the oldest event still linkable whose last step touched it or a neighbour.
+    auto& previous = step.previous_of_face;
     for (const auto& [e, footprint] : recent) {
       for (const auto f : footprint.faces) {
-        const auto [it, inserted] = previous_owner.emplace(f, e);
-        if (!inserted) it->second = std::min(it->second, e);
+        auto& p = previous[static_cast<std::size_t>(f)];
+        p = p < 0 ? e : std::min(p, e);
       }
     }
 
     // Regions: the new findings' triangles, joined by the findings and by shared vertices.
-    std::unordered_map<std::int32_t, std::int32_t> local;  // triangle → local id
-    std::vector<std::int32_t> faces;
-    const auto id_of = [&](std::int32_t f) {
-      const auto [it, inserted] = local.emplace(f, static_cast<std::int32_t>(faces.size()));
-      if (inserted) faces.push_back(f);
-      return it->second;
-    };
-    for (const auto& n : fresh) {
-      for (const auto f : n.faces) id_of(f);
+    auto& local = step.local_of_face;
+    auto& faces = step.faces;
+    faces.clear();
+    for (const auto f : ff) {
+      auto& id = local[static_cast<std::size_t>(f)];
+      if (id < 0) {
+        id = static_cast<std::int32_t>(faces.size());
+        faces.push_back(f);
+      }
     }
-    DisjointSets sets(faces.size());
+    const auto local_of = [&](std::int32_t f) { return local[static_cast<std::size_t>(f)]; };
+    auto& sets = step.sets;
+    sets.reset(faces.size());
     for (const auto& n : fresh) {
-      const auto first = local.at(n.faces.front());
-      for (const auto f : n.faces) sets.unite(first, local.at(f));
+      const auto first = local_of(n.a);
+      for (auto k = n.first_face; k < n.end_face; ++k) sets.unite(first, local_of(ff[k]));
     }
-    std::unordered_map<std::int32_t, std::int32_t> at_vertex;  // welded vertex → local id
+    auto& at_vertex = step.local_of_vertex;
     for (std::size_t i = 0; i < faces.size(); ++i) {
       for (int k = 0; k < 3; ++k) {
-        const auto [it, inserted] =
-            at_vertex.emplace(topology.welded_triangles(faces[i], k), static_cast<std::int32_t>(i));
-        if (!inserted) sets.unite(it->second, static_cast<std::int32_t>(i));
+        auto& id = at_vertex[static_cast<std::size_t>(topology.welded_triangles(faces[i], k))];
+        if (id < 0) {
+          id = static_cast<std::int32_t>(i);
+        } else {
+          sets.unite(id, static_cast<std::int32_t>(i));
+        }
+      }
+    }
+    for (const auto f : faces) {
+      for (int k = 0; k < 3; ++k) {
+        at_vertex[static_cast<std::size_t>(topology.welded_triangles(f, k))] = -1;
       }
     }
     // Each region continues the events whose previous triangles it touches (oldest wins; the
     // others end, merged into it) or starts a new one.
-    std::map<std::int32_t, std::vector<std::int32_t>> owners;  // region root → events
+    auto& links = step.links;
+    links.clear();
     for (std::size_t i = 0; i < faces.size(); ++i) {
-      const auto it = previous_owner.find(faces[i]);
-      if (it == previous_owner.end()) continue;
-      auto& list = owners[sets.find(static_cast<std::int32_t>(i))];
-      const auto e = resolve(it->second);
-      if (std::find(list.begin(), list.end(), e) == list.end()) list.push_back(e);
+      const auto p = previous[static_cast<std::size_t>(faces[i])];
+      if (p >= 0) links.emplace_back(sets.find(static_cast<std::int32_t>(i)), p);
     }
-    std::map<std::int32_t, std::int32_t> region_event;
-    std::map<std::int32_t, bool> region_has_ccd;
-    std::map<std::int32_t, double> region_toi;
+    for (const auto& [e, footprint] : recent) {
+      (void)e;
+      for (const auto f : footprint.faces) previous[static_cast<std::size_t>(f)] = -1;
+    }
+    std::sort(links.begin(), links.end());
+    const auto n_local = faces.size();
+    step.region_event.assign(n_local, -1);
+    step.region_has_ccd.assign(n_local, 0);
+    step.region_toi.resize(n_local);
     for (const auto& n : fresh) {
-      const auto root = sets.find(local.at(n.faces.front()));
-      if (!n.dcd) {
-        region_has_ccd[root] = true;
-        auto [it, inserted] = region_toi.emplace(root, n.toi);
-        if (!inserted) it->second = std::min(it->second, n.toi);
+      if (n.dcd) continue;
+      const auto root = static_cast<std::size_t>(sets.find(local_of(n.a)));
+      if (step.region_has_ccd[root] == 0) {
+        step.region_has_ccd[root] = 1;
+        step.region_toi[root] = n.toi;
+      } else {
+        step.region_toi[root] = std::min(step.region_toi[root], n.toi);
       }
     }
-    for (std::size_t i = 0; i < faces.size(); ++i) {
+    auto& roots = step.roots;
+    roots.clear();
+    auto& list = step.owners;
+    for (std::size_t i = 0; i < n_local; ++i) {
       const auto root = sets.find(static_cast<std::int32_t>(i));
-      if (region_event.contains(root)) continue;
-      auto& list = owners[root];
-      for (auto& owner : list) owner = resolve(owner);  // an earlier region may have merged it
+      const auto r = static_cast<std::size_t>(root);
+      if (step.region_event[r] >= 0) continue;
+      list.clear();
+      const auto begin = std::lower_bound(
+          links.begin(),
+          links.end(),
+          std::make_pair(root, std::numeric_limits<std::int32_t>::min()));
+      for (auto it = begin; it != links.end() && it->first == root; ++it) {
+        list.push_back(resolve(it->second));  // an earlier region may have merged it
+      }
       std::sort(list.begin(), list.end());
       list.erase(std::unique(list.begin(), list.end()), list.end());
       std::int32_t e = -1;
       if (list.empty()) {
         e = static_cast<std::int32_t>(events.size());
-        EventRecord r;
-        r.id = e;
-        const bool between = ccd != nullptr && region_has_ccd.contains(root);
-        r.first_sample = between ? ccd->row.sample : sample;
-        r.t_first = between ? ccd->row.t0 : t_sample;
+        EventRecord rec;
+        rec.id = e;
+        const bool between = ccd != nullptr && step.region_has_ccd[r] != 0;
+        rec.first_sample = between ? ccd->row.sample : sample;
+        rec.t_first = between ? ccd->row.t0 : t_sample;
         if (between) {
-          r.t_first_contact = ccd->row.t0 + region_toi.at(root) * (ccd->row.t1 - ccd->row.t0);
+          rec.t_first_contact = ccd->row.t0 + step.region_toi[r] * (ccd->row.t1 - ccd->row.t0);
         }
-        events.push_back(std::move(r));
+        events.push_back(std::move(rec));
         event_driver_counts.emplace_back();
       } else {
         e = list.front();
         for (std::size_t j = 1; j < list.size(); ++j) merge(list[j], e);
       }
-      region_event[root] = e;
+      step.region_event[r] = e;
+      roots.push_back(root);
     }
+    const auto event_of = [&](std::int32_t i) {
+      return step.region_event[static_cast<std::size_t>(sets.find(i))];
+    };
     // Labels, counts, parts, bones, depth.
-    std::map<std::int32_t, std::int64_t> pairs_now;
-    std::map<std::int32_t, double> length_now;
+    const auto n_events = events.size();
+    step.pairs_now.assign(n_events, 0);
+    step.length_now.assign(n_events, 0.0);
+    step.has_length.assign(n_events, 0);
     const bool need_positions =
         dcd != nullptr &&
         std::any_of(fresh.begin(), fresh.end(), [](const NewFinding& n) { return n.dcd; });
@@ -638,17 +723,19 @@ struct EventTracker::Impl {
     const bool have_positions =
         need_positions && positions_at && posed.rows() == mesh.num_vertices();
     for (const auto& n : fresh) {
-      const auto e = region_event.at(sets.find(local.at(n.faces.front())));
+      const auto e = event_of(local_of(n.a));
       *n.label = e;
-      auto& r = events[static_cast<std::size_t>(e)];
+      const auto ue = static_cast<std::size_t>(e);
+      auto& r = events[ue];
       if (n.dcd) {
         ++r.dcd_pairs;
-        ++pairs_now[e];
+        ++step.pairs_now[ue];
         if (have_positions) {
           const auto corner = [&](std::int32_t f, int k) -> Eigen::Vector3d {
             return posed.row(mesh.triangles(f, k)).transpose();
           };
-          length_now[e] += intersection_length(
+          step.has_length[ue] = 1;
+          step.length_now[ue] += intersection_length(
               corner(n.a, 0),
               corner(n.a, 1),
               corner(n.a, 2),
@@ -660,8 +747,8 @@ struct EventTracker::Impl {
         ++r.ccd_contacts;
       }
     }
-    for (std::size_t i = 0; i < faces.size(); ++i) {
-      const auto e = region_event.at(sets.find(static_cast<std::int32_t>(i)));
+    for (std::size_t i = 0; i < n_local; ++i) {
+      const auto e = event_of(static_cast<std::int32_t>(i));
       auto& r = events[static_cast<std::size_t>(e)];
       const auto f = static_cast<std::size_t>(faces[i]);
       const auto part = mesh.face_part[f];
@@ -670,30 +757,45 @@ struct EventTracker::Impl {
       }
       if (face_driver[f] >= 0) ++event_driver_counts[static_cast<std::size_t>(e)][face_driver[f]];
     }
-    for (const auto& [root, e] : region_event) {
-      (void)root;
-      auto& r = events[static_cast<std::size_t>(e)];
+    for (const auto root : roots) {
+      const auto e = static_cast<std::size_t>(step.region_event[static_cast<std::size_t>(root)]);
+      auto& r = events[e];
       r.last_sample = sample;
       r.t_last = t_sample;
-      const auto pairs = pairs_now.contains(e) ? pairs_now.at(e) : 0;
+      const auto pairs = step.pairs_now[e];
       if (pairs > r.peak_pairs) {
         r.peak_pairs = pairs;
         r.peak_sample = sample;
       }
-      if (length_now.contains(e)) r.depth = std::max(r.depth, length_now.at(e));
+      if (step.has_length[e] != 0) r.depth = std::max(r.depth, step.length_now[e]);
     }
     // What later steps link to: this step's triangles and their neighbours, per event.
-    std::map<std::int32_t, std::vector<std::int32_t>> footprints;
-    for (std::size_t i = 0; i < faces.size(); ++i) {
-      auto& list = footprints[region_event.at(sets.find(static_cast<std::int32_t>(i)))];
-      list.push_back(faces[i]);
-      for_each_neighbour(faces[i], [&](std::int32_t g) { list.push_back(g); });
+    auto& by_event = step.by_event;
+    by_event.clear();
+    for (std::size_t i = 0; i < n_local; ++i) {
+      by_event.emplace_back(event_of(static_cast<std::int32_t>(i)), static_cast<std::int32_t>(i));
     }
-    for (auto& [e, list] : footprints) {
-      std::sort(list.begin(), list.end());
-      list.erase(std::unique(list.begin(), list.end()), list.end());
-      recent[e] = Footprint{sample, t_sample, std::move(list)};
+    std::sort(by_event.begin(), by_event.end());
+    auto& mark = step.footprint_mark;
+    for (std::size_t j = 0; j < by_event.size();) {
+      const auto e = by_event[j].first;
+      std::vector<std::int32_t> footprint;
+      const auto take = [&](std::int32_t g) {
+        auto& m = mark[static_cast<std::size_t>(g)];
+        if (m != e) {
+          m = e;
+          footprint.push_back(g);
+        }
+      };
+      for (; j < by_event.size() && by_event[j].first == e; ++j) {
+        const auto f = faces[static_cast<std::size_t>(by_event[j].second)];
+        take(f);
+        for_each_neighbour(f, take);
+      }
+      for (const auto g : footprint) mark[static_cast<std::size_t>(g)] = -1;
+      recent[e] = Footprint{sample, t_sample, std::move(footprint)};
     }
+    for (const auto f : faces) local[static_cast<std::size_t>(f)] = -1;
     std::erase_if(recent, [&](const auto& entry) {
       return events[static_cast<std::size_t>(entry.first)].merged_into >= 0;
     });
