@@ -132,6 +132,10 @@ void make_report(
   report.row.times.skin_us = skin_us;
   report.contacts.clear();
   report.dcd_pairs.clear();
+  // Sized once: growing by doubling would copy a large row's contacts and first-touch about twice
+  // their memory (113,854 contacts on the cloth-ball step: 6.4 MB).
+  report.contacts.reserve(result.contacts.size());
+  report.dcd_pairs.reserve(result.dcd_pairs.size());
   std::int64_t vf = 0;
   std::int64_t ee = 0;
   for (const auto& contact : result.contacts) {
