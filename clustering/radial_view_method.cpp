@@ -221,8 +221,8 @@ RadialViewMethod::RadialViewMethod(
   const auto num_atomic = at(clusters_.num_atomic());
   const auto num_components = at(clusters_.num_components());
   // Everything an interval touches is sized here (the candidates' blocks by blocks_).
+  // No edge volumes: the feature stage forms them from the vertices' (bounded memory).
   bounds_.vertices.reserve(at(topology_.num_vertices()));
-  bounds_.edges.reserve(at(topology_.num_edges()));
   bounds_.triangles.reserve(num_faces);
   cluster_bounds_.resize(num_atomic);
   triangle_mask_.assign(num_faces, culling::kMaskOther);
@@ -816,7 +816,7 @@ void RadialViewMethod::ccd(const culling::Interval& interval, culling::FrameResu
   const auto t_refit = Clock::now();
   const double half_width = 0.5 * method_options_.min_separation;
   culling::swept_vertex_bounds<3>(x_t0, x_t1, half_width, bounds_.vertices);
-  bounds_.derive(topology_);
+  bounds_.derive(topology_, /*with_edges=*/false);
   // The unmasked pair traversals test node pairs in the relative motion too when the interval
   // moves enough for it to prune (docs/culling.md "Relative boxes at the nodes").
   const bool node_relative =

@@ -59,9 +59,10 @@ struct FeatureBounds {
   std::vector<Dop<N>> triangles;
 
   /// Fills triangles (and edges, unless with_edges is false) from `vertices`. DCD needs no edge
-  /// volumes, nor does ccd_candidates_from_triangle_pairs (it forms them from the vertices'); brute
-  /// force and the radial view's pair checks read them. Allocation-free once the vectors have
-  /// their sizes.
+  /// volumes, nor does ccd_candidates_from_triangle_pairs (it forms them from the vertices', and
+  /// so the hierarchy methods and the radial view ask for none); brute force and the scenes'
+  /// inter-object checks (PairChecker) read them. Allocation-free once the vectors have their
+  /// sizes.
   void derive(const FeatureTopology& topology, bool with_edges = true);
   /// triangles = each triangle's static volume at x, bit for bit what static_vertex_bounds(x,
   /// vertices) then derive(topology, false) give, read from the corners' positions directly: the
