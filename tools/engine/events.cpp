@@ -513,9 +513,10 @@ struct EventTracker::Impl {
     std::vector<double> region_toi;
     std::vector<std::int32_t> roots;  ///< region roots in the order their events are settled
     std::vector<std::int32_t> owners;
-    std::vector<std::int64_t> pairs_now;  ///< by event: this step's new DCD pairs
-    std::vector<double> length_now;       ///< by event: this step's intersection length
-    std::vector<std::uint8_t> has_length;
+    /// By event, 0 between steps (a step zeroes the entries of the events it touched): this
+    /// step's new DCD pairs and their intersection length.
+    std::vector<std::int64_t> pairs_now;
+    std::vector<double> length_now;
     std::vector<std::pair<std::int32_t, std::int32_t>> by_event;  ///< (event, local id)
   };
   StepScratch step;
@@ -713,9 +714,8 @@ struct EventTracker::Impl {
     };
     // Labels, counts, parts, bones, depth.
     const auto n_events = events.size();
-    step.pairs_now.assign(n_events, 0);
-    step.length_now.assign(n_events, 0.0);
-    step.has_length.assign(n_events, 0);
+    step.pairs_now.resize(n_events, 0);
+    step.length_now.resize(n_events, 0.0);
     const bool need_positions =
         dcd != nullptr &&
         std::any_of(fresh.begin(), fresh.end(), [](const NewFinding& n) { return n.dcd; });
@@ -734,7 +734,6 @@ struct EventTracker::Impl {
           const auto corner = [&](std::int32_t f, int k) -> Eigen::Vector3d {
             return posed.row(mesh.triangles(f, k)).transpose();
           };
-          step.has_length[ue] = 1;
           step.length_now[ue] += intersection_length(
               corner(n.a, 0),
               corner(n.a, 1),
@@ -767,7 +766,10 @@ struct EventTracker::Impl {
         r.peak_pairs = pairs;
         r.peak_sample = sample;
       }
-      if (step.has_length[e] != 0) r.depth = std::max(r.depth, step.length_now[e]);
+      // Lengths are >= 0 and a depth starts at 0: an event without positions keeps its depth.
+      r.depth = std::max(r.depth, step.length_now[e]);
+      step.pairs_now[e] = 0;  // another root of the same event sees 0: nothing changes twice
+      step.length_now[e] = 0.0;
     }
     // What later steps link to: this step's triangles and their neighbours, per event.
     auto& by_event = step.by_event;
