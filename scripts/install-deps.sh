@@ -12,6 +12,7 @@ packages=(
   libplplot-dev plplot-driver-cairo
   nlohmann-json3-dev python3-h5py
   libtinyxml-dev libconsole-bridge-dev  # used directly by skinning/urdf*.cpp (SRDF, urdfdom messages)
+  libpugixml-dev  # the Collada extras assimp does not hand over (skinning/detail/collada_bind_shape.cpp)
   pybind11-dev python3-pybind11 python3-dev python3-numpy python3-pytest  # the Python module (python/)
   python3-distributed  # skelcd.batch: clips as tasks on a Dask cluster
   "$@"

@@ -28,7 +28,7 @@ struct ColladaExtras {
   std::string bad_frame_rate;
 };
 
-/// The extras of a Collada file (`.dae`); empty for any other file, or a file TinyXML cannot
+/// The extras of a Collada file (`.dae`); empty for any other file, or a file pugixml cannot
 /// parse (assimp then says what is wrong with it).
 /// @throws InvalidInput naming the file and controller for a bind shape matrix that is not 16
 ///   finite numbers.

@@ -212,6 +212,39 @@ TEST(ClipFrameRate, ColladaFrameRateComesFromThe3dsMaxExtra) {
       }));
 }
 
+// The <frame_rate> as XML writes it: blanks around the number, an entity, CDATA; a rate that is
+// two numbers is named as one line, its blanks folded (the problem line has no line breaks).
+TEST(ClipFrameRate, ColladaFrameRateIsReadAsXmlWritesIt) {
+  const fs::path file = assimp_model("Collada/anims_with_full_rotations_between_keys.DAE");
+  const std::string text = read_bytes(file);
+  const std::string open = "<technique profile=\"MAX3D\"><frame_rate>";
+  const auto from = text.find(open);
+  ASSERT_NE(from, std::string::npos);
+  const auto to = text.find("</frame_rate>", from);
+  ASSERT_NE(to, std::string::npos);
+  const auto with_rate = [&](const std::string& rate, const std::string& name) {
+    std::string changed = text;
+    changed.replace(from + open.size(), to - from - open.size(), rate);
+    const fs::path out = test::temp_dir("clip_frame_rate_collada_text") / (name + ".dae");
+    write_bytes(out, changed);
+    return load_model(out);
+  };
+  for (const auto& [rate, name] : std::vector<std::pair<std::string, std::string>>{
+           {"\n      24  \n    ", "blanks"}, {"&#50;4", "entity"}, {"<![CDATA[24]]>", "cdata"}}) {
+    const LoadedModel model = with_rate(rate, name);
+    ASSERT_FALSE(model.clips.empty()) << name;
+    EXPECT_EQ(model.clips[0].rate_hz, 24.0) << name;
+    EXPECT_EQ(model.clips[0].rate_source, FrameRateSource::file) << name;
+  }
+  const LoadedModel two = with_rate("\n  24\n\t 25 ", "two_numbers");
+  ASSERT_FALSE(two.clips.empty());
+  EXPECT_NE(two.clips[0].rate_source, FrameRateSource::file);
+  EXPECT_TRUE(std::any_of(two.problems.begin(), two.problems.end(), [](const std::string& p) {
+    return p.find("Collada <frame_rate> '24 25' is not a positive number; ignored") !=
+           std::string::npos;
+  }));
+}
+
 TEST(ClipFrameRate, ColladaWithoutFrameRateFollowsItsEvenlySpacedKeys) {
   const fs::path file = asset("characters/stormtrooper/stormtrooper.dae");
   ASSERT_EQ(max3d_frame_rate(file), 0.0);
