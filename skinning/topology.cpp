@@ -76,8 +76,8 @@ void build_edges(Topology& topo) {
   topo.face_edges.setConstant(nf, 3, -1);
   // The half-edges in (key, face, side) order. A counting sort by the smaller end puts each in its
   // vertex's bucket in (face, side) order; a stable sort of a bucket by key finishes it (buckets
-  // are a vertex's valence long). A whole std::sort took ~50 ms of the cloth-ball step's 92k
-  // triangles.
+  // are a vertex's valence long). A std::sort of them all made the cloth-ball step's first
+  // build_topology ~30 % slower (92k triangles: 49.4 against 37.8 ms, docs/benchmarks.md).
   std::vector<std::int32_t> start(nw + 1, 0);
   for (std::int32_t f = 0; f < nf; ++f) {
     for (std::int32_t k = 0; k < 3; ++k) {
