@@ -4,7 +4,9 @@
 // negatively) needs no test (docs/radial-view.md); every other pair does. Each triangle carries a
 // *class mask* — one bit: positive, negative or other — and each hierarchy node the union of its
 // triangles' bits, so a node pair whose two masks are the same single sign is skipped without
-// descending. Pairs from different mega clusters are traversed without masks (traversal.hpp).
+// descending. The masked traversals walk the wide copy of the hierarchy as the unmasked ones do
+// (culling/traversal.cpp), a lane's mask being its binary node's. Pairs from different mega
+// clusters are traversed without masks (traversal.hpp).
 
 #include <cstdint>
 #include <span>
@@ -32,6 +34,18 @@ enum class MaskedPairs : std::uint8_t {
   tested,   ///< pairs that need a test (not mask_pair_skipped)
   skipped,  ///< exactly the pairs a `tested` traversal leaves out (for re-checking them)
 };
+
+/// Can two sets of triangles with masks a and b (two hierarchy nodes) hold a pair `which`
+/// selects?
+[[nodiscard]] inline bool node_pair_wanted(std::uint8_t a, std::uint8_t b, MaskedPairs which) {
+  if (which == MaskedPairs::tested) return !mask_pair_skipped(a, b);
+  return (a & b & (kMaskPositive | kMaskNegative)) != 0;  // a skipped pair: one sign on both sides
+}
+
+/// Does `which` select the pair of two triangles with masks a and b?
+[[nodiscard]] inline bool pair_wanted(std::uint8_t a, std::uint8_t b, MaskedPairs which) {
+  return mask_pair_skipped(a, b) == (which == MaskedPairs::skipped);
+}
 
 /// Node masks of `bvh`: out[n] = OR of triangle_mask over node n's triangles.
 /// @param triangle_mask indexed by triangle id.  @param out resized to #nodes.

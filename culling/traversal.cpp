@@ -12,6 +12,7 @@
 #include <emmintrin.h>
 #endif
 
+#include "culling/cluster_checks.hpp"
 #include "culling/feature_topology.hpp"
 
 namespace skelcd::culling {
@@ -235,11 +236,24 @@ inline unsigned shared_lanes(
 #endif
 }
 
+/// The class masks of a masked walk (culling/cluster_checks.hpp): the binary nodes' masks of both
+/// trees (one tree's twice in a self walk), read per wide lane through WideBvhNode::node, and the
+/// triangles' by triangle id.
+struct WalkMasks {
+  const std::uint8_t* node_a = nullptr;
+  const std::uint8_t* node_b = nullptr;
+  const std::uint8_t* triangles = nullptr;
+  MaskedPairs which = MaskedPairs::tested;
+};
+
 /// One traversal over wide nodes: of one tree with itself (kSelf: a and b are the same tree) or of
 /// two trees. Entries on the stack are slot pairs whose float volumes overlap (the first entry
 /// excepted: it is the virtual roots, never tested).
 /// kSieve: a FanSieve settles pairs instead of emitting them (self traversal only).
-template <int N, bool kSelf, bool kSieve = false>
+/// kMasked: only node pairs that may hold a pair `masks.which` selects are visited
+/// (node_pair_wanted on the lanes' masks), only such triangle pairs (pair_wanted) are emitted, each
+/// as (smaller id, larger id) in a pair walk too.
+template <int N, bool kSelf, bool kSieve = false, bool kMasked = false>
 class Walk {
  public:
   Walk(
@@ -251,8 +265,10 @@ class Walk {
       std::vector<TrianglePair>& out,
       std::int64_t& bv_tests,
       std::size_t max_pairs,
-      FanSieve* sieve = nullptr)
+      FanSieve* sieve = nullptr,
+      const WalkMasks& masks = {})
       : sieve_(sieve),
+        masks_(masks),
         a_(a),
         b_(b),
         wide_a_(a.wide_nodes()),
@@ -312,12 +328,23 @@ class Walk {
     }
     const WideBvhNode<N>& w = wide_a_[to_size(c)];
     const int m = w.num_children;
+    std::array<std::uint8_t, kWidth> lane_masks{};
+    if constexpr (kMasked) {
+      for (int i = 0; i < m; ++i) lane_masks[to_size(i)] = masks_.node_a[to_size(w.node[i])];
+    }
     for (int i = 0; i < m; ++i) {
+      if constexpr (kMasked) {
+        const std::uint8_t mi = lane_masks[to_size(i)];
+        if (!node_pair_wanted(mi, mi, masks_.which)) continue;
+      }
       if (w.child[i] >= 0 || w.count[i] > 1) push(stack_, slot(c, i), slot(c, i));
     }
     for (int i = 0; i + 1 < m; ++i) {
       // Children i < j: lanes above i.
-      unsigned mask = overlap_lanes<N>(w, w, i) & ~((2u << i) - 1u);
+      const unsigned above = ~((2u << i) - 1u);
+      const unsigned wanted = wanted_lanes(lane_masks, m, lane_masks[to_size(i)]) & above;
+      if (wanted == 0) continue;
+      unsigned mask = overlap_lanes<N>(w, w, i) & wanted;
       if (relative_ && mask != 0)
         mask = end_boxes_meet(ends_a_[to_size(c)], ends_a_[to_size(c)], i, mask);
       bv_tests_ += m - 1 - i;
@@ -350,6 +377,9 @@ class Walk {
     if (cb < 0 || (ca >= 0 && pa.count[la] >= pb.count[lb])) {
       const WideBvhNode<N>& w = wide_a_[to_size(ca)];
       unsigned mask = overlap_lanes<N>(w, pb, lb);
+      if constexpr (kMasked) {
+        mask &= wanted_children(w, masks_.node_a, masks_.node_b[to_size(pb.node[lb])]);
+      }
       if (relative_ && mask != 0) {
         mask = end_boxes_meet(ends_a_[to_size(ca)], ends_b_[node_of(sb)], lb, mask);
       }
@@ -366,6 +396,9 @@ class Walk {
     } else {
       const WideBvhNode<N>& w = wide_b_[to_size(cb)];
       unsigned mask = overlap_lanes<N>(w, pa, la);
+      if constexpr (kMasked) {
+        mask &= wanted_children(w, masks_.node_b, masks_.node_a[to_size(pa.node[la])]);
+      }
       if (relative_ && mask != 0) {
         mask = end_boxes_meet(ends_b_[to_size(cb)], ends_a_[node_of(sa)], la, mask);
       }
@@ -466,9 +499,16 @@ class Walk {
             if constexpr (kSieve) {
               if (settles(i, sj, ti, tj, settled)) continue;
             }
+            if constexpr (kMasked) {
+              if (!pair_wanted(
+                      masks_.triangles[to_size(ti)], masks_.triangles[to_size(tj)], masks_.which)) {
+                continue;
+              }
+            }
             if (!overlap(bounds_a_[to_size(ti)], bounds_b_[to_size(tj)])) continue;
-            // Ordered a < b within one tree (a select, not a branch), as given across two.
-            if constexpr (kSelf) {
+            // Ordered a < b within one tree (a select, not a branch), as given across two (a
+            // masked walk's two trees are parts of one mesh: ordered too).
+            if constexpr (kSelf || kMasked) {
               out_.push_back({std::min(ti, tj), std::max(ti, tj)});
             } else {
               out_.push_back({ti, tj});
@@ -479,6 +519,34 @@ class Walk {
     }
     bv_tests_ += tests;
     if constexpr (kSieve) sieve_->settled += settled;
+  }
+
+  /// Bit j (j < m) set when lanes with masks `mask` and lane_masks[j] may hold a wanted pair; all
+  /// m bits without masks.
+  [[nodiscard]] unsigned wanted_lanes(
+      const std::array<std::uint8_t, kWidth>& lane_masks, int m, std::uint8_t mask) const {
+    unsigned bits = (1u << m) - 1u;
+    if constexpr (kMasked) {
+      bits = 0;
+      for (int j = 0; j < m; ++j) {
+        bits |= static_cast<unsigned>(node_pair_wanted(mask, lane_masks[to_size(j)], masks_.which))
+                << j;
+      }
+    }
+    return bits;
+  }
+
+  /// Bit i set when child i of `w` (node masks `node_masks`) and a node with mask `other` may hold
+  /// a wanted pair.
+  [[nodiscard]] unsigned wanted_children(
+      const WideBvhNode<N>& w, const std::uint8_t* node_masks, std::uint8_t other) const {
+    unsigned bits = 0;
+    for (int i = 0; i < w.num_children; ++i) {
+      bits |= static_cast<unsigned>(
+                  node_pair_wanted(node_masks[to_size(w.node[i])], other, masks_.which))
+              << i;
+    }
+    return bits;
   }
 
   static constexpr int kSlotAxes = Bvh<N>::kSlotAxes;
@@ -566,6 +634,7 @@ class Walk {
   }
 
   FanSieve* sieve_;
+  WalkMasks masks_;
   const Bvh<N>& a_;
   const Bvh<N>& b_;
   std::span<const WideBvhNode<N>> wide_a_;
@@ -755,7 +824,110 @@ void pair_traverse(
       std::numeric_limits<std::size_t>::max());
 }
 
+// The masked traversals of culling/cluster_checks.hpp: the same wide walk, with the class masks.
+template <int N>
+bool masked_self_traverse_some(
+    const Bvh<N>& bvh,
+    std::span<const Dop<N>> triangle_bounds,
+    std::span<const std::uint8_t> node_mask,
+    std::span<const std::uint8_t> triangle_mask,
+    MaskedPairs which,
+    TraversalScratch& scratch,
+    std::vector<TrianglePair>& out,
+    std::int64_t& bv_tests,
+    std::size_t max_pairs) {
+  if (bvh.empty()) return true;
+  assert(node_mask.size() == bvh.nodes().size());
+  const WalkMasks masks{node_mask.data(), node_mask.data(), triangle_mask.data(), which};
+  return Walk<N, true, false, true>(
+             bvh,
+             triangle_bounds,
+             bvh,
+             triangle_bounds,
+             scratch.stack,
+             out,
+             bv_tests,
+             max_pairs,
+             nullptr,
+             masks)
+      .run();
+}
+
+template <int N>
+bool masked_pair_traverse_some(
+    const Bvh<N>& a,
+    std::span<const std::uint8_t> node_mask_a,
+    const Bvh<N>& b,
+    std::span<const std::uint8_t> node_mask_b,
+    std::span<const Dop<N>> triangle_bounds,
+    std::span<const std::uint8_t> triangle_mask,
+    MaskedPairs which,
+    TraversalScratch& scratch,
+    std::vector<TrianglePair>& out,
+    std::int64_t& bv_tests,
+    std::size_t max_pairs) {
+  if (a.empty() || b.empty()) return true;
+  assert(node_mask_a.size() == a.nodes().size() && node_mask_b.size() == b.nodes().size());
+  const WalkMasks masks{node_mask_a.data(), node_mask_b.data(), triangle_mask.data(), which};
+  return Walk<N, false, false, true>(
+             a,
+             triangle_bounds,
+             b,
+             triangle_bounds,
+             scratch.stack,
+             out,
+             bv_tests,
+             max_pairs,
+             nullptr,
+             masks)
+      .run();
+}
+
 template void start_self_traversal<3>(const Bvh<3>&, TraversalScratch&);
+template bool masked_self_traverse_some<3>(
+    const Bvh<3>&,
+    std::span<const Dop<3>>,
+    std::span<const std::uint8_t>,
+    std::span<const std::uint8_t>,
+    MaskedPairs,
+    TraversalScratch&,
+    std::vector<TrianglePair>&,
+    std::int64_t&,
+    std::size_t);
+template bool masked_self_traverse_some<8>(
+    const Bvh<8>&,
+    std::span<const Dop<8>>,
+    std::span<const std::uint8_t>,
+    std::span<const std::uint8_t>,
+    MaskedPairs,
+    TraversalScratch&,
+    std::vector<TrianglePair>&,
+    std::int64_t&,
+    std::size_t);
+template bool masked_pair_traverse_some<3>(
+    const Bvh<3>&,
+    std::span<const std::uint8_t>,
+    const Bvh<3>&,
+    std::span<const std::uint8_t>,
+    std::span<const Dop<3>>,
+    std::span<const std::uint8_t>,
+    MaskedPairs,
+    TraversalScratch&,
+    std::vector<TrianglePair>&,
+    std::int64_t&,
+    std::size_t);
+template bool masked_pair_traverse_some<8>(
+    const Bvh<8>&,
+    std::span<const std::uint8_t>,
+    const Bvh<8>&,
+    std::span<const std::uint8_t>,
+    std::span<const Dop<8>>,
+    std::span<const std::uint8_t>,
+    MaskedPairs,
+    TraversalScratch&,
+    std::vector<TrianglePair>&,
+    std::int64_t&,
+    std::size_t);
 template void start_self_traversal<8>(const Bvh<8>&, TraversalScratch&);
 template bool self_traverse_some<3>(
     const Bvh<3>&,

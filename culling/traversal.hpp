@@ -89,8 +89,9 @@ struct TraversalScratch {
   };
   std::vector<Entry> stack;
 
-  /// Reserves the proven maximum stack size of a self traversal of `bvh`, over its wide nodes
-  /// (self_traverse) or its binary nodes (masked_self_traverse, culling/cluster_checks.hpp).
+  /// Reserves the proven maximum stack size of a self traversal of `bvh` (self_traverse and the
+  /// masked one, culling/cluster_checks.hpp: both walk the wide nodes), and of a walk over its
+  /// binary nodes.
   /// Wide: 9·(wide_depth − 1) + 1 entries — an entry's processing pushes at most one entry per
   /// child or per two children (a node against itself: 4 + 6, so 9 left pending besides the one
   /// processed next; two nodes: 4, so 3), and a path descends at most wide_depth − 1 self levels
