@@ -647,25 +647,9 @@ void Bvh<N>::refit_end_boxes(
       }
     }
   };
-  if (node_volumes_) {
-    // The binary nodes bottom-up (children after their parent), then each wide lane a copy of its
-    // binary node's.
-    node_end_boxes_.resize(nodes_.size());
-    for (std::size_t n = nodes_.size(); n-- > 0;) {
-      const BvhNode& node = nodes_[n];
-      NodeEndBoxes& e = node_end_boxes_[n];
-      if (node.is_leaf()) {
-        slot_boxes(static_cast<std::size_t>(node.begin), static_cast<std::size_t>(node.end), e);
-      } else {
-        e = node_end_boxes_[n + 1];
-        merge_ends(e, node_end_boxes_[static_cast<std::size_t>(node.right)]);
-      }
-    }
-  }
   end_boxes_.resize(wide_.size());
-  // As refit_wide_only: children after their parent, so one backward sweep is bottom-up; a lane is
-  // its binary node's boxes, or else a bucket's from its triangles' corners and an inner lane the
-  // union of its wide node's lanes.
+  // As refit_wide_only: children after their parent, so one backward sweep is bottom-up; a
+  // bucket's lane from its triangles' corners, an inner lane the union of its wide node's lanes.
   for (std::size_t n = wide_.size(); n-- > 0;) {
     const WideBvhNode<N>& w = wide_[n];
     WideEndBoxes& e = end_boxes_[n];
@@ -678,9 +662,7 @@ void Bvh<N>::refit_end_boxes(
     for (int lane = 0; lane < w.num_children; ++lane) {
       const auto i = static_cast<std::size_t>(lane);
       NodeEndBoxes lane_boxes;
-      if (node_volumes_) {
-        lane_boxes = node_end_boxes_[static_cast<std::size_t>(w.node[i])];
-      } else if (w.child[i] < 0) {
+      if (w.child[i] < 0) {
         const auto begin = static_cast<std::size_t>(~w.child[i]);
         slot_boxes(begin, begin + static_cast<std::size_t>(w.count[i]), lane_boxes);
       } else {

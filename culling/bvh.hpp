@@ -107,9 +107,9 @@ struct alignas(16) WideEndBoxes {
   float hi1[3][4];
 };
 
-/// One binary node's boxes at the two ends of an interval (Bvh::node_end_boxes), as floats rounded
-/// outwards: lo0[k], hi0[k] at t = 0 and lo1[k], hi1[k] at t = 1 on axis k < 3; the fourth slot
-/// of each is 0 (so that four axes are tested at once, the fourth always meeting).
+/// One vertex's (or a set of them: a lane's, while Bvh::refit_end_boxes gathers it) boxes at the
+/// two ends of an interval, as floats rounded outwards: lo0[k], hi0[k] at t = 0 and lo1[k], hi1[k]
+/// at t = 1 on axis k < 3; the fourth slot of each is 0.
 struct alignas(16) NodeEndBoxes {
   float lo0[4];
   float hi0[4];
@@ -208,20 +208,12 @@ class Bvh {
     return slot_bounds_.data() + static_cast<std::size_t>(kSlotAxes + k) * slot_stride();
   }
   /// Fills end_boxes() for an interval from its vertices' end boxes (vertex_end_boxes, indexed by
-  /// the vertex ids of `triangles`, the triangles the tree was built from); with binary node
-  /// volumes also node_end_boxes(). Valid until the next refit()
-  /// (which drops them), so that a traversal never reads boxes of another interval. Allocates
-  /// once (#wide nodes × 192 bytes, and #nodes × 64 with binary node volumes).
+  /// the vertex ids of `triangles`, the triangles the tree was built from). Valid until the next
+  /// refit() (which drops them), so that a traversal never reads boxes of another interval.
+  /// Allocates once (#wide nodes × 192 bytes). Every traversal walks the wide nodes (the masked
+  /// ones too), so the binary nodes get none.
   void refit_end_boxes(
       const skinning::Triangles& triangles, std::span<const NodeEndBoxes> vertex_ends);
-  /// The binary nodes' end boxes (NodeEndBoxes), by node of nodes(); filled by refit_end_boxes
-  /// when the tree keeps its binary node volumes (BvhOptions::node_volumes: the masked
-  /// traversals walk the binary nodes), else empty; empty too unless refit_end_boxes ran after
-  /// the last refit().
-  [[nodiscard]] std::span<const NodeEndBoxes> node_end_boxes() const {
-    return end_boxes_ready_ ? std::span<const NodeEndBoxes>(node_end_boxes_)
-                            : std::span<const NodeEndBoxes>();
-  }
   /// The wide nodes' end boxes (WideEndBoxes), by wide node; empty unless refit_end_boxes ran
   /// after the last refit().
   [[nodiscard]] std::span<const WideEndBoxes> end_boxes() const {
@@ -252,7 +244,6 @@ class Bvh {
   std::vector<std::int32_t> order_;
   std::vector<WideBvhNode<N>> wide_;
   std::vector<WideEndBoxes> end_boxes_;
-  std::vector<NodeEndBoxes> node_end_boxes_;
   bool end_boxes_ready_ = false;
   [[nodiscard]] std::size_t slot_stride() const { return order_.size() + kSlotPadding; }
   static constexpr std::size_t kSlotPadding = 3;

@@ -180,39 +180,6 @@ unsigned end_boxes_meet(const WideEndBoxes& w, const WideEndBoxes& q, int lane, 
 #endif
 }
 
-bool node_end_boxes_meet(const NodeEndBoxes& a, const NodeEndBoxes& b) {
-#if defined(__SSE2__)
-  // Boxes that overlap at t = 0 overlap in any relative motion (each relative box holds its box at
-  // t = 0): the common case where little moves, settled without computing u.
-  const __m128 a_lo0 = _mm_load_ps(a.lo0);
-  const __m128 a_hi0 = _mm_load_ps(a.hi0);
-  const __m128 b_lo0 = _mm_load_ps(b.lo0);
-  const __m128 b_hi0 = _mm_load_ps(b.hi0);
-  if (_mm_movemask_ps(_mm_and_ps(_mm_cmple_ps(a_lo0, b_hi0), _mm_cmple_ps(b_lo0, a_hi0))) == 0xf) {
-    return true;
-  }
-  // The three axes and the padding slot (all 0: always meeting) at once.
-  const __m128 ok = relative_meet(
-      _mm_load_ps(a.lo0),
-      _mm_load_ps(a.hi0),
-      _mm_load_ps(a.lo1),
-      _mm_load_ps(a.hi1),
-      _mm_load_ps(b.lo0),
-      _mm_load_ps(b.hi0),
-      _mm_load_ps(b.lo1),
-      _mm_load_ps(b.hi1));
-  return _mm_movemask_ps(ok) == 0xf;
-#else
-  for (int k = 0; k < 3; ++k) {
-    if (!relative_meet(
-            a.lo0[k], a.hi0[k], a.lo1[k], a.hi1[k], b.lo0[k], b.hi0[k], b.lo1[k], b.hi1[k])) {
-      return false;
-    }
-  }
-  return true;
-#endif
-}
-
 namespace {
 
 /// Bit i set when corner i (0..2) of `a` is a vertex of `b` (corners as in SlotAdjacency::corners;

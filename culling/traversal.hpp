@@ -75,10 +75,6 @@ void certified_slots(
 [[nodiscard]] unsigned end_boxes_meet(
     const WideEndBoxes& w, const WideEndBoxes& q, int lane, unsigned wanted = 0xfu);
 
-/// end_boxes_meet for two binary nodes' end boxes (Bvh::node_end_boxes), the masked traversals'
-/// test (culling/cluster_checks.hpp): true when the nodes may come within reach of each other.
-[[nodiscard]] bool node_end_boxes_meet(const NodeEndBoxes& a, const NodeEndBoxes& b);
-
 /// Caller-owned scratch of a traversal: the stack of pending node pairs. Reserve it once for the
 /// hierarchies it will traverse; a traversal then allocates nothing. One per thread when
 /// traversals run in parallel (a stack seeded with a frontier of node pairs is the unit to split).
