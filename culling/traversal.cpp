@@ -851,6 +851,7 @@ bool masked_pair_traverse_some(
 }
 
 template void start_self_traversal<3>(const Bvh<3>&, TraversalScratch&);
+template void start_self_traversal<8>(const Bvh<8>&, TraversalScratch&);
 template bool masked_self_traverse_some<3>(
     const Bvh<3>&,
     std::span<const Dop<3>>,
@@ -895,7 +896,6 @@ template bool masked_pair_traverse_some<8>(
     std::vector<TrianglePair>&,
     std::int64_t&,
     std::size_t);
-template void start_self_traversal<8>(const Bvh<8>&, TraversalScratch&);
 template bool self_traverse_some<3>(
     const Bvh<3>&,
     std::span<const Dop<3>>,
