@@ -295,22 +295,21 @@ class Walk {
     }
     const WideBvhNode<N>& w = wide_a_[to_size(c)];
     const int m = w.num_children;
-    std::array<std::uint8_t, kWidth> lane_masks{};
-    if constexpr (kMasked) {
-      for (int i = 0; i < m; ++i) lane_masks[to_size(i)] = masks_.node_a[to_size(w.node[i])];
-    }
     for (int i = 0; i < m; ++i) {
       if constexpr (kMasked) {
-        const std::uint8_t mi = lane_masks[to_size(i)];
+        const std::uint8_t mi = masks_.node_a[to_size(w.node[i])];
         if (!node_pair_wanted(mi, mi, masks_.which)) continue;
       }
       if (w.child[i] >= 0 || w.count[i] > 1) push(stack_, slot(c, i), slot(c, i));
     }
     for (int i = 0; i + 1 < m; ++i) {
-      // Children i < j: lanes above i.
-      const unsigned above = ~((2u << i) - 1u);
-      const unsigned wanted = wanted_lanes(lane_masks, m, lane_masks[to_size(i)]) & above;
-      if (wanted == 0) continue;
+      // Children i < j: lanes above i (a masked walk: only those that may hold a wanted pair
+      // with i, and none tested when there are none).
+      unsigned wanted = ~((2u << i) - 1u);
+      if constexpr (kMasked) {
+        wanted &= wanted_children(w, masks_.node_a, masks_.node_a[to_size(w.node[i])]);
+        if (wanted == 0) continue;
+      }
       unsigned mask = overlap_lanes<N>(w, w, i) & wanted;
       if (relative_ && mask != 0)
         mask = end_boxes_meet(ends_a_[to_size(c)], ends_a_[to_size(c)], i, mask);
@@ -486,21 +485,6 @@ class Walk {
     }
     bv_tests_ += tests;
     if constexpr (kSieve) sieve_->settled += settled;
-  }
-
-  /// Bit j (j < m) set when lanes with masks `mask` and lane_masks[j] may hold a wanted pair; all
-  /// m bits without masks.
-  [[nodiscard]] unsigned wanted_lanes(
-      const std::array<std::uint8_t, kWidth>& lane_masks, int m, std::uint8_t mask) const {
-    unsigned bits = (1u << m) - 1u;
-    if constexpr (kMasked) {
-      bits = 0;
-      for (int j = 0; j < m; ++j) {
-        bits |= static_cast<unsigned>(node_pair_wanted(mask, lane_masks[to_size(j)], masks_.which))
-                << j;
-      }
-    }
-    return bits;
   }
 
   /// Bit i set when child i of `w` (node masks `node_masks`) and a node with mask `other` may hold

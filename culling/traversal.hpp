@@ -3,7 +3,6 @@
 // two hierarchies against each other (inter-object). They report triangle pairs whose volumes
 // overlap; what to test inside a pair is the caller's business (culling/candidates.hpp).
 
-#include <algorithm>
 #include <array>
 #include <cstdint>
 #include <span>
@@ -85,27 +84,21 @@ struct TraversalScratch {
   };
   std::vector<Entry> stack;
 
-  /// Reserves the proven maximum stack size of a self traversal of `bvh` (self_traverse and the
-  /// masked one, culling/cluster_checks.hpp: both walk the wide nodes), and of a walk over its
-  /// binary nodes.
-  /// Wide: 9·(wide_depth − 1) + 1 entries — an entry's processing pushes at most one entry per
-  /// child or per two children (a node against itself: 4 + 6, so 9 left pending besides the one
-  /// processed next; two nodes: 4, so 3), and a path descends at most wide_depth − 1 self levels
-  /// from the root, then at most 2·(wide_depth − L) pair levels below self level L.
-  /// Binary: 4·depth + 1 (two pending per self level, one per pair level).
+  /// Reserves the proven maximum stack size of a self traversal of `bvh` over its wide nodes
+  /// (self_traverse, and the masked one of culling/cluster_checks.hpp, which pushes a subset):
+  /// 9·(wide_depth − 1) + 1 entries — an entry's processing pushes at most one entry per child or
+  /// per two children (a node against itself: 4 + 6, so 9 left pending besides the one processed
+  /// next; two nodes: 4, so 3), and a path descends at most wide_depth − 1 self levels from the
+  /// root, then at most 2·(wide_depth − L) pair levels below self level L.
   template <int N>
   void reserve_self(const Bvh<N>& bvh) {
-    reserve(std::max(
-        9 * static_cast<std::size_t>(bvh.wide_depth()) + 4,
-        4 * static_cast<std::size_t>(bvh.depth()) + 4));
+    reserve(9 * static_cast<std::size_t>(bvh.wide_depth()) + 4);
   }
-  /// Reserves the maximum stack size of a pair traversal of (a, b): wide 3·(wide_depth(a) +
-  /// wide_depth(b)) + 1 (three pending per level of either tree); binary depth(a) + depth(b) + 1.
+  /// Reserves the maximum stack size of a pair traversal of (a, b) (masked or not):
+  /// 3·(wide_depth(a) + wide_depth(b)) + 1 (three pending per level of either tree).
   template <int N>
   void reserve_pair(const Bvh<N>& a, const Bvh<N>& b) {
-    reserve(std::max(
-        3 * static_cast<std::size_t>(a.wide_depth() + b.wide_depth()) + 4,
-        static_cast<std::size_t>(a.depth() + b.depth()) + 4));
+    reserve(3 * static_cast<std::size_t>(a.wide_depth() + b.wide_depth()) + 4);
   }
   void reserve(std::size_t n) {
     if (stack.capacity() < n) stack.reserve(n);
