@@ -229,7 +229,8 @@ RadialViewMethod::RadialViewMethod(
   node_masks_.resize(num_atomic);
   std::size_t deepest = 0;
   for (std::int32_t a = 0; a < clusters_.num_atomic(); ++a) {
-    node_masks_[at(a)].resize(clusters_.local_bvh(a).nodes().size());
+    node_masks_[at(a)].nodes.resize(clusters_.local_bvh(a).nodes().size());
+    node_masks_[at(a)].slots.resize(clusters_.local_bvh(a).triangle_order().size() + 3);
     deepest = std::max(deepest, static_cast<std::size_t>(clusters_.local_bvh(a).depth()));
   }
   scratch_.reserve(std::max(
@@ -639,7 +640,6 @@ std::int64_t RadialViewMethod::traverse(double half_width, culling::FrameResult&
           local,
           tri_bounds,
           node_masks_[at(a)],
-          triangle_mask_,
           MaskedPairs::tested,
           scratch_,
           pairs,
@@ -663,7 +663,6 @@ std::int64_t RadialViewMethod::traverse(double half_width, culling::FrameResult&
             local_b,
             node_masks_[at(cp.b)],
             tri_bounds,
-            triangle_mask_,
             MaskedPairs::tested,
             scratch_,
             pairs,
@@ -738,7 +737,7 @@ std::int64_t RadialViewMethod::retest_frontier(
         const auto nodes = local.nodes();
         const auto node_bounds = local.node_bounds();
         const auto order = local.triangle_order();
-        const auto& masks = node_masks_[at(a)];
+        const auto& masks = node_masks_[at(a)].nodes;
         node_stack_.clear();
         node_stack_.push_back(0);
         while (!node_stack_.empty()) {

@@ -1,6 +1,8 @@
 #include "culling/cluster_checks.hpp"
 
+#include <algorithm>
 #include <cassert>
+#include <cstddef>
 #include <limits>
 #include <utility>
 
@@ -20,22 +22,23 @@ inline void push(std::vector<Entry>& stack, std::int32_t a, std::int32_t b) {
 
 template <int N>
 void node_class_masks(
-    const Bvh<N>& bvh,
-    std::span<const std::uint8_t> triangle_mask,
-    std::vector<std::uint8_t>& out) {
+    const Bvh<N>& bvh, std::span<const std::uint8_t> triangle_mask, ClassMasks& out) {
   const auto nodes = bvh.nodes();
   const auto order = bvh.triangle_order();
-  out.resize(nodes.size());
+  out.slots.resize(order.size() + 3);
+  for (std::size_t s = 0; s < order.size(); ++s) out.slots[s] = triangle_mask[at(order[s])];
+  std::fill(out.slots.begin() + static_cast<std::ptrdiff_t>(order.size()), out.slots.end(), 0);
+  out.nodes.resize(nodes.size());
   // Children follow their parent in depth-first order: one backward sweep is bottom-up.
   for (std::size_t n = nodes.size(); n-- > 0;) {
     const BvhNode& node = nodes[n];
     std::uint8_t m = 0;
     if (node.is_leaf()) {
-      for (std::int32_t s = node.begin; s < node.end; ++s) m |= triangle_mask[at(order[at(s)])];
+      for (std::int32_t s = node.begin; s < node.end; ++s) m |= out.slots[at(s)];
     } else {
-      m = out[n + 1] | out[at(node.right)];
+      m = out.nodes[n + 1] | out.nodes[at(node.right)];
     }
-    out[n] = m;
+    out.nodes[n] = m;
   }
 }
 
@@ -50,8 +53,7 @@ template <int N>
 void masked_self_traverse(
     const Bvh<N>& bvh,
     std::span<const Dop<N>> triangle_bounds,
-    std::span<const std::uint8_t> node_mask,
-    std::span<const std::uint8_t> triangle_mask,
+    const ClassMasks& masks,
     MaskedPairs which,
     TraversalScratch& scratch,
     std::vector<TrianglePair>& out,
@@ -60,8 +62,7 @@ void masked_self_traverse(
   masked_self_traverse_some(
       bvh,
       triangle_bounds,
-      node_mask,
-      triangle_mask,
+      masks,
       which,
       scratch,
       out,
@@ -79,11 +80,10 @@ void start_masked_pair_traversal(const Bvh<N>& a, const Bvh<N>& b, TraversalScra
 template <int N>
 void masked_pair_traverse(
     const Bvh<N>& a,
-    std::span<const std::uint8_t> node_mask_a,
+    const ClassMasks& masks_a,
     const Bvh<N>& b,
-    std::span<const std::uint8_t> node_mask_b,
+    const ClassMasks& masks_b,
     std::span<const Dop<N>> triangle_bounds,
-    std::span<const std::uint8_t> triangle_mask,
     MaskedPairs which,
     TraversalScratch& scratch,
     std::vector<TrianglePair>& out,
@@ -91,11 +91,10 @@ void masked_pair_traverse(
   start_masked_pair_traversal(a, b, scratch);
   masked_pair_traverse_some(
       a,
-      node_mask_a,
+      masks_a,
       b,
-      node_mask_b,
+      masks_b,
       triangle_bounds,
-      triangle_mask,
       which,
       scratch,
       out,
@@ -103,26 +102,44 @@ void masked_pair_traverse(
       std::numeric_limits<std::size_t>::max());
 }
 
-template void node_class_masks<3>(
-    const Bvh<3>&, std::span<const std::uint8_t>, std::vector<std::uint8_t>&);
-template void node_class_masks<8>(
-    const Bvh<8>&, std::span<const std::uint8_t>, std::vector<std::uint8_t>&);
+template void node_class_masks<3>(const Bvh<3>&, std::span<const std::uint8_t>, ClassMasks&);
+template void node_class_masks<8>(const Bvh<8>&, std::span<const std::uint8_t>, ClassMasks&);
 template void masked_self_traverse<3>(
-    const Bvh<3>&, std::span<const Dop<3>>, std::span<const std::uint8_t>,
-    std::span<const std::uint8_t>, MaskedPairs, TraversalScratch&, std::vector<TrianglePair>&,
+    const Bvh<3>&,
+    std::span<const Dop<3>>,
+    const ClassMasks&,
+    MaskedPairs,
+    TraversalScratch&,
+    std::vector<TrianglePair>&,
     std::int64_t&);
 template void masked_self_traverse<8>(
-    const Bvh<8>&, std::span<const Dop<8>>, std::span<const std::uint8_t>,
-    std::span<const std::uint8_t>, MaskedPairs, TraversalScratch&, std::vector<TrianglePair>&,
+    const Bvh<8>&,
+    std::span<const Dop<8>>,
+    const ClassMasks&,
+    MaskedPairs,
+    TraversalScratch&,
+    std::vector<TrianglePair>&,
     std::int64_t&);
 template void masked_pair_traverse<3>(
-    const Bvh<3>&, std::span<const std::uint8_t>, const Bvh<3>&, std::span<const std::uint8_t>,
-    std::span<const Dop<3>>, std::span<const std::uint8_t>, MaskedPairs, TraversalScratch&,
-    std::vector<TrianglePair>&, std::int64_t&);
+    const Bvh<3>&,
+    const ClassMasks&,
+    const Bvh<3>&,
+    const ClassMasks&,
+    std::span<const Dop<3>>,
+    MaskedPairs,
+    TraversalScratch&,
+    std::vector<TrianglePair>&,
+    std::int64_t&);
 template void masked_pair_traverse<8>(
-    const Bvh<8>&, std::span<const std::uint8_t>, const Bvh<8>&, std::span<const std::uint8_t>,
-    std::span<const Dop<8>>, std::span<const std::uint8_t>, MaskedPairs, TraversalScratch&,
-    std::vector<TrianglePair>&, std::int64_t&);
+    const Bvh<8>&,
+    const ClassMasks&,
+    const Bvh<8>&,
+    const ClassMasks&,
+    std::span<const Dop<8>>,
+    MaskedPairs,
+    TraversalScratch&,
+    std::vector<TrianglePair>&,
+    std::int64_t&);
 
 template void start_masked_self_traversal<3>(const Bvh<3>&, TraversalScratch&);
 template void start_masked_self_traversal<8>(const Bvh<8>&, TraversalScratch&);

@@ -47,25 +47,30 @@ enum class MaskedPairs : std::uint8_t {
   return mask_pair_skipped(a, b) == (which == MaskedPairs::skipped);
 }
 
-/// Node masks of `bvh`: out[n] = OR of triangle_mask over node n's triangles.
-/// @param triangle_mask indexed by triangle id.  @param out resized to #nodes.
+/// The class masks a masked traversal of one hierarchy reads: each binary node's (the OR over its
+/// triangles, tested per wide lane through WideBvhNode::node) and each slot's (the mask of the
+/// triangle at that position of triangle_order(): a bucket's four slots are tested at once).
+struct ClassMasks {
+  std::vector<std::uint8_t> nodes;  ///< #nodes
+  std::vector<std::uint8_t> slots;  ///< #triangles + 3: four can be read from any slot
+};
+
+/// The class masks of `bvh` (ClassMasks) from the triangles' masks.
+/// @param triangle_mask indexed by triangle id.  @param out resized, its memory kept.
 template <int N>
 void node_class_masks(
-    const Bvh<N>& bvh,
-    std::span<const std::uint8_t> triangle_mask,
-    std::vector<std::uint8_t>& out);
+    const Bvh<N>& bvh, std::span<const std::uint8_t> triangle_mask, ClassMasks& out);
 
 /// Self traversal of one hierarchy with masks: appends every pair a < b of its triangles whose
 /// volumes overlap and that `which` selects, each once. Counts node-pair and triangle-pair
 /// volume tests in bv_tests.
-/// @param node_mask node_class_masks(bvh, triangle_mask).
+/// @param masks node_class_masks(bvh, triangle_mask).
 /// @note Allocation-free once `scratch` is reserved (reserve_self) and `out` has the capacity.
 template <int N>
 void masked_self_traverse(
     const Bvh<N>& bvh,
     std::span<const Dop<N>> triangle_bounds,
-    std::span<const std::uint8_t> node_mask,
-    std::span<const std::uint8_t> triangle_mask,
+    const ClassMasks& masks,
     MaskedPairs which,
     TraversalScratch& scratch,
     std::vector<TrianglePair>& out,
@@ -83,8 +88,7 @@ template <int N>
 bool masked_self_traverse_some(
     const Bvh<N>& bvh,
     std::span<const Dop<N>> triangle_bounds,
-    std::span<const std::uint8_t> node_mask,
-    std::span<const std::uint8_t> triangle_mask,
+    const ClassMasks& masks,
     MaskedPairs which,
     TraversalScratch& scratch,
     std::vector<TrianglePair>& out,
@@ -96,11 +100,10 @@ bool masked_self_traverse_some(
 template <int N>
 void masked_pair_traverse(
     const Bvh<N>& a,
-    std::span<const std::uint8_t> node_mask_a,
+    const ClassMasks& masks_a,
     const Bvh<N>& b,
-    std::span<const std::uint8_t> node_mask_b,
+    const ClassMasks& masks_b,
     std::span<const Dop<N>> triangle_bounds,
-    std::span<const std::uint8_t> triangle_mask,
     MaskedPairs which,
     TraversalScratch& scratch,
     std::vector<TrianglePair>& out,
@@ -112,11 +115,10 @@ void start_masked_pair_traversal(const Bvh<N>& a, const Bvh<N>& b, TraversalScra
 template <int N>
 bool masked_pair_traverse_some(
     const Bvh<N>& a,
-    std::span<const std::uint8_t> node_mask_a,
+    const ClassMasks& masks_a,
     const Bvh<N>& b,
-    std::span<const std::uint8_t> node_mask_b,
+    const ClassMasks& masks_b,
     std::span<const Dop<N>> triangle_bounds,
-    std::span<const std::uint8_t> triangle_mask,
     MaskedPairs which,
     TraversalScratch& scratch,
     std::vector<TrianglePair>& out,

@@ -6,6 +6,7 @@
 #include <cassert>
 #include <cmath>
 #include <cstdint>
+#include <cstring>
 #include <limits>
 
 #if defined(__SSE2__)
@@ -203,15 +204,36 @@ inline unsigned shared_lanes(
 #endif
 }
 
-/// The class masks of a masked walk (culling/cluster_checks.hpp): the binary nodes' masks of both
-/// trees (one tree's twice in a self walk), read per wide lane through WideBvhNode::node, and the
-/// triangles' by triangle id.
+/// The class masks of a masked walk (culling/cluster_checks.hpp, ClassMasks) of both trees (one
+/// tree's twice in a self walk): the binary nodes', read per wide lane through WideBvhNode::node,
+/// and the slots', four at a time.
 struct WalkMasks {
   const std::uint8_t* node_a = nullptr;
   const std::uint8_t* node_b = nullptr;
-  const std::uint8_t* triangles = nullptr;
+  const std::uint8_t* slots_a = nullptr;
+  const std::uint8_t* slots_b = nullptr;  // padded: four can be read from any slot
   MaskedPairs which = MaskedPairs::tested;
 };
+
+/// Bit c set when the triangle pair of slot masks (mi, slots[c]), c < 4, is one `which` selects:
+/// pair_wanted (cluster_checks.hpp) on four slots at once. A pair is skipped when both masks are
+/// the same single sign, so with `mi` of no single sign every lane is a tested pair.
+inline unsigned wanted_slots(std::uint8_t mi, const std::uint8_t* slots, MaskedPairs which) {
+#if defined(__SSE2__)
+  if (mi != kMaskPositive && mi != kMaskNegative) return which == MaskedPairs::tested ? 0xFu : 0u;
+  std::int32_t four = 0;
+  std::memcpy(&four, slots, sizeof four);
+  const __m128i eq = _mm_cmpeq_epi8(_mm_cvtsi32_si128(four), _mm_set1_epi8(static_cast<char>(mi)));
+  const auto same = static_cast<unsigned>(_mm_movemask_epi8(eq)) & 0xFu;
+  return which == MaskedPairs::tested ? ~same & 0xFu : same;
+#else
+  unsigned bits = 0;
+  for (unsigned c = 0; c < 4; ++c) {
+    bits |= static_cast<unsigned>(pair_wanted(mi, slots[c], which)) << c;
+  }
+  return bits;
+#endif
+}
 
 /// One traversal over wide nodes: of one tree with itself (kSelf: a and b are the same tree) or of
 /// two trees. Entries on the stack are slot pairs whose float volumes overlap (the first entry
@@ -435,6 +457,8 @@ class Walk {
         const std::int32_t i = i0 + std::countr_zero(a_mask);
         a_mask &= a_mask - 1;
         const std::int32_t ti = order_a_[to_size(i)];
+        [[maybe_unused]] std::uint8_t mi = 0;
+        if constexpr (kMasked) mi = masks_.slots_a[to_size(i)];
         for (std::int32_t j0 = same ? i + 1 : begin_b; j0 < end_b; j0 += kWidth) {
           const std::int32_t n = std::min(kWidth, end_b - j0);
           // Four slots of b at once in float (the slots past the tree's last are empty), which only
@@ -446,6 +470,7 @@ class Walk {
           unsigned mask = float_overlap_slots(i, j0) & ((1u << n) - 1u);
 #endif
           tests += n;
+          if constexpr (kMasked) mask &= wanted_slots(mi, masks_.slots_b + j0, masks_.which);
           if constexpr (kSieve) {
             // Every corner of slot i certified: its window settles the neighbours it shares a
             // vertex with, four at a time (a pair that shares one overlaps: its bit is in mask).
@@ -464,12 +489,6 @@ class Walk {
             // pair needs no exact volume test.
             if constexpr (kSieve) {
               if (settles(i, sj, ti, tj, settled)) continue;
-            }
-            if constexpr (kMasked) {
-              if (!pair_wanted(
-                      masks_.triangles[to_size(ti)], masks_.triangles[to_size(tj)], masks_.which)) {
-                continue;
-              }
             }
             if (!overlap(bounds_a_[to_size(ti)], bounds_b_[to_size(tj)])) continue;
             // Ordered a < b within one tree (a select, not a branch), as given across two (a
@@ -780,16 +799,17 @@ template <int N>
 bool masked_self_traverse_some(
     const Bvh<N>& bvh,
     std::span<const Dop<N>> triangle_bounds,
-    std::span<const std::uint8_t> node_mask,
-    std::span<const std::uint8_t> triangle_mask,
+    const ClassMasks& masks,
     MaskedPairs which,
     TraversalScratch& scratch,
     std::vector<TrianglePair>& out,
     std::int64_t& bv_tests,
     std::size_t max_pairs) {
   if (bvh.empty()) return true;
-  assert(node_mask.size() == bvh.nodes().size());
-  const WalkMasks masks{node_mask.data(), node_mask.data(), triangle_mask.data(), which};
+  assert(masks.nodes.size() == bvh.nodes().size());
+  assert(masks.slots.size() == bvh.triangle_order().size() + 3);
+  const WalkMasks walk_masks{
+      masks.nodes.data(), masks.nodes.data(), masks.slots.data(), masks.slots.data(), which};
   return Walk<N, true, false, true>(
              bvh,
              triangle_bounds,
@@ -800,26 +820,32 @@ bool masked_self_traverse_some(
              bv_tests,
              max_pairs,
              nullptr,
-             masks)
+             walk_masks)
       .run();
 }
 
 template <int N>
 bool masked_pair_traverse_some(
     const Bvh<N>& a,
-    std::span<const std::uint8_t> node_mask_a,
+    const ClassMasks& masks_a,
     const Bvh<N>& b,
-    std::span<const std::uint8_t> node_mask_b,
+    const ClassMasks& masks_b,
     std::span<const Dop<N>> triangle_bounds,
-    std::span<const std::uint8_t> triangle_mask,
     MaskedPairs which,
     TraversalScratch& scratch,
     std::vector<TrianglePair>& out,
     std::int64_t& bv_tests,
     std::size_t max_pairs) {
   if (a.empty() || b.empty()) return true;
-  assert(node_mask_a.size() == a.nodes().size() && node_mask_b.size() == b.nodes().size());
-  const WalkMasks masks{node_mask_a.data(), node_mask_b.data(), triangle_mask.data(), which};
+  assert(masks_a.nodes.size() == a.nodes().size() && masks_b.nodes.size() == b.nodes().size());
+  assert(masks_a.slots.size() == a.triangle_order().size() + 3);
+  assert(masks_b.slots.size() == b.triangle_order().size() + 3);
+  const WalkMasks walk_masks{
+      masks_a.nodes.data(),
+      masks_b.nodes.data(),
+      masks_a.slots.data(),
+      masks_b.slots.data(),
+      which};
   return Walk<N, false, false, true>(
              a,
              triangle_bounds,
@@ -830,7 +856,7 @@ bool masked_pair_traverse_some(
              bv_tests,
              max_pairs,
              nullptr,
-             masks)
+             walk_masks)
       .run();
 }
 
@@ -839,8 +865,7 @@ template void start_self_traversal<8>(const Bvh<8>&, TraversalScratch&);
 template bool masked_self_traverse_some<3>(
     const Bvh<3>&,
     std::span<const Dop<3>>,
-    std::span<const std::uint8_t>,
-    std::span<const std::uint8_t>,
+    const ClassMasks&,
     MaskedPairs,
     TraversalScratch&,
     std::vector<TrianglePair>&,
@@ -849,8 +874,7 @@ template bool masked_self_traverse_some<3>(
 template bool masked_self_traverse_some<8>(
     const Bvh<8>&,
     std::span<const Dop<8>>,
-    std::span<const std::uint8_t>,
-    std::span<const std::uint8_t>,
+    const ClassMasks&,
     MaskedPairs,
     TraversalScratch&,
     std::vector<TrianglePair>&,
@@ -858,11 +882,10 @@ template bool masked_self_traverse_some<8>(
     std::size_t);
 template bool masked_pair_traverse_some<3>(
     const Bvh<3>&,
-    std::span<const std::uint8_t>,
+    const ClassMasks&,
     const Bvh<3>&,
-    std::span<const std::uint8_t>,
+    const ClassMasks&,
     std::span<const Dop<3>>,
-    std::span<const std::uint8_t>,
     MaskedPairs,
     TraversalScratch&,
     std::vector<TrianglePair>&,
@@ -870,11 +893,10 @@ template bool masked_pair_traverse_some<3>(
     std::size_t);
 template bool masked_pair_traverse_some<8>(
     const Bvh<8>&,
-    std::span<const std::uint8_t>,
+    const ClassMasks&,
     const Bvh<8>&,
-    std::span<const std::uint8_t>,
+    const ClassMasks&,
     std::span<const Dop<8>>,
-    std::span<const std::uint8_t>,
     MaskedPairs,
     TraversalScratch&,
     std::vector<TrianglePair>&,

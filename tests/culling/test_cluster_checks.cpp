@@ -90,7 +90,7 @@ TEST(ClusterChecks, MaskedSelfTraversalSplitsTheOverlappingPairs) {
     bvh.refit(tb);
     for (const std::uint64_t seed : {1u, 2u, 3u}) {
       const auto mask = random_masks(nf, seed);
-      std::vector<std::uint8_t> node_mask;
+      ClassMasks node_mask;
       node_class_masks<3>(bvh, mask, node_mask);
       Pairs want_tested, want_skipped;
       for (std::size_t a = 0; a < nf; ++a) {
@@ -105,22 +105,20 @@ TEST(ClusterChecks, MaskedSelfTraversalSplitsTheOverlappingPairs) {
       TraversalScratch scratch;
       Pairs tested, skipped;
       std::int64_t bv_tested = 0, bv_skipped = 0;
-      masked_self_traverse<3>(bvh, tb, node_mask, mask, MaskedPairs::tested, scratch, tested,
-                              bv_tested);
-      masked_self_traverse<3>(bvh, tb, node_mask, mask, MaskedPairs::skipped, scratch, skipped,
-                              bv_skipped);
+      masked_self_traverse<3>(bvh, tb, node_mask, MaskedPairs::tested, scratch, tested, bv_tested);
+      masked_self_traverse<3>(
+          bvh, tb, node_mask, MaskedPairs::skipped, scratch, skipped, bv_skipped);
       EXPECT_EQ(sorted(tested), want_tested) << "leaf " << leaf << " seed " << seed;
       EXPECT_EQ(sorted(skipped), want_skipped) << "leaf " << leaf << " seed " << seed;
       EXPECT_EQ(tested.size(), sorted(tested).size());
       // Pruning by masks: fewer volume tests than the same traversal with nothing to prune (every
       // triangle kMaskOther: all pairs tested; self_traverse counts its wide tests otherwise).
       const std::vector<std::uint8_t> other(nf, kMaskOther);
-      std::vector<std::uint8_t> other_nodes;
+      ClassMasks other_nodes;
       node_class_masks<3>(bvh, other, other_nodes);
       Pairs all;
       std::int64_t bv_all = 0;
-      masked_self_traverse<3>(
-          bvh, tb, other_nodes, other, MaskedPairs::tested, scratch, all, bv_all);
+      masked_self_traverse<3>(bvh, tb, other_nodes, MaskedPairs::tested, scratch, all, bv_all);
       EXPECT_EQ(sorted(all).size(), want_tested.size() + want_skipped.size());
       EXPECT_LT(bv_tested, bv_all);
     }
@@ -139,7 +137,7 @@ TEST(ClusterChecks, MaskedPairTraversalSplitsTheOverlappingPairs) {
   a.refit(tb);
   b.refit(tb);
   const auto mask = random_masks(static_cast<std::size_t>(nf), 11);
-  std::vector<std::uint8_t> ma, mb;
+  ClassMasks ma, mb;
   node_class_masks<3>(a, mask, ma);
   node_class_masks<3>(b, mask, mb);
   Pairs want_tested, want_skipped;
@@ -156,8 +154,8 @@ TEST(ClusterChecks, MaskedPairTraversalSplitsTheOverlappingPairs) {
   TraversalScratch scratch;
   Pairs tested, skipped;
   std::int64_t bv = 0;
-  masked_pair_traverse<3>(a, ma, b, mb, tb, mask, MaskedPairs::tested, scratch, tested, bv);
-  masked_pair_traverse<3>(a, ma, b, mb, tb, mask, MaskedPairs::skipped, scratch, skipped, bv);
+  masked_pair_traverse<3>(a, ma, b, mb, tb, MaskedPairs::tested, scratch, tested, bv);
+  masked_pair_traverse<3>(a, ma, b, mb, tb, MaskedPairs::skipped, scratch, skipped, bv);
   EXPECT_EQ(sorted(tested), sorted(want_tested));
   EXPECT_EQ(sorted(skipped), sorted(want_skipped));
 }

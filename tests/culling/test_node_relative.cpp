@@ -236,7 +236,7 @@ TEST(NodeRelative, ABodyCarriedFarWhileItMovesKeepsItsContactsWithFarFewerPairs)
   // every triangle "other" (nothing skipped by masks): the same subset, as few.
   {
     std::vector<std::uint8_t> tri_mask(static_cast<std::size_t>(ft.num_triangles()), kMaskOther);
-    std::vector<std::uint8_t> node_mask;
+    ClassMasks node_mask;
     node_class_masks<3>(bvh, tri_mask, node_mask);
     FeatureBounds<3> bounds;
     swept_vertex_bounds<3>(x0, x1, 0.0, bounds.vertices);
@@ -253,7 +253,7 @@ TEST(NodeRelative, ABodyCarriedFarWhileItMovesKeepsItsContactsWithFarFewerPairs)
       std::int64_t tests = 0;
       auto& out = masked[with_ends ? 1 : 0];
       masked_self_traverse<3>(
-          bvh, bounds.triangles, node_mask, tri_mask, MaskedPairs::tested, scratch, out, tests);
+          bvh, bounds.triangles, node_mask, MaskedPairs::tested, scratch, out, tests);
       std::sort(out.begin(), out.end());
     }
     EXPECT_EQ(masked[0], plain.pairs);
