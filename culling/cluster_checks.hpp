@@ -8,6 +8,7 @@
 // (culling/traversal.cpp), a lane's mask being its binary node's. Pairs from different mega
 // clusters are traversed without masks (traversal.hpp).
 
+#include <cstddef>
 #include <cstdint>
 #include <span>
 #include <vector>
@@ -51,8 +52,10 @@ enum class MaskedPairs : std::uint8_t {
 /// triangles, tested per wide lane through WideBvhNode::node) and each slot's (the mask of the
 /// triangle at that position of triangle_order(): a bucket's four slots are tested at once).
 struct ClassMasks {
+  /// Slots past the tree's last, so that four can be read from any slot.
+  static constexpr std::size_t kSlotPadding = 3;
   std::vector<std::uint8_t> nodes;  ///< #nodes
-  std::vector<std::uint8_t> slots;  ///< #triangles + 3: four can be read from any slot
+  std::vector<std::uint8_t> slots;  ///< #triangles + kSlotPadding
 };
 
 /// The class masks of `bvh` (ClassMasks) from the triangles' masks.
