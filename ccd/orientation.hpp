@@ -1,7 +1,9 @@
 #pragma once
 // Exact orientation of four points: Shewchuk's static floating-point filter first (inline, decides
-// almost every call), then a filtered double with a proven dynamic error bound and a GMP rational
-// fallback when neither can decide (ccd/detail/filtered.hpp, docs/ccd.md).
+// almost every call), then orient3d_exact: on exactly representable coordinate differences a
+// zero row (four points in one axis plane) answers 0 at once, otherwise a filtered double with a
+// proven dynamic error bound, floating-point expansions, and GMP rationals near underflow
+// (ccd/detail/filtered.hpp, docs/ccd.md "Exact predicates").
 
 #include <Eigen/Core>
 #include <cmath>
@@ -9,8 +11,8 @@
 
 namespace skelcd::ccd {
 
-/// The exact predicate behind orient3d (filtered double, then GMP): use orient3d, which screens
-/// with a cheaper filter first.
+/// The exact predicate behind orient3d (axis plane, filtered double, expansion, GMP): use
+/// orient3d, which screens with a cheaper filter first.
 [[nodiscard]] int orient3d_exact(
     const Eigen::Vector3d& a,
     const Eigen::Vector3d& b,

@@ -136,7 +136,10 @@ TEST(Expansion, ProductsNearUnderflowOrOverflowAreFlagged) {
 // orient3d_exact (ccd/orientation.cpp), the fallback of every DCD filter, against rationals on the
 // inputs that reach it on real meshes: flat fans and coplanar grids at mesh scale (exact zeros),
 // near-coplanar points nudged by one ulp, the same grids from 2^-200 to 2^200, and coordinates of
-// both signs whose differences round. Both its dynamic filter and its expansion path answer here.
+// both signs whose differences round. Every path answers here: the axis plane of exact differences
+// (the flat fans: a nudge of one ulp off the plane must not be called 0), the dynamic filter and
+// the expansion on exact differences (the grids, the generic points) and on the points themselves
+// (the differences that round).
 TEST(Expansion, ExactOrient3dAgreesWithRationalsOnMeshLikeInputs) {
   std::mt19937_64 rng(29);
   std::uniform_real_distribution<double> mesh(0.4, 0.7);  // one sign, within 2x: exact differences
