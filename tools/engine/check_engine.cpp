@@ -147,8 +147,11 @@ CheckOutcome check_model(
   // (which takes the topology by move: FeatureTopology::built_from still holds there).
   std::shared_ptr<const culling::FeatureTopology> features;
   if (!parallel) {
+    // Counted with the weld (`topology`): it is built whatever the baseline, also with `none`.
     phase = std::chrono::steady_clock::now();
     features = std::make_shared<const culling::FeatureTopology>(motion->mesh(), topology);
+    outcome.setup.topology += ms_since(phase);
+    phase = std::chrono::steady_clock::now();
     baseline = baseline_findings(request.baseline, *motion, topology, features);
     outcome.setup.baseline = ms_since(phase);
   }

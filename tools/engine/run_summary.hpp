@@ -89,7 +89,8 @@ struct RunLabels {
 /// import is the caller's). In a parallel run the baseline's DCD runs on a thread of its own beside
 /// the segmentation and the methods' builds, so the parts may add up to more than `total`.
 struct SetupTimes {
-  double topology = 0;      ///< welding the mesh (shared by the segmentation, baseline, methods)
+  double topology = 0;      ///< welding the mesh (shared by the segmentation, baseline, methods);
+                            ///< in a serial run also its FeatureTopology (baseline and methods)
   double segmentation = 0;  ///< the radial view's segmentation, computed or read (0: none)
   double baseline = 0;      ///< the baseline's findings (its DCD)
   double methods = 0;       ///< building the runner: every worker's culling method
