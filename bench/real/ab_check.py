@@ -1,7 +1,10 @@
 #!/usr/bin/env python3
-"""A/B of two skelcd builds on one whole `skelcd check`: alternating runs, each side's least wall
-time and least CPU time (user + system, the import's child included) and its largest peak RSS,
-and whether the two JSON summaries agree once the timings are left out (exit 1 when they do not).
+"""A/B of two skelcd builds on one whole `skelcd check`: alternating runs (old first in odd
+rounds, new first in even ones: on a VM whose speed drifts, a fixed order can favour one side),
+each side's least wall time and least CPU time (user + system, the import's child included), its
+largest peak RSS, and its least in-process times from the summary (`ms_per_interval`, the rows'
+own; `setup_ms.total`, before the first row) — steadier than the whole process's — and whether
+the two JSON summaries agree once the timings are left out (exit 1 when they do not).
 
     python3 bench/real/ab_check.py OLD_SKELCD NEW_SKELCD REPEAT -- MODEL [check options…]
 
@@ -53,20 +56,24 @@ def main():
     args = sys.argv[5:]
     runs = {side: [] for side in sides}
     summaries = {}
-    for _ in range(repeat):
-        for side, exe in sides.items():
-            wall, cpu, rss, summary = run(exe, args)
-            runs[side].append((wall, cpu, rss))
+    for round_index in range(repeat):
+        order = ["old", "new"] if round_index % 2 == 0 else ["new", "old"]
+        for side in order:
+            wall, cpu, rss, summary = run(sides[side], args)
+            runs[side].append(
+                (wall, cpu, rss, summary["ms_per_interval"], summary["setup_ms"]["total"]))
             summaries[side] = without_timings(summary)
     best = {
-        side: (min(r[0] for r in rs), min(r[1] for r in rs), max(r[2] for r in rs))
+        side: (min(r[0] for r in rs), min(r[1] for r in rs), max(r[2] for r in rs),
+               min(r[3] for r in rs), min(r[4] for r in rs))
         for side, rs in runs.items()
     }
-    for side, (wall, cpu, rss) in best.items():
+    for side, (wall, cpu, rss, per_row, setup) in best.items():
         print(f"{side}: wall {wall * 1e3:9.1f} ms  cpu {cpu * 1e3:9.1f} ms  peak RSS "
-              f"{rss / 1024:7.1f} MiB")
-    print(f"old/new: wall {best['old'][0] / best['new'][0]:.3f}  cpu "
-          f"{best['old'][1] / best['new'][1]:.3f}  peak RSS {best['old'][2] / best['new'][2]:.3f}")
+              f"{rss / 1024:7.1f} MiB  ms_per_interval {per_row:9.3f}  set-up {setup:8.1f} ms")
+    o, n = best["old"], best["new"]
+    print(f"old/new: wall {o[0] / n[0]:.3f}  cpu {o[1] / n[1]:.3f}  peak RSS {o[2] / n[2]:.3f}  "
+          f"ms_per_interval {o[3] / n[3]:.3f}  set-up {o[4] / n[4]:.3f}")
     same = summaries["old"] == summaries["new"]
     print("summaries (timings left out): " + ("identical" if same else "DIFFERENT"))
     sys.exit(0 if same else 1)
