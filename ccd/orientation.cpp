@@ -23,9 +23,10 @@ int orient3d_exact(
     const Eigen::Vector3d& d) {
   using detail::lift;
   // The coordinates of a real mesh mostly differ exactly in double (those read from 32-bit
-  // files always do, unless their exponents are 29 apart): the determinant is then one of the
-  // differences themselves, and what reaches this call — the filter could not decide — is mostly
-  // an exact zero, often of corners in one axis plane (a flat cloth, a mesh's flat parts).
+  // files always do, unless their exponents are more than 28 apart): the determinant is then a
+  // polynomial in three exact difference vectors, and what reaches this call — the filter could
+  // not decide — is mostly an exact zero, often of corners in one axis plane (a flat cloth, a
+  // mesh's flat parts).
   double u[3];
   double v[3];
   double w[3];
