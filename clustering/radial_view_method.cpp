@@ -230,8 +230,7 @@ RadialViewMethod::RadialViewMethod(
   std::size_t deepest = 0;
   for (std::int32_t a = 0; a < clusters_.num_atomic(); ++a) {
     node_masks_[at(a)].nodes.resize(clusters_.local_bvh(a).nodes().size());
-    node_masks_[at(a)].slots.resize(
-        clusters_.local_bvh(a).triangle_order().size() + culling::ClassMasks::kSlotPadding);
+    node_masks_[at(a)].slots.resize(clusters_.local_bvh(a).slot_stride());
     deepest = std::max(deepest, static_cast<std::size_t>(clusters_.local_bvh(a).depth()));
   }
   scratch_.reserve(std::max(

@@ -201,6 +201,9 @@ class Bvh {
   /// k < kSlotAxes and s in [0, #triangles + 3), the last three slots empty (+inf, −inf) so that
   /// any four consecutive slots of the tree can be read at once. The traversals test a triangle
   /// against four of a bucket with them (a float test that only prunes). Refit writes them.
+  /// Slots of one axis of slot_lo / slot_hi: #triangles + 3. Per-slot arrays of the traversals'
+  /// callers (ClassMasks::slots) are as long, for the same four-at-a-time reads.
+  [[nodiscard]] std::size_t slot_stride() const { return order_.size() + kSlotPadding; }
   [[nodiscard]] const float* slot_lo(int k) const {
     return slot_bounds_.data() + static_cast<std::size_t>(k) * slot_stride();
   }
@@ -245,7 +248,6 @@ class Bvh {
   std::vector<WideBvhNode<N>> wide_;
   std::vector<WideEndBoxes> end_boxes_;
   bool end_boxes_ready_ = false;
-  [[nodiscard]] std::size_t slot_stride() const { return order_.size() + kSlotPadding; }
   static constexpr std::size_t kSlotPadding = 3;
   std::vector<float> slot_bounds_;  // 2·kSlotAxes rows of slot_stride(): lo by axis, then hi
   struct Item {

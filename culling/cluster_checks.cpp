@@ -25,7 +25,7 @@ void node_class_masks(
     const Bvh<N>& bvh, std::span<const std::uint8_t> triangle_mask, ClassMasks& out) {
   const auto nodes = bvh.nodes();
   const auto order = bvh.triangle_order();
-  out.slots.resize(order.size() + ClassMasks::kSlotPadding);
+  out.slots.resize(bvh.slot_stride());
   for (std::size_t s = 0; s < order.size(); ++s) out.slots[s] = triangle_mask[at(order[s])];
   std::fill(out.slots.begin() + static_cast<std::ptrdiff_t>(order.size()), out.slots.end(), 0);
   out.nodes.resize(nodes.size());

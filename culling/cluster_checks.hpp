@@ -8,7 +8,6 @@
 // (culling/traversal.cpp), a lane's mask being its binary node's. Pairs from different mega
 // clusters are traversed without masks (traversal.hpp).
 
-#include <cstddef>
 #include <cstdint>
 #include <span>
 #include <vector>
@@ -52,10 +51,8 @@ enum class MaskedPairs : std::uint8_t {
 /// triangles, tested per wide lane through WideBvhNode::node) and each slot's (the mask of the
 /// triangle at that position of triangle_order(): a bucket's four slots are tested at once).
 struct ClassMasks {
-  /// Slots past the tree's last, so that four can be read from any slot.
-  static constexpr std::size_t kSlotPadding = 3;
   std::vector<std::uint8_t> nodes;  ///< #nodes
-  std::vector<std::uint8_t> slots;  ///< #triangles + kSlotPadding
+  std::vector<std::uint8_t> slots;  ///< Bvh::slot_stride(): four can be read from any slot
 };
 
 /// The class masks of `bvh` (ClassMasks) from the triangles' masks.

@@ -807,7 +807,7 @@ bool masked_self_traverse_some(
     std::size_t max_pairs) {
   if (bvh.empty()) return true;
   assert(masks.nodes.size() == bvh.nodes().size());
-  assert(masks.slots.size() == bvh.triangle_order().size() + ClassMasks::kSlotPadding);
+  assert(masks.slots.size() == bvh.slot_stride());
   const WalkMasks walk_masks{
       masks.nodes.data(), masks.nodes.data(), masks.slots.data(), masks.slots.data(), which};
   return Walk<N, true, false, true>(
@@ -838,8 +838,8 @@ bool masked_pair_traverse_some(
     std::size_t max_pairs) {
   if (a.empty() || b.empty()) return true;
   assert(masks_a.nodes.size() == a.nodes().size() && masks_b.nodes.size() == b.nodes().size());
-  assert(masks_a.slots.size() == a.triangle_order().size() + ClassMasks::kSlotPadding);
-  assert(masks_b.slots.size() == b.triangle_order().size() + ClassMasks::kSlotPadding);
+  assert(masks_a.slots.size() == a.slot_stride());
+  assert(masks_b.slots.size() == b.slot_stride());
   const WalkMasks walk_masks{
       masks_a.nodes.data(),
       masks_b.nodes.data(),
