@@ -88,6 +88,20 @@ inline bool overlap_bit(const Dop<N>& a, const Dop<N>& b) {
 /// buffers without branches (a slot is written, then kept or not) and appended at once.
 constexpr std::size_t kChunkPairs = 64;
 
+/// Prefetch distances of owned_feature_pairs, in pairs, and the mesh size from which it
+/// prefetches (below it the records and volumes it reads stay in the caches).
+constexpr std::size_t kFeatureFar = 16;
+constexpr std::size_t kFeatureNear = 8;
+constexpr std::int32_t kFeaturePrefetchFrom = 16384;
+
+/// Asks for every cache line of a volume (8-byte aligned: its last byte may start one more).
+template <int N>
+inline void prefetch_volume(const Dop<N>& d) {
+  const auto* bytes = reinterpret_cast<const char*>(&d);
+  for (std::size_t k = 0; k < sizeof(Dop<N>); k += 64) __builtin_prefetch(bytes + k);
+  __builtin_prefetch(bytes + sizeof(Dop<N>) - 1);
+}
+
 /// The feature stage of ccd_candidates_from_triangle_pairs, with the part-exclusion checks compiled
 /// in or out (`kExclusions` = topology.has_exclusions(): without exclusions every *_excluded is
 /// false). Reads one OwnedFeatures record per triangle instead of the owned bits, corners, side
@@ -134,8 +148,26 @@ void owned_feature_pairs(
     num_vf = 0;
     num_ee = 0;
   };
+  // The pairs' triangles are scattered over a large mesh: ask for a later pair's records ahead,
+  // its owned-feature records kFeatureFar pairs on, its volumes kFeatureNear pairs on (from the
+  // records, by then in the cache). The first triangle of a pair mostly repeats; only b's.
+  const bool prefetch = topology.num_triangles() >= kFeaturePrefetchFrom;
+  const std::size_t num_pairs = pairs.size();
   std::size_t in_chunk = 0;
-  for (const TrianglePair& p : pairs) {
+  for (std::size_t i = 0; i < num_pairs; ++i) {
+    if (prefetch && i + kFeatureFar < num_pairs) {
+      const TrianglePair& f = pairs[i + kFeatureFar];
+      __builtin_prefetch(&topology.owned_features(f.a));
+      __builtin_prefetch(&topology.owned_features(f.b));
+    }
+    if (prefetch && i + kFeatureNear < num_pairs) {
+      const TrianglePair& f = pairs[i + kFeatureNear];
+      prefetch_volume(bounds.triangles[at(f.b)]);
+      for (const std::int32_t v : topology.owned_features(f.b).corners) {
+        prefetch_volume(bounds.vertices[at(v)]);
+      }
+    }
+    const TrianglePair& p = pairs[i];
     if constexpr (kExclusions) {
       if (topology.owned_pairs_excluded(p.a, p.b)) continue;
     }
