@@ -5,13 +5,14 @@ Debian rigged character and every cloth step, the DCD of posed frames against CG
 memory, and the findings compared between them.
 
   scripts/bench_real.py [--skelcd build/tools/skelcd] [--dcd build/bench/real/dcd_vs_cgal]
-                        [--samples 4] [--repeat 3] [--cap 60] [--no-debian] [--models FILE…]
+                        [--samples 4] [--repeat 3] [--min-ms 50] [--cap 60] [--no-debian]
+                        [--models FILE…]
                         [--cloth DIR…] [--json-out FILE]
 
 DCD: `dcd_vs_cgal MODEL --json` (bench/real/dcd_vs_cgal.cpp; built by `make bench-real` when
 libcgal-dev is installed) poses --samples frames spread over the first clip (each frame of a cloth
 step) and times skelcd's `bvh` DCD and CGAL 5.5's self_intersections, one thread each, fastest of
---repeat runs, and compares the pairs (CGAL's extra pairs at vertices its soup-to-mesh conversion
+at least --repeat runs and of as many as make --min-ms ms per frame and side, and compares the pairs (CGAL's extra pairs at vertices its soup-to-mesh conversion
 duplicated are counted apart, see the source). It also times `incremental`: the DCD a clip
 check runs at a sample after the first, the previous sample's pairs updated from the interval's CCD
 contacts (culling/incremental_dcd.hpp; the previous DCD and the CCD untimed, as the check has them).
@@ -134,9 +135,9 @@ def findings_mib(run):
     return n * sum(CONTACT_RECORD_BYTES.values()) / 2.0**20 + min(max(run["log_mib"], 0.0), rows)
 
 
-def dcd_rows(dcd, model, samples, repeat, timeout):
+def dcd_rows(dcd, model, samples, repeat, min_ms, timeout):
     cmd = [dcd, model, "--json", "--samples", str(samples), "--repeat", str(repeat),
-           "--methods", "bvh,incremental"]
+           "--min-ms", str(min_ms), "--methods", "bvh,incremental"]
     code, out, err, _, _ = run_measured(cmd, timeout)
     rows = [json.loads(line) for line in out.splitlines() if line.startswith("{")]
     if code == 2 or not rows:
@@ -179,6 +180,9 @@ def main():
     ap.add_argument("--dcd", default=str(REPO / "build/bench/real/dcd_vs_cgal"))
     ap.add_argument("--samples", type=int, default=4, help="posed frames per model for DCD")
     ap.add_argument("--repeat", type=int, default=3, help="DCD runs per frame (fastest kept)")
+    ap.add_argument("--min-ms", type=float, default=50.0,
+                    help="and more DCD runs until they add up to this many ms per frame and side "
+                         "(a sub-ms frame's fastest of 3 moves by ±20%%)")
     ap.add_argument("--cap", type=float, default=60.0, help="seconds one CCD run may take")
     ap.add_argument("--min-triangles", type=int, default=1000,
                     help="models below this are listed but left out of the summary lines")
@@ -212,7 +216,7 @@ def main():
         print(f"# {name}", file=sys.stderr)
         try:
             if have_cgal:
-                rows = dcd_rows(args.dcd, model, args.samples, args.repeat, 20 * args.cap)
+                rows = dcd_rows(args.dcd, model, args.samples, args.repeat, args.min_ms, 20 * args.cap)
                 r["triangles"] = rows[0]["triangles"]
                 r["dcd"] = rows
                 for row in rows:
