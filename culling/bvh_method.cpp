@@ -109,6 +109,19 @@ class BvhMethod final : public MethodBase {
     // block_pairs triangle pairs: the candidates held at once stay bounded on any motion (the
     // de-duplication is by ownership within each triangle pair, so blocks never repeat a test).
     blocks_.start_ccd(topology_, bounds_, x_t0, x_t1, tests_, options_.accuracy, ccd_options_, out);
+    // Pairs that share a vertex whose fan is certified over the interval have no feature pairs
+    // (candidates.hpp): settled where the traversal meets them, as in the DCD, instead of going
+    // through the relative filter and the feature stage (not with part exclusions, whose CCD rule
+    // is per feature).
+    FanSieve sieve{.slots = &slots_, .certified = {}, .full = {}, .topology = &topology_};
+    if (!topology_.has_exclusions()) {
+      sieve.certified = blocks_.certify_interval_fans();
+      if (!sieve.certified.empty()) {
+        certified_slots(slots_, sieve.certified, full_slots_);
+        sieve.full = full_slots_;
+      }
+    }
+    FanSieve* const sieving = sieve.certified.empty() ? nullptr : &sieve;
     start_self_traversal<N>(bvh_, scratch_);
     if (relative_pairs_) {
       relative_.start(RelativePairTrial::trial_pairs(topology_.num_triangles()));
@@ -116,13 +129,14 @@ class BvhMethod final : public MethodBase {
     blocks_.drain([&](std::vector<TrianglePair>& pairs, std::size_t max_pairs) {
       const std::size_t first = pairs.size();
       const bool done = self_traverse_some<N>(
-          bvh_, bounds_.triangles, scratch_, pairs, out.counters.bv_tests, max_pairs);
+          bvh_, bounds_.triangles, scratch_, pairs, out.counters.bv_tests, max_pairs, sieving);
       if (relative_pairs_) {
         relative_.filter(topology_, x_t0, x_t1, 0.5 * options_.min_separation, pairs, first);
       }
       return done;
     });
     blocks_.finish();
+    out.counters.candidate_pairs += sieve.settled;
     const auto t2 = Clock::now();
     out.times.refit_us += micros(t0, t1);
     out.times.traverse_us += micros(t1, t2) - blocks_.test_us();

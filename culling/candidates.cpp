@@ -148,26 +148,26 @@ void owned_feature_pairs(
     num_vf = 0;
     num_ee = 0;
   };
-  // The pairs' triangles are scattered over a large mesh: ask for a later pair's records ahead,
-  // its owned-feature records kFeatureFar pairs on, its volumes kFeatureNear pairs on (from the
-  // records, by then in the cache). The first triangle of a pair mostly repeats; only b's.
+  // The pairs' triangles are scattered over a large mesh: ask for a later pair's owned-feature
+  // records kFeatureFar pairs on and its volumes kFeatureNear pairs on (the second triangle's,
+  // from its record, by then in the cache: the first triangle of a pair mostly repeats).
   const bool prefetch = topology.num_triangles() >= kFeaturePrefetchFrom;
   const std::size_t num_pairs = pairs.size();
   std::size_t in_chunk = 0;
-  for (std::size_t i = 0; i < num_pairs; ++i) {
-    if (prefetch && i + kFeatureFar < num_pairs) {
-      const TrianglePair& f = pairs[i + kFeatureFar];
+  for (std::size_t at_pair = 0; at_pair < num_pairs; ++at_pair) {
+    if (prefetch && at_pair + kFeatureFar < num_pairs) {
+      const TrianglePair& f = pairs[at_pair + kFeatureFar];
       __builtin_prefetch(&topology.owned_features(f.a));
       __builtin_prefetch(&topology.owned_features(f.b));
     }
-    if (prefetch && i + kFeatureNear < num_pairs) {
-      const TrianglePair& f = pairs[i + kFeatureNear];
+    if (prefetch && at_pair + kFeatureNear < num_pairs) {
+      const TrianglePair& f = pairs[at_pair + kFeatureNear];
       prefetch_volume(bounds.triangles[at(f.b)]);
       for (const std::int32_t v : topology.owned_features(f.b).corners) {
         prefetch_volume(bounds.vertices[at(v)]);
       }
     }
-    const TrianglePair& p = pairs[i];
+    const TrianglePair& p = pairs[at_pair];
     if constexpr (kExclusions) {
       if (topology.owned_pairs_excluded(p.a, p.b)) continue;
     }

@@ -93,6 +93,13 @@ struct IntervalFans {
     if (s == 0) s = fans->certified_over(*x_t0, *x_t1, v) ? 1 : 2;
     return s == 1;
   }
+  /// Decides every vertex now; `flags` (resized) is 1 where certified, else 0 (FanSieve's form).
+  void certify_all(std::vector<std::uint8_t>& flags) {
+    flags.resize(state.size());
+    for (std::size_t v = 0; v < state.size(); ++v) {
+      flags[v] = static_cast<std::uint8_t>(certified(static_cast<std::int32_t>(v)));
+    }
+  }
 };
 
 /// Triangle pairs per CCD block: the hierarchy methods turn their traversal's pairs into feature

@@ -99,6 +99,14 @@ void PairBlocks<N>::start_dcd(
 }
 
 template <int N>
+std::span<const std::uint8_t> PairBlocks<N>::certify_interval_fans() {
+  assert(out_ != nullptr && continuous_);
+  if (!use_fans_) return {};
+  interval_fans_.certify_all(interval_flags_);
+  return interval_flags_;
+}
+
+template <int N>
 void PairBlocks<N>::flush() {
   assert(out_ != nullptr);
   if (pairs_.empty()) return;

@@ -71,6 +71,12 @@ class PairBlocks {
   /// FanSieve of the producer may settle pairs with.
   [[nodiscard]] std::span<const std::uint8_t> fans() const { return fans_; }
 
+  /// CCD: decides every vertex's fan over the query's interval now (they are otherwise decided
+  /// when a pair first shares the vertex) and returns them as a FanSieve wants them (1 where
+  /// certified); empty when the query does not use fans (ccd_uses_fans). Valid until the next
+  /// query.
+  std::span<const std::uint8_t> certify_interval_fans();
+
   /// The pending block: producers append here.
   [[nodiscard]] std::vector<TrianglePair>& pairs() { return pairs_; }
   [[nodiscard]] std::size_t block_pairs() const { return block_pairs_; }
@@ -122,8 +128,9 @@ class PairBlocks {
   ccd::Accuracy accuracy_ = ccd::Accuracy::conservative;
   const ccd::CcdOptions* ccd_options_ = nullptr;
   std::span<const std::uint8_t> fans_;
-  bool use_fans_ = false;                   ///< CCD: ccd_uses_fans for this query
-  IntervalFans interval_fans_;              ///< CCD: the query's fans, decided on demand
+  bool use_fans_ = false;                     ///< CCD: ccd_uses_fans for this query
+  IntervalFans interval_fans_;                ///< CCD: the query's fans, decided on demand
+  std::vector<std::uint8_t> interval_flags_;  ///< CCD: certify_interval_fans' flags
   std::vector<ccd::TrianglePlane> planes_;  ///< the DCD instant's (dcd_planes); kept across queries
   bool use_planes_ = false;  ///< planes_ holds this instant's planes (the first block decides)
   std::size_t first_ = 0;    ///< out's findings before this query
