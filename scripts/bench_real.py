@@ -182,7 +182,7 @@ def main():
     ap.add_argument("--repeat", type=int, default=3, help="DCD runs per frame (fastest kept)")
     ap.add_argument("--min-ms", type=float, default=50.0,
                     help="and more DCD runs until they add up to this many ms per frame and side "
-                         "(a sub-ms frame's fastest of 3 moves by ±20%%)")
+                         "(a sub-ms frame's fastest of 3 moved by up to 45%%)")
     ap.add_argument("--cap", type=float, default=60.0, help="seconds one CCD run may take")
     ap.add_argument("--min-triangles", type=int, default=1000,
                     help="models below this are listed but left out of the summary lines")

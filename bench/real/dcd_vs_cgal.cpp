@@ -5,8 +5,9 @@
 //               [--json] [--cpu-time]
 //
 // --min-ms: each side runs at least R times and on until its runs add up to M ms (default 50, 0 for
-// R runs only; at most 10,000 runs): the fastest of three runs of a frame that takes 0.3 ms moved
-// by ±20 % from one run of the program to the next, and the small characters' ratios with it.
+// R runs only; at most 10,000 runs): with the fastest of three runs, a frame that takes 0.3 ms read
+// anywhere from 3.7 to 6.9x CGAL from one run of the program to the next (ninja), and the small
+// characters moved the geometric mean with them.
 //
 // --cpu-time times the calling thread's CPU time instead of the wall clock: on a machine shared
 // with other jobs, where a thread waits for a core, it compares two builds without the waits (the
