@@ -113,14 +113,12 @@ class BvhMethod final : public MethodBase {
     // (candidates.hpp): settled where the traversal meets them, as in the DCD, instead of going
     // through the relative filter and the feature stage (not with part exclusions, whose CCD rule
     // is per feature).
-    FanSieve sieve{.slots = &slots_, .certified = {}, .full = {}, .topology = &topology_};
-    if (!topology_.has_exclusions()) {
-      sieve.certified = blocks_.certify_interval_fans();
-      if (!sieve.certified.empty()) {
-        certified_slots(slots_, sieve.certified, full_slots_);
-        sieve.full = full_slots_;
-      }
-    }
+    FanSieve sieve = fan_sieve(
+        slots_,
+        topology_.has_exclusions() ? std::span<const std::uint8_t>{}
+                                   : blocks_.certify_interval_fans(),
+        full_slots_,
+        topology_);
     FanSieve* const sieving = sieve.certified.empty() ? nullptr : &sieve;
     start_self_traversal<N>(bvh_, scratch_);
     if (relative_pairs_) {

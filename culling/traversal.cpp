@@ -738,6 +738,19 @@ void certified_slots(
   }
 }
 
+FanSieve fan_sieve(
+    const SlotAdjacency& slots,
+    std::span<const std::uint8_t> certified,
+    std::vector<std::uint8_t>& full,
+    const FeatureTopology& topology) {
+  FanSieve sieve{.slots = &slots, .certified = certified, .full = {}, .topology = &topology};
+  if (!certified.empty()) {
+    certified_slots(slots, certified, full);
+    sieve.full = full;
+  }
+  return sieve;
+}
+
 template <int N>
 void self_traverse(
     const Bvh<N>& bvh,

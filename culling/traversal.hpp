@@ -35,7 +35,9 @@ struct SlotAdjacency {
 
 /// What a DCD self traversal settles instead of emitting (docs/culling.md "DCD"): two triangles
 /// that share a vertex whose fan is certified at the instant (culling/vertex_fans.hpp) have no
-/// common point beyond what they share, so the pair needs no test. Those pairs are 80–95 % of a
+/// common point beyond what they share, so the pair needs no test. `bvh`'s and `kdop`'s CCD
+/// traversals use it too, with the fans certified over the interval (docs/culling.md "Vertex fans
+/// over an interval"): such a pair has no feature pair to test. Those pairs are 80–95 % of a
 /// DCD's candidates on real meshes; dropping them where the traversal finds them saves their
 /// emission, their block and their filter. The pairs the sieve lets through are exactly the
 /// others: a pair sharing no certified vertex, one sharing three vertices (a duplicate face, which
@@ -57,6 +59,14 @@ void certified_slots(
     const SlotAdjacency& slots,
     std::span<const std::uint8_t> certified,
     std::vector<std::uint8_t>& full);
+
+/// A FanSieve over `slots` for the `certified` vertices, its FanSieve::full computed into `full`
+/// (left empty, as the sieve, when no vertex list is given: it then settles nothing).
+FanSieve fan_sieve(
+    const SlotAdjacency& slots,
+    std::span<const std::uint8_t> certified,
+    std::vector<std::uint8_t>& full,
+    const FeatureTopology& topology);
 
 /// Bit i set when child i of wide node `w` (its lane i) and lane `lane` of wide node `q` may come
 /// within reach of each other over the interval, judged by their end boxes (Bvh::end_boxes) in

@@ -11,11 +11,12 @@ memory, and the findings compared between them.
 
 DCD: `dcd_vs_cgal MODEL --json` (bench/real/dcd_vs_cgal.cpp; built by `make bench-real` when
 libcgal-dev is installed) poses --samples frames spread over the first clip (each frame of a cloth
-step) and times skelcd's `bvh` DCD and CGAL 5.5's self_intersections, one thread each, fastest of
-at least --repeat runs and of as many as make --min-ms ms per frame and side, and compares the pairs (CGAL's extra pairs at vertices its soup-to-mesh conversion
-duplicated are counted apart, see the source). It also times `incremental`: the DCD a clip
-check runs at a sample after the first, the previous sample's pairs updated from the interval's CCD
-contacts (culling/incremental_dcd.hpp; the previous DCD and the CCD untimed, as the check has them).
+step) and times skelcd's `bvh` DCD and CGAL 5.5's self_intersections, one thread each, fastest of at
+least --repeat runs and of as many as make --min-ms ms per frame and side, and compares the pairs
+(CGAL's extra pairs at vertices its soup-to-mesh conversion duplicated are counted apart, see the
+source). It also times `incremental`: the DCD a clip check runs at a sample after the first, the
+previous sample's pairs updated from the interval's CCD contacts (culling/incremental_dcd.hpp; the
+previous DCD and the CCD untimed, as the check has them).
 
 CCD: `skelcd check MODEL --query ccd --threads 1 --method M --json -o LOG` for each method, each in
 its own process so that its peak RSS (ru_maxrss from wait4) is its own. A clip whose bvh run takes
@@ -216,7 +217,8 @@ def main():
         print(f"# {name}", file=sys.stderr)
         try:
             if have_cgal:
-                rows = dcd_rows(args.dcd, model, args.samples, args.repeat, args.min_ms, 20 * args.cap)
+                rows = dcd_rows(args.dcd, model, args.samples, args.repeat, args.min_ms,
+                                20 * args.cap)
                 r["triangles"] = rows[0]["triangles"]
                 r["dcd"] = rows
                 for row in rows:

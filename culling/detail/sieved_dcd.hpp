@@ -32,11 +32,7 @@ void sieved_self_dcd(
     PairBlocks<N>& blocks,
     FrameResult& out) {
   start_self_traversal<N>(bvh, scratch);
-  FanSieve sieve{.slots = &slots, .certified = blocks.fans(), .full = {}, .topology = &topology};
-  if (!sieve.certified.empty()) {
-    certified_slots(slots, sieve.certified, full_slots);
-    sieve.full = full_slots;
-  }
+  FanSieve sieve = fan_sieve(slots, blocks.fans(), full_slots, topology);
   blocks.drain([&](std::vector<TrianglePair>& pairs, std::size_t max_pairs) {
     return self_traverse_some<N>(
         bvh, triangle_bounds, scratch, pairs, out.counters.bv_tests, max_pairs, &sieve);
