@@ -48,7 +48,7 @@ CcdResult conservative_after_aabbs(
     return p;
   };
   const auto relative_apart = [&] {
-    return detail::relative_boxes_apart<2>(
+    return detail::relative_stage_apart<2>(
         {&q.ea0_t0, &q.ea1_t0, &q.eb0_t0, &q.eb1_t0},
         {&q.ea0_t1, &q.ea1_t1, &q.eb0_t1, &q.eb1_t1},
         0.5 * options.min_separation);

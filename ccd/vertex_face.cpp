@@ -49,7 +49,7 @@ CcdResult conservative_after_aabbs(
     return p;
   };
   const auto relative_apart = [&] {
-    return detail::relative_boxes_apart<1>(
+    return detail::relative_stage_apart<1>(
         {&q.v_t0, &q.f0_t0, &q.f1_t0, &q.f2_t0},
         {&q.v_t1, &q.f0_t1, &q.f1_t1, &q.f2_t1},
         0.5 * options.min_separation);

@@ -1,16 +1,24 @@
 #pragma once
-// The relative-box stage of the conservative pipeline (docs/ccd.md, "Relative boxes"): the query's
-// points minus one common motion. Subtracting t·u from every point of a vertex-face or edge-edge
-// query changes no distance between them at any instant t, and a point moving linearly from p₀ to
-// p₁ moves, less t·u, inside the box of p₀ and p₁ − u. So when the boxes of the two features'
-// relative ends, each grown by half of min_separation, are apart on some axis, the features never
-// come within min_separation of each other over [0, 1]. Any u is sound; u is the mean displacement
-// of the query's four points. With a contact distance each p₁ − u is bracketed by the doubles
-// around its rounded value (round-to-nearest is within half an ulp), so the boxes hold the exact
-// relative ends. Without one the boxes need not hold them: every end compared is an input
-// coordinate or fl(p₁ − u) with the query's one u, and rounding is monotone (fl(x − u) < fl(y − u)
-// implies x < y, fl(x − u) < c implies x − u < c for a double c, and the same the other way), so a
-// strict gap between the rounded ends is a gap between the exact ones.
+// The relative stage of the conservative pipeline (docs/ccd.md, "Relative boxes and directions
+// apart at both ends").
+//
+// Without a contact distance: directions apart at both ends. For a fixed direction n, each point's
+// projection p(t)·n is linear in t, so min over one feature's points minus max over the other's is
+// concave in t (a minimum of linear functions minus a maximum of them). Positive at t = 0 and at
+// t = 1, it is positive on all of [0, 1]: the two hulls, hence the features, stay on the two sides
+// of a plane normal to n at every instant. The stage tries the three axes and the six diagonals
+// x ± y, y ± z, z ± x. Each projection is one coordinate or one rounded sum of two, and rounding
+// is monotone (x < y whenever fl(x) < fl(y), overflow to ±inf included), so a strict gap between
+// the rounded projections is a gap between the exact ones.
+//
+// With a contact distance: the relative boxes. Subtracting t·u from every point of a vertex-face
+// or edge-edge query changes no distance between them at any instant t, and a point moving
+// linearly from p₀ to p₁ moves, less t·u, inside the box of p₀ and p₁ − u. So when the boxes of the
+// two features' relative ends, each grown by half of min_separation, are apart on some axis, the
+// features never come within min_separation of each other over [0, 1]. Any u is sound; u is the
+// mean displacement of the query's four points. Each p₁ − u is bracketed by the doubles around its
+// rounded value (round-to-nearest is within half an ulp), so the boxes hold the exact relative
+// ends.
 
 #include <Eigen/Core>
 #include <algorithm>
@@ -80,6 +88,82 @@ template <std::size_t NA>
     double half_width) {
   return half_width > 0.0 ? relative_boxes_apart_as<NA, true>(t0, t1, half_width)
                           : relative_boxes_apart_as<NA, false>(t0, t1, half_width);
+}
+
+/// Whether one of three directions separates the features (a: the first NA points, b: the other
+/// 4 − NA) strictly at t = 0 and at t = 1, the same way round at both; `project` maps a point to
+/// its three rounded projections.
+template <std::size_t NA, typename Project>
+[[nodiscard]] bool ends_apart_on(
+    const std::array<const Eigen::Vector3d*, 4>& t0,
+    const std::array<const Eigen::Vector3d*, 4>& t1,
+    Project&& project) {
+  // lo/hi[time][side][direction] of the rounded projections.
+  double lo[2][2][3];
+  double hi[2][2][3];
+  for (std::size_t time = 0; time < 2; ++time) {
+    const auto& points = time == 0 ? t0 : t1;
+    for (std::size_t i = 0; i < 4; ++i) {
+      const std::array<double, 3> v = project(*points[i]);
+      const std::size_t side = i < NA ? 0 : 1;
+      const bool first = i == 0 || i == NA;
+      for (std::size_t d = 0; d < 3; ++d) {
+        lo[time][side][d] = first ? v[d] : std::min(lo[time][side][d], v[d]);
+        hi[time][side][d] = first ? v[d] : std::max(hi[time][side][d], v[d]);
+      }
+    }
+  }
+  bool apart = false;
+  for (std::size_t d = 0; d < 3; ++d) {
+    const bool below = hi[0][0][d] < lo[0][1][d] && hi[1][0][d] < lo[1][1][d];
+    const bool above = hi[0][1][d] < lo[0][0][d] && hi[1][1][d] < lo[1][0][d];
+    apart = apart || below || above;
+  }
+  return apart;
+}
+
+/// True when one of nine directions — x, y, z, x + y, y + z, z + x, x − y, y − z, z − x — separates
+/// the features (a: the first NA points, b: the other 4 − NA) strictly at t = 0 and at t = 1, the
+/// same way round at both: they then never touch over [0, 1] (the header's argument). False
+/// whenever a coordinate is not finite: such queries go on to the rest of the pipeline (a hit, as
+/// documented).
+template <std::size_t NA>
+[[nodiscard]] bool ends_apart(
+    const std::array<const Eigen::Vector3d*, 4>& t0,
+    const std::array<const Eigen::Vector3d*, 4>& t1) {
+  static_assert(NA >= 1 && NA <= 3);
+  constexpr double kMax = std::numeric_limits<double>::max();
+  bool finite = true;
+  for (std::size_t i = 0; i < 4; ++i) {
+    finite = finite && t0[i]->cwiseAbs().maxCoeff() <= kMax && t1[i]->cwiseAbs().maxCoeff() <= kMax;
+  }
+  if (!finite) return false;
+  return ends_apart_on<NA>(
+             t0,
+             t1,
+             [](const Eigen::Vector3d& p) {
+               return std::array<double, 3>{p[0], p[1], p[2]};
+             }) ||
+         ends_apart_on<NA>(
+             t0,
+             t1,
+             [](const Eigen::Vector3d& p) {
+               return std::array<double, 3>{p[0] + p[1], p[1] + p[2], p[2] + p[0]};
+             }) ||
+         ends_apart_on<NA>(t0, t1, [](const Eigen::Vector3d& p) {
+           return std::array<double, 3>{p[0] - p[1], p[1] - p[2], p[2] - p[0]};
+         });
+}
+
+/// The pipeline's relative stage: ends_apart without a contact distance (half_width 0),
+/// relative_boxes_apart with one.
+template <std::size_t NA>
+[[nodiscard]] bool relative_stage_apart(
+    const std::array<const Eigen::Vector3d*, 4>& t0,
+    const std::array<const Eigen::Vector3d*, 4>& t1,
+    double half_width) {
+  return half_width > 0.0 ? relative_boxes_apart_as<NA, true>(t0, t1, half_width)
+                          : ends_apart<NA>(t0, t1);
 }
 
 }  // namespace skelcd::ccd::detail

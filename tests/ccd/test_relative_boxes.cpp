@@ -183,5 +183,82 @@ TEST(RelativeBoxes, WithoutContactDistanceApartOnlyWhenTheExactBoxesAre) {
   expect_apart_only_when_exactly_apart<2>(20261128);
 }
 
+// Without contact distance the stage is ends_apart (relative_boxes.hpp): nine directions, each
+// projection a coordinate or one rounded sum or difference of two, compared unbracketed. On the
+// same grid of a few ulps a sum or difference of two coordinates is exact in long double, so each
+// query the stage calls apart must be apart, exactly, on one direction at t = 0 and at t = 1, the
+// same way round.
+template <std::size_t NA>
+void expect_ends_apart_only_when_exactly_apart(std::uint32_t seed) {
+  static_assert(std::numeric_limits<long double>::digits >= 64);
+  constexpr double kUlp = 0x1p-52;
+  std::mt19937 rng(seed);
+  std::uniform_int_distribution<int> grid(-6, 6);
+  std::uniform_int_distribution<int> low_bits(0, 64);
+  std::array<Eigen::Vector3d, 4> p0, p1;
+  const std::array<const Eigen::Vector3d*, 4> t0{&p0[0], &p0[1], &p0[2], &p0[3]};
+  const std::array<const Eigen::Vector3d*, 4> t1{&p1[0], &p1[1], &p1[2], &p1[3]};
+  const auto project = [](const Eigen::Vector3d& p, int d) {
+    const long double x = p[0], y = p[1], z = p[2];
+    const long double v[9] = {x, y, z, x + y, y + z, z + x, x - y, y - z, z - x};
+    return v[d];
+  };
+  int apart = 0;
+  for (int trial = 0; trial < 200000; ++trial) {
+    for (std::size_t i = 0; i < 4; ++i) {
+      for (Eigen::Index k = 0; k < 3; ++k) {
+        p0[i][k] = 1.5 + grid(rng) * kUlp;
+        p1[i][k] = p0[i][k] + (0.1 + low_bits(rng) * 0x1p-56);
+      }
+    }
+    if (!detail::ends_apart<NA>(t0, t1)) continue;
+    ++apart;
+    bool exactly_apart = false;
+    for (int d = 0; d < 9; ++d) {
+      // lo/hi[time][side]
+      long double lo[2][2] = {{INFINITY, INFINITY}, {INFINITY, INFINITY}};
+      long double hi[2][2] = {{-INFINITY, -INFINITY}, {-INFINITY, -INFINITY}};
+      for (std::size_t time = 0; time < 2; ++time) {
+        for (std::size_t i = 0; i < 4; ++i) {
+          const std::size_t side = i < NA ? 0 : 1;
+          const long double v = project(time == 0 ? p0[i] : p1[i], d);
+          lo[time][side] = std::min(lo[time][side], v);
+          hi[time][side] = std::max(hi[time][side], v);
+        }
+      }
+      exactly_apart = exactly_apart || (hi[0][0] < lo[0][1] && hi[1][0] < lo[1][1]) ||
+                      (hi[0][1] < lo[0][0] && hi[1][1] < lo[1][0]);
+    }
+    ASSERT_TRUE(exactly_apart) << "trial " << trial;
+  }
+  EXPECT_GT(apart, 1000);  // enough separated queries for the check to mean something
+}
+
+TEST(RelativeBoxes, EndsApartOnlyWhenTheExactProjectionsAre) {
+  expect_ends_apart_only_when_exactly_apart<1>(20261130);
+  expect_ends_apart_only_when_exactly_apart<2>(20261131);
+}
+
+// Two edges in z = 0 that only the diagonal x + y separates (their boxes overlap), still over the
+// interval: apart; the same with the second edge carried across the first: apart at t = 0 only,
+// so not apart. A non-finite coordinate: never apart.
+TEST(RelativeBoxes, EndsApartOnADiagonalAndNotWhenCrossing) {
+  std::array<Eigen::Vector3d, 4> p0{
+      Eigen::Vector3d(-2.0, 1.0, 0.0),
+      Eigen::Vector3d(1.0, -2.0, 0.0),
+      Eigen::Vector3d(2.0, -1.0, 0.0),
+      Eigen::Vector3d(-1.0, 2.0, 0.0)};
+  std::array<Eigen::Vector3d, 4> p1 = p0;
+  const std::array<const Eigen::Vector3d*, 4> t0{&p0[0], &p0[1], &p0[2], &p0[3]};
+  const std::array<const Eigen::Vector3d*, 4> t1{&p1[0], &p1[1], &p1[2], &p1[3]};
+  EXPECT_TRUE(detail::ends_apart<2>(t0, t1));
+  p1[2] -= Eigen::Vector3d(4.0, 4.0, 0.0);
+  p1[3] -= Eigen::Vector3d(4.0, 4.0, 0.0);
+  EXPECT_FALSE(detail::ends_apart<2>(t0, t1));
+  p1 = p0;
+  p1[0][2] = std::numeric_limits<double>::infinity();
+  EXPECT_FALSE(detail::ends_apart<2>(t0, t1));
+}
+
 }  // namespace
 }  // namespace skelcd::ccd
