@@ -66,116 +66,33 @@ inline unsigned overlap_lanes(const WideBvhNode<N>& w, const WideBvhNode<N>& q, 
 #endif
 }
 
-#if defined(__SSE2__)
-/// Both lanes' relative boxes on one axis (four lanes at once), with the common motion u of each
-/// lane pair (end_boxes_meet): all-ones where they meet. A lane of w: w_lo0 … w_hi1; of q: q_lo0 …
-/// q_hi1 (broadcast or per lane).
-inline __m128 relative_meet(
-    __m128 w_lo0,
-    __m128 w_hi0,
-    __m128 w_lo1,
-    __m128 w_hi1,
-    __m128 q_lo0,
-    __m128 q_hi0,
-    __m128 q_lo1,
-    __m128 q_hi1) {
-  const __m128 sign = _mm_set1_ps(-0.0f);
-  const __m128 scale = _mm_set1_ps(0x1p-22f);
-  const __m128 tiny = _mm_set1_ps(std::numeric_limits<float>::min());
-  const __m128 largest = _mm_set1_ps(std::numeric_limits<float>::max());
-  const __m128 quarter = _mm_set1_ps(0.25f);
-  // The margin that puts fl(x) below (above) every value it may have rounded.
-  const auto margin = [&](__m128 x) {
-    return _mm_add_ps(_mm_mul_ps(_mm_andnot_ps(sign, x), scale), tiny);
-  };
-  // u = ((centre₁ − centre₀) of w's lane + that of q's lane) / 2, twice-centres halved twice.
-  const __m128 dw = _mm_sub_ps(_mm_add_ps(w_lo1, w_hi1), _mm_add_ps(w_lo0, w_hi0));
-  const __m128 dq = _mm_sub_ps(_mm_add_ps(q_lo1, q_hi1), _mm_add_ps(q_lo0, q_hi0));
-  __m128 u = _mm_mul_ps(_mm_add_ps(dw, dq), quarter);
-  u = _mm_and_ps(u, _mm_cmple_ps(_mm_andnot_ps(sign, u), largest));  // NaN, ±inf → 0
-  const __m128 w_lo = _mm_sub_ps(w_lo1, u);
-  const __m128 w_hi = _mm_sub_ps(w_hi1, u);
-  const __m128 q_lo = _mm_sub_ps(q_lo1, u);
-  const __m128 q_hi = _mm_sub_ps(q_hi1, u);
-  const __m128 w_rlo = _mm_min_ps(w_lo0, _mm_sub_ps(w_lo, margin(w_lo)));
-  const __m128 w_rhi = _mm_max_ps(w_hi0, _mm_add_ps(w_hi, margin(w_hi)));
-  const __m128 q_rlo = _mm_min_ps(q_lo0, _mm_sub_ps(q_lo, margin(q_lo)));
-  const __m128 q_rhi = _mm_max_ps(q_hi0, _mm_add_ps(q_hi, margin(q_hi)));
-  return _mm_and_ps(_mm_cmple_ps(w_rlo, q_rhi), _mm_cmple_ps(q_rlo, w_rhi));
-}
-#else
-/// The scalar relative_meet of one axis of one lane pair.
-inline bool relative_meet(
-    float w_lo0,
-    float w_hi0,
-    float w_lo1,
-    float w_hi1,
-    float q_lo0,
-    float q_hi0,
-    float q_lo1,
-    float q_hi1) {
-  const auto margin = [](float x) {
-    return std::abs(x) * 0x1p-22f + std::numeric_limits<float>::min();
-  };
-  const float dw = (w_lo1 + w_hi1) - (w_lo0 + w_hi0);
-  const float dq = (q_lo1 + q_hi1) - (q_lo0 + q_hi0);
-  float u = (dw + dq) * 0.25f;
-  if (!(std::abs(u) <= std::numeric_limits<float>::max())) u = 0.0f;
-  const float w_lo = w_lo1 - u;
-  const float w_hi = w_hi1 - u;
-  const float q_lo = q_lo1 - u;
-  const float q_hi = q_hi1 - u;
-  const float w_rlo = std::min(w_lo0, w_lo - margin(w_lo));
-  const float w_rhi = std::max(w_hi0, w_hi + margin(w_hi));
-  const float q_rlo = std::min(q_lo0, q_lo - margin(q_lo));
-  const float q_rhi = std::max(q_hi0, q_hi + margin(q_hi));
-  return w_rlo <= q_rhi && q_rlo <= w_rhi;
-}
-#endif
-
 }  // namespace
 
 unsigned end_boxes_meet(const WideEndBoxes& w, const WideEndBoxes& q, int lane, unsigned wanted) {
+  // Apart on an axis when one lane's box lies strictly below the other's at t = 0 and at t = 1
+  // (traversal.hpp says why that holds in between). NaN compares false: such lanes meet.
 #if defined(__SSE2__)
-  // Lanes whose boxes overlap at t = 0 overlap in any relative motion (each relative box holds its
-  // box at t = 0): when that settles every wanted lane — little moves — u is not computed.
-  __m128 still = _mm_castsi128_ps(_mm_set1_epi32(-1));
+  __m128 apart = _mm_setzero_ps();
   for (int k = 0; k < 3; ++k) {
-    still = _mm_and_ps(still, _mm_cmple_ps(_mm_load_ps(w.lo0[k]), _mm_set1_ps(q.hi0[k][lane])));
-    still = _mm_and_ps(still, _mm_cmple_ps(_mm_set1_ps(q.lo0[k][lane]), _mm_load_ps(w.hi0[k])));
+    const __m128 below = _mm_and_ps(
+        _mm_cmplt_ps(_mm_load_ps(w.hi0[k]), _mm_set1_ps(q.lo0[k][lane])),
+        _mm_cmplt_ps(_mm_load_ps(w.hi1[k]), _mm_set1_ps(q.lo1[k][lane])));
+    const __m128 above = _mm_and_ps(
+        _mm_cmplt_ps(_mm_set1_ps(q.hi0[k][lane]), _mm_load_ps(w.lo0[k])),
+        _mm_cmplt_ps(_mm_set1_ps(q.hi1[k][lane]), _mm_load_ps(w.lo1[k])));
+    apart = _mm_or_ps(apart, _mm_or_ps(below, above));
   }
-  if ((static_cast<unsigned>(_mm_movemask_ps(still)) & wanted) == wanted) return wanted;
-  __m128 ok = _mm_castsi128_ps(_mm_set1_epi32(-1));
-  for (int k = 0; k < 3; ++k) {
-    ok = _mm_and_ps(
-        ok,
-        relative_meet(
-            _mm_load_ps(w.lo0[k]),
-            _mm_load_ps(w.hi0[k]),
-            _mm_load_ps(w.lo1[k]),
-            _mm_load_ps(w.hi1[k]),
-            _mm_set1_ps(q.lo0[k][lane]),
-            _mm_set1_ps(q.hi0[k][lane]),
-            _mm_set1_ps(q.lo1[k][lane]),
-            _mm_set1_ps(q.hi1[k][lane])));
-  }
-  return static_cast<unsigned>(_mm_movemask_ps(ok)) & wanted;
+  return ~static_cast<unsigned>(_mm_movemask_ps(apart)) & wanted;
 #else
   unsigned mask = 0;
   for (int i = 0; i < kWidth; ++i) {
-    bool hit = true;
+    bool apart = false;
     for (int k = 0; k < 3; ++k) {
-      hit = hit && relative_meet(
-                       w.lo0[k][i],
-                       w.hi0[k][i],
-                       w.lo1[k][i],
-                       w.hi1[k][i],
-                       q.lo0[k][lane],
-                       q.hi0[k][lane],
-                       q.lo1[k][lane],
-                       q.hi1[k][lane]);
+      const bool below = w.hi0[k][i] < q.lo0[k][lane] && w.hi1[k][i] < q.lo1[k][lane];
+      const bool above = q.hi0[k][lane] < w.lo0[k][i] && q.hi1[k][lane] < w.lo1[k][i];
+      apart = apart || below || above;
     }
-    mask |= static_cast<unsigned>(hit) << i;
+    mask |= static_cast<unsigned>(!apart) << i;
   }
   return mask & wanted;
 #endif

@@ -69,18 +69,17 @@ FanSieve fan_sieve(
     const FeatureTopology& topology);
 
 /// Bit i set when child i of wide node `w` (its lane i) and lane `lane` of wide node `q` may come
-/// within reach of each other over the interval, judged by their end boxes (Bvh::end_boxes) in
-/// the motion relative to a common velocity u (docs/culling.md "Relative boxes at the nodes"). A
-/// point x(t) = (1 − t) x₀ + t x₁ of a lane's triangles, minus t u, stays in the hull of the lane's
-/// box at t = 0 and its box at t = 1 shifted by −u; two points within reach of each other stay so
-/// when both lose the same t u. Any u is sound: u is half the sum of the two lanes' box-centre
-/// displacements (the pair's mean motion), 0 where that is not finite. The shifted ends are
-/// rounded outwards by a margin: x − (fl(|x|·2⁻²²) + FLT_MIN), rounded, is below every value
-/// that rounds to x, for any float x (and above for +). Bits of unused lanes are 0. The self and
-/// pair traversals apply it to every node pair when both trees have end boxes.
-/// Only the lanes in `wanted` are looked at (the others' bits are 0); lanes whose boxes overlap
-/// at t = 0 are kept without computing u, and when that settles all of `wanted` nothing else is
-/// computed.
+/// within reach of each other over the interval, judged by their end boxes (Bvh::end_boxes;
+/// docs/culling.md "Relative boxes at the nodes"): they are apart when, on some axis, one lane's
+/// box lies strictly below the other's both at t = 0 and at t = 1. For points x(t) and y(t) of
+/// the two lanes' triangles, moving linearly, y_k(t) − x_k(t) is linear in t, so positive at both
+/// ends it is positive in between: no point of one lane reaches a point of the other over [0, 1]
+/// (nor within 2·half_width, the boxes being grown by it). The boxes are floats rounded outwards,
+/// so strict gaps between them are gaps between the exact ends. This is a test in the motion
+/// relative to any common velocity at once — stronger than the hull of the box at t = 0 and the
+/// box at t = 1 shifted by one chosen u, which it replaced — and it needs no arithmetic. Bits of
+/// unused lanes are 0. The self and pair traversals apply it to every node pair when both trees
+/// have end boxes. Only the lanes in `wanted` are looked at (the others' bits are 0).
 [[nodiscard]] unsigned end_boxes_meet(
     const WideEndBoxes& w, const WideEndBoxes& q, int lane, unsigned wanted = 0xfu);
 
