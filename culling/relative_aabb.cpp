@@ -4,6 +4,7 @@
 #include <array>
 #include <cassert>
 #include <cmath>
+#include <limits>
 
 #include "culling/dop.hpp"
 
@@ -17,29 +18,41 @@ inline bool shares_vertex(const std::array<std::int32_t, 3>& a, const std::array
   return false;
 }
 
-/// The swept box of one triangle in the relative motion: its corners at t = 0 (exact) and at
-/// t = 1 minus the common displacement `w`. With `bracket`, each rounded difference is bracketed
-/// by its neighbours (round-to-nearest is within one ulp of the exact difference); without, the
-/// box holds the rounded differences themselves, which is enough for a test without width
-/// (RelativeAabbFilter's class comment says why).
-Aabb relative_box(
+/// A triangle's box at t = 0 and at t = 1: lo/hi[time][axis]. Exact (min and max of doubles).
+void end_boxes(
     const std::array<std::int32_t, 3>& t,
     const skinning::Positions& x_t0,
     const skinning::Positions& x_t1,
-    const Eigen::Vector3d& w,
-    bool bracket) {
-  Aabb box = Aabb::empty();
-  for (const std::int32_t v : t) {
-    const auto i = static_cast<Eigen::Index>(v);
-    for (std::size_t k = 0; k < 3; ++k) {
+    double (&lo)[2][kEndDirections],
+    double (&hi)[2][kEndDirections]) {
+  const auto v0 = static_cast<Eigen::Index>(t[0]);
+  const auto v1 = static_cast<Eigen::Index>(t[1]);
+  const auto v2 = static_cast<Eigen::Index>(t[2]);
+  constexpr double kMax = std::numeric_limits<double>::max();
+  constexpr double kInf = std::numeric_limits<double>::infinity();
+  for (std::size_t time = 0; time < 2; ++time) {
+    const skinning::Positions& x = time == 0 ? x_t0 : x_t1;
+    for (std::size_t k = 0; k < kEndDirections; ++k) {
       const auto c = static_cast<Eigen::Index>(k);
-      const double p0 = x_t0(i, c);
-      const double p1 = x_t1(i, c) - w[c];
-      box.lo[k] = std::min({box.lo[k], p0, bracket ? next_down(p1) : p1});
-      box.hi[k] = std::max({box.hi[k], p0, bracket ? next_up(p1) : p1});
+      const double p0 = x(v0, c), p1 = x(v1, c), p2 = x(v2, c);
+      // A coordinate that is not finite: the widest box, never apart from anything.
+      const bool finite = std::abs(p0) <= kMax && std::abs(p1) <= kMax && std::abs(p2) <= kMax;
+      lo[time][k] = finite ? std::min({p0, p1, p2}) : -kInf;
+      hi[time][k] = finite ? std::max({p0, p1, p2}) : kInf;
     }
   }
-  return box;
+}
+
+/// How far apart two boxes must be on an axis for points 2·half_width apart or less to be
+/// excluded, rounded up (0 for half_width 0).
+double end_reach(double half_width) { return half_width == 0.0 ? 0.0 : next_up(2.0 * half_width); }
+
+/// Whether one triangle's box on an axis, [·, hi0] at t = 0 and [·, hi1] at t = 1, lies more than
+/// `reach` below another's, [lo0b, ·] and [lo1b, ·], at both ends (strictly; the sum rounded up
+/// when reach > 0).
+inline bool below_at_both_ends(double hi0, double hi1, double lo0b, double lo1b, double reach) {
+  if (reach == 0.0) return hi0 < lo0b && hi1 < lo1b;
+  return next_up(hi0 + reach) < lo0b && next_up(hi1 + reach) < lo1b;
 }
 
 }  // namespace
@@ -51,23 +64,18 @@ bool relative_boxes_overlap(
     const skinning::Positions& x_t1,
     double half_width) {
   assert(half_width >= 0.0);
-  const auto& ta = topology.triangle(pair.a);
-  const auto& tb = topology.triangle(pair.b);
-  // The mean displacement of the six corners over the interval (velocity × Δt, Δt = 1).
-  Eigen::Vector3d w = Eigen::Vector3d::Zero();
-  for (const auto* t : {&ta, &tb}) {
-    for (const std::int32_t v : *t) {
-      const auto i = static_cast<Eigen::Index>(v);
-      w += (x_t1.row(i) - x_t0.row(i)).transpose();
+  double alo[2][kEndDirections], ahi[2][kEndDirections];
+  double blo[2][kEndDirections], bhi[2][kEndDirections];
+  end_boxes(topology.triangle(pair.a), x_t0, x_t1, alo, ahi);
+  end_boxes(topology.triangle(pair.b), x_t0, x_t1, blo, bhi);
+  const double reach = end_reach(half_width);
+  for (std::size_t k = 0; k < kEndDirections; ++k) {
+    if (below_at_both_ends(ahi[0][k], ahi[1][k], blo[0][k], blo[1][k], reach) ||
+        below_at_both_ends(bhi[0][k], bhi[1][k], alo[0][k], alo[1][k], reach)) {
+      return false;
     }
   }
-  w /= 6.0;
-  const bool bracket = half_width > 0.0;
-  Aabb a = relative_box(ta, x_t0, x_t1, w, bracket);
-  Aabb b = relative_box(tb, x_t0, x_t1, w, bracket);
-  a.inflate(half_width);
-  b.inflate(half_width);
-  return a.overlaps(b);
+  return true;
 }
 
 namespace {
@@ -112,19 +120,13 @@ void RelativeAabbFilter::prepare(
   triangles_.resize(static_cast<std::size_t>(num_triangles));
   for (std::int32_t f = 0; f < num_triangles; ++f) {
     Triangle& t = triangles_[static_cast<std::size_t>(f)];
-    const auto& corners = topology.triangle(f);
-    for (std::size_t k = 0; k < 3; ++k) {
-      const auto c = static_cast<Eigen::Index>(k);
-      const auto v0 = static_cast<Eigen::Index>(corners[0]);
-      const auto v1 = static_cast<Eigen::Index>(corners[1]);
-      const auto v2 = static_cast<Eigen::Index>(corners[2]);
-      t.lo0[k] = std::min({x_t0(v0, c), x_t0(v1, c), x_t0(v2, c)});
-      t.hi0[k] = std::max({x_t0(v0, c), x_t0(v1, c), x_t0(v2, c)});
-      t.lo1[k] = std::min({x_t1(v0, c), x_t1(v1, c), x_t1(v2, c)});
-      t.hi1[k] = std::max({x_t1(v0, c), x_t1(v1, c), x_t1(v2, c)});
-      t.sixth_displacement[k] = (((x_t1(v0, c) - x_t0(v0, c)) + (x_t1(v1, c) - x_t0(v1, c))) +
-                                 (x_t1(v2, c) - x_t0(v2, c))) /
-                                6.0;
+    double lo[2][kEndDirections], hi[2][kEndDirections];
+    end_boxes(topology.triangle(f), x_t0, x_t1, lo, hi);
+    for (std::size_t k = 0; k < kEndDirections; ++k) {
+      t.lo0[k] = lo[0][k];
+      t.hi0[k] = hi[0][k];
+      t.lo1[k] = lo[1][k];
+      t.hi1[k] = hi[1][k];
     }
   }
 }
@@ -133,33 +135,14 @@ bool RelativeAabbFilter::overlap(const TrianglePair& pair, double half_width) co
   assert(half_width >= 0.0);
   const Triangle& a = triangles_[static_cast<std::size_t>(pair.a)];
   const Triangle& b = triangles_[static_cast<std::size_t>(pair.b)];
-  if (half_width == 0.0) {
-    // Apart on an axis when one box's lower end is above the other's upper end. Every end is a
-    // double of the input (lo0, hi0) or a rounded fl(y - w) with the pair's one w, and rounding
-    // is monotone: fl(y - w) > fl(z - w) implies y > z, fl(y - w) > c implies y - w > c for a
-    // double c, and likewise the other way round. So a strict inequality between the rounded ends
-    // holds between the exact ones: no bracketing, and no box to build.
-    for (std::size_t k = 0; k < 3; ++k) {
-      const double w = a.sixth_displacement[k] + b.sixth_displacement[k];
-      const double a_lo = std::min(a.lo0[k], a.lo1[k] - w);
-      const double a_hi = std::max(a.hi0[k], a.hi1[k] - w);
-      const double b_lo = std::min(b.lo0[k], b.lo1[k] - w);
-      const double b_hi = std::max(b.hi0[k], b.hi1[k] - w);
-      if (a_lo > b_hi || b_lo > a_hi) return false;
+  const double reach = end_reach(half_width);
+  for (std::size_t k = 0; k < kEndDirections; ++k) {
+    if (below_at_both_ends(a.hi0[k], a.hi1[k], b.lo0[k], b.lo1[k], reach) ||
+        below_at_both_ends(b.hi0[k], b.hi1[k], a.lo0[k], a.lo1[k], reach)) {
+      return false;
     }
-    return true;
   }
-  Aabb ra, rb;
-  for (std::size_t k = 0; k < 3; ++k) {
-    const double w = a.sixth_displacement[k] + b.sixth_displacement[k];
-    ra.lo[k] = std::min(a.lo0[k], next_down(a.lo1[k] - w));
-    ra.hi[k] = std::max(a.hi0[k], next_up(a.hi1[k] - w));
-    rb.lo[k] = std::min(b.lo0[k], next_down(b.lo1[k] - w));
-    rb.hi[k] = std::max(b.hi0[k], next_up(b.hi1[k] - w));
-  }
-  ra.inflate(half_width);
-  rb.inflate(half_width);
-  return ra.overlaps(rb);
+  return true;
 }
 
 std::int64_t RelativeAabbFilter::filter(

@@ -1,11 +1,13 @@
 #pragma once
 // The relative axis-aligned bounding box filter (paper 002, §6): two triangles that move together
-// do not meet, however large their swept boxes. Subtracting one common velocity from all six
-// vertices changes no distance between points of the two triangles at any instant, so if the swept
-// boxes of the *relative* motion are apart, the triangles are apart over the whole interval. The
-// common velocity is the mean of the six (any vector would be sound; the mean makes the boxes
-// small). Rounding is outward: each relative end position is bracketed by the doubles around it
-// (with a width; without one, monotone rounding is enough: RelativeAabbFilter).
+// do not meet, however large their swept boxes. The paper subtracts one common velocity from all
+// six vertices and tests the swept boxes of the relative motion. Since 2026-11-30 the filter tests
+// instead each triangle's box at t = 0 and at t = 1: two triangles are apart when, on some axis,
+// one's box lies strictly below the other's at both ends (grown by the width). For points x(t),
+// y(t) of the two, moving linearly, y_k(t) − x_k(t) is linear in t, so positive at both ends it
+// is positive in between. That holds in the motion relative to every common velocity at once: it
+// removes every pair the relative boxes removed, and more, with no arithmetic but the width's
+// (docs/culling.md "Relative boxes at the nodes"). The names stay those of the paper's filter.
 
 #include <array>
 #include <cstddef>
@@ -18,9 +20,15 @@
 
 namespace skelcd::culling {
 
-/// True when the swept AABBs of triangles a and b, in the motion relative to the mean velocity of
-/// their six corners and grown by `half_width` each, overlap. False proves that no point of a comes
-/// within 2·half_width of a point of b at any t in [0,1].
+/// The directions the filter compares on: the three axes. (Nine — the axes and x ± y, y ± z,
+/// z ± x — removed a third more of cloth-ball's pairs but cost more to prepare than they saved on
+/// the characters: docs/benchmarks.md "Apart at both ends".)
+inline constexpr std::size_t kEndDirections = 3;
+
+/// False when, on some axis, the box of triangle a lies more than 2·half_width below that of b, or
+/// above it, both at t = 0 and at t = 1 (the header's argument): no point of a then comes within
+/// 2·half_width of a point of b at any t in [0,1]. True otherwise, and whenever a coordinate is not
+/// finite.
 /// @param x_t0,x_t1 #W × 3 welded positions.  @pre half_width >= 0.
 [[nodiscard]] bool relative_boxes_overlap(
     const FeatureTopology& topology,
@@ -41,17 +49,11 @@ std::int64_t relative_aabb_filter(
     std::vector<TrianglePair>& pairs,
     std::size_t first = 0);
 
-/// The same filter with what each triangle contributes computed once per interval (prepare):
-/// its corners' box at t = 0, at t = 1, and a sixth of the sum of its corners' displacements, so
-/// that a pair costs two box translations instead of twelve corner lookups. The relative box of a
-/// triangle is [min(lo₀, ↓(lo₁ − w)), max(hi₀, ↑(hi₁ − w))] per axis: the rounded min of the
-/// corners' x₁ − w is the rounded (min x₁) − w (rounding is monotone), bracketed outwards as above;
-/// w, the mean of the six displacements, is the sum of the two triangles' sixths (another rounding
-/// of the mean: any common vector is sound). Without width (`half_width` 0, as the radial-view
-/// methods run) no end is bracketed: the boxes are apart only when a rounded end lies strictly
-/// beyond another, and since each end is an input double or fl(y − w) with the pair's one w,
-/// monotone rounding makes the exact ends lie so too. Tested against relative_boxes_overlap and
-/// exact arithmetic (tests/culling/test_cluster_checks.cpp).
+/// The same filter with each triangle's boxes at t = 0 and t = 1 computed once per interval
+/// (prepare), so that a pair costs two records instead of twelve corner lookups. Every bound is an
+/// input double (min and max are exact); with width the gap must exceed 2·half_width with the sum
+/// rounded up. Tested against relative_boxes_overlap and exact arithmetic
+/// (tests/culling/test_cluster_checks.cpp).
 class RelativeAabbFilter {
  public:
   /// Per-triangle boxes and displacements of the interval x_t0 → x_t1 (#W × 3 each).
@@ -71,8 +73,9 @@ class RelativeAabbFilter {
       std::size_t first = 0) const;
 
  private:
+  /// A triangle's box at t = 0 and at t = 1 (96 bytes).
   struct Triangle {
-    std::array<double, 3> lo0, hi0, lo1, hi1, sixth_displacement;
+    double lo0[kEndDirections], hi0[kEndDirections], lo1[kEndDirections], hi1[kEndDirections];
   };
   std::vector<Triangle> triangles_;
 };

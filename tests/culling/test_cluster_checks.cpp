@@ -269,12 +269,12 @@ TEST(ClusterChecks, RelativeBoxesOfARigidTranslation) {
   EXPECT_TRUE(prepared.overlap({0, 1}, 0.0));
 }
 
-TEST(ClusterChecks, RelativeBoxesWithoutWidthAreApartOnlyWhenTheExactOnesAre) {
-  // Without width neither filter brackets the rounded ends fl(x₁ − w) (relative_aabb.hpp). Here
-  // every coordinate lies in [1, 2) on a grid of a few ulps, so ends tie and cross at the last bit,
-  // and w, the common displacement ~0.1, is computed as each filter computes it; x₁ − w is then
-  // exact in long double (at most 57 significant bits). Every pair a filter calls apart must have
-  // exactly separated relative boxes.
+TEST(ClusterChecks, EndBoxesAreApartOnlyWhenTheExactPointsAre) {
+  // The filters compare the triangles' boxes at t = 0 and at t = 1 (relative_aabb.hpp): min and
+  // max of doubles, exact. Every coordinate here lies in [1, 2) on a grid of a few ulps, so boxes
+  // tie and cross at the last bit. Every pair a filter calls apart must be apart, exactly, on an
+  // axis at t = 0 and at t = 1, the same way round — and so, at every t of a sampled set, every
+  // point of one (the corners' combinations, in long double) strictly on one side of the other.
   static_assert(std::numeric_limits<long double>::digits >= 64);
   constexpr double kUlp = 0x1p-52;
   std::mt19937 rng(20261127);
@@ -288,17 +288,26 @@ TEST(ClusterChecks, RelativeBoxesWithoutWidthAreApartOnlyWhenTheExactOnesAre) {
   const FeatureTopology ft(mesh, topo);
   ASSERT_EQ(ft.triangle(0), (std::array<std::int32_t, 3>{0, 1, 2}));
   ASSERT_EQ(ft.triangle(1), (std::array<std::int32_t, 3>{3, 4, 5}));
-  // Exact separation of the relative boxes for the common displacement w.
-  const auto exactly_apart = [&](const Eigen::Vector3d& w) {
+  const auto exactly_apart = [&] {
     for (Eigen::Index k = 0; k < 3; ++k) {
-      std::array<long double, 2> lo{INFINITY, INFINITY}, hi{-INFINITY, -INFINITY};
-      for (Eigen::Index v = 0; v < 6; ++v) {
-        const std::size_t side = v < 3 ? 0 : 1;
-        const long double end = static_cast<long double>(x1(v, k)) - static_cast<long double>(w[k]);
-        lo[side] = std::min({lo[side], static_cast<long double>(x0(v, k)), end});
-        hi[side] = std::max({hi[side], static_cast<long double>(x0(v, k)), end});
+      // lo/hi[time][side]
+      long double lo[2][2], hi[2][2];
+      for (std::size_t time = 0; time < 2; ++time) {
+        for (std::size_t side = 0; side < 2; ++side) {
+          lo[time][side] = INFINITY;
+          hi[time][side] = -INFINITY;
+          const auto first = 3 * static_cast<Eigen::Index>(side);
+          for (Eigen::Index v = first; v < first + 3; ++v) {
+            const long double p = (time == 0 ? x0 : x1)(v, k);
+            lo[time][side] = std::min(lo[time][side], p);
+            hi[time][side] = std::max(hi[time][side], p);
+          }
+        }
       }
-      if (lo[0] > hi[1] || lo[1] > hi[0]) return true;
+      if ((hi[0][0] < lo[0][1] && hi[1][0] < lo[1][1]) ||
+          (hi[0][1] < lo[0][0] && hi[1][1] < lo[1][0])) {
+        return true;
+      }
     }
     return false;
   };
@@ -311,27 +320,50 @@ TEST(ClusterChecks, RelativeBoxesWithoutWidthAreApartOnlyWhenTheExactOnesAre) {
         x1(v, k) = x0(v, k) + (0.1 + low_bits(rng) * 0x1p-56);
       }
     }
-    // w as each filter forms it: the prepared one adds each triangle's summed displacement over
-    // 6; relative_boxes_overlap sums the six displacements in order and divides once.
-    Eigen::Vector3d w_prepared, w_unprepared;
-    for (Eigen::Index k = 0; k < 3; ++k) {
-      const auto d = [&](Eigen::Index v) { return x1(v, k) - x0(v, k); };
-      w_prepared[k] = ((d(0) + d(1)) + d(2)) / 6.0 + ((d(3) + d(4)) + d(5)) / 6.0;
-      w_unprepared[k] = (((((d(0) + d(1)) + d(2)) + d(3)) + d(4)) + d(5)) / 6.0;
-    }
     prepared.prepare(ft, x0, x1);
-    if (!prepared.overlap({0, 1}, 0.0)) {
+    const bool prepared_says = !prepared.overlap({0, 1}, 0.0);
+    const bool unprepared_says = !relative_boxes_overlap(ft, {0, 1}, x0, x1, 0.0);
+    ASSERT_EQ(prepared_says, unprepared_says) << "trial " << trial;
+    if (prepared_says) {
       ++prepared_apart;
-      ASSERT_TRUE(exactly_apart(w_prepared)) << "trial " << trial;
+      ASSERT_TRUE(exactly_apart()) << "trial " << trial;
     }
-    if (!relative_boxes_overlap(ft, {0, 1}, x0, x1, 0.0)) {
-      ++unprepared_apart;
-      ASSERT_TRUE(exactly_apart(w_unprepared)) << "trial " << trial;
-    }
+    unprepared_apart += unprepared_says ? 1 : 0;
   }
   // Enough separated pairs for the check to mean something.
   EXPECT_GT(prepared_apart, 1000);
   EXPECT_GT(unprepared_apart, 1000);
+}
+
+TEST(ClusterChecks, EndBoxesWithWidthAndWhenCrossing) {
+  // Two still triangles in z = 0, 0.7 apart on x (a: x ≤ 0, b: x ≥ 0.7): apart without width and
+  // with 0.34 each (0.68 < 0.7); within reach with 0.36 each (0.72).
+  skinning::Positions x0(6, 3);
+  x0 << 0, 0, 0, -1, 1, 0, -1, -1, 0, 0.7, 0, 0, 1.7, 1, 0, 1.7, -1, 0;
+  skinning::Mesh mesh =
+      test::single_part_mesh(x0, (skinning::Triangles(2, 3) << 0, 1, 2, 3, 4, 5).finished());
+  const auto topo = test::simple_topology(mesh);
+  const FeatureTopology ft(mesh, topo);
+  RelativeAabbFilter prepared;
+  prepared.prepare(ft, x0, x0);
+  for (const double half_width : {0.0, 0.34}) {
+    EXPECT_FALSE(relative_boxes_overlap(ft, {0, 1}, x0, x0, half_width)) << half_width;
+    EXPECT_FALSE(prepared.overlap({0, 1}, half_width)) << half_width;
+  }
+  EXPECT_TRUE(relative_boxes_overlap(ft, {0, 1}, x0, x0, 0.36));
+  EXPECT_TRUE(prepared.overlap({0, 1}, 0.36));
+  // b carried across a over the interval (apart at t = 0, on the other side at t = 1): it meets.
+  skinning::Positions x1 = x0;
+  x1.block(3, 0, 3, 1).array() -= 3.0;
+  prepared.prepare(ft, x0, x1);
+  EXPECT_TRUE(relative_boxes_overlap(ft, {0, 1}, x0, x1, 0.0));
+  EXPECT_TRUE(prepared.overlap({0, 1}, 0.0));
+  // A coordinate that is not finite: never apart.
+  skinning::Positions bad = x0;
+  bad(0, 0) = std::numeric_limits<double>::quiet_NaN();
+  prepared.prepare(ft, bad, bad);
+  EXPECT_TRUE(relative_boxes_overlap(ft, {0, 1}, bad, bad, 0.0));
+  EXPECT_TRUE(prepared.overlap({0, 1}, 0.0));
 }
 
 }  // namespace
