@@ -31,6 +31,10 @@
 
 #include "ccd/detail/float_bounds.hpp"
 
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
+
 namespace skelcd::ccd::detail {
 
 /// relative_boxes_apart with (kWidth: half_width > 0) or without a contact distance.
@@ -132,6 +136,54 @@ template <std::size_t NA>
     const std::array<const Eigen::Vector3d*, 4>& t0,
     const std::array<const Eigen::Vector3d*, 4>& t1) {
   static_assert(NA >= 1 && NA <= 3);
+#if defined(__SSE2__)
+  // Two directions a register: (x, y), (z, z), then (x + y, y + z), (x − y, y − z), (z + x, z − x)
+  // — z − x as z + (−x), the same rounding — when the axes did not separate. x − x is 0 for a
+  // finite x and NaN otherwise, so their sum over the query says whether every coordinate is
+  // finite.
+  const __m128d negate_high = _mm_set_pd(-0.0, 0.0);
+  __m128d zeros = _mm_setzero_pd();
+  const auto apart_on = [&]<std::size_t kRegisters>(auto&& registers) {
+    __m128d lo[2][2][kRegisters];
+    __m128d hi[2][2][kRegisters];
+    for (std::size_t time = 0; time < 2; ++time) {
+      const auto& points = time == 0 ? t0 : t1;
+      for (std::size_t i = 0; i < 4; ++i) {
+        __m128d v[kRegisters];
+        registers(points[i]->data(), v);
+        const std::size_t side = i < NA ? 0 : 1;
+        const bool first = i == 0 || i == NA;
+        for (std::size_t r = 0; r < kRegisters; ++r) {
+          lo[time][side][r] = first ? v[r] : _mm_min_pd(lo[time][side][r], v[r]);
+          hi[time][side][r] = first ? v[r] : _mm_max_pd(hi[time][side][r], v[r]);
+        }
+      }
+    }
+    __m128d apart = _mm_setzero_pd();
+    for (std::size_t r = 0; r < kRegisters; ++r) {
+      const __m128d below = _mm_and_pd(
+          _mm_cmplt_pd(hi[0][0][r], lo[0][1][r]), _mm_cmplt_pd(hi[1][0][r], lo[1][1][r]));
+      const __m128d above = _mm_and_pd(
+          _mm_cmplt_pd(hi[0][1][r], lo[0][0][r]), _mm_cmplt_pd(hi[1][1][r], lo[1][0][r]));
+      apart = _mm_or_pd(apart, _mm_or_pd(below, above));
+    }
+    return _mm_movemask_pd(apart) != 0;
+  };
+  const bool on_axes = apart_on.template operator()<2>([&](const double* p, __m128d* v) {
+    v[0] = _mm_loadu_pd(p);
+    v[1] = _mm_load1_pd(p + 2);
+    zeros = _mm_add_pd(zeros, _mm_add_pd(_mm_sub_pd(v[0], v[0]), _mm_sub_pd(v[1], v[1])));
+  });
+  if (_mm_movemask_pd(_mm_cmpeq_pd(zeros, _mm_setzero_pd())) != 3) return false;
+  if (on_axes) return true;
+  return apart_on.template operator()<3>([&](const double* p, __m128d* v) {
+    const __m128d xy = _mm_loadu_pd(p);
+    const __m128d yz = _mm_loadu_pd(p + 1);
+    v[0] = _mm_add_pd(xy, yz);
+    v[1] = _mm_sub_pd(xy, yz);
+    v[2] = _mm_add_pd(_mm_load1_pd(p + 2), _mm_xor_pd(_mm_load1_pd(p), negate_high));
+  });
+#else
   constexpr double kMax = std::numeric_limits<double>::max();
   bool finite = true;
   for (std::size_t i = 0; i < 4; ++i) {
@@ -153,6 +205,7 @@ template <std::size_t NA>
          ends_apart_on<NA>(t0, t1, [](const Eigen::Vector3d& p) {
            return std::array<double, 3>{p[0] - p[1], p[1] - p[2], p[2] - p[0]};
          });
+#endif
 }
 
 /// The pipeline's relative stage: ends_apart without a contact distance (half_width 0),
