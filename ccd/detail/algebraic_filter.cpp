@@ -108,9 +108,9 @@ struct Node {
   std::array<Lanes, kPairs> g_err;
 };
 
-// A certain root of c in [lo, hi] (certified sign change): narrow toward the first root while the
-// signs allow. Every root of c in the interval is a contact here, so the first root is the TOI.
-AlgebraicVerdict narrow(double lo, double hi, std::array<double, 4> c, double e, double toi_tolerance) {
+/// Bisection of narrow(): the sign change kept by halving the Bernstein coefficients.
+AlgebraicVerdict narrow_by_halving(
+    double lo, double hi, std::array<double, 4> c, double e, double toi_tolerance) {
   for (int step = 0; step < 64 && hi - lo > toi_tolerance; ++step) {
     std::array<double, 4> left, right;
     const double e2 = halve(c, e, left, right);
@@ -131,7 +131,102 @@ AlgebraicVerdict narrow(double lo, double hi, std::array<double, 4> c, double e,
   return {AlgebraicOutcome::contact, lo, hi};
 }
 
-// x cross y and its permanent (absolute values, terms added).
+/// +1 (−1) when every exact cubic within e of the coefficients c is strictly increasing
+/// (decreasing) on its interval: the Bernstein coefficients of the derivative, 3 (c_{i+1} − c_i),
+/// all of one sign. Each difference of the exact coefficients lies within 2e of c_{i+1} − c_i,
+/// which its rounding moves by at most eps |d|. 0 otherwise (NaN included).
+int monotone(const std::array<double, 4>& c, double e) {
+  int up = 0;
+  int down = 0;
+  for (std::size_t i = 0; i < 3; ++i) {
+    const double d = c[i + 1] - c[i];
+    const double slack = add_up(2.0 * e, 2.0 * kEps * std::abs(d));
+    up += d > slack ? 1 : 0;
+    down += -d > slack ? 1 : 0;
+  }
+  return up == 3 ? 1 : (down == 3 ? -1 : 0);
+}
+
+/// The certified sign of every exact cubic within e of the Bernstein coefficients c at parameter
+/// s in (0, 1) (0: not certified), and the computed value. de Casteljau with a = fl(1 − s): a
+/// differs from 1 − s by at most eps (1 − s), which moves each weight a^(3−i) s^i by at most
+/// ((1 + eps)³ − 1) of itself, so the polynomial with a in place of 1 − s is within 3.01 eps M of
+/// the exact one (M = max |c_i|, the weights summing to 1); each leaf-to-root chain of the scheme
+/// sees 6 roundings, so the evaluation is within 7 eps (1 + 4 eps) M of that (rounding_bound with
+/// the permanent ≤ (1 + eps)³ M); the coefficients' error e passes through weights summing to at
+/// most (1 + eps)³; and each of the 12 products may add kUnderflowUnit. 16 eps M covers the first
+/// two with room, and 16 kUnderflowUnit the last.
+int certified_sign_at(const std::array<double, 4>& c, double e, double s, double& value) {
+  const double a = 1.0 - s;
+  const double b01 = a * c[0] + s * c[1];
+  const double b12 = a * c[1] + s * c[2];
+  const double b23 = a * c[2] + s * c[3];
+  const double b012 = a * b01 + s * b12;
+  const double b123 = a * b12 + s * b23;
+  value = a * b012 + s * b123;
+  const double m =
+      std::max(std::max(std::abs(c[0]), std::abs(c[1])), std::max(std::abs(c[2]), std::abs(c[3])));
+  const double bound =
+      add_up(add_up(e * (1.0 + 8.0 * kEps), 16.0 * kEps * m), 16.0 * kUnderflowUnit);
+  return value > bound ? 1 : (-value > bound ? -1 : 0);
+}
+
+/// A certain root of c in [lo, hi] (certified sign change): narrow toward the first root while the
+/// signs allow. Every root of c in the interval is a contact here, so the first root is the TOI.
+/// When every exact cubic within e is monotone on [lo, hi] it has one root there, and signs
+/// certified at points bracket it: regula falsi with the Illinois step (the value kept at an end
+/// retained twice is halved), a few evaluations instead of a halving per bit. Where a sign cannot
+/// be certified, or the cubic is not monotone, the bracket is narrowed by halving
+/// (narrow_by_halving) from there. The result is a bracket of doubles around the exact root:
+/// lo + s (hi − lo), with hi − lo a power of two, is rounded outwards.
+AlgebraicVerdict narrow(
+    double lo, double hi, std::array<double, 4> c, double e, double toi_tolerance) {
+  if (!(hi - lo > toi_tolerance) || monotone(c, e) == 0) {
+    return narrow_by_halving(lo, hi, c, e, toi_tolerance);
+  }
+  const double width = hi - lo;
+  // The signs at the two ends are certain (certain_sign_change): s_lo keeps c's sign at 0.
+  double s_lo = 0.0, s_hi = 1.0;
+  double v_lo = c[0], v_hi = c[3];
+  const bool positive_first = c[0] > 0.0;
+  int kept = 0;  // +1: the low end was kept last time, −1: the high end
+  const auto bracket = [&] {
+    const double t_lo = s_lo == 0.0 ? lo : next_down(lo + s_lo * width);
+    const double t_hi = s_hi == 1.0 ? hi : next_up(lo + s_hi * width);
+    return AlgebraicVerdict{AlgebraicOutcome::contact, std::max(t_lo, lo), std::min(t_hi, hi)};
+  };
+  for (int step = 0; step < 64; ++step) {
+    const AlgebraicVerdict v = bracket();
+    if (!(v.t_hi - v.t_lo > toi_tolerance)) return v;
+    double s = s_lo + (s_hi - s_lo) * (v_lo / (v_lo - v_hi));
+    if (!(s > s_lo && s < s_hi)) s = 0.5 * (s_lo + s_hi);
+    if (!(s > s_lo && s < s_hi)) return v;
+    double value = 0.0;
+    const int sign = certified_sign_at(c, e, s, value);
+    if (sign == 0) break;
+    if ((sign > 0) == positive_first) {
+      s_lo = s;
+      v_lo = value;
+      if (kept == 1) v_hi *= 0.5;
+      kept = 1;
+    } else {
+      s_hi = s;
+      v_hi = value;
+      if (kept == -1) v_lo *= 0.5;
+      kept = -1;
+    }
+  }
+  // A sign not certified near the root, or 64 steps: halving on the interval reached so far.
+  // Its Bernstein coefficients come from the node's by two de Casteljau splits; rather than
+  // carry those, halve from the node while the certified bracket [s_lo, s_hi] still holds.
+  const AlgebraicVerdict v = bracket();
+  const AlgebraicVerdict halved = narrow_by_halving(lo, hi, c, e, toi_tolerance);
+  // Both contain the root: their intersection does too.
+  const double t_lo = std::max(v.t_lo, halved.t_lo);
+  const double t_hi = std::min(v.t_hi, halved.t_hi);
+  return t_lo <= t_hi ? AlgebraicVerdict{AlgebraicOutcome::contact, t_lo, t_hi} : halved;
+}
+
 struct CrossPerm {
   Eigen::Vector3d value;
   Eigen::Vector3d permanent;

@@ -2,9 +2,14 @@
 // the screened coplanarity bound, the paired quartics, the early exit on the first two quartics and
 // the two-lane algebraic filter, kept here verbatim, must give the same CcdResult bits and the same
 // CcdStats on every query — random, near-degenerate, scaled to tiny and huge coordinates,
-// non-finite, and with min_separation. And the pieces one by one: the screen's bound against the
-// exact bound, the paired quartics against cross_dot_quartic.
+// non-finite, and with min_separation — but for the bracket of a contact the algebraic filter
+// certifies: since 2026-11-30 it is narrowed by regula falsi where the cubic is monotone
+// (docs/ccd.md, "Narrowing a certain contact"), so the two brackets must share a point (each
+// holds the first contact) and the new one be no wider than the tolerance or the old one. And the
+// pieces one by one: the screen's bound against the exact bound, the paired quartics against
+// cross_dot_quartic, the narrowing against the exact roots of exact cubics.
 
+#include <gmpxx.h>
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -345,9 +350,19 @@ CcdResult reference_conservative(
 
 bool same_bits(double a, double b) { return std::memcmp(&a, &b, sizeof a) == 0; }
 
-::testing::AssertionResult same_result(const CcdResult& a, const CcdResult& b) {
-  if (a.hit == b.hit && same_bits(a.toi_lower, b.toi_lower) &&
-      same_bits(a.toi_upper, b.toi_upper) && a.status == b.status) {
+// The two brackets of one contact: sharing a point (each holds the first contact), `mine` no
+// wider than the tolerance or `theirs`.
+bool same_contact(
+    double mine_lo, double mine_hi, double theirs_lo, double theirs_hi, double tolerance) {
+  return mine_lo <= theirs_hi && theirs_lo <= mine_hi && mine_lo <= mine_hi &&
+         mine_hi - mine_lo <= std::max(tolerance, theirs_hi - theirs_lo);
+}
+
+::testing::AssertionResult same_result(const CcdResult& a, const CcdResult& b, double tolerance) {
+  const bool bits = same_bits(a.toi_lower, b.toi_lower) && same_bits(a.toi_upper, b.toi_upper);
+  const bool contact = a.hit && a.status == CcdStatus::contact &&
+                       same_contact(a.toi_lower, a.toi_upper, b.toi_lower, b.toi_upper, tolerance);
+  if (a.hit == b.hit && (bits || contact) && a.status == b.status) {
     return ::testing::AssertionSuccess();
   }
   return ::testing::AssertionFailure()
@@ -409,14 +424,14 @@ void compare(
                             : reference_conservative(ee, options, theirs);
   ++theirs.queries;
   if (b.hit) ++theirs.hits;
-  ASSERT_TRUE(same_result(a, b)) << what << (vertex_face ? " vf" : " ee");
+  ASSERT_TRUE(same_result(a, b, options.toi_tolerance)) << what << (vertex_face ? " vf" : " ee");
   ASSERT_TRUE(same_stats(mine, theirs)) << what << (vertex_face ? " vf" : " ee");
   if (options.min_separation == 0.0 &&
       !(vertex_face ? swept_aabbs_disjoint(vf) : swept_aabbs_disjoint(ee))) {
     const CcdResult c = vertex_face
                             ? vertex_face_ccd_after_swept_aabbs(vf, Accuracy::conservative, options)
                             : edge_edge_ccd_after_swept_aabbs(ee, Accuracy::conservative, options);
-    ASSERT_TRUE(same_result(c, b)) << what << " after swept AABBs";
+    ASSERT_TRUE(same_result(c, b, options.toi_tolerance)) << what << " after swept AABBs";
   }
   coverage.stats += mine;
   ++coverage.checked;
@@ -623,11 +638,67 @@ TEST(KernelEquivalence, AlgebraicFilterOnRandomPolynomials) {
     const AlgebraicVerdict a = detail::algebraic_filter(c, g, count, tolerance);
     const AlgebraicVerdict b = reference_algebraic_filter(c, g, count, tolerance);
     ASSERT_EQ(a.outcome, b.outcome) << i;
-    ASSERT_TRUE(same_bits(a.t_lo, b.t_lo)) << i;
-    ASSERT_TRUE(same_bits(a.t_hi, b.t_hi)) << i;
+    if (a.outcome == AlgebraicOutcome::contact) {
+      ASSERT_TRUE(same_contact(a.t_lo, a.t_hi, b.t_lo, b.t_hi, tolerance))
+          << i << ": [" << a.t_lo << ", " << a.t_hi << "] / [" << b.t_lo << ", " << b.t_hi << "]";
+    } else {
+      ASSERT_TRUE(same_bits(a.t_lo, b.t_lo)) << i;
+      ASSERT_TRUE(same_bits(a.t_hi, b.t_hi)) << i;
+    }
     ++outcomes[static_cast<int>(a.outcome)];
   }
   for (const int n : outcomes) EXPECT_GT(n, 100);
+}
+
+// Exact cubics (error 0) with a certain sign change on [0, 1] and no quartic: the filter reports
+// a contact whose bracket must hold a root, checked in rational arithmetic: the exact Bernstein
+// polynomial's signs at t_lo and t_hi differ or one of them is 0. A monotone cubic has one root,
+// the first: its bracket must be narrowed to the tolerance. Monotone and not, steep and nearly
+// flat at the root (the middle coefficients on the chord).
+TEST(KernelEquivalence, NarrowingHoldsTheExactFirstRoot) {
+  std::mt19937_64 rng(20261130);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  const auto exact_at = [](const std::array<double, 4>& c, const mpq_class& t) -> mpq_class {
+    const mpq_class a = 1 - t;
+    return mpq_class(mpq_class(c[0]) * a * a * a + 3 * mpq_class(c[1]) * a * a * t) +
+           mpq_class(3 * mpq_class(c[2]) * a * t * t + mpq_class(c[3]) * t * t * t);
+  };
+  int monotone = 0, checked = 0;
+  for (int i = 0; i < 20000; ++i) {
+    BernsteinCubic c;
+    for (double& b : c.coefficients) b = u(rng);
+    if (i % 3 == 0) {
+      // Monotone: increasing coefficients from a negative start.
+      std::sort(c.coefficients.begin(), c.coefficients.end());
+      if (i % 6 == 0) std::reverse(c.coefficients.begin(), c.coefficients.end());
+    }
+    if (i % 5 == 0)
+      c.coefficients[1] = c.coefficients[2] = 0.5 * (c.coefficients[0] + c.coefficients[3]);
+    c.error = 0.0;
+    const auto& b = c.coefficients;
+    if (!((b[0] > 0.0 && b[3] < 0.0) || (b[0] < 0.0 && b[3] > 0.0))) continue;
+    const double tolerance = i % 2 == 0 ? 1e-6 : 1e-3;
+    const AlgebraicVerdict v = detail::algebraic_filter(c, nullptr, 0, tolerance);
+    ASSERT_EQ(v.outcome, AlgebraicOutcome::contact) << i;
+    ASSERT_LE(v.t_lo, v.t_hi) << i;
+    const mpq_class lo(v.t_lo), hi(v.t_hi);
+    const int s_lo = sgn(exact_at(b, lo));
+    const int s_hi = sgn(exact_at(b, hi));
+    ASSERT_TRUE(s_lo == 0 || s_hi == 0 || s_lo != s_hi)
+        << i << ": no root in [" << v.t_lo << ", " << v.t_hi << "]";
+    // No earlier root: for a monotone cubic the sign at t_lo is the sign at 0 (or 0 there).
+    const bool increasing = b[0] < b[1] && b[1] < b[2] && b[2] < b[3];
+    const bool decreasing = b[0] > b[1] && b[1] > b[2] && b[2] > b[3];
+    if (increasing || decreasing) {
+      // Monotone (exactly, with error 0): narrowed all the way.
+      ++monotone;
+      ASSERT_LE(v.t_hi - v.t_lo, tolerance) << i;
+      ASSERT_TRUE(s_lo == 0 || s_lo == sgn(exact_at(b, 0))) << i << ": a root before " << v.t_lo;
+    }
+    ++checked;
+  }
+  EXPECT_GT(checked, 5000);
+  EXPECT_GT(monotone, 2000);
 }
 
 }  // namespace
