@@ -98,8 +98,9 @@ struct alignas(16) WideBvhNode {
 /// The lanes of one wide node as boxes at the two ends of an interval (Bvh::refit_end_boxes): the
 /// box of the lane's triangles' corners at t = 0 (lo0, hi0) and at t = 1 (lo1, hi1), grown by a
 /// half width, as floats rounded outwards, axis by axis four lanes side by side like
-/// WideBvhNode's (unused lanes empty). A traversal tests two lanes' boxes in the motion relative
-/// to a common velocity (culling/traversal.hpp, docs/culling.md "Relative boxes at the nodes").
+/// WideBvhNode's (unused lanes empty). A traversal tests whether two lanes' boxes lie apart on an
+/// axis at both ends (end_boxes_meet, culling/traversal.hpp; docs/culling.md "Relative boxes at
+/// the nodes").
 struct alignas(16) WideEndBoxes {
   float lo0[3][4];
   float hi0[3][4];

@@ -56,7 +56,7 @@ std::int64_t relative_aabb_filter(
 /// (tests/culling/test_cluster_checks.cpp).
 class RelativeAabbFilter {
  public:
-  /// Per-triangle boxes and displacements of the interval x_t0 → x_t1 (#W × 3 each).
+  /// Per-triangle boxes at the two ends of the interval x_t0 → x_t1 (#W × 3 each).
   /// Allocation-free once sized for the topology.
   void prepare(
       const FeatureTopology& topology,

@@ -1,6 +1,6 @@
 #pragma once
-// The relative stage of the conservative pipeline (docs/ccd.md, "Relative boxes and directions
-// apart at both ends").
+// The relative stage of the conservative pipeline (docs/ccd.md, "Relative boxes" and its
+// "Directions apart at both ends").
 //
 // Without a contact distance: directions apart at both ends. For a fixed direction n, each point's
 // projection p(t)·n is linear in t, so min over one feature's points minus max over the other's is
@@ -37,7 +37,9 @@
 
 namespace skelcd::ccd::detail {
 
-/// relative_boxes_apart with (kWidth: half_width > 0) or without a contact distance.
+/// relative_boxes_apart with (kWidth: half_width > 0) or without a contact distance. The pipeline
+/// asks it only with one (relative_stage_apart); without, ends_apart removes every query it would
+/// and more.
 template <std::size_t NA, bool kWidth>
 [[nodiscard]] bool relative_boxes_apart_as(
     const std::array<const Eigen::Vector3d*, 4>& t0,
