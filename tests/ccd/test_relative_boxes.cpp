@@ -135,31 +135,48 @@ TEST(RelativeBoxes, RejectsCoplanarFeaturesThatMoveTogether) {
   EXPECT_TRUE(vertex_face_ccd(v, Accuracy::conservative, with_relative(true, 1.1), vf_within).hit);
 }
 
-// Without contact distance the stage compares rounded ends fl(p₁ − u) unbracketed
-// (relative_boxes.hpp). Every coordinate here lies in [1, 2) on a grid of a few ulps, so ends tie
-// and cross at the last bit; u is formed as the stage forms it, and p₁ − u is exact in long double
-// (at most 57 significant bits). Every query the stage calls apart, for a vertex and a face (NA =
-// 1) and for two edges (NA = 2), must have exactly separated relative boxes.
-template <std::size_t NA>
-void expect_apart_only_when_exactly_apart(std::uint32_t seed) {
-  static_assert(std::numeric_limits<long double>::digits >= 64);
-  constexpr double kUlp = 0x1p-52;
-  std::mt19937 rng(seed);
-  std::uniform_int_distribution<int> grid(-6, 6);
-  std::uniform_int_distribution<int> low_bits(0, 64);
+// Four points at t = 0 and t = 1 whose every coordinate lies in [1, 2) on a grid of a few ulps,
+// each moved by about 0.1 in the last bits: ends and projections tie and cross at the last bit,
+// and a difference or sum of two coordinates is exact in long double (at most 57 significant
+// bits).
+struct GridQuery {
+  std::mt19937 rng;
+  std::uniform_int_distribution<int> grid{-6, 6};
+  std::uniform_int_distribution<int> low_bits{0, 64};
   std::array<Eigen::Vector3d, 4> p0, p1;
-  const std::array<const Eigen::Vector3d*, 4> t0{&p0[0], &p0[1], &p0[2], &p0[3]};
-  const std::array<const Eigen::Vector3d*, 4> t1{&p1[0], &p1[1], &p1[2], &p1[3]};
-  int apart = 0;
-  for (int trial = 0; trial < 200000; ++trial) {
+  std::array<const Eigen::Vector3d*, 4> t0{&p0[0], &p0[1], &p0[2], &p0[3]};
+  std::array<const Eigen::Vector3d*, 4> t1{&p1[0], &p1[1], &p1[2], &p1[3]};
+
+  explicit GridQuery(std::uint32_t seed) : rng(seed) {}
+  GridQuery(const GridQuery&) = delete;
+  GridQuery& operator=(const GridQuery&) = delete;
+  void next() {
+    constexpr double kUlp = 0x1p-52;
     for (std::size_t i = 0; i < 4; ++i) {
       for (Eigen::Index k = 0; k < 3; ++k) {
         p0[i][k] = 1.5 + grid(rng) * kUlp;
         p1[i][k] = p0[i][k] + (0.1 + low_bits(rng) * 0x1p-56);
       }
     }
-    if (!detail::relative_boxes_apart<NA>(t0, t1, 0.0)) continue;
+  }
+};
+
+// relative_boxes_apart without contact distance (which the pipeline no longer asks: its stage is
+// then ends_apart) compares rounded ends fl(p₁ − u) unbracketed (relative_boxes.hpp). On the grid,
+// with u formed as the function forms it, p₁ − u is exact in long double. Every query it calls
+// apart, for a vertex and a face (NA = 1) and for two edges (NA = 2), must have exactly separated
+// relative boxes.
+template <std::size_t NA>
+void expect_apart_only_when_exactly_apart(std::uint32_t seed) {
+  static_assert(std::numeric_limits<long double>::digits >= 64);
+  GridQuery q(seed);
+  int apart = 0;
+  for (int trial = 0; trial < 200000; ++trial) {
+    q.next();
+    if (!detail::relative_boxes_apart<NA>(q.t0, q.t1, 0.0)) continue;
     ++apart;
+    const auto& p0 = q.p0;
+    const auto& p1 = q.p1;
     const Eigen::Vector3d u =
         0.25 * (((p1[0] - p0[0]) + (p1[1] - p0[1])) + ((p1[2] - p0[2]) + (p1[3] - p0[3])));
     bool exactly_apart = false;
@@ -191,13 +208,9 @@ TEST(RelativeBoxes, WithoutContactDistanceApartOnlyWhenTheExactBoxesAre) {
 template <std::size_t NA>
 void expect_ends_apart_only_when_exactly_apart(std::uint32_t seed) {
   static_assert(std::numeric_limits<long double>::digits >= 64);
-  constexpr double kUlp = 0x1p-52;
-  std::mt19937 rng(seed);
-  std::uniform_int_distribution<int> grid(-6, 6);
-  std::uniform_int_distribution<int> low_bits(0, 64);
-  std::array<Eigen::Vector3d, 4> p0, p1;
-  const std::array<const Eigen::Vector3d*, 4> t0{&p0[0], &p0[1], &p0[2], &p0[3]};
-  const std::array<const Eigen::Vector3d*, 4> t1{&p1[0], &p1[1], &p1[2], &p1[3]};
+  GridQuery q(seed);
+  const auto& p0 = q.p0;
+  const auto& p1 = q.p1;
   const auto project = [](const Eigen::Vector3d& p, int d) {
     const long double x = p[0], y = p[1], z = p[2];
     const long double v[9] = {x, y, z, x + y, y + z, z + x, x - y, y - z, z - x};
@@ -205,13 +218,8 @@ void expect_ends_apart_only_when_exactly_apart(std::uint32_t seed) {
   };
   int apart = 0;
   for (int trial = 0; trial < 200000; ++trial) {
-    for (std::size_t i = 0; i < 4; ++i) {
-      for (Eigen::Index k = 0; k < 3; ++k) {
-        p0[i][k] = 1.5 + grid(rng) * kUlp;
-        p1[i][k] = p0[i][k] + (0.1 + low_bits(rng) * 0x1p-56);
-      }
-    }
-    if (!detail::ends_apart<NA>(t0, t1)) continue;
+    q.next();
+    if (!detail::ends_apart<NA>(q.t0, q.t1)) continue;
     ++apart;
     bool exactly_apart = false;
     for (int d = 0; d < 9; ++d) {
