@@ -19,6 +19,7 @@
 #include "culling/normal_cone.hpp"
 #include "culling/pair_blocks.hpp"
 #include "culling/pair_sort.hpp"
+#include "culling/relative_aabb.hpp"
 #include "culling/traversal.hpp"
 #include "culling/vertex_bounds.hpp"
 #include "skinning/errors.hpp"
@@ -393,14 +394,22 @@ class AutoMethod final : public detail::MethodBase {
     blocks_.start_ccd(
         topology_, *bounds_, x_t0, x_t1, tests_, options_.accuracy, ccd_options_, out);
     const std::span<const Aabb> tri(bounds_->triangles);
+    // The pairs this method traverses go through the relative filter when its trial says it
+    // pays, as `kdop`'s do (docs/culling.md "Relative boxes in `kdop`"): one trial per query.
+    relative_.start(RelativePairTrial::trial_pairs(topology_.num_triangles()));
+    const double half_width = 0.5 * options_.min_separation;
     for (const AabbBvh* h : groups) {
       if (h == nullptr || h->empty()) continue;
       start_self_traversal<3>(*h, scratch_);
       blocks_.drain([&](std::vector<TrianglePair>& pairs, std::size_t max_pairs) {
-        return self_traverse_some<3>(*h, tri, scratch_, pairs, out.counters.bv_tests, max_pairs);
+        const std::size_t first = pairs.size();
+        const bool done =
+            self_traverse_some<3>(*h, tri, scratch_, pairs, out.counters.bv_tests, max_pairs);
+        relative_.filter(topology_, x_t0, x_t1, half_width, pairs, first);
+        return done;
       });
     }
-    if (between) traverse_between(out.counters.bv_tests);
+    if (between) traverse_between(out.counters.bv_tests, &x_t0, &x_t1);
     blocks_.finish();
     const auto t2 = Clock::now();
     // Merge: canonical order, each pair once (a vertex shared by an open and a closed component
@@ -502,19 +511,30 @@ class AutoMethod final : public detail::MethodBase {
     if (!closed_bvh_.empty()) closed_bvh_.refit(bounds_->triangles);
   }
 
-  /// The pairs between the two groups (both hierarchies refit), into blocks_ in installments.
-  void traverse_between(std::int64_t& bv_tests) {
+  /// The pairs between the two groups (both hierarchies refit), into blocks_ in installments;
+  /// for a CCD (x_t0, x_t1 given) through the query's relative filter (relative_).
+  void traverse_between(
+      std::int64_t& bv_tests,
+      const skinning::Positions* x_t0 = nullptr,
+      const skinning::Positions* x_t1 = nullptr) {
     const std::span<const Aabb> tri(bounds_->triangles);
     start_pair_traversal<3>(*open_hierarchy_, *closed_hierarchy_, scratch_);
     blocks_.drain([&](std::vector<TrianglePair>& pairs, std::size_t max_pairs) {
-      return pair_traverse_some<3>(
+      const std::size_t first = pairs.size();
+      const bool done = pair_traverse_some<3>(
           *open_hierarchy_, tri, *closed_hierarchy_, tri, scratch_, pairs, bv_tests, max_pairs);
+      if (x_t0 != nullptr) {
+        relative_.filter(topology_, *x_t0, *x_t1, 0.5 * options_.min_separation, pairs, first);
+      }
+      return done;
     });
   }
 
   std::vector<ComponentRoute> routes_;
   std::vector<std::int32_t> open_triangles_;
   std::vector<std::int32_t> closed_triangles_;
+  /// The CCD's relative filter over the pairs traversed here, decided per query by its trial.
+  RelativePairTrial relative_;
   AabbBvh open_bvh_;  ///< built here when the open group has no cone method
   AabbBvh closed_bvh_;
   std::unique_ptr<CullingMethod> open_method_;

@@ -1,7 +1,7 @@
-// `kdop`'s relative pairs (culling/relative_aabb.hpp, RelativePairTrial; docs/culling.md
-// "Relative boxes in `kdop`"): a CCD query keeps the relative AABB filter only when a trial on its
-// first pairs shows that it removes enough of them, and its contacts are those of the same
-// hierarchy without the filter, and of `bvh`, either way.
+// `kdop`'s relative pairs, and `auto`'s (culling/relative_aabb.hpp, RelativePairTrial;
+// docs/culling.md "Relative boxes in `kdop`"): a CCD query keeps the relative AABB filter only when
+// a trial on its first pairs shows that it removes enough of them, and its contacts are those of
+// the same hierarchy without the filter, and of `bvh`, either way.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -168,6 +168,45 @@ TEST(RelativePairs, RealClipsHaveTheSameContactsWithAndWithoutTheFilter) {
     EXPECT_GT(contacts, 0u) << file;
     EXPECT_LT(with, without) << file << ": the filter was kept on some intervals";
   }
+}
+
+// `auto` filters the pairs it traverses itself (its `bvh` groups and the pairs between groups:
+// culling/routed_method.cpp) with the same trial. Without a rig its closed components go to `bvh`
+// traversed by `auto`: carried far, the body loses most of its pairs and keeps `bvh`'s contacts
+// (none); over intervals of the stormtrooper's clip, where its shells interpenetrate and touch,
+// the contacts are `bvh`'s exactly.
+TEST(RelativePairs, AutoFiltersThePairsItTraversesAndKeepsTheContacts) {
+  {
+    const Model m("CesiumMan.glb");
+    skinning::Positions far = m.rest;
+    far.col(0).array() += 3.0;
+    far.col(2).array() -= 1.0;
+    auto routed = make_method("auto", *m.loaded.mesh, m.topology);
+    auto bvh = make_method("bvh", *m.loaded.mesh, m.topology);
+    const Outcome a = ccd(*routed, m.rest, far);
+    const Outcome b = ccd(*bvh, m.rest, far);
+    EXPECT_EQ(a.contacts, b.contacts);
+    EXPECT_LT(a.candidate_pairs * 2, b.candidate_pairs) << "most pairs removed";
+  }
+  const Model m("stormtrooper/stormtrooper.dae");
+  const auto motion = m.loaded.motion();
+  auto routed = make_method("auto", *m.loaded.mesh, m.topology);
+  auto bvh = make_method("bvh", *m.loaded.mesh, m.topology);
+  skinning::Positions posed, x0, x1;
+  std::size_t contacts = 0;
+  const int n = motion->num_samples();
+  const int step = std::max(1, n / 8);
+  for (int k = 0; k + step < n; k += step) {
+    motion->positions(k, posed);
+    skinning::gather_welded(m.topology, posed, x0);
+    motion->positions(k + step, posed);
+    skinning::gather_welded(m.topology, posed, x1);
+    const Outcome a = ccd(*routed, x0, x1);
+    const Outcome b = ccd(*bvh, x0, x1);
+    ASSERT_EQ(a.contacts, b.contacts) << "interval from " << k;
+    contacts += a.contacts.size();
+  }
+  EXPECT_GT(contacts, 0u);
 }
 
 }  // namespace
