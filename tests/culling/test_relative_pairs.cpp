@@ -142,29 +142,39 @@ TEST(RelativePairs, TheTrialKeepsTheFilterOnlyWhenItRemovesAQuarterOfItsPairs) {
 
 // A clip with motion of its own: every interval of RobotExpressive's first clip and of the
 // stormtrooper's, same contacts with and without the filter, and the filter kept on some.
+/// Calls visit(x0, x1, k) on intervals of about n/parts samples each of the model's first clip
+/// (welded positions at samples k and k + step).
+template <typename Visit>
+void for_clip_intervals(const Model& m, int parts, Visit&& visit) {
+  const auto motion = m.loaded.motion();
+  skinning::Positions posed, x0, x1;
+  const int n = motion->num_samples();
+  const int step = std::max(1, n / parts);
+  for (int k = 0; k + step < n; k += step) {
+    motion->positions(k, posed);
+    skinning::gather_welded(m.topology, posed, x0);
+    motion->positions(k + step, posed);
+    skinning::gather_welded(m.topology, posed, x1);
+    visit(x0, x1, k);
+  }
+}
+
 TEST(RelativePairs, RealClipsHaveTheSameContactsWithAndWithoutTheFilter) {
   for (const std::string file : {"RobotExpressive.glb", "stormtrooper/stormtrooper.dae"}) {
     const Model m(file);
-    const auto motion = m.loaded.motion();
     auto kdop = make_method("kdop", *m.loaded.mesh, m.topology);
     auto plain = detail::make_bvh_method<8>("kdop", *m.loaded.mesh, m.topology, {}, false);
-    skinning::Positions posed, x0, x1;
     std::int64_t with = 0, without = 0;
     std::size_t contacts = 0;
-    const int n = motion->num_samples();
-    const int step = std::max(1, n / 12);
-    for (int k = 0; k + step < n; k += step) {
-      motion->positions(k, posed);
-      skinning::gather_welded(m.topology, posed, x0);
-      motion->positions(k + step, posed);
-      skinning::gather_welded(m.topology, posed, x1);
-      const Outcome a = ccd(*kdop, x0, x1);
-      const Outcome b = ccd(*plain, x0, x1);
-      ASSERT_EQ(a.contacts, b.contacts) << file << " interval from " << k;
-      with += a.candidate_pairs;
-      without += b.candidate_pairs;
-      contacts += a.contacts.size();
-    }
+    for_clip_intervals(
+        m, 12, [&](const skinning::Positions& x0, const skinning::Positions& x1, int k) {
+          const Outcome a = ccd(*kdop, x0, x1);
+          const Outcome b = ccd(*plain, x0, x1);
+          ASSERT_EQ(a.contacts, b.contacts) << file << " interval from " << k;
+          with += a.candidate_pairs;
+          without += b.candidate_pairs;
+          contacts += a.contacts.size();
+        });
     EXPECT_GT(contacts, 0u) << file;
     EXPECT_LT(with, without) << file << ": the filter was kept on some intervals";
   }
@@ -189,23 +199,16 @@ TEST(RelativePairs, AutoFiltersThePairsItTraversesAndKeepsTheContacts) {
     EXPECT_LT(a.candidate_pairs * 2, b.candidate_pairs) << "most pairs removed";
   }
   const Model m("stormtrooper/stormtrooper.dae");
-  const auto motion = m.loaded.motion();
   auto routed = make_method("auto", *m.loaded.mesh, m.topology);
   auto bvh = make_method("bvh", *m.loaded.mesh, m.topology);
-  skinning::Positions posed, x0, x1;
   std::size_t contacts = 0;
-  const int n = motion->num_samples();
-  const int step = std::max(1, n / 8);
-  for (int k = 0; k + step < n; k += step) {
-    motion->positions(k, posed);
-    skinning::gather_welded(m.topology, posed, x0);
-    motion->positions(k + step, posed);
-    skinning::gather_welded(m.topology, posed, x1);
-    const Outcome a = ccd(*routed, x0, x1);
-    const Outcome b = ccd(*bvh, x0, x1);
-    ASSERT_EQ(a.contacts, b.contacts) << "interval from " << k;
-    contacts += a.contacts.size();
-  }
+  for_clip_intervals(
+      m, 8, [&](const skinning::Positions& x0, const skinning::Positions& x1, int k) {
+        const Outcome a = ccd(*routed, x0, x1);
+        const Outcome b = ccd(*bvh, x0, x1);
+        ASSERT_EQ(a.contacts, b.contacts) << "interval from " << k;
+        contacts += a.contacts.size();
+      });
   EXPECT_GT(contacts, 0u);
 }
 
