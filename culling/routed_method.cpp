@@ -354,7 +354,8 @@ class AutoMethod final : public detail::MethodBase {
       }
       detail::sieved_self_dcd<3>(*h, tri, topology_, slots, full_slots_, scratch_, blocks_, out);
     }
-    if (between) traverse_between(out.counters.bv_tests);
+    if (between)
+      traverse_between(out.counters.bv_tests, [](std::vector<TrianglePair>&, std::size_t) {});
     blocks_.finish();
     const auto t2 = Clock::now();
     // Merge: sorted, each pair once.
@@ -397,7 +398,9 @@ class AutoMethod final : public detail::MethodBase {
     // The pairs this method traverses go through the relative filter when its trial says it
     // pays, as `kdop`'s do (docs/culling.md "Relative boxes in `kdop`"): one trial per query.
     relative_.start(RelativePairTrial::trial_pairs(topology_.num_triangles()));
-    const double half_width = 0.5 * options_.min_separation;
+    const auto filter = [&](std::vector<TrianglePair>& pairs, std::size_t first) {
+      relative_.filter(topology_, x_t0, x_t1, 0.5 * options_.min_separation, pairs, first);
+    };
     for (const AabbBvh* h : groups) {
       if (h == nullptr || h->empty()) continue;
       start_self_traversal<3>(*h, scratch_);
@@ -405,11 +408,11 @@ class AutoMethod final : public detail::MethodBase {
         const std::size_t first = pairs.size();
         const bool done =
             self_traverse_some<3>(*h, tri, scratch_, pairs, out.counters.bv_tests, max_pairs);
-        relative_.filter(topology_, x_t0, x_t1, half_width, pairs, first);
+        filter(pairs, first);
         return done;
       });
     }
-    if (between) traverse_between(out.counters.bv_tests, &x_t0, &x_t1);
+    if (between) traverse_between(out.counters.bv_tests, filter);
     blocks_.finish();
     const auto t2 = Clock::now();
     // Merge: canonical order, each pair once (a vertex shared by an open and a closed component
@@ -511,21 +514,18 @@ class AutoMethod final : public detail::MethodBase {
     if (!closed_bvh_.empty()) closed_bvh_.refit(bounds_->triangles);
   }
 
-  /// The pairs between the two groups (both hierarchies refit), into blocks_ in installments;
-  /// for a CCD (x_t0, x_t1 given) through the query's relative filter (relative_).
-  void traverse_between(
-      std::int64_t& bv_tests,
-      const skinning::Positions* x_t0 = nullptr,
-      const skinning::Positions* x_t1 = nullptr) {
+  /// The pairs between the two groups (both hierarchies refit), into blocks_ in installments,
+  /// each installment from pairs[first] on passed to filter(pairs, first) (the CCD's relative
+  /// filter; nothing for a DCD).
+  template <typename Filter>
+  void traverse_between(std::int64_t& bv_tests, Filter&& filter) {
     const std::span<const Aabb> tri(bounds_->triangles);
     start_pair_traversal<3>(*open_hierarchy_, *closed_hierarchy_, scratch_);
     blocks_.drain([&](std::vector<TrianglePair>& pairs, std::size_t max_pairs) {
       const std::size_t first = pairs.size();
       const bool done = pair_traverse_some<3>(
           *open_hierarchy_, tri, *closed_hierarchy_, tri, scratch_, pairs, bv_tests, max_pairs);
-      if (x_t0 != nullptr) {
-        relative_.filter(topology_, *x_t0, *x_t1, 0.5 * options_.min_separation, pairs, first);
-      }
+      filter(pairs, first);
       return done;
     });
   }

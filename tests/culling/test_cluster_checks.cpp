@@ -273,8 +273,8 @@ TEST(ClusterChecks, EndBoxesAreApartOnlyWhenTheExactPointsAre) {
   // The filters compare the triangles' boxes at t = 0 and at t = 1 (relative_aabb.hpp): min and
   // max of doubles, exact. Every coordinate here lies in [1, 2) on a grid of a few ulps, so boxes
   // tie and cross at the last bit. Every pair a filter calls apart must be apart, exactly, on an
-  // axis at t = 0 and at t = 1, the same way round — and so, at every t of a sampled set, every
-  // point of one (the corners' combinations, in long double) strictly on one side of the other.
+  // axis at t = 0 and at t = 1, the same way round (checked in long double), which by the
+  // header's argument keeps them apart at every t in between.
   static_assert(std::numeric_limits<long double>::digits >= 64);
   constexpr double kUlp = 0x1p-52;
   std::mt19937 rng(20261127);
