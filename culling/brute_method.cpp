@@ -54,7 +54,12 @@ class BruteMethod final : public MethodBase {
     const bool fans = ccd_uses_fans(topology_, tests_, ccd_options_);
     if (fans) fans_.start(topology_.fans(), x_t0, x_t1, topology_.num_vertices());
     ccd_candidates_brute_force<3>(
-        topology_, bounds_, features_, out.counters, fans ? &fans_ : nullptr);
+        topology_,
+        bounds_,
+        features_,
+        out.counters,
+        fans ? &fans_ : nullptr,
+        interval_ends(ccd_options_.min_separation, x_t0, x_t1));
     const auto t2 = Clock::now();
     run_ccd_tests(topology_, features_, x_t0, x_t1, tests_, options_.accuracy, ccd_options_, out);
     const auto t3 = Clock::now();

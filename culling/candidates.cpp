@@ -73,16 +73,107 @@ void FeatureBounds<N>::static_triangles(
 
 namespace {
 
-/// Overlap of two closed volumes as one bit, without branches: about half the feature pairs of a
-/// candidate triangle pair overlap, so a branch on each comparison is mispredicted often.
-template <int N>
-inline bool overlap_bit(const Dop<N>& a, const Dop<N>& b) {
-  bool ok = true;
-  for (std::size_t k = 0; k < static_cast<std::size_t>(N); ++k) {
-    ok = ok & (a.lo[k] <= b.hi[k]) & (b.lo[k] <= a.hi[k]);
+/// A feature's axis-aligned boxes at t = 0 (lo0, hi0) and at t = 1 (lo1, hi1).
+struct EndBoxes {
+  std::array<double, 3> lo0, hi0, lo1, hi1;
+  void merge(const EndBoxes& o) {
+    for (std::size_t k = 0; k < 3; ++k) {
+      lo0[k] = std::min(lo0[k], o.lo0[k]);
+      hi0[k] = std::max(hi0[k], o.hi0[k]);
+      lo1[k] = std::min(lo1[k], o.lo1[k]);
+      hi1[k] = std::max(hi1[k], o.hi1[k]);
+    }
   }
-  return ok;
-}
+};
+
+/// What the feature stage tests a feature pair on: the swept volumes of the interval
+/// (FeatureBounds). A face's is its triangle's; an edge's the union of its endpoints' (bit for bit
+/// what FeatureBounds::derive stores), formed from corner volumes the VF pairs have just read, so
+/// that no per-edge volumes need be held (bounded memory).
+template <int N>
+struct SweptVolumes {
+  const FeatureBounds<N>& bounds;
+
+  [[nodiscard]] const Dop<N>& vertex(std::int32_t v) const { return bounds.vertices[at(v)]; }
+  [[nodiscard]] const Dop<N>& face(std::int32_t f, const std::array<std::int32_t, 3>&) const {
+    return bounds.triangles[at(f)];
+  }
+  [[nodiscard]] Dop<N> edge(const std::array<std::int32_t, 2>& ends) const {
+    Dop<N> d = bounds.vertices[at(ends[0])];
+    d.merge(bounds.vertices[at(ends[1])]);
+    return d;
+  }
+  /// Overlap of two closed volumes as one bit, without branches: about half the feature pairs of
+  /// a candidate triangle pair overlap, so a branch on each comparison is mispredicted often.
+  [[nodiscard]] static bool meet(const Dop<N>& a, const Dop<N>& b) {
+    bool ok = true;
+    for (std::size_t k = 0; k < static_cast<std::size_t>(N); ++k) {
+      ok = ok & (a.lo[k] <= b.hi[k]) & (b.lo[k] <= a.hi[k]);
+    }
+    return ok;
+  }
+  /// Asks for a face's volume and its corners' (8-byte aligned: a volume's last byte may start
+  /// one more cache line).
+  void prefetch(std::int32_t f, const std::array<std::int32_t, 3>& corners) const {
+    prefetch_volume(bounds.triangles[at(f)]);
+    for (const std::int32_t v : corners) prefetch_volume(bounds.vertices[at(v)]);
+  }
+  static void prefetch_volume(const Dop<N>& d) {
+    const auto* bytes = reinterpret_cast<const char*>(&d);
+    for (std::size_t k = 0; k < sizeof(Dop<N>); k += 64) __builtin_prefetch(bytes + k);
+    __builtin_prefetch(bytes + sizeof(Dop<N>) - 1);
+  }
+};
+
+/// Without a contact distance, on the coordinate axes: each feature's boxes at t = 0 and at
+/// t = 1, read from the positions (row-major: vertex v at 3 v). Two features meet unless an axis
+/// separates them strictly at both ends, the same way round: two linearly moving point sets on the
+/// two sides of a fixed direction at t = 0 and at t = 1 stay so in between (the gap is concave in
+/// t; docs/culling.md "Apart at both ends in the feature stage"). Swept boxes that miss each other
+/// are apart at both ends, so this drops every pair the swept AABBs drop, and more; coordinates
+/// are compared as they are, so it is exact.
+struct EndPositions {
+  const double* x0;
+  const double* x1;
+
+  [[nodiscard]] EndBoxes vertex(std::int32_t v) const {
+    EndBoxes e;
+    for (std::size_t k = 0; k < 3; ++k) {
+      e.lo0[k] = e.hi0[k] = x0[3 * at(v) + k];
+      e.lo1[k] = e.hi1[k] = x1[3 * at(v) + k];
+    }
+    return e;
+  }
+  [[nodiscard]] EndBoxes face(std::int32_t, const std::array<std::int32_t, 3>& corners) const {
+    EndBoxes e = vertex(corners[0]);
+    e.merge(vertex(corners[1]));
+    e.merge(vertex(corners[2]));
+    return e;
+  }
+  [[nodiscard]] EndBoxes edge(const std::array<std::int32_t, 2>& ends) const {
+    EndBoxes e = vertex(ends[0]);
+    e.merge(vertex(ends[1]));
+    return e;
+  }
+  /// Not apart on any axis (NaN compares false: never apart), without branches.
+  [[nodiscard]] static bool meet(const EndBoxes& a, const EndBoxes& b) {
+    bool apart = false;
+    for (std::size_t k = 0; k < 3; ++k) {
+      apart = apart | ((a.hi0[k] < b.lo0[k]) & (a.hi1[k] < b.lo1[k])) |
+              ((b.hi0[k] < a.lo0[k]) & (b.hi1[k] < a.lo1[k]));
+    }
+    return !apart;
+  }
+  /// Asks for the corners' positions at both ends (24 bytes each: up to two cache lines).
+  void prefetch(std::int32_t, const std::array<std::int32_t, 3>& corners) const {
+    for (const std::int32_t v : corners) {
+      for (const double* x : {x0, x1}) {
+        __builtin_prefetch(x + 3 * at(v));
+        __builtin_prefetch(x + 3 * at(v) + 2);
+      }
+    }
+  }
+};
 
 /// Triangle pairs per chunk of the feature stage: a chunk's candidates are written to fixed
 /// buffers without branches (a slot is written, then kept or not) and appended at once.
@@ -94,24 +185,17 @@ constexpr std::size_t kFeatureFar = 16;
 constexpr std::size_t kFeatureNear = 8;
 constexpr std::int32_t kFeaturePrefetchFrom = 16384;
 
-/// Asks for every cache line of a volume (8-byte aligned: its last byte may start one more).
-template <int N>
-inline void prefetch_volume(const Dop<N>& d) {
-  const auto* bytes = reinterpret_cast<const char*>(&d);
-  for (std::size_t k = 0; k < sizeof(Dop<N>); k += 64) __builtin_prefetch(bytes + k);
-  __builtin_prefetch(bytes + sizeof(Dop<N>) - 1);
-}
-
 /// The feature stage of ccd_candidates_from_triangle_pairs, with the part-exclusion checks compiled
 /// in or out (`kExclusions` = topology.has_exclusions(): without exclusions every *_excluded is
-/// false). Reads one OwnedFeatures record per triangle instead of the owned bits, corners, side
-/// edges and their endpoints from four arrays; the pairs, the rules and the order of what is
-/// appended are those of the bit-by-bit loop.
-template <int N, bool kExclusions, bool kFans>
+/// false), feature pairs tested on `boxes` (SweptVolumes or EndPositions). Reads one
+/// OwnedFeatures record per triangle instead of the owned bits, corners, side edges and their
+/// endpoints from four arrays; the pairs, the rules and the order of what is appended are those
+/// of the bit-by-bit loop.
+template <bool kExclusions, bool kFans, class Boxes>
 void owned_feature_pairs(
     const FeatureTopology& topology,
     std::span<const TrianglePair> pairs,
-    const FeatureBounds<N>& bounds,
+    const Boxes& boxes,
     IntervalFans* fans,
     FeatureCandidates& out,
     std::int64_t& feature_bv_tests,
@@ -124,9 +208,9 @@ void owned_feature_pairs(
   std::size_t num_ee = 0;
   std::int64_t tests = 0;
   // VF pairs of the vertices `owner` owns against face `face`: each slot is written, and kept
-  // when the pair is not on a corner of the face and the volumes overlap.
+  // when the pair is not on a corner of the face and the boxes meet.
   const auto vertices_vs_face = [&](const Owned& owner, const Owned& face, std::int32_t f) {
-    const Dop<N>& face_bounds = bounds.triangles[at(f)];
+    const auto& face_box = boxes.face(f, face.corners);
     for (std::size_t k = 0; k < owner.num_vertices; ++k) {
       const std::int32_t v = owner.vertices[k];
       bool wanted = !is_corner(v, face.corners);
@@ -134,13 +218,8 @@ void owned_feature_pairs(
       tests += wanted;
       vf[num_vf] = {v, f};
       num_vf += static_cast<std::size_t>(wanted) &
-                static_cast<std::size_t>(overlap_bit(bounds.vertices[at(v)], face_bounds));
+                static_cast<std::size_t>(Boxes::meet(boxes.vertex(v), face_box));
     }
-  };
-  const auto edge_volume = [&](const std::array<std::int32_t, 2>& ends) {
-    Dop<N> d = bounds.vertices[at(ends[0])];
-    d.merge(bounds.vertices[at(ends[1])]);
-    return d;
   };
   const auto flush = [&] {
     out.vf.insert(out.vf.end(), vf.begin(), vf.begin() + static_cast<std::ptrdiff_t>(num_vf));
@@ -149,7 +228,7 @@ void owned_feature_pairs(
     num_ee = 0;
   };
   // The pairs' triangles are scattered over a large mesh: ask for a later pair's owned-feature
-  // records kFeatureFar pairs on and its volumes kFeatureNear pairs on (the second triangle's,
+  // records kFeatureFar pairs on and its boxes kFeatureNear pairs on (the second triangle's,
   // from its record, by then in the cache: the first triangle of a pair mostly repeats).
   const bool prefetch = topology.num_triangles() >= kFeaturePrefetchFrom;
   const std::size_t num_pairs = pairs.size();
@@ -162,10 +241,7 @@ void owned_feature_pairs(
     }
     if (prefetch && at_pair + kFeatureNear < num_pairs) {
       const TrianglePair& f = pairs[at_pair + kFeatureNear];
-      prefetch_volume(bounds.triangles[at(f.b)]);
-      for (const std::int32_t v : topology.owned_features(f.b).corners) {
-        prefetch_volume(bounds.vertices[at(v)]);
-      }
+      boxes.prefetch(f.b, topology.owned_features(f.b).corners);
     }
     const TrianglePair& p = pairs[at_pair];
     if constexpr (kExclusions) {
@@ -183,15 +259,14 @@ void owned_feature_pairs(
     // VF: the vertices each triangle owns against the other triangle's face.
     vertices_vs_face(a, b, p.b);
     vertices_vs_face(b, a, p.a);
-    // EE: the edges a owns against the edges b owns. An edge's volume is the union of its
-    // endpoints' (FeatureBounds::derive, bit for bit), formed here from corner volumes the VF
-    // pairs above have just read, so that no per-edge volumes need be held (bounded memory).
-    std::array<Dop<N>, 3> edges_b;
+    // EE: the edges a owns against the edges b owns.
+    using EdgeBox = decltype(boxes.edge(a.edge_ends[0]));
+    std::array<EdgeBox, 3> edges_b;
     const std::size_t num_edges_b = a.num_edges != 0 ? b.num_edges : 0;  // none needed otherwise
-    for (std::size_t j = 0; j < num_edges_b; ++j) edges_b[j] = edge_volume(b.edge_ends[j]);
+    for (std::size_t j = 0; j < num_edges_b; ++j) edges_b[j] = boxes.edge(b.edge_ends[j]);
     for (std::size_t i = 0; i < a.num_edges; ++i) {
       const std::int32_t ea = a.edges[i];
-      const Dop<N> bounds_a = edge_volume(a.edge_ends[i]);
+      const EdgeBox box_a = boxes.edge(a.edge_ends[i]);
       for (std::size_t j = 0; j < b.num_edges; ++j) {
         const std::int32_t eb = b.edges[j];
         bool wanted = !share_endpoint(a.edge_ends[i], b.edge_ends[j]);
@@ -199,7 +274,7 @@ void owned_feature_pairs(
         tests += wanted;
         ee[num_ee] = {std::min(ea, eb), std::max(ea, eb)};
         num_ee += static_cast<std::size_t>(wanted) &
-                  static_cast<std::size_t>(overlap_bit(bounds_a, edges_b[j]));
+                  static_cast<std::size_t>(Boxes::meet(box_a, edges_b[j]));
       }
     }
     if (++in_chunk == kChunkPairs) {
@@ -220,35 +295,45 @@ void ccd_candidates_from_triangle_pairs(
     const FeatureBounds<N>& bounds,
     FeatureCandidates& out,
     Counters& counters,
-    IntervalFans* fans) {
+    IntervalFans* fans,
+    const IntervalEnds& ends) {
   std::int64_t feature_bv_tests = 0;
   std::int64_t candidate_pairs = 0;
-  const auto run = [&]<bool kExclusions, bool kFans>() {
-    owned_feature_pairs<N, kExclusions, kFans>(
-        topology, pairs, bounds, fans, out, feature_bv_tests, candidate_pairs);
+  const auto with = [&](const auto& boxes) {
+    const auto run = [&]<bool kExclusions, bool kFans>() {
+      owned_feature_pairs<kExclusions, kFans>(
+          topology, pairs, boxes, fans, out, feature_bv_tests, candidate_pairs);
+    };
+    if (topology.has_exclusions()) {
+      fans == nullptr ? run.template operator()<true, false>()
+                      : run.template operator()<true, true>();
+    } else {
+      fans == nullptr ? run.template operator()<false, false>()
+                      : run.template operator()<false, true>();
+    }
   };
-  if (topology.has_exclusions()) {
-    fans == nullptr ? run.template operator()<true, false>()
-                    : run.template operator()<true, true>();
+  if (const bool by_ends = N == 3 && ends.x_t0 != nullptr; by_ends) {
+    with(EndPositions{ends.x_t0->data(), ends.x_t1->data()});
   } else {
-    fans == nullptr ? run.template operator()<false, false>()
-                    : run.template operator()<false, true>();
+    with(SweptVolumes<N>{bounds});
   }
   counters.feature_bv_tests += feature_bv_tests;
   counters.candidate_pairs += candidate_pairs;
 }
 
-template <int N>
-void ccd_candidates_brute_force(
+namespace {
+
+/// ccd_candidates_brute_force on `boxes` (SweptVolumes or EndPositions, as the hierarchies').
+template <class Boxes>
+void brute_feature_pairs(
     const FeatureTopology& topology,
-    const FeatureBounds<N>& bounds,
+    const Boxes& boxes,
     FeatureCandidates& out,
-    Counters& counters,
+    std::int64_t& tests,
     IntervalFans* fans) {
   const std::int32_t num_faces = topology.num_triangles();
   const std::int32_t num_vertices = topology.num_vertices();
   const std::int32_t num_edges = topology.num_edges();
-  std::int64_t tests = 0;
   // The fan rule of ccd_candidates_from_triangle_pairs, on the pair of owners a hierarchy would
   // have formed the feature pair from.
   const auto settled = [&](std::int32_t a, std::int32_t b) {
@@ -258,25 +343,46 @@ void ccd_candidates_brute_force(
   // Every vertex that lies on a triangle against every face it is not a corner of.
   for (std::int32_t v = 0; v < num_vertices; ++v) {
     if (topology.vertex_owner(v) < 0) continue;
-    const Dop<N>& bv = bounds.vertices[at(v)];
+    const auto bv = boxes.vertex(v);
     for (std::int32_t f = 0; f < num_faces; ++f) {
-      if (is_corner(v, topology.triangle(f)) || topology.vertex_face_excluded(v, f)) continue;
+      const auto& t = topology.triangle(f);
+      if (is_corner(v, t) || topology.vertex_face_excluded(v, f)) continue;
       if (settled(topology.vertex_owner(v), f)) continue;
       ++tests;
-      if (bv.overlaps(bounds.triangles[at(f)])) out.vf.push_back({v, f});
+      if (Boxes::meet(bv, boxes.face(f, t))) out.vf.push_back({v, f});
     }
   }
   // Every pair of edges a < b without a common endpoint.
   for (std::int32_t a = 0; a < num_edges; ++a) {
-    const Dop<N>& ba = bounds.edges[at(a)];
     const auto& ends_a = topology.edge(a);
+    const auto ba = boxes.edge(ends_a);
     for (std::int32_t b = a + 1; b < num_edges; ++b) {
       if (share_endpoint(ends_a, topology.edge(b)) || topology.edges_excluded(a, b)) continue;
       if (settled(topology.edge_owner(a), topology.edge_owner(b))) continue;
       ++tests;
-      if (ba.overlaps(bounds.edges[at(b)])) out.ee.push_back({a, b});
+      if (Boxes::meet(ba, boxes.edge(topology.edge(b)))) out.ee.push_back({a, b});
     }
   }
+}
+
+}  // namespace
+
+template <int N>
+void ccd_candidates_brute_force(
+    const FeatureTopology& topology,
+    const FeatureBounds<N>& bounds,
+    FeatureCandidates& out,
+    Counters& counters,
+    IntervalFans* fans,
+    const IntervalEnds& ends) {
+  std::int64_t tests = 0;
+  if (N == 3 && ends.x_t0 != nullptr) {
+    brute_feature_pairs(
+        topology, EndPositions{ends.x_t0->data(), ends.x_t1->data()}, out, tests, fans);
+  } else {
+    brute_feature_pairs(topology, SweptVolumes<N>{bounds}, out, tests, fans);
+  }
+  const std::int32_t num_faces = topology.num_triangles();
   counters.feature_bv_tests += tests;
   counters.candidate_pairs += static_cast<std::int64_t>(num_faces) * (num_faces - 1) / 2;
 }
@@ -319,18 +425,30 @@ template void ccd_candidates_from_triangle_pairs<3>(
     const FeatureBounds<3>&,
     FeatureCandidates&,
     Counters&,
-    IntervalFans*);
+    IntervalFans*,
+    const IntervalEnds&);
 template void ccd_candidates_from_triangle_pairs<8>(
     const FeatureTopology&,
     std::span<const TrianglePair>,
     const FeatureBounds<8>&,
     FeatureCandidates&,
     Counters&,
-    IntervalFans*);
+    IntervalFans*,
+    const IntervalEnds&);
 template void ccd_candidates_brute_force<3>(
-    const FeatureTopology&, const FeatureBounds<3>&, FeatureCandidates&, Counters&, IntervalFans*);
+    const FeatureTopology&,
+    const FeatureBounds<3>&,
+    FeatureCandidates&,
+    Counters&,
+    IntervalFans*,
+    const IntervalEnds&);
 template void ccd_candidates_brute_force<8>(
-    const FeatureTopology&, const FeatureBounds<8>&, FeatureCandidates&, Counters&, IntervalFans*);
+    const FeatureTopology&,
+    const FeatureBounds<8>&,
+    FeatureCandidates&,
+    Counters&,
+    IntervalFans*,
+    const IntervalEnds&);
 template void dcd_candidates_brute_force<3>(
     const FeatureTopology&, std::span<const Dop<3>>, std::vector<TrianglePair>&, Counters&);
 template void dcd_candidates_brute_force<8>(

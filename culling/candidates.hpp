@@ -5,7 +5,9 @@
 // - a VF pair whose vertex is a corner of the face, an EE pair whose edges share an endpoint, and
 //   a triangle with itself are never tested; no pair is excluded by distance;
 // - part exclusions as in FeatureTopology;
-// - a feature pair is tested only when its features' volumes (of the interval) overlap.
+// - a feature pair is tested only when its features' volumes (of the interval) overlap; the AABB
+//   methods without a contact distance test instead that no axis separates the features at both
+//   ends of the interval (IntervalEnds), which drops every pair the swept boxes drop, and more.
 // CCD de-duplication (docs/culling.md has the proof): candidate triangle pair {A, B} produces
 // (vertex owned by A, face B), (vertex owned by B, face A) and (edge owned by A, edge owned by B).
 // A feature's volume lies inside its owner's, so a feature pair whose volumes overlap always has
@@ -102,6 +104,23 @@ struct IntervalFans {
   }
 };
 
+/// The positions at the two ends of a CCD interval, for the feature stage of the AABB methods
+/// (N = 3) without a contact distance: a feature pair is then dropped when an axis separates its
+/// features strictly at t = 0 and at t = 1, the same way round (they never touch in between), in
+/// place of the swept boxes' test, whose every rejection it makes too. The 16-DOP (N = 8) keeps
+/// its swept test: its diagonals already reject about what the axes' ends would add.
+struct IntervalEnds {
+  const skinning::Positions* x_t0 = nullptr;
+  const skinning::Positions* x_t1 = nullptr;
+};
+
+/// IntervalEnds{&x_t0, &x_t1} without a contact distance, else none (the swept volumes, grown by
+/// half of it, are tested).
+[[nodiscard]] inline IntervalEnds interval_ends(
+    double min_separation, const skinning::Positions& x_t0, const skinning::Positions& x_t1) {
+  return min_separation == 0.0 ? IntervalEnds{&x_t0, &x_t1} : IntervalEnds{};
+}
+
 /// Triangle pairs per CCD block: the hierarchy methods turn their traversal's pairs into feature
 /// candidates and test them a block at a time, so that what they hold at once (pairs, at most 15
 /// feature candidates each, the tests' outcomes: a few MB) is bounded whatever the motion, and a
@@ -125,7 +144,8 @@ void ccd_candidates_from_triangle_pairs(
     const FeatureBounds<N>& bounds,
     FeatureCandidates& out,
     Counters& counters,
-    IntervalFans* fans = nullptr);
+    IntervalFans* fans = nullptr,
+    const IntervalEnds& ends = {});
 
 /// CCD brute force: appends every VF pair (vertex on some triangle × triangle) and EE pair
 /// (a < b) that passes the rules above — O(#W·#F + #E²) volume tests, no hierarchy.
@@ -139,7 +159,8 @@ void ccd_candidates_brute_force(
     const FeatureBounds<N>& bounds,
     FeatureCandidates& out,
     Counters& counters,
-    IntervalFans* fans = nullptr);
+    IntervalFans* fans = nullptr,
+    const IntervalEnds& ends = {});
 
 /// The DCD rules for one triangle pair: not part-excluded, not a duplicate face (the same three
 /// welded vertices). Pairs sharing one or two vertices are checked: the exact test handles them.

@@ -19,10 +19,12 @@ double micros(Clock::time_point from, Clock::time_point to) {
 
 // Every feature pair of ccd_candidates_from_triangle_pairs passed the volume filter with the
 // swept volumes of the interval (vertex_bounds.hpp: on the coordinate axes of Aabb and Kdop16 the
-// positions' own min / max, grown by min_separation / 2). With min_separation 0 those are exactly
-// the swept AABBs the ccd/ kernels test first, and they overlap: the kernels may skip that stage
-// (ccd/after_swept_aabbs.hpp, which checks the distance and accuracy; the results are the same).
-// Substituted tests are left alone.
+// positions' own min / max, grown by min_separation / 2) or, for Aabb without a contact
+// distance, the test of its features' boxes at both ends, which passes only where the swept boxes
+// overlap (boxes that miss each other on an axis are apart there at both ends). With
+// min_separation 0 those are exactly the swept AABBs the ccd/ kernels test first, and they
+// overlap: the kernels may skip that stage (ccd/after_swept_aabbs.hpp, which checks the distance
+// and accuracy; the results are the same). Substituted tests are left alone.
 ElementaryTests after_swept_aabbs(ElementaryTests tests) {
   if (tests.vertex_face == static_cast<ElementaryTests::VertexFaceFn>(&ccd::vertex_face_ccd)) {
     tests.vertex_face = &ccd::vertex_face_ccd_after_swept_aabbs;
@@ -120,7 +122,8 @@ void PairBlocks<N>::flush() {
         *bounds_,
         features_,
         out.counters,
-        use_fans_ ? &interval_fans_ : nullptr);
+        use_fans_ ? &interval_fans_ : nullptr,
+        interval_ends(ccd_options_->min_separation, *x_t0_, *x_t1_));
     const auto t1 = Clock::now();
     run_ccd_tests(
         *topology_,

@@ -366,9 +366,10 @@ TEST(Methods, AgreeOnGeneratedMeshesWithKnownCollisions) {
         if (acc == Accuracy::exact) {
           EXPECT_EQ(ck.contacts, cb.contacts) << what;
         } else {
-          // 16-DOPs cull more pairs, so kdop may lack a conservative false positive — never more.
+          // 16-DOPs cull pairs on their diagonals, so kdop may lack a conservative false
+          // positive — never more: the pairs only kdop tests are those the AABB methods' feature
+          // stage finds apart on an axis at both ends, as the kernels' relative stage does.
           EXPECT_TRUE(is_subset(ck.contacts, cb.contacts)) << what;
-          EXPECT_LE(ck.counters.vf_tests, cb.counters.vf_tests) << what;
         }
         // The culling worked: fewer volume tests than brute force's (on meshes large enough
         // for a hierarchy to matter).
