@@ -3,6 +3,11 @@
 #include <algorithm>
 #include <array>
 #include <cstddef>
+#include <initializer_list>
+
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
 
 namespace skelcd::culling {
 namespace {
@@ -73,19 +78,6 @@ void FeatureBounds<N>::static_triangles(
 
 namespace {
 
-/// A feature's axis-aligned boxes at t = 0 (lo0, hi0) and at t = 1 (lo1, hi1).
-struct EndBoxes {
-  std::array<double, 3> lo0, hi0, lo1, hi1;
-  void merge(const EndBoxes& o) {
-    for (std::size_t k = 0; k < 3; ++k) {
-      lo0[k] = std::min(lo0[k], o.lo0[k]);
-      hi0[k] = std::max(hi0[k], o.hi0[k]);
-      lo1[k] = std::min(lo1[k], o.lo1[k]);
-      hi1[k] = std::max(hi1[k], o.hi1[k]);
-    }
-  }
-};
-
 /// What the feature stage tests a feature pair on: the swept volumes of the interval
 /// (FeatureBounds). A face's is its triangle's; an edge's the union of its endpoints' (bit for bit
 /// what FeatureBounds::derive stores), formed from corner volumes the VF pairs have just read, so
@@ -136,27 +128,100 @@ struct EndPositions {
   const double* x0;
   const double* x1;
 
-  [[nodiscard]] EndBoxes vertex(std::int32_t v) const {
-    EndBoxes e;
-    for (std::size_t k = 0; k < 3; ++k) {
-      e.lo0[k] = e.hi0[k] = x0[3 * at(v) + k];
-      e.lo1[k] = e.hi1[k] = x1[3 * at(v) + k];
+#if defined(__SSE2__)
+  // Two registers per coordinate triple: (x, y) and (z, z).
+  struct Point {
+    __m128d at0[2], at1[2];
+  };
+  struct Box {
+    __m128d lo0[2], hi0[2], lo1[2], hi1[2];
+  };
+  [[nodiscard]] Point vertex(std::int32_t v) const {
+    const double* p0 = x0 + 3 * at(v);
+    const double* p1 = x1 + 3 * at(v);
+    return {{_mm_loadu_pd(p0), _mm_load1_pd(p0 + 2)}, {_mm_loadu_pd(p1), _mm_load1_pd(p1 + 2)}};
+  }
+  [[nodiscard]] Box face(std::int32_t, const std::array<std::int32_t, 3>& corners) const {
+    return hull({vertex(corners[0]), vertex(corners[1]), vertex(corners[2])});
+  }
+  [[nodiscard]] Box edge(const std::array<std::int32_t, 2>& ends) const {
+    return hull({vertex(ends[0]), vertex(ends[1])});
+  }
+  [[nodiscard]] static Box hull(std::initializer_list<Point> points) {
+    const Point& first = *points.begin();
+    Box b{
+        {first.at0[0], first.at0[1]},
+        {first.at0[0], first.at0[1]},
+        {first.at1[0], first.at1[1]},
+        {first.at1[0], first.at1[1]}};
+    for (const Point& p : points) {
+      for (std::size_t r = 0; r < 2; ++r) {
+        b.lo0[r] = _mm_min_pd(b.lo0[r], p.at0[r]);
+        b.hi0[r] = _mm_max_pd(b.hi0[r], p.at0[r]);
+        b.lo1[r] = _mm_min_pd(b.lo1[r], p.at1[r]);
+        b.hi1[r] = _mm_max_pd(b.hi1[r], p.at1[r]);
+      }
     }
-    return e;
-  }
-  [[nodiscard]] EndBoxes face(std::int32_t, const std::array<std::int32_t, 3>& corners) const {
-    EndBoxes e = vertex(corners[0]);
-    e.merge(vertex(corners[1]));
-    e.merge(vertex(corners[2]));
-    return e;
-  }
-  [[nodiscard]] EndBoxes edge(const std::array<std::int32_t, 2>& ends) const {
-    EndBoxes e = vertex(ends[0]);
-    e.merge(vertex(ends[1]));
-    return e;
+    return b;
   }
   /// Not apart on any axis (NaN compares false: never apart), without branches.
-  [[nodiscard]] static bool meet(const EndBoxes& a, const EndBoxes& b) {
+  [[nodiscard]] static bool meet(const Box& a, const Box& b) {
+    __m128d apart = _mm_setzero_pd();
+    for (std::size_t r = 0; r < 2; ++r) {
+      const __m128d below =
+          _mm_and_pd(_mm_cmplt_pd(a.hi0[r], b.lo0[r]), _mm_cmplt_pd(a.hi1[r], b.lo1[r]));
+      const __m128d above =
+          _mm_and_pd(_mm_cmplt_pd(b.hi0[r], a.lo0[r]), _mm_cmplt_pd(b.hi1[r], a.lo1[r]));
+      apart = _mm_or_pd(apart, _mm_or_pd(below, above));
+    }
+    return _mm_movemask_pd(apart) == 0;
+  }
+  [[nodiscard]] static bool meet(const Point& p, const Box& b) {
+    __m128d apart = _mm_setzero_pd();
+    for (std::size_t r = 0; r < 2; ++r) {
+      const __m128d below =
+          _mm_and_pd(_mm_cmplt_pd(p.at0[r], b.lo0[r]), _mm_cmplt_pd(p.at1[r], b.lo1[r]));
+      const __m128d above =
+          _mm_and_pd(_mm_cmplt_pd(b.hi0[r], p.at0[r]), _mm_cmplt_pd(b.hi1[r], p.at1[r]));
+      apart = _mm_or_pd(apart, _mm_or_pd(below, above));
+    }
+    return _mm_movemask_pd(apart) == 0;
+  }
+#else
+  struct Point {
+    std::array<double, 3> at0, at1;
+  };
+  struct Box {
+    std::array<double, 3> lo0, hi0, lo1, hi1;
+  };
+  [[nodiscard]] Point vertex(std::int32_t v) const {
+    Point p;
+    for (std::size_t k = 0; k < 3; ++k) {
+      p.at0[k] = x0[3 * at(v) + k];
+      p.at1[k] = x1[3 * at(v) + k];
+    }
+    return p;
+  }
+  [[nodiscard]] Box face(std::int32_t, const std::array<std::int32_t, 3>& corners) const {
+    return hull({vertex(corners[0]), vertex(corners[1]), vertex(corners[2])});
+  }
+  [[nodiscard]] Box edge(const std::array<std::int32_t, 2>& ends) const {
+    return hull({vertex(ends[0]), vertex(ends[1])});
+  }
+  [[nodiscard]] static Box hull(std::initializer_list<Point> points) {
+    const Point& first = *points.begin();
+    Box b{first.at0, first.at0, first.at1, first.at1};
+    for (const Point& p : points) {
+      for (std::size_t k = 0; k < 3; ++k) {
+        b.lo0[k] = std::min(b.lo0[k], p.at0[k]);
+        b.hi0[k] = std::max(b.hi0[k], p.at0[k]);
+        b.lo1[k] = std::min(b.lo1[k], p.at1[k]);
+        b.hi1[k] = std::max(b.hi1[k], p.at1[k]);
+      }
+    }
+    return b;
+  }
+  [[nodiscard]] static bool meet(const Box& a, const Box& b) {
     bool apart = false;
     for (std::size_t k = 0; k < 3; ++k) {
       apart = apart | ((a.hi0[k] < b.lo0[k]) & (a.hi1[k] < b.lo1[k])) |
@@ -164,6 +229,10 @@ struct EndPositions {
     }
     return !apart;
   }
+  [[nodiscard]] static bool meet(const Point& p, const Box& b) {
+    return meet(Box{p.at0, p.at0, p.at1, p.at1}, b);
+  }
+#endif
   /// Asks for the corners' positions at both ends (24 bytes each: up to two cache lines).
   void prefetch(std::int32_t, const std::array<std::int32_t, 3>& corners) const {
     for (const std::int32_t v : corners) {
