@@ -84,6 +84,8 @@ namespace {
 /// that no per-edge volumes need be held (bounded memory).
 template <int N>
 struct SweptVolumes {
+  /// The triangles' volumes overlap: the traversal tested them.
+  static constexpr bool kTrianglesFirst = false;
   const FeatureBounds<N>& bounds;
 
   [[nodiscard]] const Dop<N>& vertex(std::int32_t v) const { return bounds.vertices[at(v)]; }
@@ -125,6 +127,8 @@ struct SweptVolumes {
 /// are apart at both ends, so this drops every pair the swept AABBs drop, and more; coordinates
 /// are compared as they are, so it is exact.
 struct EndPositions {
+  /// The two triangles' boxes first: the traversal tested their swept boxes only.
+  static constexpr bool kTrianglesFirst = true;
   const double* x0;
   const double* x1;
 
@@ -278,18 +282,18 @@ void owned_feature_pairs(
   std::int64_t tests = 0;
   // VF pairs of the vertices `owner` owns against face `face`: each slot is written, and kept
   // when the pair is not on a corner of the face and the boxes meet.
-  const auto vertices_vs_face = [&](const Owned& owner, const Owned& face, std::int32_t f) {
-    const auto& face_box = boxes.face(f, face.corners);
-    for (std::size_t k = 0; k < owner.num_vertices; ++k) {
-      const std::int32_t v = owner.vertices[k];
-      bool wanted = !is_corner(v, face.corners);
-      if constexpr (kExclusions) wanted = wanted && !topology.vertex_face_excluded(v, f);
-      tests += wanted;
-      vf[num_vf] = {v, f};
-      num_vf += static_cast<std::size_t>(wanted) &
-                static_cast<std::size_t>(Boxes::meet(boxes.vertex(v), face_box));
-    }
-  };
+  const auto vertices_vs_face =
+      [&](const Owned& owner, const Owned& face, std::int32_t f, const auto& face_box) {
+        for (std::size_t k = 0; k < owner.num_vertices; ++k) {
+          const std::int32_t v = owner.vertices[k];
+          bool wanted = !is_corner(v, face.corners);
+          if constexpr (kExclusions) wanted = wanted && !topology.vertex_face_excluded(v, f);
+          tests += wanted;
+          vf[num_vf] = {v, f};
+          num_vf += static_cast<std::size_t>(wanted) &
+                    static_cast<std::size_t>(Boxes::meet(boxes.vertex(v), face_box));
+        }
+      };
   const auto flush = [&] {
     out.vf.insert(out.vf.end(), vf.begin(), vf.begin() + static_cast<std::ptrdiff_t>(num_vf));
     out.ee.insert(out.ee.end(), ee.begin(), ee.begin() + static_cast<std::ptrdiff_t>(num_ee));
@@ -316,18 +320,28 @@ void owned_feature_pairs(
     if constexpr (kExclusions) {
       if (topology.owned_pairs_excluded(p.a, p.b)) continue;
     }
-    ++candidate_pairs;
     const Owned& a = topology.owned_features(p.a);
     const Owned& b = topology.owned_features(p.b);
     if constexpr (kFans) {
       // A corner both share whose fan is certified over the interval: the two triangles never
       // meet beyond what they share, so no feature pair they own can touch (a candidate pair, as
       // a DCD pair a fan settles, with no feature pairs).
-      if (share_certified_corner(a.corners, b.corners, *fans)) continue;
+      if (share_certified_corner(a.corners, b.corners, *fans)) {
+        ++candidate_pairs;
+        continue;
+      }
     }
+    const auto& face_a = boxes.face(p.a, a.corners);
+    const auto& face_b = boxes.face(p.b, b.corners);
+    if constexpr (Boxes::kTrianglesFirst) {
+      // Triangles apart hold features apart: no pair of theirs can meet, and the pair is culled
+      // (not a candidate, as the relative filter's pairs were not).
+      if (!Boxes::meet(face_a, face_b)) continue;
+    }
+    ++candidate_pairs;
     // VF: the vertices each triangle owns against the other triangle's face.
-    vertices_vs_face(a, b, p.b);
-    vertices_vs_face(b, a, p.a);
+    vertices_vs_face(a, b, p.b, face_b);
+    vertices_vs_face(b, a, p.a, face_a);
     // EE: the edges a owns against the edges b owns.
     using EdgeBox = decltype(boxes.edge(a.edge_ends[0]));
     std::array<EdgeBox, 3> edges_b;

@@ -399,6 +399,7 @@ class AutoMethod final : public detail::MethodBase {
     // pays, as `kdop`'s do (docs/culling.md "Relative boxes in `kdop`"): one trial per query.
     relative_.start(RelativePairTrial::trial_pairs(topology_.num_triangles()));
     const auto filter = [&](std::vector<TrianglePair>& pairs, std::size_t first) {
+      if (options_.min_separation == 0.0) return;
       relative_.filter(topology_, x_t0, x_t1, 0.5 * options_.min_separation, pairs, first);
     };
     for (const AabbBvh* h : groups) {
