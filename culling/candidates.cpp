@@ -145,12 +145,6 @@ struct EndPositions {
     const double* p1 = x1 + 3 * at(v);
     return {{_mm_loadu_pd(p0), _mm_load1_pd(p0 + 2)}, {_mm_loadu_pd(p1), _mm_load1_pd(p1 + 2)}};
   }
-  [[nodiscard]] Box face(std::int32_t, const std::array<std::int32_t, 3>& corners) const {
-    return hull({vertex(corners[0]), vertex(corners[1]), vertex(corners[2])});
-  }
-  [[nodiscard]] Box edge(const std::array<std::int32_t, 2>& ends) const {
-    return hull({vertex(ends[0]), vertex(ends[1])});
-  }
   [[nodiscard]] static Box hull(std::initializer_list<Point> points) {
     const Point& first = *points.begin();
     Box b{
@@ -170,23 +164,24 @@ struct EndPositions {
   }
   /// Not apart on any axis (NaN compares false: never apart), without branches.
   [[nodiscard]] static bool meet(const Box& a, const Box& b) {
-    __m128d apart = _mm_setzero_pd();
-    for (std::size_t r = 0; r < 2; ++r) {
-      const __m128d below =
-          _mm_and_pd(_mm_cmplt_pd(a.hi0[r], b.lo0[r]), _mm_cmplt_pd(a.hi1[r], b.lo1[r]));
-      const __m128d above =
-          _mm_and_pd(_mm_cmplt_pd(b.hi0[r], a.lo0[r]), _mm_cmplt_pd(b.hi1[r], a.lo1[r]));
-      apart = _mm_or_pd(apart, _mm_or_pd(below, above));
-    }
-    return _mm_movemask_pd(apart) == 0;
+    return meet_as(a.lo0, a.hi0, a.lo1, a.hi1, b);
   }
   [[nodiscard]] static bool meet(const Point& p, const Box& b) {
+    return meet_as(p.at0, p.at0, p.at1, p.at1, b);
+  }
+  /// meet() of the box with these bounds (a point: lo = hi) and b.
+  [[nodiscard]] static bool meet_as(
+      const __m128d* lo0,
+      const __m128d* hi0,
+      const __m128d* lo1,
+      const __m128d* hi1,
+      const Box& b) {
     __m128d apart = _mm_setzero_pd();
     for (std::size_t r = 0; r < 2; ++r) {
       const __m128d below =
-          _mm_and_pd(_mm_cmplt_pd(p.at0[r], b.lo0[r]), _mm_cmplt_pd(p.at1[r], b.lo1[r]));
+          _mm_and_pd(_mm_cmplt_pd(hi0[r], b.lo0[r]), _mm_cmplt_pd(hi1[r], b.lo1[r]));
       const __m128d above =
-          _mm_and_pd(_mm_cmplt_pd(b.hi0[r], p.at0[r]), _mm_cmplt_pd(b.hi1[r], p.at1[r]));
+          _mm_and_pd(_mm_cmplt_pd(b.hi0[r], lo0[r]), _mm_cmplt_pd(b.hi1[r], lo1[r]));
       apart = _mm_or_pd(apart, _mm_or_pd(below, above));
     }
     return _mm_movemask_pd(apart) == 0;
@@ -205,12 +200,6 @@ struct EndPositions {
       p.at1[k] = x1[3 * at(v) + k];
     }
     return p;
-  }
-  [[nodiscard]] Box face(std::int32_t, const std::array<std::int32_t, 3>& corners) const {
-    return hull({vertex(corners[0]), vertex(corners[1]), vertex(corners[2])});
-  }
-  [[nodiscard]] Box edge(const std::array<std::int32_t, 2>& ends) const {
-    return hull({vertex(ends[0]), vertex(ends[1])});
   }
   [[nodiscard]] static Box hull(std::initializer_list<Point> points) {
     const Point& first = *points.begin();
@@ -237,6 +226,12 @@ struct EndPositions {
     return meet(Box{p.at0, p.at0, p.at1, p.at1}, b);
   }
 #endif
+  [[nodiscard]] Box face(std::int32_t, const std::array<std::int32_t, 3>& corners) const {
+    return hull({vertex(corners[0]), vertex(corners[1]), vertex(corners[2])});
+  }
+  [[nodiscard]] Box edge(const std::array<std::int32_t, 2>& ends) const {
+    return hull({vertex(ends[0]), vertex(ends[1])});
+  }
   /// Asks for the corners' positions at both ends (24 bytes each: up to two cache lines).
   void prefetch(std::int32_t, const std::array<std::int32_t, 3>& corners) const {
     for (const std::int32_t v : corners) {
@@ -369,6 +364,17 @@ void owned_feature_pairs(
   feature_bv_tests += tests;
 }
 
+/// Calls `f` with what the feature stage tests on: the positions at both ends for the AABB
+/// methods without a contact distance (ends given), else the swept volumes.
+template <int N, class F>
+void with_boxes(const FeatureBounds<N>& bounds, const IntervalEnds& ends, F&& f) {
+  if (N == 3 && ends.x_t0 != nullptr) {
+    f(EndPositions{ends.x_t0->data(), ends.x_t1->data()});
+  } else {
+    f(SweptVolumes<N>{bounds});
+  }
+}
+
 }  // namespace
 
 template <int N>
@@ -382,7 +388,7 @@ void ccd_candidates_from_triangle_pairs(
     const IntervalEnds& ends) {
   std::int64_t feature_bv_tests = 0;
   std::int64_t candidate_pairs = 0;
-  const auto with = [&](const auto& boxes) {
+  with_boxes(bounds, ends, [&](const auto& boxes) {
     const auto run = [&]<bool kExclusions, bool kFans>() {
       owned_feature_pairs<kExclusions, kFans>(
           topology, pairs, boxes, fans, out, feature_bv_tests, candidate_pairs);
@@ -394,12 +400,7 @@ void ccd_candidates_from_triangle_pairs(
       fans == nullptr ? run.template operator()<false, false>()
                       : run.template operator()<false, true>();
     }
-  };
-  if (const bool by_ends = N == 3 && ends.x_t0 != nullptr; by_ends) {
-    with(EndPositions{ends.x_t0->data(), ends.x_t1->data()});
-  } else {
-    with(SweptVolumes<N>{bounds});
-  }
+  });
   counters.feature_bv_tests += feature_bv_tests;
   counters.candidate_pairs += candidate_pairs;
 }
@@ -459,12 +460,9 @@ void ccd_candidates_brute_force(
     IntervalFans* fans,
     const IntervalEnds& ends) {
   std::int64_t tests = 0;
-  if (N == 3 && ends.x_t0 != nullptr) {
-    brute_feature_pairs(
-        topology, EndPositions{ends.x_t0->data(), ends.x_t1->data()}, out, tests, fans);
-  } else {
-    brute_feature_pairs(topology, SweptVolumes<N>{bounds}, out, tests, fans);
-  }
+  with_boxes(bounds, ends, [&](const auto& boxes) {
+    brute_feature_pairs(topology, boxes, out, tests, fans);
+  });
   const std::int32_t num_faces = topology.num_triangles();
   counters.feature_bv_tests += tests;
   counters.candidate_pairs += static_cast<std::int64_t>(num_faces) * (num_faces - 1) / 2;
