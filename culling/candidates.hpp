@@ -132,11 +132,13 @@ inline constexpr std::size_t kCcdBlockPairs = std::size_t{1} << 15;
 /// `pairs` (any order within a pair) to `out`. Reads bounds.vertices and bounds.triangles only:
 /// an edge's volume is formed as the union of its endpoints' (bit for bit what derive() stores),
 /// so the caller need not hold #E edge volumes.
-/// Counts counters.candidate_pairs (triangle pairs not wholly part-excluded) and
-/// counters.feature_bv_tests.
+/// Counts counters.candidate_pairs (triangle pairs not wholly part-excluded, less those the ends
+/// test below finds apart) and counters.feature_bv_tests.
 /// `fans`: when not null, the query's fans over its interval: a triangle pair sharing a certified
 /// corner is a candidate with no feature pairs — none of them can come into contact
 /// (docs/culling.md, "Vertex fans over an interval").
+/// `ends` (N = 3; interval_ends): when given, the positions at both ends are read instead of
+/// `bounds`: the two triangles are tested first, then each feature pair (IntervalEnds).
 template <int N>
 void ccd_candidates_from_triangle_pairs(
     const FeatureTopology& topology,
@@ -153,6 +155,7 @@ void ccd_candidates_from_triangle_pairs(
 /// triangle pair is a candidate of brute force).
 /// `fans` as for ccd_candidates_from_triangle_pairs: a feature pair whose owners (vertex_owner,
 /// edge_owner) share a certified corner is skipped, as the hierarchy methods skip their pair.
+/// `ends` as for ccd_candidates_from_triangle_pairs (each feature pair; the same pairs result).
 template <int N>
 void ccd_candidates_brute_force(
     const FeatureTopology& topology,
