@@ -121,14 +121,15 @@ class BvhMethod final : public MethodBase {
         topology_);
     FanSieve* const sieving = sieve.certified.empty() ? nullptr : &sieve;
     start_self_traversal<N>(bvh_, scratch_);
-    if (relative_pairs_) {
-      relative_.start(RelativePairTrial::trial_pairs(topology_.num_triangles()));
-    }
+    // `kdop`'s relative pair filter, with a contact distance: without one the feature stage tests
+    // the two triangles at both ends first, the same test on the positions (candidates.hpp).
+    const bool filter_pairs = relative_pairs_ && options_.min_separation > 0.0;
+    if (filter_pairs) relative_.start(RelativePairTrial::trial_pairs(topology_.num_triangles()));
     blocks_.drain([&](std::vector<TrianglePair>& pairs, std::size_t max_pairs) {
       const std::size_t first = pairs.size();
       const bool done = self_traverse_some<N>(
           bvh_, bounds_.triangles, scratch_, pairs, out.counters.bv_tests, max_pairs, sieving);
-      if (relative_pairs_) {
+      if (filter_pairs) {
         relative_.filter(topology_, x_t0, x_t1, 0.5 * options_.min_separation, pairs, first);
       }
       return done;

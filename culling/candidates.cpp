@@ -364,11 +364,11 @@ void owned_feature_pairs(
   feature_bv_tests += tests;
 }
 
-/// Calls `f` with what the feature stage tests on: the positions at both ends for the AABB
-/// methods without a contact distance (ends given), else the swept volumes.
+/// Calls `f` with what the feature stage tests on: the positions at both ends without a contact
+/// distance (ends given), else the swept volumes.
 template <int N, class F>
 void with_boxes(const FeatureBounds<N>& bounds, const IntervalEnds& ends, F&& f) {
-  if (N == 3 && ends.x_t0 != nullptr) {
+  if (ends.x_t0 != nullptr) {
     f(EndPositions{ends.x_t0->data(), ends.x_t1->data()});
   } else {
     f(SweptVolumes<N>{bounds});

@@ -5,9 +5,10 @@
 // - a VF pair whose vertex is a corner of the face, an EE pair whose edges share an endpoint, and
 //   a triangle with itself are never tested; no pair is excluded by distance;
 // - part exclusions as in FeatureTopology;
-// - a feature pair is tested only when its features' volumes (of the interval) overlap; the AABB
-//   methods without a contact distance test instead that no axis separates the features at both
-//   ends of the interval (IntervalEnds), which drops every pair the swept boxes drop, and more.
+// - with a contact distance, a feature pair is tested only when its features' volumes (of the
+//   interval, grown by half of it) overlap; without one, only when no coordinate axis separates
+//   its two triangles and then its features at both ends of the interval (IntervalEnds), which
+//   drops every pair the swept AABBs drop, and more.
 // CCD de-duplication (docs/culling.md has the proof): candidate triangle pair {A, B} produces
 // (vertex owned by A, face B), (vertex owned by B, face A) and (edge owned by A, edge owned by B).
 // A feature's volume lies inside its owner's, so a feature pair whose volumes overlap always has
@@ -104,11 +105,11 @@ struct IntervalFans {
   }
 };
 
-/// The positions at the two ends of a CCD interval, for the feature stage of the AABB methods
-/// (N = 3) without a contact distance: a feature pair is then dropped when an axis separates its
-/// features strictly at t = 0 and at t = 1, the same way round (they never touch in between), in
-/// place of the swept boxes' test, whose every rejection it makes too. The 16-DOP (N = 8) keeps
-/// its swept test: its diagonals already reject about what the axes' ends would add.
+/// The positions at the two ends of a CCD interval, for the feature stage without a contact
+/// distance: a triangle pair, then each feature pair, is dropped when a coordinate axis separates
+/// the two strictly at t = 0 and at t = 1, the same way round (they never touch in between), in
+/// place of the swept volumes' test (AABB or 16-DOP: the 16-DOP's diagonals reject little that
+/// this does not, and its volumes cost loads; measured in docs/benchmarks.md).
 struct IntervalEnds {
   const skinning::Positions* x_t0 = nullptr;
   const skinning::Positions* x_t1 = nullptr;
@@ -137,7 +138,7 @@ inline constexpr std::size_t kCcdBlockPairs = std::size_t{1} << 15;
 /// `fans`: when not null, the query's fans over its interval: a triangle pair sharing a certified
 /// corner is a candidate with no feature pairs — none of them can come into contact
 /// (docs/culling.md, "Vertex fans over an interval").
-/// `ends` (N = 3; interval_ends): when given, the positions at both ends are read instead of
+/// `ends` (interval_ends): when given, the positions at both ends are read instead of
 /// `bounds`: the two triangles are tested first, then each feature pair (IntervalEnds).
 template <int N>
 void ccd_candidates_from_triangle_pairs(

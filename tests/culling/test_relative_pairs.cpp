@@ -37,10 +37,12 @@ Outcome ccd(CullingMethod& method, const skinning::Positions& x0, const skinning
 using Model = test::WeldedCharacter;
 
 // A body carried along rigidly, far over one interval: the swept boxes of every pair overlap its
-// neighbours' along the whole path, the relative boxes are the body's own. The trial keeps the
-// filter, which removes most pairs; the contacts stay exactly those of the same 16-DOP hierarchy
-// without it and of `bvh` (none: the body is the rest pose, carried), and the counters are the
-// same with blocks of 64 pairs (the trial then spans many installments) as in one piece.
+// neighbours' along the whole path, the relative boxes are the body's own. With a contact
+// distance (the filter's case since the feature stage tests the triangles at both ends without
+// one) the trial keeps the filter, which removes most pairs; the contacts stay exactly those of
+// the same 16-DOP hierarchy without it and of `bvh` (none: the body is the rest pose, carried),
+// and the counters are the same with blocks of 64 pairs (the trial then spans many
+// installments) as in one piece. Without a contact distance the feature stage culls as many.
 TEST(RelativePairs, ABodyCarriedFarKeepsTheFilterAndTheContacts) {
   const Model m("CesiumMan.glb");
   skinning::Positions far = m.rest;
@@ -48,7 +50,7 @@ TEST(RelativePairs, ABodyCarriedFarKeepsTheFilterAndTheContacts) {
   far.col(2).array() -= 1.0;
   std::int64_t one_piece = -1;
   for (const std::size_t block : {std::size_t{1} << 15, std::size_t{64}}) {
-    const MethodOptions options{.block_pairs = block};
+    const MethodOptions options{.min_separation = 1e-3, .block_pairs = block};
     auto kdop = make_method("kdop", *m.loaded.mesh, m.topology, options);
     auto plain = detail::make_bvh_method<8>("kdop", *m.loaded.mesh, m.topology, options, false);
     auto bvh = make_method("bvh", *m.loaded.mesh, m.topology, options);
@@ -60,6 +62,11 @@ TEST(RelativePairs, ABodyCarriedFarKeepsTheFilterAndTheContacts) {
     EXPECT_LT(a.candidate_pairs * 4, b.candidate_pairs) << block << ": most pairs removed";
     if (one_piece < 0) one_piece = a.candidate_pairs;
     EXPECT_EQ(a.candidate_pairs, one_piece) << block;
+    auto at_zero =
+        make_method("kdop", *m.loaded.mesh, m.topology, MethodOptions{.block_pairs = block});
+    const Outcome d = ccd(*at_zero, m.rest, far);
+    EXPECT_EQ(d.contacts, a.contacts) << block;
+    EXPECT_LT(d.candidate_pairs * 4, b.candidate_pairs) << block << ": culled at both ends";
   }
 }
 
@@ -160,10 +167,12 @@ void for_clip_intervals(const Model& m, int parts, Visit&& visit) {
 }
 
 TEST(RelativePairs, RealClipsHaveTheSameContactsWithAndWithoutTheFilter) {
+  // With a contact distance: the filter's case (without one the feature stage culls those pairs).
+  const MethodOptions options{.min_separation = 1e-4};
   for (const std::string file : {"RobotExpressive.glb", "stormtrooper/stormtrooper.dae"}) {
     const Model m(file);
-    auto kdop = make_method("kdop", *m.loaded.mesh, m.topology);
-    auto plain = detail::make_bvh_method<8>("kdop", *m.loaded.mesh, m.topology, {}, false);
+    auto kdop = make_method("kdop", *m.loaded.mesh, m.topology, options);
+    auto plain = detail::make_bvh_method<8>("kdop", *m.loaded.mesh, m.topology, options, false);
     std::int64_t with = 0, without = 0;
     std::size_t contacts = 0;
     for_clip_intervals(
@@ -180,11 +189,6 @@ TEST(RelativePairs, RealClipsHaveTheSameContactsWithAndWithoutTheFilter) {
   }
 }
 
-// `auto` filters the pairs it traverses itself (its `bvh` groups and the pairs between groups:
-// culling/routed_method.cpp) with the same trial. Without a rig its closed components go to `bvh`
-// traversed by `auto`: carried far, the body loses most of its pairs and keeps `bvh`'s contacts
-// (none); over intervals of the stormtrooper's clip, where its shells interpenetrate and touch,
-// the contacts are `bvh`'s exactly.
 // `auto`'s pairs that it traverses itself. Without a contact distance its feature stage tests
 // the two triangles' boxes at both ends before their features (candidates.hpp, IntervalEnds:
 // the relative filter's test, on the positions), so no trial filter runs; with one, the trial
