@@ -612,7 +612,7 @@ std::int64_t RadialViewMethod::traverse(double half_width, culling::FrameResult&
       const std::size_t first = pairs.size();
       const bool done = some(pairs, max_pairs);
       found += static_cast<std::int64_t>(pairs.size() - first);
-      if (options_.relative_aabb && half_width > 0.0) {
+      if (filters_pairs()) {
         stats_.relative_aabb_culled += relative_filter_.filter(topology_, half_width, pairs, first);
       }
       if (ghosts_ && !ghosts_own_real_features_) {
@@ -764,7 +764,7 @@ std::int64_t RadialViewMethod::retest_frontier(
       }
     }
     found += static_cast<std::int64_t>(pairs.size() - first);
-    if (options_.relative_aabb && half_width > 0.0) {
+    if (filters_pairs()) {
       stats_.relative_aabb_culled += relative_filter_.filter(topology_, half_width, pairs, first);
     }
     return next == frontier_.size();
@@ -835,7 +835,7 @@ void RadialViewMethod::ccd(const culling::Interval& interval, culling::FrameResu
     cluster_bounds_[at(a)] = local.node_bounds()[0];
   }
   clusters_.global_bvh().refit(cluster_bounds_);
-  if (options_.relative_aabb && half_width > 0.0) relative_filter_.prepare(topology_, x_t0, x_t1);
+  if (filters_pairs()) relative_filter_.prepare(topology_, x_t0, x_t1);
   const auto t_patches = Clock::now();
   // 1'. The patches' winding numbers: their rays gather triangles through the refit hierarchies.
   classify_patches(x_t0);

@@ -141,6 +141,12 @@ class RadialViewMethod final : public culling::CullingMethod {
       const skinning::Positions& x, skinning::Positions& capped) const;
   /// Drops the findings of ghost features from `out` and renumbers edges to the real mesh's.
   void drop_ghosts(culling::FrameResult& out);
+  /// The relative AABB filter runs on the cluster pairs: when asked for and the shared feature
+  /// stage does not make its test itself (with a contact distance: culling/candidates.hpp).
+  [[nodiscard]] bool filters_pairs() const {
+    return options_.relative_aabb &&
+           !culling::feature_stage_tests_ends(method_options_.min_separation);
+  }
 
   void check_positions(const skinning::Positions& x, const char* call, const char* which) const;
   /// The intersecting pairs at x_t0 (known, carried or from a DCD here), each component's status

@@ -123,7 +123,7 @@ class BvhMethod final : public MethodBase {
     start_self_traversal<N>(bvh_, scratch_);
     // `kdop`'s relative pair filter, with a contact distance: without one the feature stage tests
     // the two triangles at both ends first, the same test on the positions (candidates.hpp).
-    const bool filter_pairs = relative_pairs_ && options_.min_separation > 0.0;
+    const bool filter_pairs = relative_pairs_ && !feature_stage_tests_ends(options_.min_separation);
     if (filter_pairs) relative_.start(RelativePairTrial::trial_pairs(topology_.num_triangles()));
     blocks_.drain([&](std::vector<TrianglePair>& pairs, std::size_t max_pairs) {
       const std::size_t first = pairs.size();

@@ -115,11 +115,18 @@ struct IntervalEnds {
   const skinning::Positions* x_t1 = nullptr;
 };
 
-/// IntervalEnds{&x_t0, &x_t1} without a contact distance, else none (the swept volumes, grown by
-/// half of it, are tested).
+/// True when the feature stage tests at both ends (no contact distance): its first test of a
+/// triangle pair is then the relative pair filters' (RelativeAabbFilter), so a method runs those
+/// only when this is false.
+[[nodiscard]] inline bool feature_stage_tests_ends(double min_separation) {
+  return min_separation == 0.0;
+}
+
+/// IntervalEnds{&x_t0, &x_t1} when feature_stage_tests_ends, else none (the swept volumes, grown
+/// by half the contact distance, are tested).
 [[nodiscard]] inline IntervalEnds interval_ends(
     double min_separation, const skinning::Positions& x_t0, const skinning::Positions& x_t1) {
-  return min_separation == 0.0 ? IntervalEnds{&x_t0, &x_t1} : IntervalEnds{};
+  return feature_stage_tests_ends(min_separation) ? IntervalEnds{&x_t0, &x_t1} : IntervalEnds{};
 }
 
 /// Triangle pairs per CCD block: the hierarchy methods turn their traversal's pairs into feature

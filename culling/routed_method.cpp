@@ -395,12 +395,15 @@ class AutoMethod final : public detail::MethodBase {
     blocks_.start_ccd(
         topology_, *bounds_, x_t0, x_t1, tests_, options_.accuracy, ccd_options_, out);
     const std::span<const Aabb> tri(bounds_->triangles);
-    // The pairs this method traverses go through the relative filter when its trial says it
-    // pays, as `kdop`'s do (docs/culling.md "Relative boxes in `kdop`"): one trial per query.
-    relative_.start(RelativePairTrial::trial_pairs(topology_.num_triangles()));
+    // With a contact distance the pairs this method traverses go through the relative filter when
+    // its trial says it pays, as `kdop`'s do (docs/culling.md "Relative boxes in `kdop`"): one
+    // trial per query. Without one the feature stage makes that test (candidates.hpp).
+    const bool filter_pairs = !feature_stage_tests_ends(options_.min_separation);
+    if (filter_pairs) relative_.start(RelativePairTrial::trial_pairs(topology_.num_triangles()));
     const auto filter = [&](std::vector<TrianglePair>& pairs, std::size_t first) {
-      if (options_.min_separation == 0.0) return;
-      relative_.filter(topology_, x_t0, x_t1, 0.5 * options_.min_separation, pairs, first);
+      if (filter_pairs) {
+        relative_.filter(topology_, x_t0, x_t1, 0.5 * options_.min_separation, pairs, first);
+      }
     };
     for (const AabbBvh* h : groups) {
       if (h == nullptr || h->empty()) continue;
