@@ -192,12 +192,22 @@ class AutoMethod final : public detail::MethodBase {
       rest.row(w) = mesh.rest_positions.row(topology.representative_vertex[sz(w)]);
     }
     const std::string open_name = routing.open_method;
-    const std::string closed_name = closed_method_name(options, routing);
+    // The closed group's method: the routes' (RoutingOptions::all_closed_method when every
+    // component goes with the closed ones), else the one asked for or the best registered.
+    const auto closed_route = std::find_if(routes_.begin(), routes_.end(), [](const auto& r) {
+      return r.closed || r.capped || r.small;
+    });
+    const std::string closed_name =
+        closed_route != routes_.end() ? closed_route->method : closed_method_name(options, routing);
     if (!open_triangles_.empty()) {
       open_method_ = make_group_method(open_name, mesh, topology, options, open_triangles_);
     }
     if (!closed_triangles_.empty()) {
-      if (whole_mesh_method(closed_name)) {
+      if (open_triangles_.empty() && closed_name == "bvh") {
+        // The whole mesh is one `bvh` group: the method itself answers (its DCD sieve and its
+        // CCD's vertex fans), rather than a traversal here that has neither.
+        closed_method_ = make_method(closed_name, mesh, topology, options);
+      } else if (whole_mesh_method(closed_name)) {
         // A whole-mesh method (`dynamic`): the open triangles are excluded — when there are any
         // (the exclusions would otherwise cost it the culling of clusters that span parts).
         closed_method_ = make_method(
@@ -590,6 +600,7 @@ std::vector<ComponentRoute> route_components(
   }
   std::vector<ComponentRoute> routes;
   routes.reserve(components.size());
+  bool all_closed = routing.closed_method.empty() && !routing.all_closed_method.empty();
   for (std::size_t c = 0; c < components.size(); ++c) {
     ComponentRoute r;
     r.component = static_cast<std::int32_t>(c);
@@ -599,9 +610,32 @@ std::vector<ComponentRoute> route_components(
     r.num_triangles = static_cast<std::int32_t>(components[c].faces.size());
     r.small = !r.closed && !r.capped && r.num_triangles < routing.min_open_triangles;
     r.method = r.closed || r.capped || r.small ? closed_name : routing.open_method;
+    // Closed or small whether capped or not: the rule does not depend on the closed method.
+    all_closed = all_closed && (r.closed || r.num_triangles < routing.min_open_triangles);
     routes.push_back(std::move(r));
   }
+  if (all_closed) {
+    check_group_method(routing.all_closed_method, /*open=*/false);
+    const MethodNeeds needs = method_needs(routing.all_closed_method);
+    if (needs.bone_poses || needs.segmentation) {
+      throw InvalidInput(
+          "culling::make_method(auto): all_closed_method '" + routing.all_closed_method +
+          "' needs more than the mesh (bones or a segmentation)");
+    }
+    for (auto& r : routes) r.method = routing.all_closed_method;
+  }
   return routes;
+}
+
+bool routes_whole_mesh_to_all_closed_method(
+    const skinning::Topology& topology,
+    const MethodOptions& options,
+    const RoutingOptions& routing) {
+  if (routing.all_closed_method.empty() || !routing.closed_method.empty()) return false;
+  const auto routes = route_components(topology, options, routing);
+  return !routes.empty() && std::all_of(routes.begin(), routes.end(), [&](const ComponentRoute& r) {
+    return r.closed || r.num_triangles < routing.min_open_triangles;
+  });
 }
 
 std::vector<std::string> auto_group_methods(

@@ -30,6 +30,14 @@ struct RoutingOptions {
   /// Method for closed components: empty picks the best registered closed-part method whose needs
   /// are met, else kClosedFallbackMethod. Otherwise any name above, or any registered method.
   std::string closed_method;
+  /// With `closed_method` empty: a mesh whose every component is closed or has fewer than
+  /// min_open_triangles triangles (none for the open method, none there only because the closed
+  /// method caps its holes) goes whole to this method instead. `bvh` by default: on the real
+  /// characters that are closed throughout, `dynamic` took 0.81-1.48x `bvh`'s time per
+  /// interval, 1.09x in geometric mean, since every method's feature stage drops what radial view
+  /// culls there (docs/benchmarks.md "auto against bvh: the default method"). Empty: the closed
+  /// method, as for any mesh. It must need nothing beyond the mesh (no bones, no segmentation).
+  std::string all_closed_method = std::string(kClosedFallbackMethod);
   /// Open components with fewer triangles go with the closed ones (ComponentRoute::small): the
   /// cone methods have nothing to gain on a small open part, and a group of its own costs `auto`
   /// the group's hierarchies and the traversal between the groups (docs/dual-cone.md, "Routing").
@@ -48,9 +56,19 @@ struct RoutingOptions {
 /// The methods `auto` uses for the open and the closed components under `options`: {open, closed}.
 /// The closed one, unless `routing` names one, is the registered method of RouteKind::closed with
 /// the highest priority whose needs the options meet (`dynamic` with a segmentation and bone
-/// poses), else kClosedFallbackMethod.
+/// poses), else kClosedFallbackMethod. (RoutingOptions::all_closed_method, which may take a mesh
+/// closed throughout instead, needs nothing beyond the mesh.)
 [[nodiscard]] std::vector<std::string> auto_group_methods(
     const MethodOptions& options, const RoutingOptions& routing = {});
+
+/// Whether `auto` sends the whole mesh to RoutingOptions::all_closed_method (every component closed
+/// or under min_open_triangles, `closed_method` not named), so that what only the closed method
+/// needs (a segmentation) need not be made: the answer does not depend on whether those needs are
+/// met.
+[[nodiscard]] bool routes_whole_mesh_to_all_closed_method(
+    const skinning::Topology& topology,
+    const MethodOptions& options = {},
+    const RoutingOptions& routing = {});
 
 /// The plan of make_routed_method: one route per component, in component order. Uses
 /// Topology::components, or finds the edge-connected components itself when that is empty.

@@ -14,6 +14,7 @@
 #include "culling/feature_topology.hpp"
 #include "culling/method.hpp"
 #include "culling/relative_aabb.hpp"
+#include "culling/routed_method.hpp"
 #include "culling/traversal.hpp"
 #include "culling/vertex_bounds.hpp"
 #include "skinning/load.hpp"
@@ -192,8 +193,15 @@ TEST(RelativePairs, RealClipsHaveTheSameContactsWithAndWithoutTheFilter) {
 // `auto`'s pairs that it traverses itself. Without a contact distance its feature stage tests
 // the two triangles' boxes at both ends before their features (candidates.hpp, IntervalEnds:
 // the relative filter's test, on the positions), so no trial filter runs; with one, the trial
-// filter culls them as `kdop`'s does. Either way the contacts are `bvh`'s.
+// filter culls them as `kdop`'s does. Either way the contacts are `bvh`'s. Both characters are
+// closed or small throughout, which `auto` would hand whole to `bvh` (RoutingOptions::
+// all_closed_method): its own traversal is asked for here, every group a cone group traversed
+// without its cones.
 TEST(RelativePairs, AutoCullsThePairsItTraversesAndKeepsTheContacts) {
+  RoutingOptions traverse_here;
+  traverse_here.closed_method = "enhanced-dual-cone";
+  traverse_here.dcd_cone_share = 0;
+  traverse_here.ccd_cone_share = 0;
   {
     const Model m("CesiumMan.glb");
     skinning::Positions far = m.rest;
@@ -201,14 +209,14 @@ TEST(RelativePairs, AutoCullsThePairsItTraversesAndKeepsTheContacts) {
     far.col(2).array() -= 1.0;
     const FeatureTopology ft(*m.loaded.mesh, m.topology);
     const auto swept = static_cast<std::int64_t>(swept_pairs(ft, m.rest, far).size());
-    auto routed = make_method("auto", *m.loaded.mesh, m.topology);
+    auto routed = make_routed_method(*m.loaded.mesh, m.topology, {}, traverse_here);
     auto bvh = make_method("bvh", *m.loaded.mesh, m.topology);
     const Outcome a = ccd(*routed, m.rest, far);
     const Outcome b = ccd(*bvh, m.rest, far);
     EXPECT_EQ(a.contacts, b.contacts);
     EXPECT_LT(a.candidate_pairs * 2, swept) << "most pairs culled at both ends";
     const MethodOptions apart{.min_separation = 1e-3};
-    auto routed_apart = make_method("auto", *m.loaded.mesh, m.topology, apart);
+    auto routed_apart = make_routed_method(*m.loaded.mesh, m.topology, apart, traverse_here);
     auto bvh_apart = make_method("bvh", *m.loaded.mesh, m.topology, apart);
     const Outcome c = ccd(*routed_apart, m.rest, far);
     const Outcome d = ccd(*bvh_apart, m.rest, far);
@@ -216,7 +224,7 @@ TEST(RelativePairs, AutoCullsThePairsItTraversesAndKeepsTheContacts) {
     EXPECT_LT(c.candidate_pairs * 2, d.candidate_pairs) << "most pairs removed by the filter";
   }
   const Model m("stormtrooper/stormtrooper.dae");
-  auto routed = make_method("auto", *m.loaded.mesh, m.topology);
+  auto routed = make_routed_method(*m.loaded.mesh, m.topology, {}, traverse_here);
   auto bvh = make_method("bvh", *m.loaded.mesh, m.topology);
   std::size_t contacts = 0;
   for_clip_intervals(

@@ -3,6 +3,7 @@
 // through a BVH pair traversal — and the answer is exactly `bvh`'s.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <set>
 #include <string>
 #include <tuple>
@@ -207,6 +208,60 @@ TEST(Routing, ClothFunnelRoutesThreeClothPartsAndTheFunnelAndMatchesBvh) {
   auto b = make_method("bvh", s.mesh, s.topo);
   EXPECT_EQ(dcd(*a, s.frames[1]).dcd_pairs, dcd(*b, s.frames[1]).dcd_pairs);
   EXPECT_EQ(keys(ccd(*a, s.frames[0], s.frames[1])), keys(ccd(*b, s.frames[0], s.frames[1])));
+}
+
+TEST(Routing, AMeshClosedThroughoutGoesWholeToBvh) {
+  // CesiumMan: one closed component. With bones announced the closed-part method would be
+  // test-closed; a mesh closed throughout goes whole to RoutingOptions::all_closed_method (`bvh`)
+  // instead, which answers itself: bvh's pairs, and every counter bvh's.
+  const auto model = skinning::load_model(test::asset("characters/CesiumMan.glb"));
+  const auto motion = model.motion({});
+  const skinning::Mesh& mesh = *model.mesh;
+  const auto topo = skinning::build_topology(mesh);
+  MethodOptions options;
+  options.num_bones = 1;
+  EXPECT_TRUE(routes_whole_mesh_to_all_closed_method(topo, options));
+  const int before = fake_built;
+  auto a = make_method("auto", mesh, topo, options);
+  EXPECT_EQ(fake_built, before);
+  ASSERT_FALSE(routes_of(*a).empty());
+  for (const auto& r : routes_of(*a)) EXPECT_EQ(r.method, "bvh");
+  auto b = make_method("bvh", mesh, topo, options);
+  skinning::Positions p0, p1;
+  motion->positions(0, p0);
+  motion->positions(std::min(6, motion->num_samples() - 1), p1);
+  const skinning::Positions x0 = test::welded(topo, p0);
+  const skinning::Positions x1 = test::welded(topo, p1);
+  const FrameResult want = ccd(*b, x0, x1);
+  const FrameResult got = ccd(*a, x0, x1);
+  EXPECT_GT(want.counters.candidate_pairs, 0);
+  EXPECT_EQ(got.contacts, want.contacts);
+  EXPECT_EQ(got.counters.bv_tests, want.counters.bv_tests);
+  EXPECT_EQ(got.counters.candidate_pairs, want.counters.candidate_pairs);
+  EXPECT_EQ(got.counters.vf_tests, want.counters.vf_tests);
+  EXPECT_EQ(got.counters.ee_tests, want.counters.ee_tests);
+  const FrameResult want_dcd = dcd(*b, x1);
+  const FrameResult got_dcd = dcd(*a, x1);
+  EXPECT_EQ(got_dcd.dcd_pairs, want_dcd.dcd_pairs);
+  EXPECT_EQ(got_dcd.counters.tt_tests, want_dcd.counters.tt_tests);
+  // Without the rule the closed-part method takes it, with the same answer.
+  RoutingOptions keep;
+  keep.all_closed_method.clear();
+  EXPECT_FALSE(routes_whole_mesh_to_all_closed_method(topo, options, keep));
+  auto c = make_routed_method(mesh, topo, options, keep);
+  EXPECT_EQ(fake_built, before + 1);
+  for (const auto& r : routes_of(*c)) EXPECT_EQ(r.method, "test-closed");
+  EXPECT_EQ(ccd(*c, x0, x1).contacts, want.contacts);
+  // The rule's method must need nothing beyond the mesh.
+  RoutingOptions needy;
+  needy.all_closed_method = "test-closed";
+  EXPECT_THROW_MESSAGE(
+      (void)make_routed_method(mesh, topo, options, needy),
+      InvalidInput,
+      "needs more than the mesh");
+  // A mesh with a large open part is not closed throughout: the skirt scene keeps its groups.
+  const OpenScene s = test::skirt_body_scene(9, 14, 16, 10, {0.3, 0.5});
+  EXPECT_FALSE(routes_whole_mesh_to_all_closed_method(s.topo, options));
 }
 
 TEST(Routing, RobotExpressiveCharacterRoutesItsOpenAndClosedPartsAndMatchesBvh) {

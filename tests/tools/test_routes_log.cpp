@@ -3,6 +3,7 @@
 
 #include <gtest/gtest.h>
 
+#include <filesystem>
 #include <fstream>
 #include <map>
 #include <set>
@@ -44,20 +45,35 @@ bool closed_by_edges(const skinning::Triangles& F, const std::vector<std::int32_
   return true;
 }
 
-TEST(RoutesLog, AutoWritesWhereEachComponentWent) {
-  const auto model = skelcd::test::asset("characters/RobotExpressive.glb");
-  const auto log = skelcd::test::temp_dir("routes-log") / "auto.h5";
+/// What check_routes saw of one model's /routes.
+struct RoutesSeen {
+  std::int32_t too_small = 0;          ///< open parts with small holes but too few triangles to cap
+  std::set<bool> kinds;                ///< closed and/or open components
+  std::set<std::string> open_methods;  ///< the methods of the open components
+  bool whole = false;                  ///< every component closed or under 256 triangles
+};
+
+/// Runs `check --method auto` on a rig's clip and checks its /routes against the mesh's own edges:
+/// a mesh whose every component is closed or under RoutingOptions::min_open_triangles goes whole
+/// to `bvh` (RoutingOptions::all_closed_method); otherwise closed components go to the
+/// radial-view method, and so do open ones with small holes only, and open ones too small for a
+/// group of their own, the rest to the open method.
+RoutesSeen check_routes(const std::filesystem::path& model, const std::string& name) {
+  RoutesSeen seen;
+  const auto log = skelcd::test::temp_dir("routes-log-" + name) / "auto.h5";
   const auto r = run_skelcd({"check", model.string(), "--method", "auto", "--frames", "0:1", "-o", log.string()});
-  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  if (r.exit_code != 0) return seen;
 
   const auto loaded = skinning::load_model(model);
   const auto topology = skinning::build_topology(*loaded.mesh);
   const auto header = read_log(log).header;
-  ASSERT_EQ(header.routes.size(), topology.components.size());
-  // Open components whose every hole is a small loop (at most 64 edges; none of the robot's loops
-  // passes a vertex twice, which would split it) in a component without non-manifold edges, with
-  // at least kMinTrianglesPerGhost triangles per loop edge, are capped by the radial-view method
-  // and go with the closed ones; the others go to the open method.
+  EXPECT_EQ(header.routes.size(), topology.components.size());
+  if (header.routes.size() != topology.components.size()) return seen;
+  // Open components whose every hole is a small loop (at most 64 edges; a loop that passes a
+  // vertex twice would be split) in a component without non-manifold edges, with at least
+  // kMinTrianglesPerGhost triangles per loop edge, are capped by the radial-view method and go
+  // with the closed ones; the others go to the open method.
   std::vector<std::uint8_t> small_holes(topology.components.size(), 1);
   std::vector<std::size_t> loop_edges(topology.components.size(), 0);
   for (const auto& loop : topology.boundary_loops) {
@@ -74,23 +90,25 @@ TEST(RoutesLog, AutoWritesWhereEachComponentWent) {
       }
     }
   }
-  std::int32_t too_small = 0;
   for (std::size_t c = 0; c < topology.components.size(); ++c) {
     const auto per_edge = static_cast<std::size_t>(clustering::kMinTrianglesPerGhost);
     if (small_holes[c] != 0 && topology.components[c].faces.size() < per_edge * loop_edges[c]) {
       small_holes[c] = 0;
-      ++too_small;
+      ++seen.too_small;
     }
   }
-  EXPECT_GT(too_small, 0);  // the robot's small parts: their caps would cost more than they save
   for (const std::int32_t e : topology.non_manifold_edges) {
     const auto f = topology.edge_faces[static_cast<std::size_t>(
         topology.edge_face_offsets[static_cast<std::size_t>(e)])];
     small_holes[static_cast<std::size_t>(topology.face_component[static_cast<std::size_t>(f)])] = 0;
   }
+  seen.whole = true;
+  for (std::size_t c = 0; c < topology.components.size(); ++c) {
+    const auto& component = topology.components[c];
+    seen.whole = seen.whole && (closed_by_edges(topology.welded_triangles, component.faces) ||
+                                component.faces.size() < 256);  // min_open_triangles
+  }
   std::int64_t triangles = 0;
-  std::set<bool> kinds;
-  std::set<std::string> open_methods;
   for (std::size_t i = 0; i < header.routes.size(); ++i) {
     const auto& route = header.routes[i];
     const auto& component = topology.components[i];
@@ -99,40 +117,56 @@ TEST(RoutesLog, AutoWritesWhereEachComponentWent) {
     EXPECT_EQ(route.part, loaded.mesh->face_part[static_cast<std::size_t>(component.faces.front())]);
     const bool closed = closed_by_edges(topology.welded_triangles, component.faces);
     EXPECT_EQ(route.closed, closed) << "component " << i;
-    // A rig played by its clip: closed components go to the radial-view method, and so do open
-    // ones with small holes only, and open ones too small for a group of their own.
     const bool small = component.faces.size() < 256;  // RoutingOptions::min_open_triangles
-    EXPECT_EQ(
-        route.method, closed || small_holes[i] != 0 || small ? "dynamic" : "enhanced-dual-cone")
-        << "component " << i;
-    if (!closed) open_methods.insert(route.method);
+    const std::string want = seen.whole                               ? "bvh"
+                             : closed || small_holes[i] != 0 || small ? "dynamic"
+                                                                      : "enhanced-dual-cone";
+    EXPECT_EQ(route.method, want) << "component " << i;
+    if (!closed) seen.open_methods.insert(route.method);
     triangles += route.triangles;
-    kinds.insert(closed);
+    seen.kinds.insert(closed);
   }
   EXPECT_EQ(triangles, loaded.mesh->num_triangles());
-  EXPECT_EQ(kinds.size(), 2u) << "the robot has both open and closed components";
-  // Its open parts: two are capped, the others (two with non-manifold edges) are all small.
-  EXPECT_EQ(open_methods, (std::set<std::string>{"dynamic"}));
+  return seen;
+}
+
+TEST(RoutesLog, AutoWritesWhereEachComponentWent) {
+  // RobotExpressive: closed parts and open ones, every open one under 256 triangles — the whole
+  // mesh to `bvh`.
+  const RoutesSeen robot =
+      check_routes(skelcd::test::asset("characters/RobotExpressive.glb"), "robot");
+  EXPECT_TRUE(robot.whole);
+  EXPECT_GT(robot.too_small, 0);  // small parts whose caps would cost more than they save
+  EXPECT_EQ(robot.kinds.size(), 2u) << "the robot has both open and closed components";
+  EXPECT_EQ(robot.open_methods, (std::set<std::string>{"bvh"}));
+  // BCN_Epileptic: open parts only, some of 256 triangles or more, whose holes the radial-view
+  // method caps or not: each part where it fits.
+  const RoutesSeen bcn = check_routes(skelcd::test::assimp_model("X/BCN_Epileptic.X"), "bcn");
+  EXPECT_FALSE(bcn.whole);
+  EXPECT_EQ(bcn.kinds, (std::set<bool>{false}));
+  EXPECT_TRUE(bcn.open_methods.count("dynamic") != 0) << "a part with small holes only";
 }
 
 TEST(RoutesLog, AutoWithEveryComponentInOneGroupIsThatGroupsMethod) {
-  // Testwuson (54 parts, 53 of them small and open) and RobotExpressive: every component goes with
-  // the closed ones, so `auto` is `dynamic` over the whole mesh — the same candidate pairs, tests
-  // and findings at every frame (no group split, no part exclusions added for an empty open group).
+  // Testwuson (54 parts, 53 of them small and open) and RobotExpressive: every component is closed
+  // or under 256 triangles, so `auto` hands the whole mesh to `bvh` (RoutingOptions::
+  // all_closed_method) — the same candidate pairs, tests and findings at every frame (no group
+  // split, no traversal of its own).
   for (const auto& model :
        {skelcd::test::assimp_model("X/Testwuson.X"),
         skelcd::test::asset("characters/RobotExpressive.glb")}) {
     SCOPED_TRACE(model.string());
     const auto dir = skelcd::test::temp_dir("routes-one-group");
     std::vector<LogData> logs;
-    for (const char* method : {"auto", "dynamic"}) {
+    for (const char* method : {"auto", "bvh"}) {
       const auto log = dir / (std::string(method) + ".h5");
       const auto r = run_skelcd(
           {"check", model.string(), "--method", method, "--frames", "0:5", "-o", log.string()});
       ASSERT_EQ(r.exit_code, 0) << r.err;
       logs.push_back(read_log(log));
     }
-    for (const auto& route : logs[0].header.routes) EXPECT_EQ(route.method, "dynamic");
+    ASSERT_FALSE(logs[0].header.routes.empty());
+    for (const auto& route : logs[0].header.routes) EXPECT_EQ(route.method, "bvh");
     ASSERT_EQ(logs[0].frames.size(), logs[1].frames.size());
     std::int64_t candidates = 0;
     for (std::size_t i = 0; i < logs[0].frames.size(); ++i) {

@@ -487,7 +487,9 @@ TEST(BundledScenes, EachParsesPlansRunsAndLogsEveryPlannedRow) {
       EXPECT_TRUE(result.plan.objects[0].cones);
     }
     if (std::string(name) == "cape") {
-      EXPECT_TRUE(result.plan.objects[0].segmentation);  // closed body under auto, a rig
+      // The body is closed throughout: auto sends it whole to bvh, without a segmentation.
+      EXPECT_TRUE(result.plan.objects[0].facts.auto_whole_to_bvh);
+      EXPECT_FALSE(result.plan.objects[0].segmentation);
       EXPECT_FALSE(result.plan.objects[0].cones);
       EXPECT_TRUE(result.plan.objects[1].cones);  // the open cape
       EXPECT_FALSE(result.plan.objects[1].segmentation);

@@ -6,6 +6,7 @@
 #include <memory>
 
 #include "culling/method_registry.hpp"
+#include "culling/routed_method.hpp"
 #include "segmentation/segmentation.hpp"
 #include "skinning/errors.hpp"
 #include "tools/io/segmentation_file.hpp"
@@ -48,6 +49,17 @@ RadialViewSetup setup_radial_view(
     if (method == "dynamic") {
       setup.gamma = args.gamma;
       setup.seed = static_cast<std::int64_t>(args.seed);
+    }
+    return setup;
+  }
+  // Nor when every part is closed or small (under 256 triangles): `auto` then sends the whole mesh
+  // to `bvh` (culling::RoutingOptions::all_closed_method).
+  if (method == "auto" && topology != nullptr &&
+      culling::routes_whole_mesh_to_all_closed_method(*topology)) {
+    setup.segmentation_source = "none (auto: every part closed or small, the whole mesh to bvh)";
+    if (!args.segmentation.empty()) {
+      std::cerr << "skelcd: note: " << args.segmentation
+                << " is not used: auto sends a mesh whose every part is closed or small to bvh\n";
     }
     return setup;
   }

@@ -29,13 +29,14 @@ void decide_stages(ObjectPlan& o) {
   if (self && is_cone_method(o.method)) {
     o.cones = true;
   } else if (self && o.method == "auto") {
-    o.cones = o.facts.open_components > 0;
+    o.cones = o.facts.open_components > 0 && !o.facts.auto_whole_to_bvh;
   }
   // Radial view culls intervals only: a DCD-only object answers with `bvh` and is not segmented.
   if (o.self_ccd && radial) {
     o.segmentation = true;
   } else if (o.self_ccd && o.method == "auto") {
-    o.segmentation = o.facts.closed_components > 0 && o.facts.rig_motion;
+    o.segmentation =
+        o.facts.closed_components > 0 && o.facts.rig_motion && !o.facts.auto_whole_to_bvh;
   }
   if (!o.load) return;
   auto& s = o.skipped;
@@ -49,7 +50,10 @@ void decide_stages(ObjectPlan& o) {
     if (!self) {
       s.push_back("cones: pair checks only (pairs use the hierarchies)");
     } else if (o.method == "auto") {
-      s.push_back("cones: no open part (auto uses cones only for parts with a boundary)");
+      s.push_back(
+          o.facts.open_components > 0
+              ? "cones: every part closed or small (auto sends the whole mesh to bvh)"
+              : "cones: no open part (auto uses cones only for parts with a boundary)");
     } else {
       s.push_back("cones: method " + o.method + " uses none");
     }
@@ -65,6 +69,8 @@ void decide_stages(ObjectPlan& o) {
       s.push_back(
           o.facts.closed_components == 0
               ? "segmentation: no closed part (auto segments only closed parts)"
+          : o.facts.auto_whole_to_bvh
+              ? "segmentation: every part closed or small (auto sends the whole mesh to bvh)"
               : "segmentation: not moved by its own skeleton (closed parts go to bvh)");
     } else {
       s.push_back("segmentation: method " + o.method + " uses none (only rvbc, dynamic)");

@@ -15,6 +15,7 @@
 #include "culling/feature_topology.hpp"
 #include "culling/method_registry.hpp"
 #include "culling/pair_checker.hpp"
+#include "culling/routed_method.hpp"
 #include "skinning/errors.hpp"
 #include "skinning/generators.hpp"
 #include "skinning/rig_motion.hpp"
@@ -293,6 +294,7 @@ ObjectFacts facts_of(const SceneObject& so, const LoadedObject& lo) {
   for (const auto& c : lo.topology.components)
     (c.closed ? f.closed_components : f.open_components)++;
   f.rig_motion = lo.motion->num_bones() > 0;
+  f.auto_whole_to_bvh = culling::routes_whole_mesh_to_all_closed_method(lo.topology);
   return f;
 }
 
