@@ -356,13 +356,8 @@ class AutoMethod final : public detail::MethodBase {
     for (std::size_t g = 0; g < groups.size(); ++g) {
       const AabbBvh* h = groups[g];
       if (h == nullptr || h->empty()) continue;
-      // The slots' corners and windows: built by the first DCD (a CCD-only check never holds
-      // them; #F x 24 bytes).
-      SlotAdjacency& slots = dcd_slots_[g];
-      if (slots.corners.size() != h->triangle_order().size()) {
-        slots = SlotAdjacency(topology_, h->triangle_order());
-      }
-      detail::sieved_self_dcd<3>(*h, tri, topology_, slots, full_slots_, scratch_, blocks_, out);
+      detail::sieved_self_dcd<3>(
+          *h, tri, topology_, slots_of(g, *h), full_slots_, scratch_, blocks_, out);
     }
     if (between)
       traverse_between(out.counters.bv_tests, [](std::vector<TrianglePair>&, std::size_t) {});
@@ -415,16 +410,29 @@ class AutoMethod final : public detail::MethodBase {
         relative_.filter(topology_, x_t0, x_t1, 0.5 * options_.min_separation, pairs, first);
       }
     };
-    for (const AabbBvh* h : groups) {
+    // Pairs that share a vertex whose fan is certified over the interval are settled where the
+    // traversal meets them, as `bvh` does (not with part exclusions, whose CCD rule is per
+    // feature): the fans are certified once per query, each group's slots built on first need.
+    std::span<const std::uint8_t> certified;
+    bool certify = !topology_.has_exclusions();
+    for (std::size_t g = 0; g < groups.size(); ++g) {
+      const AabbBvh* h = groups[g];
       if (h == nullptr || h->empty()) continue;
+      if (certify) {
+        certified = blocks_.certify_interval_fans();
+        certify = false;
+      }
+      FanSieve sieve = fan_sieve(slots_of(g, *h), certified, full_slots_, topology_);
+      FanSieve* const sieving = sieve.certified.empty() ? nullptr : &sieve;
       start_self_traversal<3>(*h, scratch_);
       blocks_.drain([&](std::vector<TrianglePair>& pairs, std::size_t max_pairs) {
         const std::size_t first = pairs.size();
-        const bool done =
-            self_traverse_some<3>(*h, tri, scratch_, pairs, out.counters.bv_tests, max_pairs);
+        const bool done = self_traverse_some<3>(
+            *h, tri, scratch_, pairs, out.counters.bv_tests, max_pairs, sieving);
         filter(pairs, first);
         return done;
       });
+      out.counters.candidate_pairs += sieve.settled;
     }
     if (between) traverse_between(out.counters.bv_tests, filter);
     blocks_.finish();
@@ -559,7 +567,17 @@ class AutoMethod final : public detail::MethodBase {
   detail::ConeMethodBase* closed_cone_ = nullptr;
   /// Per group (open, closed), SlotAdjacency of the hierarchy a DCD traverses here, built by the
   /// first DCD; and the sieve's per-slot buffer.
-  std::array<SlotAdjacency, 2> dcd_slots_;
+  /// The slots' corners and windows of group g's hierarchy (open, closed), for the fan sieves:
+  /// built by the first query that traverses the group here (#F x 24 bytes).
+  SlotAdjacency& slots_of(std::size_t g, const AabbBvh& h) {
+    SlotAdjacency& slots = group_slots_[g];
+    if (slots.corners.size() != h.triangle_order().size()) {
+      slots = SlotAdjacency(topology_, h.triangle_order());
+    }
+    return slots;
+  }
+
+  std::array<SlotAdjacency, 2> group_slots_;
   std::vector<std::uint8_t> full_slots_;
   /// Per group (open, closed): a cone group's DCD, CCD takes its method's cone-culled traversal
   /// (choose_traversals).
