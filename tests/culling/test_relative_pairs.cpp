@@ -195,21 +195,22 @@ TEST(RelativePairs, RealClipsHaveTheSameContactsWithAndWithoutTheFilter) {
 // the relative filter's test, on the positions), so no trial filter runs; with one, the trial
 // filter culls them as `kdop`'s does. Either way the contacts are `bvh`'s. Both characters are
 // closed or small throughout, which `auto` would hand whole to `bvh` (RoutingOptions::
-// all_closed_method): its own traversal is asked for here, every group a cone group traversed
-// without its cones.
+// all_closed_method): its own traversal is asked for here, their small open parts a group of their
+// own (min_open_triangles 1), both groups named `bvh`.
 TEST(RelativePairs, AutoCullsThePairsItTraversesAndKeepsTheContacts) {
   RoutingOptions traverse_here;
-  traverse_here.closed_method = "enhanced-dual-cone";
-  traverse_here.dcd_cone_share = 0;
-  traverse_here.ccd_cone_share = 0;
+  traverse_here.open_method = "bvh";
+  traverse_here.closed_method = "bvh";
+  traverse_here.min_open_triangles = 1;
   {
-    const Model m("CesiumMan.glb");
+    const Model m("RobotExpressive.glb");
     skinning::Positions far = m.rest;
     far.col(0).array() += 3.0;
     far.col(2).array() -= 1.0;
     const FeatureTopology ft(*m.loaded.mesh, m.topology);
     const auto swept = static_cast<std::int64_t>(swept_pairs(ft, m.rest, far).size());
     auto routed = make_routed_method(*m.loaded.mesh, m.topology, {}, traverse_here);
+    EXPECT_EQ(routed_structures(*routed).own_hierarchies, 2);  // traversed here
     auto bvh = make_method("bvh", *m.loaded.mesh, m.topology);
     const Outcome a = ccd(*routed, m.rest, far);
     const Outcome b = ccd(*bvh, m.rest, far);

@@ -136,15 +136,28 @@ TEST(Routing, ConeGroupsTakeTheTraversalsChosenAtRest) {
   RoutingOptions never;
   never.dcd_cone_share = 0;
   never.ccd_cone_share = 0;
-  for (const auto& [s, routing, cones] :
-       {std::tuple{&funnel, RoutingOptions{}, false},
-        std::tuple{&skirt, RoutingOptions{}, true},
-        std::tuple{&skirt, never, false}}) {
+  RoutingOptions ccd_only;
+  ccd_only.dcd_cone_share = 0;
+  // {scene, routing, DCD by the cones, CCD by the cones}. A cone group whose cones pay for
+  // neither query is a `bvh` group (drop_idle_cones): the funnel's sheets (cones cull too little
+  // at rest), the skirt told never to use them — and, the other group being `bvh` too, the whole
+  // mesh goes to the `bvh` method, every counter its own.
+  for (const auto& [s, routing, dcd_cones, ccd_cones] :
+       {std::tuple{&funnel, RoutingOptions{}, false, false},
+        std::tuple{&skirt, RoutingOptions{}, true, true},
+        std::tuple{&skirt, ccd_only, false, true},
+        std::tuple{&skirt, never, false, false}}) {
     auto a = make_routed_method(s->mesh, s->topo, {}, routing);
     auto b = make_method("bvh", s->mesh, s->topo);
+    const bool whole = !dcd_cones && !ccd_cones;
     int cone_groups = 0;
-    for (const auto& r : routes_of(*a)) cone_groups += r.method == "enhanced-dual-cone" ? 1 : 0;
-    EXPECT_EQ(cone_groups, s == &funnel ? 2 : 1);
+    for (const auto& r : routes_of(*a)) {
+      cone_groups += r.method == "enhanced-dual-cone" ? 1 : 0;
+      if (whole) {
+        EXPECT_EQ(r.method, "bvh");
+      }
+    }
+    EXPECT_EQ(cone_groups, whole ? 0 : 1);
     for (const auto& x : s->frames) {
       const FrameResult want = dcd(*b, x);
       EXPECT_FALSE(want.dcd_pairs.empty());
@@ -153,11 +166,14 @@ TEST(Routing, ConeGroupsTakeTheTraversalsChosenAtRest) {
         EXPECT_EQ(got.dcd_pairs, want.dcd_pairs);
         EXPECT_EQ(got.counters.dcd_pairs, want.counters.dcd_pairs);
         EXPECT_EQ(got.counters.bv_tests, first.counters.bv_tests);
-        if (cones) {
+        if (dcd_cones) {
           EXPECT_LT(got.counters.tt_tests, want.counters.tt_tests);
         } else {
           EXPECT_EQ(got.counters.tt_tests, want.counters.tt_tests);
           EXPECT_EQ(got.counters.candidate_pairs, want.counters.candidate_pairs);
+        }
+        if (whole) {
+          EXPECT_EQ(got.counters.bv_tests, want.counters.bv_tests);
         }
       }
     }
@@ -167,17 +183,14 @@ TEST(Routing, ConeGroupsTakeTheTraversalsChosenAtRest) {
     for (const FrameResult& got : {first, ccd(*a, s->frames.front(), s->frames.back())}) {
       EXPECT_EQ(keys(got), keys(want));
       EXPECT_EQ(got.counters.bv_tests, first.counters.bv_tests);
-      const auto tests = [](const FrameResult& r) {
-        return r.counters.vf_tests + r.counters.ee_tests;
-      };
-      if (cones) {
+      if (ccd_cones) {
         EXPECT_LT(got.counters.candidate_pairs, want.counters.candidate_pairs);
       } else {
-        // At most `bvh`'s pairs and tests, and most of them (the counts once differed by the
-        // pairs the relative filter removed: a few hundred on the funnel's step).
-        EXPECT_LE(got.counters.candidate_pairs, want.counters.candidate_pairs);
-        EXPECT_GT(got.counters.candidate_pairs, want.counters.candidate_pairs * 9 / 10);
-        EXPECT_LE(tests(got), tests(want));
+        EXPECT_EQ(got.counters.candidate_pairs, want.counters.candidate_pairs);
+        EXPECT_EQ(got.counters.bv_tests, want.counters.bv_tests);
+        EXPECT_EQ(
+            got.counters.vf_tests + got.counters.ee_tests,
+            want.counters.vf_tests + want.counters.ee_tests);
       }
     }
   }
@@ -201,10 +214,20 @@ TEST(Routing, ClothFunnelRoutesThreeClothPartsAndTheFunnelAndMatchesBvh) {
     // Open parts under RoutingOptions::min_open_triangles go with the closed ones.
     EXPECT_EQ(r.small, !r.closed && r.num_triangles < routing.min_open_triangles);
     small += r.small ? 1 : 0;
-    EXPECT_EQ(r.method, r.closed || r.small ? "bvh" : "enhanced-dual-cone");
+    // The sheets' cones cull too little at rest to pay for either query: the sheets are a `bvh`
+    // group, and with the funnel's `bvh` group the whole mesh goes to `bvh`.
+    EXPECT_EQ(r.method, "bvh");
   }
   EXPECT_EQ(open, 3);
   EXPECT_EQ(small, 1);  // the 200-triangle piece of cloth
+  // Without the cones' choice at rest (shares of 1: any cull pays) the sheets keep their method.
+  RoutingOptions eager;
+  eager.dcd_cone_share = 1;
+  eager.ccd_cone_share = 1;
+  const auto with_cones = make_routed_method(s.mesh, s.topo, {}, eager);
+  for (const auto& r : routes_of(*with_cones)) {
+    EXPECT_EQ(r.method, r.closed || r.small ? "bvh" : "enhanced-dual-cone");
+  }
   auto b = make_method("bvh", s.mesh, s.topo);
   EXPECT_EQ(dcd(*a, s.frames[1]).dcd_pairs, dcd(*b, s.frames[1]).dcd_pairs);
   EXPECT_EQ(keys(ccd(*a, s.frames[0], s.frames[1])), keys(ccd(*b, s.frames[0], s.frames[1])));

@@ -648,8 +648,9 @@ void ClipRunner::run_parallel(const FrameCallback& on_frame) {
 
 std::vector<LogRoute> ClipRunner::routes(std::int32_t part_offset) const {
   std::vector<LogRoute> routes;
-  if (options_.method != "auto") return routes;
-  for (const auto& r : culling::route_components(topology_, method_options_)) {
+  if (options_.method != "auto" || !method_) return routes;
+  // The method's own: `auto` may change a route once built (a cone group whose cones do not pay).
+  for (const auto& r : culling::routes_of(*method_)) {
     routes.push_back(LogRoute{
         .component = r.component,
         .part = r.part + part_offset,
