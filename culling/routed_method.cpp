@@ -310,10 +310,10 @@ class AutoMethod final : public detail::MethodBase {
   /// method its hierarchy, split at the median as the cone tests assume: the group becomes a `bvh`
   /// group instead (surface-area splits; its routes say `bvh`), and the cone method is freed.
   /// When that leaves `bvh` groups only (the other group, if any, `bvh` too), the `bvh` method
-  /// answers for the whole mesh (its DCD sieve; no traversal between the groups) and this returns
-  /// true: nothing is traversed here. On the cloth steps, whose
-  /// sheets' cones cull half of the overlapping pairs at rest, `auto` cost 1.07-1.12x `bvh` per
-  /// interval before (docs/benchmarks.md "auto against bvh: the default method").
+  /// answers for the whole mesh (no traversal between the groups) and this returns true: nothing
+  /// is traversed here. On the cloth steps, whose sheets' cones cull half of the overlapping pairs
+  /// at rest, `auto` cost 1.07-1.12x `bvh` per interval before (docs/dual-cone.md "`auto`:
+  /// routing").
   bool drop_idle_cones(
       const skinning::Mesh& mesh,
       const skinning::Topology& topology,
@@ -599,10 +599,8 @@ class AutoMethod final : public detail::MethodBase {
   /// here for a DCD (dcd).
   detail::ConeMethodBase* open_cone_ = nullptr;
   detail::ConeMethodBase* closed_cone_ = nullptr;
-  /// Per group (open, closed), SlotAdjacency of the hierarchy a DCD traverses here, built by the
-  /// first DCD; and the sieve's per-slot buffer.
-  /// The slots' corners and windows of group g's hierarchy (open, closed), for the fan sieves:
-  /// built by the first query that traverses the group here (#F x 24 bytes).
+  /// The slots' corners and windows of group g's hierarchy (open, closed), for the fan sieves of
+  /// both queries: built by the first query that traverses the group here (#F x 24 bytes).
   SlotAdjacency& slots_of(std::size_t g, const AabbBvh& h) {
     SlotAdjacency& slots = group_slots_[g];
     if (slots.corners.size() != h.triangle_order().size()) {
@@ -612,7 +610,7 @@ class AutoMethod final : public detail::MethodBase {
   }
 
   std::array<SlotAdjacency, 2> group_slots_;
-  std::vector<std::uint8_t> full_slots_;
+  std::vector<std::uint8_t> full_slots_;  ///< the sieves' per-slot buffer
   /// Per group (open, closed): a cone group's DCD, CCD takes its method's cone-culled traversal
   /// (choose_traversals).
   std::array<bool, 2> dcd_by_cones_{};
