@@ -103,6 +103,22 @@ std::vector<skinning::Component> components_of(const skinning::Topology& topolog
   return out;
 }
 
+/// Whether a route goes with the closed group: closed, every hole one the closed method caps
+/// itself (ComponentRoute::capped), or a small open part (ComponentRoute::small).
+bool in_closed_group(const ComponentRoute& r) { return r.closed || r.capped || r.small; }
+
+/// RoutingOptions::all_closed_method's rule: it is set, `closed_method` is not named, and every
+/// component is closed or under min_open_triangles — whether the closed method caps holes or not.
+bool whole_to_all_closed_method(
+    const std::vector<skinning::Component>& components, const RoutingOptions& routing) {
+  return !routing.all_closed_method.empty() && routing.closed_method.empty() &&
+         !components.empty() &&
+         std::all_of(components.begin(), components.end(), [&](const skinning::Component& c) {
+           return c.closed ||
+                  static_cast<std::int32_t>(c.faces.size()) < routing.min_open_triangles;
+         });
+}
+
 /// A copy of `mesh` whose parts are split into (part, open) and (part, closed), with every pair
 /// that involves an open triangle excluded on top of the mesh's own exclusions: what a whole-mesh
 /// method (an extension's `dynamic`) is given so that it tests only closed-closed pairs.
@@ -175,9 +191,7 @@ class AutoMethod final : public detail::MethodBase {
       auto& r = routes_[c];
       if (r.part < 0 && !components[c].faces.empty())
         r.part = topology_.face_part(components[c].faces[0]);
-      // Closed, every hole one the closed method caps itself (ComponentRoute::capped), or a small
-      // open part (ComponentRoute::small).
-      const bool closed = r.closed || r.capped || r.small;
+      const bool closed = in_closed_group(r);
       for (const std::int32_t f : components[c].faces) {
         (closed ? closed_triangles_ : open_triangles_).push_back(f);
         open_face[sz(f)] = closed ? 0 : 1;
@@ -194,20 +208,14 @@ class AutoMethod final : public detail::MethodBase {
     const std::string open_name = routing.open_method;
     // The closed group's method: the routes' (RoutingOptions::all_closed_method when every
     // component goes with the closed ones), else the one asked for or the best registered.
-    const auto closed_route = std::find_if(routes_.begin(), routes_.end(), [](const auto& r) {
-      return r.closed || r.capped || r.small;
-    });
+    const auto closed_route = std::find_if(routes_.begin(), routes_.end(), in_closed_group);
     const std::string closed_name =
         closed_route != routes_.end() ? closed_route->method : closed_method_name(options, routing);
     if (!open_triangles_.empty()) {
       open_method_ = make_group_method(open_name, mesh, topology, options, open_triangles_);
     }
     if (!closed_triangles_.empty()) {
-      if (open_triangles_.empty() && closed_name == "bvh") {
-        // The whole mesh is one `bvh` group: the method itself answers (its DCD sieve and its
-        // CCD's vertex fans), rather than a traversal here that has neither.
-        closed_method_ = make_method(closed_name, mesh, topology, options);
-      } else if (whole_mesh_method(closed_name)) {
+      if (whole_mesh_method(closed_name)) {
         // A whole-mesh method (`dynamic`): the open triangles are excluded — when there are any
         // (the exclusions would otherwise cost it the culling of clusters that span parts).
         closed_method_ = make_method(
@@ -230,7 +238,8 @@ class AutoMethod final : public detail::MethodBase {
     open_cone_ = dynamic_cast<detail::ConeMethodBase*>(open_method_.get());
     closed_cone_ = dynamic_cast<detail::ConeMethodBase*>(closed_method_.get());
     choose_traversals(rest, routing);
-    if (drop_idle_cones(mesh, topology, options)) return;  // the whole mesh to `bvh`
+    drop_idle_cones();
+    if (to_whole_bvh(mesh, topology, options)) return;  // nothing traversed here
     const detail::ConeMethodBase* open_cone = open_cone_;
     const detail::ConeMethodBase* closed_cone = closed_cone_;
     BvhOptions own_bvh = options.bvh;
@@ -308,35 +317,39 @@ class AutoMethod final : public detail::MethodBase {
 
   /// A cone group whose cones pay for neither query (choose_traversals) would only lend this
   /// method its hierarchy, split at the median as the cone tests assume: the group becomes a `bvh`
-  /// group instead (surface-area splits; its routes say `bvh`), and the cone method is freed.
-  /// When that leaves `bvh` groups only (the other group, if any, `bvh` too), the `bvh` method
-  /// answers for the whole mesh (no traversal between the groups) and this returns true: nothing
-  /// is traversed here. On the cloth steps, whose sheets' cones cull half of the overlapping pairs
-  /// at rest, `auto` cost 1.07-1.12x `bvh` per interval before (docs/dual-cone.md "`auto`:
-  /// routing").
-  bool drop_idle_cones(
-      const skinning::Mesh& mesh,
-      const skinning::Topology& topology,
-      const MethodOptions& options) {
-    bool dropped = false;
+  /// group instead (surface-area splits; its routes say `bvh`), and the cone method is freed. On
+  /// the cloth steps, whose sheets' cones cull half of the overlapping pairs at rest, `auto` cost
+  /// 1.07-1.12x `bvh` per interval before (docs/dual-cone.md "`auto`: routing").
+  void drop_idle_cones() {
     for (std::size_t g = 0; g < 2; ++g) {
       detail::ConeMethodBase*& cone = g == 0 ? open_cone_ : closed_cone_;
       if (cone == nullptr || dcd_by_cones_[g] || ccd_by_cones_[g]) continue;
       cone = nullptr;
-      dropped = true;
+      dropped_cones_ = true;
       (g == 0 ? open_method_ : closed_method_).reset();
       for (auto& r : routes_) {
-        const bool closed_group = r.closed || r.capped || r.small;
-        if (closed_group == (g == 1)) r.method = "bvh";
+        if (in_closed_group(r) == (g == 1)) r.method = "bvh";
       }
     }
-    // Every group a `bvh` group now (no method of its own on either side): one `bvh` for the mesh.
-    if (dropped && open_method_ == nullptr && closed_method_ == nullptr) {
-      for (auto& r : routes_) r.method = "bvh";
-      closed_method_ = make_method("bvh", mesh, topology, options);
-      return true;
+  }
+
+  /// When no group has a method of its own (every group `bvh`) and one group holds the mesh, or
+  /// the other became `bvh` by drop_idle_cones, the `bvh` method answers for the whole mesh (its
+  /// DCD sieve and CCD fans, no traversal between groups), on this method's FeatureTopology, and
+  /// this returns true. Two groups named `bvh` by the routing options stay traversed here.
+  bool to_whole_bvh(
+      const skinning::Mesh& mesh,
+      const skinning::Topology& topology,
+      const MethodOptions& options) {
+    const bool one_group = open_triangles_.empty() || closed_triangles_.empty();
+    if (open_method_ != nullptr || closed_method_ != nullptr || !(one_group || dropped_cones_)) {
+      return false;
     }
-    return false;
+    for (auto& r : routes_) r.method = "bvh";
+    MethodOptions shared = options;
+    shared.features = features_;
+    closed_method_ = make_method("bvh", mesh, topology, shared);
+    return true;
   }
 
   /// What this method holds for its own traversal (routed_structures).
@@ -610,6 +623,7 @@ class AutoMethod final : public detail::MethodBase {
   }
 
   std::array<SlotAdjacency, 2> group_slots_;
+  bool dropped_cones_ = false;            ///< drop_idle_cones made a cone group a `bvh` group
   std::vector<std::uint8_t> full_slots_;  ///< the sieves' per-slot buffer
   /// Per group (open, closed): a cone group's DCD, CCD takes its method's cone-culled traversal
   /// (choose_traversals).
@@ -650,7 +664,6 @@ std::vector<ComponentRoute> route_components(
   }
   std::vector<ComponentRoute> routes;
   routes.reserve(components.size());
-  bool all_closed = routing.closed_method.empty() && !routing.all_closed_method.empty();
   for (std::size_t c = 0; c < components.size(); ++c) {
     ComponentRoute r;
     r.component = static_cast<std::int32_t>(c);
@@ -660,11 +673,9 @@ std::vector<ComponentRoute> route_components(
     r.num_triangles = static_cast<std::int32_t>(components[c].faces.size());
     r.small = !r.closed && !r.capped && r.num_triangles < routing.min_open_triangles;
     r.method = r.closed || r.capped || r.small ? closed_name : routing.open_method;
-    // Closed or small whether capped or not: the rule does not depend on the closed method.
-    all_closed = all_closed && (r.closed || r.num_triangles < routing.min_open_triangles);
     routes.push_back(std::move(r));
   }
-  if (all_closed) {
+  if (whole_to_all_closed_method(components, routing)) {
     check_group_method(routing.all_closed_method, /*open=*/false);
     const MethodNeeds needs = method_needs(routing.all_closed_method);
     if (needs.bone_poses || needs.segmentation) {
@@ -678,14 +689,8 @@ std::vector<ComponentRoute> route_components(
 }
 
 bool routes_whole_mesh_to_all_closed_method(
-    const skinning::Topology& topology,
-    const MethodOptions& options,
-    const RoutingOptions& routing) {
-  if (routing.all_closed_method.empty() || !routing.closed_method.empty()) return false;
-  const auto routes = route_components(topology, options, routing);
-  return !routes.empty() && std::all_of(routes.begin(), routes.end(), [&](const ComponentRoute& r) {
-    return r.closed || r.num_triangles < routing.min_open_triangles;
-  });
+    const skinning::Topology& topology, const RoutingOptions& routing) {
+  return whole_to_all_closed_method(components_of(topology), routing);
 }
 
 std::vector<std::string> auto_group_methods(

@@ -63,12 +63,9 @@ struct RoutingOptions {
 
 /// Whether `auto` sends the whole mesh to RoutingOptions::all_closed_method (every component closed
 /// or under min_open_triangles, `closed_method` not named), so that what only the closed method
-/// needs (a segmentation) need not be made: the answer does not depend on whether those needs are
-/// met.
+/// needs (a segmentation) need not be made: the answer depends on the components alone.
 [[nodiscard]] bool routes_whole_mesh_to_all_closed_method(
-    const skinning::Topology& topology,
-    const MethodOptions& options = {},
-    const RoutingOptions& routing = {});
+    const skinning::Topology& topology, const RoutingOptions& routing = {});
 
 /// The plan of make_routed_method: one route per component, in component order. Uses
 /// Topology::components, or finds the edge-connected components itself when that is empty.

@@ -243,12 +243,14 @@ TEST(Routing, AMeshClosedThroughoutGoesWholeToBvh) {
   const auto topo = skinning::build_topology(mesh);
   MethodOptions options;
   options.num_bones = 1;
-  EXPECT_TRUE(routes_whole_mesh_to_all_closed_method(topo, options));
+  EXPECT_TRUE(routes_whole_mesh_to_all_closed_method(topo));
   const int before = fake_built;
   auto a = make_method("auto", mesh, topo, options);
   EXPECT_EQ(fake_built, before);
   ASSERT_FALSE(routes_of(*a).empty());
   for (const auto& r : routes_of(*a)) EXPECT_EQ(r.method, "bvh");
+  // The `bvh` method it hands the mesh to is built on auto's own FeatureTopology.
+  EXPECT_EQ(routed_structures(*a).feature_topologies, 1);
   auto b = make_method("bvh", mesh, topo, options);
   skinning::Positions p0, p1;
   motion->positions(0, p0);
@@ -270,7 +272,7 @@ TEST(Routing, AMeshClosedThroughoutGoesWholeToBvh) {
   // Without the rule the closed-part method takes it, with the same answer.
   RoutingOptions keep;
   keep.all_closed_method.clear();
-  EXPECT_FALSE(routes_whole_mesh_to_all_closed_method(topo, options, keep));
+  EXPECT_FALSE(routes_whole_mesh_to_all_closed_method(topo, keep));
   auto c = make_routed_method(mesh, topo, options, keep);
   EXPECT_EQ(fake_built, before + 1);
   for (const auto& r : routes_of(*c)) EXPECT_EQ(r.method, "test-closed");
@@ -284,7 +286,7 @@ TEST(Routing, AMeshClosedThroughoutGoesWholeToBvh) {
       "needs more than the mesh");
   // A mesh with a large open part is not closed throughout: the skirt scene keeps its groups.
   const OpenScene s = test::skirt_body_scene(9, 14, 16, 10, {0.3, 0.5});
-  EXPECT_FALSE(routes_whole_mesh_to_all_closed_method(s.topo, options));
+  EXPECT_FALSE(routes_whole_mesh_to_all_closed_method(s.topo));
 }
 
 TEST(Routing, RobotExpressiveCharacterRoutesItsOpenAndClosedPartsAndMatchesBvh) {
