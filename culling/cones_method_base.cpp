@@ -63,10 +63,10 @@ ConeMethodBase::ConeMethodBase(
       // The cone theorems say "no intersection", not "no pair within a distance": with a contact
       // distance the method culls nothing and equals `bvh` (docs/dual-cone.md).
       cull_enabled_(options.min_separation == 0.0),
+      needs_contours_(needs_contours),
       blocks_(
           options.block_pairs,
           block_reserve(options.block_pairs, bvh_.leaf_size(), topology_.num_triangles())) {
-  if (needs_contours) contours_ = NodeContours(bvh_, topology_);
   const auto num_faces = static_cast<std::size_t>(topology_.num_triangles());
   bounds_.vertices.reserve(static_cast<std::size_t>(topology_.num_vertices()));
   bounds_.triangles.reserve(num_faces);
@@ -75,9 +75,22 @@ ConeMethodBase::ConeMethodBase(
   pair_stack_.reserve(2 * depth + 8);
 }
 
+void ConeMethodBase::ensure_contours() const {
+  if (!needs_contours_ || contours_built_) return;
+  contours_ = NodeContours(bvh_, topology_);
+  contours_built_ = true;
+}
+
+bool ConeMethodBase::node_culled_without_contours(std::int32_t n, const Interval& interval) {
+  if (!needs_contours_) return node_culled(n, interval);
+  Eigen::Vector3d axis;
+  return contour_tested(bvh_, n) && normal_test(n, axis);
+}
+
 void ConeMethodBase::dcd(const Instant& at, FrameResult& out) {
   const skinning::Positions& x = at.x;
   check_positions(x, "detect_dcd", "x");
+  ensure_contours();
   stats_ = {};
   stats_.culling_disabled = !cull_enabled_;
   const auto t0 = Clock::now();
@@ -124,17 +137,31 @@ ConeMethodBase::Interval ConeMethodBase::refit_instant(const skinning::Positions
 
 std::int64_t ConeMethodBase::count_dcd_pairs(const skinning::Positions& x, std::int64_t cap) {
   check_positions(x, "detect_dcd", "x");
+  ensure_contours();
+  return count_pairs(x, cap, false);
+}
+
+std::int64_t ConeMethodBase::count_dcd_pairs_at_least(
+    const skinning::Positions& x, std::int64_t cap) {
+  check_positions(x, "detect_dcd", "x");
+  return count_pairs(x, cap, true);
+}
+
+std::int64_t ConeMethodBase::count_pairs(
+    const skinning::Positions& x, std::int64_t cap, bool without_contours) {
   stats_ = {};
   stats_.culling_disabled = !cull_enabled_;
   const Interval interval = refit_instant(x);
   blocks_.pairs().clear();
   counting_ = true;
+  without_contours_ = without_contours;
   counted_ = 0;
   count_cap_ = cap;
   std::int64_t bv_tests = 0;
   traverse(interval, bv_tests);
   pair_added();
   counting_ = false;
+  without_contours_ = false;
   return counted_;
 }
 
@@ -143,6 +170,7 @@ void ConeMethodBase::ccd(const culling::Interval& query, FrameResult& out) {
   const skinning::Positions& x_t1 = query.x_t1;
   check_positions(x_t0, "detect_ccd", "x_t0");
   check_positions(x_t1, "detect_ccd", "x_t1");
+  ensure_contours();
   stats_ = {};
   stats_.culling_disabled = !cull_enabled_;
   const auto t0 = Clock::now();
@@ -200,7 +228,8 @@ void ConeMethodBase::traverse(const Interval& interval, std::int64_t& bv_tests) 
     const std::int32_t r = node.right;
     const bool leaf_children = nodes[sz(l)].is_leaf() && nodes[sz(r)].is_leaf();
     // SelfCollide(N): the method's cone test first; a culled node's whole subtree is done.
-    if (cull_enabled_ && node_culled(n, interval)) {
+    if (cull_enabled_ && (without_contours_ ? node_culled_without_contours(n, interval)
+                                            : node_culled(n, interval))) {
       ++stats_.nodes_culled;
       continue;
     }

@@ -29,7 +29,12 @@ class ConeMethodBase : public MethodBase, public ConeStatistics {
 
   [[nodiscard]] const ConeCullingStats& cone_stats() const override { return stats_; }
   [[nodiscard]] const ConeStatistics* cone_statistics() const override { return this; }
-  [[nodiscard]] const NodeContours& contours() const override { return contours_; }
+  /// Built on the first query (or here): `auto` may free a cone method before it asks one
+  /// (count_dcd_pairs_at_least), and the contours are most of its set-up on cloth.
+  [[nodiscard]] const NodeContours& contours() const override {
+    ensure_contours();
+    return contours_;
+  }
 
   /// The hierarchy over this method's triangles, refit by each query, and the volumes of every
   /// vertex and triangle of the mesh at the last query (no edges:
@@ -51,6 +56,12 @@ class ConeMethodBase : public MethodBase, public ConeStatistics {
   /// or a leaf's pairs more). For `auto`'s choice, which only needs to know whether the count
   /// stays under a bound. Allocation-free.
   [[nodiscard]] std::int64_t count_dcd_pairs(const skinning::Positions& x, std::int64_t cap);
+  /// A lower bound of count_dcd_pairs(x, cap), found without the contours: the same traversal
+  /// with node_culled_without_contours, which culls every node node_culled culls (and maybe
+  /// more), so it visits a subset of the nodes and produces a subset of the pairs. When it reaches
+  /// `cap`, so does count_dcd_pairs, and the contours need not be built to know it.
+  [[nodiscard]] std::int64_t count_dcd_pairs_at_least(
+      const skinning::Positions& x, std::int64_t cap);
 
  protected:
   /// Where a self-test descends when its node is not culled.
@@ -90,10 +101,18 @@ class ConeMethodBase : public MethodBase, public ConeStatistics {
   /// The method's test of internal node `node`: true when its surface is proven free of
   /// self-collision over the instant / interval. Counts its failures in stats_.
   [[nodiscard]] virtual bool node_culled(std::int32_t node, const Interval& interval) = 0;
+  /// True for every node that node_culled culls, without reading the contours (for
+  /// count_dcd_pairs_at_least). With contours (`normal-cone`, `enhanced-dual-cone`: their test
+  /// needs a node with a contour, condition 1 and then the contour's): a node with a contour
+  /// whose normal test passes. Without: node_culled itself.
+  [[nodiscard]] virtual bool node_culled_without_contours(
+      std::int32_t node, const Interval& interval);
+  /// Builds the contours when the method needs them and has not built them yet.
+  void ensure_contours() const;
 
   AabbBvh bvh_;
   NormalConeTree cones_;
-  NodeContours contours_;
+  mutable NodeContours contours_;  ///< read after ensure_contours()
   ContourTester contour_tester_;
   ConeCullingStats stats_;
 
@@ -101,6 +120,9 @@ class ConeMethodBase : public MethodBase, public ConeStatistics {
   /// Refits everything a cone-culled DCD at x reads (static volumes, the hierarchy with its binary
   /// node volumes, the cones); returns the instant as the node tests see it.
   Interval refit_instant(const skinning::Positions& x);
+  /// count_dcd_pairs and count_dcd_pairs_at_least (x checked): the DCD traversal at x, its pairs
+  /// counted up to `cap`, culled by node_culled or by node_culled_without_contours.
+  std::int64_t count_pairs(const skinning::Positions& x, std::int64_t cap, bool without_contours);
   void traverse(const Interval& interval, std::int64_t& bv_tests);
   /// Collide(a, b) of Algorithm 3: every triangle pair (one under a, one under b) whose volumes
   /// overlap, as (min, max); the node with more triangles is split first.
@@ -123,6 +145,9 @@ class ConeMethodBase : public MethodBase, public ConeStatistics {
 
   Descent descent_;
   bool cull_enabled_;
+  bool needs_contours_;
+  mutable bool contours_built_ = false;
+  bool without_contours_ = false;  ///< count_dcd_pairs_at_least is counting
   FeatureBounds<3> bounds_;
   std::vector<std::int32_t> self_stack_;
   std::vector<std::pair<std::int32_t, std::int32_t>> pair_stack_;

@@ -72,6 +72,12 @@ int sub_surfaces(const AabbBvh& bvh, std::int32_t node, std::array<std::int32_t,
   return count;
 }
 
+bool contour_tested(const AabbBvh& bvh, std::int32_t node) {
+  const auto nodes = bvh.nodes();
+  const BvhNode& n = nodes[sz(node)];
+  return !n.is_leaf() && !(nodes[sz(node + 1)].is_leaf() && nodes[sz(n.right)].is_leaf());
+}
+
 NodeContours::NodeContours(const AabbBvh& bvh, const FeatureTopology& topology) {
   const auto nodes = bvh.nodes();
   const auto order = bvh.triangle_order();
@@ -108,7 +114,7 @@ NodeContours::NodeContours(const AabbBvh& bvh, const FeatureTopology& topology) 
     std::array<std::int32_t, 4> parts{};
     const int num_parts = sub_surfaces(bvh, static_cast<std::int32_t>(i), parts);
     const BvhNode& node = nodes[i];
-    if (num_parts == 0 || (nodes[i + 1].is_leaf() && nodes[sz(node.right)].is_leaf())) {
+    if (num_parts == 0 || !contour_tested(bvh, static_cast<std::int32_t>(i))) {
       ++status_counts_[static_cast<std::size_t>(ContourStatus::not_tested)];
       continue;
     }

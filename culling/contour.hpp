@@ -67,6 +67,10 @@ struct ContourFan {
 /// or the child itself when it is a leaf. Returns how many (0 for a leaf, 2..4 otherwise).
 int sub_surfaces(const AabbBvh& bvh, std::int32_t node, std::array<std::int32_t, 4>& out);
 
+/// Whether NodeContours gives `node` a contour of its own (any status but not_tested): an internal
+/// node with at least one internal child. Known from the hierarchy alone, before the contours.
+[[nodiscard]] bool contour_tested(const AabbBvh& bvh, std::int32_t node);
+
 /// The contours of every node of one hierarchy, built once per mesh.
 class NodeContours {
  public:

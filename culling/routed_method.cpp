@@ -309,7 +309,12 @@ class AutoMethod final : public detail::MethodBase {
       };
       const std::int64_t dcd_cap = cap_of(routing.dcd_cone_share);
       const std::int64_t ccd_cap = cap_of(routing.ccd_cone_share);
-      const std::int64_t cones = cone->count_dcd_pairs(rest, std::max(dcd_cap, ccd_cap));
+      const std::int64_t cap = std::max(dcd_cap, ccd_cap);
+      // A lower bound first, without the contours: when even it reaches the larger cap, the cones
+      // pay for neither query (drop_idle_cones frees the method before it builds its contours:
+      // about 100 ms of `auto`'s set-up on the cloth-ball step). Else the count proper.
+      const std::int64_t cones =
+          cone->count_dcd_pairs_at_least(rest, cap) >= cap ? cap : cone->count_dcd_pairs(rest, cap);
       dcd_by_cones_[g] = cones < dcd_cap;
       ccd_by_cones_[g] = cones < ccd_cap;
     }

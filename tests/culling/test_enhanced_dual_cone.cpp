@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <array>
+#include <limits>
 #include <set>
 #include <sstream>
 #include <string>
@@ -15,6 +16,7 @@
 #include "ccd/vertex_face.hpp"
 #include "culling/candidates.hpp"
 #include "culling/cones_method.hpp"
+#include "culling/cones_method_base.hpp"
 #include "culling/enhanced_dual_cone.hpp"
 #include "culling/method.hpp"
 #include "skinning/errors.hpp"
@@ -319,6 +321,63 @@ TEST(DualCone, MissesCollisionsInsideThePipeAndTheWrappedSheetWhereEnhancedDoesN
     const auto d = keys(dual_ccd);
     const auto b = keys(bvh_ccd);
     EXPECT_TRUE(std::includes(b.begin(), b.end(), d.begin(), d.end()));
+  }
+}
+
+// `auto` asks a cone group's count without the contours first (count_dcd_pairs_at_least) and
+// frees the method when even that reaches its cap: the bound must never exceed the count, or a
+// group whose cones pay would be dropped. It visits a subset of the nodes (every node the contour
+// test culls, the normal test alone culls too), so its pairs are a subset.
+TEST(ConeMethods, CountWithoutContoursIsALowerBoundOfTheCount) {
+  std::vector<OpenScene> scenes = small_open_scenes();
+  scenes.push_back(test::cloth_funnel_scene(test::asset("cloth-funnel/frames")));
+  constexpr std::int64_t kAll = std::numeric_limits<std::int64_t>::max();
+  std::int64_t strictly_lower = 0;
+  for (const OpenScene& s : scenes) {
+    for (const auto& name : kExactMethods) {
+      MethodOptions apart;
+      apart.min_separation = 1e-3;  // no culling at all: the two counts agree
+      for (const MethodOptions& options : {MethodOptions{}, apart}) {
+        auto m = make_method(name, s.mesh, s.topo, options);
+        auto* cones = dynamic_cast<detail::ConeMethodBase*>(m.get());
+        ASSERT_NE(cones, nullptr) << name;
+        for (const auto& x : s.frames) {
+          const std::int64_t lower = cones->count_dcd_pairs_at_least(x, kAll);
+          const std::int64_t count = cones->count_dcd_pairs(x, kAll);
+          EXPECT_LE(lower, count) << name;
+          if (options.min_separation > 0.0) {
+            EXPECT_GT(count, 0) << name;
+            EXPECT_EQ(lower, count) << name;
+          }
+          strictly_lower += lower < count ? 1 : 0;
+          // With a cap, both stop there or below it as they would without.
+          const std::int64_t cap = count / 2 + 1;
+          EXPECT_EQ(cones->count_dcd_pairs(x, cap) >= cap, count >= cap) << name;
+          EXPECT_LE(std::min(cones->count_dcd_pairs_at_least(x, cap), cap), std::min(count, cap));
+        }
+      }
+    }
+  }
+  // The contour tests cull less than the normal tests alone somewhere (the crossing layers).
+  EXPECT_GT(strictly_lower, 0);
+}
+
+TEST(ConeMethods, ContoursAreThereBeforeTheFirstQuery) {
+  // Built on first need (a query, the count, or this accessor): never an empty set of contours.
+  const auto s = test::wrap_sheet_scene(8, 90, {0.30, 0.36});
+  for (const auto& name : kExactMethods) {
+    auto m = make_method(name, s.mesh, s.topo);
+    const auto* cones = dynamic_cast<const detail::ConeMethodBase*>(m.get());
+    ASSERT_NE(cones, nullptr) << name;
+    std::int64_t nodes = 0;
+    for (const std::int64_t n : m->cone_statistics()->contours().status_counts()) nodes += n;
+    EXPECT_EQ(nodes, static_cast<std::int64_t>(cones->hierarchy().nodes().size())) << name;
+    EXPECT_GT(
+        m->cone_statistics()
+            ->contours()
+            .status_counts()[static_cast<std::size_t>(ContourStatus::loops)],
+        0)
+        << name;
   }
 }
 
