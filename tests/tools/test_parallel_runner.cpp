@@ -367,6 +367,33 @@ TEST(ParallelRunner, AnErrorComesAfterExactlyTheRowsASerialRunReports) {
   }
 }
 
+TEST(ParallelRunner, AMethodThatCannotBeBuiltStopsTheRunnerWithItsError) {
+  // The workers' methods are built together by oneTBB's threads: a failure on any of them, or on
+  // every one, reaches the caller as that error (none is lost, nothing outlives the constructor;
+  // builds not yet started when one fails are cancelled).
+  const auto l = load("gen:rope?triangles=200&frames=2");
+  ShiftMotion motion(*l.motion, 20);
+  for (const int failing_call : {0, 1, 2, 3, -1}) {  // -1: every call
+    std::atomic<int> calls{0};
+    RunOptions options;
+    options.threads = 4;
+    options.block_samples = 3;
+    options.factory_methods_stateless = true;
+    const auto factory =
+        [&](const skinning::Mesh&,
+            const skinning::Topology&,
+            const culling::MethodOptions&) -> std::unique_ptr<culling::CullingMethod> {
+      const int call = calls++;
+      if (failing_call < 0 || call == failing_call) {
+        throw InvalidInput("probe method " + std::to_string(call) + " refused");
+      }
+      return std::make_unique<ProbeMethod>([](int) {});
+    };
+    EXPECT_THROW_MESSAGE(ClipRunner(motion, options, factory), InvalidInput, "refused");
+    EXPECT_LE(calls.load(), 4) << failing_call;  // one build per worker at most
+  }
+}
+
 TEST(ParallelRunner, ThreadsResolveAndStatefulRunsStaySerial) {
   EXPECT_EQ(resolve_threads(0), std::max(1, tbb::info::default_concurrency()));
   EXPECT_EQ(resolve_threads(3), 3);
