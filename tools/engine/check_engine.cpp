@@ -131,12 +131,18 @@ CheckOutcome check_model(
   skinning::Topology topology = skinning::build_topology(motion->mesh());
   outcome.setup.topology = ms_since(phase);
   BaselineFindings baseline;
+  // A parallel run's baseline thread builds the mesh's FeatureTopology first, for its `bvh`; the
+  // runner takes it when the baseline is done by the time the runner is built.
+  std::shared_ptr<const culling::FeatureTopology> baseline_features;
   std::future<void> baseline_task;  // after what it reads: waited for before they go
   if (parallel) {
     baseline_task = std::async(
-        std::launch::async, [&baseline, &request, &motion, &topology, &outcome, &ms_since] {
+        std::launch::async,
+        [&baseline, &baseline_features, &request, &motion, &topology, &outcome, &ms_since] {
           const auto began = std::chrono::steady_clock::now();
-          baseline = baseline_findings(request.baseline, *motion, topology);
+          baseline_features =
+              std::make_shared<const culling::FeatureTopology>(motion->mesh(), topology);
+          baseline = baseline_findings(request.baseline, *motion, topology, baseline_features);
           outcome.setup.baseline = ms_since(began);
         });
   }
@@ -156,13 +162,21 @@ CheckOutcome check_model(
     outcome.setup.baseline = ms_since(phase);
   }
   phase = std::chrono::steady_clock::now();
+  // A parallel run's baseline done already (the segmentation took longer): its refusal now, as
+  // in a serial run, and its feature topology and the weld go to the runner as a serial run's
+  // do. Otherwise the runner builds its own, on a copy of the weld, while the baseline's thread
+  // still reads this one. Either way the same rows.
+  if (baseline_task.valid() &&
+      baseline_task.wait_for(std::chrono::seconds(0)) == std::future_status::ready) {
+    baseline_task.get();
+    features = std::move(baseline_features);
+  }
   ClipRunner runner = [&] {
     try {
-      // (A parallel run's runner gets a copy: the baseline's thread may still read this one.)
       return ClipRunner(
           *motion,
           options,
-          parallel ? skinning::Topology(topology) : std::move(topology),
+          baseline_task.valid() ? skinning::Topology(topology) : std::move(topology),
           {},
           std::move(features));
     } catch (...) {
@@ -172,6 +186,7 @@ CheckOutcome check_model(
   }();
   outcome.setup.methods = ms_since(phase);
   if (baseline_task.valid()) baseline_task.get();
+  baseline_features.reset();  // when the runner built its own: freed, as the baseline's `bvh` is
   outcome.plan = runner.plan();
   outcome.clip = motion->name();
   outcome.fps = motion->rate_hz();
