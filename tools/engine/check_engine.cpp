@@ -131,8 +131,8 @@ CheckOutcome check_model(
   skinning::Topology topology = skinning::build_topology(motion->mesh());
   outcome.setup.topology = ms_since(phase);
   BaselineFindings baseline;
-  // A parallel run's baseline thread builds the mesh's FeatureTopology first, for its `bvh`; the
-  // runner takes it when the baseline is done by the time the runner is built.
+  // A parallel run's baseline thread builds the mesh's FeatureTopology first, for its `bvh` (when
+  // it has a DCD); the runner takes it when the baseline is done by the time the runner is built.
   std::shared_ptr<const culling::FeatureTopology> baseline_features;
   std::future<void> baseline_task;  // after what it reads: waited for before they go
   if (parallel) {
@@ -140,8 +140,12 @@ CheckOutcome check_model(
         std::launch::async,
         [&baseline, &baseline_features, &request, &motion, &topology, &outcome, &ms_since] {
           const auto began = std::chrono::steady_clock::now();
-          baseline_features =
-              std::make_shared<const culling::FeatureTopology>(motion->mesh(), topology);
+          // Only a baseline with a DCD of its own builds one (not `none`, nor a log's findings).
+          const auto kind = request.baseline.kind;
+          if (kind == BaselineSpec::Kind::rest || kind == BaselineSpec::Kind::sample) {
+            baseline_features =
+                std::make_shared<const culling::FeatureTopology>(motion->mesh(), topology);
+          }
           baseline = baseline_findings(request.baseline, *motion, topology, baseline_features);
           outcome.setup.baseline = ms_since(began);
         });
