@@ -429,6 +429,7 @@ template <int N>
 void Bvh<N>::refit(std::span<const Volume> triangle_bounds) {
   constexpr auto kN = static_cast<std::size_t>(N);
   end_boxes_ready_ = false;  // they were of another interval
+  slot_ends_ready_ = false;
   if (!node_volumes_) {
     refit_wide_only(triangle_bounds);
     return;
@@ -689,6 +690,28 @@ void Bvh<N>::refit_end_boxes(
     }
   }
   end_boxes_ready_ = true;
+}
+
+template <int N>
+void Bvh<N>::refit_slot_ends(
+    const skinning::Triangles& triangles, std::span<const NodeEndBoxes> vertex_ends) {
+  const std::size_t stride = slot_stride();
+  // The padding slots are never read for a pair (their lanes are masked off): zeros.
+  if (slot_ends_.size() != 12 * stride) slot_ends_.assign(12 * stride, 0.0f);
+  float* const rows = slot_ends_.data();
+  for (std::size_t s = 0; s < order_.size(); ++s) {
+    const auto f = static_cast<Eigen::Index>(order_[s]);
+    NodeEndBoxes box = vertex_ends[static_cast<std::size_t>(triangles(f, 0))];
+    merge_ends(box, vertex_ends[static_cast<std::size_t>(triangles(f, 1))]);
+    merge_ends(box, vertex_ends[static_cast<std::size_t>(triangles(f, 2))]);
+    for (std::size_t k = 0; k < 3; ++k) {
+      rows[k * stride + s] = box.lo0[k];
+      rows[(3 + k) * stride + s] = box.hi0[k];
+      rows[(6 + k) * stride + s] = box.lo1[k];
+      rows[(9 + k) * stride + s] = box.hi1[k];
+    }
+  }
+  slot_ends_ready_ = true;
 }
 
 template class Bvh<3>;

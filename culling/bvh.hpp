@@ -166,6 +166,7 @@ class Bvh {
   /// copy). Allocation-free.
   void refit_wide(std::span<const Volume> triangle_bounds) {
     end_boxes_ready_ = false;
+    slot_ends_ready_ = false;
     refit_wide_only(triangle_bounds);
   }
 
@@ -218,6 +219,19 @@ class Bvh {
   /// ones too), so the binary nodes get none.
   void refit_end_boxes(
       const skinning::Triangles& triangles, std::span<const NodeEndBoxes> vertex_ends);
+  /// The triangles' own end boxes by slot, from their corners' (vertex_end_boxes): 12 rows of
+  /// slot_stride() floats — lo at t = 0 on x, y, z, then hi at t = 0, lo at t = 1, hi at t = 1 —
+  /// so that the traversals drop a triangle pair whose boxes lie apart on an axis at both ends
+  /// before it is emitted, four slots at a time (docs/culling.md, "Apart at both ends in the
+  /// leaves"). Valid until the next refit(), as end_boxes(). Allocates once (#triangles × 48
+  /// bytes).
+  void refit_slot_ends(
+      const skinning::Triangles& triangles, std::span<const NodeEndBoxes> vertex_ends);
+  /// Row r of the slot end boxes (refit_slot_ends), or null unless it ran after the last refit().
+  [[nodiscard]] const float* slot_ends(int r) const {
+    return slot_ends_ready_ ? slot_ends_.data() + static_cast<std::size_t>(r) * slot_stride()
+                            : nullptr;
+  }
   /// The wide nodes' end boxes (WideEndBoxes), by wide node; empty unless refit_end_boxes ran
   /// after the last refit().
   [[nodiscard]] std::span<const WideEndBoxes> end_boxes() const {
@@ -249,6 +263,8 @@ class Bvh {
   std::vector<WideBvhNode<N>> wide_;
   std::vector<WideEndBoxes> end_boxes_;
   bool end_boxes_ready_ = false;
+  std::vector<float> slot_ends_;  // 12 rows of slot_stride(): refit_slot_ends
+  bool slot_ends_ready_ = false;
   static constexpr std::size_t kSlotPadding = 3;
   std::vector<float> slot_bounds_;  // 2·kSlotAxes rows of slot_stride(): lo by axis, then hi
   struct Item {

@@ -100,10 +100,27 @@ class BvhMethod final : public MethodBase {
     bvh_.refit(bounds_.triangles);
     // `kdop`: node pairs tested in the relative motion too when the interval moves enough for it
     // to prune (docs/culling.md "Relative boxes at the nodes").
-    if (relative_pairs_ && motion_scale(topology_, x_t0, x_t1) >= kNodeRelativeMotion) {
+    const bool node_ends =
+        relative_pairs_ && motion_scale(topology_, x_t0, x_t1) >= kNodeRelativeMotion;
+    if (node_ends) {
       vertex_end_boxes(x_t0, x_t1, 0.5 * options_.min_separation, vertex_ends_);
       bvh_.refit_end_boxes(topology_.welded_triangles(), vertex_ends_);
     }
+    // Without a contact distance the feature stage first drops the triangle pairs apart at both
+    // ends (candidates.hpp): the leaves drop them instead, four at a time, before they are
+    // emitted (docs/culling.md, "Apart at both ends in the leaves"). The slots' end boxes cost
+    // about as much per triangle as two such pairs cost the feature stage: they are built when
+    // the last interval saw that many, or once this one has (between two installments of the
+    // traversal). Only the time depends on it: the rows are the same either way.
+    const bool ends_tested = feature_stage_tests_ends(options_.min_separation);
+    const std::int64_t pays = kSlotEndsPayPerTriangle * topology_.num_triangles();
+    bool slot_ends = false;
+    const auto build_slot_ends = [&] {
+      if (!node_ends) vertex_end_boxes(x_t0, x_t1, 0.0, vertex_ends_);
+      bvh_.refit_slot_ends(topology_.welded_triangles(), vertex_ends_);
+      slot_ends = true;
+    };
+    if (ends_tested && slot_ends_pay_) build_slot_ends();
     const auto t1 = Clock::now();
     // Self traversal → triangle pairs → de-duplicated feature pairs → tests, in blocks of
     // block_pairs triangle pairs: the candidates held at once stay bounded on any motion (the
@@ -121,20 +138,34 @@ class BvhMethod final : public MethodBase {
         topology_);
     FanSieve* const sieving = sieve.certified.empty() ? nullptr : &sieve;
     start_self_traversal<N>(bvh_, scratch_);
+    scratch_.apart_at_both_ends = 0;
+    const std::int64_t candidates_before = out.counters.candidate_pairs;
+    std::int64_t emitted = 0;
     // `kdop`'s relative pair filter, with a contact distance: without one the feature stage tests
     // the two triangles at both ends first, the same test on the positions (candidates.hpp).
     const bool filter_pairs = relative_pairs_ && !feature_stage_tests_ends(options_.min_separation);
     if (filter_pairs) relative_.start(RelativePairTrial::trial_pairs(topology_.num_triangles()));
     blocks_.drain([&](std::vector<TrianglePair>& pairs, std::size_t max_pairs) {
+      // The pairs so far that the feature stage found apart at both ends.
+      if (ends_tested && !slot_ends &&
+          emitted - (out.counters.candidate_pairs - candidates_before) >= pays) {
+        build_slot_ends();
+      }
       const std::size_t first = pairs.size();
       const bool done = self_traverse_some<N>(
           bvh_, bounds_.triangles, scratch_, pairs, out.counters.bv_tests, max_pairs, sieving);
+      emitted += static_cast<std::int64_t>(pairs.size() - first);
       if (filter_pairs) {
         relative_.filter(topology_, x_t0, x_t1, 0.5 * options_.min_separation, pairs, first);
       }
       return done;
     });
     blocks_.finish();
+    // The pairs apart at both ends this interval, dropped in the leaves or by the feature stage
+    // (what it did not keep): the next interval builds the slot end boxes from the start when
+    // they would have paid here.
+    const std::int64_t kept = out.counters.candidate_pairs - candidates_before;
+    slot_ends_pay_ = scratch_.apart_at_both_ends + emitted - kept >= pays;
     out.counters.candidate_pairs += sieve.settled;
     const auto t2 = Clock::now();
     out.times.refit_us += micros(t0, t1);
@@ -149,6 +180,10 @@ class BvhMethod final : public MethodBase {
   SlotAdjacency slots_{topology_, bvh_.triangle_order()};
   std::vector<std::uint8_t> full_slots_;
   std::vector<NodeEndBoxes> vertex_ends_;  // sized by the first interval that moves enough
+  // Whether the last interval had enough pairs apart at both ends for the slot end boxes to pay
+  // (pairs per triangle), when ccd builds them.
+  static constexpr std::int64_t kSlotEndsPayPerTriangle = 2;
+  bool slot_ends_pay_ = false;
   FeatureBounds<N> bounds_;
   TraversalScratch scratch_;
   PairBlocks<N> blocks_{

@@ -197,6 +197,13 @@ class Walk {
       b_lo_[k] = b.slot_lo(axis);
       b_hi_[k] = b.slot_hi(axis);
     }
+    slot_ends_ = a.slot_ends(0) != nullptr && b.slot_ends(0) != nullptr;
+    if (slot_ends_) {
+      for (std::size_t r = 0; r < 12; ++r) {
+        ends_rows_a_[r] = a.slot_ends(static_cast<int>(r));
+        ends_rows_b_[r] = b.slot_ends(static_cast<int>(r));
+      }
+    }
     if (sieve != nullptr) {
       corners_ = sieve->slots->corners.data();
       window_ = sieve->slots->window.data();
@@ -204,6 +211,9 @@ class Walk {
       certified_ = sieve->certified.data();
     }
   }
+
+  /// Pairs dropped in the leaves as apart at both ends (slot end boxes), so far.
+  [[nodiscard]] std::int64_t apart_at_both_ends() const { return apart_; }
 
   /// Runs until the stack is empty (true) or `out` holds max_pairs (false).
   bool run() {
@@ -398,6 +408,14 @@ class Walk {
               mask &= ~window_settled;
             }
           }
+          // Triangles apart on an axis at both ends: the feature stage's first test drops them
+          // (candidates.hpp); here four at once, before they are emitted. A pair that shares a
+          // vertex never lies apart, so the sieve's count above stays what it was.
+          if (slot_ends_ && mask != 0) {
+            const unsigned apart = slots_apart_at_both_ends(i, j0) & mask;
+            apart_ += std::popcount(apart);
+            mask &= ~apart;
+          }
           while (mask != 0) {
             const std::int32_t sj = j0 + std::countr_zero(mask);
             const std::int32_t tj = order_b_[to_size(sj)];
@@ -421,6 +439,46 @@ class Walk {
     }
     bv_tests_ += tests;
     if constexpr (kSieve) sieve_->settled += settled;
+  }
+
+  /// Bit c set when slot sa of a and slot sb + c of b (c < 4) lie apart on an axis at both ends
+  /// of the interval by their end boxes (Bvh::refit_slot_ends): floats rounded outwards, so apart
+  /// here is apart in the exact boxes too.
+  [[nodiscard]] unsigned slots_apart_at_both_ends(std::int32_t sa, std::int32_t sb) const {
+    const auto ia = to_size(sa);
+    const auto ib = to_size(sb);
+#if defined(__SSE2__)
+    __m128 apart = _mm_setzero_ps();
+    for (std::size_t k = 0; k < 3; ++k) {
+      const __m128 below = _mm_and_ps(
+          _mm_cmplt_ps(_mm_set1_ps(ends_rows_a_[3 + k][ia]), _mm_loadu_ps(ends_rows_b_[k] + ib)),
+          _mm_cmplt_ps(
+              _mm_set1_ps(ends_rows_a_[9 + k][ia]), _mm_loadu_ps(ends_rows_b_[6 + k] + ib)));
+      const __m128 above = _mm_and_ps(
+          _mm_cmplt_ps(_mm_loadu_ps(ends_rows_b_[3 + k] + ib), _mm_set1_ps(ends_rows_a_[k][ia])),
+          _mm_cmplt_ps(
+              _mm_loadu_ps(ends_rows_b_[9 + k] + ib), _mm_set1_ps(ends_rows_a_[6 + k][ia])));
+      apart = _mm_or_ps(apart, _mm_or_ps(below, above));
+    }
+    return static_cast<unsigned>(_mm_movemask_ps(apart));
+#else
+    unsigned bits = 0;
+    for (std::size_t c = 0; c < 4; ++c) {
+      bool apart = false;
+      for (std::size_t k = 0; k < 3; ++k) {
+        const auto row = [&](const std::array<const float*, 12>& rows,
+                             std::size_t r,
+                             std::size_t s) { return rows[r][s]; };
+        apart = apart ||
+                (row(ends_rows_a_, 3 + k, ia) < row(ends_rows_b_, k, ib + c) &&
+                 row(ends_rows_a_, 9 + k, ia) < row(ends_rows_b_, 6 + k, ib + c)) ||
+                (row(ends_rows_b_, 3 + k, ib + c) < row(ends_rows_a_, k, ia) &&
+                 row(ends_rows_b_, 9 + k, ib + c) < row(ends_rows_a_, 6 + k, ia));
+      }
+      bits |= static_cast<unsigned>(apart) << c;
+    }
+    return bits;
+#endif
   }
 
   /// Bit i set when child i of `w` (node masks `node_masks`) and a node with mask `other` may hold
@@ -546,6 +604,11 @@ class Walk {
   std::array<const float*, kAxes> a_hi_{};
   std::array<const float*, kAxes> b_lo_{};
   std::array<const float*, kAxes> b_hi_{};
+  // The slots' end boxes of both trees (Bvh::refit_slot_ends), when both have them.
+  bool slot_ends_ = false;
+  std::int64_t apart_ = 0;
+  std::array<const float*, 12> ends_rows_a_{};
+  std::array<const float*, 12> ends_rows_b_{};
   const std::array<std::int32_t, 4>* corners_ = nullptr;
   const std::uint64_t* window_ = nullptr;
   const std::uint8_t* full_ = nullptr;
@@ -572,24 +635,20 @@ bool self_traverse_some(
     FanSieve* sieve) {
   if (bvh.empty()) return true;
   if (sieve == nullptr || sieve->certified.empty()) {
-    return Walk<N, true>(
-               bvh, triangle_bounds, bvh, triangle_bounds, scratch.stack, out, bv_tests, max_pairs)
-        .run();
+    Walk<N, true> walk(
+        bvh, triangle_bounds, bvh, triangle_bounds, scratch.stack, out, bv_tests, max_pairs);
+    const bool done = walk.run();
+    scratch.apart_at_both_ends += walk.apart_at_both_ends();
+    return done;
   }
   assert(sieve->slots != nullptr && sieve->topology != nullptr);
   assert(sieve->slots->corners.size() == bvh.triangle_order().size());
   assert(sieve->full.size() == sieve->slots->corners.size());
-  return Walk<N, true, true>(
-             bvh,
-             triangle_bounds,
-             bvh,
-             triangle_bounds,
-             scratch.stack,
-             out,
-             bv_tests,
-             max_pairs,
-             sieve)
-      .run();
+  Walk<N, true, true> walk(
+      bvh, triangle_bounds, bvh, triangle_bounds, scratch.stack, out, bv_tests, max_pairs, sieve);
+  const bool done = walk.run();
+  scratch.apart_at_both_ends += walk.apart_at_both_ends();
+  return done;
 }
 
 SlotAdjacency::SlotAdjacency(const FeatureTopology& topology, std::span<const std::int32_t> order)

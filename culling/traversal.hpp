@@ -92,6 +92,9 @@ struct TraversalScratch {
     std::int32_t b;
   };
   std::vector<Entry> stack;
+  /// Triangle pairs self_traverse_some dropped in the leaves as apart at both ends (when the tree
+  /// has its slot end boxes, Bvh::refit_slot_ends), added up until the caller resets it.
+  std::int64_t apart_at_both_ends = 0;
 
   /// Reserves the proven maximum stack size of a self traversal of `bvh` over its wide nodes
   /// (self_traverse, and the masked one of culling/cluster_checks.hpp, which pushes a subset):

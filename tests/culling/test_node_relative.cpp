@@ -267,5 +267,104 @@ TEST(NodeRelative, ABodyCarriedFarWhileItMovesKeepsItsContactsWithFarFewerPairs)
   EXPECT_EQ(traverse(bvh, ft, x0, x0, true).pairs, still.pairs);
 }
 
+// The leaves' test (Bvh::refit_slot_ends, docs/culling.md "Apart at both ends in the leaves"):
+// with the slots' end boxes a self traversal emits the pairs it emitted without them but those
+// whose triangles lie apart on an axis at both ends — each one it drops is apart in the exact
+// boxes (floats rounded outwards), it drops all but the few a float rounding keeps, it counts
+// what it drops, and a refit takes the boxes away.
+TEST(NodeRelative, LeavesDropThePairsApartAtBothEndsAndOnlyThose) {
+  const Model m("CesiumMan.glb");
+  const FeatureTopology ft(*m.loaded.mesh, m.topology);
+  const skinning::Positions x0 = m.sample(0);
+  const skinning::Positions x1 = m.sample(20);
+  Bvh<3> bvh(ft.welded_triangles(), m.rest);
+  FeatureBounds<3> bounds;
+  swept_vertex_bounds<3>(x0, x1, 0.0, bounds.vertices);
+  bounds.derive(ft, /*with_edges=*/false);
+  const auto run = [&](bool slot_ends, std::int64_t& dropped) {
+    bvh.refit(bounds.triangles);
+    EXPECT_EQ(bvh.slot_ends(0), nullptr) << "a refit drops the slot end boxes";
+    if (slot_ends) {
+      std::vector<NodeEndBoxes> vertices;
+      vertex_end_boxes(x0, x1, 0.0, vertices);
+      bvh.refit_slot_ends(ft.welded_triangles(), vertices);
+      EXPECT_NE(bvh.slot_ends(11), nullptr);
+    }
+    TraversalScratch scratch;
+    std::vector<TrianglePair> pairs;
+    std::int64_t bv_tests = 0;
+    self_traverse<3>(bvh, bounds.triangles, scratch, pairs, bv_tests);
+    dropped = scratch.apart_at_both_ends;
+    std::sort(pairs.begin(), pairs.end());
+    return pairs;
+  };
+  // Apart on an axis at both ends, in the exact boxes of the two triangles' corners.
+  const auto apart = [&](const TrianglePair& p) {
+    for (int k = 0; k < 3; ++k) {
+      double lo[2][2], hi[2][2];  // [triangle][time]
+      for (int which = 0; which < 2; ++which) {
+        const auto& t = ft.triangle(which == 0 ? p.a : p.b);
+        for (int time = 0; time < 2; ++time) {
+          const skinning::Positions& x = time == 0 ? x0 : x1;
+          lo[which][time] = std::min({x(t[0], k), x(t[1], k), x(t[2], k)});
+          hi[which][time] = std::max({x(t[0], k), x(t[1], k), x(t[2], k)});
+        }
+      }
+      if ((hi[0][0] < lo[1][0] && hi[0][1] < lo[1][1]) ||
+          (hi[1][0] < lo[0][0] && hi[1][1] < lo[0][1])) {
+        return true;
+      }
+    }
+    return false;
+  };
+  std::int64_t none = -1;
+  const std::vector<TrianglePair> all = run(false, none);
+  EXPECT_EQ(none, 0);
+  std::int64_t dropped = -1;
+  const std::vector<TrianglePair> kept = run(true, dropped);
+  EXPECT_EQ(static_cast<std::int64_t>(all.size() - kept.size()), dropped);
+  EXPECT_TRUE(std::includes(all.begin(), all.end(), kept.begin(), kept.end()));
+  std::int64_t apart_all = 0;
+  std::int64_t apart_kept = 0;
+  for (const auto& p : all) apart_all += apart(p) ? 1 : 0;
+  for (const auto& p : kept) apart_kept += apart(p) ? 1 : 0;
+  // Every dropped pair is apart; of the apart ones, the float boxes keep at most 1 %.
+  EXPECT_EQ(apart_all - apart_kept, dropped);
+  EXPECT_GT(dropped, static_cast<std::int64_t>(all.size() / 10)) << all.size();
+  EXPECT_LE(apart_kept * 100, apart_all);
+}
+
+// `bvh` and `kdop` build the slots' end boxes when the last interval had two pairs apart at both
+// ends per triangle, or once this one has (between the traversal's installments): the same rows
+// whichever way. The same interval four times on one method — the first from a method that never
+// had them, the second after an interval where they paid, the last after one where they did not
+// (no motion) — gives the same counters and contacts each time.
+TEST(NodeRelative, TheLeavesEndBoxesChangeNoCounterWhenEverTheyAreBuilt) {
+  const Model m("CesiumMan.glb");
+  const skinning::Positions x0 = m.sample(0);
+  const skinning::Positions x1 = m.sample(20);
+  const auto same = [](const FrameResult& a, const FrameResult& b) {
+    EXPECT_EQ(a.contacts, b.contacts);
+    EXPECT_EQ(a.counters.candidate_pairs, b.counters.candidate_pairs);
+    EXPECT_EQ(a.counters.bv_tests, b.counters.bv_tests);
+    EXPECT_EQ(a.counters.feature_bv_tests, b.counters.feature_bv_tests);
+    EXPECT_EQ(a.counters.vf_tests, b.counters.vf_tests);
+    EXPECT_EQ(a.counters.ee_tests, b.counters.ee_tests);
+  };
+  for (const std::string name : {"bvh", "kdop"}) {
+    auto method = make_method(name, *m.loaded.mesh, m.topology);
+    const auto ccd = [&](const skinning::Positions& a, const skinning::Positions& b) {
+      FrameResult r;
+      method->detect_ccd(a, b, r);
+      return r;
+    };
+    const FrameResult first = ccd(x0, x1);
+    EXPECT_GT(first.contacts.size(), 0u) << name;
+    same(ccd(x0, x1), first);
+    EXPECT_TRUE(ccd(x0, x0).contacts.empty()) << name;
+    same(ccd(x0, x1), first);
+  }
+}
+
 }  // namespace
 }  // namespace skelcd::culling
