@@ -831,6 +831,9 @@ void RadialViewMethod::ccd(const culling::Interval& interval, culling::FrameResu
     local.refit(bounds_.triangles);
     if (node_relative) {
       local.refit_end_boxes(topology_.welded_triangles(), vertex_ends_);
+      // And the slots' (docs/culling.md "Apart at both ends in the leaves"): on an interval that
+      // moves this much, many pairs the swept volumes pass lie apart at both ends.
+      if (half_width == 0.0) local.refit_slot_ends(topology_.welded_triangles(), vertex_ends_);
     }
     cluster_bounds_[at(a)] = local.node_bounds()[0];
   }
