@@ -60,17 +60,30 @@ Traversed traverse(
   return t;
 }
 
+/// CesiumMan's samples 0 → 20 (its walk moves every part), its tree over the rest pose and the
+/// triangles' swept volumes of that interval (the tree not refit yet).
+struct SweptCesium {
+  Model m{"CesiumMan.glb"};
+  FeatureTopology ft{*m.loaded.mesh, m.topology};
+  skinning::Positions x0 = m.sample(0);
+  skinning::Positions x1 = m.sample(20);
+  Bvh<3> bvh{ft.welded_triangles(), m.rest};
+  FeatureBounds<3> bounds;
+  SweptCesium() {
+    swept_vertex_bounds<3>(x0, x1, 0.0, bounds.vertices);
+    bounds.derive(ft, /*with_edges=*/false);
+  }
+};
+
 // Every lane's boxes hold its triangles' corners at t = 0 and t = 1, grown by the half width;
 // the next refit drops them (a traversal of another interval must not read them).
 TEST(NodeRelative, EndBoxesHoldEveryCornerAndARefitDropsThem) {
-  const Model m("CesiumMan.glb");
-  const FeatureTopology ft(*m.loaded.mesh, m.topology);
-  const skinning::Positions x0 = m.sample(0);
-  const skinning::Positions x1 = m.sample(20);
-  Bvh<3> bvh(ft.welded_triangles(), m.rest);
-  FeatureBounds<3> bounds;
-  swept_vertex_bounds<3>(x0, x1, 0.0, bounds.vertices);
-  bounds.derive(ft, /*with_edges=*/false);
+  SweptCesium c;
+  const FeatureTopology& ft = c.ft;
+  const skinning::Positions& x0 = c.x0;
+  const skinning::Positions& x1 = c.x1;
+  Bvh<3>& bvh = c.bvh;
+  FeatureBounds<3>& bounds = c.bounds;
   bvh.refit(bounds.triangles);
   EXPECT_TRUE(bvh.end_boxes().empty());
   const double half_width = 1e-3;
@@ -111,7 +124,7 @@ TEST(NodeRelative, EndBoxesHoldEveryCornerAndARefitDropsThem) {
   EXPECT_GT(checked, 3 * 3 * ft.num_triangles());
   // A traversal-only tree (`kdop`'s, without binary node volumes) has the same shape and gets the
   // same boxes, bit for bit.
-  Bvh<3> wide_only(ft.welded_triangles(), m.rest, BvhOptions{.node_volumes = false});
+  Bvh<3> wide_only(ft.welded_triangles(), c.m.rest, BvhOptions{.node_volumes = false});
   wide_only.refit(bounds.triangles);
   wide_only.refit_end_boxes(ft.welded_triangles(), vertices);
   ASSERT_EQ(wide_only.end_boxes().size(), ends.size());
@@ -273,14 +286,12 @@ TEST(NodeRelative, ABodyCarriedFarWhileItMovesKeepsItsContactsWithFarFewerPairs)
 // boxes (floats rounded outwards), it drops all but the few a float rounding keeps, it counts
 // what it drops, and a refit takes the boxes away.
 TEST(NodeRelative, LeavesDropThePairsApartAtBothEndsAndOnlyThose) {
-  const Model m("CesiumMan.glb");
-  const FeatureTopology ft(*m.loaded.mesh, m.topology);
-  const skinning::Positions x0 = m.sample(0);
-  const skinning::Positions x1 = m.sample(20);
-  Bvh<3> bvh(ft.welded_triangles(), m.rest);
-  FeatureBounds<3> bounds;
-  swept_vertex_bounds<3>(x0, x1, 0.0, bounds.vertices);
-  bounds.derive(ft, /*with_edges=*/false);
+  SweptCesium c;
+  const FeatureTopology& ft = c.ft;
+  const skinning::Positions& x0 = c.x0;
+  const skinning::Positions& x1 = c.x1;
+  Bvh<3>& bvh = c.bvh;
+  const FeatureBounds<3>& bounds = c.bounds;
   const auto run = [&](bool slot_ends, std::int64_t& dropped) {
     bvh.refit(bounds.triangles);
     EXPECT_EQ(bvh.slot_ends(0), nullptr) << "a refit drops the slot end boxes";
