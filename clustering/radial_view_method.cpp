@@ -10,6 +10,7 @@
 
 #include "ccd/orientation.hpp"
 #include "clustering/side_winding.hpp"
+#include "culling/candidates.hpp"
 #include "culling/cluster_checks.hpp"
 #include "culling/relative_aabb.hpp"
 #include "culling/vertex_bounds.hpp"
@@ -833,7 +834,9 @@ void RadialViewMethod::ccd(const culling::Interval& interval, culling::FrameResu
       local.refit_end_boxes(topology_.welded_triangles(), vertex_ends_);
       // And the slots' (docs/culling.md "Apart at both ends in the leaves"): on an interval that
       // moves this much, many pairs the swept volumes pass lie apart at both ends.
-      if (half_width == 0.0) local.refit_slot_ends(topology_.welded_triangles(), vertex_ends_);
+      if (culling::feature_stage_tests_ends(method_options_.min_separation)) {
+        local.refit_slot_ends(topology_.welded_triangles(), vertex_ends_);
+      }
     }
     cluster_bounds_[at(a)] = local.node_bounds()[0];
   }

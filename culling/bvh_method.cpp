@@ -143,7 +143,7 @@ class BvhMethod final : public MethodBase {
     std::int64_t emitted = 0;
     // `kdop`'s relative pair filter, with a contact distance: without one the feature stage tests
     // the two triangles at both ends first, the same test on the positions (candidates.hpp).
-    const bool filter_pairs = relative_pairs_ && !feature_stage_tests_ends(options_.min_separation);
+    const bool filter_pairs = relative_pairs_ && !ends_tested;
     if (filter_pairs) relative_.start(RelativePairTrial::trial_pairs(topology_.num_triangles()));
     blocks_.drain([&](std::vector<TrianglePair>& pairs, std::size_t max_pairs) {
       // The pairs so far that the feature stage found apart at both ends.

@@ -462,18 +462,15 @@ class Walk {
     }
     return static_cast<unsigned>(_mm_movemask_ps(apart));
 #else
+    const auto& a = ends_rows_a_;
+    const auto& b = ends_rows_b_;
     unsigned bits = 0;
     for (std::size_t c = 0; c < 4; ++c) {
+      const std::size_t j = ib + c;
       bool apart = false;
       for (std::size_t k = 0; k < 3; ++k) {
-        const auto row = [&](const std::array<const float*, 12>& rows,
-                             std::size_t r,
-                             std::size_t s) { return rows[r][s]; };
-        apart = apart ||
-                (row(ends_rows_a_, 3 + k, ia) < row(ends_rows_b_, k, ib + c) &&
-                 row(ends_rows_a_, 9 + k, ia) < row(ends_rows_b_, 6 + k, ib + c)) ||
-                (row(ends_rows_b_, 3 + k, ib + c) < row(ends_rows_a_, k, ia) &&
-                 row(ends_rows_b_, 9 + k, ib + c) < row(ends_rows_a_, 6 + k, ia));
+        apart = apart || (a[3 + k][ia] < b[k][j] && a[9 + k][ia] < b[6 + k][j]) ||
+                (b[3 + k][j] < a[k][ia] && b[9 + k][j] < a[6 + k][ia]);
       }
       bits |= static_cast<unsigned>(apart) << c;
     }

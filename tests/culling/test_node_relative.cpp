@@ -79,11 +79,7 @@ struct SweptCesium {
 // the next refit drops them (a traversal of another interval must not read them).
 TEST(NodeRelative, EndBoxesHoldEveryCornerAndARefitDropsThem) {
   SweptCesium c;
-  const FeatureTopology& ft = c.ft;
-  const skinning::Positions& x0 = c.x0;
-  const skinning::Positions& x1 = c.x1;
-  Bvh<3>& bvh = c.bvh;
-  FeatureBounds<3>& bounds = c.bounds;
+  auto& [m, ft, x0, x1, bvh, bounds] = c;
   bvh.refit(bounds.triangles);
   EXPECT_TRUE(bvh.end_boxes().empty());
   const double half_width = 1e-3;
@@ -124,7 +120,7 @@ TEST(NodeRelative, EndBoxesHoldEveryCornerAndARefitDropsThem) {
   EXPECT_GT(checked, 3 * 3 * ft.num_triangles());
   // A traversal-only tree (`kdop`'s, without binary node volumes) has the same shape and gets the
   // same boxes, bit for bit.
-  Bvh<3> wide_only(ft.welded_triangles(), c.m.rest, BvhOptions{.node_volumes = false});
+  Bvh<3> wide_only(ft.welded_triangles(), m.rest, BvhOptions{.node_volumes = false});
   wide_only.refit(bounds.triangles);
   wide_only.refit_end_boxes(ft.welded_triangles(), vertices);
   ASSERT_EQ(wide_only.end_boxes().size(), ends.size());
@@ -287,11 +283,7 @@ TEST(NodeRelative, ABodyCarriedFarWhileItMovesKeepsItsContactsWithFarFewerPairs)
 // what it drops, and a refit takes the boxes away.
 TEST(NodeRelative, LeavesDropThePairsApartAtBothEndsAndOnlyThose) {
   SweptCesium c;
-  const FeatureTopology& ft = c.ft;
-  const skinning::Positions& x0 = c.x0;
-  const skinning::Positions& x1 = c.x1;
-  Bvh<3>& bvh = c.bvh;
-  const FeatureBounds<3>& bounds = c.bounds;
+  auto& [m, ft, x0, x1, bvh, bounds] = c;
   const auto run = [&](bool slot_ends, std::int64_t& dropped) {
     bvh.refit(bounds.triangles);
     EXPECT_EQ(bvh.slot_ends(0), nullptr) << "a refit drops the slot end boxes";
