@@ -10,6 +10,7 @@
 #include <bit>
 #include <cmath>
 #include <cstdint>
+#include <limits>
 
 #include "ccd/detail/float_bounds.hpp"
 #include "ccd/detail/lanes.hpp"
@@ -182,6 +183,23 @@ BernsteinCubic moving_orientation_cubic(const MovingOrientationQuery& query) {
   detail::DifferenceTriple t0, t1;
   orientation_differences(query, t0, t1);
   return detail::trilinear_determinant(t0, t1);
+}
+
+PolynomialSign moving_orientation_sign(const MovingOrientationQuery& query, int max_subdivisions) {
+  detail::DifferenceTriple t0, t1;
+  orientation_differences(query, t0, t1);
+  const detail::TrilinearScreen screen = detail::trilinear_screen(t0, t1);
+  const auto& b = screen.coefficients;
+  // cubic_sign's finiteness check, then its first test (hull_sign) with the larger error: NaN
+  // fails every comparison, and error_upper is +inf or NaN whenever the exact bound is not finite.
+  constexpr double kMax = std::numeric_limits<double>::max();
+  if (std::abs(b[0]) <= kMax && std::abs(b[1]) <= kMax && std::abs(b[2]) <= kMax &&
+      std::abs(b[3]) <= kMax) {
+    const PolynomialSign s = hull_sign(b, screen.error_upper);
+    if (s != PolynomialSign::uncertain) return s;
+  }
+  return cubic_sign(
+      BernsteinCubic{screen.coefficients, detail::trilinear_error(t0, t1)}, max_subdivisions);
 }
 
 double moving_normal_bound(const MovingOrientationQuery& query) {

@@ -60,6 +60,15 @@ struct MovingOrientationQuery {
 /// form (no power-basis detour), with the rounding-error bound of docs/ccd.md.
 [[nodiscard]] BernsteinCubic moving_orientation_cubic(const MovingOrientationQuery& query);
 
+/// cubic_sign(moving_orientation_cubic(query), max_subdivisions), the same answer for every
+/// query, cheaper when the sign is clear: the coefficients' hull is first tried with the error
+/// bound of the CCD coplanarity screen (from the largest coordinate magnitudes, docs/ccd.md
+/// "Screening the coplanarity cubic"), which is at least the exact bound whenever that is finite;
+/// a sign it certifies is the one cubic_sign certifies at its first test. Otherwise the exact
+/// bound and cubic_sign, as before.
+[[nodiscard]] PolynomialSign moving_orientation_sign(
+    const MovingOrientationQuery& query, int max_subdivisions = 4);
+
 /// Bound N with |n(t)| <= N for all t in [0,1], n(t) = (b(t) - a(t)) x (c(t) - a(t)) (rounding
 /// included). Used to turn a distance into a bound on the orientation cubic.
 [[nodiscard]] double moving_normal_bound(const MovingOrientationQuery& query);

@@ -98,8 +98,18 @@ std::string_view to_string(OrientationClass c) {
   }
 }
 
+namespace {
+
+/// cubic_sign(orientation_cubic(t, q_t0, q_t1)), screened first (ccd::moving_orientation_sign).
+PolynomialSign orientation_sign(
+    const MovingTriangle& t, const Eigen::Vector3d& q_t0, const Eigen::Vector3d& q_t1) {
+  return ccd::moving_orientation_sign({t.a_t0, t.b_t0, t.c_t0, q_t0, t.a_t1, t.b_t1, t.c_t1, q_t1});
+}
+
+}  // namespace
+
 OrientationClass classify(const MovingTriangle& triangle, const MovingPoint& observer) {
-  return to_class(ccd::cubic_sign(orientation_cubic(triangle, observer.t0, observer.t1)));
+  return to_class(orientation_sign(triangle, observer.t0, observer.t1));
 }
 
 ProjectionRange projection_range(const MovingTriangle& t, const MovingSegment& s) {
@@ -125,23 +135,33 @@ ProjectionRange projection_range(const MovingTriangle& t, const MovingSegment& s
   return {std::clamp(lo, 0.0, 1.0), std::clamp(hi, 0.0, 1.0)};
 }
 
-OrientationClass classify(const MovingTriangle& triangle, const MovingSegment& observer) {
-  // f₁, f₂: the cubics of the two endpoints. At any instant and any point x of the triangle,
-  // h(x) = (1 − σ(x))·f₁ + σ(x)·f₂ with σ(x) in [0,1] (docs/radial-view.md), so two cubics of one
-  // proven sign settle the class for every σ at once.
+namespace {
+
+/// classify's answer for a segment observer whose end cubics do not settle it alone: only σ in
+/// the proven enclosure [lo, hi] matters; h is affine in σ, so the sign at both ends of the
+/// enclosure decides it.
+OrientationClass classify_blended(const MovingTriangle& triangle, const MovingSegment& observer) {
   const BernsteinCubic f1 = orientation_cubic(triangle, observer.q1_t0, observer.q1_t1);
   const BernsteinCubic f2 = orientation_cubic(triangle, observer.q2_t0, observer.q2_t1);
-  const PolynomialSign s1 = ccd::cubic_sign(f1);
-  const PolynomialSign s2 = ccd::cubic_sign(f2);
-  if (s1 == s2 && s1 != PolynomialSign::uncertain) return to_class(s1);
-  // Otherwise only σ in the proven enclosure [lo, hi] matters; h is affine in σ, so the sign at
-  // both ends of the enclosure decides it.
   const ProjectionRange r = projection_range(triangle, observer);
   const PolynomialSign lo = ccd::cubic_sign(blend(f1, f2, r.lo));
   if (lo == PolynomialSign::uncertain) return OrientationClass::uncertain;
   if (r.hi == r.lo) return to_class(lo);
   const PolynomialSign hi = ccd::cubic_sign(blend(f1, f2, r.hi));
   return lo == hi ? to_class(lo) : OrientationClass::uncertain;
+}
+
+}  // namespace
+
+OrientationClass classify(const MovingTriangle& triangle, const MovingSegment& observer) {
+  // f₁, f₂: the cubics of the two endpoints. At any instant and any point x of the triangle,
+  // h(x) = (1 − σ(x))·f₁ + σ(x)·f₂ with σ(x) in [0,1] (docs/radial-view.md), so two cubics of one
+  // proven sign settle the class for every σ at once.
+  const PolynomialSign s1 = orientation_sign(triangle, observer.q1_t0, observer.q1_t1);
+  if (s1 == PolynomialSign::uncertain) return classify_blended(triangle, observer);
+  const PolynomialSign s2 = orientation_sign(triangle, observer.q2_t0, observer.q2_t1);
+  if (s1 == s2) return to_class(s1);
+  return classify_blended(triangle, observer);
 }
 
 }  // namespace skelcd::clustering

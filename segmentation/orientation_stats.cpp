@@ -69,7 +69,7 @@ OrientationCounts count_orientations_interval(
       }
       q.q_t0 = head_t0 + s * axis_t0;
       q.q_t1 = head_t1 + s * (tail_t1 - head_t1);
-      add(counts, static_cast<int>(ccd::cubic_sign(ccd::moving_orientation_cubic(q))));
+      add(counts, static_cast<int>(ccd::moving_orientation_sign(q)));
     }
   }
   return counts;
