@@ -131,24 +131,40 @@ void BM_triangles_intersect(benchmark::State& state, bool shared_vertex) {
   state.counters["intersecting"] = static_cast<double>(hits) / 4096.0;
 }
 
-void BM_moving_orientation_cubic(benchmark::State& state) {
+// The orientation class of a triangle against an observer: `screened` = moving_orientation_sign
+// (the coplanarity screen's bound first), else cubic_sign of the full cubic — the same answers.
+// `small_motion`: every point moves by at most 0.05 over the interval (a radial-view interval:
+// the sign is mostly clear), else t0 and t1 are independent (mostly uncertain).
+void BM_moving_orientation(benchmark::State& state, bool screened, bool small_motion) {
   std::mt19937_64 rng(4);
   std::uniform_real_distribution<double> u(-1, 1);
+  const auto point = [&] {
+    const double x = u(rng), y = u(rng), z = u(rng);
+    return Eigen::Vector3d(x, y, z);
+  };
   std::vector<MovingOrientationQuery> qs;
+  int certain = 0;
   for (int i = 0; i < 4096; ++i) {
     MovingOrientationQuery q;
-    for (auto* p : {&q.a_t0, &q.b_t0, &q.c_t0, &q.q_t0, &q.a_t1, &q.b_t1, &q.c_t1, &q.q_t1}) {
-      const double x = u(rng), y = u(rng), z = u(rng);
-      *p = Eigen::Vector3d(x, y, z);
-    }
+    for (auto* p : {&q.a_t0, &q.b_t0, &q.c_t0, &q.q_t0}) *p = point();
+    q.a_t1 = small_motion ? Eigen::Vector3d(q.a_t0 + 0.05 * point()) : point();
+    q.b_t1 = small_motion ? Eigen::Vector3d(q.b_t0 + 0.05 * point()) : point();
+    q.c_t1 = small_motion ? Eigen::Vector3d(q.c_t0 + 0.05 * point()) : point();
+    q.q_t1 = small_motion ? Eigen::Vector3d(q.q_t0 + 0.05 * point()) : point();
     qs.push_back(q);
+    certain += moving_orientation_sign(q) != PolynomialSign::uncertain ? 1 : 0;
   }
   std::size_t i = 0;
   for (auto _ : state) {
-    benchmark::DoNotOptimize(cubic_sign(moving_orientation_cubic(qs[i])));
+    if (screened) {
+      benchmark::DoNotOptimize(moving_orientation_sign(qs[i]));
+    } else {
+      benchmark::DoNotOptimize(cubic_sign(moving_orientation_cubic(qs[i])));
+    }
     i = (i + 1) & 4095;
   }
   state.SetItemsProcessed(state.iterations());
+  state.counters["certain"] = static_cast<double>(certain) / 4096.0;
 }
 
 void register_all() {
@@ -161,7 +177,15 @@ void register_all() {
   benchmark::RegisterBenchmark("triangles_intersect/random", [](benchmark::State& s) { BM_triangles_intersect(s, false); });
   benchmark::RegisterBenchmark("triangles_intersect/shared_vertex",
                                [](benchmark::State& s) { BM_triangles_intersect(s, true); });
-  benchmark::RegisterBenchmark("moving_orientation_cubic+cubic_sign", BM_moving_orientation_cubic);
+  for (const bool small : {false, true}) {
+    const std::string motion = small ? "/small_motion" : "/random";
+    benchmark::RegisterBenchmark(
+        ("moving_orientation_cubic+cubic_sign" + motion).c_str(),
+        [small](benchmark::State& s) { BM_moving_orientation(s, false, small); });
+    benchmark::RegisterBenchmark(
+        ("moving_orientation_sign" + motion).c_str(),
+        [small](benchmark::State& s) { BM_moving_orientation(s, true, small); });
+  }
 }
 
 }  // namespace
