@@ -124,7 +124,7 @@ void evaluate(
 
 }  // namespace
 
-void run_ccd_tests(
+void run_ccd_tests_unsorted(
     const FeatureTopology& topology,
     const FeatureCandidates& candidates,
     const skinning::Positions& x_t0,
@@ -134,7 +134,6 @@ void run_ccd_tests(
     const ccd::CcdOptions& options,
     FrameResult& out) {
   assert(tests.vertex_face != nullptr && tests.edge_edge != nullptr);
-  const std::size_t first = out.contacts.size();
   Counters& c = out.counters;
   // Vertex-face queries: outcomes in candidate order, the hits appended in that order.
   evaluate(
@@ -174,11 +173,20 @@ void run_ccd_tests(
         const EdgeEdgePair& p = candidates.ee[i];
         out.contacts.push_back({CcdContact::Kind::ee, p.a, p.b, o.toi_lower, o.toi_upper});
       });
-  // std::sort works in place: no allocation.
-  std::sort(
-      out.contacts.begin() + static_cast<std::ptrdiff_t>(first),
-      out.contacts.end(),
-      [](const CcdContact& a, const CcdContact& b) { return a.before(b); });
+}
+
+void run_ccd_tests(
+    const FeatureTopology& topology,
+    const FeatureCandidates& candidates,
+    const skinning::Positions& x_t0,
+    const skinning::Positions& x_t1,
+    const ElementaryTests& tests,
+    ccd::Accuracy accuracy,
+    const ccd::CcdOptions& options,
+    FrameResult& out) {
+  const std::size_t first = out.contacts.size();
+  run_ccd_tests_unsorted(topology, candidates, x_t0, x_t1, tests, accuracy, options, out);
+  sort_contacts(std::span(out.contacts).subspan(first));
 }
 
 void run_dcd_tests(

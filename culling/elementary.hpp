@@ -91,6 +91,19 @@ void run_ccd_tests(
     const ccd::CcdOptions& options,
     FrameResult& out);
 
+/// run_ccd_tests without the sort: the hits appended in test order (the VF candidates' order,
+/// then the EE candidates'). For a caller that sorts what several calls appended once, at the end
+/// (PairBlocks): one sort instead of one per call and another over them all.
+void run_ccd_tests_unsorted(
+    const FeatureTopology& topology,
+    const FeatureCandidates& candidates,
+    const skinning::Positions& x_t0,
+    const skinning::Positions& x_t1,
+    const ElementaryTests& tests,
+    ccd::Accuracy accuracy,
+    const ccd::CcdOptions& options,
+    FrameResult& out);
+
 /// Runs the exact triangle-triangle test of each pair (with the corners the two share as mesh
 /// vertices) and appends the intersecting ones to out.dcd_pairs, sorted (a, b). Counts tt_tests
 /// and dcd_pairs. Split over tests.threads as run_ccd_tests.

@@ -125,7 +125,7 @@ void PairBlocks<N>::flush() {
         use_fans_ ? &interval_fans_ : nullptr,
         interval_ends(ccd_options_->min_separation, *x_t0_, *x_t1_));
     const auto t1 = Clock::now();
-    run_ccd_tests(
+    run_ccd_tests_unsorted(
         *topology_,
         features_,
         *x_t0_,
@@ -172,11 +172,8 @@ void PairBlocks<N>::finish() {
   flush();
   FrameResult& out = *out_;
   if (continuous_) {
-    // Each block's contacts are sorted; the query's are sorted as one (in place).
-    std::sort(
-        out.contacts.begin() + static_cast<std::ptrdiff_t>(first_),
-        out.contacts.end(),
-        [](const CcdContact& a, const CcdContact& b) { return a.before(b); });
+    // The blocks' contacts, in test order, sorted as one.
+    sort_contacts(std::span(out.contacts).subspan(first_));
   } else {
     sort_pairs(std::span(out.dcd_pairs).subspan(first_));
   }

@@ -32,11 +32,12 @@ Memory on the inputs of at least 10,000 triangles (the issue's "1 KiB per triang
 findings themselves need"), per method: the raw figure, (peak RSS - floor) / triangles, and beside
 it the same minus the findings, (peak RSS - floor - findings) / triangles, where
 
-  findings = n x (32 + 56 + 56) bytes + min(log, n x 56 bytes)
+  findings = n x (32 + 32 + 56 + 56) bytes + min(log, n x 56 bytes)
 
 - n: the most contacts of one interval (counted per /contacts `frame` in the method's log).
-- In memory: while an interval is reported, the run holds each of its contacts three times: the
-  method's culling::CcdContact (32 bytes, the query's FrameResult), the interval's
+- In memory: while an interval is reported, the run holds each of its contacts four times: the
+  method's culling::CcdContact (32 bytes, the query's FrameResult), the buffer its radix sort
+  keeps per thread for the next query (32, culling/pair_sort.cpp), the interval's
   tools::ContactRow (56, the FrameReport) and the event tracker's labelled ContactRow (56)
   (tools/engine/runner.cpp, check_engine.cpp). Counted at their sizes: what the vectors hold
   beyond (they grow by doubling) stays in the figure.
@@ -46,9 +47,9 @@ it the same minus the findings, (peak RSS - floor - findings) / triangles, where
   4 MiB whatever the findings, see cloth-funnel's 134 contacts: mostly libhdf5's own pages, about
   2.8 MiB resident once a file is written, and the metadata cache's 0.5 MB index; docs/benchmarks.md
   "Fixed costs") is not the findings' and stays in the figure.
-tests/tools/test_log.cpp checks the three sizes. On the cloth steps the heap peak is reached while
-the three in-memory copies are held (valgrind massif, docs/benchmarks.md "Real assets"); where a
-peak is reached before any contact exists, "minus findings" understates it by up to n x 144 bytes.
+tests/tools/test_log.cpp checks the sizes. On the cloth steps the heap peak is reached while
+the in-memory copies are held (valgrind massif, docs/benchmarks.md "Real assets"); where a
+peak is reached before any contact exists, "minus findings" understates it by up to n x 176 bytes.
 """
 
 import argparse
@@ -68,7 +69,8 @@ CCD_METHODS = ["bvh", "kdop", "dynamic", "auto"]
 LARGE_TRIANGLES = 10000  # per-method memory line: inputs this large or larger
 # Bytes of one CCD contact in each record held in memory while an interval is reported, and in the
 # log writer's row buffer (the module docstring; tests/tools/test_log.cpp checks the sizes).
-CONTACT_RECORD_BYTES = {"culling::CcdContact": 32, "tools::ContactRow (report)": 56,
+CONTACT_RECORD_BYTES = {"culling::CcdContact": 32, "culling::CcdContact (sort buffer)": 32,
+                        "tools::ContactRow (report)": 56,
                         "tools::ContactRow (labelled copy)": 56}
 CONTACT_DISK_BYTES = 56  # tools::detail::ContactDisk
 

@@ -1,6 +1,7 @@
 // sort_pairs (culling/pair_sort.hpp) orders triangle pairs exactly as std::sort does: on short and
 // long spans, on ids that need few bits and on ids up to INT32_MAX, with repeated pairs, and on a
-// part of a vector whose front is left alone.
+// part of a vector whose front is left alone. sort_contacts orders CCD contacts as a stable sort by
+// CcdContact::before does, each contact's times of impact moving with it.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -64,6 +65,56 @@ TEST(PairSort, SortsOnlyTheSpanItIsGiven) {
   sort_pairs(std::span(pairs).subspan(1000));
   EXPECT_TRUE(std::equal(front.begin(), front.end(), pairs.begin()));
   EXPECT_TRUE(std::equal(back_sorted.begin(), back_sorted.end(), pairs.begin() + 1000));
+}
+
+std::vector<CcdContact> random_contacts(std::size_t n, std::int32_t largest, std::uint32_t seed) {
+  std::mt19937 rng(seed);
+  std::uniform_int_distribution<std::int32_t> id(0, largest);
+  std::uniform_real_distribution<double> time(0.0, 1.0);
+  std::vector<CcdContact> contacts(n);
+  for (auto& c : contacts) {
+    const double t = time(rng);
+    c = {
+        rng() % 2 == 0 ? CcdContact::Kind::vf : CcdContact::Kind::ee,
+        id(rng),
+        id(rng),
+        t,
+        t + 0.001};
+  }
+  return contacts;
+}
+
+void expect_contacts_sorted_like_std(std::vector<CcdContact> contacts) {
+  std::vector<CcdContact> expected = contacts;
+  std::stable_sort(expected.begin(), expected.end(), [](const CcdContact& a, const CcdContact& b) {
+    return a.before(b);
+  });
+  sort_contacts(contacts);
+  EXPECT_EQ(contacts, expected);  // the times too: each record moved whole
+}
+
+TEST(ContactSort, OrdersAsAStableSortByBeforeForEverySizeAndIdRange) {
+  const std::int32_t kLargest[] = {0, 3, 92229, std::numeric_limits<std::int32_t>::max()};
+  const std::size_t kSizes[] = {0, 1, 255, 256, 257, 120000};
+  std::uint32_t seed = 100;
+  for (const std::int32_t largest : kLargest) {
+    for (const std::size_t n : kSizes) {
+      SCOPED_TRACE(testing::Message() << "largest id " << largest << ", " << n << " contacts");
+      expect_contacts_sorted_like_std(random_contacts(n, largest, seed++));
+    }
+  }
+}
+
+TEST(ContactSort, SortsOnlyTheSpanItIsGivenAndKeepsRepeatedPairsInOrder) {
+  std::vector<CcdContact> contacts = random_contacts(3000, 20, 5);  // many repeated (kind, a, b)
+  const std::vector<CcdContact> front(contacts.begin(), contacts.begin() + 500);
+  std::vector<CcdContact> back(contacts.begin() + 500, contacts.end());
+  std::stable_sort(back.begin(), back.end(), [](const CcdContact& a, const CcdContact& b) {
+    return a.before(b);
+  });
+  sort_contacts(std::span(contacts).subspan(500));
+  EXPECT_TRUE(std::equal(front.begin(), front.end(), contacts.begin()));
+  EXPECT_TRUE(std::equal(back.begin(), back.end(), contacts.begin() + 500));
 }
 
 }  // namespace
