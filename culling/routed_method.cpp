@@ -107,16 +107,54 @@ std::vector<skinning::Component> components_of(const skinning::Topology& topolog
 /// itself (ComponentRoute::capped), or a small open part (ComponentRoute::small).
 bool in_closed_group(const ComponentRoute& r) { return r.closed || r.capped || r.small; }
 
+/// Component c (of topology.components) has every hole capped by `info`'s method: a 1 per
+/// component of closing_loops (none when the method caps no holes or the topology has no
+/// components of its own).
+std::vector<std::uint8_t> capped_components(
+    const skinning::Topology& topology, std::size_t num_components, const MethodInfo* info) {
+  std::vector<std::uint8_t> capped(num_components, 0);
+  if (info == nullptr || info->closes_holes_up_to <= 0 || topology.components.empty() ||
+      topology.face_component.empty()) {
+    return capped;
+  }
+  for (const auto& loop : skinning::closing_loops(
+           topology, info->closes_holes_up_to, info->closes_holes_triangles_per_side)) {
+    capped[sz(topology.face_component[sz(loop.front().face)])] = 1;
+  }
+  return capped;
+}
+
+/// The registered closed-part method of highest priority, whatever its needs: the one whose hole
+/// capping the all_closed_method rule asks about (it is the closed method whenever its needs are
+/// met, and the rule is decided before a segmentation exists).
+const MethodInfo* first_closed_method() {
+  const MethodInfo* best = nullptr;
+  for (const MethodInfo* m : registered_methods()) {
+    if (m->route != RouteKind::closed) continue;
+    if (best == nullptr || m->route_priority > best->route_priority) best = m;
+  }
+  return best;
+}
+
 /// RoutingOptions::all_closed_method's rule: it is set, `closed_method` is not named, and every
-/// component is closed or under min_open_triangles — whether the closed method caps holes or not.
+/// component is closed, under min_open_triangles, or open only at holes the highest-priority
+/// closed-part method caps (first_closed_method) — whether that method's needs are met or not.
 bool whole_to_all_closed_method(
-    const std::vector<skinning::Component>& components, const RoutingOptions& routing) {
-  return !routing.all_closed_method.empty() && routing.closed_method.empty() &&
-         !components.empty() &&
-         std::all_of(components.begin(), components.end(), [&](const skinning::Component& c) {
-           return c.closed ||
-                  static_cast<std::int32_t>(c.faces.size()) < routing.min_open_triangles;
-         });
+    const skinning::Topology& topology,
+    const std::vector<skinning::Component>& components,
+    const RoutingOptions& routing) {
+  if (routing.all_closed_method.empty() || !routing.closed_method.empty() || components.empty()) {
+    return false;
+  }
+  const std::vector<std::uint8_t> capped =
+      capped_components(topology, components.size(), first_closed_method());
+  for (std::size_t c = 0; c < components.size(); ++c) {
+    if (!components[c].closed && capped[c] == 0 &&
+        static_cast<std::int32_t>(components[c].faces.size()) >= routing.min_open_triangles) {
+      return false;
+    }
+  }
+  return true;
 }
 
 /// A copy of `mesh` whose parts are split into (part, open) and (part, closed), with every pair
@@ -656,17 +694,8 @@ std::vector<ComponentRoute> route_components(
   check_group_method(closed_name, /*open=*/false);
   const auto components = components_of(topology);
   // Open components whose every hole the closed method closes itself go with the closed ones.
-  std::vector<std::uint8_t> capped(components.size(), 0);
-  const MethodInfo* closed_info = find_method(closed_name);
-  if (closed_info != nullptr && closed_info->closes_holes_up_to > 0 &&
-      !topology.components.empty() && !topology.face_component.empty()) {
-    for (const auto& loop : skinning::closing_loops(
-             topology,
-             closed_info->closes_holes_up_to,
-             closed_info->closes_holes_triangles_per_side)) {
-      capped[sz(topology.face_component[sz(loop.front().face)])] = 1;
-    }
-  }
+  const std::vector<std::uint8_t> capped =
+      capped_components(topology, components.size(), find_method(closed_name));
   std::vector<ComponentRoute> routes;
   routes.reserve(components.size());
   for (std::size_t c = 0; c < components.size(); ++c) {
@@ -680,7 +709,7 @@ std::vector<ComponentRoute> route_components(
     r.method = r.closed || r.capped || r.small ? closed_name : routing.open_method;
     routes.push_back(std::move(r));
   }
-  if (whole_to_all_closed_method(components, routing)) {
+  if (whole_to_all_closed_method(topology, components, routing)) {
     check_group_method(routing.all_closed_method, /*open=*/false);
     const MethodNeeds needs = method_needs(routing.all_closed_method);
     if (needs.bone_poses || needs.segmentation) {
@@ -695,7 +724,7 @@ std::vector<ComponentRoute> route_components(
 
 bool routes_whole_mesh_to_all_closed_method(
     const skinning::Topology& topology, const RoutingOptions& routing) {
-  return whole_to_all_closed_method(components_of(topology), routing);
+  return whole_to_all_closed_method(topology, components_of(topology), routing);
 }
 
 std::vector<std::string> auto_group_methods(

@@ -30,13 +30,15 @@ struct RoutingOptions {
   /// Method for closed components: empty picks the best registered closed-part method whose needs
   /// are met, else kClosedFallbackMethod. Otherwise any name above, or any registered method.
   std::string closed_method;
-  /// With `closed_method` empty: a mesh whose every component is closed or has fewer than
-  /// min_open_triangles triangles (none for the open method, none there only because the closed
-  /// method caps its holes) goes whole to this method instead. `bvh` by default: on the real
-  /// characters that are closed throughout, `dynamic` took 0.81-1.48x `bvh`'s time per
-  /// interval, 1.09x in geometric mean, since every method's feature stage drops what radial view
-  /// culls there (docs/benchmarks.md "auto against bvh: the default method"). Empty: the closed
-  /// method, as for any mesh. It must need nothing beyond the mesh (no bones, no segmentation).
+  /// With `closed_method` empty: a mesh whose every component is closed, has fewer than
+  /// min_open_triangles triangles, or is open only at holes the registered closed-part method of
+  /// highest priority caps (whether its needs are met or not; none for the open method) goes
+  /// whole to this method instead. `bvh` by default: on the real characters that are closed
+  /// throughout, `dynamic` took 0.81-1.48x `bvh`'s time per interval, 1.09x in geometric mean,
+  /// since every method's feature stage drops what radial view culls there, and 1.16x on
+  /// BCN_Epileptic, capped throughout (docs/benchmarks.md "auto against bvh: the default
+  /// method", docs/dual-cone.md "Routing"). Empty: the closed method, as for any mesh. It must
+  /// need nothing beyond the mesh (no bones, no segmentation).
   std::string all_closed_method = std::string(kClosedFallbackMethod);
   /// Open components with fewer triangles go with the closed ones (ComponentRoute::small): the
   /// cone methods have nothing to gain on a small open part, and a group of its own costs `auto`
@@ -61,9 +63,10 @@ struct RoutingOptions {
 [[nodiscard]] std::vector<std::string> auto_group_methods(
     const MethodOptions& options, const RoutingOptions& routing = {});
 
-/// Whether `auto` sends the whole mesh to RoutingOptions::all_closed_method (every component closed
-/// or under min_open_triangles, `closed_method` not named), so that what only the closed method
-/// needs (a segmentation) need not be made: the answer depends on the components alone.
+/// Whether `auto` sends the whole mesh to RoutingOptions::all_closed_method (every component
+/// closed, under min_open_triangles or capped, `closed_method` not named), so that what only the
+/// closed method needs (a segmentation) need not be made: the answer depends on the topology
+/// alone.
 [[nodiscard]] bool routes_whole_mesh_to_all_closed_method(
     const skinning::Topology& topology, const RoutingOptions& routing = {});
 

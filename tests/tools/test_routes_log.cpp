@@ -50,14 +50,14 @@ struct RoutesSeen {
   std::int32_t too_small = 0;          ///< open parts with small holes but too few triangles to cap
   std::set<bool> kinds;                ///< closed and/or open components
   std::set<std::string> open_methods;  ///< the methods of the open components
-  bool whole = false;                  ///< every component closed or under 256 triangles
+  bool whole = false;  ///< every component closed, under 256 triangles, or with small holes only
 };
 
 /// Runs `check --method auto` on a rig's clip and checks its /routes against the mesh's own edges:
-/// a mesh whose every component is closed or under RoutingOptions::min_open_triangles goes whole
-/// to `bvh` (RoutingOptions::all_closed_method); otherwise closed components go to the
-/// radial-view method, and so do open ones with small holes only, and open ones too small for a
-/// group of their own, the rest to the open method.
+/// a mesh whose every component is closed, under RoutingOptions::min_open_triangles, or open only
+/// at holes the radial-view method caps goes whole to `bvh` (RoutingOptions::all_closed_method);
+/// otherwise closed components go to the radial-view method, and so do open ones with small holes
+/// only, and open ones too small for a group of their own, the rest to the open method.
 RoutesSeen check_routes(const std::filesystem::path& model, const std::string& name) {
   RoutesSeen seen;
   const auto log = skelcd::test::temp_dir("routes-log-" + name) / "auto.h5";
@@ -106,7 +106,8 @@ RoutesSeen check_routes(const std::filesystem::path& model, const std::string& n
   for (std::size_t c = 0; c < topology.components.size(); ++c) {
     const auto& component = topology.components[c];
     seen.whole = seen.whole && (closed_by_edges(topology.welded_triangles, component.faces) ||
-                                component.faces.size() < 256);  // min_open_triangles
+                                component.faces.size() < 256 ||  // min_open_triangles
+                                small_holes[c] != 0);
   }
   std::int64_t triangles = 0;
   for (std::size_t i = 0; i < header.routes.size(); ++i) {
@@ -139,22 +140,24 @@ TEST(RoutesLog, AutoWritesWhereEachComponentWent) {
   EXPECT_GT(robot.too_small, 0);  // small parts whose caps would cost more than they save
   EXPECT_EQ(robot.kinds.size(), 2u) << "the robot has both open and closed components";
   EXPECT_EQ(robot.open_methods, (std::set<std::string>{"bvh"}));
-  // BCN_Epileptic: open parts only, some of 256 triangles or more, whose holes the radial-view
-  // method caps or not: each part where it fits.
+  // BCN_Epileptic: open parts only, some of 256 triangles or more, each with small holes only
+  // (the radial-view method would cap them) or under 256 triangles — the whole mesh to `bvh` too.
   const RoutesSeen bcn = check_routes(skelcd::test::assimp_model("X/BCN_Epileptic.X"), "bcn");
-  EXPECT_FALSE(bcn.whole);
+  EXPECT_TRUE(bcn.whole);
   EXPECT_EQ(bcn.kinds, (std::set<bool>{false}));
-  EXPECT_TRUE(bcn.open_methods.count("dynamic") != 0) << "a part with small holes only";
+  EXPECT_EQ(bcn.open_methods, (std::set<std::string>{"bvh"}));
 }
 
 TEST(RoutesLog, AutoWithEveryComponentInOneGroupIsThatGroupsMethod) {
   // Testwuson (54 parts, 53 of them small and open) and RobotExpressive: every component is closed
-  // or under 256 triangles, so `auto` hands the whole mesh to `bvh` (RoutingOptions::
-  // all_closed_method) — the same candidate pairs, tests and findings at every frame (no group
-  // split, no traversal of its own).
+  // or under 256 triangles; BCN_Epileptic: every component under 256 triangles or open only at
+  // holes the radial-view method would cap. So `auto` hands the whole mesh to `bvh`
+  // (RoutingOptions::all_closed_method) — the same candidate pairs, tests and findings at every
+  // frame (no group split, no traversal of its own).
   for (const auto& model :
        {skelcd::test::assimp_model("X/Testwuson.X"),
-        skelcd::test::asset("characters/RobotExpressive.glb")}) {
+        skelcd::test::asset("characters/RobotExpressive.glb"),
+        skelcd::test::assimp_model("X/BCN_Epileptic.X")}) {
     SCOPED_TRACE(model.string());
     const auto dir = skelcd::test::temp_dir("routes-one-group");
     std::vector<LogData> logs;

@@ -52,14 +52,17 @@ RadialViewSetup setup_radial_view(
     }
     return setup;
   }
-  // Nor when every part is closed or small (under 256 triangles): `auto` then sends the whole mesh
-  // to `bvh` (culling::RoutingOptions::all_closed_method).
+  // Nor when every part is closed, small (under 256 triangles) or open only at holes the radial
+  // view would cap: `auto` then sends the whole mesh to `bvh` (culling::RoutingOptions::
+  // all_closed_method).
   if (method == "auto" && topology != nullptr &&
       culling::routes_whole_mesh_to_all_closed_method(*topology)) {
-    setup.segmentation_source = "none (auto: every part closed or small, the whole mesh to bvh)";
+    setup.segmentation_source =
+        "none (auto: every part closed, small or capped, the whole mesh to bvh)";
     if (!args.segmentation.empty()) {
       std::cerr << "skelcd: note: " << args.segmentation
-                << " is not used: auto sends a mesh whose every part is closed or small to bvh\n";
+                << " is not used: auto sends a mesh whose every part is closed, small or capped to "
+                   "bvh\n";
     }
     return setup;
   }

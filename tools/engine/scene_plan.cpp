@@ -52,7 +52,7 @@ void decide_stages(ObjectPlan& o) {
     } else if (o.method == "auto") {
       s.push_back(
           o.facts.open_components > 0
-              ? "cones: every part closed or small (auto sends the whole mesh to bvh)"
+              ? "cones: every part closed, small or capped (auto sends the whole mesh to bvh)"
               : "cones: no open part (auto uses cones only for parts with a boundary)");
     } else {
       s.push_back("cones: method " + o.method + " uses none");
@@ -70,7 +70,8 @@ void decide_stages(ObjectPlan& o) {
           o.facts.closed_components == 0
               ? "segmentation: no closed part (auto segments only closed parts)"
           : o.facts.auto_whole_to_bvh
-              ? "segmentation: every part closed or small (auto sends the whole mesh to bvh)"
+              ? "segmentation: every part closed, small or capped (auto sends the whole mesh to "
+                "bvh)"
               : "segmentation: not moved by its own skeleton (closed parts go to bvh)");
     } else {
       s.push_back("segmentation: method " + o.method + " uses none (only rvbc, dynamic)");

@@ -24,7 +24,8 @@ struct ObjectFacts {
   std::int32_t open_components = 0;  ///< edge-connected components with a boundary
   std::int32_t closed_components = 0;
   bool rig_motion = false;  ///< moved by its own skeleton (the radial-view methods need that)
-  /// Every component closed or under 256 triangles: `auto` sends the whole mesh to `bvh`
+  /// Every component closed, under 256 triangles or open only at holes the radial view would cap:
+  /// `auto` sends the whole mesh to `bvh`
   /// (culling::routes_whole_mesh_to_all_closed_method), with no cones and no segmentation.
   bool auto_whole_to_bvh = false;
 };
