@@ -223,13 +223,17 @@ class AutoMethod final : public detail::MethodBase {
     // The plan, with each component's part taken from the mesh.
     routes_ = route_components(topology, options, routing);
     const auto components = components_of(topology);
+    // The whole mesh to all_closed_method: one group, whatever each part would have been (an
+    // open part capped only by a closed method whose needs are not met would otherwise be built
+    // a cone group of its own, only to be dropped).
+    const bool whole = whole_to_all_closed_method(topology, components, routing);
     const auto nf = static_cast<std::size_t>(topology_.num_triangles());
     std::vector<std::uint8_t> open_face(nf, 0);
     for (std::size_t c = 0; c < components.size(); ++c) {
       auto& r = routes_[c];
       if (r.part < 0 && !components[c].faces.empty())
         r.part = topology_.face_part(components[c].faces[0]);
-      const bool closed = in_closed_group(r);
+      const bool closed = whole || in_closed_group(r);
       for (const std::int32_t f : components[c].faces) {
         (closed ? closed_triangles_ : open_triangles_).push_back(f);
         open_face[sz(f)] = closed ? 0 : 1;
