@@ -124,7 +124,7 @@ void evaluate(
 
 }  // namespace
 
-void run_ccd_tests_unsorted(
+void run_ccd_tests(
     const FeatureTopology& topology,
     const FeatureCandidates& candidates,
     const skinning::Positions& x_t0,
@@ -132,8 +132,10 @@ void run_ccd_tests_unsorted(
     const ElementaryTests& tests,
     ccd::Accuracy accuracy,
     const ccd::CcdOptions& options,
-    FrameResult& out) {
+    FrameResult& out,
+    ContactOrder order) {
   assert(tests.vertex_face != nullptr && tests.edge_edge != nullptr);
+  const std::size_t first = out.contacts.size();
   Counters& c = out.counters;
   // Vertex-face queries: outcomes in candidate order, the hits appended in that order.
   evaluate(
@@ -173,20 +175,7 @@ void run_ccd_tests_unsorted(
         const EdgeEdgePair& p = candidates.ee[i];
         out.contacts.push_back({CcdContact::Kind::ee, p.a, p.b, o.toi_lower, o.toi_upper});
       });
-}
-
-void run_ccd_tests(
-    const FeatureTopology& topology,
-    const FeatureCandidates& candidates,
-    const skinning::Positions& x_t0,
-    const skinning::Positions& x_t1,
-    const ElementaryTests& tests,
-    ccd::Accuracy accuracy,
-    const ccd::CcdOptions& options,
-    FrameResult& out) {
-  const std::size_t first = out.contacts.size();
-  run_ccd_tests_unsorted(topology, candidates, x_t0, x_t1, tests, accuracy, options, out);
-  sort_contacts(std::span(out.contacts).subspan(first));
+  if (order == ContactOrder::sorted) sort_contacts(std::span(out.contacts).subspan(first));
 }
 
 void run_dcd_tests(

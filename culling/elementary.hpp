@@ -75,9 +75,15 @@ struct ElementaryTests {
 /// ccd::edge_edge_ccd, ccd::triangles_intersect).
 [[nodiscard]] ElementaryTests with_ccd_defaults(ElementaryTests tests);
 
+/// The order run_ccd_tests leaves the contacts it appends in: canonical (kind, a, b), or as
+/// tested (the VF candidates' order, then the EE candidates') for a caller that sorts what several
+/// calls appended once, at the end (PairBlocks: one sort instead of one per call and another over
+/// them all).
+enum class ContactOrder : std::uint8_t { sorted, as_tested };
+
 /// Runs the VF and EE tests of `candidates` over the interval x_t0 → x_t1 and appends the hits to
-/// out.contacts, then sorts the appended contacts canonically (kind, a, b). Counts vf_tests,
-/// ee_tests, vf_contacts, ee_contacts. With tests.threads > 1 and at least
+/// out.contacts, then sorts the appended contacts canonically (kind, a, b) unless told otherwise.
+/// Counts vf_tests, ee_tests, vf_contacts, ee_contacts. With tests.threads > 1 and at least
 /// kParallelElementaryThreshold queries of a kind, those queries are split over threads; the
 /// output is the same.
 /// @param x_t0,x_t1 #W × 3 welded positions.  @pre `tests` has no null member.
@@ -89,20 +95,8 @@ void run_ccd_tests(
     const ElementaryTests& tests,
     ccd::Accuracy accuracy,
     const ccd::CcdOptions& options,
-    FrameResult& out);
-
-/// run_ccd_tests without the sort: the hits appended in test order (the VF candidates' order,
-/// then the EE candidates'). For a caller that sorts what several calls appended once, at the end
-/// (PairBlocks): one sort instead of one per call and another over them all.
-void run_ccd_tests_unsorted(
-    const FeatureTopology& topology,
-    const FeatureCandidates& candidates,
-    const skinning::Positions& x_t0,
-    const skinning::Positions& x_t1,
-    const ElementaryTests& tests,
-    ccd::Accuracy accuracy,
-    const ccd::CcdOptions& options,
-    FrameResult& out);
+    FrameResult& out,
+    ContactOrder order = ContactOrder::sorted);
 
 /// Runs the exact triangle-triangle test of each pair (with the corners the two share as mesh
 /// vertices) and appends the intersecting ones to out.dcd_pairs, sorted (a, b). Counts tt_tests

@@ -125,7 +125,7 @@ void PairBlocks<N>::flush() {
         use_fans_ ? &interval_fans_ : nullptr,
         interval_ends(ccd_options_->min_separation, *x_t0_, *x_t1_));
     const auto t1 = Clock::now();
-    run_ccd_tests_unsorted(
+    run_ccd_tests(
         *topology_,
         features_,
         *x_t0_,
@@ -133,7 +133,8 @@ void PairBlocks<N>::flush() {
         after_swept_aabbs(*tests_),
         accuracy_,
         *ccd_options_,
-        out);
+        out,
+        ContactOrder::as_tested);  // sorted once, by finish()
     feature_us_ += micros(t0, t1);
     test_us_ += micros(t1, Clock::now());
   } else {
