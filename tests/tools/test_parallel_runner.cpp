@@ -13,11 +13,14 @@
 #include <cmath>
 #include <limits>
 #include <mutex>
+#include <set>
+#include <string>
 #include <thread>
 #include <vector>
 
 #include "clustering/bone_poses.hpp"
 #include "culling/method_registry.hpp"
+#include "culling/routed_method.hpp"
 #include "segmentation/segmentation.hpp"
 #include "skinning/errors.hpp"
 #include "skinning/load.hpp"
@@ -125,6 +128,45 @@ TEST(ParallelRunner, RealCharacterRowsEqualSerialForBvhDynamicAndAuto) {
     EXPECT_EQ(serial.size(), 12u + 11u);
     EXPECT_GT(expect_same_rows(serial, parallel), 0u) << "no findings: the clip proves nothing";
   }
+}
+
+TEST(ParallelRunner, AutosRoutedMethodRowsEqualSerial) {
+  // `auto` sends BCN_Epileptic whole to `bvh` (every part capped or small: RoutingOptions::
+  // all_closed_method). Without that rule, and with the segmentation `dynamic` needs, its routed
+  // method gives every part to `dynamic` (capped or small), which answers through `auto` — as
+  // `auto` did before the rule took capped parts: in blocks of 2 samples over 4 workers, the
+  // serial rows.
+  const auto l = load(kCharacter);
+  culling::RoutingOptions grouped;
+  grouped.all_closed_method.clear();
+  std::vector<FrameReport> out[2];
+  std::set<std::string> methods;
+  for (const int k : {0, 1}) {
+    RunOptions options;
+    options.method = "dynamic";  // so that setup_radial_view makes the segmentation
+    options.frames = parse_frame_range("36:47");
+    options.threads = k == 0 ? 1 : 4;
+    options.block_samples = 2;
+    options.factory_methods_stateless = true;
+    (void)setup_radial_view(RadialViewArguments{}, l.model, *l.motion, options);
+    ClipRunner runner(
+        *l.motion,
+        options,
+        [&grouped, &methods](
+            const skinning::Mesh& mesh,
+            const skinning::Topology& topology,
+            const culling::MethodOptions& method_options) {
+          auto m = culling::make_routed_method(mesh, topology, method_options, grouped);
+          for (const auto& route : culling::routes_of(*m)) methods.insert(route.method);
+          return m;
+        });
+    if (k == 1) {
+      EXPECT_EQ(runner.plan().threads, 4) << runner.plan().serial_reason;
+    }
+    out[k] = collect(runner);
+  }
+  EXPECT_EQ(methods, (std::set<std::string>{"dynamic"}));
+  EXPECT_GT(expect_same_rows(out[0], out[1]), 0u) << "no findings: the clip proves nothing";
 }
 
 // Incremental DCD (RunOptions::incremental_dcd, the default with both queries) against full DCD at
