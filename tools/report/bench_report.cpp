@@ -1,6 +1,5 @@
 #include "tools/report/bench_report.hpp"
 
-#include <plplot.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -16,6 +15,7 @@
 #include "culling/method.hpp"
 #include "culling/method_registry.hpp"
 #include "skinning/errors.hpp"
+#include "tools/report/plplot_library.hpp"
 #include "tools/report/progress.hpp"
 #include "tools/report/summary_json.hpp"
 

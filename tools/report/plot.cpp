@@ -1,7 +1,5 @@
 #include "tools/report/plot.hpp"
 
-#include <plplot.h>
-
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -10,6 +8,7 @@
 
 #include "skinning/errors.hpp"
 #include "tools/report/highlight.hpp"
+#include "tools/report/plplot_library.hpp"
 
 namespace skelcd::tools {
 namespace {
