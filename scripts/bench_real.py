@@ -27,7 +27,9 @@ and features); `dynamic` needs a skeleton and is "n/a" on frame sequences.
 Prints a Markdown table and summary lines: DCD speed-up over CGAL (geometric mean and minimum over
 the frames of models with at least --min-triangles triangles), CCD ms per interval ratios bvh/M,
 the ceiling of bvh/dynamic (bvh's ms over the `elementary` + `skin` ms that dynamic's run still
-spends per interval: its ratio if its culling took no time at all), peak RSS above the process's floor (`skelcd --help`) per triangle. Exits 1 when any pair or contact set differs, 2 on a failed run.
+spends per interval: its ratio if its culling took no time at all), peak RSS above the process's
+floor (`skelcd --help`) per triangle. Exits 1 when any pair or contact set differs, 2 on a failed
+run.
 
 Memory on the inputs of at least 10,000 triangles (the issue's "1 KiB per triangle plus what the
 findings themselves need"), per method: the raw figure, (peak RSS - floor) / triangles, and beside

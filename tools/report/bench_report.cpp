@@ -433,6 +433,7 @@ const char* marker(ccd::Accuracy accuracy) {
 void write_bench_plot(
     const std::filesystem::path& path, const BenchReport& report, const std::string& title) {
   const std::string name = path.string();
+  (void)detail::plplot();  // PLplot itself first (opened on first use): without it, no file
   {
     // PLplot reports a file it cannot open by exiting the process; check writability first.
     std::ofstream probe(path, std::ios::binary | std::ios::trunc);

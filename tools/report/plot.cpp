@@ -225,7 +225,9 @@ void write_png_plot(
     int width,
     int panel_height) {
   const std::string name = path.string();
-  // PLplot reports a file it cannot open by exiting the process; check writability first.
+  // PLplot itself first (opened on first use): without it no file is created. Then, as PLplot
+  // reports a file it cannot open by exiting the process, the file's writability.
+  (void)detail::plplot();
   {
     std::ofstream probe(path, std::ios::binary | std::ios::trunc);
     if (!probe) throw IoError(name + ": cannot write plot");

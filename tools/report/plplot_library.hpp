@@ -11,7 +11,7 @@
 #include <string>
 #include <utility>
 
-// The PLplot functions the plots call (add one here to call it).
+// The PLplot functions the plots call (to call another: add it here and #undef its macro below).
 #define SKELCD_PLPLOT_FUNCTIONS(X) \
   X(pladv)                         \
   X(plbox)                         \
