@@ -139,15 +139,20 @@ const MethodInfo* first_closed_method() {
 /// RoutingOptions::all_closed_method's rule: it is set, `closed_method` is not named, and every
 /// component is closed, under min_open_triangles, or open only at holes the highest-priority
 /// closed-part method caps (first_closed_method) — whether that method's needs are met or not.
+/// `capped`: capped_components for first_closed_method(), when the caller has it (else computed
+/// here, only when the rule is asked at all).
 bool whole_to_all_closed_method(
     const skinning::Topology& topology,
     const std::vector<skinning::Component>& components,
-    const RoutingOptions& routing) {
+    const RoutingOptions& routing,
+    const std::vector<std::uint8_t>* capped_by_first = nullptr) {
   if (routing.all_closed_method.empty() || !routing.closed_method.empty() || components.empty()) {
     return false;
   }
   const std::vector<std::uint8_t> capped =
-      capped_components(topology, components.size(), first_closed_method());
+      capped_by_first != nullptr
+          ? *capped_by_first
+          : capped_components(topology, components.size(), first_closed_method());
   for (std::size_t c = 0; c < components.size(); ++c) {
     if (!components[c].closed && capped[c] == 0 &&
         static_cast<std::int32_t>(components[c].faces.size()) >= routing.min_open_triangles) {
@@ -156,6 +161,21 @@ bool whole_to_all_closed_method(
   }
   return true;
 }
+
+/// route_components' routes with what they were made from: the components, and whether the
+/// all_closed_method rule sends the whole mesh to one method (whole_to_all_closed_method).
+struct RoutePlan {
+  std::vector<skinning::Component> components;
+  std::vector<ComponentRoute> routes;
+  bool whole = false;
+};
+
+/// route_components, keeping the components and the rule's decision (each hole-capping search,
+/// skinning::closing_loops, made once: `auto`'s constructor needs all three).
+RoutePlan plan_routes(
+    const skinning::Topology& topology,
+    const MethodOptions& options,
+    const RoutingOptions& routing);
 
 /// A copy of `mesh` whose parts are split into (part, open) and (part, closed), with every pair
 /// that involves an open triangle excluded on top of the mesh's own exclusions: what a whole-mesh
@@ -221,12 +241,13 @@ class AutoMethod final : public detail::MethodBase {
           std::to_string(routing.ccd_cone_share) + ")");
     }
     // The plan, with each component's part taken from the mesh.
-    routes_ = route_components(topology, options, routing);
-    const auto components = components_of(topology);
+    RoutePlan plan = plan_routes(topology, options, routing);
+    routes_ = std::move(plan.routes);
+    const auto& components = plan.components;
     // The whole mesh to all_closed_method: one group, whatever each part would have been (an
     // open part capped only by a closed method whose needs are not met would otherwise be built
     // a cone group of its own, only to be dropped).
-    const bool whole = whole_to_all_closed_method(topology, components, routing);
+    const bool whole = plan.whole;
     const auto nf = static_cast<std::size_t>(topology_.num_triangles());
     std::vector<std::uint8_t> open_face(nf, 0);
     for (std::size_t c = 0; c < components.size(); ++c) {
@@ -689,18 +710,27 @@ class AutoMethod final : public detail::MethodBase {
 
 }  // namespace
 
-std::vector<ComponentRoute> route_components(
+namespace {
+
+RoutePlan plan_routes(
     const skinning::Topology& topology,
     const MethodOptions& options,
     const RoutingOptions& routing) {
+  RoutePlan plan;
   const std::string closed_name = closed_method_name(options, routing);
   check_group_method(routing.open_method, /*open=*/true);
   check_group_method(closed_name, /*open=*/false);
-  const auto components = components_of(topology);
+  plan.components = components_of(topology);
+  const auto& components = plan.components;
   // Open components whose every hole the closed method closes itself go with the closed ones.
+  const MethodInfo* closed_info = find_method(closed_name);
   const std::vector<std::uint8_t> capped =
-      capped_components(topology, components.size(), find_method(closed_name));
-  std::vector<ComponentRoute> routes;
+      capped_components(topology, components.size(), closed_info);
+  // The all_closed_method rule's capping: the same loops when its method is the closed one.
+  const MethodInfo* first = first_closed_method();
+  const std::vector<std::uint8_t> capped_by_first =
+      first == closed_info ? capped : capped_components(topology, components.size(), first);
+  auto& routes = plan.routes;
   routes.reserve(components.size());
   for (std::size_t c = 0; c < components.size(); ++c) {
     ComponentRoute r;
@@ -713,7 +743,8 @@ std::vector<ComponentRoute> route_components(
     r.method = r.closed || r.capped || r.small ? closed_name : routing.open_method;
     routes.push_back(std::move(r));
   }
-  if (whole_to_all_closed_method(topology, components, routing)) {
+  plan.whole = whole_to_all_closed_method(topology, components, routing, &capped_by_first);
+  if (plan.whole) {
     check_group_method(routing.all_closed_method, /*open=*/false);
     const MethodNeeds needs = method_needs(routing.all_closed_method);
     if (needs.bone_poses || needs.segmentation) {
@@ -723,7 +754,16 @@ std::vector<ComponentRoute> route_components(
     }
     for (auto& r : routes) r.method = routing.all_closed_method;
   }
-  return routes;
+  return plan;
+}
+
+}  // namespace
+
+std::vector<ComponentRoute> route_components(
+    const skinning::Topology& topology,
+    const MethodOptions& options,
+    const RoutingOptions& routing) {
+  return plan_routes(topology, options, routing).routes;
 }
 
 bool routes_whole_mesh_to_all_closed_method(
