@@ -59,8 +59,11 @@ PairChecker::PairChecker(
   }
   ccd_options_.min_separation = options.min_separation;
   ccd_options_.relative_boxes = true;  // docs/ccd.md, "Relative boxes"
-  bvh_a_ = AabbBvh(topology_a_.welded_triangles(), welded_rest(mesh_a, topology_a), options.bvh);
-  bvh_b_ = AabbBvh(topology_b_.welded_triangles(), welded_rest(mesh_b, topology_b), options.bvh);
+  // Traversed on their wide copies only (pair_traverse): no binary node volumes to refit.
+  BvhOptions bvh = options.bvh;
+  bvh.node_volumes = false;
+  bvh_a_ = AabbBvh(topology_a_.welded_triangles(), welded_rest(mesh_a, topology_a), bvh);
+  bvh_b_ = AabbBvh(topology_b_.welded_triangles(), welded_rest(mesh_b, topology_b), bvh);
   scratch_.reserve_pair(bvh_a_, bvh_b_);
   const auto faces =
       static_cast<std::size_t>(topology_a_.num_triangles() + topology_b_.num_triangles());
