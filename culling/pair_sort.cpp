@@ -73,7 +73,10 @@ void sort_pairs(std::span<TrianglePair> pairs) {
 
 void sort_contacts(std::span<CcdContact> contacts) {
   // The key (kind << 2 bits) | (a << bits) | b orders as (kind, a, b) when every id fits in
-  // `bits` bits.
+  // `bits` bits and the kind in one.
+  static_assert(
+      static_cast<int>(CcdContact::Kind::vf) == 0 && static_cast<int>(CcdContact::Kind::ee) == 1,
+      "the key gives the kind one bit");
   std::uint32_t largest = 0;
   for (const CcdContact& c : contacts) {
     assert(c.a >= 0 && c.b >= 0);

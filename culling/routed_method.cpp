@@ -136,25 +136,24 @@ const MethodInfo* first_closed_method() {
   return best;
 }
 
-/// RoutingOptions::all_closed_method's rule: it is set, `closed_method` is not named, and every
+/// Whether RoutingOptions::all_closed_method's rule is asked at all: it is set, `closed_method`
+/// is not named, and there are components.
+bool all_closed_rule_asked(
+    const std::vector<skinning::Component>& components, const RoutingOptions& routing) {
+  return !routing.all_closed_method.empty() && routing.closed_method.empty() && !components.empty();
+}
+
+/// RoutingOptions::all_closed_method's rule: it is asked (all_closed_rule_asked), and every
 /// component is closed, under min_open_triangles, or open only at holes the highest-priority
 /// closed-part method caps (first_closed_method) — whether that method's needs are met or not.
-/// `capped`: capped_components for first_closed_method(), when the caller has it (else computed
-/// here, only when the rule is asked at all).
+/// `capped_by_first`: capped_components for first_closed_method().
 bool whole_to_all_closed_method(
-    const skinning::Topology& topology,
     const std::vector<skinning::Component>& components,
     const RoutingOptions& routing,
-    const std::vector<std::uint8_t>* capped_by_first = nullptr) {
-  if (routing.all_closed_method.empty() || !routing.closed_method.empty() || components.empty()) {
-    return false;
-  }
-  const std::vector<std::uint8_t> capped =
-      capped_by_first != nullptr
-          ? *capped_by_first
-          : capped_components(topology, components.size(), first_closed_method());
+    const std::vector<std::uint8_t>& capped_by_first) {
+  if (!all_closed_rule_asked(components, routing)) return false;
   for (std::size_t c = 0; c < components.size(); ++c) {
-    if (!components[c].closed && capped[c] == 0 &&
+    if (!components[c].closed && capped_by_first[c] == 0 &&
         static_cast<std::int32_t>(components[c].faces.size()) >= routing.min_open_triangles) {
       return false;
     }
@@ -726,10 +725,6 @@ RoutePlan plan_routes(
   const MethodInfo* closed_info = find_method(closed_name);
   const std::vector<std::uint8_t> capped =
       capped_components(topology, components.size(), closed_info);
-  // The all_closed_method rule's capping: the same loops when its method is the closed one.
-  const MethodInfo* first = first_closed_method();
-  const std::vector<std::uint8_t> capped_by_first =
-      first == closed_info ? capped : capped_components(topology, components.size(), first);
   auto& routes = plan.routes;
   routes.reserve(components.size());
   for (std::size_t c = 0; c < components.size(); ++c) {
@@ -743,7 +738,14 @@ RoutePlan plan_routes(
     r.method = r.closed || r.capped || r.small ? closed_name : routing.open_method;
     routes.push_back(std::move(r));
   }
-  plan.whole = whole_to_all_closed_method(topology, components, routing, &capped_by_first);
+  if (all_closed_rule_asked(components, routing)) {
+    // The rule's capping: the same loops when its method is the closed one.
+    const MethodInfo* first = first_closed_method();
+    plan.whole = whole_to_all_closed_method(
+        components,
+        routing,
+        first == closed_info ? capped : capped_components(topology, components.size(), first));
+  }
   if (plan.whole) {
     check_group_method(routing.all_closed_method, /*open=*/false);
     const MethodNeeds needs = method_needs(routing.all_closed_method);
@@ -768,7 +770,10 @@ std::vector<ComponentRoute> route_components(
 
 bool routes_whole_mesh_to_all_closed_method(
     const skinning::Topology& topology, const RoutingOptions& routing) {
-  return whole_to_all_closed_method(topology, components_of(topology), routing);
+  const auto components = components_of(topology);
+  if (!all_closed_rule_asked(components, routing)) return false;
+  return whole_to_all_closed_method(
+      components, routing, capped_components(topology, components.size(), first_closed_method()));
 }
 
 std::vector<std::string> auto_group_methods(
