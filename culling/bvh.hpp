@@ -42,6 +42,9 @@ struct BvhOptions {
   /// cone methods, whose binary tree is their traversal's.
   bool float_node_volumes = false;
   BvhSplit split = BvhSplit::surface_area;
+
+  /// Every member equal: the same tree from the same triangles and positions (HierarchyCache).
+  friend bool operator==(const BvhOptions&, const BvhOptions&) = default;
 };
 
 /// A node volume as floats rounded outwards (BvhOptions::float_node_volumes).

@@ -8,6 +8,7 @@
 #include "culling/candidates.hpp"
 #include "culling/detail/method_base.hpp"
 #include "culling/detail/sieved_dcd.hpp"
+#include "culling/hierarchy_cache.hpp"
 #include "culling/pair_blocks.hpp"
 #include "culling/relative_aabb.hpp"
 #include "culling/traversal.hpp"
@@ -51,10 +52,12 @@ class BvhMethod final : public MethodBase {
       bool relative_pairs)
       : MethodBase(name, mesh, topology, options),
         relative_pairs_(relative_pairs),
-        bvh_(
+        bvh_(build_hierarchy<N>(
+            options.hierarchies.get(),
             topology_.welded_triangles(),
             welded_rest_positions(mesh, topology),
-            traversal_only(options.bvh)) {
+            nullptr,
+            traversal_only(options.bvh))) {
     // Everything an interval touches is sized here; only the blocks' feature candidates and the
     // caller's findings may still grow (with the motion), and they keep their capacity — and
     // `kdop`'s relative boxes (#F × 120 bytes), sized by the first query whose trial keeps them:

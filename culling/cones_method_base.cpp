@@ -4,6 +4,7 @@
 #include <cassert>
 #include <string>
 
+#include "culling/hierarchy_cache.hpp"
 #include "culling/vertex_bounds.hpp"
 #include "skinning/errors.hpp"
 
@@ -50,15 +51,12 @@ ConeMethodBase::ConeMethodBase(
     const std::vector<std::int32_t>* subset,
     std::shared_ptr<const FeatureTopology> features)
     : MethodBase(name, mesh, topology, options, std::move(features)),
-      bvh_(
-          subset == nullptr
-              ? AabbBvh(
-                    topology_.welded_triangles(), welded_rest(mesh, topology), cone_bvh(options))
-              : AabbBvh(
-                    topology_.welded_triangles(),
-                    welded_rest(mesh, topology),
-                    *subset,
-                    cone_bvh(options))),
+      bvh_(build_hierarchy<3>(
+          options.hierarchies.get(),
+          topology_.welded_triangles(),
+          welded_rest(mesh, topology),
+          subset,
+          cone_bvh(options))),
       descent_(descent),
       // The cone theorems say "no intersection", not "no pair within a distance": with a contact
       // distance the method culls nothing and equals `bvh` (docs/dual-cone.md).

@@ -26,6 +26,8 @@ struct Segmentation;
 
 namespace skelcd::culling {
 
+class HierarchyCache;  // culling/hierarchy_cache.hpp
+
 /// Parameters of methods declared above culling/ (radial view, paper 002 §5).
 struct MethodParameters {
   double gamma = 0.05;     ///< `dynamic`'s merge threshold γ, in [0, 1]
@@ -58,6 +60,10 @@ struct MethodOptions {
   /// takes it only when it was built from the very mesh and topology objects it is given
   /// (FeatureTopology::built_from); otherwise, and when null, it builds its own.
   std::shared_ptr<const FeatureTopology> features{};
+  /// Hierarchies shared with the methods built beside this one (HierarchyCache: the first to ask
+  /// builds, the others copy). Null: each method builds its own. The runner gives one to the
+  /// methods of a parallel run's workers and closes it once they are built.
+  std::shared_ptr<HierarchyCache> hierarchies{};
 };
 
 /// Where one connected component (Topology::components) goes under `auto` (routed_method.hpp).

@@ -19,6 +19,7 @@
 #include <vector>
 
 #include "clustering/bone_poses.hpp"
+#include "culling/hierarchy_cache.hpp"
 #include "culling/method_registry.hpp"
 #include "culling/routed_method.hpp"
 #include "segmentation/segmentation.hpp"
@@ -128,6 +129,56 @@ TEST(ParallelRunner, RealCharacterRowsEqualSerialForBvhDynamicAndAuto) {
     EXPECT_EQ(serial.size(), 12u + 11u);
     EXPECT_GT(expect_same_rows(serial, parallel), 0u) << "no findings: the clip proves nothing";
   }
+}
+
+TEST(ParallelRunner, WorkersShareOneBuildOfEachHierarchyAndTheCacheIsClosedAfter) {
+  // bvh, and auto (which sends BCN_Epileptic whole to `bvh`): four workers' methods, one build
+  // of their hierarchy, shared with what the caller built through the same cache first (a
+  // parallel check's baseline `bvh`); closed when the runner is built. The rows are the serial
+  // run's (RealCharacterRowsEqualSerialForBvhDynamicAndAuto).
+  const auto l = load(kCharacter);
+  for (const char* method : {"bvh", "auto"}) {
+    SCOPED_TRACE(method);
+    RunOptions options;
+    options.method = method;
+    options.frames = parse_frame_range("0:20");
+    options.threads = 4;
+    options.block_samples = 2;
+    auto topology = skinning::build_topology(l.motion->mesh());
+    auto cache = std::make_shared<culling::HierarchyCache>();
+    (void)culling::make_method("bvh", l.motion->mesh(), topology, [&] {
+      culling::MethodOptions o;
+      o.hierarchies = cache;
+      return o;
+    }());
+    ASSERT_EQ(cache->builds(), 1u);
+    ClipRunner runner(*l.motion, options, std::move(topology), {}, {}, cache);
+    ASSERT_EQ(runner.plan().threads, 4) << runner.plan().serial_reason;
+    EXPECT_EQ(cache->builds(), 1u);
+    EXPECT_EQ(cache->reuses(), 4u);
+    // Closed: what it built is freed and later calls keep nothing.
+    (void)culling::make_method("bvh", l.motion->mesh(), runner.topology(), [&] {
+      culling::MethodOptions o;
+      o.hierarchies = cache;
+      return o;
+    }());
+    EXPECT_EQ(cache->builds(), 1u);
+    EXPECT_EQ(cache->reuses(), 4u);
+  }
+  // A run that turns out serial closes the caller's cache without using it.
+  RunOptions serial;
+  serial.method = "bvh";
+  serial.frames = parse_frame_range("0:3");
+  serial.threads = 1;
+  auto cache = std::make_shared<culling::HierarchyCache>();
+  ClipRunner runner(*l.motion, serial, skinning::build_topology(l.motion->mesh()), {}, {}, cache);
+  EXPECT_EQ(cache->builds(), 0u);
+  (void)culling::make_method("bvh", l.motion->mesh(), runner.topology(), [&] {
+    culling::MethodOptions o;
+    o.hierarchies = cache;
+    return o;
+  }());
+  EXPECT_EQ(cache->builds(), 0u);
 }
 
 TEST(ParallelRunner, AutosRoutedMethodRowsEqualSerial) {

@@ -8,6 +8,7 @@
 #include <future>
 #include <memory>
 
+#include "culling/hierarchy_cache.hpp"
 #include "culling/method.hpp"
 #include "skinning/errors.hpp"
 #include "skinning/generators.hpp"
@@ -134,11 +135,22 @@ CheckOutcome check_model(
   // A parallel run's baseline thread builds the mesh's FeatureTopology first, for its `bvh` (when
   // it has a DCD); the runner takes it when the baseline is done by the time the runner is built.
   std::shared_ptr<const culling::FeatureTopology> baseline_features;
+  // A parallel run's baseline `bvh` and its workers' methods build the same hierarchy: once,
+  // by whichever asks first; the others copy it (culling::HierarchyCache). The runner closes it.
+  std::shared_ptr<culling::HierarchyCache> hierarchies;
   std::future<void> baseline_task;  // after what it reads: waited for before they go
   if (parallel) {
+    hierarchies = std::make_shared<culling::HierarchyCache>();
     baseline_task = std::async(
         std::launch::async,
-        [&baseline, &baseline_features, &request, &motion, &topology, &outcome, &ms_since] {
+        [&baseline,
+         &baseline_features,
+         &request,
+         &motion,
+         &topology,
+         &outcome,
+         &ms_since,
+         hierarchies] {
           const auto began = std::chrono::steady_clock::now();
           // Only a baseline with a DCD of its own builds one (not `none`, nor a log's findings).
           const auto kind = request.baseline.kind;
@@ -146,7 +158,8 @@ CheckOutcome check_model(
             baseline_features =
                 std::make_shared<const culling::FeatureTopology>(motion->mesh(), topology);
           }
-          baseline = baseline_findings(request.baseline, *motion, topology, baseline_features);
+          baseline = baseline_findings(
+              request.baseline, *motion, topology, baseline_features, hierarchies);
           outcome.setup.baseline = ms_since(began);
         });
   }
@@ -182,7 +195,8 @@ CheckOutcome check_model(
           options,
           baseline_task.valid() ? skinning::Topology(topology) : std::move(topology),
           {},
-          std::move(features));
+          std::move(features),
+          std::move(hierarchies));
     } catch (...) {
       if (baseline_task.valid()) baseline_task.get();  // its refusal first, as in a serial run
       throw;

@@ -1002,7 +1002,8 @@ BaselineFindings baseline_findings(
     const BaselineSpec& spec,
     const skinning::Motion& motion,
     const skinning::Topology& topology,
-    std::shared_ptr<const culling::FeatureTopology> features) {
+    std::shared_ptr<const culling::FeatureTopology> features,
+    std::shared_ptr<culling::HierarchyCache> hierarchies) {
   const skinning::Mesh& mesh = motion.mesh();
   const auto positions_at = [&motion](std::int32_t sample, skinning::Positions& out) {
     motion.positions(sample, out);
@@ -1010,6 +1011,7 @@ BaselineFindings baseline_findings(
   const auto dcd = [&](const skinning::Positions& x) {
     culling::MethodOptions options;
     options.features = features;
+    options.hierarchies = hierarchies;
     const auto method = culling::make_method("bvh", mesh, topology, options);
     skinning::Positions welded;
     skinning::gather_welded(topology, x, welded);

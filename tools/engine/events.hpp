@@ -19,7 +19,8 @@
 
 namespace skelcd::culling {
 class FeatureTopology;
-}
+class HierarchyCache;
+}  // namespace skelcd::culling
 
 namespace skelcd::tools {
 
@@ -114,13 +115,16 @@ class EventTracker {
 /// The baseline findings of `spec` for `motion`: DCD (`bvh`, exact) at the rest pose or at a
 /// sample of the motion, nothing for none, a log's findings. `topology` is the motion mesh's;
 /// `features`, when given and built from the two (culling::FeatureTopology::built_from), is the
-/// `bvh`'s instead of one of its own (a serial check shares it with its runner).
+/// `bvh`'s instead of one of its own (a serial check shares it with its runner). `hierarchies`,
+/// when given, is where the `bvh` takes its hierarchy from (a parallel check's runner builds
+/// the same one beside it: culling::HierarchyCache).
 /// @throws as above.
 [[nodiscard]] BaselineFindings baseline_findings(
     const BaselineSpec& spec,
     const skinning::Motion& motion,
     const skinning::Topology& topology,
-    std::shared_ptr<const culling::FeatureTopology> features = {});
+    std::shared_ptr<const culling::FeatureTopology> features = {},
+    std::shared_ptr<culling::HierarchyCache> hierarchies = {});
 
 /// Length of the segment along which triangles (p0, p1, p2) and (q0, q1, q2) intersect (0 when
 /// they do not, or are coplanar): the depth measure of an event.

@@ -18,6 +18,7 @@
 #include <tuple>
 #include <utility>
 
+#include "culling/hierarchy_cache.hpp"
 #include "culling/incremental_dcd.hpp"
 #include "culling/method_registry.hpp"
 #include "culling/routed_method.hpp"
@@ -409,7 +410,8 @@ ClipRunner::ClipRunner(
     const RunOptions& options,
     skinning::Topology topology,
     MethodFactory factory,
-    std::shared_ptr<const culling::FeatureTopology> features)
+    std::shared_ptr<const culling::FeatureTopology> features,
+    std::shared_ptr<culling::HierarchyCache> hierarchies)
     : motion_(motion),
       options_(options),
       factory_(std::move(factory)),
@@ -473,9 +475,22 @@ ClipRunner::ClipRunner(
   // running, where threads of their own left oneTBB to create its workers at the first block
   // (1.5-3 ms before the second thread took one, on this 2-core VM).
   if (plan_.threads <= 1) {
+    if (hierarchies) hierarchies->close();  // one method: nothing to share; the caller's freed
     method_ = build_method();
     return;
   }
+  // The workers' methods are alike: each hierarchy is built once (by the first thread to ask,
+  // or by the caller's baseline), the others copy it. Closed when they are built, so that the
+  // trees it holds are not kept for the run; the methods keep their own copies.
+  method_options_.hierarchies =
+      hierarchies ? std::move(hierarchies) : std::make_shared<culling::HierarchyCache>();
+  struct CloseWhenBuilt {
+    culling::MethodOptions& options;
+    ~CloseWhenBuilt() {
+      options.hierarchies->close();
+      options.hierarchies.reset();
+    }
+  } close_when_built{method_options_};
   spare_methods_.resize(static_cast<std::size_t>(plan_.threads - 1));
   const tbb::global_control allowed(
       tbb::global_control::max_allowed_parallelism, static_cast<std::size_t>(plan_.threads));

@@ -104,14 +104,19 @@ class ClipRunner {
   /// before this runner builds its method, and the two never hold memory at once. `features`,
   /// when the caller built it from motion.mesh() and this topology before moving the topology in
   /// (culling::FeatureTopology::built_from still holds), is the one the runner's methods share
-  /// instead of a new one (a serial check's baseline `bvh` used it first).
+  /// instead of a new one (a serial check's baseline `bvh` used it first). `hierarchies`, in a
+  /// parallel run, the cache its workers' methods build their hierarchies through (one build,
+  /// copied: culling::HierarchyCache), shared with whatever the caller builds beside them (a
+  /// parallel check's baseline `bvh`); without one a parallel run makes its own. Closed once the
+  /// methods are built.
   /// @pre topology == skinning::build_topology(motion.mesh()).
   ClipRunner(
       const skinning::Motion& motion,
       const RunOptions& options,
       skinning::Topology topology,
       MethodFactory factory = {},
-      std::shared_ptr<const culling::FeatureTopology> features = {});
+      std::shared_ptr<const culling::FeatureTopology> features = {},
+      std::shared_ptr<culling::HierarchyCache> hierarchies = {});
 
   [[nodiscard]] const RunPlan& plan() const { return plan_; }
   [[nodiscard]] const skinning::Topology& topology() const { return topology_; }

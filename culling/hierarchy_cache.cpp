@@ -1,0 +1,115 @@
+#include "culling/hierarchy_cache.hpp"
+
+#include <cstring>
+#include <exception>
+#include <future>
+#include <memory>
+#include <utility>
+
+namespace skelcd::culling {
+
+struct HierarchyCache::Entry {
+  int volume_axes = 0;  // N
+  skinning::Triangles triangles;
+  skinning::Positions positions;
+  bool whole = true;  // built over every triangle, not a subset
+  std::vector<std::int32_t> subset;
+  BvhOptions options;
+  /// The tree (a Bvh<volume_axes>), once built; its build's exception otherwise.
+  std::shared_future<std::shared_ptr<const void>> tree;
+};
+
+namespace {
+
+template <typename Matrix>
+bool same_bytes(const Matrix& a, const Matrix& b) {
+  using Scalar = typename Matrix::Scalar;
+  return a.rows() == b.rows() && a.cols() == b.cols() &&
+         (a.size() == 0 ||
+          std::memcmp(a.data(), b.data(), static_cast<std::size_t>(a.size()) * sizeof(Scalar)) ==
+              0);
+}
+
+}  // namespace
+
+HierarchyCache::HierarchyCache() = default;
+HierarchyCache::~HierarchyCache() = default;
+
+template <int N>
+Bvh<N> HierarchyCache::get(
+    const skinning::Triangles& triangles,
+    const skinning::Positions& positions,
+    const std::vector<std::int32_t>* subset,
+    const BvhOptions& options) {
+  std::promise<std::shared_ptr<const void>> promise;       // set when this call builds
+  std::shared_future<std::shared_ptr<const void>> theirs;  // valid when another call did
+  {
+    std::lock_guard lock(mutex_);
+    if (closed_) return build_hierarchy<N>(nullptr, triangles, positions, subset, options);
+    for (const Entry& e : entries_) {
+      if (e.volume_axes == N && e.options == options && e.whole == (subset == nullptr) &&
+          (subset == nullptr || e.subset == *subset) && same_bytes(e.triangles, triangles) &&
+          same_bytes(e.positions, positions)) {
+        theirs = e.tree;
+        ++reuses_;
+        break;
+      }
+    }
+    if (!theirs.valid()) {  // this call builds it, outside the lock
+      Entry& e = entries_.emplace_back();
+      e.volume_axes = N;
+      e.triangles = triangles;
+      e.positions = positions;
+      e.whole = subset == nullptr;
+      if (subset != nullptr) e.subset = *subset;
+      e.options = options;
+      e.tree = promise.get_future().share();
+      ++builds_;
+    }
+  }
+  // Another call's tree: its build waited for (get() rethrows its failure), then copied.
+  if (theirs.valid()) return *static_cast<const Bvh<N>*>(theirs.get().get());
+  try {
+    auto built = std::make_shared<const Bvh<N>>(
+        build_hierarchy<N>(nullptr, triangles, positions, subset, options));
+    promise.set_value(built);
+    return *built;
+  } catch (...) {
+    promise.set_exception(std::current_exception());
+    throw;
+  }
+}
+
+void HierarchyCache::close() {
+  std::list<Entry> freed;
+  {
+    std::lock_guard lock(mutex_);
+    closed_ = true;
+    freed.swap(entries_);
+  }
+  // Freed outside the lock; a caller still waiting on an entry holds its future, which keeps
+  // the tree it waits for.
+}
+
+std::size_t HierarchyCache::builds() const {
+  std::lock_guard lock(mutex_);
+  return builds_;
+}
+
+std::size_t HierarchyCache::reuses() const {
+  std::lock_guard lock(mutex_);
+  return reuses_;
+}
+
+template Bvh<3> HierarchyCache::get<3>(
+    const skinning::Triangles&,
+    const skinning::Positions&,
+    const std::vector<std::int32_t>*,
+    const BvhOptions&);
+template Bvh<8> HierarchyCache::get<8>(
+    const skinning::Triangles&,
+    const skinning::Positions&,
+    const std::vector<std::int32_t>*,
+    const BvhOptions&);
+
+}  // namespace skelcd::culling

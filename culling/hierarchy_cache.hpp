@@ -1,0 +1,74 @@
+#pragma once
+// Hierarchies built once and copied where several methods over one mesh are built at the same
+// time (docs/culling.md "One build for every thread"): a parallel run's workers each hold a
+// method of their own, and the baseline's DCD builds a `bvh` beside them.
+
+#include <cstddef>
+#include <cstdint>
+#include <list>
+#include <mutex>
+#include <vector>
+
+#include "culling/bvh.hpp"
+#include "skinning/mesh.hpp"
+
+namespace skelcd::culling {
+
+/// Built hierarchies keyed by what they were built from: the first caller asking for one builds
+/// it, callers asking for the same while it builds wait for it, and every caller gets a copy —
+/// the same bits as its own build (the build is deterministic), for the cost of copying its
+/// arrays instead of sorting the triangles again. The key is the inputs themselves, compared
+/// byte for byte (the triangles, the positions, the subset, the options and the volume), so two
+/// callers share a tree only when they would have built the same one. Thread-safe.
+///
+/// It holds every tree it built until close(): its owner closes it once the methods that share
+/// it are built (the runner does), so that the copies are not held for the whole run.
+class HierarchyCache {
+ public:
+  HierarchyCache();
+  HierarchyCache(const HierarchyCache&) = delete;
+  HierarchyCache& operator=(const HierarchyCache&) = delete;
+  ~HierarchyCache();
+
+  /// Bvh<N>(triangles, positions, options), or Bvh<N>(triangles, positions, *subset, options)
+  /// when `subset` is not null. A build that throws throws in every caller waiting for it (the
+  /// same message as their own build).
+  template <int N>
+  [[nodiscard]] Bvh<N> get(
+      const skinning::Triangles& triangles,
+      const skinning::Positions& positions,
+      const std::vector<std::int32_t>* subset,
+      const BvhOptions& options);
+
+  /// Frees every tree held; later calls build without keeping what they build.
+  void close();
+
+  /// Trees built here (not copies), since construction; for tests.
+  [[nodiscard]] std::size_t builds() const;
+  /// Copies handed out of a tree another call built; for tests.
+  [[nodiscard]] std::size_t reuses() const;
+
+ private:
+  struct Entry;
+  mutable std::mutex mutex_;
+  std::list<Entry> entries_;  // a list: an entry stays where it is while callers wait on it
+  bool closed_ = false;
+  std::size_t builds_ = 0;
+  std::size_t reuses_ = 0;
+};
+
+/// What a method builds its hierarchy with: a copy from `cache` when one is given
+/// (MethodOptions::hierarchies), its own build otherwise. `subset` as HierarchyCache::get.
+template <int N>
+[[nodiscard]] Bvh<N> build_hierarchy(
+    HierarchyCache* cache,
+    const skinning::Triangles& triangles,
+    const skinning::Positions& positions,
+    const std::vector<std::int32_t>* subset,
+    const BvhOptions& options) {
+  if (cache != nullptr) return cache->get<N>(triangles, positions, subset, options);
+  return subset == nullptr ? Bvh<N>(triangles, positions, options)
+                           : Bvh<N>(triangles, positions, *subset, options);
+}
+
+}  // namespace skelcd::culling

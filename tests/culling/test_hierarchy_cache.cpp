@@ -1,0 +1,196 @@
+// HierarchyCache: a parallel run's methods build each hierarchy once and copy it. A copy must be
+// the tree the caller would have built (same nodes, order and wide nodes), a tree is shared only
+// between callers that would have built the same one, a failing build fails every caller
+// waiting for it, and a closed cache holds nothing.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <cstring>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "culling/hierarchy_cache.hpp"
+#include "skinning/errors.hpp"
+#include "tests/culling/welded_character.hpp"
+#include "tests/support/test_support.hpp"
+
+namespace skelcd::culling {
+namespace {
+
+/// Same binary nodes, triangle order and wide nodes (children, counts, nodes, lanes).
+template <int N>
+void expect_same_tree(const Bvh<N>& a, const Bvh<N>& b) {
+  ASSERT_EQ(a.nodes().size(), b.nodes().size());
+  for (std::size_t n = 0; n < a.nodes().size(); ++n) {
+    ASSERT_EQ(a.nodes()[n].begin, b.nodes()[n].begin) << "node " << n;
+    ASSERT_EQ(a.nodes()[n].end, b.nodes()[n].end) << "node " << n;
+    ASSERT_EQ(a.nodes()[n].right, b.nodes()[n].right) << "node " << n;
+  }
+  ASSERT_TRUE(std::equal(
+      a.triangle_order().begin(),
+      a.triangle_order().end(),
+      b.triangle_order().begin(),
+      b.triangle_order().end()));
+  ASSERT_EQ(a.wide_nodes().size(), b.wide_nodes().size());
+  for (std::size_t n = 0; n < a.wide_nodes().size(); ++n) {
+    const auto& wa = a.wide_nodes()[n];
+    const auto& wb = b.wide_nodes()[n];
+    ASSERT_EQ(wa.num_children, wb.num_children) << "wide node " << n;
+    ASSERT_EQ(0, std::memcmp(wa.child, wb.child, sizeof wa.child)) << "wide node " << n;
+    ASSERT_EQ(0, std::memcmp(wa.count, wb.count, sizeof wa.count)) << "wide node " << n;
+    ASSERT_EQ(0, std::memcmp(wa.node, wb.node, sizeof wa.node)) << "wide node " << n;
+  }
+  EXPECT_EQ(a.depth(), b.depth());
+  EXPECT_EQ(a.leaf_size(), b.leaf_size());
+  EXPECT_EQ(a.node_bounds().size(), b.node_bounds().size());
+}
+
+TEST(HierarchyCache, CallersOfOneTreeShareOneBuildAndGetTheTreeTheirOwnBuildGives) {
+  const test::WeldedCharacter fox("Fox.glb");
+  const auto& triangles = fox.topology.welded_triangles;
+  const BvhOptions options{.leaf_size = 1, .node_volumes = false};
+  const Bvh<3> own(triangles, fox.rest, options);
+
+  // Four threads ask at once: one builds, three wait for it and copy.
+  HierarchyCache cache;
+  std::vector<Bvh<3>> got(4);
+  std::vector<std::thread> threads;
+  std::atomic<int> ready{0};
+  for (std::size_t i = 0; i < got.size(); ++i) {
+    threads.emplace_back([&, i] {
+      ++ready;
+      while (ready.load() < 4) std::this_thread::yield();
+      got[i] = cache.get<3>(triangles, fox.rest, nullptr, options);
+    });
+  }
+  for (auto& t : threads) t.join();
+  EXPECT_EQ(cache.builds(), 1u);
+  EXPECT_EQ(cache.reuses(), 3u);
+  for (const auto& tree : got) expect_same_tree(tree, own);
+  // build_hierarchy without a cache is the plain build.
+  expect_same_tree(build_hierarchy<3>(nullptr, triangles, fox.rest, nullptr, options), own);
+}
+
+TEST(HierarchyCache, TreesAreSharedOnlyBetweenCallersThatWouldBuildTheSameOne) {
+  const test::WeldedCharacter fox("Fox.glb");
+  const auto& triangles = fox.topology.welded_triangles;
+  const BvhOptions options{.leaf_size = 1, .node_volumes = false};
+  HierarchyCache cache;
+  (void)cache.get<3>(triangles, fox.rest, nullptr, options);
+  ASSERT_EQ(cache.builds(), 1u);
+
+  // Each of these differs from the first in one input and gets a tree of its own, equal to its
+  // own build.
+  skinning::Positions moved = fox.rest;
+  moved(7, 1) = std::nextafter(moved(7, 1), 1e300);  // one coordinate, one bit
+  skinning::Triangles flipped = triangles;
+  std::swap(flipped(3, 1), flipped(3, 2));  // one triangle's orientation
+  std::vector<std::int32_t> half;
+  for (std::int32_t f = 0; f < static_cast<std::int32_t>(triangles.rows()); f += 2)
+    half.push_back(f);
+  std::vector<std::int32_t> all(static_cast<std::size_t>(triangles.rows()));
+  for (std::size_t f = 0; f < all.size(); ++f) all[f] = static_cast<std::int32_t>(f);
+
+  std::size_t builds = 1;
+  const auto fresh = [&](const char* what, auto&& get, auto&& own) {
+    SCOPED_TRACE(what);
+    expect_same_tree(get(), own());
+    EXPECT_EQ(cache.builds(), ++builds);
+    EXPECT_EQ(cache.reuses(), 0u);
+  };
+  fresh(
+      "one coordinate",
+      [&] { return cache.get<3>(triangles, moved, nullptr, options); },
+      [&] { return Bvh<3>(triangles, moved, options); });
+  fresh(
+      "one triangle",
+      [&] { return cache.get<3>(flipped, fox.rest, nullptr, options); },
+      [&] { return Bvh<3>(flipped, fox.rest, options); });
+  fresh(
+      "a subset",
+      [&] { return cache.get<3>(triangles, fox.rest, &half, options); },
+      [&] { return Bvh<3>(triangles, fox.rest, half, options); });
+  fresh(  // every triangle listed: the same tree, but not the same call
+      "the whole as a subset",
+      [&] { return cache.get<3>(triangles, fox.rest, &all, options); },
+      [&] { return Bvh<3>(triangles, fox.rest, all, options); });
+  fresh(
+      "leaf size",
+      [&] {
+        return cache.get<3>(
+            triangles, fox.rest, nullptr, BvhOptions{.leaf_size = 4, .node_volumes = false});
+      },
+      [&] {
+        return Bvh<3>(triangles, fox.rest, BvhOptions{.leaf_size = 4, .node_volumes = false});
+      });
+  fresh(
+      "node volumes",
+      [&] { return cache.get<3>(triangles, fox.rest, nullptr, BvhOptions{}); },
+      [&] { return Bvh<3>(triangles, fox.rest, BvhOptions{}); });
+  fresh(
+      "median split",
+      [&] {
+        return cache.get<3>(
+            triangles,
+            fox.rest,
+            nullptr,
+            BvhOptions{.node_volumes = false, .split = BvhSplit::median});
+      },
+      [&] {
+        return Bvh<3>(
+            triangles, fox.rest, BvhOptions{.node_volumes = false, .split = BvhSplit::median});
+      });
+  fresh(
+      "16-DOP",
+      [&] { return cache.get<8>(triangles, fox.rest, nullptr, options); },
+      [&] { return Bvh<8>(triangles, fox.rest, options); });
+
+  // Asked again, each is a copy.
+  expect_same_tree(
+      cache.get<3>(triangles, fox.rest, &half, options),
+      Bvh<3>(triangles, fox.rest, half, options));
+  expect_same_tree(
+      cache.get<8>(triangles, fox.rest, nullptr, options), Bvh<8>(triangles, fox.rest, options));
+  EXPECT_EQ(cache.builds(), builds);
+  EXPECT_EQ(cache.reuses(), 2u);
+}
+
+TEST(HierarchyCache, AFailingBuildFailsEveryCallerWithItsMessage) {
+  const test::WeldedCharacter fox("Fox.glb");
+  skinning::Triangles bad = fox.topology.welded_triangles;
+  bad(5, 2) = static_cast<std::int32_t>(fox.rest.rows());  // one past the last vertex
+  HierarchyCache cache;
+  for (int i = 0; i < 2; ++i) {
+    EXPECT_THROW_MESSAGE(
+        (void)cache.get<3>(bad, fox.rest, nullptr, BvhOptions{}),
+        InvalidInput,
+        "triangle 5 corner 2");
+  }
+  EXPECT_EQ(cache.builds(), 1u);
+  EXPECT_EQ(cache.reuses(), 1u);
+  // The good triangles still build.
+  expect_same_tree(
+      cache.get<3>(fox.topology.welded_triangles, fox.rest, nullptr, BvhOptions{}),
+      Bvh<3>(fox.topology.welded_triangles, fox.rest, BvhOptions{}));
+}
+
+TEST(HierarchyCache, AClosedCacheBuildsForEachCallerAndKeepsNothing) {
+  const test::WeldedCharacter fox("Fox.glb");
+  const auto& triangles = fox.topology.welded_triangles;
+  HierarchyCache cache;
+  (void)cache.get<3>(triangles, fox.rest, nullptr, BvhOptions{});
+  cache.close();
+  for (int i = 0; i < 2; ++i) {
+    expect_same_tree(
+        cache.get<3>(triangles, fox.rest, nullptr, BvhOptions{}),
+        Bvh<3>(triangles, fox.rest, BvhOptions{}));
+  }
+  EXPECT_EQ(cache.builds(), 1u);  // the one before close(); the others neither kept nor shared
+  EXPECT_EQ(cache.reuses(), 0u);
+}
+
+}  // namespace
+}  // namespace skelcd::culling
