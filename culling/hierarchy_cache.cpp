@@ -43,9 +43,10 @@ Bvh<N> HierarchyCache::get(
     const BvhOptions& options) {
   std::promise<std::shared_ptr<const void>> promise;       // set when this call builds
   std::shared_future<std::shared_ptr<const void>> theirs;  // valid when another call did
+  bool keep = true;  // false once closed: built for this caller alone
   {
     std::lock_guard lock(mutex_);
-    if (closed_) return build_hierarchy<N>(nullptr, triangles, positions, subset, options);
+    keep = !closed_;
     for (const Entry& e : entries_) {
       if (e.volume_axes == N && e.options == options && e.whole == (subset == nullptr) &&
           (subset == nullptr || e.subset == *subset) && same_bytes(e.triangles, triangles) &&
@@ -55,7 +56,7 @@ Bvh<N> HierarchyCache::get(
         break;
       }
     }
-    if (!theirs.valid()) {  // this call builds it, outside the lock
+    if (keep && !theirs.valid()) {  // this call builds it, outside the lock
       Entry& e = entries_.emplace_back();
       e.volume_axes = N;
       e.triangles = triangles;
@@ -69,6 +70,7 @@ Bvh<N> HierarchyCache::get(
   }
   // Another call's tree: its build waited for (get() rethrows its failure), then copied.
   if (theirs.valid()) return *static_cast<const Bvh<N>*>(theirs.get().get());
+  if (!keep) return build_hierarchy<N>(nullptr, triangles, positions, subset, options);
   try {
     auto built = std::make_shared<const Bvh<N>>(
         build_hierarchy<N>(nullptr, triangles, positions, subset, options));
