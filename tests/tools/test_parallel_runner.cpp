@@ -131,6 +131,16 @@ TEST(ParallelRunner, RealCharacterRowsEqualSerialForBvhDynamicAndAuto) {
   }
 }
 
+/// Builds a `bvh` whose hierarchy comes through `cache` (what a parallel check's baseline does).
+void bvh_through(
+    const std::shared_ptr<culling::HierarchyCache>& cache,
+    const skinning::Mesh& mesh,
+    const skinning::Topology& topology) {
+  culling::MethodOptions options;
+  options.hierarchies = cache;
+  (void)culling::make_method("bvh", mesh, topology, options);
+}
+
 TEST(ParallelRunner, WorkersShareOneBuildOfEachHierarchyAndTheCacheIsClosedAfter) {
   // bvh, and auto (which sends BCN_Epileptic whole to `bvh`): four workers' methods, one build
   // of their hierarchy, shared with what the caller built through the same cache first (a
@@ -146,22 +156,14 @@ TEST(ParallelRunner, WorkersShareOneBuildOfEachHierarchyAndTheCacheIsClosedAfter
     options.block_samples = 2;
     auto topology = skinning::build_topology(l.motion->mesh());
     auto cache = std::make_shared<culling::HierarchyCache>();
-    (void)culling::make_method("bvh", l.motion->mesh(), topology, [&] {
-      culling::MethodOptions o;
-      o.hierarchies = cache;
-      return o;
-    }());
+    bvh_through(cache, l.motion->mesh(), topology);
     ASSERT_EQ(cache->builds(), 1u);
     ClipRunner runner(*l.motion, options, std::move(topology), {}, {}, cache);
     ASSERT_EQ(runner.plan().threads, 4) << runner.plan().serial_reason;
     EXPECT_EQ(cache->builds(), 1u);
     EXPECT_EQ(cache->reuses(), 4u);
     // Closed: what it built is freed and later calls keep nothing.
-    (void)culling::make_method("bvh", l.motion->mesh(), runner.topology(), [&] {
-      culling::MethodOptions o;
-      o.hierarchies = cache;
-      return o;
-    }());
+    bvh_through(cache, l.motion->mesh(), runner.topology());
     EXPECT_EQ(cache->builds(), 1u);
     EXPECT_EQ(cache->reuses(), 4u);
   }
@@ -173,11 +175,7 @@ TEST(ParallelRunner, WorkersShareOneBuildOfEachHierarchyAndTheCacheIsClosedAfter
   auto cache = std::make_shared<culling::HierarchyCache>();
   ClipRunner runner(*l.motion, serial, skinning::build_topology(l.motion->mesh()), {}, {}, cache);
   EXPECT_EQ(cache->builds(), 0u);
-  (void)culling::make_method("bvh", l.motion->mesh(), runner.topology(), [&] {
-    culling::MethodOptions o;
-    o.hierarchies = cache;
-    return o;
-  }());
+  bvh_through(cache, l.motion->mesh(), runner.topology());
   EXPECT_EQ(cache->builds(), 0u);
 }
 
