@@ -22,7 +22,10 @@ namespace skelcd::culling {
 /// callers share a tree only when they would have built the same one. Thread-safe.
 ///
 /// It holds every tree it built until close(): its owner closes it once the methods that share
-/// it are built (the runner does), so that the copies are not held for the whole run.
+/// it are built (the runner does), so that the copies are not held for the whole run. Each tree
+/// also keeps its key — a copy of the triangles and positions it was built from, the whole mesh's
+/// even for a subset — so it suits a few trees over one mesh (a parallel check keeps one or two:
+/// 58–314 KB of keys on the bundled characters and the Panda), not one per cluster.
 class HierarchyCache {
  public:
   HierarchyCache();
