@@ -4,7 +4,6 @@
 #include <exception>
 #include <future>
 #include <memory>
-#include <utility>
 
 namespace skelcd::culling {
 

@@ -8,7 +8,7 @@
 #include "skinning/errors.hpp"
 
 #ifndef SKELCD_PLPLOT_SONAME
-#error "SKELCD_PLPLOT_SONAME (the PLplot library's soname) is set by tools/report/CMakeLists.txt"
+#error "SKELCD_PLPLOT_SONAME (its soname) comes with the skelcd_plplot_headers target"
 #endif
 
 namespace skelcd::tools::detail {
