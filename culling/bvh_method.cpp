@@ -148,10 +148,11 @@ class BvhMethod final : public MethodBase {
     // the two triangles at both ends first, the same test on the positions (candidates.hpp).
     const bool filter_pairs = relative_pairs_ && !ends_tested;
     if (filter_pairs) relative_.start(RelativePairTrial::trial_pairs(topology_.num_triangles()));
-    blocks_.drain([&](std::vector<TrianglePair>& pairs, std::size_t max_pairs) {
+    // With threads to spare the tests of each block run beside the next installment
+    // (PairBlocks::drain_overlapped), which reads what they kept through candidates_kept() only.
+    blocks_.drain_overlapped([&](std::vector<TrianglePair>& pairs, std::size_t max_pairs) {
       // The pairs so far that the feature stage found apart at both ends.
-      if (ends_tested && !slot_ends &&
-          emitted - (out.counters.candidate_pairs - candidates_before) >= pays) {
+      if (ends_tested && !slot_ends && emitted - blocks_.candidates_kept() >= pays) {
         build_slot_ends();
       }
       const std::size_t first = pairs.size();

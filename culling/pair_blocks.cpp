@@ -1,5 +1,7 @@
 #include "culling/pair_blocks.hpp"
 
+#include <tbb/task_group.h>
+
 #include <algorithm>
 #include <cassert>
 #include <chrono>
@@ -54,6 +56,9 @@ void PairBlocks<N>::start(
   out_ = &out;
   pairs_.clear();
   blocks_ = 0;
+  candidates_at_start_ = out.counters.candidate_pairs;
+  kept_ = 0;
+  kept_visible_ = 0;
   feature_us_ = 0.0;
   test_us_ = 0.0;
 }
@@ -110,15 +115,55 @@ std::span<const std::uint8_t> PairBlocks<N>::certify_interval_fans() {
 
 template <int N>
 void PairBlocks<N>::flush() {
+  flush_block(pairs_);
+}
+
+template <int N>
+void PairBlocks<N>::drain_beside(Installment step) {
   assert(out_ != nullptr);
-  if (pairs_.empty()) return;
+  for (bool done = false; !done;) {
+    if (!full()) {
+      done = step(pairs_, block_pairs_);
+      continue;
+    }
+    // The full block is tested here while another thread fills the next one: `step` then
+    // appends to an empty block, as it would after drain's flush.
+    if (spare_.capacity() < pairs_.capacity()) spare_.reserve(pairs_.capacity());
+    std::swap(pairs_, spare_);
+    overlapping_ = true;
+    bool next_done = false;
+    tbb::task_group group;
+    group.run([&] { next_done = step(pairs_, block_pairs_); });
+    try {
+      flush_block(spare_);
+    } catch (...) {
+      // The installment reads what the tests hold: it ends before they go.
+      try {
+        group.wait();
+      } catch (...) {  // NOLINT(bugprone-empty-catch): the tests' exception is the one reported
+      }
+      overlapping_ = false;
+      throw;
+    }
+    group.wait();  // rethrows the installment's exception
+    overlapping_ = false;
+    kept_visible_ = kept_;
+    done = next_done;
+  }
+  flush_if_full();
+}
+
+template <int N>
+void PairBlocks<N>::flush_block(std::vector<TrianglePair>& block) {
+  assert(out_ != nullptr);
+  if (block.empty()) return;
   FrameResult& out = *out_;
   const auto t0 = Clock::now();
   if (continuous_) {
     features_.clear();
     ccd_candidates_from_triangle_pairs<N>(
         *topology_,
-        pairs_,
+        block,
         *bounds_,
         features_,
         out.counters,
@@ -139,7 +184,7 @@ void PairBlocks<N>::flush() {
     test_us_ += micros(t1, Clock::now());
   } else {
     // Pairs across two hierarchies come as (triangle of a, triangle of b): DCD wants a < b.
-    for (auto& p : pairs_) {
+    for (auto& p : block) {
       if (p.b < p.a) std::swap(p.a, p.b);
     }
     const auto t1 = Clock::now();
@@ -148,13 +193,13 @@ void PairBlocks<N>::flush() {
       // save: worth it when this instant tests about as many pairs as there are triangles (a
       // first block that is full, or as long), not for a query that tests a few pairs (CesiumMan:
       // ~2,500 tests, 4,300 triangles).
-      use_planes_ = pairs_.size() >=
+      use_planes_ = block.size() >=
                     std::min(block_pairs_, static_cast<std::size_t>(topology_->num_triangles()));
       if (use_planes_) dcd_planes(*topology_, *x_t0_, *tests_, planes_);
     }
     filter_and_run_dcd_tests(
         *topology_,
-        pairs_,
+        block,
         *x_t0_,
         *tests_,
         fans_,
@@ -164,8 +209,10 @@ void PairBlocks<N>::flush() {
     feature_us_ += micros(t0, t1);
     test_us_ += micros(t1, Clock::now());
   }
-  pairs_.clear();
+  block.clear();
   ++blocks_;
+  kept_ = out.counters.candidate_pairs - candidates_at_start_;
+  if (!overlapping_) kept_visible_ = kept_;
 }
 
 template <int N>

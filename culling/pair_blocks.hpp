@@ -9,6 +9,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <span>
+#include <type_traits>
 #include <vector>
 
 #include "culling/bvh.hpp"
@@ -100,6 +101,33 @@ class PairBlocks {
     }
   }
 
+  /// drain, with each full block tested while `step` produces the next installment on another
+  /// thread when the tests have threads (ElementaryTests::threads > 1, which the runner gives a
+  /// query only when it checks no other one at the time: docs/check.md "Threads"). The blocks,
+  /// their order and so every finding and counter are drain's; only the time changes. At most two
+  /// blocks of pairs are held (the one tested, the one filling). `step` runs beside the tests, so
+  /// it may write to the findings' counters only `bv_tests` and read none of the findings or
+  /// counters that the tests write; what the tests kept so far is candidates_kept(). On one
+  /// thread it is drain, allocation-free as drain is.
+  template <class Step>
+  void drain_overlapped(Step&& step) {
+    if (tests_->threads <= 1) {
+      drain(step);
+      return;
+    }
+    using Callable = std::remove_reference_t<Step>;
+    drain_beside(Installment{
+        const_cast<void*>(static_cast<const void*>(&step)),
+        [](void* f, std::vector<TrianglePair>& pairs, std::size_t max_pairs) {
+          return (*static_cast<Callable*>(f))(pairs, max_pairs);
+        }});
+  }
+
+  /// Triangle pairs the feature stage kept (CCD candidate pairs) in the blocks of this query
+  /// tested before the current installment began: readable by an installment of
+  /// drain_overlapped.
+  [[nodiscard]] std::int64_t candidates_kept() const { return kept_visible_; }
+
   /// Tests what is pending, then sorts the findings appended since start_* canonically (contacts
   /// by (kind, a, b), DCD pairs by (a, b)) in place. Ends the query.
   void finish();
@@ -113,9 +141,22 @@ class PairBlocks {
 
  private:
   void start(const FeatureTopology& topology, const ElementaryTests& tests, FrameResult& out);
+  /// A producer of drain_overlapped, not owned (no allocation to pass it).
+  struct Installment {
+    void* step;
+    bool (*call)(void* step, std::vector<TrianglePair>& pairs, std::size_t max_pairs);
+    bool operator()(std::vector<TrianglePair>& pairs, std::size_t max_pairs) const {
+      return call(step, pairs, max_pairs);
+    }
+  };
+  /// drain_overlapped with threads for the tests.
+  void drain_beside(Installment step);
+  /// flush() of `block` (pairs_, or spare_ while drain_overlapped fills pairs_).
+  void flush_block(std::vector<TrianglePair>& block);
 
   std::size_t block_pairs_;
   std::vector<TrianglePair> pairs_;
+  std::vector<TrianglePair> spare_;  ///< drain_overlapped: the block being tested (empty otherwise)
   FeatureCandidates features_;
   // The query being run (null between queries).
   const FeatureTopology* topology_ = nullptr;
@@ -135,6 +176,10 @@ class PairBlocks {
   bool use_planes_ = false;  ///< planes_ holds this instant's planes (the first block decides)
   std::size_t first_ = 0;    ///< out's findings before this query
   std::int64_t blocks_ = 0;
+  std::int64_t candidates_at_start_ = 0;  ///< out.counters.candidate_pairs at start_*
+  std::int64_t kept_ = 0;                 ///< candidate pairs kept by this query's blocks so far
+  std::int64_t kept_visible_ = 0;         ///< kept_ as of the last installment's start
+  bool overlapping_ = false;              ///< drain_overlapped is running
   double feature_us_ = 0.0;
   double test_us_ = 0.0;
 };

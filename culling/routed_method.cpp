@@ -539,7 +539,7 @@ class AutoMethod final : public detail::MethodBase {
       FanSieve sieve = fan_sieve(slots_of(g, *h), certified, full_slots_, topology_);
       FanSieve* const sieving = sieve.certified.empty() ? nullptr : &sieve;
       start_self_traversal<3>(*h, scratch_);
-      blocks_.drain([&](std::vector<TrianglePair>& pairs, std::size_t max_pairs) {
+      blocks_.drain_overlapped([&](std::vector<TrianglePair>& pairs, std::size_t max_pairs) {
         const std::size_t first = pairs.size();
         const bool done = self_traverse_some<3>(
             *h, tri, scratch_, pairs, out.counters.bv_tests, max_pairs, sieving);
@@ -657,7 +657,7 @@ class AutoMethod final : public detail::MethodBase {
   void traverse_between(std::int64_t& bv_tests, Filter&& filter) {
     const std::span<const Aabb> tri(bounds_->triangles);
     start_pair_traversal<3>(*open_hierarchy_, *closed_hierarchy_, scratch_);
-    blocks_.drain([&](std::vector<TrianglePair>& pairs, std::size_t max_pairs) {
+    blocks_.drain_overlapped([&](std::vector<TrianglePair>& pairs, std::size_t max_pairs) {
       const std::size_t first = pairs.size();
       const bool done = pair_traverse_some<3>(
           *open_hierarchy_, tri, *closed_hierarchy_, tri, scratch_, pairs, bv_tests, max_pairs);

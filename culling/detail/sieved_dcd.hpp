@@ -33,7 +33,9 @@ void sieved_self_dcd(
     FrameResult& out) {
   start_self_traversal<N>(bvh, scratch);
   FanSieve sieve = fan_sieve(slots, blocks.fans(), full_slots, topology);
-  blocks.drain([&](std::vector<TrianglePair>& pairs, std::size_t max_pairs) {
+  // The tests of a block beside the next installment when they have threads to spare: the
+  // traversal writes bv_tests and its own sieve only.
+  blocks.drain_overlapped([&](std::vector<TrianglePair>& pairs, std::size_t max_pairs) {
     return self_traverse_some<N>(
         bvh, triangle_bounds, scratch, pairs, out.counters.bv_tests, max_pairs, &sieve);
   });
