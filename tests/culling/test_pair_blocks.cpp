@@ -137,8 +137,8 @@ bool counting_test(const ccd::TriangleTriangleQuery&, const ccd::SharedCorners&)
   return false;
 }
 
-/// Every pair of triangles a < b of the sheet whose ids differ by 1 to 8: tested, none shares
-/// nothing with the DCD rules' exclusions (the sheet has no parts).
+/// Every pair of triangles a < b of the sheet whose ids differ by 1 to 8: each one a DCD candidate
+/// that reaches the test (the sheet has no parts to exclude, and a custom test sees every pair).
 std::vector<TrianglePair> some_pairs(std::int32_t num_triangles) {
   std::vector<TrianglePair> pairs;
   for (std::int32_t a = 0; a < num_triangles; ++a) {
