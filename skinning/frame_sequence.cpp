@@ -10,7 +10,9 @@
 #include <cmath>
 #include <cstring>
 #include <fstream>
+#include <functional>
 #include <sstream>
+#include <string_view>
 
 #include "skinning/errors.hpp"
 #include "skinning/load.hpp"
@@ -27,8 +29,20 @@ std::string lower(std::string s) {
 }
 
 std::string read_bytes(const fs::path& file) {
-  std::ifstream in(file, std::ios::binary);
+  std::ifstream in(file, std::ios::binary | std::ios::ate);
   if (!in) throw IoError(file.string() + ": cannot open frame file");
+  // A file of known size is read into a string of that size (one copy, not a stream's two: a
+  // long sequence's frames are read again for each sample).
+  const std::streamoff size = in.tellg();
+  if (size >= 0) {
+    std::string bytes(static_cast<std::size_t>(size), '\0');
+    in.seekg(0);
+    in.read(bytes.data(), size);
+    if (!in || in.gcount() != size) throw IoError(file.string() + ": cannot read frame file");
+    return bytes;
+  }
+  in.clear();
+  in.seekg(0);
   std::ostringstream bytes;
   bytes << in.rdbuf();
   if (in.bad()) throw IoError(file.string() + ": cannot read frame file");
@@ -379,13 +393,28 @@ FrameMesh read_ply(const fs::path& file, const std::string& bytes) {
 
 }  // namespace
 
+namespace {
+
+/// read_frame_mesh of the file's bytes, read already.
+FrameMesh parse_frame_mesh(const fs::path& file, const std::string& bytes) {
+  const std::string ext = lower(file.extension().string());
+  if (ext != ".obj" && ext != ".ply") {
+    throw IoError(file.string() + ": a frame file must be .obj or .ply");
+  }
+  return ext == ".obj" ? read_obj(file, bytes) : read_ply(file, bytes);
+}
+
+/// What tells a frame file's bytes from other bytes (within one process).
+std::size_t checksum(const std::string& bytes) { return std::hash<std::string_view>{}(bytes); }
+
+}  // namespace
+
 FrameMesh read_frame_mesh(const fs::path& file) {
   const std::string ext = lower(file.extension().string());
   if (ext != ".obj" && ext != ".ply") {
     throw IoError(file.string() + ": a frame file must be .obj or .ply");
   }
-  const std::string bytes = read_bytes(file);
-  return ext == ".obj" ? read_obj(file, bytes) : read_ply(file, bytes);
+  return parse_frame_mesh(file, read_bytes(file));
 }
 
 bool natural_less(std::string_view a, std::string_view b) {
@@ -463,18 +492,29 @@ FrameSequenceMotion::FrameSequenceMotion(
   if (files.empty()) throw InvalidInput("frame sequence: no frame files");
   auto data = std::make_shared<Data>();
   data->name = name.empty() ? files.front().parent_path().filename().string() : std::move(name);
-  data->frames.reserve(files.size());
+  data->checksums.reserve(files.size());
   Triangles triangles;
+  Positions first;
+  bool keep = true;  // decided once the first frame's size is known
   for (std::size_t i = 0; i < files.size(); ++i) {
-    FrameMesh frame = read_frame_mesh(files[i]);
+    const std::string bytes = read_bytes(files[i]);
+    data->checksums.push_back(checksum(bytes));
+    FrameMesh frame = parse_frame_mesh(files[i], bytes);
     if (i == 0) {
       triangles = std::move(frame.triangles);
+      const double frame_bytes = 24.0 * static_cast<double>(frame.positions.rows());
+      keep = frame_bytes * static_cast<double>(files.size()) <=
+             static_cast<double>(options.kept_bytes_per_triangle) *
+                 static_cast<double>(triangles.rows());
+      if (keep) data->frames.reserve(files.size());
+      first = frame.positions;
     } else {
       // Identical topology: the same vertex count and the same triangles, index for index.
       const std::string where = files[i].string() + ": frame " + std::to_string(i);
-      if (frame.positions.rows() != data->frames[0].rows()) {
-        throw InvalidInput(where + " has " + std::to_string(frame.positions.rows()) + " vertices, frame 0 (" +
-                           files[0].string() + ") has " + std::to_string(data->frames[0].rows()));
+      if (frame.positions.rows() != first.rows()) {
+        throw InvalidInput(
+            where + " has " + std::to_string(frame.positions.rows()) + " vertices, frame 0 (" +
+            files[0].string() + ") has " + std::to_string(first.rows()));
       }
       if (frame.triangles.rows() != triangles.rows()) {
         throw InvalidInput(where + " has " + std::to_string(frame.triangles.rows()) + " triangles, frame 0 (" +
@@ -487,10 +527,10 @@ FrameSequenceMotion::FrameSequenceMotion(
         }
       }
     }
-    data->frames.push_back(std::move(frame.positions));
+    if (keep) data->frames.push_back(std::move(frame.positions));
   }
   Mesh& mesh = data->mesh;
-  mesh.rest_positions = data->frames[0];
+  mesh.rest_positions = std::move(first);
   mesh.triangles = std::move(triangles);
   const auto nv = static_cast<std::size_t>(mesh.num_vertices());
   const auto nf = static_cast<std::size_t>(mesh.num_triangles());
@@ -519,7 +559,25 @@ std::unique_ptr<FrameSequenceMotion> FrameSequenceMotion::with_rate(double rate_
 
 void FrameSequenceMotion::positions(int i, Positions& out) const {
   assert(i >= 0 && i < num_samples());
-  out = data_->frames[static_cast<std::size_t>(i)];
+  const auto k = static_cast<std::size_t>(i);
+  if (!data_->frames.empty()) {
+    out = data_->frames[k];
+    return;
+  }
+  if (k == 0) {
+    out = data_->mesh.rest_positions;
+    return;
+  }
+  // Read again: the same bytes give the same positions (the parse is deterministic); other bytes
+  // would give a frame nobody checked.
+  const fs::path& file = data_->files[k];
+  const std::string bytes = read_bytes(file);
+  if (checksum(bytes) != data_->checksums[k]) {
+    throw IoError(
+        file.string() + ": frame " + std::to_string(i) +
+        " changed since the sequence was read (its bytes differ)");
+  }
+  out = parse_frame_mesh(file, bytes).positions;
 }
 
 FrameSequenceMotion load_frame_sequence(const fs::path& spec, const FrameSequenceOptions& options) {

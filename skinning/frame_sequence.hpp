@@ -46,12 +46,23 @@ struct FrameMesh {
 /// @throws IoError when the folder does not exist; InvalidInput when nothing matches.
 [[nodiscard]] std::vector<std::filesystem::path> list_frame_files(const std::filesystem::path& spec);
 
+/// A sequence keeps its frames in memory while they take at most this many bytes per triangle
+/// (a quarter of the 1 KiB per triangle a check may use, docs/benchmarks.md): the two frames of a
+/// cloth step (24 bytes per triangle), not a long simulation, whose frames are read again from
+/// their files when a sample asks.
+inline constexpr std::size_t kKeptFrameBytesPerTriangle = 256;
+
 struct FrameSequenceOptions {
   /// Frames per second: sample i is at time i / rate_hz.
   double rate_hz = kDefaultFrameRateHz;
+  /// Frames kept in memory while #frames × #V × 24 ≤ this × #F; else only the first (the rest
+  /// pose) is, and positions() reads a frame's file again (0: always read again).
+  std::size_t kept_bytes_per_triangle = kKeptFrameBytesPerTriangle;
 };
 
-/// Every frame held in memory (#frames × #V × 24 bytes), read and checked once at construction.
+/// Every frame read and checked once at construction; kept in memory when they are few
+/// (FrameSequenceOptions::kept_bytes_per_triangle), else read again by positions(), so that a
+/// long sequence holds one frame per caller at a time.
 class FrameSequenceMotion final : public Motion {
  public:
   /// Reads `files` (in this order).
@@ -65,10 +76,15 @@ class FrameSequenceMotion final : public Motion {
 
   /// The first frame: one part named after the sequence.
   [[nodiscard]] const Mesh& mesh() const override { return data_->mesh; }
-  [[nodiscard]] int num_samples() const override { return static_cast<int>(data_->frames.size()); }
+  [[nodiscard]] int num_samples() const override { return static_cast<int>(data_->files.size()); }
   [[nodiscard]] double sample_time(int i) const override { return i / rate_hz_; }
   [[nodiscard]] std::string name() const override { return data_->name; }
+  /// Frame i's positions: from memory, or read again from its file (thread-safe either way).
+  /// @throws IoError naming the file when it cannot be read again or its bytes are no longer
+  ///   those read at construction.
   void positions(int i, Positions& out) const override;
+  /// True when every frame is held in memory (else each but the first is read when asked for).
+  [[nodiscard]] bool frames_in_memory() const { return !data_->frames.empty(); }
 
   [[nodiscard]] const std::filesystem::path& frame_file(int i) const {
     return data_->files[static_cast<std::size_t>(i)];
@@ -81,7 +97,8 @@ class FrameSequenceMotion final : public Motion {
  private:
   struct Data {
     std::vector<std::filesystem::path> files;
-    std::vector<Positions> frames;
+    std::vector<Positions> frames;       ///< every frame, or none (read again: positions())
+    std::vector<std::size_t> checksums;  ///< of each file's bytes, as read at construction
     Mesh mesh;
     std::string name;
   };

@@ -196,6 +196,60 @@ TEST(FrameSequence, MismatchedTopologyIsRefusedNamingTheFrame) {
   EXPECT_EQ(load_frame_sequence(dir).num_samples(), 3);
 }
 
+TEST(FrameSequence, FramesBeyondTheBudgetAreReadAgainBitExactly) {
+  // The funnel's two frames take 2 × 9,450 × 24 bytes, 24.5 per triangle: kept by default.
+  const FrameSequenceMotion kept = load_frame_sequence(funnel_frames());
+  EXPECT_TRUE(kept.frames_in_memory());
+  // With no budget only the first frame is held; the others are read again, to the same bits.
+  const FrameSequenceMotion read_again(
+      list_frame_files(funnel_frames()), FrameSequenceOptions{.kept_bytes_per_triangle = 0});
+  EXPECT_FALSE(read_again.frames_in_memory());
+  ASSERT_EQ(read_again.num_samples(), kept.num_samples());
+  EXPECT_TRUE(read_again.mesh().rest_positions == kept.mesh().rest_positions);
+  EXPECT_TRUE(read_again.mesh().triangles == kept.mesh().triangles);
+  for (int i = 0; i < kept.num_samples(); ++i) {
+    Positions a, b;
+    kept.positions(i, a);
+    read_again.positions(i, b);
+    ASSERT_EQ(a.rows(), b.rows());
+    EXPECT_EQ(
+        0, std::memcmp(a.data(), b.data(), sizeof(double) * static_cast<std::size_t>(a.size())))
+        << "frame " << i;
+  }
+  // A budget just below the two frames' size reads them again too; at it, they are kept.
+  const std::size_t per_triangle = (2 * 9450 * 24) / 18484;  // 24 (24.54 rounded down)
+  EXPECT_FALSE(FrameSequenceMotion(
+                   list_frame_files(funnel_frames()),
+                   FrameSequenceOptions{.kept_bytes_per_triangle = per_triangle})
+                   .frames_in_memory());
+  EXPECT_TRUE(FrameSequenceMotion(
+                  list_frame_files(funnel_frames()),
+                  FrameSequenceOptions{.kept_bytes_per_triangle = per_triangle + 1})
+                  .frames_in_memory());
+}
+
+TEST(FrameSequence, AFrameChangedAfterReadingIsRefusedNamingIt) {
+  const fs::path dir = test::temp_dir("frames_changed");
+  const std::string square = "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3\nf 1 3 4\n";
+  write_file(dir / "frame1.obj", square);
+  write_file(dir / "frame2.obj", "v 0 0 1\nv 1 0 1\nv 1 1 1\nv 0 1 1\nf 1 2 3\nf 1 3 4\n");
+  write_file(dir / "frame3.obj", square);
+  const FrameSequenceMotion motion(
+      list_frame_files(dir), FrameSequenceOptions{.kept_bytes_per_triangle = 0});
+  Positions x;
+  motion.positions(1, x);
+  EXPECT_EQ(x(2, 2), 1.0);
+  // Rewritten with the same topology and other positions: not the frame that was checked.
+  write_file(dir / "frame2.obj", "v 0 0 2\nv 1 0 2\nv 1 1 2\nv 0 1 2\nf 1 2 3\nf 1 3 4\n");
+  EXPECT_THROW_MESSAGE(motion.positions(1, x), IoError, "frame2.obj: frame 1 changed since");
+  fs::remove(dir / "frame3.obj");
+  EXPECT_THROW_MESSAGE(motion.positions(2, x), IoError, "frame3.obj: cannot open frame file");
+  // The first frame is the rest pose, held: its file is not read again.
+  fs::remove(dir / "frame1.obj");
+  motion.positions(0, x);
+  EXPECT_EQ(x(2, 0), 1.0);
+}
+
 TEST(FrameSequence, BadCoordinatesAndIndicesAreRefused) {
   const fs::path dir = test::temp_dir("frames_bad");
   write_file(dir / "nan.obj", "v 0 0 0\nv 1 nan 0\nv 0 1 0\nf 1 2 3\n");
