@@ -57,7 +57,6 @@ void PairBlocks<N>::start(
   pairs_.clear();
   blocks_ = 0;
   candidates_at_start_ = out.counters.candidate_pairs;
-  kept_ = 0;
   kept_visible_ = 0;
   feature_us_ = 0.0;
   test_us_ = 0.0;
@@ -147,7 +146,7 @@ void PairBlocks<N>::drain_beside(Installment step) {
     }
     group.wait();  // rethrows the installment's exception
     overlapping_ = false;
-    kept_visible_ = kept_;
+    kept_visible_ = out_->counters.candidate_pairs - candidates_at_start_;
     done = next_done;
   }
   flush_if_full();
@@ -211,8 +210,7 @@ void PairBlocks<N>::flush_block(std::vector<TrianglePair>& block) {
   }
   block.clear();
   ++blocks_;
-  kept_ = out.counters.candidate_pairs - candidates_at_start_;
-  if (!overlapping_) kept_visible_ = kept_;
+  if (!overlapping_) kept_visible_ = out.counters.candidate_pairs - candidates_at_start_;
 }
 
 template <int N>

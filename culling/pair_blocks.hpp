@@ -177,9 +177,10 @@ class PairBlocks {
   std::size_t first_ = 0;    ///< out's findings before this query
   std::int64_t blocks_ = 0;
   std::int64_t candidates_at_start_ = 0;  ///< out.counters.candidate_pairs at start_*
-  std::int64_t kept_ = 0;                 ///< candidate pairs kept by this query's blocks so far
-  std::int64_t kept_visible_ = 0;         ///< kept_ as of the last installment's start
-  bool overlapping_ = false;              ///< drain_overlapped is running
+  /// Candidate pairs this query's tested blocks kept, as of the current installment's start
+  /// (updated after each block, between rounds while drain_overlapped runs).
+  std::int64_t kept_visible_ = 0;
+  bool overlapping_ = false;  ///< drain_overlapped is running
   double feature_us_ = 0.0;
   double test_us_ = 0.0;
 };
