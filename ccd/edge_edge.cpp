@@ -5,6 +5,7 @@
 #include <cassert>
 
 #include "ccd/after_swept_aabbs.hpp"
+#include "ccd/coplanarity_screen.hpp"
 #include "ccd/detail/conservative_pipeline.hpp"
 #include "ccd/detail/fast_ccd.hpp"
 #include "ccd/detail/relative_boxes.hpp"
@@ -16,8 +17,13 @@ namespace {
 
 // conservative, once the swept AABBs are known to overlap: the pipeline of
 // detail/conservative_pipeline.hpp.
+/// `known`: the query's coplanarity screen, already computed and not certified (the pipeline
+/// then goes on from its next stage), or null.
 CcdResult conservative_after_aabbs(
-    const EdgeEdgeQuery& q, const CcdOptions& options, CcdStats& stats) {
+    const EdgeEdgeQuery& q,
+    const CcdOptions& options,
+    CcdStats& stats,
+    const detail::TrilinearScreen* known = nullptr) {
   // c(t) = (b0 - a0) . ((a1 - a0) x (b1 - b0)); n = d_a x d_b.
   const detail::DifferenceTriple t0{q.eb0_t0 - q.ea0_t0, q.ea1_t0 - q.ea0_t0, q.eb1_t0 - q.eb0_t0};
   const detail::DifferenceTriple t1{q.eb0_t1 - q.ea0_t1, q.ea1_t1 - q.ea0_t1, q.eb1_t1 - q.eb0_t1};
@@ -53,6 +59,10 @@ CcdResult conservative_after_aabbs(
         {&q.ea0_t1, &q.ea1_t1, &q.eb0_t1, &q.eb1_t1},
         0.5 * options.min_separation);
   };
+  if (known != nullptr) {
+    return detail::pipeline_after_screen(
+        t0, t1, *known, 0.0, 0.0, quartic_inputs, problem, relative_apart, options, stats);
+  }
   return detail::conservative_pipeline(
       t0, t1, quartic_inputs, problem, relative_apart, options, stats);
 }
@@ -104,6 +114,21 @@ CcdResult edge_edge_ccd_after_swept_aabbs(
   }
   CcdStats stats;
   return conservative_after_aabbs(query, options, stats);
+}
+
+CcdResult edge_edge_ccd_after_screen(
+    const EdgeEdgeQuery& query,
+    const CcdOptions& options,
+    const CoplanarityScreens& screens,
+    int lane) {
+  assert(options.min_separation == 0.0);
+  assert((screens.apart >> lane & 1u) == 0);
+  const auto k = static_cast<std::size_t>(lane);
+  detail::TrilinearScreen known;
+  known.coefficients = screens.coefficients[k];
+  known.magnitude = screens.magnitude[k];
+  CcdStats stats;
+  return conservative_after_aabbs(query, options, stats, &known);
 }
 
 }  // namespace skelcd::ccd

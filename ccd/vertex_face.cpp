@@ -5,6 +5,7 @@
 #include <cassert>
 
 #include "ccd/after_swept_aabbs.hpp"
+#include "ccd/coplanarity_screen.hpp"
 #include "ccd/detail/conservative_pipeline.hpp"
 #include "ccd/detail/fast_ccd.hpp"
 #include "ccd/detail/relative_boxes.hpp"
@@ -16,8 +17,13 @@ namespace {
 
 // conservative, once the swept AABBs are known to overlap: the pipeline of
 // detail/conservative_pipeline.hpp.
+/// `known`: the query's coplanarity screen, already computed and not certified (the pipeline
+/// then goes on from its next stage), or null.
 CcdResult conservative_after_aabbs(
-    const VertexFaceQuery& q, const CcdOptions& options, CcdStats& stats) {
+    const VertexFaceQuery& q,
+    const CcdOptions& options,
+    CcdStats& stats,
+    const detail::TrilinearScreen* known = nullptr) {
   // c(t) = (p - a) . ((b - a) x (c - a)).
   const detail::DifferenceTriple t0{q.v_t0 - q.f0_t0, q.f1_t0 - q.f0_t0, q.f2_t0 - q.f0_t0};
   const detail::DifferenceTriple t1{q.v_t1 - q.f0_t1, q.f1_t1 - q.f0_t1, q.f2_t1 - q.f0_t1};
@@ -54,6 +60,10 @@ CcdResult conservative_after_aabbs(
         {&q.v_t1, &q.f0_t1, &q.f1_t1, &q.f2_t1},
         0.5 * options.min_separation);
   };
+  if (known != nullptr) {
+    return detail::pipeline_after_screen(
+        t0, t1, *known, 0.0, 0.0, quartic_inputs, problem, relative_apart, options, stats);
+  }
   return detail::conservative_pipeline(
       t0, t1, quartic_inputs, problem, relative_apart, options, stats);
 }
@@ -106,6 +116,21 @@ CcdResult vertex_face_ccd_after_swept_aabbs(
   }
   CcdStats stats;
   return conservative_after_aabbs(query, options, stats);
+}
+
+CcdResult vertex_face_ccd_after_screen(
+    const VertexFaceQuery& query,
+    const CcdOptions& options,
+    const CoplanarityScreens& screens,
+    int lane) {
+  assert(options.min_separation == 0.0);
+  assert((screens.apart >> lane & 1u) == 0);
+  const auto k = static_cast<std::size_t>(lane);
+  detail::TrilinearScreen known;
+  known.coefficients = screens.coefficients[k];
+  known.magnitude = screens.magnitude[k];
+  CcdStats stats;
+  return conservative_after_aabbs(query, options, stats, &known);
 }
 
 }  // namespace skelcd::ccd

@@ -5,10 +5,13 @@
 #include <tbb/task_arena.h>
 
 #include <algorithm>
+#include <array>
 #include <cassert>
 #include <cstdint>
 #include <vector>
 
+#include "ccd/after_swept_aabbs.hpp"
+#include "ccd/coplanarity_screen.hpp"
 #include "culling/pair_sort.hpp"
 
 namespace skelcd::culling {
@@ -75,13 +78,17 @@ thread_local std::vector<Outcome> tl_outcomes;
 /// Per calling thread, likewise: which welded vertices have a certified fan at the DCD instant.
 thread_local std::vector<std::uint8_t> tl_certified_fans;
 
-/// Calls `test(i, outcome)` for i in [0, n), on this thread or split over oneTBB workers when
+/// Calls `test_range(i, count, outcomes)` for consecutive ranges [i, i + count) covering [0, n),
+/// the outcome of query i + k into outcomes[k], on this thread or split over oneTBB workers when
 /// `threads` > 1 and n is large enough, a window of kElementaryOutcomeWindow queries at a time;
 /// then `consume(i, outcome)` for each query of the window, in order. Every outcome goes to its
 /// own slot, so the order of `consume` calls is i's whatever the split.
-template <typename Test, typename Consume>
-void evaluate(
-    std::size_t n, const ElementaryTests& tests, const Test& test, const Consume& consume) {
+template <typename TestRange, typename Consume>
+void evaluate_ranges(
+    std::size_t n,
+    const ElementaryTests& tests,
+    const TestRange& test_range,
+    const Consume& consume) {
   if (n == 0) return;
   const std::size_t window = std::min(n, kElementaryOutcomeWindow);
   if (tl_outcomes.size() < window) {
@@ -104,9 +111,7 @@ void evaluate(
         tbb::parallel_for(
             tbb::blocked_range<std::size_t>(0, count, 64),
             [&](const tbb::blocked_range<std::size_t>& range) {
-              for (std::size_t i = range.begin(); i != range.end(); ++i) {
-                test(first + i, outcomes[i]);
-              }
+              test_range(first + range.begin(), range.size(), outcomes + range.begin());
               report(range.size());
             });
       });
@@ -114,11 +119,69 @@ void evaluate(
       constexpr std::size_t kReportEvery = 1024;
       for (std::size_t start = 0; start < count; start += kReportEvery) {
         const std::size_t end = std::min(count, start + kReportEvery);
-        for (std::size_t i = start; i < end; ++i) test(first + i, outcomes[i]);
+        test_range(first + start, end - start, outcomes + start);
         report(end - start);
       }
     }
     for (std::size_t i = 0; i < count; ++i) consume(first + i, outcomes[i]);
+  }
+}
+
+/// Which kernels `tests` hold: the ccd/ kernels, the same without their swept-AABB stage
+/// (ccd/after_swept_aabbs.hpp), or others (substituted tests, or one of each).
+enum class KernelUse : std::uint8_t { other, product, after_swept_aabbs };
+
+KernelUse kernel_use(const ElementaryTests& tests) {
+  using VertexFaceFn = ElementaryTests::VertexFaceFn;
+  using EdgeEdgeFn = ElementaryTests::EdgeEdgeFn;
+  if (tests.vertex_face == static_cast<VertexFaceFn>(&ccd::vertex_face_ccd) &&
+      tests.edge_edge == static_cast<EdgeEdgeFn>(&ccd::edge_edge_ccd)) {
+    return KernelUse::product;
+  }
+  if (tests.vertex_face == static_cast<VertexFaceFn>(&ccd::vertex_face_ccd_after_swept_aabbs) &&
+      tests.edge_edge == static_cast<EdgeEdgeFn>(&ccd::edge_edge_ccd_after_swept_aabbs)) {
+    return KernelUse::after_swept_aabbs;
+  }
+  return KernelUse::other;
+}
+
+/// evaluate_ranges with `test(i, outcome)` called for each query.
+template <typename Test, typename Consume>
+void evaluate(
+    std::size_t n, const ElementaryTests& tests, const Test& test, const Consume& consume) {
+  evaluate_ranges(
+      n,
+      tests,
+      [&](std::size_t first, std::size_t count, Outcome* outcomes) {
+        for (std::size_t k = 0; k < count; ++k) test(first + k, outcomes[k]);
+      },
+      consume);
+}
+
+/// Tests queries [first, first + count) into outcomes, four at a time: the coplanarity screens of
+/// the four (ccd/coplanarity_screen.hpp; `screen(quads)`) settle those they certify apart, and
+/// `test(i, outcome, screens, lane)` tests the others. `quad(i)` gives query i's four point
+/// indices; a short last group repeats its last query.
+template <typename Quad, typename Screen, typename Test>
+void screened_range(
+    std::size_t first,
+    std::size_t count,
+    Outcome* outcomes,
+    const Quad& quad,
+    const Screen& screen,
+    const Test& test) {
+  std::array<std::array<std::int32_t, 4>, 4> quads;
+  for (std::size_t g = 0; g < count; g += 4) {
+    const std::size_t m = std::min<std::size_t>(4, count - g);
+    for (std::size_t k = 0; k < 4; ++k) quads[k] = quad(first + g + std::min(k, m - 1));
+    const ccd::CoplanarityScreens screens = screen(quads);
+    for (std::size_t k = 0; k < m; ++k) {
+      if ((screens.apart >> k & 1u) != 0) {
+        outcomes[g + k] = Outcome{.hit = false};
+      } else {
+        test(first + g + k, outcomes[g + k], screens, static_cast<int>(k));
+      }
+    }
   }
 }
 
@@ -137,17 +200,48 @@ void run_ccd_tests(
   assert(tests.vertex_face != nullptr && tests.edge_edge != nullptr);
   const std::size_t first = out.contacts.size();
   Counters& c = out.counters;
+  // The product's kernels asked for contact itself: each group of four queries is screened at
+  // once first (ccd/coplanarity_screen.hpp), and the kernel called for those the screen leaves —
+  // from its next stage when it would skip the swept AABBs (after_swept_aabbs.hpp), from its
+  // start otherwise: the same decisions, without assembling and calling for the queries the
+  // screen settles.
+  const KernelUse use = kernel_use(tests);
+  const bool screened = use != KernelUse::other && accuracy == ccd::Accuracy::conservative &&
+                        options.min_separation == 0.0;
+  const bool after_screen = screened && use == KernelUse::after_swept_aabbs;
+  const double* const xd_t0 = x_t0.data();  // row-major: vertex v at 3 v
+  const double* const xd_t1 = x_t1.data();
   // Vertex-face queries: outcomes in candidate order, the hits appended in that order.
-  evaluate(
+  const auto vf_query = [&](std::size_t i) {
+    const VertexFacePair& p = candidates.vf[i];
+    return vertex_face_query(x_t0, x_t1, p.vertex, x_t0, x_t1, topology.triangle(p.face));
+  };
+  const auto vf_test = [&](std::size_t i, Outcome& o) {
+    const ccd::CcdResult r = tests.vertex_face(vf_query(i), accuracy, options);
+    o = {.toi_lower = r.toi_lower, .toi_upper = r.toi_upper, .hit = r.hit};
+  };
+  const auto vf_quad = [&](std::size_t i) {
+    const VertexFacePair& p = candidates.vf[i];
+    const auto& f = topology.triangle(p.face);
+    return std::array<std::int32_t, 4>{p.vertex, f[0], f[1], f[2]};
+  };
+  const auto vf_screen = [&](const std::array<std::array<std::int32_t, 4>, 4>& quads) {
+    return ccd::vertex_face_screen_x4(xd_t0, xd_t1, quads);
+  };
+  const auto vf_rest = [&](std::size_t i, Outcome& o, const ccd::CoplanarityScreens& s, int k) {
+    if (!after_screen) return vf_test(i, o);
+    const ccd::CcdResult r = ccd::vertex_face_ccd_after_screen(vf_query(i), options, s, k);
+    o = {.toi_lower = r.toi_lower, .toi_upper = r.toi_upper, .hit = r.hit};
+  };
+  evaluate_ranges(
       candidates.vf.size(),
       tests,
-      [&](std::size_t i, Outcome& o) {
-        const VertexFacePair& p = candidates.vf[i];
-        const ccd::CcdResult r = tests.vertex_face(
-            vertex_face_query(x_t0, x_t1, p.vertex, x_t0, x_t1, topology.triangle(p.face)),
-            accuracy,
-            options);
-        o = {.toi_lower = r.toi_lower, .toi_upper = r.toi_upper, .hit = r.hit};
+      [&](std::size_t from, std::size_t count, Outcome* outcomes) {
+        if (screened) {
+          screened_range(from, count, outcomes, vf_quad, vf_screen, vf_rest);
+        } else {
+          for (std::size_t k = 0; k < count; ++k) vf_test(from + k, outcomes[k]);
+        }
       },
       [&](std::size_t i, const Outcome& o) {
         ++c.vf_tests;
@@ -157,16 +251,37 @@ void run_ccd_tests(
         out.contacts.push_back({CcdContact::Kind::vf, p.vertex, p.face, o.toi_lower, o.toi_upper});
       });
   // Edge-edge queries, likewise.
-  evaluate(
+  const auto ee_query = [&](std::size_t i) {
+    const EdgeEdgePair& p = candidates.ee[i];
+    return edge_edge_query(x_t0, x_t1, topology.edge(p.a), x_t0, x_t1, topology.edge(p.b));
+  };
+  const auto ee_test = [&](std::size_t i, Outcome& o) {
+    const ccd::CcdResult r = tests.edge_edge(ee_query(i), accuracy, options);
+    o = {.toi_lower = r.toi_lower, .toi_upper = r.toi_upper, .hit = r.hit};
+  };
+  const auto ee_quad = [&](std::size_t i) {
+    const EdgeEdgePair& p = candidates.ee[i];
+    const auto& a = topology.edge(p.a);
+    const auto& b = topology.edge(p.b);
+    return std::array<std::int32_t, 4>{a[0], a[1], b[0], b[1]};
+  };
+  const auto ee_screen = [&](const std::array<std::array<std::int32_t, 4>, 4>& quads) {
+    return ccd::edge_edge_screen_x4(xd_t0, xd_t1, quads);
+  };
+  const auto ee_rest = [&](std::size_t i, Outcome& o, const ccd::CoplanarityScreens& s, int k) {
+    if (!after_screen) return ee_test(i, o);
+    const ccd::CcdResult r = ccd::edge_edge_ccd_after_screen(ee_query(i), options, s, k);
+    o = {.toi_lower = r.toi_lower, .toi_upper = r.toi_upper, .hit = r.hit};
+  };
+  evaluate_ranges(
       candidates.ee.size(),
       tests,
-      [&](std::size_t i, Outcome& o) {
-        const EdgeEdgePair& p = candidates.ee[i];
-        const ccd::CcdResult r = tests.edge_edge(
-            edge_edge_query(x_t0, x_t1, topology.edge(p.a), x_t0, x_t1, topology.edge(p.b)),
-            accuracy,
-            options);
-        o = {.toi_lower = r.toi_lower, .toi_upper = r.toi_upper, .hit = r.hit};
+      [&](std::size_t from, std::size_t count, Outcome* outcomes) {
+        if (screened) {
+          screened_range(from, count, outcomes, ee_quad, ee_screen, ee_rest);
+        } else {
+          for (std::size_t k = 0; k < count; ++k) ee_test(from + k, outcomes[k]);
+        }
       },
       [&](std::size_t i, const Outcome& o) {
         ++c.ee_tests;

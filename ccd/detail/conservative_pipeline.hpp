@@ -51,43 +51,23 @@ inline bool certified_negative(const BernsteinQuartic& g) {
 // finite.
 inline constexpr double kQuarticScreenMagnitude = 0x1p190;
 
-/// @param coplanarity_t0/_t1 X, Y, Z with c(t) = X . (Y x Z) and n = Y x Z; every point of the
-/// query appears in one of them.
-/// @param make_quartic_inputs fills arrays of QuadrupleDifferences and of edge-length bounds L_i
-/// and returns how many (3 or 4): at a point within distance s of contact, g_i >= -s |n| L_i
-/// (docs/ccd.md). Every vector is a difference of two of the query's points. `lengths` is null
-/// when min_separation is 0 (they are not needed).
-/// @param make_problem returns the solver's InclusionProblem (only the few queries that reach it
-/// pay for it).
-/// @param relative_apart returns relative_boxes_apart for the query (asked only with
-/// CcdOptions::relative_boxes, of the queries the coplanarity stage leaves).
+/// The pipeline after stage 1's screen (trilinear_screen, certified_sign) has failed to certify a
+/// sign: from stage 1½ on. conservative_pipeline's parameters; `screen` is the screen of
+/// coplanarity_t0/_t1 (its coefficients and magnitude are read), `normal_bound` and `margin` what
+/// conservative_pipeline derives from min_separation (both 0 without it).
 template <typename MakeQuarticInputs, typename MakeProblem, typename RelativeApart>
-CcdResult conservative_pipeline(
+CcdResult pipeline_after_screen(
     const DifferenceTriple& coplanarity_t0,
     const DifferenceTriple& coplanarity_t1,
+    const TrilinearScreen& screen,
+    double normal_bound,
+    double margin,
     MakeQuarticInputs&& make_quartic_inputs,
     MakeProblem&& make_problem,
     RelativeApart&& relative_apart,
     const CcdOptions& options,
     CcdStats& stats) {
   const double s = options.min_separation;
-  // Stage 1, the coplanarity cubic. First with an error bound from the largest coordinate
-  // magnitudes, >= the exact bound of trilinear_error: when that certifies a sign, so would
-  // cubic_sign (same coefficients, smaller error, no subdivision needed). Otherwise the exact
-  // bound and cubic_sign as before.
-  const TrilinearScreen screen = trilinear_screen(coplanarity_t0, coplanarity_t1);
-  double normal_bound = 0.0;
-  double margin = 0.0;
-  if (s > 0.0) {
-    // |c(t)| <= s |n(t)| <= s N at any time within s: widen the error by s N (docs/ccd.md).
-    normal_bound = cross_norm_bound(coplanarity_t0, coplanarity_t1);
-    margin = s * normal_bound * kRoundUp;
-  }
-  if (certified_sign(
-          screen.coefficients, s > 0.0 ? add_up(screen.error_upper, margin) : screen.error_upper)) {
-    ++stats.coplanarity_rejected;
-    return {};
-  }
   // Stage 1½, the relative boxes: after the cheap coplanarity screen, so that the queries it
   // rejects cost nothing more, and before the exact coplanarity bound, its subdivisions and the
   // quartics, which the queries it removes would reach.
@@ -151,6 +131,56 @@ CcdResult conservative_pipeline(
   if (!r.hit) ++stats.solver_rejected;
   if (r.status == CcdStatus::iteration_limit) ++stats.iteration_limit;
   return {r.hit, r.toi_lower, r.toi_upper, r.status};
+}
+
+/// @param coplanarity_t0/_t1 X, Y, Z with c(t) = X . (Y x Z) and n = Y x Z; every point of the
+/// query appears in one of them.
+/// @param make_quartic_inputs fills arrays of QuadrupleDifferences and of edge-length bounds L_i
+/// and returns how many (3 or 4): at a point within distance s of contact, g_i >= -s |n| L_i
+/// (docs/ccd.md). Every vector is a difference of two of the query's points. `lengths` is null
+/// when min_separation is 0 (they are not needed).
+/// @param make_problem returns the solver's InclusionProblem (only the few queries that reach it
+/// pay for it).
+/// @param relative_apart returns relative_boxes_apart for the query (asked only with
+/// CcdOptions::relative_boxes, of the queries the coplanarity stage leaves).
+template <typename MakeQuarticInputs, typename MakeProblem, typename RelativeApart>
+CcdResult conservative_pipeline(
+    const DifferenceTriple& coplanarity_t0,
+    const DifferenceTriple& coplanarity_t1,
+    MakeQuarticInputs&& make_quartic_inputs,
+    MakeProblem&& make_problem,
+    RelativeApart&& relative_apart,
+    const CcdOptions& options,
+    CcdStats& stats) {
+  const double s = options.min_separation;
+  // Stage 1, the coplanarity cubic. First with an error bound from the largest coordinate
+  // magnitudes, >= the exact bound of trilinear_error: when that certifies a sign, so would
+  // cubic_sign (same coefficients, smaller error, no subdivision needed). Otherwise the exact
+  // bound and cubic_sign as before.
+  const TrilinearScreen screen = trilinear_screen(coplanarity_t0, coplanarity_t1);
+  double normal_bound = 0.0;
+  double margin = 0.0;
+  if (s > 0.0) {
+    // |c(t)| <= s |n(t)| <= s N at any time within s: widen the error by s N (docs/ccd.md).
+    normal_bound = cross_norm_bound(coplanarity_t0, coplanarity_t1);
+    margin = s * normal_bound * kRoundUp;
+  }
+  if (certified_sign(
+          screen.coefficients, s > 0.0 ? add_up(screen.error_upper, margin) : screen.error_upper)) {
+    ++stats.coplanarity_rejected;
+    return {};
+  }
+  return pipeline_after_screen(
+      coplanarity_t0,
+      coplanarity_t1,
+      screen,
+      normal_bound,
+      margin,
+      make_quartic_inputs,
+      make_problem,
+      relative_apart,
+      options,
+      stats);
 }
 
 }  // namespace skelcd::ccd::detail

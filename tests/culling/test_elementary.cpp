@@ -3,16 +3,23 @@
 // scratch each thread keeps between calls stays one window whatever the size of the calls.
 
 #include <gtest/gtest.h>
+#include <tbb/task_arena.h>
 
+#include <algorithm>
+#include <array>
 #include <atomic>
 #include <cmath>
 #include <cstdint>
 #include <thread>
 #include <vector>
 
+#include "ccd/after_swept_aabbs.hpp"
+#include "culling/candidates.hpp"
 #include "culling/elementary.hpp"
 #include "culling/feature_topology.hpp"
 #include "tests/culling/procedural_meshes.hpp"
+#include "tests/culling/test_dual_cone_scenes.hpp"
+#include "tests/support/test_support.hpp"
 
 namespace skelcd::culling {
 namespace {
@@ -163,6 +170,110 @@ TEST(Elementary, CcdCallsLargerThanTheWindowKeepEachHitsOwnTimes) {
     EXPECT_EQ(out.counters.vf_tests, static_cast<std::int64_t>(candidates.vf.size()));
     EXPECT_EQ(out.counters.vf_contacts, static_cast<std::int64_t>(expected.size()));
     EXPECT_LE(elementary_outcome_capacity(), kElementaryOutcomeWindow);
+  }
+}
+
+// The product's kernels reached through a pointer of the test's own: run_ccd_tests cannot tell
+// them from a substituted test and calls them for every query, unscreened.
+ccd::CcdResult vertex_face_unscreened(
+    const ccd::VertexFaceQuery& q, ccd::Accuracy accuracy, const ccd::CcdOptions& options) {
+  return ccd::vertex_face_ccd(q, accuracy, options);
+}
+ccd::CcdResult edge_edge_unscreened(
+    const ccd::EdgeEdgeQuery& q, ccd::Accuracy accuracy, const ccd::CcdOptions& options) {
+  return ccd::edge_edge_ccd(q, accuracy, options);
+}
+
+/// Every pair of triangles a < b whose swept boxes over x_t0 → x_t1 overlap (sweep and prune on
+/// x): the candidates of a whole-mesh CCD without a hierarchy.
+std::vector<TrianglePair> swept_box_pairs(
+    const FeatureTopology& topology,
+    const skinning::Positions& x_t0,
+    const skinning::Positions& x_t1) {
+  const std::int32_t n = topology.num_triangles();
+  std::vector<std::array<double, 6>> box(static_cast<std::size_t>(n));
+  for (std::int32_t t = 0; t < n; ++t) {
+    auto& b = box[static_cast<std::size_t>(t)];
+    b = {1e300, 1e300, 1e300, -1e300, -1e300, -1e300};
+    for (const std::int32_t v : topology.triangle(t)) {
+      for (const skinning::Positions* x : {&x_t0, &x_t1}) {
+        for (int k = 0; k < 3; ++k) {
+          const auto i = static_cast<std::size_t>(k);
+          b[i] = std::min(b[i], (*x)(v, k));
+          b[i + 3] = std::max(b[i + 3], (*x)(v, k));
+        }
+      }
+    }
+  }
+  std::vector<std::int32_t> order(static_cast<std::size_t>(n));
+  for (std::int32_t t = 0; t < n; ++t) order[static_cast<std::size_t>(t)] = t;
+  std::sort(order.begin(), order.end(), [&](std::int32_t a, std::int32_t b) {
+    return box[static_cast<std::size_t>(a)][0] < box[static_cast<std::size_t>(b)][0];
+  });
+  std::vector<TrianglePair> pairs;
+  for (std::size_t i = 0; i < order.size(); ++i) {
+    const auto& a = box[static_cast<std::size_t>(order[i])];
+    for (std::size_t j = i + 1; j < order.size(); ++j) {
+      const auto& b = box[static_cast<std::size_t>(order[j])];
+      if (b[0] > a[3]) break;
+      if (b[1] <= a[4] && a[1] <= b[4] && b[2] <= a[5] && a[2] <= b[5]) {
+        pairs.push_back({std::min(order[i], order[j]), std::max(order[i], order[j])});
+      }
+    }
+  }
+  return pairs;
+}
+
+TEST(Elementary, ScreenedQueriesFindExactlyWhatTheKernelFindsForEachQuery) {
+  // run_ccd_tests screens the product's kernels' queries four at a time and goes on from the
+  // screen for the queries it leaves (ccd/coplanarity_screen.hpp). On a real step — the
+  // cloth-funnel's pinch, every feature pair of its overlapping swept boxes — that finds the
+  // contacts, times and counters that calling the kernel for every query finds: with the full
+  // kernels, with the kernels after the swept boxes (as the traversing methods call them), on one
+  // thread and on two.
+  const test::OpenScene s = test::cloth_funnel_scene(test::asset("cloth-funnel/frames"));
+  const FeatureTopology features(s.mesh, s.topo);
+  const skinning::Positions& x_t0 = s.frames[0];
+  const skinning::Positions& x_t1 = s.frames[1];
+  const std::vector<TrianglePair> pairs = swept_box_pairs(features, x_t0, x_t1);
+  FeatureCandidates candidates;
+  Counters ignored;
+  ccd_candidates_from_triangle_pairs<3>(
+      features, pairs, FeatureBounds<3>{}, candidates, ignored, nullptr, {&x_t0, &x_t1});
+  ASSERT_GT(candidates.vf.size(), 2000u);
+  ASSERT_GT(candidates.ee.size(), 10000u);
+  const auto run = [&](ElementaryTests tests, std::int32_t threads) {
+    tests.threads = threads;
+    FrameResult out;
+    tbb::task_arena arena(threads);
+    arena.execute([&] {
+      run_ccd_tests(
+          features,
+          candidates,
+          x_t0,
+          x_t1,
+          with_ccd_defaults(tests),
+          ccd::Accuracy::conservative,
+          {},
+          out);
+    });
+    return out;
+  };
+  const FrameResult want =
+      run({.vertex_face = &vertex_face_unscreened, .edge_edge = &edge_edge_unscreened}, 1);
+  // The step's contacts (107 EE and 27 VF in the whole check) are among these candidates.
+  EXPECT_GT(want.counters.ee_contacts, 50);
+  EXPECT_GT(want.counters.vf_contacts, 10);
+  const ElementaryTests after_boxes{
+      .vertex_face = &ccd::vertex_face_ccd_after_swept_aabbs,
+      .edge_edge = &ccd::edge_edge_ccd_after_swept_aabbs};
+  for (const std::int32_t threads : {1, 2}) {
+    for (const ElementaryTests& tests : {ElementaryTests{}, after_boxes}) {
+      const FrameResult got = run(tests, threads);
+      EXPECT_EQ(got.contacts, want.contacts) << threads << " threads";  // ids and times
+      EXPECT_EQ(got.counters.vf_tests, want.counters.vf_tests);
+      EXPECT_EQ(got.counters.ee_tests, want.counters.ee_tests);
+    }
   }
 }
 

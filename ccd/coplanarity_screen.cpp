@@ -1,0 +1,219 @@
+// The coplanarity screen of four queries at once: detail::trilinear_screen and certified_sign
+// (detail/trilinear_cubic.hpp, detail/conservative_pipeline.hpp) with one query per lane of a
+// four-double vector. Each lane goes through the scalar code's IEEE operations in its order (no
+// FMA: the build passes -ffp-contract=off), so each bit is the scalar decision.
+
+#include "ccd/coplanarity_screen.hpp"
+
+#include <algorithm>
+#include <bit>
+#include <cstddef>
+#include <cstring>
+#include <limits>
+
+#include "ccd/detail/float_bounds.hpp"
+#include "ccd/detail/screen_x4.hpp"
+
+// Four-double vectors are passed between the inline helpers below; where the baseline ABI has no
+// AVX they are split, which is what the note is about. Nothing crosses a library boundary.
+#pragma GCC diagnostic ignored "-Wpsabi"
+
+namespace skelcd::ccd {
+namespace {
+
+using V = double __attribute__((vector_size(32)));
+using VBits = std::int64_t __attribute__((vector_size(32)));
+
+struct V3 {
+  V x, y, z;
+};
+
+/// Coordinates of one point role across four queries: lane k is query k's point `role`.
+[[gnu::always_inline]] inline V3 gather(const double* x, ScreenQuads q, std::size_t role) {
+  const double* p0 = x + 3 * static_cast<std::ptrdiff_t>(q[0][role]);
+  const double* p1 = x + 3 * static_cast<std::ptrdiff_t>(q[1][role]);
+  const double* p2 = x + 3 * static_cast<std::ptrdiff_t>(q[2][role]);
+  const double* p3 = x + 3 * static_cast<std::ptrdiff_t>(q[3][role]);
+  return {
+      V{p0[0], p1[0], p2[0], p3[0]}, V{p0[1], p1[1], p2[1], p3[1]}, V{p0[2], p1[2], p2[2], p3[2]}};
+}
+
+[[gnu::always_inline]] inline V3 minus(const V3& a, const V3& b) {
+  return {a.x - b.x, a.y - b.y, a.z - b.z};
+}
+
+/// y x z as Eigen's cross (and detail::cross): (y1 z2 - y2 z1, y2 z0 - y0 z2, y0 z1 - y1 z0).
+[[gnu::always_inline]] inline V3 cross(const V3& y, const V3& z) {
+  return {y.y * z.z - y.z * z.y, y.z * z.x - y.x * z.z, y.x * z.y - y.y * z.x};
+}
+
+/// x . c summed left to right, as detail::dot.
+[[gnu::always_inline]] inline V dot(const V3& x, const V3& c) {
+  return x.x * c.x + x.y * c.y + x.z * c.z;
+}
+
+/// The bits of v, and the vector of bits b. By memcpy, which compiles to nothing: GCC 12's UBSan
+/// reports std::bit_cast of these 32-byte vectors as a load of a null pointer.
+[[gnu::always_inline]] inline VBits bits_of(const V& v) {
+  VBits b;
+  std::memcpy(&b, &v, sizeof b);
+  return b;
+}
+[[gnu::always_inline]] inline V from_bits(const VBits& b) {
+  V v;
+  std::memcpy(&v, &b, sizeof v);
+  return v;
+}
+
+[[gnu::always_inline]] inline V vabs(const V& v) {
+  constexpr std::int64_t kMagnitude = std::numeric_limits<std::int64_t>::max();
+  return from_bits(bits_of(v) & kMagnitude);
+}
+
+/// std::max(a, b) per lane: (a < b) ? b : a.
+[[gnu::always_inline]] inline V vmax(const V& a, const V& b) { return a < b ? b : a; }
+
+/// detail::max_abs.
+[[gnu::always_inline]] inline V max_abs(const V3& v) {
+  return vmax(vmax(vabs(v.x), vabs(v.y)), vabs(v.z));
+}
+
+/// The screens of the triples X, Y, Z at t0 and t1 (c(t) = X . (Y x Z)), lane k query k's. `x0` …
+/// `z1` are the differences, formed as the kernels form them.
+[[gnu::always_inline]] inline CoplanarityScreens screen(
+    const V3& x0, const V3& y0, const V3& z0, const V3& x1, const V3& y1, const V3& z1) {
+  // trilinear_coefficients: the dets d_ijk = X_i . (Y_j x Z_k).
+  const V3 c00 = cross(y0, z0);
+  const V3 c10 = cross(y1, z0);
+  const V3 c01 = cross(y0, z1);
+  const V3 c11 = cross(y1, z1);
+  const V d000 = dot(x0, c00);
+  const V d010 = dot(x0, c10);
+  const V d100 = dot(x1, c00);
+  const V d110 = dot(x1, c10);
+  const V d001 = dot(x0, c01);
+  const V d011 = dot(x0, c11);
+  const V d101 = dot(x1, c01);
+  const V d111 = dot(x1, c11);
+  const V b0 = d000;
+  const V b1 = ((d100 + d010) + d001) / 3.0;
+  const V b2 = ((d011 + d101) + d110) / 3.0;
+  const V b3 = d111;
+  // trilinear_screen's error bound from the largest coordinate magnitudes.
+  const V x = vmax(max_abs(x0), max_abs(x1));
+  const V y = vmax(max_abs(y0), max_abs(y1));
+  const V z = vmax(max_abs(z0), max_abs(z1));
+  const V q = y * z;
+  const V cross_perm = q + q;
+  const V r = x * cross_perm;
+  const V det_perm = (r + r) + r;
+  constexpr double kInf = std::numeric_limits<double>::infinity();
+  const V perm = det_perm < 0x1p1020 ? det_perm * detail::kRoundUp : V{kInf, kInf, kInf, kInf};
+  const V rounding = detail::rounding_bound(11, 1.0) * perm;
+  // detail::times_subnormal_power_of_two<1070>(1 + x), both of its branches per lane.
+  const V one_x = 1.0 + x;
+  const V shifted = one_x * 16.0 + 0x1p52;
+  const V in_units = from_bits(bits_of(shifted) - std::bit_cast<std::int64_t>(0x1p52));
+  const V scaled = (one_x * 0x1p-600) * detail::power_of_two(600 - 1070);
+  const V underflow = ((one_x >= 0.0) & (one_x < 0x1p48)) ? in_units : scaled;
+  const V error = (rounding + underflow) * detail::kRoundUp;
+  // certified_sign: finite coefficients, all above the error or all below its negative.
+  constexpr double kMax = std::numeric_limits<double>::max();
+  const VBits finite =
+      (vabs(b0) <= kMax) & (vabs(b1) <= kMax) & (vabs(b2) <= kMax) & (vabs(b3) <= kMax);
+  const VBits positive = (b0 > error) & (b1 > error) & (b2 > error) & (b3 > error);
+  const VBits negative = (-b0 > error) & (-b1 > error) & (-b2 > error) & (-b3 > error);
+  const VBits certified = finite & (positive | negative);
+  CoplanarityScreens out;
+  for (std::size_t k = 0; k < 4; ++k) {
+    out.apart |= static_cast<unsigned>(certified[k] != 0) << k;
+    out.coefficients[k] = {b0[k], b1[k], b2[k], b3[k]};
+    // trilinear_screen's magnitude, std::max({x, y, z}): the largest, the first of equals.
+    out.magnitude[k] = std::max({x[k], y[k], z[k]});
+  }
+  return out;
+}
+
+/// The vertex-face screen: X = v - f0, Y = f1 - f0, Z = f2 - f0 (vertex_face.cpp).
+[[gnu::always_inline]] inline CoplanarityScreens vertex_face_body(
+    const double* x_t0, const double* x_t1, ScreenQuads q) {
+  const V3 f0_t0 = gather(x_t0, q, 1);
+  const V3 f0_t1 = gather(x_t1, q, 1);
+  return screen(
+      minus(gather(x_t0, q, 0), f0_t0),
+      minus(gather(x_t0, q, 2), f0_t0),
+      minus(gather(x_t0, q, 3), f0_t0),
+      minus(gather(x_t1, q, 0), f0_t1),
+      minus(gather(x_t1, q, 2), f0_t1),
+      minus(gather(x_t1, q, 3), f0_t1));
+}
+
+/// The edge-edge screen: X = eb0 - ea0, Y = ea1 - ea0, Z = eb1 - eb0 (edge_edge.cpp).
+[[gnu::always_inline]] inline CoplanarityScreens edge_edge_body(
+    const double* x_t0, const double* x_t1, ScreenQuads q) {
+  const V3 ea0_t0 = gather(x_t0, q, 0);
+  const V3 eb0_t0 = gather(x_t0, q, 2);
+  const V3 ea0_t1 = gather(x_t1, q, 0);
+  const V3 eb0_t1 = gather(x_t1, q, 2);
+  return screen(
+      minus(eb0_t0, ea0_t0),
+      minus(gather(x_t0, q, 1), ea0_t0),
+      minus(gather(x_t0, q, 3), eb0_t0),
+      minus(eb0_t1, ea0_t1),
+      minus(gather(x_t1, q, 1), ea0_t1),
+      minus(gather(x_t1, q, 3), eb0_t1));
+}
+
+#if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
+#define SKELCD_SCREEN_AVX2 1
+// The same bodies compiled for AVX2: one instruction per operation on the four lanes.
+[[gnu::target("avx2")]] CoplanarityScreens vertex_face_avx2(
+    const double* x_t0, const double* x_t1, ScreenQuads q) {
+  return vertex_face_body(x_t0, x_t1, q);
+}
+[[gnu::target("avx2")]] CoplanarityScreens edge_edge_avx2(
+    const double* x_t0, const double* x_t1, ScreenQuads q) {
+  return edge_edge_body(x_t0, x_t1, q);
+}
+/// Whether this CPU has AVX2, asked once.
+bool has_avx2() {
+  static const bool kHas = [] {
+    __builtin_cpu_init();
+    return __builtin_cpu_supports("avx2") != 0;
+  }();
+  return kHas;
+}
+#endif
+
+}  // namespace
+
+CoplanarityScreens vertex_face_screen_x4(
+    const double* x_t0, const double* x_t1, ScreenQuads queries) {
+#if defined(SKELCD_SCREEN_AVX2)
+  if (has_avx2()) return vertex_face_avx2(x_t0, x_t1, queries);
+#endif
+  return vertex_face_body(x_t0, x_t1, queries);
+}
+
+CoplanarityScreens edge_edge_screen_x4(
+    const double* x_t0, const double* x_t1, ScreenQuads queries) {
+#if defined(SKELCD_SCREEN_AVX2)
+  if (has_avx2()) return edge_edge_avx2(x_t0, x_t1, queries);
+#endif
+  return edge_edge_body(x_t0, x_t1, queries);
+}
+
+namespace detail {
+
+CoplanarityScreens vertex_face_screen_x4_baseline(
+    const double* x_t0, const double* x_t1, ScreenQuads queries) {
+  return vertex_face_body(x_t0, x_t1, queries);
+}
+
+CoplanarityScreens edge_edge_screen_x4_baseline(
+    const double* x_t0, const double* x_t1, ScreenQuads queries) {
+  return edge_edge_body(x_t0, x_t1, queries);
+}
+
+}  // namespace detail
+}  // namespace skelcd::ccd
