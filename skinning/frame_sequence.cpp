@@ -13,6 +13,7 @@
 #include <functional>
 #include <sstream>
 #include <string_view>
+#include <type_traits>
 
 #include "skinning/errors.hpp"
 #include "skinning/load.hpp"
@@ -238,23 +239,19 @@ class PlyReader {
 
   /// decode() of an integral type, as the integer itself.
   [[nodiscard]] static std::int64_t decode_integer(PlyType type, const char* at, bool swap) {
-    const std::size_t n = type_size(type);
-    unsigned char raw[4];
-    std::memcpy(raw, at, n);
-    if (swap) std::reverse(raw, raw + n);
     switch (type) {
       case PlyType::kInt8:
-        return static_cast<std::int8_t>(raw[0]);
+        return load<std::int8_t>(at, swap);
       case PlyType::kUint8:
-        return raw[0];
+        return load<std::uint8_t>(at, swap);
       case PlyType::kInt16:
-        return load<std::int16_t>(raw);
+        return load<std::int16_t>(at, swap);
       case PlyType::kUint16:
-        return load<std::uint16_t>(raw);
+        return load<std::uint16_t>(at, swap);
       case PlyType::kInt32:
-        return load<std::int32_t>(raw);
+        return load<std::int32_t>(at, swap);
       case PlyType::kUint32:
-        return load<std::uint32_t>(raw);
+        return load<std::uint32_t>(at, swap);
       case PlyType::kFloat32:
       case PlyType::kFloat64:
         break;
@@ -264,29 +261,50 @@ class PlyReader {
 
   /// The binary value of `type` at `at` (type_size(type) bytes), in the file's byte order.
   [[nodiscard]] static double decode(PlyType type, const char* at, bool swap) {
-    const std::size_t n = type_size(type);
-    unsigned char raw[8];
-    std::memcpy(raw, at, n);
-    if (swap) std::reverse(raw, raw + n);
     switch (type) {
-      case PlyType::kInt8: return static_cast<double>(static_cast<std::int8_t>(raw[0]));
-      case PlyType::kUint8: return static_cast<double>(raw[0]);
-      case PlyType::kInt16: return static_cast<double>(load<std::int16_t>(raw));
-      case PlyType::kUint16: return static_cast<double>(load<std::uint16_t>(raw));
-      case PlyType::kInt32: return static_cast<double>(load<std::int32_t>(raw));
-      case PlyType::kUint32: return static_cast<double>(load<std::uint32_t>(raw));
-      case PlyType::kFloat32: return static_cast<double>(load<float>(raw));
-      case PlyType::kFloat64: return load<double>(raw);
+      case PlyType::kInt8:
+        return static_cast<double>(load<std::int8_t>(at, swap));
+      case PlyType::kUint8:
+        return static_cast<double>(load<std::uint8_t>(at, swap));
+      case PlyType::kInt16:
+        return static_cast<double>(load<std::int16_t>(at, swap));
+      case PlyType::kUint16:
+        return static_cast<double>(load<std::uint16_t>(at, swap));
+      case PlyType::kInt32:
+        return static_cast<double>(load<std::int32_t>(at, swap));
+      case PlyType::kUint32:
+        return static_cast<double>(load<std::uint32_t>(at, swap));
+      case PlyType::kFloat32:
+        return static_cast<double>(load<float>(at, swap));
+      case PlyType::kFloat64:
+        return load<double>(at, swap);
     }
     return 0.0;
   }
 
  private:
+  /// The T stored at `at`, its bytes reversed first when `swap`: one byte-swap instruction
+  /// (a big-endian file's values were reversed byte by byte, most of a cloth-ball frame's read).
   template <typename T>
-  static T load(const unsigned char* raw) {
-    T v;
-    std::memcpy(&v, raw, sizeof v);
-    return v;
+  static T load(const char* at, bool swap) {
+    if constexpr (sizeof(T) == 1) {
+      T v;
+      std::memcpy(&v, at, 1);
+      return v;
+    } else {
+      using Bits = std::conditional_t<
+          sizeof(T) == 2,
+          std::uint16_t,
+          std::conditional_t<sizeof(T) == 4, std::uint32_t, std::uint64_t>>;
+      Bits bits;
+      std::memcpy(&bits, at, sizeof bits);
+      if (swap) {
+        if constexpr (sizeof(T) == 2) bits = __builtin_bswap16(bits);
+        if constexpr (sizeof(T) == 4) bits = __builtin_bswap32(bits);
+        if constexpr (sizeof(T) == 8) bits = __builtin_bswap64(bits);
+      }
+      return std::bit_cast<T>(bits);
+    }
   }
 
   double read_ascii() {

@@ -2,17 +2,19 @@
 // the binary PLY written here), vertex order as in the file (and as assimp reads it), natural
 // order, globs, refused topologies and coordinates.
 
-#include "skinning/frame_sequence.hpp"
-
-#include <cmath>
-#include <cstring>
-#include <fstream>
-
-#include <assimp/Importer.hpp>
 #include <assimp/scene.h>
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <assimp/Importer.hpp>
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <cstring>
+#include <fstream>
+
 #include "skinning/errors.hpp"
+#include "skinning/frame_sequence.hpp"
 #include "skinning/load.hpp"
 #include "tests/support/test_support.hpp"
 
@@ -178,6 +180,148 @@ TEST(FrameSequence, ObjAndPlyVariants) {
   // Truncated: drop the last index byte.
   write_file(dir / "cut.ply", big.substr(0, big.size() - 1));
   EXPECT_THROW_MESSAGE((void)read_frame_mesh(dir / "cut.ply"), IoError, "cut.ply: PLY body ends early");
+}
+
+// Every PLY scalar type, as a coordinate, a skipped property, a list's count and its indices:
+// the same values written as ASCII, binary little endian and binary big endian read the same,
+// and as written (each binary value of a type is read through that type's own byte order; a value
+// read with the wrong width or order would differ).
+TEST(FrameSequence, EveryPlyTypeReadsTheSameInEachByteOrder) {
+  const fs::path dir = test::temp_dir("frames_ply_types");
+  struct Type {
+    const char* name;
+    int bytes;
+    bool floating;
+    bool is_signed;
+  };
+  const Type types[] = {
+      {"char", 1, false, true},
+      {"uchar", 1, false, false},
+      {"short", 2, false, true},
+      {"ushort", 2, false, false},
+      {"int", 4, false, true},
+      {"uint", 4, false, false},
+      {"float", 4, true, true},
+      {"double", 8, true, true}};
+  // A value of `t` with distinct bytes where the width allows (so a swapped read is seen).
+  const auto value = [](const Type& t, int vertex, int axis) -> double {
+    const int k = 3 * vertex + axis;
+    if (t.floating) return (t.bytes == 4 ? 1.5 : 1.0 + 0x1p-40) * (k + 1) * (axis == 1 ? -1 : 1);
+    if (t.bytes == 1) return t.is_signed ? -(k + 1) : 200 + k;
+    if (t.bytes == 2) return t.is_signed ? -(0x1234 + k) : 0xA1B2 + k;
+    return t.is_signed ? -(305419896.0 + k) : 2712847316.0 + k;  // 0x12345678, 0xA1B2C3D4
+  };
+  const auto put = [](std::string& out, const Type& t, double v, bool big) {
+    unsigned char raw[8];
+    switch (t.bytes) {
+      case 1: {
+        const auto b = t.is_signed ? static_cast<std::uint8_t>(static_cast<std::int8_t>(v))
+                                   : static_cast<std::uint8_t>(v);
+        std::memcpy(raw, &b, 1);
+        break;
+      }
+      case 2: {
+        const auto b = t.is_signed ? static_cast<std::uint16_t>(static_cast<std::int16_t>(v))
+                                   : static_cast<std::uint16_t>(v);
+        std::memcpy(raw, &b, 2);
+        break;
+      }
+      case 4: {
+        if (t.floating) {
+          const auto f = static_cast<float>(v);
+          std::memcpy(raw, &f, 4);
+        } else {
+          const auto b = t.is_signed ? static_cast<std::uint32_t>(static_cast<std::int32_t>(v))
+                                     : static_cast<std::uint32_t>(v);
+          std::memcpy(raw, &b, 4);
+        }
+        break;
+      }
+      default:
+        std::memcpy(raw, &v, 8);
+    }
+    const auto n = static_cast<std::size_t>(t.bytes);
+    if (big) std::reverse(raw, raw + n);  // this machine is little endian (x86-64)
+    out.append(reinterpret_cast<const char*>(raw), n);
+  };
+  const Type index_types[] = {types[0], types[1], types[2], types[3], types[4], types[5]};
+  int files = 0;
+  for (const Type& coordinate : types) {
+    for (const Type& index : index_types) {
+      // The list count: a type other than the index's, where there is one of that width.
+      const Type& count = index_types[(&index - index_types + 1) % 6];
+      const Type& skipped = types[(&coordinate - types + 3) % 8];
+      std::string header = "ply\nformat FORMAT 1.0\nelement vertex 4\n";
+      for (const char* axis : {"x", "y", "z"})
+        header += std::string("property ") + coordinate.name + " " + axis + "\n";
+      header += std::string("property ") + skipped.name + " extra\n";
+      header += std::string("element face 2\nproperty list ") + count.name + " " + index.name +
+                " vertex_indices\nend_header\n";
+      const int faces[2][3] = {{0, 1, 2}, {3, 2, 1}};
+      std::vector<FrameMesh> read;
+      for (const char* format : {"ascii", "binary_little_endian", "binary_big_endian"}) {
+        std::string text = header;
+        text.replace(text.find("FORMAT"), 6, format);
+        const bool ascii = std::string(format) == "ascii";
+        const bool big = std::string(format) == "binary_big_endian";
+        for (int v = 0; v < 4; ++v) {
+          for (int a = 0; a < 3; ++a) {
+            const double x = value(coordinate, v, a);
+            if (ascii) {
+              char buffer[64];
+              std::snprintf(
+                  buffer,
+                  sizeof buffer,
+                  "%.17g ",
+                  coordinate.bytes == 4 && coordinate.floating
+                      ? static_cast<double>(static_cast<float>(x))
+                      : x);
+              text += buffer;
+            } else {
+              put(text, coordinate, x, big);
+            }
+          }
+          const double e = value(skipped, v, 0);
+          if (ascii) {
+            text += std::to_string(static_cast<long long>(std::llround(e))) + "\n";
+          } else {
+            put(text, skipped, e, big);
+          }
+        }
+        for (const auto& f : faces) {
+          if (ascii) {
+            text += "3 " + std::to_string(f[0]) + " " + std::to_string(f[1]) + " " +
+                    std::to_string(f[2]) + "\n";
+          } else {
+            put(text, count, 3, big);
+            for (const int i : f) put(text, index, i, big);
+          }
+        }
+        const fs::path file =
+            dir / (std::string(coordinate.name) + "_" + index.name + "_" + format + ".ply");
+        write_file(file, text);
+        read.push_back(read_frame_mesh(file));
+        ++files;
+      }
+      SCOPED_TRACE(
+          std::string(coordinate.name) + " coordinates, " + count.name + "/" + index.name +
+          " lists, " + skipped.name + " skipped");
+      for (const FrameMesh& m : read) {
+        ASSERT_EQ(m.positions.rows(), 4);
+        ASSERT_EQ(m.triangles.rows(), 2);
+        for (int v = 0; v < 4; ++v) {
+          for (int a = 0; a < 3; ++a) {
+            double want = value(coordinate, v, a);
+            if (coordinate.floating && coordinate.bytes == 4) want = static_cast<float>(want);
+            EXPECT_EQ(m.positions(v, a), want) << v << "," << a;
+          }
+        }
+        EXPECT_EQ(m.triangles.row(0), Eigen::RowVector3i(0, 1, 2));
+        EXPECT_EQ(m.triangles.row(1), Eigen::RowVector3i(3, 2, 1));
+      }
+    }
+  }
+  EXPECT_EQ(files, 8 * 6 * 3);
 }
 
 TEST(FrameSequence, MismatchedTopologyIsRefusedNamingTheFrame) {
