@@ -59,9 +59,27 @@ std::string read_bytes(const fs::path& file) {
 }
 
 // Builds the FrameMesh from polygons, checking indices and finiteness.
-FrameMesh finish(const fs::path& file, std::vector<double>&& xyz,
-                 const std::vector<std::int64_t>& corners, const std::vector<std::size_t>& face_sizes) {
-  FrameMesh m;
+/// What a reader collects before finish() checks it: coordinates, face corners, face sizes.
+/// Held by the caller, so that a sequence's frames reuse its storage (a cloth-ball frame's is
+/// about 4 MB: fresh pages for each frame cost more than decoding it).
+struct FrameScratch {
+  std::vector<double> xyz;
+  std::vector<std::int64_t> corners;
+  std::vector<std::size_t> face_sizes;
+
+  void clear() {
+    xyz.clear();
+    corners.clear();
+    face_sizes.clear();
+  }
+};
+
+/// Checks what a reader collected and writes the frame into `m` (its storage reused when the
+/// sizes are the same).
+void finish(const fs::path& file, const FrameScratch& scratch, FrameMesh& m) {
+  const std::vector<double>& xyz = scratch.xyz;
+  const std::vector<std::int64_t>& corners = scratch.corners;
+  const std::vector<std::size_t>& face_sizes = scratch.face_sizes;
   const auto nv = static_cast<Eigen::Index>(xyz.size() / 3);
   m.positions.resize(nv, 3);
   for (Eigen::Index v = 0; v < nv; ++v) {
@@ -100,16 +118,17 @@ FrameMesh finish(const fs::path& file, std::vector<double>&& xyz,
     }
     at += face_sizes[f];
   }
-  return m;
 }
 
 // ---------------------------------------------------------------------------------------------
 // OBJ: `v x y z [w | r g b]` and `f a b c ...` with `a`, `a/t`, `a//n`, `a/t/n`; negative indices
 // count back from the last vertex read.
-FrameMesh read_obj(const fs::path& file, const std::string& text) {
-  std::vector<double> xyz;
-  std::vector<std::int64_t> corners;
-  std::vector<std::size_t> face_sizes;
+void read_obj(
+    const fs::path& file, const std::string& text, FrameScratch& scratch, FrameMesh& out) {
+  scratch.clear();
+  std::vector<double>& xyz = scratch.xyz;
+  std::vector<std::int64_t>& corners = scratch.corners;
+  std::vector<std::size_t>& face_sizes = scratch.face_sizes;
   std::size_t line_number = 0;
   std::size_t pos = 0;
   while (pos < text.size()) {
@@ -155,7 +174,7 @@ FrameMesh read_obj(const fs::path& file, const std::string& text) {
       face_sizes.push_back(n);
     }
   }
-  return finish(file, std::move(xyz), corners, face_sizes);
+  finish(file, scratch, out);
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -326,7 +345,8 @@ class PlyReader {
   PlyFormat format_;
 };
 
-FrameMesh read_ply(const fs::path& file, const std::string& bytes) {
+void read_ply(
+    const fs::path& file, const std::string& bytes, FrameScratch& scratch, FrameMesh& out) {
   // Header: lines up to and including "end_header".
   std::size_t pos = 0;
   std::vector<PlyElement> elements;
@@ -410,9 +430,10 @@ FrameMesh read_ply(const fs::path& file, const std::string& bytes) {
     }
     return static_cast<std::int64_t>(index);
   };
-  std::vector<double> xyz;
-  std::vector<std::int64_t> corners;
-  std::vector<std::size_t> face_sizes;
+  scratch.clear();
+  std::vector<double>& xyz = scratch.xyz;
+  std::vector<std::int64_t>& corners = scratch.corners;
+  std::vector<std::size_t>& face_sizes = scratch.face_sizes;
   bool have_vertices = false;
   for (const PlyElement& e : elements) {
     int ix = -1, iy = -1, iz = -1, ilist = -1;
@@ -539,7 +560,7 @@ FrameMesh read_ply(const fs::path& file, const std::string& bytes) {
     }
   }
   if (!have_vertices) throw IoError(file.string() + ": PLY file has no vertex element");
-  return finish(file, std::move(xyz), corners, face_sizes);
+  finish(file, scratch, out);
 }
 
 }  // namespace
@@ -555,9 +576,22 @@ bool is_obj(const fs::path& file) {
   return ext == ".obj";
 }
 
+/// read_frame_mesh of the file's bytes, read already, into `out` with `scratch`'s storage.
+void parse_frame_mesh(
+    const fs::path& file, const std::string& bytes, FrameScratch& scratch, FrameMesh& out) {
+  if (is_obj(file)) {
+    read_obj(file, bytes, scratch, out);
+  } else {
+    read_ply(file, bytes, scratch, out);
+  }
+}
+
 /// read_frame_mesh of the file's bytes, read already.
 FrameMesh parse_frame_mesh(const fs::path& file, const std::string& bytes) {
-  return is_obj(file) ? read_obj(file, bytes) : read_ply(file, bytes);
+  FrameScratch scratch;
+  FrameMesh out;
+  parse_frame_mesh(file, bytes, scratch, out);
+  return out;
 }
 
 /// What tells a frame file's bytes from other bytes (within one process).
@@ -649,11 +683,15 @@ FrameSequenceMotion::FrameSequenceMotion(
   Triangles triangles;
   Positions first;
   bool keep = true;  // decided once the first frame's size is known
+  // The bytes, the reader's scratch and the frame are reused from file to file: a frame that is
+  // not kept leaves its storage to the next.
   std::string bytes;
+  FrameScratch scratch;
+  FrameMesh frame;
   for (std::size_t i = 0; i < files.size(); ++i) {
     read_bytes(files[i], bytes);
     data->checksums.push_back(checksum(bytes));
-    FrameMesh frame = parse_frame_mesh(files[i], bytes);
+    parse_frame_mesh(files[i], bytes, scratch, frame);
     if (i == 0) {
       triangles = std::move(frame.triangles);
       const double frame_bytes = 24.0 * static_cast<double>(frame.positions.rows());
