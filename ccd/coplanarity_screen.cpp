@@ -134,85 +134,88 @@ struct V3 {
   return out;
 }
 
-/// The vertex-face screen: X = v - f0, Y = f1 - f0, Z = f2 - f0 (vertex_face.cpp).
-[[gnu::always_inline]] inline CoplanarityScreens vertex_face_body(
+/// The screens of four queries of one kind, the differences formed as the kernels form them:
+/// vertex-face (vertex_face.cpp) X = v - f0, Y = f1 - f0, Z = f2 - f0; edge-edge (edge_edge.cpp)
+/// X = eb0 - ea0, Y = ea1 - ea0, Z = eb1 - eb0.
+template <bool kVertexFace>
+[[gnu::always_inline]] inline CoplanarityScreens body(
     const double* x_t0, const double* x_t1, ScreenQuads q) {
-  const V3 f0_t0 = gather(x_t0, q, 1);
-  const V3 f0_t1 = gather(x_t1, q, 1);
-  return screen(
-      minus(gather(x_t0, q, 0), f0_t0),
-      minus(gather(x_t0, q, 2), f0_t0),
-      minus(gather(x_t0, q, 3), f0_t0),
-      minus(gather(x_t1, q, 0), f0_t1),
-      minus(gather(x_t1, q, 2), f0_t1),
-      minus(gather(x_t1, q, 3), f0_t1));
+  // Roles: vertex-face (v, f0, f1, f2), edge-edge (ea0, ea1, eb0, eb1).
+  const V3 p0_t0 = gather(x_t0, q, 0), p1_t0 = gather(x_t0, q, 1);
+  const V3 p2_t0 = gather(x_t0, q, 2), p3_t0 = gather(x_t0, q, 3);
+  const V3 p0_t1 = gather(x_t1, q, 0), p1_t1 = gather(x_t1, q, 1);
+  const V3 p2_t1 = gather(x_t1, q, 2), p3_t1 = gather(x_t1, q, 3);
+  if constexpr (kVertexFace) {
+    return screen(
+        minus(p0_t0, p1_t0),
+        minus(p2_t0, p1_t0),
+        minus(p3_t0, p1_t0),
+        minus(p0_t1, p1_t1),
+        minus(p2_t1, p1_t1),
+        minus(p3_t1, p1_t1));
+  } else {
+    return screen(
+        minus(p2_t0, p0_t0),
+        minus(p1_t0, p0_t0),
+        minus(p3_t0, p2_t0),
+        minus(p2_t1, p0_t1),
+        minus(p1_t1, p0_t1),
+        minus(p3_t1, p2_t1));
+  }
 }
 
-/// The edge-edge screen: X = eb0 - ea0, Y = ea1 - ea0, Z = eb1 - eb0 (edge_edge.cpp).
-[[gnu::always_inline]] inline CoplanarityScreens edge_edge_body(
-    const double* x_t0, const double* x_t1, ScreenQuads q) {
-  const V3 ea0_t0 = gather(x_t0, q, 0);
-  const V3 eb0_t0 = gather(x_t0, q, 2);
-  const V3 ea0_t1 = gather(x_t1, q, 0);
-  const V3 eb0_t1 = gather(x_t1, q, 2);
-  return screen(
-      minus(eb0_t0, ea0_t0),
-      minus(gather(x_t0, q, 1), ea0_t0),
-      minus(gather(x_t0, q, 3), eb0_t0),
-      minus(eb0_t1, ea0_t1),
-      minus(gather(x_t1, q, 1), ea0_t1),
-      minus(gather(x_t1, q, 3), eb0_t1));
-}
-
+/// Whether the screens run on AVX2: this CPU has it (asked once).
+bool use_avx2() {
 #if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
-#define SKELCD_SCREEN_AVX2 1
-// The same bodies compiled for AVX2: one instruction per operation on the four lanes.
-[[gnu::target("avx2")]] CoplanarityScreens vertex_face_avx2(
-    const double* x_t0, const double* x_t1, ScreenQuads q) {
-  return vertex_face_body(x_t0, x_t1, q);
-}
-[[gnu::target("avx2")]] CoplanarityScreens edge_edge_avx2(
-    const double* x_t0, const double* x_t1, ScreenQuads q) {
-  return edge_edge_body(x_t0, x_t1, q);
-}
-/// Whether this CPU has AVX2, asked once.
-bool has_avx2() {
   static const bool kHas = [] {
     __builtin_cpu_init();
     return __builtin_cpu_supports("avx2") != 0;
   }();
   return kHas;
+#else
+  return false;
+#endif
+}
+
+#if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
+/// body compiled for AVX2: one instruction per operation on the four lanes.
+template <bool kVertexFace>
+[[gnu::target("avx2")]] CoplanarityScreens body_avx2(
+    const double* x_t0, const double* x_t1, ScreenQuads q) {
+  return body<kVertexFace>(x_t0, x_t1, q);
 }
 #endif
+
+template <bool kVertexFace>
+CoplanarityScreens dispatch(const double* x_t0, const double* x_t1, ScreenQuads q) {
+#if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
+  if (use_avx2()) return body_avx2<kVertexFace>(x_t0, x_t1, q);
+#endif
+  return body<kVertexFace>(x_t0, x_t1, q);
+}
 
 }  // namespace
 
 CoplanarityScreens vertex_face_screen_x4(
     const double* x_t0, const double* x_t1, ScreenQuads queries) {
-#if defined(SKELCD_SCREEN_AVX2)
-  if (has_avx2()) return vertex_face_avx2(x_t0, x_t1, queries);
-#endif
-  return vertex_face_body(x_t0, x_t1, queries);
+  return dispatch<true>(x_t0, x_t1, queries);
 }
 
 CoplanarityScreens edge_edge_screen_x4(
     const double* x_t0, const double* x_t1, ScreenQuads queries) {
-#if defined(SKELCD_SCREEN_AVX2)
-  if (has_avx2()) return edge_edge_avx2(x_t0, x_t1, queries);
-#endif
-  return edge_edge_body(x_t0, x_t1, queries);
+  return dispatch<false>(x_t0, x_t1, queries);
 }
 
 namespace detail {
 
 CoplanarityScreens vertex_face_screen_x4_baseline(
     const double* x_t0, const double* x_t1, ScreenQuads queries) {
-  return vertex_face_body(x_t0, x_t1, queries);
+  return body<true>(x_t0, x_t1, queries);
 }
 
 CoplanarityScreens edge_edge_screen_x4_baseline(
     const double* x_t0, const double* x_t1, ScreenQuads queries) {
-  return edge_edge_body(x_t0, x_t1, queries);
+  return body<false>(x_t0, x_t1, queries);
 }
 
 }  // namespace detail

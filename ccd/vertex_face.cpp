@@ -9,6 +9,7 @@
 #include "ccd/detail/conservative_pipeline.hpp"
 #include "ccd/detail/fast_ccd.hpp"
 #include "ccd/detail/relative_boxes.hpp"
+#include "ccd/detail/screen_x4.hpp"
 #include "ccd/exact_ccd.hpp"
 #include "ccd/filters.hpp"
 
@@ -123,12 +124,8 @@ CcdResult vertex_face_ccd_after_screen(
     const CcdOptions& options,
     const CoplanarityScreens& screens,
     int lane) {
-  assert(options.min_separation == 0.0);
-  assert((screens.apart >> lane & 1u) == 0);
-  const auto k = static_cast<std::size_t>(lane);
-  detail::TrilinearScreen known;
-  known.coefficients = screens.coefficients[k];
-  known.magnitude = screens.magnitude[k];
+  assert(options.min_separation == 0.0 && (screens.apart >> lane & 1u) == 0);
+  const detail::TrilinearScreen known = detail::lane_screen(screens, lane);
   CcdStats stats;
   return conservative_after_aabbs(query, options, stats, &known);
 }

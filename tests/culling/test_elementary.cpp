@@ -18,6 +18,7 @@
 #include "culling/elementary.hpp"
 #include "culling/feature_topology.hpp"
 #include "tests/culling/procedural_meshes.hpp"
+#include "tests/culling/renamed_kernels.hpp"
 #include "tests/culling/test_dual_cone_scenes.hpp"
 #include "tests/support/test_support.hpp"
 
@@ -173,17 +174,6 @@ TEST(Elementary, CcdCallsLargerThanTheWindowKeepEachHitsOwnTimes) {
   }
 }
 
-// The product's kernels reached through a pointer of the test's own: run_ccd_tests cannot tell
-// them from a substituted test and calls them for every query, unscreened.
-ccd::CcdResult vertex_face_unscreened(
-    const ccd::VertexFaceQuery& q, ccd::Accuracy accuracy, const ccd::CcdOptions& options) {
-  return ccd::vertex_face_ccd(q, accuracy, options);
-}
-ccd::CcdResult edge_edge_unscreened(
-    const ccd::EdgeEdgeQuery& q, ccd::Accuracy accuracy, const ccd::CcdOptions& options) {
-  return ccd::edge_edge_ccd(q, accuracy, options);
-}
-
 /// Every pair of triangles a < b whose swept boxes over x_t0 → x_t1 overlap (sweep and prune on
 /// x): the candidates of a whole-mesh CCD without a hierarchy.
 std::vector<TrianglePair> swept_box_pairs(
@@ -259,8 +249,10 @@ TEST(Elementary, ScreenedQueriesFindExactlyWhatTheKernelFindsForEachQuery) {
     });
     return out;
   };
-  const FrameResult want =
-      run({.vertex_face = &vertex_face_unscreened, .edge_edge = &edge_edge_unscreened}, 1);
+  // The kernels under other names (renamed_kernels.hpp): called for every query, unscreened.
+  const FrameResult want = run(
+      {.vertex_face = &test::renamed_vertex_face_ccd, .edge_edge = &test::renamed_edge_edge_ccd},
+      1);
   // The step's contacts (107 EE and 27 VF in the whole check) are among these candidates.
   EXPECT_GT(want.counters.ee_contacts, 50);
   EXPECT_GT(want.counters.vf_contacts, 10);

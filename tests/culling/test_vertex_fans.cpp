@@ -19,6 +19,7 @@
 #include "skinning/load.hpp"
 #include "skinning/topology.hpp"
 #include "tests/culling/procedural_meshes.hpp"
+#include "tests/culling/renamed_kernels.hpp"
 #include "tests/culling/welded_character.hpp"
 #include "tests/support/test_support.hpp"
 
@@ -541,16 +542,11 @@ TEST(VertexFans, DcdOnRealCharactersIsUnchangedAndTestsFewerPairs) {
   }
 }
 
-/// The product's CCD kernels under other names: the culling stages settle pairs by fans only for
-/// ccd::vertex_face_ccd / ccd::edge_edge_ccd themselves, so these see every feature pair.
-ccd::CcdResult every_vf(
-    const ccd::VertexFaceQuery& q, ccd::Accuracy accuracy, const ccd::CcdOptions& options) {
-  return ccd::vertex_face_ccd(q, accuracy, options);
-}
-ccd::CcdResult every_ee(
-    const ccd::EdgeEdgeQuery& q, ccd::Accuracy accuracy, const ccd::CcdOptions& options) {
-  return ccd::edge_edge_ccd(q, accuracy, options);
-}
+/// The product's CCD kernels under other names (renamed_kernels.hpp): the culling stages settle
+/// pairs by fans only for ccd::vertex_face_ccd / ccd::edge_edge_ccd themselves, so these see
+/// every feature pair.
+constexpr auto every_vf = &test::renamed_vertex_face_ccd;
+constexpr auto every_ee = &test::renamed_edge_edge_ccd;
 
 /// The triangles as a mesh's index rows.
 skinning::Triangles as_triangles(const std::vector<Tri>& tris) {
@@ -577,7 +573,7 @@ std::vector<CcdContact> every_contact(
       mesh,
       topo,
       {.accuracy = ccd::Accuracy::exact,
-       .elementary = {.vertex_face = &every_vf, .edge_edge = &every_ee}});
+       .elementary = {.vertex_face = every_vf, .edge_edge = every_ee}});
   FrameResult r;
   brute->detect_ccd(x0, x1, r);
   return r.contacts;
@@ -704,7 +700,7 @@ TEST(VertexFans, CcdOnRealCharactersIsUnchangedAndTestsFewerPairs) {
           method,
           mesh,
           character.topology,
-          {.elementary = {.vertex_face = &every_vf, .edge_edge = &every_ee}});
+          {.elementary = {.vertex_face = every_vf, .edge_edge = every_ee}});
       std::int64_t tests_with = 0, tests_without = 0, contacts = 0;
       const int n = character.loaded.motion()->num_samples();
       for (int k = 0; k + 1 < n; k += std::max(1, n / 12)) {
