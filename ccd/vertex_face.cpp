@@ -17,9 +17,8 @@ namespace skelcd::ccd {
 namespace {
 
 // conservative, once the swept AABBs are known to overlap: the pipeline of
-// detail/conservative_pipeline.hpp.
-/// `known`: the query's coplanarity screen, already computed and not certified (the pipeline
-/// then goes on from its next stage), or null.
+// detail/conservative_pipeline.hpp. `known`: the query's coplanarity screen, already computed
+// and not certified (the pipeline then goes on from its next stage), or null.
 CcdResult conservative_after_aabbs(
     const VertexFaceQuery& q,
     const CcdOptions& options,

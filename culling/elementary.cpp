@@ -12,6 +12,7 @@
 
 #include "ccd/after_swept_aabbs.hpp"
 #include "ccd/coplanarity_screen.hpp"
+#include "ccd/filters.hpp"
 #include "culling/pair_sort.hpp"
 
 namespace skelcd::culling {
@@ -201,14 +202,14 @@ void run_ccd_tests(
   const std::size_t first = out.contacts.size();
   Counters& c = out.counters;
   // The product's kernels asked for contact itself: each group of four queries is screened at
-  // once first (ccd/coplanarity_screen.hpp), and the kernel called for those the screen leaves —
-  // from its next stage when it would skip the swept AABBs (after_swept_aabbs.hpp), from its
-  // start otherwise: the same decisions, without assembling and calling for the queries the
-  // screen settles.
+  // once first (ccd/coplanarity_screen.hpp), and the kernel goes on from the stage after its
+  // screen for those the screen leaves — after its swept-AABB stage, which the plain kernels run
+  // first and the *_after_swept_aabbs ones skip (after_swept_aabbs.hpp): the same decisions,
+  // without assembling and calling for the queries the screen settles.
   const KernelUse use = kernel_use(tests);
   const bool screened = use != KernelUse::other && accuracy == ccd::Accuracy::conservative &&
                         options.min_separation == 0.0;
-  const bool after_screen = screened && use == KernelUse::after_swept_aabbs;
+  const bool swept_first = use == KernelUse::product;
   const double* const xd_t0 = x_t0.data();  // row-major: vertex v at 3 v
   const double* const xd_t1 = x_t1.data();
   // Vertex-face queries: outcomes in candidate order, the hits appended in that order.
@@ -229,8 +230,10 @@ void run_ccd_tests(
     return ccd::vertex_face_screen_x4(xd_t0, xd_t1, quads);
   };
   const auto vf_rest = [&](std::size_t i, Outcome& o, const ccd::CoplanarityScreens& s, int k) {
-    if (!after_screen) return vf_test(i, o);
-    const ccd::CcdResult r = ccd::vertex_face_ccd_after_screen(vf_query(i), options, s, k);
+    const ccd::VertexFaceQuery q = vf_query(i);
+    const ccd::CcdResult r = swept_first && ccd::swept_aabbs_disjoint(q)
+                                 ? ccd::CcdResult{}
+                                 : ccd::vertex_face_ccd_after_screen(q, options, s, k);
     o = {.toi_lower = r.toi_lower, .toi_upper = r.toi_upper, .hit = r.hit};
   };
   evaluate_ranges(
@@ -269,8 +272,10 @@ void run_ccd_tests(
     return ccd::edge_edge_screen_x4(xd_t0, xd_t1, quads);
   };
   const auto ee_rest = [&](std::size_t i, Outcome& o, const ccd::CoplanarityScreens& s, int k) {
-    if (!after_screen) return ee_test(i, o);
-    const ccd::CcdResult r = ccd::edge_edge_ccd_after_screen(ee_query(i), options, s, k);
+    const ccd::EdgeEdgeQuery q = ee_query(i);
+    const ccd::CcdResult r = swept_first && ccd::swept_aabbs_disjoint(q)
+                                 ? ccd::CcdResult{}
+                                 : ccd::edge_edge_ccd_after_screen(q, options, s, k);
     o = {.toi_lower = r.toi_lower, .toi_upper = r.toi_upper, .hit = r.hit};
   };
   evaluate_ranges(

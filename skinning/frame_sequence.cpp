@@ -58,7 +58,6 @@ std::string read_bytes(const fs::path& file) {
   return bytes;
 }
 
-// Builds the FrameMesh from polygons, checking indices and finiteness.
 /// What a reader collects before finish() checks it: coordinates, face corners, face sizes.
 /// Held by the caller, so that a sequence's frames reuse its storage (a cloth-ball frame's is
 /// about 4 MB: fresh pages for each frame cost more than decoding it).
@@ -74,8 +73,8 @@ struct FrameScratch {
   }
 };
 
-/// Checks what a reader collected and writes the frame into `m` (its storage reused when the
-/// sizes are the same).
+/// Builds the frame from what a reader collected — polygons split into fans, indices and
+/// finiteness checked — into `m` (its storage reused when the sizes are the same).
 void finish(const fs::path& file, const FrameScratch& scratch, FrameMesh& m) {
   const std::vector<double>& xyz = scratch.xyz;
   const std::vector<std::int64_t>& corners = scratch.corners;
@@ -280,25 +279,10 @@ class PlyReader {
 
   /// The binary value of `type` at `at` (type_size(type) bytes), in the file's byte order.
   [[nodiscard]] static double decode(PlyType type, const char* at, bool swap) {
-    switch (type) {
-      case PlyType::kInt8:
-        return static_cast<double>(load<std::int8_t>(at, swap));
-      case PlyType::kUint8:
-        return static_cast<double>(load<std::uint8_t>(at, swap));
-      case PlyType::kInt16:
-        return static_cast<double>(load<std::int16_t>(at, swap));
-      case PlyType::kUint16:
-        return static_cast<double>(load<std::uint16_t>(at, swap));
-      case PlyType::kInt32:
-        return static_cast<double>(load<std::int32_t>(at, swap));
-      case PlyType::kUint32:
-        return static_cast<double>(load<std::uint32_t>(at, swap));
-      case PlyType::kFloat32:
-        return static_cast<double>(load<float>(at, swap));
-      case PlyType::kFloat64:
-        return load<double>(at, swap);
-    }
-    return 0.0;
+    if (type == PlyType::kFloat32) return static_cast<double>(load<float>(at, swap));
+    if (type == PlyType::kFloat64) return load<double>(at, swap);
+    // Every integer of these types converts to double exactly.
+    return static_cast<double>(decode_integer(type, at, swap));
   }
 
  private:
