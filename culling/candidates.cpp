@@ -2,11 +2,16 @@
 
 #include <algorithm>
 #include <array>
+#include <atomic>
 #include <cstddef>
 #include <initializer_list>
+#include <type_traits>
 
 #if defined(__SSE2__)
 #include <emmintrin.h>
+#endif
+#if defined(__x86_64__) && defined(__GNUC__)
+#define SKELCD_FEATURE_AVX2 1
 #endif
 
 namespace skelcd::culling {
@@ -186,6 +191,53 @@ struct EndPositions {
     }
     return _mm_movemask_pd(apart) == 0;
   }
+  /// A triangle's extents at both ends on the six face diagonals, two a register:
+  /// (x + y, y + z), (x − y, y − z), (z + x, z − x); z − x as z + (−x), the same rounding.
+  struct DiagonalBox {
+    __m128d lo0[3], hi0[3], lo1[3], hi1[3];
+  };
+  [[nodiscard]] DiagonalBox diagonal_face(const std::array<std::int32_t, 3>& corners) const {
+    const __m128d negate_high = _mm_set_pd(-0.0, 0.0);
+    const auto project = [&](const double* p, __m128d* v) {
+      const __m128d xy = _mm_loadu_pd(p);
+      const __m128d yz = _mm_loadu_pd(p + 1);
+      v[0] = _mm_add_pd(xy, yz);
+      v[1] = _mm_sub_pd(xy, yz);
+      v[2] = _mm_add_pd(_mm_load1_pd(p + 2), _mm_xor_pd(_mm_load1_pd(p), negate_high));
+    };
+    DiagonalBox b;
+    project(x0 + 3 * at(corners[0]), b.lo0);
+    project(x1 + 3 * at(corners[0]), b.lo1);
+    for (std::size_t r = 0; r < 3; ++r) {
+      b.hi0[r] = b.lo0[r];
+      b.hi1[r] = b.lo1[r];
+    }
+    for (std::size_t k = 1; k < 3; ++k) {
+      __m128d v0[3], v1[3];
+      project(x0 + 3 * at(corners[k]), v0);
+      project(x1 + 3 * at(corners[k]), v1);
+      for (std::size_t r = 0; r < 3; ++r) {
+        b.lo0[r] = _mm_min_pd(b.lo0[r], v0[r]);
+        b.hi0[r] = _mm_max_pd(b.hi0[r], v0[r]);
+        b.lo1[r] = _mm_min_pd(b.lo1[r], v1[r]);
+        b.hi1[r] = _mm_max_pd(b.hi1[r], v1[r]);
+      }
+    }
+    return b;
+  }
+  /// Not apart on any face diagonal at both ends (the rounded projections compared: rounding is
+  /// monotone, so rounded values strictly apart are exact values strictly apart).
+  [[nodiscard]] static bool diagonal_meet(const DiagonalBox& a, const DiagonalBox& b) {
+    __m128d apart = _mm_setzero_pd();
+    for (std::size_t r = 0; r < 3; ++r) {
+      const __m128d below =
+          _mm_and_pd(_mm_cmplt_pd(a.hi0[r], b.lo0[r]), _mm_cmplt_pd(a.hi1[r], b.lo1[r]));
+      const __m128d above =
+          _mm_and_pd(_mm_cmplt_pd(b.hi0[r], a.lo0[r]), _mm_cmplt_pd(b.hi1[r], a.lo1[r]));
+      apart = _mm_or_pd(apart, _mm_or_pd(below, above));
+    }
+    return _mm_movemask_pd(apart) == 0;
+  }
 #else
   struct Point {
     std::array<double, 3> at0, at1;
@@ -225,6 +277,37 @@ struct EndPositions {
   [[nodiscard]] static bool meet(const Point& p, const Box& b) {
     return meet(Box{p.at0, p.at0, p.at1, p.at1}, b);
   }
+  struct DiagonalBox {
+    std::array<double, 6> lo0, hi0, lo1, hi1;
+  };
+  [[nodiscard]] DiagonalBox diagonal_face(const std::array<std::int32_t, 3>& corners) const {
+    const auto project = [](const double* p) {
+      return std::array<double, 6>{
+          p[0] + p[1], p[1] + p[2], p[0] - p[1], p[1] - p[2], p[2] + p[0], p[2] - p[0]};
+    };
+    DiagonalBox b;
+    b.lo0 = b.hi0 = project(x0 + 3 * at(corners[0]));
+    b.lo1 = b.hi1 = project(x1 + 3 * at(corners[0]));
+    for (std::size_t k = 1; k < 3; ++k) {
+      const auto v0 = project(x0 + 3 * at(corners[k]));
+      const auto v1 = project(x1 + 3 * at(corners[k]));
+      for (std::size_t d = 0; d < 6; ++d) {
+        b.lo0[d] = std::min(b.lo0[d], v0[d]);
+        b.hi0[d] = std::max(b.hi0[d], v0[d]);
+        b.lo1[d] = std::min(b.lo1[d], v1[d]);
+        b.hi1[d] = std::max(b.hi1[d], v1[d]);
+      }
+    }
+    return b;
+  }
+  [[nodiscard]] static bool diagonal_meet(const DiagonalBox& a, const DiagonalBox& b) {
+    bool apart = false;
+    for (std::size_t d = 0; d < 6; ++d) {
+      apart = apart | ((a.hi0[d] < b.lo0[d]) & (a.hi1[d] < b.lo1[d])) |
+              ((b.hi0[d] < a.lo0[d]) & (b.hi1[d] < a.lo1[d]));
+    }
+    return !apart;
+  }
 #endif
   [[nodiscard]] Box face(std::int32_t, const std::array<std::int32_t, 3>& corners) const {
     return hull({vertex(corners[0]), vertex(corners[1]), vertex(corners[2])});
@@ -243,6 +326,123 @@ struct EndPositions {
   }
 };
 
+#if defined(SKELCD_FEATURE_AVX2)
+// Four-double vectors pass between the inline members below; where the baseline ABI has no AVX
+// they are split, which is what the note is about. Nothing crosses a library boundary.
+#pragma GCC diagnostic ignored "-Wpsabi"
+
+using V4 = double __attribute__((vector_size(32)));
+using M4 = std::int64_t __attribute__((vector_size(32)));
+
+/// EndPositions on four-double vectors: a point's coordinates at one end in one vector,
+/// (x, y, z, z), and a triangle's face-diagonal projections in two, (x + y, y + z, z + x, z + x)
+/// and (x − y, y − z, z − x, z − x) — each the same single rounding as EndPositions', so that
+/// both decide every pair alike. Written with GCC's vector extensions and inlined only into
+/// owned_feature_pairs_avx2, where each operation is one AVX2 instruction.
+struct EndPositionsWide {
+  static constexpr bool kTrianglesFirst = true;
+  const double* x0;
+  const double* x1;
+
+  struct Point {
+    V4 at0, at1;
+  };
+  struct Box {
+    V4 lo0, hi0, lo1, hi1;
+  };
+  struct DiagonalBox {
+    Box sums, differences;
+  };
+  [[gnu::always_inline]] static V4 load(const double* p) { return V4{p[0], p[1], p[2], p[2]}; }
+  /// minpd and maxpd: the second operand unless the first is below (above) it.
+  [[gnu::always_inline]] static V4 min(const V4& a, const V4& b) { return a < b ? a : b; }
+  [[gnu::always_inline]] static V4 max(const V4& a, const V4& b) { return a > b ? a : b; }
+  [[gnu::always_inline]] [[nodiscard]] Point vertex(std::int32_t v) const {
+    return {load(x0 + 3 * at(v)), load(x1 + 3 * at(v))};
+  }
+  [[gnu::always_inline]] static void widen(Box& b, const Point& p) {
+    b.lo0 = min(b.lo0, p.at0);
+    b.hi0 = max(b.hi0, p.at0);
+    b.lo1 = min(b.lo1, p.at1);
+    b.hi1 = max(b.hi1, p.at1);
+  }
+  /// Not apart on any lane at both ends (NaN compares false: never apart).
+  [[gnu::always_inline]] [[nodiscard]] static bool meet_as(
+      const V4& lo0, const V4& hi0, const V4& lo1, const V4& hi1, const Box& b) {
+    const M4 apart = ((hi0 < b.lo0) & (hi1 < b.lo1)) | ((b.hi0 < lo0) & (b.hi1 < lo1));
+    // Any lane set: or-ing the halves, then the two lanes left.
+    const M4 halves = apart | __builtin_shuffle(apart, M4{2, 3, 2, 3});
+    return (halves[0] | halves[1]) == 0;
+  }
+  [[gnu::always_inline]] [[nodiscard]] static bool meet(const Box& a, const Box& b) {
+    return meet_as(a.lo0, a.hi0, a.lo1, a.hi1, b);
+  }
+  [[gnu::always_inline]] [[nodiscard]] static bool meet(const Point& p, const Box& b) {
+    return meet_as(p.at0, p.at0, p.at1, p.at1, b);
+  }
+  [[gnu::always_inline]] [[nodiscard]] Box face(
+      std::int32_t, const std::array<std::int32_t, 3>& corners) const {
+    const Point p = vertex(corners[0]);
+    Box b{p.at0, p.at0, p.at1, p.at1};
+    widen(b, vertex(corners[1]));
+    widen(b, vertex(corners[2]));
+    return b;
+  }
+  [[gnu::always_inline]] [[nodiscard]] Box edge(const std::array<std::int32_t, 2>& ends) const {
+    const Point p = vertex(ends[0]);
+    Box b{p.at0, p.at0, p.at1, p.at1};
+    widen(b, vertex(ends[1]));
+    return b;
+  }
+  /// (y, z, x, x) of (x, y, z, z).
+  [[gnu::always_inline]] static V4 rotate(const V4& v) {
+    return __builtin_shuffle(v, M4{1, 2, 0, 0});
+  }
+  [[gnu::always_inline]] [[nodiscard]] DiagonalBox diagonal_face(
+      const std::array<std::int32_t, 3>& corners) const {
+    DiagonalBox b;
+    for (std::size_t k = 0; k < 3; ++k) {
+      const Point q = vertex(corners[k]);
+      const Point sums{q.at0 + rotate(q.at0), q.at1 + rotate(q.at1)};
+      const Point differences{q.at0 - rotate(q.at0), q.at1 - rotate(q.at1)};
+      if (k == 0) {
+        b.sums = {sums.at0, sums.at0, sums.at1, sums.at1};
+        b.differences = {differences.at0, differences.at0, differences.at1, differences.at1};
+      } else {
+        widen(b.sums, sums);
+        widen(b.differences, differences);
+      }
+    }
+    return b;
+  }
+  [[gnu::always_inline]] [[nodiscard]] static bool diagonal_meet(
+      const DiagonalBox& a, const DiagonalBox& b) {
+    return meet(a.sums, b.sums) && meet(a.differences, b.differences);
+  }
+  [[gnu::always_inline]] void prefetch(
+      std::int32_t, const std::array<std::int32_t, 3>& corners) const {
+    for (const std::int32_t v : corners) {
+      for (const double* x : {x0, x1}) {
+        __builtin_prefetch(x + 3 * at(v));
+        __builtin_prefetch(x + 3 * at(v) + 2);
+      }
+    }
+  }
+};
+
+std::atomic<bool> baseline_forced{false};
+
+/// Whether the feature stage runs on AVX2: this CPU has it (asked once), and the tests have not
+/// asked for the baseline build (detail::force_baseline_feature_stage).
+bool use_avx2() {
+  static const bool kHas = [] {
+    __builtin_cpu_init();
+    return __builtin_cpu_supports("avx2") != 0;
+  }();
+  return kHas && !baseline_forced.load(std::memory_order_relaxed);
+}
+#endif
+
 /// Triangle pairs per chunk of the feature stage: a chunk's candidates are written to fixed
 /// buffers without branches (a slot is written, then kept or not) and appended at once.
 constexpr std::size_t kChunkPairs = 64;
@@ -253,14 +453,41 @@ constexpr std::size_t kFeatureFar = 16;
 constexpr std::size_t kFeatureNear = 8;
 constexpr std::int32_t kFeaturePrefetchFrom = 16384;
 
+/// owned_feature_pairs' VF pairs of the vertices `owner` owns against face `f` (record `face`,
+/// volume `face_box`): each slot is written, and kept when the pair is not on a corner of the
+/// face and the boxes meet.
+template <bool kExclusions, class Boxes, class FaceBox>
+[[gnu::always_inline]] inline void vertices_vs_face(
+    const FeatureTopology& topology,
+    const Boxes& boxes,
+    const FeatureTopology::OwnedFeatures& owner,
+    const FeatureTopology::OwnedFeatures& face,
+    std::int32_t f,
+    const FaceBox& face_box,
+    VertexFacePair* vf,
+    std::size_t& num_vf,
+    std::int64_t& tests) {
+  for (std::size_t k = 0; k < owner.num_vertices; ++k) {
+    const std::int32_t v = owner.vertices[k];
+    bool wanted = !is_corner(v, face.corners);
+    if constexpr (kExclusions) wanted = wanted && !topology.vertex_face_excluded(v, f);
+    tests += wanted;
+    vf[num_vf] = {v, f};
+    num_vf += static_cast<std::size_t>(wanted) &
+              static_cast<std::size_t>(Boxes::meet(boxes.vertex(v), face_box));
+  }
+}
+
 /// The feature stage of ccd_candidates_from_triangle_pairs, with the part-exclusion checks compiled
 /// in or out (`kExclusions` = topology.has_exclusions(): without exclusions every *_excluded is
-/// false), feature pairs tested on `boxes` (SweptVolumes or EndPositions). Reads one
-/// OwnedFeatures record per triangle instead of the owned bits, corners, side edges and their
-/// endpoints from four arrays; the pairs, the rules and the order of what is appended are those
-/// of the bit-by-bit loop.
+/// false), feature pairs tested on `boxes` (SweptVolumes, EndPositions or EndPositionsWide).
+/// Reads one OwnedFeatures record per triangle instead of the owned bits, corners, side edges and
+/// their endpoints from four arrays; the pairs, the rules and the order of what is appended are
+/// those of the bit-by-bit loop, less the feature pairs of triangles apart on a face diagonal at
+/// both ends (docs/culling.md, "The triangles on the face diagonals"). Inlined into each caller,
+/// so that owned_feature_pairs_avx2 is built for AVX2 whole.
 template <bool kExclusions, bool kFans, class Boxes>
-void owned_feature_pairs(
+[[gnu::always_inline]] inline void owned_feature_pairs(
     const FeatureTopology& topology,
     std::span<const TrianglePair> pairs,
     const Boxes& boxes,
@@ -277,18 +504,6 @@ void owned_feature_pairs(
   std::int64_t tests = 0;
   // VF pairs of the vertices `owner` owns against face `face`: each slot is written, and kept
   // when the pair is not on a corner of the face and the boxes meet.
-  const auto vertices_vs_face =
-      [&](const Owned& owner, const Owned& face, std::int32_t f, const auto& face_box) {
-        for (std::size_t k = 0; k < owner.num_vertices; ++k) {
-          const std::int32_t v = owner.vertices[k];
-          bool wanted = !is_corner(v, face.corners);
-          if constexpr (kExclusions) wanted = wanted && !topology.vertex_face_excluded(v, f);
-          tests += wanted;
-          vf[num_vf] = {v, f};
-          num_vf += static_cast<std::size_t>(wanted) &
-                    static_cast<std::size_t>(Boxes::meet(boxes.vertex(v), face_box));
-        }
-      };
   const auto flush = [&] {
     out.vf.insert(out.vf.end(), vf.begin(), vf.begin() + static_cast<std::ptrdiff_t>(num_vf));
     out.ee.insert(out.ee.end(), ee.begin(), ee.begin() + static_cast<std::ptrdiff_t>(num_ee));
@@ -334,9 +549,11 @@ void owned_feature_pairs(
       if (!Boxes::meet(face_a, face_b)) continue;
     }
     ++candidate_pairs;
+    const std::size_t vf_before = num_vf;
+    const std::size_t ee_before = num_ee;
     // VF: the vertices each triangle owns against the other triangle's face.
-    vertices_vs_face(a, b, p.b, face_b);
-    vertices_vs_face(b, a, p.a, face_a);
+    vertices_vs_face<kExclusions>(topology, boxes, a, b, p.b, face_b, vf.data(), num_vf, tests);
+    vertices_vs_face<kExclusions>(topology, boxes, b, a, p.a, face_a, vf.data(), num_vf, tests);
     // EE: the edges a owns against the edges b owns.
     using EdgeBox = decltype(boxes.edge(a.edge_ends[0]));
     std::array<EdgeBox, 3> edges_b;
@@ -355,6 +572,16 @@ void owned_feature_pairs(
                   static_cast<std::size_t>(Boxes::meet(box_a, edges_b[j]));
       }
     }
+    // Feature pairs kept, from triangles a face diagonal separates at both ends: none of them
+    // can touch (the axes' argument along a fixed direction; rounded projections strictly apart
+    // are exact ones strictly apart). Dropped again; pairs that kept nothing are not tested.
+    if constexpr (Boxes::kTrianglesFirst) {
+      if ((num_vf != vf_before || num_ee != ee_before) &&
+          !Boxes::diagonal_meet(boxes.diagonal_face(a.corners), boxes.diagonal_face(b.corners))) {
+        num_vf = vf_before;
+        num_ee = ee_before;
+      }
+    }
     if (++in_chunk == kChunkPairs) {
       flush();
       in_chunk = 0;
@@ -363,6 +590,22 @@ void owned_feature_pairs(
   flush();
   feature_bv_tests += tests;
 }
+
+#if defined(SKELCD_FEATURE_AVX2)
+/// owned_feature_pairs built for AVX2 (EndPositionsWide): the same pairs, rules and order.
+template <bool kExclusions, bool kFans>
+[[gnu::target("avx2")]] void owned_feature_pairs_avx2(
+    const FeatureTopology& topology,
+    std::span<const TrianglePair> pairs,
+    const EndPositionsWide& boxes,
+    IntervalFans* fans,
+    FeatureCandidates& out,
+    std::int64_t& feature_bv_tests,
+    std::int64_t& candidate_pairs) {
+  owned_feature_pairs<kExclusions, kFans>(
+      topology, pairs, boxes, fans, out, feature_bv_tests, candidate_pairs);
+}
+#endif
 
 /// Calls `f` with what the feature stage tests on: the positions at both ends without a contact
 /// distance (ends given), else the swept volumes.
@@ -390,6 +633,21 @@ void ccd_candidates_from_triangle_pairs(
   std::int64_t candidate_pairs = 0;
   with_boxes(bounds, ends, [&](const auto& boxes) {
     const auto run = [&]<bool kExclusions, bool kFans>() {
+#if defined(SKELCD_FEATURE_AVX2)
+      if constexpr (std::is_same_v<std::decay_t<decltype(boxes)>, EndPositions>) {
+        if (use_avx2()) {
+          owned_feature_pairs_avx2<kExclusions, kFans>(
+              topology,
+              pairs,
+              EndPositionsWide{boxes.x0, boxes.x1},
+              fans,
+              out,
+              feature_bv_tests,
+              candidate_pairs);
+          return;
+        }
+      }
+#endif
       owned_feature_pairs<kExclusions, kFans>(
           topology, pairs, boxes, fans, out, feature_bv_tests, candidate_pairs);
     };
@@ -424,6 +682,18 @@ void brute_feature_pairs(
     return fans != nullptr &&
            share_certified_corner(topology.triangle(a), topology.triangle(b), *fans);
   };
+  // The face-diagonal rule of ccd_candidates_from_triangle_pairs on the same owners: their
+  // triangles apart on a face diagonal at both ends form none of their feature pairs (tested
+  // but not kept). The axis rule needs no counterpart: triangles apart on an axis hold their
+  // features apart on it, which the feature test below finds.
+  const auto owners_apart = [&](std::int32_t a, std::int32_t b) {
+    if constexpr (Boxes::kTrianglesFirst) {
+      return !Boxes::diagonal_meet(
+          boxes.diagonal_face(topology.triangle(a)), boxes.diagonal_face(topology.triangle(b)));
+    } else {
+      return false;
+    }
+  };
   // Every vertex that lies on a triangle against every face it is not a corner of.
   for (std::int32_t v = 0; v < num_vertices; ++v) {
     if (topology.vertex_owner(v) < 0) continue;
@@ -433,7 +703,8 @@ void brute_feature_pairs(
       if (is_corner(v, t) || topology.vertex_face_excluded(v, f)) continue;
       if (settled(topology.vertex_owner(v), f)) continue;
       ++tests;
-      if (Boxes::meet(bv, boxes.face(f, t))) out.vf.push_back({v, f});
+      if (Boxes::meet(bv, boxes.face(f, t)) && !owners_apart(topology.vertex_owner(v), f))
+        out.vf.push_back({v, f});
     }
   }
   // Every pair of edges a < b without a common endpoint.
@@ -444,7 +715,9 @@ void brute_feature_pairs(
       if (share_endpoint(ends_a, topology.edge(b)) || topology.edges_excluded(a, b)) continue;
       if (settled(topology.edge_owner(a), topology.edge_owner(b))) continue;
       ++tests;
-      if (Boxes::meet(ba, boxes.edge(topology.edge(b)))) out.ee.push_back({a, b});
+      if (Boxes::meet(ba, boxes.edge(topology.edge(b))) &&
+          !owners_apart(topology.edge_owner(a), topology.edge_owner(b)))
+        out.ee.push_back({a, b});
     }
   }
 }
@@ -497,6 +770,18 @@ void dcd_candidates_brute_force(
   counters.bv_tests += tests;
   counters.candidate_pairs += static_cast<std::int64_t>(num_faces) * (num_faces - 1) / 2;
 }
+
+namespace detail {
+
+void force_baseline_feature_stage(bool baseline) {
+#if defined(SKELCD_FEATURE_AVX2)
+  baseline_forced.store(baseline, std::memory_order_relaxed);
+#else
+  (void)baseline;
+#endif
+}
+
+}  // namespace detail
 
 template struct FeatureBounds<3>;
 template struct FeatureBounds<8>;

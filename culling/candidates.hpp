@@ -146,7 +146,10 @@ inline constexpr std::size_t kCcdBlockPairs = std::size_t{1} << 15;
 /// corner is a candidate with no feature pairs — none of them can come into contact
 /// (docs/culling.md, "Vertex fans over an interval").
 /// `ends` (interval_ends): when given, the positions at both ends are read instead of
-/// `bounds`: the two triangles are tested first, then each feature pair (IntervalEnds).
+/// `bounds`: the two triangles are tested first, then each feature pair (IntervalEnds), and the
+/// feature pairs a triangle pair kept are dropped again when a face diagonal (x ± y, y ± z,
+/// z ± x) separates its two triangles at both ends (counted as tested; docs/culling.md, "The
+/// triangles on the face diagonals").
 template <int N>
 void ccd_candidates_from_triangle_pairs(
     const FeatureTopology& topology,
@@ -157,13 +160,21 @@ void ccd_candidates_from_triangle_pairs(
     IntervalFans* fans = nullptr,
     const IntervalEnds& ends = {});
 
+namespace detail {
+/// For the tests: true makes ccd_candidates_from_triangle_pairs run its baseline (SSE2) build
+/// even on a CPU with AVX2, false lets it choose again. Both builds give the same pairs in the
+/// same order.
+void force_baseline_feature_stage(bool baseline);
+}  // namespace detail
+
 /// CCD brute force: appends every VF pair (vertex on some triangle × triangle) and EE pair
 /// (a < b) that passes the rules above — O(#W·#F + #E²) volume tests, no hierarchy.
 /// Counts counters.feature_bv_tests; sets counters.candidate_pairs to #F·(#F−1)/2 (every
 /// triangle pair is a candidate of brute force).
 /// `fans` as for ccd_candidates_from_triangle_pairs: a feature pair whose owners (vertex_owner,
 /// edge_owner) share a certified corner is skipped, as the hierarchy methods skip their pair.
-/// `ends` as for ccd_candidates_from_triangle_pairs (each feature pair; the same pairs result).
+/// `ends` as for ccd_candidates_from_triangle_pairs (each feature pair, and the diagonal rule on
+/// the two owners the hierarchy forms it from: the same pairs result).
 template <int N>
 void ccd_candidates_brute_force(
     const FeatureTopology& topology,

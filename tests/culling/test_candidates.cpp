@@ -384,11 +384,51 @@ bool apart_on_an_axis_at_both_ends(
   return false;
 }
 
-TEST(CcdCandidates, EndsOnTheAxesDropOnlyPairsThatNeverTouchAndMatchBruteForce) {
+/// True when a face diagonal (x ± y, y ± z, z ± x) separates the corners of triangles `a` and `b`
+/// strictly at t0 and at t1, the same way round, each projection rounded as a double: rounding is
+/// monotone, so rounded projections strictly apart are exact ones strictly apart.
+bool triangles_apart_on_a_diagonal_at_both_ends(
+    const Scene& s, const std::array<std::int32_t, 3>& a, const std::array<std::int32_t, 3>& b) {
+  const auto project = [](const skinning::Positions& x, std::int32_t v, int d) {
+    const double px = x(v, 0), py = x(v, 1), pz = x(v, 2);
+    switch (d) {
+      case 0:
+        return px + py;
+      case 1:
+        return px - py;
+      case 2:
+        return py + pz;
+      case 3:
+        return py - pz;
+      case 4:
+        return pz + px;
+      default:
+        return pz - px;
+    }
+  };
+  for (int d = 0; d < 6; ++d) {
+    for (const int below_side : {0, 1}) {
+      bool apart = true;
+      for (const auto* x : {&s.x_t0, &s.x_t1}) {
+        for (const std::int32_t p : below_side == 0 ? a : b) {
+          for (const std::int32_t q : below_side == 0 ? b : a)
+            apart = apart && project(*x, p, d) < project(*x, q, d);
+        }
+      }
+      if (apart) return true;
+    }
+  }
+  return false;
+}
+
+TEST(CcdCandidates, EndsOnTheAxesAndDiagonalsDropOnlyPairsThatNeverTouchAndMatchBruteForce) {
   // Without a contact distance the AABB methods test a feature pair on its features' boxes at
-  // t0 and at t1 instead of their swept boxes: every pair the swept boxes keep or drop, less those
-  // an axis separates at both ends. The dropped pairs are checked against the exact kernels.
+  // t0 and at t1 instead of their swept boxes, after its owners' triangles on the face diagonals
+  // at both ends: every pair the swept boxes keep or drop, less those an axis separates at both
+  // ends and those whose owner triangles a face diagonal separates at both ends. The dropped
+  // pairs are checked against the exact kernels.
   std::int64_t dropped = 0;
+  std::int64_t dropped_by_diagonal = 0;
   for (const Scene& s : scenes()) {
     SCOPED_TRACE(s.name);
     const Built<3> b = bounds_of<3>(s, 0.0);
@@ -412,7 +452,12 @@ TEST(CcdCandidates, EndsOnTheAxesDropOnlyPairsThatNeverTouchAndMatchBruteForce) 
       if (kept_vf.count(p)) continue;
       ++dropped;
       const auto& f = b.topology.triangle(p.face);
-      EXPECT_TRUE(apart_on_an_axis_at_both_ends(s, {p.vertex}, {f[0], f[1], f[2]}));
+      if (!apart_on_an_axis_at_both_ends(s, {p.vertex}, {f[0], f[1], f[2]})) {
+        ++dropped_by_diagonal;
+        EXPECT_TRUE(triangles_apart_on_a_diagonal_at_both_ends(
+            s, b.topology.triangle(b.topology.vertex_owner(p.vertex)), f))
+            << "VF (" << p.vertex << ", " << p.face << ")";
+      }
       const auto q = vertex_face_query(s.x_t0, s.x_t1, p.vertex, s.x_t0, s.x_t1, f);
       EXPECT_FALSE(ccd::vertex_face_ccd(q, ccd::Accuracy::exact, options).hit)
           << "VF (" << p.vertex << ", " << p.face << ") was dropped but touches";
@@ -422,12 +467,20 @@ TEST(CcdCandidates, EndsOnTheAxesDropOnlyPairsThatNeverTouchAndMatchBruteForce) 
       ++dropped;
       const auto& ea = b.topology.edge(p.a);
       const auto& eb = b.topology.edge(p.b);
-      EXPECT_TRUE(apart_on_an_axis_at_both_ends(s, {ea[0], ea[1]}, {eb[0], eb[1]}));
+      if (!apart_on_an_axis_at_both_ends(s, {ea[0], ea[1]}, {eb[0], eb[1]})) {
+        ++dropped_by_diagonal;
+        EXPECT_TRUE(triangles_apart_on_a_diagonal_at_both_ends(
+            s,
+            b.topology.triangle(b.topology.edge_owner(p.a)),
+            b.topology.triangle(b.topology.edge_owner(p.b))))
+            << "EE (" << p.a << ", " << p.b << ")";
+      }
       const auto q = edge_edge_query(s.x_t0, s.x_t1, ea, s.x_t0, s.x_t1, eb);
       EXPECT_FALSE(ccd::edge_edge_ccd(q, ccd::Accuracy::exact, options).hit)
           << "EE (" << p.a << ", " << p.b << ") was dropped but touches";
     }
-    // A hierarchy hands over the owners of exactly these pairs, each once.
+    // A hierarchy hands over the owners of exactly these pairs, each once — the feature stage's
+    // AVX2 build (where the CPU has it) and its baseline build alike.
     for (const int leaf : {1, 4}) {
       Bvh<3> bvh(b.topology.welded_triangles(), s.x_t0, BvhOptions{leaf});
       bvh.refit(b.bounds.triangles);
@@ -435,17 +488,24 @@ TEST(CcdCandidates, EndsOnTheAxesDropOnlyPairsThatNeverTouchAndMatchBruteForce) 
       std::vector<TrianglePair> pairs;
       Counters counters;
       self_traverse<3>(bvh, b.bounds.triangles, scratch, pairs, counters.bv_tests);
-      FeatureCandidates got;
-      ccd_candidates_from_triangle_pairs<3>(
-          b.topology, pairs, b.bounds, got, counters, nullptr, ends);
-      EXPECT_FALSE(has_duplicates(got.vf));
-      EXPECT_FALSE(has_duplicates(got.ee));
-      EXPECT_EQ(sorted(got.vf), by_ends.vf);
-      EXPECT_EQ(sorted(got.ee), by_ends.ee);
+      for (const bool baseline : {false, true}) {
+        SCOPED_TRACE(baseline ? "baseline build" : "as the CPU allows");
+        detail::force_baseline_feature_stage(baseline);
+        FeatureCandidates got;
+        ccd_candidates_from_triangle_pairs<3>(
+            b.topology, pairs, b.bounds, got, counters, nullptr, ends);
+        detail::force_baseline_feature_stage(false);
+        EXPECT_FALSE(has_duplicates(got.vf));
+        EXPECT_FALSE(has_duplicates(got.ee));
+        EXPECT_EQ(sorted(got.vf), by_ends.vf);
+        EXPECT_EQ(sorted(got.ee), by_ends.ee);
+      }
     }
   }
-  // The scenes move their parts past each other: some pairs are dropped (else this proved nothing).
+  // The scenes move their parts past each other: some pairs are dropped, some by the diagonals
+  // alone (else this proved nothing).
   EXPECT_GT(dropped, 0);
+  EXPECT_GT(dropped_by_diagonal, 0);
 }
 
 TEST(CcdCandidates, FanSharingOneVertexStillYieldsItsCrossings) {
