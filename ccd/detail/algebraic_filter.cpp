@@ -4,8 +4,11 @@
 
 #include <Eigen/Geometry>
 #include <algorithm>
+#include <atomic>
 #include <cassert>
 #include <cmath>
+#include <cstdint>
+#include <limits>
 
 #include "ccd/detail/float_bounds.hpp"
 #include "ccd/detail/lanes.hpp"
@@ -342,6 +345,146 @@ void cross_dot_quartic_pair(
       add_up(rounding_bound(18, p[0]), times_subnormal_power_of_two<1068>(1.0 + m[0] * m[0]));
   g1.error =
       add_up(rounding_bound(18, p[1]), times_subnormal_power_of_two<1068>(1.0 + m[1] * m[1]));
+}
+
+namespace {
+
+// Four-double vectors pass between the inline helpers below; where the baseline ABI has no AVX
+// they are split, which is what the note is about. Nothing crosses a library boundary.
+#pragma GCC diagnostic ignored "-Wpsabi"
+
+using Lanes4 = double __attribute__((vector_size(32)));
+using LaneBits4 = std::int64_t __attribute__((vector_size(32)));
+
+struct Lanes4x3 {
+  Lanes4 x, y, z;
+};
+
+/// |v| per lane as std::abs does it: the sign bit cleared (a vector cast reinterprets the bits).
+[[gnu::always_inline]] inline Lanes4 abs4(const Lanes4& v) {
+  constexpr std::int64_t kMagnitude = std::numeric_limits<std::int64_t>::max();
+  return reinterpret_cast<Lanes4>(reinterpret_cast<LaneBits4>(v) & kMagnitude);
+}
+/// std::max(a, b) per lane: (a < b) ? b : a.
+[[gnu::always_inline]] inline Lanes4 max4(const Lanes4& a, const Lanes4& b) {
+  return a < b ? b : a;
+}
+[[gnu::always_inline]] inline Lanes4x3 abs4(const Lanes4x3& v) {
+  return {abs4(v.x), abs4(v.y), abs4(v.z)};
+}
+/// The vector `m` of the four quadruples, lane k from q[k].
+[[gnu::always_inline]] inline Lanes4x3 gather4(
+    const QuadrupleDifferences* q, Eigen::Vector3d QuadrupleDifferences::*m) {
+  const Eigen::Vector3d& v0 = q[0].*m;
+  const Eigen::Vector3d& v1 = q[1].*m;
+  const Eigen::Vector3d& v2 = q[2].*m;
+  const Eigen::Vector3d& v3 = q[3].*m;
+  return {
+      Lanes4{v0[0], v1[0], v2[0], v3[0]},
+      Lanes4{v0[1], v1[1], v2[1], v3[1]},
+      Lanes4{v0[2], v1[2], v2[2], v3[2]}};
+}
+/// As detail/lanes.hpp's cross, cross_permanent, dot and max_abs, four lanes.
+[[gnu::always_inline]] inline Lanes4x3 cross4(const Lanes4x3& y, const Lanes4x3& z) {
+  return {y.y * z.z - y.z * z.y, y.z * z.x - y.x * z.z, y.x * z.y - y.y * z.x};
+}
+[[gnu::always_inline]] inline Lanes4x3 cross_permanent4(const Lanes4x3& ay, const Lanes4x3& az) {
+  return {ay.y * az.z + ay.z * az.y, ay.z * az.x + ay.x * az.z, ay.x * az.y + ay.y * az.x};
+}
+[[gnu::always_inline]] inline Lanes4 dot4(const Lanes4x3& x, const Lanes4x3& c) {
+  return x.x * c.x + x.y * c.y + x.z * c.z;
+}
+[[gnu::always_inline]] inline Lanes4 max_abs4(const Lanes4x3& v) {
+  return max4(max4(abs4(v.x), abs4(v.y)), abs4(v.z));
+}
+
+/// cross_dot_quartic_pair with four lanes: lane k computes g[k] from q[k] through the same
+/// operations in the same order.
+[[gnu::always_inline]] inline void quartics_x4_body(
+    const QuadrupleDifferences* q, BernsteinQuartic* g) {
+  using Q = QuadrupleDifferences;
+  const Lanes4x3 a[2] = {gather4(q, &Q::a_t0), gather4(q, &Q::a_t1)};
+  const Lanes4x3 b[2] = {gather4(q, &Q::b_t0), gather4(q, &Q::b_t1)};
+  const Lanes4x3 c[2] = {gather4(q, &Q::c_t0), gather4(q, &Q::c_t1)};
+  const Lanes4x3 d[2] = {gather4(q, &Q::d_t0), gather4(q, &Q::d_t1)};
+  const Lanes4x3 aa[2] = {abs4(a[0]), abs4(a[1])};
+  const Lanes4x3 ab_[2] = {abs4(b[0]), abs4(b[1])};
+  const Lanes4x3 ac[2] = {abs4(c[0]), abs4(c[1])};
+  const Lanes4x3 ad[2] = {abs4(d[0]), abs4(d[1])};
+  Lanes4x3 ab[4], ab_perm[4], cd[4], cd_perm[4];
+  for (int k = 0; k < 4; ++k) {
+    const int i = k & 1, j = k >> 1;
+    ab[k] = cross4(a[i], b[j]);
+    ab_perm[k] = cross_permanent4(aa[i], ab_[j]);
+    cd[k] = cross4(c[i], d[j]);
+    cd_perm[k] = cross_permanent4(ac[i], ad[j]);
+  }
+  static constexpr int kBits[4] = {0, 1, 1, 2};
+  Lanes4 sum[5] = {};
+  Lanes4 perm[5] = {};
+#pragma GCC unroll 4
+  for (int i = 0; i < 4; ++i) {
+#pragma GCC unroll 4
+    for (int j = 0; j < 4; ++j) {
+      const int level = kBits[i] + kBits[j];
+      sum[level] += dot4(ab[i], cd[j]);
+      perm[level] += dot4(ab_perm[i], cd_perm[j]);
+    }
+  }
+  static constexpr double kTerms[5] = {1.0, 4.0, 6.0, 4.0, 1.0};
+  Lanes4 p = {0.0, 0.0, 0.0, 0.0};
+  for (std::size_t i = 0; i < 5; ++i) {
+    const Lanes4 value = sum[i] / kTerms[i];
+    for (std::size_t k = 0; k < 4; ++k) g[k].coefficients[i] = value[k];
+    p = max4(p, perm[i] / kTerms[i]);
+  }
+  Lanes4 m = {0.0, 0.0, 0.0, 0.0};
+  for (int t = 0; t < 2; ++t) {
+    m = max4(m, max4(max4(max_abs4(a[t]), max_abs4(b[t])), max4(max_abs4(c[t]), max_abs4(d[t]))));
+  }
+  for (std::size_t k = 0; k < 4; ++k) {
+    g[k].error =
+        add_up(rounding_bound(18, p[k]), times_subnormal_power_of_two<1068>(1.0 + m[k] * m[k]));
+  }
+}
+
+#if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
+#define SKELCD_QUARTICS_AVX2 1
+/// quartics_x4_body built for AVX2: one instruction per operation on the four lanes.
+[[gnu::target("avx2")]] void quartics_x4_avx2(const QuadrupleDifferences* q, BernsteinQuartic* g) {
+  quartics_x4_body(q, g);
+}
+#endif
+
+std::atomic<bool> quartics_baseline_forced{false};
+
+}  // namespace
+
+bool cross_dot_quartics_x4_wide() {
+#if defined(SKELCD_QUARTICS_AVX2)
+  static const bool kHas = [] {
+    __builtin_cpu_init();
+    return __builtin_cpu_supports("avx2") != 0;
+  }();
+  return kHas && !quartics_baseline_forced.load(std::memory_order_relaxed);
+#else
+  return false;
+#endif
+}
+
+void force_baseline_quartics(bool baseline) {
+  quartics_baseline_forced.store(baseline, std::memory_order_relaxed);
+}
+
+void cross_dot_quartic_x4(const QuadrupleDifferences* q, BernsteinQuartic* g) {
+#if defined(SKELCD_QUARTICS_AVX2)
+  if (cross_dot_quartics_x4_wide()) {
+    quartics_x4_avx2(q, g);
+    return;
+  }
+#endif
+  cross_dot_quartic_pair(q[0], q[1], g[0], g[1]);
+  cross_dot_quartic_pair(q[2], q[3], g[2], g[3]);
 }
 
 AlgebraicVerdict algebraic_filter(const BernsteinCubic& c, const BernsteinQuartic* g, int count, double toi_tolerance) {

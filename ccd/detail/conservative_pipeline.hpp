@@ -91,7 +91,17 @@ CcdResult pipeline_after_screen(
   // bound every quartic below is finite with a finite error.
   const bool screened = std::isfinite(c.coefficients[0]) && std::isfinite(c.coefficients[3]) &&
                         screen.magnitude <= kQuarticScreenMagnitude;
-  if (screened) {
+  if (screened && cross_dot_quartics_x4_wide()) {
+    // All four at once, for what two cost (a third quartic's query fills the fourth lane, which
+    // is not read); then the early exit below on the first two, as the pairs take it.
+    if (count == 3) inputs[3] = inputs[2];
+    cross_dot_quartic_x4(inputs, g);
+    if (s == 0.0 && std::isfinite(c.error) && std::isfinite(g[0].error) &&
+        std::isfinite(g[1].error) && (certified_negative(g[0]) || certified_negative(g[1]))) {
+      ++stats.algebraic_rejected;
+      return {};
+    }
+  } else if (screened) {
     cross_dot_quartic_pair(inputs[0], inputs[1], g[0], g[1]);
     // algebraic_filter's first step, on the first two: with every error finite, a quartic
     // certified negative on [0,1] excludes the root interval and the answer is "separated". The

@@ -12,6 +12,7 @@
 #include <gmpxx.h>
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cmath>
 #include <cstring>
 #include <limits>
@@ -615,6 +616,112 @@ TEST(KernelEquivalence, PairedQuarticsAreCrossDotQuarticBitForBit) {
     ASSERT_TRUE(same_bits(g0.error, r0.error)) << i;
     ASSERT_TRUE(same_bits(g1.error, r1.error)) << i;
   }
+}
+
+TEST(KernelEquivalence, FourQuarticsAtOnceAreCrossDotQuarticBitForBit) {
+  // cross_dot_quartic_x4 in both of its builds (one AVX2 evaluation where the CPU has it, two
+  // pairs otherwise) on the random quadruples above, scales from subnormal products to large.
+  std::mt19937_64 rng(14);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  const auto vec = [&](double s) -> Eigen::Vector3d {
+    const double x = u(rng), y = u(rng), z = u(rng);
+    return Eigen::Vector3d(x, y, z) * s;
+  };
+  for (const bool baseline : {false, true}) {
+    detail::force_baseline_quartics(baseline);
+    for (int i = 0; i < 20000; ++i) {
+      detail::QuadrupleDifferences q[4];
+      for (auto& x : q) {
+        // Each lane its own scale: the lanes must not mix.
+        const double s = std::ldexp(1.0, std::uniform_int_distribution<int>(-540, 180)(rng));
+        x = {vec(s), vec(s), vec(s), vec(s), vec(s), vec(s), vec(s), vec(s)};
+        if (i % 5 == 0) x.c_t0 = x.a_t0;
+        if (i % 7 == 0) x.d_t1 = Eigen::Vector3d::Zero();
+        if (i % 11 == 0) x.b_t0 = -x.b_t0;
+      }
+      BernsteinQuartic g[4];
+      detail::cross_dot_quartic_x4(q, g);
+      for (std::size_t lane = 0; lane < 4; ++lane) {
+        const BernsteinQuartic r = detail::cross_dot_quartic(q[lane]);
+        for (std::size_t k = 0; k < 5; ++k) {
+          ASSERT_TRUE(same_bits(g[lane].coefficients[k], r.coefficients[k]))
+              << i << " lane " << lane << (baseline ? " baseline" : "");
+        }
+        ASSERT_TRUE(same_bits(g[lane].error, r.error)) << i << " lane " << lane;
+      }
+    }
+  }
+  detail::force_baseline_quartics(false);
+}
+
+TEST(KernelEquivalence, KernelsGiveTheSameAnswersWithFourQuarticsAtOnce) {
+  // The conservative pipeline computes its four inside quartics at once where cross_dot_quartic_x4
+  // is wide, and two pairs (the second only past the early exit) otherwise: the same answers, bit
+  // for bit, and the same stage counts, on the random mix, the hard cases and the cloth-funnel
+  // step. On a CPU without AVX2 both runs take the pairs.
+  struct Item {
+    bool vertex_face;
+    std::array<Eigen::Vector3d, 8> points;
+  };
+  std::vector<Item> items;
+  test::RandomQueryGenerator generator(61);
+  for (int n = 0; n < 4000; ++n) {
+    const test::RandomQuery q = generator.next();
+    items.push_back({q.vertex_face, q.points});
+  }
+  for (const test::HardCase& c : test::hard_cases(9, 2)) items.push_back({c.vertex_face, c.points});
+  for (const char* kind : {"vf", "ee"}) {
+    for (const auto& c : test::load_cloth_funnel(kind)) {
+      if (c.vertex_face) {
+        const VertexFaceQuery v = c.vf();
+        items.push_back(
+            {true, {v.v_t0, v.f0_t0, v.f1_t0, v.f2_t0, v.v_t1, v.f0_t1, v.f1_t1, v.f2_t1}});
+      } else {
+        const EdgeEdgeQuery e = c.ee();
+        items.push_back(
+            {false,
+             {e.ea0_t0, e.ea1_t0, e.eb0_t0, e.eb1_t0, e.ea0_t1, e.ea1_t1, e.eb0_t1, e.eb1_t1}});
+      }
+    }
+  }
+  CcdOptions options;
+  options.max_iterations = 2000;
+  const auto run = [&](bool baseline, CcdStats& stats) {
+    detail::force_baseline_quartics(baseline);
+    std::vector<CcdResult> out;
+    for (const Item& it : items) {
+      const auto& p = it.points;
+      out.push_back(
+          it.vertex_face ? vertex_face_ccd(
+                               {p[0], p[1], p[2], p[3], p[4], p[5], p[6], p[7]},
+                               Accuracy::conservative,
+                               options,
+                               stats)
+                         : edge_edge_ccd(
+                               {p[0], p[1], p[2], p[3], p[4], p[5], p[6], p[7]},
+                               Accuracy::conservative,
+                               options,
+                               stats));
+    }
+    detail::force_baseline_quartics(false);
+    return out;
+  };
+  CcdStats wide_stats, baseline_stats;
+  const std::vector<CcdResult> wide = run(false, wide_stats);
+  const std::vector<CcdResult> baseline = run(true, baseline_stats);
+  for (std::size_t i = 0; i < items.size(); ++i) {
+    ASSERT_EQ(wide[i].hit, baseline[i].hit) << i;
+    ASSERT_EQ(wide[i].status, baseline[i].status) << i;
+    ASSERT_TRUE(same_bits(wide[i].toi_lower, baseline[i].toi_lower)) << i;
+    ASSERT_TRUE(same_bits(wide[i].toi_upper, baseline[i].toi_upper)) << i;
+  }
+  EXPECT_EQ(wide_stats.algebraic_rejected, baseline_stats.algebraic_rejected);
+  EXPECT_EQ(wide_stats.algebraic_hits, baseline_stats.algebraic_hits);
+  EXPECT_EQ(wide_stats.solver_runs, baseline_stats.solver_runs);
+  EXPECT_EQ(wide_stats.solver_boxes, baseline_stats.solver_boxes);
+  // The quartics decide many of them either way: the comparison has teeth.
+  EXPECT_GT(wide_stats.algebraic_rejected, 500);
+  EXPECT_GT(wide_stats.algebraic_hits, 500);
 }
 
 TEST(KernelEquivalence, AlgebraicFilterOnRandomPolynomials) {
