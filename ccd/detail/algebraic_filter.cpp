@@ -487,12 +487,129 @@ void cross_dot_quartic_x4(const QuadrupleDifferences* q, BernsteinQuartic* g) {
   cross_dot_quartic_pair(q[2], q[3], g[2], g[3]);
 }
 
+namespace {
+
+/// halve for four polynomials at once, lane k halving the k-th: the pair version's operations per
+/// lane.
+[[gnu::always_inline]] inline Lanes4 halve4(
+    const std::array<Lanes4, 5>& b,
+    const Lanes4& e,
+    std::array<Lanes4, 5>& left,
+    std::array<Lanes4, 5>& right) {
+  constexpr std::size_t M = 5;
+  std::array<Lanes4, M> w = b;
+  Lanes4 m = {0.0, 0.0, 0.0, 0.0};
+  for (const Lanes4& x : b) m = max4(m, abs4(x));
+  left[0] = w[0];
+  right[M - 1] = w[M - 1];
+#pragma GCC unroll 8
+  for (std::size_t level = 1; level < M; ++level) {
+#pragma GCC unroll 8
+    for (std::size_t i = 0; i + level < M; ++i) w[i] = (w[i] + w[i + 1]) * 0.5;
+    left[level] = w[0];
+    right[M - 1 - level] = w[M - 1 - level];
+  }
+  const auto n = static_cast<int>(M) - 1;
+  const Lanes4 bound = (static_cast<double>(n + 1) * kEps) * ((m + e) * kRoundUp);
+  return ((e + bound) * kRoundUp + n * kUnderflowUnit) * kRoundUp;
+}
+
+struct Node4 {
+  double lo, hi;
+  int depth;
+  std::array<double, 4> c;
+  double c_err;
+  std::array<Lanes4, 5> g;
+  Lanes4 g_err;
+};
+
+/// algebraic_filter with its (three or four) quartics in the four lanes of one vector, quartic i
+/// in lane i (a fourth lane repeating the third, never looked at): the same nodes in the same
+/// order and the same operations per lane as the pairs, hence the same verdict.
+[[gnu::always_inline]] inline AlgebraicVerdict algebraic_filter_x4_body(
+    const BernsteinCubic& c, const BernsteinQuartic* g, int count, double toi_tolerance) {
+  std::array<Node4, kMaxDepth + 2> waiting;
+  int size = 0;
+  Node4 node;
+  node.lo = 0.0;
+  node.hi = 1.0;
+  node.depth = 0;
+  node.c = c.coefficients;
+  node.c_err = c.error;
+  for (std::size_t lane = 0; lane < 4; ++lane) {
+    const BernsteinQuartic& q = g[std::min(static_cast<int>(lane), count - 1)];
+    for (std::size_t k = 0; k < 5; ++k) node.g[k][lane] = q.coefficients[k];
+    node.g_err[lane] = q.error;
+  }
+  const LaneBits4 used = {
+      0 < count ? -1 : 0, 1 < count ? -1 : 0, 2 < count ? -1 : 0, 3 < count ? -1 : 0};
+  int visited = 0;
+  for (;;) {
+    bool excluded = hull_sign(node.c, node.c_err) != 0;
+    bool all_positive = true;
+    if (!excluded) {
+      LaneBits4 pos = node.g[0] > node.g_err;
+      LaneBits4 neg = -node.g[0] > node.g_err;
+      for (std::size_t i = 1; i < 5; ++i) {
+        pos &= node.g[i] > node.g_err;
+        neg &= -node.g[i] > node.g_err;
+      }
+      neg &= used;
+      pos |= ~used;
+      if ((neg[0] | neg[1] | neg[2] | neg[3]) != 0) excluded = true;
+      if ((pos[0] & pos[1] & pos[2] & pos[3]) == 0) all_positive = false;
+    }
+    if (excluded) {
+      if (size == 0) break;
+      node = waiting[static_cast<std::size_t>(--size)];
+      continue;
+    }
+    if (all_positive && certain_sign_change(node.c, node.c_err)) {
+      return narrow(node.lo, node.hi, node.c, node.c_err, toi_tolerance);
+    }
+    const double mid = 0.5 * (node.lo + node.hi);
+    if (++visited > kNodeBudget || node.depth >= kMaxDepth || !(node.lo < mid && mid < node.hi)) {
+      return {AlgebraicOutcome::undecided, node.lo, 1.0};
+    }
+    Node4& right = waiting[static_cast<std::size_t>(size++)];
+    right.lo = mid;
+    right.hi = node.hi;
+    right.depth = node.depth + 1;
+    std::array<double, 4> left_c;
+    right.c_err = halve(node.c, node.c_err, left_c, right.c);
+    node.c = left_c;
+    node.c_err = right.c_err;
+    std::array<Lanes4, 5> left_g;
+    right.g_err = halve4(node.g, node.g_err, left_g, right.g);
+    node.g = left_g;
+    node.g_err = right.g_err;
+    node.hi = mid;
+    node.depth = right.depth;
+  }
+  return {AlgebraicOutcome::separated, 1.0, 1.0};
+}
+
+#if defined(SKELCD_QUARTICS_AVX2)
+[[gnu::target("avx2")]] AlgebraicVerdict algebraic_filter_x4_avx2(
+    const BernsteinCubic& c, const BernsteinQuartic* g, int count, double toi_tolerance) {
+  return algebraic_filter_x4_body(c, g, count, toi_tolerance);
+}
+#endif
+
+}  // namespace
+
 AlgebraicVerdict algebraic_filter(const BernsteinCubic& c, const BernsteinQuartic* g, int count, double toi_tolerance) {
   assert(count >= 0 && count <= kMaxQuartics);
   // Overflowed bounds (coordinates near the double range) prove nothing: leave it to the solver.
   bool finite = std::isfinite(c.error);
   for (int i = 0; i < count; ++i) finite = finite && std::isfinite(g[i].error);
   if (!finite) return {AlgebraicOutcome::undecided, 0.0, 1.0};
+#if defined(SKELCD_QUARTICS_AVX2)
+  // Three or four quartics: all in one AVX2 vector (the same verdict, half the vector work).
+  if (count >= 3 && cross_dot_quartics_x4_wide()) {
+    return algebraic_filter_x4_avx2(c, g, count, toi_tolerance);
+  }
+#endif
   // Depth first, earlier half first: the left half is processed next, the right half waits.
   std::array<Node, kMaxDepth + 2> waiting;
   int size = 0;

@@ -757,6 +757,40 @@ TEST(KernelEquivalence, AlgebraicFilterOnRandomPolynomials) {
   for (const int n : outcomes) EXPECT_GT(n, 100);
 }
 
+TEST(KernelEquivalence, AlgebraicFilterGivesTheSameVerdictWithItsQuarticsInFourLanes) {
+  // With three or four quartics and AVX2 the filter carries them in the four lanes of one vector
+  // instead of two pairs: the same verdict and the same bracket, bit for bit, on random
+  // polynomials of every outcome and on coefficients from the subnormal range to 2^300. On a CPU
+  // without AVX2 both runs take the pairs.
+  std::mt19937_64 rng(15);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  int outcomes[3] = {0, 0, 0};
+  for (int i = 0; i < 40000; ++i) {
+    const double scale =
+        i % 4 == 0 ? std::ldexp(1.0, std::uniform_int_distribution<int>(-1060, 300)(rng)) : 1.0;
+    BernsteinCubic c;
+    for (double& b : c.coefficients) b = u(rng) * scale;
+    c.error = std::ldexp(scale, std::uniform_int_distribution<int>(-60, -1)(rng));
+    if (i % 11 == 0) c.error = 0.0;
+    const int count = 3 + i % 2;
+    BernsteinQuartic g[4];
+    for (int k = 0; k < count; ++k) {
+      for (double& b : g[k].coefficients) b = (u(rng) + (i % 3 == 0 ? 0.6 : 0.0)) * scale;
+      g[k].error = std::ldexp(scale, std::uniform_int_distribution<int>(-60, -1)(rng));
+    }
+    const double tolerance = i % 2 == 0 ? 1e-6 : 0.25;
+    detail::force_baseline_quartics(true);
+    const AlgebraicVerdict pairs = detail::algebraic_filter(c, g, count, tolerance);
+    detail::force_baseline_quartics(false);
+    const AlgebraicVerdict lanes = detail::algebraic_filter(c, g, count, tolerance);
+    ASSERT_EQ(lanes.outcome, pairs.outcome) << i;
+    ASSERT_TRUE(same_bits(lanes.t_lo, pairs.t_lo)) << i;
+    ASSERT_TRUE(same_bits(lanes.t_hi, pairs.t_hi)) << i;
+    ++outcomes[static_cast<int>(lanes.outcome)];
+  }
+  for (const int n : outcomes) EXPECT_GT(n, 100);
+}
+
 // Exact cubics (error 0) with a certain sign change on [0, 1] and no quartic: the filter reports
 // a contact whose bracket must hold a root, checked in rational arithmetic: the exact Bernstein
 // polynomial's signs at t_lo and t_hi differ or one of them is 0. A monotone cubic has one root,
