@@ -13,6 +13,10 @@
 #include "ccd/detail/float_bounds.hpp"
 #include "ccd/detail/lanes.hpp"
 
+// Four-double vectors pass between the inline helpers below; where the baseline ABI has no AVX
+// they are split, which is what the note is about. Nothing crosses a library boundary.
+#pragma GCC diagnostic ignored "-Wpsabi"
+
 namespace skelcd::ccd::detail {
 namespace {
 
@@ -63,16 +67,14 @@ double halve(const std::array<double, M>& b, double e, std::array<double, M>& le
   return add_up(add_up(e, rounding_bound(n, add_up(m, e))), n * kUnderflowUnit);
 }
 
-// halve for two polynomials at once, lane k halving the k-th: the same operations per lane.
-template <std::size_t M>
-Lanes halve(
-    const std::array<Lanes, M>& b,
-    Lanes e,
-    std::array<Lanes, M>& left,
-    std::array<Lanes, M>& right) {
-  std::array<Lanes, M> w = b;
-  Lanes m = {0.0, 0.0};
-  for (const Lanes x : b) m = lane_max(m, lane_abs(x));  // std::max(m, std::abs(x))
+// halve for two or four polynomials at once (L: Lanes or Lanes4), lane k halving the k-th: the
+// same operations per lane.
+template <std::size_t M, class L>
+[[gnu::always_inline]] inline L halve(
+    const std::array<L, M>& b, const L& e, std::array<L, M>& left, std::array<L, M>& right) {
+  std::array<L, M> w = b;
+  L m{};
+  for (const L& x : b) m = lane_max(m, lane_abs(x));  // std::max(m, std::abs(x))
   left[0] = w[0];
   right[M - 1] = w[M - 1];
 #pragma GCC unroll 8
@@ -84,13 +86,14 @@ Lanes halve(
   }
   const auto n = static_cast<int>(M) - 1;
   // add_up and rounding_bound per lane.
-  const Lanes bound = (static_cast<double>(n + 1) * kEps) * ((m + e) * kRoundUp);
+  const L bound = (static_cast<double>(n + 1) * kEps) * ((m + e) * kRoundUp);
   return ((e + bound) * kRoundUp + n * kUnderflowUnit) * kRoundUp;
 }
 
 // Bits of "every coefficient > e" and of "every coefficient < -e", per lane.
-template <std::size_t M>
-void hull_masks(const std::array<Lanes, M>& b, Lanes e, LaneBits& pos, LaneBits& neg) {
+template <std::size_t M, class L, class B>
+[[gnu::always_inline]] inline void hull_masks(
+    const std::array<L, M>& b, const L& e, B& pos, B& neg) {
   pos = b[0] > e;
   neg = -b[0] > e;
   for (std::size_t i = 1; i < M; ++i) {
@@ -99,16 +102,16 @@ void hull_masks(const std::array<Lanes, M>& b, Lanes e, LaneBits& pos, LaneBits&
   }
 }
 
-// The quartics travel in pairs, quartic 2p + k in lane k of pair p.
-constexpr int kPairs = kMaxQuartics / 2;
-
+// The quartics travel in groups of W lanes (L: two or four doubles), quartic W p + k in lane k
+// of group p.
+template <class L, std::size_t kGroups>
 struct Node {
   double lo, hi;
   int depth;
   std::array<double, 4> c;
   double c_err;
-  std::array<std::array<Lanes, 5>, kPairs> g;
-  std::array<Lanes, kPairs> g_err;
+  std::array<std::array<L, 5>, kGroups> g;
+  std::array<L, kGroups> g_err;
 };
 
 /// Bisection of narrow(): the sign change kept by halving the Bernstein coefficients.
@@ -288,23 +291,31 @@ BernsteinQuartic cross_dot_quartic(const QuadrupleDifferences& q) {
   return out;
 }
 
-void cross_dot_quartic_pair(
-    const QuadrupleDifferences& q0,
-    const QuadrupleDifferences& q1,
-    BernsteinQuartic& g0,
-    BernsteinQuartic& g1) {
-  // cross_dot_quartic with lane 0 doing q0 and lane 1 doing q1: the same operations in the same
-  // order per lane (detail/lanes.hpp).
-  const Lanes3 a[2] = {lanes3(q0.a_t0, q1.a_t0), lanes3(q0.a_t1, q1.a_t1)};
-  const Lanes3 b[2] = {lanes3(q0.b_t0, q1.b_t0), lanes3(q0.b_t1, q1.b_t1)};
-  const Lanes3 c[2] = {lanes3(q0.c_t0, q1.c_t0), lanes3(q0.c_t1, q1.c_t1)};
-  const Lanes3 d[2] = {lanes3(q0.d_t0, q1.d_t0), lanes3(q0.d_t1, q1.d_t1)};
-  const Lanes3 aa[2] = {lane_abs(a[0]), lane_abs(a[1])};
-  const Lanes3 ab_[2] = {lane_abs(b[0]), lane_abs(b[1])};
-  const Lanes3 ac[2] = {lane_abs(c[0]), lane_abs(c[1])};
-  const Lanes3 ad[2] = {lane_abs(d[0]), lane_abs(d[1])};
+namespace {
+
+/// cross_dot_quartic of q(k) into g(k) for the W = 2 or 4 lanes of L: lane k goes through the
+/// scalar code's operations in the same order (detail/lanes.hpp).
+template <class L, std::size_t W, class Source, class Target>
+[[gnu::always_inline]] inline void quartics_body(const Source& q, const Target& g) {
+  const auto gather = [&](Eigen::Vector3d QuadrupleDifferences::*m) {
+    if constexpr (W == 2) {
+      return lanes_of<L, 2>({&(q(0).*m), &(q(1).*m)});
+    } else {
+      return lanes_of<L, 4>({&(q(0).*m), &(q(1).*m), &(q(2).*m), &(q(3).*m)});
+    }
+  };
+  using Q = QuadrupleDifferences;
+  using L3 = LaneVec3<L>;
+  const L3 a[2] = {gather(&Q::a_t0), gather(&Q::a_t1)};
+  const L3 b[2] = {gather(&Q::b_t0), gather(&Q::b_t1)};
+  const L3 c[2] = {gather(&Q::c_t0), gather(&Q::c_t1)};
+  const L3 d[2] = {gather(&Q::d_t0), gather(&Q::d_t1)};
+  const L3 aa[2] = {lane_abs(a[0]), lane_abs(a[1])};
+  const L3 ab_[2] = {lane_abs(b[0]), lane_abs(b[1])};
+  const L3 ac[2] = {lane_abs(c[0]), lane_abs(c[1])};
+  const L3 ad[2] = {lane_abs(d[0]), lane_abs(d[1])};
   // Factor pairs: A x B with (A, B) at times (mask & 1, mask & 2), C x D at (mask & 4, mask & 8).
-  Lanes3 ab[4], ab_perm[4], cd[4], cd_perm[4];
+  L3 ab[4], ab_perm[4], cd[4], cd_perm[4];
   for (int k = 0; k < 4; ++k) {
     const int i = k & 1, j = k >> 1;
     ab[k] = cross(a[i], b[j]);
@@ -313,8 +324,8 @@ void cross_dot_quartic_pair(
     cd_perm[k] = cross_permanent(ac[i], ad[j]);
   }
   static constexpr int kBits[4] = {0, 1, 1, 2};
-  Lanes sum[5] = {};
-  Lanes perm[5] = {};
+  L sum[5] = {};
+  L perm[5] = {};
 #pragma GCC unroll 4
   for (int i = 0; i < 4; ++i) {
 #pragma GCC unroll 4
@@ -325,140 +336,50 @@ void cross_dot_quartic_pair(
     }
   }
   static constexpr double kTerms[5] = {1.0, 4.0, 6.0, 4.0, 1.0};
-  Lanes p = {0.0, 0.0};
+  L p{};
   for (std::size_t i = 0; i < 5; ++i) {
-    const Lanes value = sum[i] / kTerms[i];
-    g0.coefficients[i] = value[0];
-    g1.coefficients[i] = value[1];
+    const L value = sum[i] / kTerms[i];
+    for (std::size_t k = 0; k < W; ++k) g(k).coefficients[i] = value[k];
     p = lane_max(p, perm[i] / kTerms[i]);
   }
   // The largest coordinate magnitude of each quadruple (finite by the precondition, so any order
   // of comparisons finds the same value).
-  Lanes m = {0.0, 0.0};
+  L m{};
   for (int t = 0; t < 2; ++t) {
     m = lane_max(
         m,
         lane_max(lane_max(max_abs(a[t]), max_abs(b[t])), lane_max(max_abs(c[t]), max_abs(d[t]))));
   }
   // As in cross_dot_quartic.
-  g0.error =
-      add_up(rounding_bound(18, p[0]), times_subnormal_power_of_two<1068>(1.0 + m[0] * m[0]));
-  g1.error =
-      add_up(rounding_bound(18, p[1]), times_subnormal_power_of_two<1068>(1.0 + m[1] * m[1]));
-}
-
-namespace {
-
-// Four-double vectors pass between the inline helpers below; where the baseline ABI has no AVX
-// they are split, which is what the note is about. Nothing crosses a library boundary.
-#pragma GCC diagnostic ignored "-Wpsabi"
-
-using Lanes4 = double __attribute__((vector_size(32)));
-using LaneBits4 = std::int64_t __attribute__((vector_size(32)));
-
-struct Lanes4x3 {
-  Lanes4 x, y, z;
-};
-
-/// |v| per lane as std::abs does it: the sign bit cleared (a vector cast reinterprets the bits).
-[[gnu::always_inline]] inline Lanes4 abs4(const Lanes4& v) {
-  constexpr std::int64_t kMagnitude = std::numeric_limits<std::int64_t>::max();
-  return reinterpret_cast<Lanes4>(reinterpret_cast<LaneBits4>(v) & kMagnitude);
-}
-/// std::max(a, b) per lane: (a < b) ? b : a.
-[[gnu::always_inline]] inline Lanes4 max4(const Lanes4& a, const Lanes4& b) {
-  return a < b ? b : a;
-}
-[[gnu::always_inline]] inline Lanes4x3 abs4(const Lanes4x3& v) {
-  return {abs4(v.x), abs4(v.y), abs4(v.z)};
-}
-/// The vector `m` of the four quadruples, lane k from q[k].
-[[gnu::always_inline]] inline Lanes4x3 gather4(
-    const QuadrupleDifferences* q, Eigen::Vector3d QuadrupleDifferences::*m) {
-  const Eigen::Vector3d& v0 = q[0].*m;
-  const Eigen::Vector3d& v1 = q[1].*m;
-  const Eigen::Vector3d& v2 = q[2].*m;
-  const Eigen::Vector3d& v3 = q[3].*m;
-  return {
-      Lanes4{v0[0], v1[0], v2[0], v3[0]},
-      Lanes4{v0[1], v1[1], v2[1], v3[1]},
-      Lanes4{v0[2], v1[2], v2[2], v3[2]}};
-}
-/// As detail/lanes.hpp's cross, cross_permanent, dot and max_abs, four lanes.
-[[gnu::always_inline]] inline Lanes4x3 cross4(const Lanes4x3& y, const Lanes4x3& z) {
-  return {y.y * z.z - y.z * z.y, y.z * z.x - y.x * z.z, y.x * z.y - y.y * z.x};
-}
-[[gnu::always_inline]] inline Lanes4x3 cross_permanent4(const Lanes4x3& ay, const Lanes4x3& az) {
-  return {ay.y * az.z + ay.z * az.y, ay.z * az.x + ay.x * az.z, ay.x * az.y + ay.y * az.x};
-}
-[[gnu::always_inline]] inline Lanes4 dot4(const Lanes4x3& x, const Lanes4x3& c) {
-  return x.x * c.x + x.y * c.y + x.z * c.z;
-}
-[[gnu::always_inline]] inline Lanes4 max_abs4(const Lanes4x3& v) {
-  return max4(max4(abs4(v.x), abs4(v.y)), abs4(v.z));
-}
-
-/// cross_dot_quartic_pair with four lanes: lane k computes g[k] from q[k] through the same
-/// operations in the same order.
-[[gnu::always_inline]] inline void quartics_x4_body(
-    const QuadrupleDifferences* q, BernsteinQuartic* g) {
-  using Q = QuadrupleDifferences;
-  const Lanes4x3 a[2] = {gather4(q, &Q::a_t0), gather4(q, &Q::a_t1)};
-  const Lanes4x3 b[2] = {gather4(q, &Q::b_t0), gather4(q, &Q::b_t1)};
-  const Lanes4x3 c[2] = {gather4(q, &Q::c_t0), gather4(q, &Q::c_t1)};
-  const Lanes4x3 d[2] = {gather4(q, &Q::d_t0), gather4(q, &Q::d_t1)};
-  const Lanes4x3 aa[2] = {abs4(a[0]), abs4(a[1])};
-  const Lanes4x3 ab_[2] = {abs4(b[0]), abs4(b[1])};
-  const Lanes4x3 ac[2] = {abs4(c[0]), abs4(c[1])};
-  const Lanes4x3 ad[2] = {abs4(d[0]), abs4(d[1])};
-  Lanes4x3 ab[4], ab_perm[4], cd[4], cd_perm[4];
-  for (int k = 0; k < 4; ++k) {
-    const int i = k & 1, j = k >> 1;
-    ab[k] = cross4(a[i], b[j]);
-    ab_perm[k] = cross_permanent4(aa[i], ab_[j]);
-    cd[k] = cross4(c[i], d[j]);
-    cd_perm[k] = cross_permanent4(ac[i], ad[j]);
-  }
-  static constexpr int kBits[4] = {0, 1, 1, 2};
-  Lanes4 sum[5] = {};
-  Lanes4 perm[5] = {};
-#pragma GCC unroll 4
-  for (int i = 0; i < 4; ++i) {
-#pragma GCC unroll 4
-    for (int j = 0; j < 4; ++j) {
-      const int level = kBits[i] + kBits[j];
-      sum[level] += dot4(ab[i], cd[j]);
-      perm[level] += dot4(ab_perm[i], cd_perm[j]);
-    }
-  }
-  static constexpr double kTerms[5] = {1.0, 4.0, 6.0, 4.0, 1.0};
-  Lanes4 p = {0.0, 0.0, 0.0, 0.0};
-  for (std::size_t i = 0; i < 5; ++i) {
-    const Lanes4 value = sum[i] / kTerms[i];
-    for (std::size_t k = 0; k < 4; ++k) g[k].coefficients[i] = value[k];
-    p = max4(p, perm[i] / kTerms[i]);
-  }
-  Lanes4 m = {0.0, 0.0, 0.0, 0.0};
-  for (int t = 0; t < 2; ++t) {
-    m = max4(m, max4(max4(max_abs4(a[t]), max_abs4(b[t])), max4(max_abs4(c[t]), max_abs4(d[t]))));
-  }
-  for (std::size_t k = 0; k < 4; ++k) {
-    g[k].error =
+  for (std::size_t k = 0; k < W; ++k) {
+    g(k).error =
         add_up(rounding_bound(18, p[k]), times_subnormal_power_of_two<1068>(1.0 + m[k] * m[k]));
   }
 }
 
 #if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
 #define SKELCD_QUARTICS_AVX2 1
-/// quartics_x4_body built for AVX2: one instruction per operation on the four lanes.
+/// The four lanes built for AVX2: one instruction per operation on the four quartics.
 [[gnu::target("avx2")]] void quartics_x4_avx2(const QuadrupleDifferences* q, BernsteinQuartic* g) {
-  quartics_x4_body(q, g);
+  quartics_body<Lanes4, 4>(
+      [&](std::size_t k) -> const QuadrupleDifferences& { return q[k]; },
+      [&](std::size_t k) -> BernsteinQuartic& { return g[k]; });
 }
 #endif
 
 std::atomic<bool> quartics_baseline_forced{false};
 
 }  // namespace
+
+void cross_dot_quartic_pair(
+    const QuadrupleDifferences& q0,
+    const QuadrupleDifferences& q1,
+    BernsteinQuartic& g0,
+    BernsteinQuartic& g1) {
+  quartics_body<Lanes, 2>(
+      [&](std::size_t k) -> const QuadrupleDifferences& { return k == 0 ? q0 : q1; },
+      [&](std::size_t k) -> BernsteinQuartic& { return k == 0 ? g0 : g1; });
+}
 
 bool cross_dot_quartics_x4_wide() {
 #if defined(SKELCD_QUARTICS_AVX2)
@@ -489,165 +410,54 @@ void cross_dot_quartic_x4(const QuadrupleDifferences* q, BernsteinQuartic* g) {
 
 namespace {
 
-/// halve for four polynomials at once, lane k halving the k-th: the pair version's operations per
-/// lane.
-[[gnu::always_inline]] inline Lanes4 halve4(
-    const std::array<Lanes4, 5>& b,
-    const Lanes4& e,
-    std::array<Lanes4, 5>& left,
-    std::array<Lanes4, 5>& right) {
-  constexpr std::size_t M = 5;
-  std::array<Lanes4, M> w = b;
-  Lanes4 m = {0.0, 0.0, 0.0, 0.0};
-  for (const Lanes4& x : b) m = max4(m, abs4(x));
-  left[0] = w[0];
-  right[M - 1] = w[M - 1];
-#pragma GCC unroll 8
-  for (std::size_t level = 1; level < M; ++level) {
-#pragma GCC unroll 8
-    for (std::size_t i = 0; i + level < M; ++i) w[i] = (w[i] + w[i + 1]) * 0.5;
-    left[level] = w[0];
-    right[M - 1 - level] = w[M - 1 - level];
-  }
-  const auto n = static_cast<int>(M) - 1;
-  const Lanes4 bound = (static_cast<double>(n + 1) * kEps) * ((m + e) * kRoundUp);
-  return ((e + bound) * kRoundUp + n * kUnderflowUnit) * kRoundUp;
-}
-
-struct Node4 {
-  double lo, hi;
-  int depth;
-  std::array<double, 4> c;
-  double c_err;
-  std::array<Lanes4, 5> g;
-  Lanes4 g_err;
-};
-
-/// algebraic_filter with its (three or four) quartics in the four lanes of one vector, quartic i
-/// in lane i (a fourth lane repeating the third, never looked at): the same nodes in the same
-/// order and the same operations per lane as the pairs, hence the same verdict.
-[[gnu::always_inline]] inline AlgebraicVerdict algebraic_filter_x4_body(
+/// algebraic_filter's search with its quartics in groups of W lanes of L (two pairs of two, or
+/// one group of four): quartic W p + k in lane k of group p, a group's spare lanes repeating the
+/// last quartic and never looked at (not zeros: halving a zero error would make a subnormal
+/// product each time, a microcode assist). The nodes, their order and each lane's operations do
+/// not depend on the grouping, so neither does the verdict.
+template <class L, class B, std::size_t W, std::size_t kGroups>
+[[gnu::always_inline]] inline AlgebraicVerdict filter_body(
     const BernsteinCubic& c, const BernsteinQuartic* g, int count, double toi_tolerance) {
-  std::array<Node4, kMaxDepth + 2> waiting;
-  int size = 0;
-  Node4 node;
-  node.lo = 0.0;
-  node.hi = 1.0;
-  node.depth = 0;
-  node.c = c.coefficients;
-  node.c_err = c.error;
-  for (std::size_t lane = 0; lane < 4; ++lane) {
-    const BernsteinQuartic& q = g[std::min(static_cast<int>(lane), count - 1)];
-    for (std::size_t k = 0; k < 5; ++k) node.g[k][lane] = q.coefficients[k];
-    node.g_err[lane] = q.error;
-  }
-  const LaneBits4 used = {
-      0 < count ? -1 : 0, 1 < count ? -1 : 0, 2 < count ? -1 : 0, 3 < count ? -1 : 0};
-  int visited = 0;
-  for (;;) {
-    bool excluded = hull_sign(node.c, node.c_err) != 0;
-    bool all_positive = true;
-    if (!excluded) {
-      LaneBits4 pos = node.g[0] > node.g_err;
-      LaneBits4 neg = -node.g[0] > node.g_err;
-      for (std::size_t i = 1; i < 5; ++i) {
-        pos &= node.g[i] > node.g_err;
-        neg &= -node.g[i] > node.g_err;
-      }
-      neg &= used;
-      pos |= ~used;
-      if ((neg[0] | neg[1] | neg[2] | neg[3]) != 0) excluded = true;
-      if ((pos[0] & pos[1] & pos[2] & pos[3]) == 0) all_positive = false;
-    }
-    if (excluded) {
-      if (size == 0) break;
-      node = waiting[static_cast<std::size_t>(--size)];
-      continue;
-    }
-    if (all_positive && certain_sign_change(node.c, node.c_err)) {
-      return narrow(node.lo, node.hi, node.c, node.c_err, toi_tolerance);
-    }
-    const double mid = 0.5 * (node.lo + node.hi);
-    if (++visited > kNodeBudget || node.depth >= kMaxDepth || !(node.lo < mid && mid < node.hi)) {
-      return {AlgebraicOutcome::undecided, node.lo, 1.0};
-    }
-    Node4& right = waiting[static_cast<std::size_t>(size++)];
-    right.lo = mid;
-    right.hi = node.hi;
-    right.depth = node.depth + 1;
-    std::array<double, 4> left_c;
-    right.c_err = halve(node.c, node.c_err, left_c, right.c);
-    node.c = left_c;
-    node.c_err = right.c_err;
-    std::array<Lanes4, 5> left_g;
-    right.g_err = halve4(node.g, node.g_err, left_g, right.g);
-    node.g = left_g;
-    node.g_err = right.g_err;
-    node.hi = mid;
-    node.depth = right.depth;
-  }
-  return {AlgebraicOutcome::separated, 1.0, 1.0};
-}
-
-#if defined(SKELCD_QUARTICS_AVX2)
-[[gnu::target("avx2")]] AlgebraicVerdict algebraic_filter_x4_avx2(
-    const BernsteinCubic& c, const BernsteinQuartic* g, int count, double toi_tolerance) {
-  return algebraic_filter_x4_body(c, g, count, toi_tolerance);
-}
-#endif
-
-}  // namespace
-
-AlgebraicVerdict algebraic_filter(const BernsteinCubic& c, const BernsteinQuartic* g, int count, double toi_tolerance) {
-  assert(count >= 0 && count <= kMaxQuartics);
-  // Overflowed bounds (coordinates near the double range) prove nothing: leave it to the solver.
-  bool finite = std::isfinite(c.error);
-  for (int i = 0; i < count; ++i) finite = finite && std::isfinite(g[i].error);
-  if (!finite) return {AlgebraicOutcome::undecided, 0.0, 1.0};
-#if defined(SKELCD_QUARTICS_AVX2)
-  // Three or four quartics: all in one AVX2 vector (the same verdict, half the vector work).
-  if (count >= 3 && cross_dot_quartics_x4_wide()) {
-    return algebraic_filter_x4_avx2(c, g, count, toi_tolerance);
-  }
-#endif
   // Depth first, earlier half first: the left half is processed next, the right half waits.
-  std::array<Node, kMaxDepth + 2> waiting;
+  using N = Node<L, kGroups>;
+  std::array<N, kMaxDepth + 2> waiting;
   int size = 0;
-  Node node;
+  N node;
   node.lo = 0.0;
   node.hi = 1.0;
   node.depth = 0;
   node.c = c.coefficients;
   node.c_err = c.error;
-  // Quartic i in lane i % 2 of pair i / 2. With an odd count the last lane repeats the quartic
-  // before it and is never looked at (not zeros: halving a zero error would make a subnormal
-  // product each time, a microcode assist).
-  const int pairs = (count + 1) / 2;
-  for (int i = 0; i < 2 * pairs; ++i) {
+  constexpr int kWidth = static_cast<int>(W);
+  // Groups that hold a quartic (one, with four lanes: the caller has three or four).
+  const int groups = kGroups == 1 ? 1 : (count + kWidth - 1) / kWidth;
+  for (int i = 0; i < kWidth * groups; ++i) {
     const BernsteinQuartic& q = g[std::min(i, count - 1)];
-    const auto p = static_cast<std::size_t>(i / 2);
-    const int lane = i % 2;
+    const auto p = static_cast<std::size_t>(i / kWidth);
+    const auto lane = static_cast<std::size_t>(i % kWidth);
     for (std::size_t k = 0; k < 5; ++k) node.g[p][k][lane] = q.coefficients[k];
     node.g_err[p][lane] = q.error;
   }
   // Lanes that hold a quartic.
-  LaneBits used[kPairs];
-  for (int p = 0; p < kPairs; ++p) {
-    used[p] = LaneBits{2 * p < count ? ~0ull : 0ull, 2 * p + 1 < count ? ~0ull : 0ull};
+  std::array<B, kGroups> used;
+  for (std::size_t p = 0; p < kGroups; ++p) {
+    for (std::size_t lane = 0; lane < W; ++lane) {
+      used[p][lane] = W * p + lane < static_cast<std::size_t>(count) ? ~0ull : 0ull;
+    }
   }
   int visited = 0;
   for (;;) {
     // Coplanarity excluded here, or some inside condition failing throughout?
     bool excluded = hull_sign(node.c, node.c_err) != 0;
     bool all_positive = true;
-    for (int p = 0; p < pairs && !excluded; ++p) {
+    for (int p = 0; p < groups && !excluded; ++p) {
       const auto pp = static_cast<std::size_t>(p);
-      LaneBits pos, neg;
+      B pos, neg;
       hull_masks(node.g[pp], node.g_err[pp], pos, neg);
-      neg &= used[p];
-      pos = pos | ~used[p];
-      if ((neg[0] | neg[1]) != 0) excluded = true;
-      if ((pos[0] & pos[1]) == 0) all_positive = false;
+      neg &= used[pp];
+      pos = pos | ~used[pp];
+      if (any_lane(neg)) excluded = true;
+      if (!all_lanes(pos)) all_positive = false;
     }
     if (excluded) {
       if (size == 0) break;
@@ -662,7 +472,7 @@ AlgebraicVerdict algebraic_filter(const BernsteinCubic& c, const BernsteinQuarti
       // Undecided; everything before node.lo was excluded.
       return {AlgebraicOutcome::undecided, node.lo, 1.0};
     }
-    Node& right = waiting[static_cast<std::size_t>(size++)];
+    N& right = waiting[static_cast<std::size_t>(size++)];
     right.lo = mid;
     right.hi = node.hi;
     right.depth = node.depth + 1;
@@ -670,9 +480,9 @@ AlgebraicVerdict algebraic_filter(const BernsteinCubic& c, const BernsteinQuarti
     right.c_err = halve(node.c, node.c_err, left_c, right.c);
     node.c = left_c;
     node.c_err = right.c_err;
-    for (int p = 0; p < pairs; ++p) {
+    for (int p = 0; p < groups; ++p) {
       const auto pp = static_cast<std::size_t>(p);
-      std::array<Lanes, 5> left_g;
+      std::array<L, 5> left_g;
       right.g_err[pp] = halve(node.g[pp], node.g_err[pp], left_g, right.g[pp]);
       node.g[pp] = left_g;
       node.g_err[pp] = right.g_err[pp];
@@ -681,6 +491,30 @@ AlgebraicVerdict algebraic_filter(const BernsteinCubic& c, const BernsteinQuarti
     node.depth = right.depth;
   }
   return {AlgebraicOutcome::separated, 1.0, 1.0};
+}
+
+#if defined(SKELCD_QUARTICS_AVX2)
+/// Three or four quartics in the four lanes of one vector, built for AVX2.
+[[gnu::target("avx2")]] AlgebraicVerdict filter_x4_avx2(
+    const BernsteinCubic& c, const BernsteinQuartic* g, int count, double toi_tolerance) {
+  return filter_body<Lanes4, LaneBits4, 4, 1>(c, g, count, toi_tolerance);
+}
+#endif
+
+}  // namespace
+
+AlgebraicVerdict algebraic_filter(
+    const BernsteinCubic& c, const BernsteinQuartic* g, int count, double toi_tolerance) {
+  assert(count >= 0 && count <= kMaxQuartics);
+  // Overflowed bounds (coordinates near the double range) prove nothing: leave it to the solver.
+  bool finite = std::isfinite(c.error);
+  for (int i = 0; i < count; ++i) finite = finite && std::isfinite(g[i].error);
+  if (!finite) return {AlgebraicOutcome::undecided, 0.0, 1.0};
+#if defined(SKELCD_QUARTICS_AVX2)
+  // Three or four quartics where they come four at once: one vector (half the vector work).
+  if (count >= 3 && cross_dot_quartics_x4_wide()) return filter_x4_avx2(c, g, count, toi_tolerance);
+#endif
+  return filter_body<Lanes, LaneBits, 2, kMaxQuartics / 2>(c, g, count, toi_tolerance);
 }
 
 }  // namespace skelcd::ccd::detail

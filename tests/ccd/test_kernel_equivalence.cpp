@@ -589,22 +589,35 @@ TEST(KernelEquivalence, ScreenBoundIsAboveTheExactBound) {
   EXPECT_GT(certified, 1000);
 }
 
-TEST(KernelEquivalence, PairedQuarticsAreCrossDotQuarticBitForBit) {
-  std::mt19937_64 rng(12);
-  std::uniform_real_distribution<double> u(-1.0, 1.0);
-  const auto vec = [&](double s) -> Eigen::Vector3d {
-    const double x = u(rng), y = u(rng), z = u(rng);
+/// Random quadruples of differences for the quartics' tests: coordinates in [-s, s]; for some i
+/// a vector repeated (i % 5 == 0) or zero (i % 7 == 0).
+class RandomQuadruples {
+ public:
+  explicit RandomQuadruples(std::uint64_t seed) : rng_(seed) {}
+  /// A scale from subnormal products to large ones.
+  double scale() { return std::ldexp(1.0, std::uniform_int_distribution<int>(-540, 180)(rng_)); }
+  detail::QuadrupleDifferences next(int i, double s) {
+    detail::QuadrupleDifferences x{vec(s), vec(s), vec(s), vec(s), vec(s), vec(s), vec(s), vec(s)};
+    if (i % 5 == 0) x.c_t0 = x.a_t0;
+    if (i % 7 == 0) x.d_t1 = Eigen::Vector3d::Zero();
+    return x;
+  }
+
+ private:
+  Eigen::Vector3d vec(double s) {
+    const double x = u_(rng_), y = u_(rng_), z = u_(rng_);
     return Eigen::Vector3d(x, y, z) * s;
-  };
+  }
+  std::mt19937_64 rng_;
+  std::uniform_real_distribution<double> u_{-1.0, 1.0};
+};
+
+TEST(KernelEquivalence, PairedQuarticsAreCrossDotQuarticBitForBit) {
+  RandomQuadruples random(12);
   for (int i = 0; i < 20000; ++i) {
-    // Scales from subnormal products to large ones; some vectors zero or repeated.
-    const double s = std::ldexp(1.0, std::uniform_int_distribution<int>(-540, 180)(rng));
+    const double s = random.scale();
     detail::QuadrupleDifferences q[2];
-    for (auto& x : q) {
-      x = {vec(s), vec(s), vec(s), vec(s), vec(s), vec(s), vec(s), vec(s)};
-      if (i % 5 == 0) x.c_t0 = x.a_t0;
-      if (i % 7 == 0) x.d_t1 = Eigen::Vector3d::Zero();
-    }
+    for (auto& x : q) x = random.next(i, s);
     BernsteinQuartic g0, g1;
     detail::cross_dot_quartic_pair(q[0], q[1], g0, g1);
     const BernsteinQuartic r0 = detail::cross_dot_quartic(q[0]),
@@ -620,23 +633,15 @@ TEST(KernelEquivalence, PairedQuarticsAreCrossDotQuarticBitForBit) {
 
 TEST(KernelEquivalence, FourQuarticsAtOnceAreCrossDotQuarticBitForBit) {
   // cross_dot_quartic_x4 in both of its builds (one AVX2 evaluation where the CPU has it, two
-  // pairs otherwise) on the random quadruples above, scales from subnormal products to large.
-  std::mt19937_64 rng(14);
-  std::uniform_real_distribution<double> u(-1.0, 1.0);
-  const auto vec = [&](double s) -> Eigen::Vector3d {
-    const double x = u(rng), y = u(rng), z = u(rng);
-    return Eigen::Vector3d(x, y, z) * s;
-  };
+  // pairs otherwise) on random quadruples, each lane at its own scale (the lanes must not mix),
+  // some negated.
+  RandomQuadruples random(14);
   for (const bool baseline : {false, true}) {
     detail::force_baseline_quartics(baseline);
     for (int i = 0; i < 20000; ++i) {
       detail::QuadrupleDifferences q[4];
       for (auto& x : q) {
-        // Each lane its own scale: the lanes must not mix.
-        const double s = std::ldexp(1.0, std::uniform_int_distribution<int>(-540, 180)(rng));
-        x = {vec(s), vec(s), vec(s), vec(s), vec(s), vec(s), vec(s), vec(s)};
-        if (i % 5 == 0) x.c_t0 = x.a_t0;
-        if (i % 7 == 0) x.d_t1 = Eigen::Vector3d::Zero();
+        x = random.next(i, random.scale());
         if (i % 11 == 0) x.b_t0 = -x.b_t0;
       }
       BernsteinQuartic g[4];
