@@ -12,21 +12,24 @@
 #include <limits>
 
 #include "ccd/detail/float_bounds.hpp"
+#include "ccd/detail/lanes.hpp"
 #include "ccd/detail/screen_x4.hpp"
 
-// Four-double vectors are passed between the inline helpers below; where the baseline ABI has no
-// AVX they are split, which is what the note is about. Nothing crosses a library boundary.
+// Four-double vectors are passed between the inline helpers below (and detail/lanes.hpp's);
+// where the baseline ABI has no AVX they are split, which is what the note is about. Nothing
+// crosses a library boundary.
 #pragma GCC diagnostic ignored "-Wpsabi"
 
 namespace skelcd::ccd {
 namespace {
 
-using V = double __attribute__((vector_size(32)));
+using detail::cross;
+using detail::dot;
+using detail::lane_max;
+using detail::max_abs;
+using V = detail::Lanes4;
+using V3 = detail::LaneVec3<V>;
 using VBits = std::int64_t __attribute__((vector_size(32)));
-
-struct V3 {
-  V x, y, z;
-};
 
 /// Coordinates of one point role across four queries: lane k is query k's point `role`.
 [[gnu::always_inline]] inline V3 gather(const double* x, ScreenQuads q, std::size_t role) {
@@ -42,16 +45,6 @@ struct V3 {
   return {a.x - b.x, a.y - b.y, a.z - b.z};
 }
 
-/// y x z as Eigen's cross (and detail::cross): (y1 z2 - y2 z1, y2 z0 - y0 z2, y0 z1 - y1 z0).
-[[gnu::always_inline]] inline V3 cross(const V3& y, const V3& z) {
-  return {y.y * z.z - y.z * z.y, y.z * z.x - y.x * z.z, y.x * z.y - y.y * z.x};
-}
-
-/// x . c summed left to right, as detail::dot.
-[[gnu::always_inline]] inline V dot(const V3& x, const V3& c) {
-  return x.x * c.x + x.y * c.y + x.z * c.z;
-}
-
 /// The bits of v, and the vector of bits b. By memcpy, which compiles to nothing: GCC 12's UBSan
 /// reports std::bit_cast of these 32-byte vectors as a load of a null pointer.
 [[gnu::always_inline]] inline VBits bits_of(const V& v) {
@@ -63,19 +56,6 @@ struct V3 {
   V v;
   std::memcpy(&v, &b, sizeof v);
   return v;
-}
-
-[[gnu::always_inline]] inline V vabs(const V& v) {
-  constexpr std::int64_t kMagnitude = std::numeric_limits<std::int64_t>::max();
-  return from_bits(bits_of(v) & kMagnitude);
-}
-
-/// std::max(a, b) per lane: (a < b) ? b : a.
-[[gnu::always_inline]] inline V vmax(const V& a, const V& b) { return a < b ? b : a; }
-
-/// detail::max_abs.
-[[gnu::always_inline]] inline V max_abs(const V3& v) {
-  return vmax(vmax(vabs(v.x), vabs(v.y)), vabs(v.z));
 }
 
 /// The screens of the triples X, Y, Z at t0 and t1 (c(t) = X . (Y x Z)), lane k query k's. `x0` …
@@ -100,9 +80,9 @@ struct V3 {
   const V b2 = ((d011 + d101) + d110) / 3.0;
   const V b3 = d111;
   // trilinear_screen's error bound from the largest coordinate magnitudes.
-  const V x = vmax(max_abs(x0), max_abs(x1));
-  const V y = vmax(max_abs(y0), max_abs(y1));
-  const V z = vmax(max_abs(z0), max_abs(z1));
+  const V x = lane_max(max_abs(x0), max_abs(x1));
+  const V y = lane_max(max_abs(y0), max_abs(y1));
+  const V z = lane_max(max_abs(z0), max_abs(z1));
   const V q = y * z;
   const V cross_perm = q + q;
   const V r = x * cross_perm;
@@ -119,8 +99,8 @@ struct V3 {
   const V error = (rounding + underflow) * detail::kRoundUp;
   // certified_sign: finite coefficients, all above the error or all below its negative.
   constexpr double kMax = std::numeric_limits<double>::max();
-  const VBits finite =
-      (vabs(b0) <= kMax) & (vabs(b1) <= kMax) & (vabs(b2) <= kMax) & (vabs(b3) <= kMax);
+  const VBits finite = (detail::lane_abs(b0) <= kMax) & (detail::lane_abs(b1) <= kMax) &
+                       (detail::lane_abs(b2) <= kMax) & (detail::lane_abs(b3) <= kMax);
   const VBits positive = (b0 > error) & (b1 > error) & (b2 > error) & (b3 > error);
   const VBits negative = (-b0 > error) & (-b1 > error) & (-b2 > error) & (-b3 > error);
   const VBits certified = finite & (positive | negative);
@@ -164,19 +144,6 @@ template <bool kVertexFace>
   }
 }
 
-/// Whether the screens run on AVX2: this CPU has it (asked once).
-bool use_avx2() {
-#if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
-  static const bool kHas = [] {
-    __builtin_cpu_init();
-    return __builtin_cpu_supports("avx2") != 0;
-  }();
-  return kHas;
-#else
-  return false;
-#endif
-}
-
 #if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
 /// body compiled for AVX2: one instruction per operation on the four lanes.
 template <bool kVertexFace>
@@ -189,7 +156,7 @@ template <bool kVertexFace>
 template <bool kVertexFace>
 CoplanarityScreens dispatch(const double* x_t0, const double* x_t1, ScreenQuads q) {
 #if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
-  if (use_avx2()) return body_avx2<kVertexFace>(x_t0, x_t1, q);
+  if (detail::cpu_has_avx2()) return body_avx2<kVertexFace>(x_t0, x_t1, q);
 #endif
   return body<kVertexFace>(x_t0, x_t1, q);
 }

@@ -10,6 +10,9 @@
 #if defined(__SSE2__)
 #include <emmintrin.h>
 #endif
+
+#include "ccd/detail/lanes.hpp"
+
 #if defined(__x86_64__) && defined(__GNUC__)
 #define SKELCD_FEATURE_AVX2 1
 #endif
@@ -331,7 +334,7 @@ struct EndPositions {
 // they are split, which is what the note is about. Nothing crosses a library boundary.
 #pragma GCC diagnostic ignored "-Wpsabi"
 
-using V4 = double __attribute__((vector_size(32)));
+using V4 = ccd::detail::Lanes4;
 using M4 = std::int64_t __attribute__((vector_size(32)));
 
 /// EndPositions on four-double vectors: a point's coordinates at one end in one vector,
@@ -432,14 +435,10 @@ struct EndPositionsWide {
 
 std::atomic<bool> baseline_forced{false};
 
-/// Whether the feature stage runs on AVX2: this CPU has it (asked once), and the tests have not
+/// Whether the feature stage runs on AVX2: this CPU has it, and the tests have not
 /// asked for the baseline build (detail::force_baseline_feature_stage).
 bool use_avx2() {
-  static const bool kHas = [] {
-    __builtin_cpu_init();
-    return __builtin_cpu_supports("avx2") != 0;
-  }();
-  return kHas && !baseline_forced.load(std::memory_order_relaxed);
+  return ccd::detail::cpu_has_avx2() && !baseline_forced.load(std::memory_order_relaxed);
 }
 #endif
 

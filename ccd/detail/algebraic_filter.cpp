@@ -383,10 +383,7 @@ void cross_dot_quartic_pair(
 
 bool cross_dot_quartics_x4_wide() {
 #if defined(SKELCD_QUARTICS_AVX2)
-  static const bool kHas = [] {
-    __builtin_cpu_init();
-    return __builtin_cpu_supports("avx2") != 0;
-  }();
+  static const bool kHas = cpu_has_avx2();  // one guard per call, asked on every query
   return kHas && !quartics_baseline_forced.load(std::memory_order_relaxed);
 #else
   return false;

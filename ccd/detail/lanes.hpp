@@ -27,6 +27,20 @@ using LaneBits = std::uint64_t __attribute__((vector_size(16)));
 using Lanes4 = double __attribute__((vector_size(32)));
 using LaneBits4 = std::uint64_t __attribute__((vector_size(32)));
 
+/// Whether this CPU has AVX2, for the builds chosen at run time (the coplanarity screen, the
+/// quartics and their filter, the culling feature stage). Asked once per process.
+inline bool cpu_has_avx2() {
+#if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
+  static const bool kHas = [] {
+    __builtin_cpu_init();
+    return __builtin_cpu_supports("avx2") != 0;
+  }();
+  return kHas;
+#else
+  return false;
+#endif
+}
+
 /// |v| per lane as std::abs does it: the sign bit cleared.
 inline Lanes lane_abs(Lanes v) {
   constexpr std::uint64_t kMagnitude = ~(std::uint64_t{1} << 63);
