@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <atomic>
+#include <bit>
 #include <cstddef>
 #include <initializer_list>
 #include <type_traits>
@@ -103,6 +104,24 @@ struct SweptVolumes {
   [[nodiscard]] Dop<N> edge(const std::array<std::int32_t, 2>& ends) const {
     Dop<N> d = bounds.vertices[at(ends[0])];
     d.merge(bounds.vertices[at(ends[1])]);
+    return d;
+  }
+  /// A triangle's corners as owned_feature_pairs reads them: here their volumes, in place.
+  struct Corners {
+    std::array<const Dop<N>*, 3> at;
+  };
+  [[nodiscard]] Corners corners(const std::array<std::int32_t, 3>& c) const {
+    return {{&bounds.vertices[at(c[0])], &bounds.vertices[at(c[1])], &bounds.vertices[at(c[2])]}};
+  }
+  [[nodiscard]] static const Dop<N>& corner(const Corners& c, std::size_t slot) {
+    return *c.at[slot];
+  }
+  [[nodiscard]] const Dop<N>& face_of(std::int32_t f, const Corners&) const {
+    return bounds.triangles[at(f)];
+  }
+  [[nodiscard]] static Dop<N> edge_of(const Corners& c, const std::array<std::uint8_t, 2>& ends) {
+    Dop<N> d = *c.at[ends[0]];
+    d.merge(*c.at[ends[1]]);
     return d;
   }
   /// Overlap of two closed volumes as one bit, without branches: about half the feature pairs of
@@ -318,6 +337,22 @@ struct EndPositions {
   [[nodiscard]] Box edge(const std::array<std::int32_t, 2>& ends) const {
     return hull({vertex(ends[0]), vertex(ends[1])});
   }
+  /// A triangle's corners as owned_feature_pairs reads them: their positions, read once.
+  using Corners = std::array<Point, 3>;
+  [[nodiscard]] Corners corners(const std::array<std::int32_t, 3>& c) const {
+    return {vertex(c[0]), vertex(c[1]), vertex(c[2])};
+  }
+  [[nodiscard]] static const Point& corner(const Corners& c, std::size_t slot) { return c[slot]; }
+  [[nodiscard]] static Box face_of(std::int32_t, const Corners& c) {
+    return hull({c[0], c[1], c[2]});
+  }
+  [[nodiscard]] static Box edge_of(const Corners& c, const std::array<std::uint8_t, 2>& ends) {
+    return hull({c[ends[0]], c[ends[1]]});
+  }
+  [[nodiscard]] DiagonalBox diagonal_of(
+      const Corners&, const std::array<std::int32_t, 3>& corners) const {
+    return diagonal_face(corners);
+  }
   /// Asks for the corners' positions at both ends (24 bytes each: up to two cache lines).
   void prefetch(std::int32_t, const std::array<std::int32_t, 3>& corners) const {
     for (const std::int32_t v : corners) {
@@ -383,29 +418,36 @@ struct EndPositionsWide {
   [[gnu::always_inline]] [[nodiscard]] static bool meet(const Point& p, const Box& b) {
     return meet_as(p.at0, p.at0, p.at1, p.at1, b);
   }
-  [[gnu::always_inline]] [[nodiscard]] Box face(
-      std::int32_t, const std::array<std::int32_t, 3>& corners) const {
-    const Point p = vertex(corners[0]);
-    Box b{p.at0, p.at0, p.at1, p.at1};
-    widen(b, vertex(corners[1]));
-    widen(b, vertex(corners[2]));
-    return b;
-  }
-  [[gnu::always_inline]] [[nodiscard]] Box edge(const std::array<std::int32_t, 2>& ends) const {
-    const Point p = vertex(ends[0]);
-    Box b{p.at0, p.at0, p.at1, p.at1};
-    widen(b, vertex(ends[1]));
-    return b;
-  }
   /// (y, z, x, x) of (x, y, z, z).
   [[gnu::always_inline]] static V4 rotate(const V4& v) {
     return __builtin_shuffle(v, M4{1, 2, 0, 0});
   }
-  [[gnu::always_inline]] [[nodiscard]] DiagonalBox diagonal_face(
-      const std::array<std::int32_t, 3>& corners) const {
+  using Corners = std::array<Point, 3>;
+  [[gnu::always_inline]] [[nodiscard]] Corners corners(const std::array<std::int32_t, 3>& c) const {
+    return {vertex(c[0]), vertex(c[1]), vertex(c[2])};
+  }
+  [[gnu::always_inline]] [[nodiscard]] static const Point& corner(
+      const Corners& c, std::size_t slot) {
+    return c[slot];
+  }
+  [[gnu::always_inline]] [[nodiscard]] static Box face_of(std::int32_t, const Corners& c) {
+    Box b{c[0].at0, c[0].at0, c[0].at1, c[0].at1};
+    widen(b, c[1]);
+    widen(b, c[2]);
+    return b;
+  }
+  [[gnu::always_inline]] [[nodiscard]] static Box edge_of(
+      const Corners& c, const std::array<std::uint8_t, 2>& ends) {
+    const Point& p = c[ends[0]];
+    Box b{p.at0, p.at0, p.at1, p.at1};
+    widen(b, c[ends[1]]);
+    return b;
+  }
+  [[gnu::always_inline]] [[nodiscard]] static DiagonalBox diagonal_of(
+      const Corners& c, const std::array<std::int32_t, 3>&) {
     DiagonalBox b;
     for (std::size_t k = 0; k < 3; ++k) {
-      const Point q = vertex(corners[k]);
+      const Point& q = c[k];
       const Point sums{q.at0 + rotate(q.at0), q.at1 + rotate(q.at1)};
       const Point differences{q.at0 - rotate(q.at0), q.at1 - rotate(q.at1)};
       if (k == 0) {
@@ -452,15 +494,65 @@ constexpr std::size_t kFeatureFar = 16;
 constexpr std::size_t kFeatureNear = 8;
 constexpr std::int32_t kFeaturePrefetchFrom = 16384;
 
-/// owned_feature_pairs' VF pairs of the vertices `owner` owns against face `f` (record `face`,
-/// volume `face_box`): each slot is written, and kept when the pair is not on a corner of the
-/// face and the boxes meet.
+/// The corners two triangles share, from one comparison of their ids (a degenerate triangle may
+/// list one twice): `bits`, bit 3 i + j when corner i of a is corner j of b; `a_on_b`, bit i when
+/// a's corner i is a corner of b; `b_on_a`, bit j when b's corner j is a corner of a.
+struct SharedCorners {
+  unsigned bits = 0;
+  unsigned a_on_b = 0;
+  unsigned b_on_a = 0;
+};
+
+/// Of SharedCorners::bits: those of a's corner i (its row) and of b's corner j (its column).
+constexpr unsigned row_bits(unsigned i) { return 7u << (3 * i); }
+constexpr unsigned column_bits(unsigned j) { return 0x49u << j; }
+
+[[gnu::always_inline]] inline SharedCorners shared_corners(
+    const FeatureTopology::OwnedFeatures& a, const FeatureTopology::OwnedFeatures& b) {
+  SharedCorners s;
+#if defined(__SSE2__)
+  // Sixteen bytes from each record: the corners and, in the last lane, the first owned vertex
+  // (the next member), which the masks leave out.
+  static_assert(offsetof(FeatureTopology::OwnedFeatures, vertices) == 12);
+  const __m128i ca = _mm_loadu_si128(reinterpret_cast<const __m128i*>(&a));
+  const __m128i cb = _mm_loadu_si128(reinterpret_cast<const __m128i*>(&b));
+  const auto lanes = [](__m128i m) __attribute__((always_inline)) {
+    return static_cast<unsigned>(_mm_movemask_ps(_mm_castsi128_ps(m))) & 7u;
+  };
+  const unsigned row0 = lanes(_mm_cmpeq_epi32(_mm_shuffle_epi32(ca, 0x00), cb));
+  const unsigned row1 = lanes(_mm_cmpeq_epi32(_mm_shuffle_epi32(ca, 0x55), cb));
+  const unsigned row2 = lanes(_mm_cmpeq_epi32(_mm_shuffle_epi32(ca, 0xAA), cb));
+  s.bits = row0 | row1 << 3 | row2 << 6;
+  s.b_on_a = row0 | row1 | row2;
+  s.a_on_b = lanes(_mm_or_si128(
+      _mm_or_si128(
+          _mm_cmpeq_epi32(ca, _mm_shuffle_epi32(cb, 0x00)),
+          _mm_cmpeq_epi32(ca, _mm_shuffle_epi32(cb, 0x55))),
+      _mm_cmpeq_epi32(ca, _mm_shuffle_epi32(cb, 0xAA))));
+#else
+  for (unsigned i = 0; i < 3; ++i) {
+    for (unsigned j = 0; j < 3; ++j) {
+      if (a.corners[i] == b.corners[j]) {
+        s.bits |= 1u << (3 * i + j);
+        s.a_on_b |= 1u << i;
+        s.b_on_a |= 1u << j;
+      }
+    }
+  }
+#endif
+  return s;
+}
+
+/// owned_feature_pairs' VF pairs of the vertices `owner` owns (its corners' positions or
+/// volumes `corners`) against face `f` (volume `face_box`): each slot is written, and kept when
+/// the vertex is not a corner of the face (`on_face`: bit s when owner's corner s is) and the
+/// boxes meet.
 template <bool kExclusions, class Boxes, class FaceBox>
 [[gnu::always_inline]] inline void vertices_vs_face(
     const FeatureTopology& topology,
-    const Boxes& boxes,
     const FeatureTopology::OwnedFeatures& owner,
-    const FeatureTopology::OwnedFeatures& face,
+    const typename Boxes::Corners& corners,
+    unsigned on_face,
     std::int32_t f,
     const FaceBox& face_box,
     VertexFacePair* vf,
@@ -468,23 +560,25 @@ template <bool kExclusions, class Boxes, class FaceBox>
     std::int64_t& tests) {
   for (std::size_t k = 0; k < owner.num_vertices; ++k) {
     const std::int32_t v = owner.vertices[k];
-    bool wanted = !is_corner(v, face.corners);
+    const unsigned slot = owner.vertex_slots[k];
+    bool wanted = ((on_face >> slot) & 1u) == 0;
     if constexpr (kExclusions) wanted = wanted && !topology.vertex_face_excluded(v, f);
     tests += wanted;
     vf[num_vf] = {v, f};
     num_vf += static_cast<std::size_t>(wanted) &
-              static_cast<std::size_t>(Boxes::meet(boxes.vertex(v), face_box));
+              static_cast<std::size_t>(Boxes::meet(Boxes::corner(corners, slot), face_box));
   }
 }
 
 /// The feature stage of ccd_candidates_from_triangle_pairs, with the part-exclusion checks compiled
 /// in or out (`kExclusions` = topology.has_exclusions(): without exclusions every *_excluded is
 /// false), feature pairs tested on `boxes` (SweptVolumes, EndPositions or EndPositionsWide).
-/// Reads one OwnedFeatures record per triangle instead of the owned bits, corners, side edges and
-/// their endpoints from four arrays; the pairs, the rules and the order of what is appended are
-/// those of the bit-by-bit loop, less the feature pairs of triangles apart on a face diagonal at
-/// both ends (docs/culling.md, "The triangles on the face diagonals"). Inlined into each caller,
-/// so that owned_feature_pairs_avx2 is built for AVX2 whole.
+/// Reads one OwnedFeatures record per triangle, each corner's position (or volume) once, and
+/// compares the two triangles' corner ids once (shared_corners) for every "is a corner of" and
+/// "share an endpoint" rule; the pairs, the rules and the order of what is appended are those of
+/// the bit-by-bit loop, less the feature pairs of triangles apart on a face diagonal at both
+/// ends (docs/culling.md, "The triangles on the face diagonals"). Inlined into each caller, so
+/// that owned_feature_pairs_avx2 is built for AVX2 whole.
 template <bool kExclusions, bool kFans, class Boxes>
 [[gnu::always_inline]] inline void owned_feature_pairs(
     const FeatureTopology& topology,
@@ -501,8 +595,6 @@ template <bool kExclusions, bool kFans, class Boxes>
   std::size_t num_vf = 0;
   std::size_t num_ee = 0;
   std::int64_t tests = 0;
-  // VF pairs of the vertices `owner` owns against face `face`: each slot is written, and kept
-  // when the pair is not on a corner of the face and the boxes meet.
   const auto flush = [&] {
     out.vf.insert(out.vf.end(), vf.begin(), vf.begin() + static_cast<std::ptrdiff_t>(num_vf));
     out.ee.insert(out.ee.end(), ee.begin(), ee.begin() + static_cast<std::ptrdiff_t>(num_ee));
@@ -531,17 +623,24 @@ template <bool kExclusions, bool kFans, class Boxes>
     }
     const Owned& a = topology.owned_features(p.a);
     const Owned& b = topology.owned_features(p.b);
+    const SharedCorners shared = shared_corners(a, b);
     if constexpr (kFans) {
       // A corner both share whose fan is certified over the interval: the two triangles never
       // meet beyond what they share, so no feature pair they own can touch (a candidate pair, as
       // a DCD pair a fan settles, with no feature pairs).
-      if (share_certified_corner(a.corners, b.corners, *fans)) {
+      bool settled = false;
+      for (unsigned m = shared.a_on_b; m != 0 && !settled; m &= m - 1) {
+        settled = fans->certified(a.corners[static_cast<std::size_t>(std::countr_zero(m))]);
+      }
+      if (settled) {
         ++candidate_pairs;
         continue;
       }
     }
-    const auto& face_a = boxes.face(p.a, a.corners);
-    const auto& face_b = boxes.face(p.b, b.corners);
+    const auto corners_a = boxes.corners(a.corners);
+    const auto corners_b = boxes.corners(b.corners);
+    const auto& face_a = boxes.face_of(p.a, corners_a);
+    const auto& face_b = boxes.face_of(p.b, corners_b);
     if constexpr (Boxes::kTrianglesFirst) {
       // Triangles apart hold features apart: no pair of theirs can meet, and the pair is culled
       // (not a candidate, as the relative filter's pairs were not).
@@ -551,19 +650,28 @@ template <bool kExclusions, bool kFans, class Boxes>
     const std::size_t vf_before = num_vf;
     const std::size_t ee_before = num_ee;
     // VF: the vertices each triangle owns against the other triangle's face.
-    vertices_vs_face<kExclusions>(topology, boxes, a, b, p.b, face_b, vf.data(), num_vf, tests);
-    vertices_vs_face<kExclusions>(topology, boxes, b, a, p.a, face_a, vf.data(), num_vf, tests);
-    // EE: the edges a owns against the edges b owns.
-    using EdgeBox = decltype(boxes.edge(a.edge_ends[0]));
+    vertices_vs_face<kExclusions, Boxes>(
+        topology, a, corners_a, shared.a_on_b, p.b, face_b, vf.data(), num_vf, tests);
+    vertices_vs_face<kExclusions, Boxes>(
+        topology, b, corners_b, shared.b_on_a, p.a, face_a, vf.data(), num_vf, tests);
+    // EE: the edges a owns against the edges b owns; two share an endpoint when shared.bits has
+    // a bit in the rows of a's ends and the columns of b's.
+    using EdgeBox = decltype(Boxes::edge_of(corners_a, a.edge_slots[0]));
     std::array<EdgeBox, 3> edges_b;
+    std::array<unsigned, 3> columns_b;
     const std::size_t num_edges_b = a.num_edges != 0 ? b.num_edges : 0;  // none needed otherwise
-    for (std::size_t j = 0; j < num_edges_b; ++j) edges_b[j] = boxes.edge(b.edge_ends[j]);
+    for (std::size_t j = 0; j < num_edges_b; ++j) {
+      edges_b[j] = Boxes::edge_of(corners_b, b.edge_slots[j]);
+      columns_b[j] = column_bits(b.edge_slots[j][0]) | column_bits(b.edge_slots[j][1]);
+    }
     for (std::size_t i = 0; i < a.num_edges; ++i) {
       const std::int32_t ea = a.edges[i];
-      const EdgeBox box_a = boxes.edge(a.edge_ends[i]);
+      const EdgeBox box_a = Boxes::edge_of(corners_a, a.edge_slots[i]);
+      const unsigned rows_a =
+          shared.bits & (row_bits(a.edge_slots[i][0]) | row_bits(a.edge_slots[i][1]));
       for (std::size_t j = 0; j < b.num_edges; ++j) {
         const std::int32_t eb = b.edges[j];
-        bool wanted = !share_endpoint(a.edge_ends[i], b.edge_ends[j]);
+        bool wanted = (rows_a & columns_b[j]) == 0;
         if constexpr (kExclusions) wanted = wanted && !topology.edges_excluded(ea, eb);
         tests += wanted;
         ee[num_ee] = {std::min(ea, eb), std::max(ea, eb)};
@@ -576,7 +684,8 @@ template <bool kExclusions, bool kFans, class Boxes>
     // are exact ones strictly apart). Dropped again; pairs that kept nothing are not tested.
     if constexpr (Boxes::kTrianglesFirst) {
       if ((num_vf != vf_before || num_ee != ee_before) &&
-          !Boxes::diagonal_meet(boxes.diagonal_face(a.corners), boxes.diagonal_face(b.corners))) {
+          !Boxes::diagonal_meet(
+              boxes.diagonal_of(corners_a, a.corners), boxes.diagonal_of(corners_b, b.corners))) {
         num_vf = vf_before;
         num_ee = ee_before;
       }

@@ -156,10 +156,18 @@ FeatureTopology::FeatureTopology(
     o = {};
     o.corners = triangles_[f];
     for (std::size_t k = 0; k < 3; ++k) {
-      if (owned_[f] & (1u << k)) o.vertices[o.num_vertices++] = triangles_[f][k];
+      if (owned_[f] & (1u << k)) {
+        o.vertex_slots[o.num_vertices] = static_cast<std::uint8_t>(k);
+        o.vertices[o.num_vertices++] = triangles_[f][k];
+      }
       if (owned_[f] & (1u << (3 + k))) {
+        // Side k joins corners k and k + 1, in the edge's order.
         const std::int32_t e = face_edges_[f][k];
-        o.edge_ends[o.num_edges] = edges_[static_cast<std::size_t>(e)];
+        const auto next = static_cast<std::uint8_t>((k + 1) % 3);
+        const bool same_way = edges_[static_cast<std::size_t>(e)][0] == triangles_[f][k];
+        o.edge_slots[o.num_edges] = {
+            same_way ? static_cast<std::uint8_t>(k) : next,
+            same_way ? next : static_cast<std::uint8_t>(k)};
         o.edges[o.num_edges++] = e;
       }
     }

@@ -78,12 +78,16 @@ class FeatureTopology {
   }
   /// What the CCD feature stage reads of one triangle, in one cache line: its corners, the
   /// vertices and edges it owns in corner / side order (the set bits of owned(f), collapsed sides
-  /// never among them) and the owned edges' endpoints.
+  /// never among them) and where they are among the corners, so that the stage reads each
+  /// corner's position once and compares vertex ids once per triangle pair.
   struct alignas(64) OwnedFeatures {
     std::array<std::int32_t, 3> corners;
-    std::array<std::int32_t, 3> vertices;                  ///< the first num_vertices are owned
-    std::array<std::int32_t, 3> edges;                     ///< the first num_edges are owned
-    std::array<std::array<std::int32_t, 2>, 3> edge_ends;  ///< endpoints of edges[i]
+    std::array<std::int32_t, 3> vertices;  ///< the first num_vertices are owned
+    std::array<std::int32_t, 3> edges;     ///< the first num_edges are owned
+    /// corners[vertex_slots[k]] is vertices[k].
+    std::array<std::uint8_t, 3> vertex_slots;
+    /// corners[edge_slots[i][0]] and corners[edge_slots[i][1]] are edge(edges[i])[0] and [1].
+    std::array<std::array<std::uint8_t, 2>, 3> edge_slots;
     std::uint8_t num_vertices;
     std::uint8_t num_edges;
   };

@@ -314,10 +314,15 @@ TEST(FeatureTopology, OwnedFeaturesListTheOwnedBitsInOrder) {
       }
       ASSERT_EQ(o.num_vertices, vertices.size()) << s.name << " triangle " << f;
       ASSERT_EQ(o.num_edges, edges.size()) << s.name << " triangle " << f;
-      for (std::size_t i = 0; i < vertices.size(); ++i) EXPECT_EQ(o.vertices[i], vertices[i]);
+      for (std::size_t i = 0; i < vertices.size(); ++i) {
+        EXPECT_EQ(o.vertices[i], vertices[i]);
+        EXPECT_EQ(o.corners[o.vertex_slots[i]], vertices[i]) << s.name << " triangle " << f;
+      }
       for (std::size_t i = 0; i < edges.size(); ++i) {
         EXPECT_EQ(o.edges[i], edges[i]);
-        EXPECT_EQ(o.edge_ends[i], t.edge(edges[i])) << s.name << " triangle " << f;
+        const std::array<std::int32_t, 2> ends{
+            o.corners[o.edge_slots[i][0]], o.corners[o.edge_slots[i][1]]};
+        EXPECT_EQ(ends, t.edge(edges[i])) << s.name << " triangle " << f;
       }
     }
   }
