@@ -218,7 +218,8 @@ struct EndPositions {
   struct DiagonalBox {
     __m128d lo0[3], hi0[3], lo1[3], hi1[3];
   };
-  [[nodiscard]] DiagonalBox diagonal_face(const std::array<std::int32_t, 3>& corners) const {
+  /// The extents of the points `ids` (at least one) on the diagonals at both ends.
+  [[nodiscard]] DiagonalBox diagonal_box(std::initializer_list<std::int32_t> ids) const {
     const __m128d negate_high = _mm_set_pd(-0.0, 0.0);
     const auto project = [&](const double* p, __m128d* v) {
       const __m128d xy = _mm_loadu_pd(p);
@@ -228,24 +229,31 @@ struct EndPositions {
       v[2] = _mm_add_pd(_mm_load1_pd(p + 2), _mm_xor_pd(_mm_load1_pd(p), negate_high));
     };
     DiagonalBox b;
-    project(x0 + 3 * at(corners[0]), b.lo0);
-    project(x1 + 3 * at(corners[0]), b.lo1);
+    project(x0 + 3 * at(*ids.begin()), b.lo0);
+    project(x1 + 3 * at(*ids.begin()), b.lo1);
     for (std::size_t r = 0; r < 3; ++r) {
       b.hi0[r] = b.lo0[r];
       b.hi1[r] = b.lo1[r];
     }
-    for (std::size_t k = 1; k < 3; ++k) {
-      __m128d v0[3], v1[3];
-      project(x0 + 3 * at(corners[k]), v0);
-      project(x1 + 3 * at(corners[k]), v1);
+    for (auto id = ids.begin() + 1; id != ids.end(); ++id) {
+      DiagonalBox q;
+      project(x0 + 3 * at(*id), q.lo0);
+      project(x1 + 3 * at(*id), q.lo1);
       for (std::size_t r = 0; r < 3; ++r) {
-        b.lo0[r] = _mm_min_pd(b.lo0[r], v0[r]);
-        b.hi0[r] = _mm_max_pd(b.hi0[r], v0[r]);
-        b.lo1[r] = _mm_min_pd(b.lo1[r], v1[r]);
-        b.hi1[r] = _mm_max_pd(b.hi1[r], v1[r]);
+        q.hi0[r] = q.lo0[r];
+        q.hi1[r] = q.lo1[r];
       }
+      merge(b, q);
     }
     return b;
+  }
+  static void merge(DiagonalBox& b, const DiagonalBox& q) {
+    for (std::size_t r = 0; r < 3; ++r) {
+      b.lo0[r] = _mm_min_pd(b.lo0[r], q.lo0[r]);
+      b.hi0[r] = _mm_max_pd(b.hi0[r], q.hi0[r]);
+      b.lo1[r] = _mm_min_pd(b.lo1[r], q.lo1[r]);
+      b.hi1[r] = _mm_max_pd(b.hi1[r], q.hi1[r]);
+    }
   }
   /// Not apart on any face diagonal at both ends (the rounded projections compared: rounding is
   /// monotone, so rounded values strictly apart are exact values strictly apart).
@@ -302,25 +310,29 @@ struct EndPositions {
   struct DiagonalBox {
     std::array<double, 6> lo0, hi0, lo1, hi1;
   };
-  [[nodiscard]] DiagonalBox diagonal_face(const std::array<std::int32_t, 3>& corners) const {
+  [[nodiscard]] DiagonalBox diagonal_box(std::initializer_list<std::int32_t> ids) const {
     const auto project = [](const double* p) {
       return std::array<double, 6>{
           p[0] + p[1], p[1] + p[2], p[0] - p[1], p[1] - p[2], p[2] + p[0], p[2] - p[0]};
     };
     DiagonalBox b;
-    b.lo0 = b.hi0 = project(x0 + 3 * at(corners[0]));
-    b.lo1 = b.hi1 = project(x1 + 3 * at(corners[0]));
-    for (std::size_t k = 1; k < 3; ++k) {
-      const auto v0 = project(x0 + 3 * at(corners[k]));
-      const auto v1 = project(x1 + 3 * at(corners[k]));
-      for (std::size_t d = 0; d < 6; ++d) {
-        b.lo0[d] = std::min(b.lo0[d], v0[d]);
-        b.hi0[d] = std::max(b.hi0[d], v0[d]);
-        b.lo1[d] = std::min(b.lo1[d], v1[d]);
-        b.hi1[d] = std::max(b.hi1[d], v1[d]);
-      }
+    b.lo0 = b.hi0 = project(x0 + 3 * at(*ids.begin()));
+    b.lo1 = b.hi1 = project(x1 + 3 * at(*ids.begin()));
+    for (auto id = ids.begin() + 1; id != ids.end(); ++id) {
+      DiagonalBox q;
+      q.lo0 = q.hi0 = project(x0 + 3 * at(*id));
+      q.lo1 = q.hi1 = project(x1 + 3 * at(*id));
+      merge(b, q);
     }
     return b;
+  }
+  static void merge(DiagonalBox& b, const DiagonalBox& q) {
+    for (std::size_t d = 0; d < 6; ++d) {
+      b.lo0[d] = std::min(b.lo0[d], q.lo0[d]);
+      b.hi0[d] = std::max(b.hi0[d], q.hi0[d]);
+      b.lo1[d] = std::min(b.lo1[d], q.lo1[d]);
+      b.hi1[d] = std::max(b.hi1[d], q.hi1[d]);
+    }
   }
   [[nodiscard]] static bool diagonal_meet(const DiagonalBox& a, const DiagonalBox& b) {
     bool apart = false;
@@ -349,9 +361,28 @@ struct EndPositions {
   [[nodiscard]] static Box edge_of(const Corners& c, const std::array<std::uint8_t, 2>& ends) {
     return hull({c[ends[0]], c[ends[1]]});
   }
-  [[nodiscard]] DiagonalBox diagonal_of(
-      const Corners&, const std::array<std::int32_t, 3>& corners) const {
-    return diagonal_face(corners);
+  /// The corners' extents on the diagonals (each a point), and those of a vertex, an edge and
+  /// the face built from them (owned_feature_pairs).
+  using DiagonalCorners = std::array<DiagonalBox, 3>;
+  [[nodiscard]] DiagonalCorners diagonal_corners(
+      const Corners&, const std::array<std::int32_t, 3>& ids) const {
+    return {diagonal_box({ids[0]}), diagonal_box({ids[1]}), diagonal_box({ids[2]})};
+  }
+  [[nodiscard]] static const DiagonalBox& diagonal_vertex(
+      const DiagonalCorners& d, std::size_t slot) {
+    return d[slot];
+  }
+  [[nodiscard]] static DiagonalBox diagonal_edge(
+      const DiagonalCorners& d, const std::array<std::uint8_t, 2>& ends) {
+    DiagonalBox b = d[ends[0]];
+    merge(b, d[ends[1]]);
+    return b;
+  }
+  [[nodiscard]] static DiagonalBox diagonal_face(const DiagonalCorners& d) {
+    DiagonalBox b = d[0];
+    merge(b, d[1]);
+    merge(b, d[2]);
+    return b;
   }
   /// Asks for the corners' positions at both ends (24 bytes each: up to two cache lines).
   void prefetch(std::int32_t, const std::array<std::int32_t, 3>& corners) const {
@@ -443,26 +474,50 @@ struct EndPositionsWide {
     widen(b, c[ends[1]]);
     return b;
   }
-  [[gnu::always_inline]] [[nodiscard]] static DiagonalBox diagonal_of(
-      const Corners& c, const std::array<std::int32_t, 3>&) {
-    DiagonalBox b;
-    for (std::size_t k = 0; k < 3; ++k) {
-      const Point& q = c[k];
-      const Point sums{q.at0 + rotate(q.at0), q.at1 + rotate(q.at1)};
-      const Point differences{q.at0 - rotate(q.at0), q.at1 - rotate(q.at1)};
-      if (k == 0) {
-        b.sums = {sums.at0, sums.at0, sums.at1, sums.at1};
-        b.differences = {differences.at0, differences.at0, differences.at1, differences.at1};
-      } else {
-        widen(b.sums, sums);
-        widen(b.differences, differences);
-      }
-    }
-    return b;
-  }
   [[gnu::always_inline]] [[nodiscard]] static bool diagonal_meet(
       const DiagonalBox& a, const DiagonalBox& b) {
     return meet(a.sums, b.sums) && meet(a.differences, b.differences);
+  }
+  /// A corner's projections at both ends: (x + y, y + z, z + x, ·) and (x − y, y − z, z − x, ·).
+  struct DiagonalPoint {
+    Point sums, differences;
+  };
+  using DiagonalCorners = std::array<DiagonalPoint, 3>;
+  [[gnu::always_inline]] [[nodiscard]] static DiagonalCorners diagonal_corners(
+      const Corners& c, const std::array<std::int32_t, 3>&) {
+    DiagonalCorners d;
+    for (std::size_t k = 0; k < 3; ++k) {
+      const Point& q = c[k];
+      d[k].sums = {q.at0 + rotate(q.at0), q.at1 + rotate(q.at1)};
+      d[k].differences = {q.at0 - rotate(q.at0), q.at1 - rotate(q.at1)};
+    }
+    return d;
+  }
+  [[gnu::always_inline]] [[nodiscard]] static const DiagonalPoint& diagonal_vertex(
+      const DiagonalCorners& d, std::size_t slot) {
+    return d[slot];
+  }
+  [[gnu::always_inline]] static void widen(DiagonalBox& b, const DiagonalPoint& p) {
+    widen(b.sums, p.sums);
+    widen(b.differences, p.differences);
+  }
+  [[gnu::always_inline]] [[nodiscard]] static DiagonalBox diagonal_edge(
+      const DiagonalCorners& d, const std::array<std::uint8_t, 2>& ends) {
+    const DiagonalPoint& p = d[ends[0]];
+    DiagonalBox b{
+        {p.sums.at0, p.sums.at0, p.sums.at1, p.sums.at1},
+        {p.differences.at0, p.differences.at0, p.differences.at1, p.differences.at1}};
+    widen(b, d[ends[1]]);
+    return b;
+  }
+  [[gnu::always_inline]] [[nodiscard]] static DiagonalBox diagonal_face(const DiagonalCorners& d) {
+    DiagonalBox b = diagonal_edge(d, {0, 1});
+    widen(b, d[2]);
+    return b;
+  }
+  [[gnu::always_inline]] [[nodiscard]] static bool diagonal_meet(
+      const DiagonalPoint& p, const DiagonalBox& b) {
+    return meet(p.sums, b.sums) & meet(p.differences, b.differences);
   }
   [[gnu::always_inline]] void prefetch(
       std::int32_t, const std::array<std::int32_t, 3>& corners) const {
@@ -487,6 +542,9 @@ bool use_avx2() {
 /// Triangle pairs per chunk of the feature stage: a chunk's candidates are written to fixed
 /// buffers without branches (a slot is written, then kept or not) and appended at once.
 constexpr std::size_t kChunkPairs = 64;
+
+/// owned_feature_pairs' VF slot records: the vertex is the second triangle's.
+constexpr unsigned kOwnedByB = 4;
 
 /// Prefetch distances of owned_feature_pairs, in pairs, and the mesh size from which it
 /// prefetches (below it the records and volumes it reads stay in the caches).
@@ -556,6 +614,8 @@ template <bool kExclusions, class Boxes, class FaceBox>
     std::int32_t f,
     const FaceBox& face_box,
     VertexFacePair* vf,
+    std::uint8_t* slots,
+    unsigned tag,
     std::size_t& num_vf,
     std::int64_t& tests) {
   for (std::size_t k = 0; k < owner.num_vertices; ++k) {
@@ -565,6 +625,7 @@ template <bool kExclusions, class Boxes, class FaceBox>
     if constexpr (kExclusions) wanted = wanted && !topology.vertex_face_excluded(v, f);
     tests += wanted;
     vf[num_vf] = {v, f};
+    slots[num_vf] = static_cast<std::uint8_t>(tag | slot);
     num_vf += static_cast<std::size_t>(wanted) &
               static_cast<std::size_t>(Boxes::meet(Boxes::corner(corners, slot), face_box));
   }
@@ -576,8 +637,9 @@ template <bool kExclusions, class Boxes, class FaceBox>
 /// Reads one OwnedFeatures record per triangle, each corner's position (or volume) once, and
 /// compares the two triangles' corner ids once (shared_corners) for every "is a corner of" and
 /// "share an endpoint" rule; the pairs, the rules and the order of what is appended are those of
-/// the bit-by-bit loop, less the feature pairs of triangles apart on a face diagonal at both
-/// ends (docs/culling.md, "The triangles on the face diagonals"). Inlined into each caller, so
+/// the bit-by-bit loop, less the feature pairs apart on a face diagonal at both ends
+/// (docs/culling.md, "The triangles on the face diagonals", "Each feature pair on the
+/// diagonals"). Inlined into each caller, so
 /// that owned_feature_pairs_avx2 is built for AVX2 whole.
 template <bool kExclusions, bool kFans, class Boxes>
 [[gnu::always_inline]] inline void owned_feature_pairs(
@@ -592,6 +654,10 @@ template <bool kExclusions, bool kFans, class Boxes>
   // At most 3 + 3 VF and 3 × 3 EE candidates per triangle pair.
   std::array<VertexFacePair, 6 * kChunkPairs> vf;
   std::array<EdgeEdgePair, 9 * kChunkPairs> ee;
+  // Where each candidate's features are: VF, the vertex's corner slot (| kOwnedByB when the
+  // vertex is b's); EE, the two edges' indices among the owned ones (4 i + j).
+  std::array<std::uint8_t, 6 * kChunkPairs> vf_slot;
+  std::array<std::uint8_t, 9 * kChunkPairs> ee_slots;
   std::size_t num_vf = 0;
   std::size_t num_ee = 0;
   std::int64_t tests = 0;
@@ -651,9 +717,29 @@ template <bool kExclusions, bool kFans, class Boxes>
     const std::size_t ee_before = num_ee;
     // VF: the vertices each triangle owns against the other triangle's face.
     vertices_vs_face<kExclusions, Boxes>(
-        topology, a, corners_a, shared.a_on_b, p.b, face_b, vf.data(), num_vf, tests);
+        topology,
+        a,
+        corners_a,
+        shared.a_on_b,
+        p.b,
+        face_b,
+        vf.data(),
+        vf_slot.data(),
+        0u,
+        num_vf,
+        tests);
     vertices_vs_face<kExclusions, Boxes>(
-        topology, b, corners_b, shared.b_on_a, p.a, face_a, vf.data(), num_vf, tests);
+        topology,
+        b,
+        corners_b,
+        shared.b_on_a,
+        p.a,
+        face_a,
+        vf.data(),
+        vf_slot.data(),
+        kOwnedByB,
+        num_vf,
+        tests);
     // EE: the edges a owns against the edges b owns; two share an endpoint when shared.bits has
     // a bit in the rows of a's ends and the columns of b's.
     using EdgeBox = decltype(Boxes::edge_of(corners_a, a.edge_slots[0]));
@@ -675,19 +761,49 @@ template <bool kExclusions, bool kFans, class Boxes>
         if constexpr (kExclusions) wanted = wanted && !topology.edges_excluded(ea, eb);
         tests += wanted;
         ee[num_ee] = {std::min(ea, eb), std::max(ea, eb)};
+        ee_slots[num_ee] = static_cast<std::uint8_t>(i << 2 | j);
         num_ee += static_cast<std::size_t>(wanted) &
                   static_cast<std::size_t>(Boxes::meet(box_a, edges_b[j]));
       }
     }
-    // Feature pairs kept, from triangles a face diagonal separates at both ends: none of them
-    // can touch (the axes' argument along a fixed direction; rounded projections strictly apart
-    // are exact ones strictly apart). Dropped again; pairs that kept nothing are not tested.
+    // Feature pairs kept, apart on a face diagonal at both ends: none of them can touch (the
+    // axes' argument along a fixed direction; rounded projections strictly apart are exact ones
+    // strictly apart). Dropped again; pairs that kept nothing are not tested. The two triangles
+    // first: apart, they hold every pair of their features apart.
     if constexpr (Boxes::kTrianglesFirst) {
-      if ((num_vf != vf_before || num_ee != ee_before) &&
-          !Boxes::diagonal_meet(
-              boxes.diagonal_of(corners_a, a.corners), boxes.diagonal_of(corners_b, b.corners))) {
-        num_vf = vf_before;
-        num_ee = ee_before;
+      if (num_vf != vf_before || num_ee != ee_before) {
+        const auto diagonals_a = boxes.diagonal_corners(corners_a, a.corners);
+        const auto diagonals_b = boxes.diagonal_corners(corners_b, b.corners);
+        const auto diagonal_face_a = Boxes::diagonal_face(diagonals_a);
+        const auto diagonal_face_b = Boxes::diagonal_face(diagonals_b);
+        if (!Boxes::diagonal_meet(diagonal_face_a, diagonal_face_b)) {
+          num_vf = vf_before;
+          num_ee = ee_before;
+        } else {
+          std::size_t kept = vf_before;
+          for (std::size_t r = vf_before; r < num_vf; ++r) {
+            const unsigned d = vf_slot[r];
+            const bool meet =
+                (d & kOwnedByB) != 0
+                    ? Boxes::diagonal_meet(
+                          Boxes::diagonal_vertex(diagonals_b, d & 3u), diagonal_face_a)
+                    : Boxes::diagonal_meet(
+                          Boxes::diagonal_vertex(diagonals_a, d & 3u), diagonal_face_b);
+            vf[kept] = vf[r];
+            kept += static_cast<std::size_t>(meet);
+          }
+          num_vf = kept;
+          kept = ee_before;
+          for (std::size_t r = ee_before; r < num_ee; ++r) {
+            const unsigned d = ee_slots[r];
+            const bool meet = Boxes::diagonal_meet(
+                Boxes::diagonal_edge(diagonals_a, a.edge_slots[d >> 2]),
+                Boxes::diagonal_edge(diagonals_b, b.edge_slots[d & 3u]));
+            ee[kept] = ee[r];
+            kept += static_cast<std::size_t>(meet);
+          }
+          num_ee = kept;
+        }
       }
     }
     if (++in_chunk == kChunkPairs) {
@@ -790,14 +906,13 @@ void brute_feature_pairs(
     return fans != nullptr &&
            share_certified_corner(topology.triangle(a), topology.triangle(b), *fans);
   };
-  // The face-diagonal rule of ccd_candidates_from_triangle_pairs on the same owners: their
-  // triangles apart on a face diagonal at both ends form none of their feature pairs (tested
-  // but not kept). The axis rule needs no counterpart: triangles apart on an axis hold their
-  // features apart on it, which the feature test below finds.
-  const auto owners_apart = [&](std::int32_t a, std::int32_t b) {
+  // The face-diagonal rule of ccd_candidates_from_triangle_pairs: features apart on a face
+  // diagonal at both ends are tested but not kept. (Its triangles-first shortcuts need no
+  // counterpart: triangles apart hold their features apart, which the feature tests find.)
+  const auto diagonal_apart = [&](std::initializer_list<std::int32_t> p,
+                                  std::initializer_list<std::int32_t> q) {
     if constexpr (Boxes::kTrianglesFirst) {
-      return !Boxes::diagonal_meet(
-          boxes.diagonal_face(topology.triangle(a)), boxes.diagonal_face(topology.triangle(b)));
+      return !Boxes::diagonal_meet(boxes.diagonal_box(p), boxes.diagonal_box(q));
     } else {
       return false;
     }
@@ -811,7 +926,7 @@ void brute_feature_pairs(
       if (is_corner(v, t) || topology.vertex_face_excluded(v, f)) continue;
       if (settled(topology.vertex_owner(v), f)) continue;
       ++tests;
-      if (Boxes::meet(bv, boxes.face(f, t)) && !owners_apart(topology.vertex_owner(v), f))
+      if (Boxes::meet(bv, boxes.face(f, t)) && !diagonal_apart({v}, {t[0], t[1], t[2]}))
         out.vf.push_back({v, f});
     }
   }
@@ -823,8 +938,9 @@ void brute_feature_pairs(
       if (share_endpoint(ends_a, topology.edge(b)) || topology.edges_excluded(a, b)) continue;
       if (settled(topology.edge_owner(a), topology.edge_owner(b))) continue;
       ++tests;
-      if (Boxes::meet(ba, boxes.edge(topology.edge(b))) &&
-          !owners_apart(topology.edge_owner(a), topology.edge_owner(b)))
+      const auto& ends_b = topology.edge(b);
+      if (Boxes::meet(ba, boxes.edge(ends_b)) &&
+          !diagonal_apart({ends_a[0], ends_a[1]}, {ends_b[0], ends_b[1]}))
         out.ee.push_back({a, b});
     }
   }

@@ -148,8 +148,8 @@ inline constexpr std::size_t kCcdBlockPairs = std::size_t{1} << 15;
 /// `ends` (interval_ends): when given, the positions at both ends are read instead of
 /// `bounds`: the two triangles are tested first, then each feature pair (IntervalEnds), and the
 /// feature pairs a triangle pair kept are dropped again when a face diagonal (x ± y, y ± z,
-/// z ± x) separates its two triangles at both ends (counted as tested; docs/culling.md, "The
-/// triangles on the face diagonals").
+/// z ± x) separates the two features at both ends (counted as tested; docs/culling.md, "The
+/// triangles on the face diagonals", "Each feature pair on the diagonals").
 template <int N>
 void ccd_candidates_from_triangle_pairs(
     const FeatureTopology& topology,
@@ -173,8 +173,8 @@ void force_baseline_feature_stage(bool baseline);
 /// triangle pair is a candidate of brute force).
 /// `fans` as for ccd_candidates_from_triangle_pairs: a feature pair whose owners (vertex_owner,
 /// edge_owner) share a certified corner is skipped, as the hierarchy methods skip their pair.
-/// `ends` as for ccd_candidates_from_triangle_pairs (each feature pair, and the diagonal rule on
-/// the two owners the hierarchy forms it from: the same pairs result).
+/// `ends` as for ccd_candidates_from_triangle_pairs (each feature pair on the axes, then on the
+/// diagonals: the same pairs result).
 template <int N>
 void ccd_candidates_brute_force(
     const FeatureTopology& topology,

@@ -389,11 +389,12 @@ bool apart_on_an_axis_at_both_ends(
   return false;
 }
 
-/// True when a face diagonal (x ± y, y ± z, z ± x) separates the corners of triangles `a` and `b`
-/// strictly at t0 and at t1, the same way round, each projection rounded as a double: rounding is
-/// monotone, so rounded projections strictly apart are exact ones strictly apart.
-bool triangles_apart_on_a_diagonal_at_both_ends(
-    const Scene& s, const std::array<std::int32_t, 3>& a, const std::array<std::int32_t, 3>& b) {
+/// True when a face diagonal (x ± y, y ± z, z ± x) separates point sets `a` and `b` (welded
+/// vertex ids) strictly at t0 and at t1, the same way round, each projection rounded as a
+/// double: rounding is monotone, so rounded projections strictly apart are exact ones strictly
+/// apart.
+bool apart_on_a_diagonal_at_both_ends(
+    const Scene& s, std::initializer_list<std::int32_t> a, std::initializer_list<std::int32_t> b) {
   const auto project = [](const skinning::Positions& x, std::int32_t v, int d) {
     const double px = x(v, 0), py = x(v, 1), pz = x(v, 2);
     switch (d) {
@@ -428,12 +429,12 @@ bool triangles_apart_on_a_diagonal_at_both_ends(
 
 TEST(CcdCandidates, EndsOnTheAxesAndDiagonalsDropOnlyPairsThatNeverTouchAndMatchBruteForce) {
   // Without a contact distance the AABB methods test a feature pair on its features' boxes at
-  // t0 and at t1 instead of their swept boxes, after its owners' triangles on the face diagonals
-  // at both ends: every pair the swept boxes keep or drop, less those an axis separates at both
-  // ends and those whose owner triangles a face diagonal separates at both ends. The dropped
-  // pairs are checked against the exact kernels.
+  // t0 and at t1 instead of their swept boxes, then on the face diagonals at both ends: every
+  // pair the swept boxes keep or drop, less those an axis or a face diagonal separates at both
+  // ends. The dropped pairs are checked against the exact kernels.
   std::int64_t dropped = 0;
   std::int64_t dropped_by_diagonal = 0;
+  std::int64_t dropped_by_feature_diagonal = 0;  // whose owner triangles no diagonal separates
   for (const Scene& s : scenes()) {
     SCOPED_TRACE(s.name);
     const Built<3> b = bounds_of<3>(s, 0.0);
@@ -459,9 +460,13 @@ TEST(CcdCandidates, EndsOnTheAxesAndDiagonalsDropOnlyPairsThatNeverTouchAndMatch
       const auto& f = b.topology.triangle(p.face);
       if (!apart_on_an_axis_at_both_ends(s, {p.vertex}, {f[0], f[1], f[2]})) {
         ++dropped_by_diagonal;
-        EXPECT_TRUE(triangles_apart_on_a_diagonal_at_both_ends(
-            s, b.topology.triangle(b.topology.vertex_owner(p.vertex)), f))
+        EXPECT_TRUE(apart_on_a_diagonal_at_both_ends(s, {p.vertex}, {f[0], f[1], f[2]}))
             << "VF (" << p.vertex << ", " << p.face << ")";
+        const auto& owner = b.topology.triangle(b.topology.vertex_owner(p.vertex));
+        if (!apart_on_a_diagonal_at_both_ends(
+                s, {owner[0], owner[1], owner[2]}, {f[0], f[1], f[2]})) {
+          ++dropped_by_feature_diagonal;
+        }
       }
       const auto q = vertex_face_query(s.x_t0, s.x_t1, p.vertex, s.x_t0, s.x_t1, f);
       EXPECT_FALSE(ccd::vertex_face_ccd(q, ccd::Accuracy::exact, options).hit)
@@ -474,11 +479,13 @@ TEST(CcdCandidates, EndsOnTheAxesAndDiagonalsDropOnlyPairsThatNeverTouchAndMatch
       const auto& eb = b.topology.edge(p.b);
       if (!apart_on_an_axis_at_both_ends(s, {ea[0], ea[1]}, {eb[0], eb[1]})) {
         ++dropped_by_diagonal;
-        EXPECT_TRUE(triangles_apart_on_a_diagonal_at_both_ends(
-            s,
-            b.topology.triangle(b.topology.edge_owner(p.a)),
-            b.topology.triangle(b.topology.edge_owner(p.b))))
+        EXPECT_TRUE(apart_on_a_diagonal_at_both_ends(s, {ea[0], ea[1]}, {eb[0], eb[1]}))
             << "EE (" << p.a << ", " << p.b << ")";
+        const auto& ta = b.topology.triangle(b.topology.edge_owner(p.a));
+        const auto& tb = b.topology.triangle(b.topology.edge_owner(p.b));
+        if (!apart_on_a_diagonal_at_both_ends(s, {ta[0], ta[1], ta[2]}, {tb[0], tb[1], tb[2]})) {
+          ++dropped_by_feature_diagonal;
+        }
       }
       const auto q = edge_edge_query(s.x_t0, s.x_t1, ea, s.x_t0, s.x_t1, eb);
       EXPECT_FALSE(ccd::edge_edge_ccd(q, ccd::Accuracy::exact, options).hit)
@@ -508,9 +515,11 @@ TEST(CcdCandidates, EndsOnTheAxesAndDiagonalsDropOnlyPairsThatNeverTouchAndMatch
     }
   }
   // The scenes move their parts past each other: some pairs are dropped, some by the diagonals
-  // alone (else this proved nothing).
+  // alone, and some by the features' diagonals where their triangles' do not separate them
+  // (else this proved nothing).
   EXPECT_GT(dropped, 0);
   EXPECT_GT(dropped_by_diagonal, 0);
+  EXPECT_GT(dropped_by_feature_diagonal, 0);
 }
 
 TEST(CcdCandidates, FanSharingOneVertexStillYieldsItsCrossings) {
