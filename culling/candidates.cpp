@@ -213,7 +213,8 @@ struct EndPositions {
     }
     return _mm_movemask_pd(apart) == 0;
   }
-  /// A triangle's extents at both ends on the six face diagonals, two a register:
+  /// A point set's extents (a vertex, an edge, a face) at both ends on the six face diagonals,
+  /// two a register:
   /// (x + y, y + z), (x − y, y − z), (z + x, z − x); z − x as z + (−x), the same rounding.
   struct DiagonalBox {
     __m128d lo0[3], hi0[3], lo1[3], hi1[3];
@@ -604,7 +605,8 @@ constexpr unsigned column_bits(unsigned j) { return 0x49u << j; }
 /// owned_feature_pairs' VF pairs of the vertices `owner` owns (its corners' positions or
 /// volumes `corners`) against face `f` (volume `face_box`): each slot is written, and kept when
 /// the vertex is not a corner of the face (`on_face`: bit s when owner's corner s is) and the
-/// boxes meet.
+/// boxes meet. `slots` gets, beside each slot, the vertex's corner slot | `tag` (kOwnedByB for
+/// the second triangle's), for the diagonal test that follows.
 template <bool kExclusions, class Boxes, class FaceBox>
 [[gnu::always_inline]] inline void vertices_vs_face(
     const FeatureTopology& topology,
