@@ -41,6 +41,13 @@ CcdResult conservative_after_aabbs(
     }
     return 4;
   };
+  const auto quartics_x4 = [&](detail::BernsteinQuartic* g) {
+    return detail::inside_quartics_x4(
+        detail::InsideQuartics::edge_edge,
+        {&q.ea0_t0, &q.ea1_t0, &q.eb0_t0, &q.eb1_t0},
+        {&q.ea0_t1, &q.ea1_t1, &q.eb0_t1, &q.eb1_t1},
+        g);
+  };
   // F(t, u, v) = (a0 + u (a1 - a0)) - (b0 + v (b1 - b0)) = (a0 - b0) + u (a1 - a0) + v (b0 - b1).
   const auto problem = [&] {
     detail::InclusionProblem p;
@@ -61,10 +68,20 @@ CcdResult conservative_after_aabbs(
   };
   if (known != nullptr) {
     return detail::pipeline_after_screen(
-        t0, t1, *known, 0.0, 0.0, quartic_inputs, problem, relative_apart, options, stats);
+        t0,
+        t1,
+        *known,
+        0.0,
+        0.0,
+        quartic_inputs,
+        quartics_x4,
+        problem,
+        relative_apart,
+        options,
+        stats);
   }
   return detail::conservative_pipeline(
-      t0, t1, quartic_inputs, problem, relative_apart, options, stats);
+      t0, t1, quartic_inputs, quartics_x4, problem, relative_apart, options, stats);
 }
 
 // conservative: swept AABBs, then the rest of the pipeline.

@@ -42,6 +42,13 @@ CcdResult conservative_after_aabbs(
     }
     return 3;
   };
+  const auto quartics_x4 = [&](detail::BernsteinQuartic* g) {
+    return detail::inside_quartics_x4(
+        detail::InsideQuartics::vertex_face,
+        {&q.v_t0, &q.f0_t0, &q.f1_t0, &q.f2_t0},
+        {&q.v_t1, &q.f0_t1, &q.f1_t1, &q.f2_t1},
+        g);
+  };
   // F(t, u, v) = p - (a + u (b - a) + v (c - a)) = (p - a) + u (a - b) + v (a - c).
   const auto problem = [&] {
     detail::InclusionProblem p;
@@ -62,10 +69,20 @@ CcdResult conservative_after_aabbs(
   };
   if (known != nullptr) {
     return detail::pipeline_after_screen(
-        t0, t1, *known, 0.0, 0.0, quartic_inputs, problem, relative_apart, options, stats);
+        t0,
+        t1,
+        *known,
+        0.0,
+        0.0,
+        quartic_inputs,
+        quartics_x4,
+        problem,
+        relative_apart,
+        options,
+        stats);
   }
   return detail::conservative_pipeline(
-      t0, t1, quartic_inputs, problem, relative_apart, options, stats);
+      t0, t1, quartic_inputs, quartics_x4, problem, relative_apart, options, stats);
 }
 
 // conservative: swept AABBs, then the rest of the pipeline.

@@ -293,6 +293,25 @@ BernsteinQuartic cross_dot_quartic(const QuadrupleDifferences& q) {
 
 namespace {
 
+/// The end of cross_dot_quartic for W lanes: the coefficients from the level sums `sum`, the
+/// error bound from the permanents' level sums `perm` and the largest coordinate magnitude `m`.
+template <class L, std::size_t W, class Target>
+[[gnu::always_inline]] inline void store_quartics(
+    const L (&sum)[5], const L (&perm)[5], const L& m, const Target& g) {
+  static constexpr double kTerms[5] = {1.0, 4.0, 6.0, 4.0, 1.0};
+  L p{};
+  for (std::size_t i = 0; i < 5; ++i) {
+    const L value = sum[i] / kTerms[i];
+    for (std::size_t k = 0; k < W; ++k) g(k).coefficients[i] = value[k];
+    p = lane_max(p, perm[i] / kTerms[i]);
+  }
+  // As in cross_dot_quartic.
+  for (std::size_t k = 0; k < W; ++k) {
+    g(k).error =
+        add_up(rounding_bound(18, p[k]), times_subnormal_power_of_two<1068>(1.0 + m[k] * m[k]));
+  }
+}
+
 /// cross_dot_quartic of q(k) into g(k) for the W = 2 or 4 lanes of L: lane k goes through the
 /// scalar code's operations in the same order (detail/lanes.hpp).
 template <class L, std::size_t W, class Source, class Target>
@@ -335,13 +354,6 @@ template <class L, std::size_t W, class Source, class Target>
       perm[level] += dot(ab_perm[i], cd_perm[j]);
     }
   }
-  static constexpr double kTerms[5] = {1.0, 4.0, 6.0, 4.0, 1.0};
-  L p{};
-  for (std::size_t i = 0; i < 5; ++i) {
-    const L value = sum[i] / kTerms[i];
-    for (std::size_t k = 0; k < W; ++k) g(k).coefficients[i] = value[k];
-    p = lane_max(p, perm[i] / kTerms[i]);
-  }
   // The largest coordinate magnitude of each quadruple (finite by the precondition, so any order
   // of comparisons finds the same value).
   L m{};
@@ -350,11 +362,7 @@ template <class L, std::size_t W, class Source, class Target>
         m,
         lane_max(lane_max(max_abs(a[t]), max_abs(b[t])), lane_max(max_abs(c[t]), max_abs(d[t]))));
   }
-  // As in cross_dot_quartic.
-  for (std::size_t k = 0; k < W; ++k) {
-    g(k).error =
-        add_up(rounding_bound(18, p[k]), times_subnormal_power_of_two<1068>(1.0 + m[k] * m[k]));
-  }
+  store_quartics<L, W>(sum, perm, m, g);
 }
 
 #if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
@@ -364,6 +372,120 @@ template <class L, std::size_t W, class Source, class Target>
   quartics_body<Lanes4, 4>(
       [&](std::size_t k) -> const QuadrupleDifferences& { return q[k]; },
       [&](std::size_t k) -> BernsteinQuartic& { return g[k]; });
+}
+
+using LaneIndex4 = std::int64_t __attribute__((vector_size(32)));
+
+/// Lanes (v[i0], v[i1], v[i2], v[i3]) (one vpermpd).
+template <int i0, int i1, int i2, int i3>
+[[gnu::always_inline]] inline Lanes4 pick(const Lanes4& v) {
+  return __builtin_shuffle(v, LaneIndex4{i0, i1, i2, i3});
+}
+
+/// Lane k: point hi_k minus point lo_k, of the four points' coordinates in lanes `p`.
+template <int h0, int h1, int h2, int h3, int l0, int l1, int l2, int l3>
+[[gnu::always_inline]] inline LaneVec3<Lanes4> differences(const LaneVec3<Lanes4>& p) {
+  return {
+      pick<h0, h1, h2, h3>(p.x) - pick<l0, l1, l2, l3>(p.x),
+      pick<h0, h1, h2, h3>(p.y) - pick<l0, l1, l2, l3>(p.y),
+      pick<h0, h1, h2, h3>(p.z) - pick<l0, l1, l2, l3>(p.z)};
+}
+
+/// Lane k of each coordinate in all four lanes.
+template <int k>
+[[gnu::always_inline]] inline LaneVec3<Lanes4> splat(const LaneVec3<Lanes4>& v) {
+  return {pick<k, k, k, k>(v.x), pick<k, k, k, k>(v.y), pick<k, k, k, k>(v.z)};
+}
+
+/// inside_quartics_x4 built for AVX2. Each quartic is (A x B) . (C x D) over the four pairs of
+/// end times; one pair of factors differs per quartic (lane k: quartic k), the other is n's, the
+/// same for all: EE's (C, D), VF's (A, B). The varying pair's differences come from the points
+/// in lanes; the shared pair is crossed once for its four pairs of times (lane k: times k & 1,
+/// k >> 1, as quartics_body's factor pairs) and each result spread over the lanes. The dot
+/// products are quartics_body's, in its order, with the same operands: the same bits.
+template <InsideQuartics kWhich>
+[[gnu::target("avx2")]] void inside_quartics_avx2(
+    const std::array<const Eigen::Vector3d*, 4>& at_t0,
+    const std::array<const Eigen::Vector3d*, 4>& at_t1,
+    BernsteinQuartic* g) {
+  using L = Lanes4;
+  using L3 = LaneVec3<L>;
+  const auto in_lanes =
+      [](const std::array<const Eigen::Vector3d*, 4>& p) __attribute__((always_inline)) {
+    return lanes_of<L, 4>({p[0], p[1], p[2], p[3]});
+  };
+  const L3 points[2] = {in_lanes(at_t0), in_lanes(at_t1)};
+  constexpr bool kEdgeEdge = kWhich == InsideQuartics::edge_edge;
+  // The varying pair at each end. EE, points (a0, a1, b0, b1): A = b0 - a0, a1 - b0, b0 - a0,
+  // a1 - a0 and B = b1 - b0, b1 - b0, a1 - a0, b1 - a0. VF, points (v, f0, f1, f2): C = f1 - f0,
+  // f2 - f1, f0 - f2, f0 - f2 and D = v - f0, v - f1, v - f2, v - f2.
+  L3 first[2], second[2];
+  for (int t = 0; t < 2; ++t) {
+    if constexpr (kEdgeEdge) {
+      first[t] = differences<2, 1, 2, 1, 0, 2, 0, 0>(points[t]);
+      second[t] = differences<3, 3, 1, 3, 2, 2, 0, 0>(points[t]);
+    } else {
+      first[t] = differences<2, 3, 1, 1, 1, 2, 3, 3>(points[t]);
+      second[t] = differences<0, 0, 0, 0, 1, 2, 3, 3>(points[t]);
+    }
+  }
+  // The shared pair (EE: d_a = a1 - a0, d_b = b1 - b0; VF: f1 - f0, f2 - f0) at each end.
+  constexpr int kS1Hi = kEdgeEdge ? 1 : 2, kS1Lo = kEdgeEdge ? 0 : 1;
+  constexpr int kS2Hi = 3, kS2Lo = kEdgeEdge ? 2 : 1;
+  const Eigen::Vector3d s1[2] = {*at_t0[kS1Hi] - *at_t0[kS1Lo], *at_t1[kS1Hi] - *at_t1[kS1Lo]};
+  const Eigen::Vector3d s2[2] = {*at_t0[kS2Hi] - *at_t0[kS2Lo], *at_t1[kS2Hi] - *at_t1[kS2Lo]};
+  // Lane k: s1 at time k & 1, s2 at time k >> 1.
+  const L3 r{
+      L{s1[0][0], s1[1][0], s1[0][0], s1[1][0]},
+      L{s1[0][1], s1[1][1], s1[0][1], s1[1][1]},
+      L{s1[0][2], s1[1][2], s1[0][2], s1[1][2]}};
+  const L3 q{
+      L{s2[0][0], s2[0][0], s2[1][0], s2[1][0]},
+      L{s2[0][1], s2[0][1], s2[1][1], s2[1][1]},
+      L{s2[0][2], s2[0][2], s2[1][2], s2[1][2]}};
+  const L3 shared_all = cross(r, q);
+  const L3 shared_perm_all = cross_permanent(lane_abs(r), lane_abs(q));
+  const L3 shared[4] = {
+      splat<0>(shared_all), splat<1>(shared_all), splat<2>(shared_all), splat<3>(shared_all)};
+  const L3 shared_perm[4] = {
+      splat<0>(shared_perm_all),
+      splat<1>(shared_perm_all),
+      splat<2>(shared_perm_all),
+      splat<3>(shared_perm_all)};
+  const L3 first_abs[2] = {lane_abs(first[0]), lane_abs(first[1])};
+  const L3 second_abs[2] = {lane_abs(second[0]), lane_abs(second[1])};
+  L3 own[4], own_perm[4];
+  for (int k = 0; k < 4; ++k) {
+    const int i = k & 1, j = k >> 1;
+    own[k] = cross(first[i], second[j]);
+    own_perm[k] = cross_permanent(first_abs[i], second_abs[j]);
+  }
+  static constexpr int kBits[4] = {0, 1, 1, 2};
+  L sum[5] = {};
+  L perm[5] = {};
+#pragma GCC unroll 4
+  for (int i = 0; i < 4; ++i) {
+#pragma GCC unroll 4
+    for (int j = 0; j < 4; ++j) {
+      const int level = kBits[i] + kBits[j];
+      if constexpr (kEdgeEdge) {
+        sum[level] += dot(own[i], shared[j]);
+        perm[level] += dot(own_perm[i], shared_perm[j]);
+      } else {
+        sum[level] += dot(shared[i], own[j]);
+        perm[level] += dot(shared_perm[i], own_perm[j]);
+      }
+    }
+  }
+  L m{};
+  double shared_m = 0.0;
+  for (int t = 0; t < 2; ++t) {
+    m = lane_max(m, lane_max(max_abs(first[t]), max_abs(second[t])));
+    shared_m =
+        std::max(shared_m, std::max(s1[t].cwiseAbs().maxCoeff(), s2[t].cwiseAbs().maxCoeff()));
+  }
+  m = lane_max(m, L{shared_m, shared_m, shared_m, shared_m});
+  store_quartics<L, 4>(sum, perm, m, [&](std::size_t k) -> BernsteinQuartic& { return g[k]; });
 }
 #endif
 
@@ -392,6 +514,54 @@ bool cross_dot_quartics_x4_wide() {
 
 void force_baseline_quartics(bool baseline) {
   quartics_baseline_forced.store(baseline, std::memory_order_relaxed);
+}
+
+int inside_quartics_x4(
+    InsideQuartics which,
+    const std::array<const Eigen::Vector3d*, 4>& at_t0,
+    const std::array<const Eigen::Vector3d*, 4>& at_t1,
+    BernsteinQuartic* g) {
+#if defined(SKELCD_QUARTICS_AVX2)
+  if (cross_dot_quartics_x4_wide()) {
+    if (which == InsideQuartics::edge_edge) {
+      inside_quartics_avx2<InsideQuartics::edge_edge>(at_t0, at_t1, g);
+      return 4;
+    }
+    inside_quartics_avx2<InsideQuartics::vertex_face>(at_t0, at_t1, g);
+    return 3;
+  }
+#endif
+  // The quadruples as the kernels build them, two quartics at a time.
+  QuadrupleDifferences q[4];
+  for (int t = 0; t < 2; ++t) {
+    const auto& p = t == 0 ? at_t0 : at_t1;
+    const auto set = [&](QuadrupleDifferences& x,
+                         const Eigen::Vector3d& a,
+                         const Eigen::Vector3d& b,
+                         const Eigen::Vector3d& c,
+                         const Eigen::Vector3d& d) {
+      (t == 0 ? x.a_t0 : x.a_t1) = a;
+      (t == 0 ? x.b_t0 : x.b_t1) = b;
+      (t == 0 ? x.c_t0 : x.c_t1) = c;
+      (t == 0 ? x.d_t0 : x.d_t1) = d;
+    };
+    if (which == InsideQuartics::edge_edge) {
+      const Eigen::Vector3d w = *p[2] - *p[0], da = *p[1] - *p[0], db = *p[3] - *p[2];
+      set(q[0], w, db, da, db);
+      set(q[1], *p[1] - *p[2], db, da, db);
+      set(q[2], w, da, da, db);
+      set(q[3], da, *p[3] - *p[0], da, db);
+    } else {
+      const Eigen::Vector3d y = *p[2] - *p[1], z = *p[3] - *p[1];
+      set(q[0], y, z, y, *p[0] - *p[1]);
+      set(q[1], y, z, *p[3] - *p[2], *p[0] - *p[2]);
+      set(q[2], y, z, *p[1] - *p[3], *p[0] - *p[3]);
+      q[3] = q[2];
+    }
+  }
+  cross_dot_quartic_pair(q[0], q[1], g[0], g[1]);
+  cross_dot_quartic_pair(q[2], q[3], g[2], g[3]);
+  return which == InsideQuartics::edge_edge ? 4 : 3;
 }
 
 void cross_dot_quartic_x4(const QuadrupleDifferences* q, BernsteinQuartic* g) {

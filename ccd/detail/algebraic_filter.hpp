@@ -51,6 +51,31 @@ void cross_dot_quartic_pair(
 /// @pre every coordinate of q[0..3] is finite.
 void cross_dot_quartic_x4(const QuadrupleDifferences* q, BernsteinQuartic* g);
 
+/// The inside quartics of a query, for inside_quartics_x4.
+enum class InsideQuartics : std::uint8_t {
+  /// Points (v, f0, f1, f2): (y x z) . (y x x), (y x z) . ((f2 - f1) x (v - f1)),
+  /// (y x z) . ((f0 - f2) x (v - f2)) with x = v - f0, y = f1 - f0, z = f2 - f0, the fourth lane
+  /// repeating the third (vertex_face.cpp).
+  vertex_face,
+  /// Points (a0, a1, b0, b1): (w x d_b) . n, ((a1 - b0) x d_b) . n, (w x d_a) . n,
+  /// (d_a x (b1 - a0)) . n with w = b0 - a0, d_a = a1 - a0, d_b = b1 - b0, n = d_a x d_b
+  /// (edge_edge.cpp).
+  edge_edge,
+};
+
+/// The inside quartics of one query straight from its four points at t = 0 (`at_t0`) and t = 1,
+/// bit for bit cross_dot_quartic of the QuadrupleDifferences named above (each difference the
+/// same single subtraction). Where cross_dot_quartics_x4_wide(), one AVX2 evaluation: the
+/// differences taken four lanes at a time, and the factor pair every quartic of the query shares
+/// (n's) crossed once instead of once per quartic; otherwise the quadruples, two quartics at a
+/// time. Returns how many quartics the query has (3 or 4; g[3] is written either way).
+/// @pre every coordinate of the quadruples finite.
+int inside_quartics_x4(
+    InsideQuartics which,
+    const std::array<const Eigen::Vector3d*, 4>& at_t0,
+    const std::array<const Eigen::Vector3d*, 4>& at_t1,
+    BernsteinQuartic* g);
+
 /// Whether cross_dot_quartic_x4 computes its four quartics at once (AVX2, and not forced to the
 /// baseline): four then cost what two do.
 [[nodiscard]] bool cross_dot_quartics_x4_wide();

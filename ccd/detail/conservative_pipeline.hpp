@@ -7,6 +7,7 @@
 //   3. inclusion solver — whatever is left, from the first time the filters could not exclude.
 
 #include <algorithm>
+#include <cassert>
 #include <cmath>
 #include <limits>
 
@@ -55,7 +56,11 @@ inline constexpr double kQuarticScreenMagnitude = 0x1p190;
 /// sign: from stage 1½ on. conservative_pipeline's parameters; `screen` is the screen of
 /// coplanarity_t0/_t1 (its coefficients and magnitude are read), `normal_bound` and `margin` what
 /// conservative_pipeline derives from min_separation (both 0 without it).
-template <typename MakeQuarticInputs, typename MakeProblem, typename RelativeApart>
+template <
+    typename MakeQuarticInputs,
+    typename QuarticsX4,
+    typename MakeProblem,
+    typename RelativeApart>
 CcdResult pipeline_after_screen(
     const DifferenceTriple& coplanarity_t0,
     const DifferenceTriple& coplanarity_t1,
@@ -63,6 +68,7 @@ CcdResult pipeline_after_screen(
     double normal_bound,
     double margin,
     MakeQuarticInputs&& make_quartic_inputs,
+    QuarticsX4&& quartics_x4,
     MakeProblem&& make_problem,
     RelativeApart&& relative_apart,
     const CcdOptions& options,
@@ -85,17 +91,22 @@ CcdResult pipeline_after_screen(
   QuadrupleDifferences inputs[4];
   BernsteinQuartic g[4];
   double lengths[4] = {0.0, 0.0, 0.0, 0.0};
-  const int count = make_quartic_inputs(inputs, s > 0.0 ? lengths : nullptr);
   // Finite end coefficients mean finite X, Y, Z at both times (each coordinate reaches b_0 or b_3
   // through products and sums, which keep inf and NaN), hence finite points; with the magnitude
   // bound every quartic below is finite with a finite error.
   const bool screened = std::isfinite(c.coefficients[0]) && std::isfinite(c.coefficients[3]) &&
                         screen.magnitude <= kQuarticScreenMagnitude;
-  if (screened && cross_dot_quartics_x4_wide()) {
-    // All four at once, for what two cost (a third quartic's query fills the fourth lane, which
-    // is not read); then the early exit below on the first two, as the pairs take it.
-    if (count == 3) inputs[3] = inputs[2];
-    cross_dot_quartic_x4(inputs, g);
+  const bool wide = screened && cross_dot_quartics_x4_wide();
+  // The differences as QuadrupleDifferences only where they are read: the quartics one or two at
+  // a time, or the edge lengths (min_separation).
+  int count = wide && s == 0.0 ? 0 : make_quartic_inputs(inputs, s > 0.0 ? lengths : nullptr);
+  if (wide) {
+    // All at once from the query's points, the shared factor pair crossed once (a third
+    // quartic's query fills the fourth lane, which is not read); then the early exit below on
+    // the first two, as the pairs take it.
+    const int computed = quartics_x4(g);
+    assert(count == 0 || count == computed);
+    count = computed;
     if (s == 0.0 && std::isfinite(c.error) && std::isfinite(g[0].error) &&
         std::isfinite(g[1].error) && (certified_negative(g[0]) || certified_negative(g[1]))) {
       ++stats.algebraic_rejected;
@@ -149,15 +160,22 @@ CcdResult pipeline_after_screen(
 /// and returns how many (3 or 4): at a point within distance s of contact, g_i >= -s |n| L_i
 /// (docs/ccd.md). Every vector is a difference of two of the query's points. `lengths` is null
 /// when min_separation is 0 (they are not needed).
+/// @param quartics_x4 fills g[0..4) with the quartics of those inputs, bit for bit, and returns
+/// their count (inside_quartics_x4); called only where cross_dot_quartics_x4_wide().
 /// @param make_problem returns the solver's InclusionProblem (only the few queries that reach it
 /// pay for it).
 /// @param relative_apart returns relative_boxes_apart for the query (asked only with
 /// CcdOptions::relative_boxes, of the queries the coplanarity stage leaves).
-template <typename MakeQuarticInputs, typename MakeProblem, typename RelativeApart>
+template <
+    typename MakeQuarticInputs,
+    typename QuarticsX4,
+    typename MakeProblem,
+    typename RelativeApart>
 CcdResult conservative_pipeline(
     const DifferenceTriple& coplanarity_t0,
     const DifferenceTriple& coplanarity_t1,
     MakeQuarticInputs&& make_quartic_inputs,
+    QuarticsX4&& quartics_x4,
     MakeProblem&& make_problem,
     RelativeApart&& relative_apart,
     const CcdOptions& options,
@@ -187,6 +205,7 @@ CcdResult conservative_pipeline(
       normal_bound,
       margin,
       make_quartic_inputs,
+      quartics_x4,
       make_problem,
       relative_apart,
       options,

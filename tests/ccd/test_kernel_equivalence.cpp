@@ -659,6 +659,76 @@ TEST(KernelEquivalence, FourQuarticsAtOnceAreCrossDotQuarticBitForBit) {
   detail::force_baseline_quartics(false);
 }
 
+TEST(KernelEquivalence, InsideQuarticsFromThePointsAreCrossDotQuarticBitForBit) {
+  // inside_quartics_x4 in both of its builds takes the differences and the shared factor pair
+  // its own way: each quartic must still be cross_dot_quartic of the quadruple the kernels
+  // define (vertex_face.cpp, edge_edge.cpp), bit for bit, at every scale, with points repeated
+  // (degenerate features) and some coordinates zero.
+  std::mt19937_64 rng(23);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  std::uniform_int_distribution<int> exponent(-540, 180);
+  for (const bool baseline : {false, true}) {
+    detail::force_baseline_quartics(baseline);
+    for (int i = 0; i < 20000; ++i) {
+      const double s = std::ldexp(1.0, exponent(rng));
+      std::array<Eigen::Vector3d, 8> p;
+      for (auto& x : p) x = Eigen::Vector3d(u(rng), u(rng), u(rng)) * s;
+      if (i % 5 == 0) p[3] = p[1];
+      if (i % 7 == 0) p[6].x() = 0.0;
+      if (i % 11 == 0) p[4] = p[0] + Eigen::Vector3d(0x1p-52, 0.0, 0.0) * s;
+      // Every point on one line (here the x axis): every cross product is 0, the quartics' bound
+      // its underflow term alone, which the largest coordinate sets.
+      if (i % 13 == 0) {
+        for (auto& x : p) x.tail<2>().setZero();
+      }
+      const std::array<const Eigen::Vector3d*, 4> t0{&p[0], &p[1], &p[2], &p[3]};
+      const std::array<const Eigen::Vector3d*, 4> t1{&p[4], &p[5], &p[6], &p[7]};
+      for (const bool edge_edge : {false, true}) {
+        // The quadruples at one end (points a, b, c, d), written as the kernels define them.
+        const auto quads = [&](const Eigen::Vector3d& a,
+                               const Eigen::Vector3d& b,
+                               const Eigen::Vector3d& c,
+                               const Eigen::Vector3d& d) {
+          std::array<std::array<Eigen::Vector3d, 4>, 4> q;
+          if (edge_edge) {  // (a0, a1, b0, b1): w = b0 - a0, d_a = a1 - a0, d_b = b1 - b0
+            q[0] = {c - a, d - c, b - a, d - c};
+            q[1] = {b - c, d - c, b - a, d - c};
+            q[2] = {c - a, b - a, b - a, d - c};
+            q[3] = {b - a, d - a, b - a, d - c};
+          } else {  // (v, f0, f1, f2)
+            q[0] = {c - b, d - b, c - b, a - b};
+            q[1] = {c - b, d - b, d - c, a - c};
+            q[2] = {c - b, d - b, b - d, a - d};
+            q[3] = q[2];
+          }
+          return q;
+        };
+        const auto q0 = quads(p[0], p[1], p[2], p[3]);
+        const auto q1 = quads(p[4], p[5], p[6], p[7]);
+        BernsteinQuartic g[4];
+        const int count = detail::inside_quartics_x4(
+            edge_edge ? detail::InsideQuartics::edge_edge : detail::InsideQuartics::vertex_face,
+            t0,
+            t1,
+            g);
+        ASSERT_EQ(count, edge_edge ? 4 : 3);
+        for (std::size_t k = 0; k < 4; ++k) {
+          const detail::QuadrupleDifferences q{
+              q0[k][0], q0[k][1], q0[k][2], q0[k][3], q1[k][0], q1[k][1], q1[k][2], q1[k][3]};
+          const BernsteinQuartic r = detail::cross_dot_quartic(q);
+          for (std::size_t c = 0; c < 5; ++c) {
+            ASSERT_TRUE(same_bits(g[k].coefficients[c], r.coefficients[c]))
+                << i << (edge_edge ? " EE" : " VF") << " quartic " << k
+                << (baseline ? " baseline" : "");
+          }
+          ASSERT_TRUE(same_bits(g[k].error, r.error)) << i << " quartic " << k;
+        }
+      }
+    }
+  }
+  detail::force_baseline_quartics(false);
+}
+
 TEST(KernelEquivalence, KernelsGiveTheSameAnswersWithFourQuarticsAtOnce) {
   // The conservative pipeline computes its four inside quartics at once where cross_dot_quartic_x4
   // is wide, and two pairs (the second only past the early exit) otherwise: the same answers, bit
