@@ -2,6 +2,7 @@
 
 #include <cmath>
 
+#include "culling/candidates.hpp"
 #include "culling/detail/method_base.hpp"
 #include "culling/dual_cone.hpp"
 #include "culling/enhanced_dual_cone.hpp"
@@ -46,8 +47,11 @@ MethodBase::MethodBase(
     throw InvalidInput("culling::make_method: block_pairs must be >= 1, got 0");
   }
   ccd_options_.min_separation = options.min_separation;
-  // The kernels reject queries whose relative boxes are apart (docs/ccd.md, "Relative boxes").
-  ccd_options_.relative_boxes = true;
+  // The kernels' relative stage (docs/ccd.md, "Relative boxes"): with a contact distance, the
+  // relative boxes. Without one its test, nine directions apart at both ends, is the one the
+  // feature stage has made on every feature pair it hands over (candidates.hpp, "Each feature
+  // pair on the diagonals" in docs/culling.md): it could reject none of them, and is left out.
+  ccd_options_.relative_boxes = !feature_stage_tests_ends(options.min_separation);
 }
 
 void MethodBase::check_positions(
