@@ -550,10 +550,20 @@ class Walk {
 
   /// The exact (double) volume test of a triangle pair.
   [[nodiscard]] static bool overlap(const Dop<N>& a, const Dop<N>& b) {
+    constexpr auto kN = static_cast<std::size_t>(N);
+    std::size_t k = 0;
     bool ok = true;
-    for (std::size_t k = 0; k < static_cast<std::size_t>(N); ++k) {
-      ok = ok & (a.lo[k] <= b.hi[k]) & (b.lo[k] <= a.hi[k]);
+#if defined(__SSE2__)
+    // Two axes a compare (cmplepd is false on NaN, as <= is), an odd last axis alone.
+    __m128d both = _mm_castsi128_pd(_mm_set1_epi32(-1));
+    for (; k + 2 <= kN; k += 2) {
+      const __m128d below = _mm_cmple_pd(_mm_loadu_pd(&a.lo[k]), _mm_loadu_pd(&b.hi[k]));
+      const __m128d above = _mm_cmple_pd(_mm_loadu_pd(&b.lo[k]), _mm_loadu_pd(&a.hi[k]));
+      both = _mm_and_pd(both, _mm_and_pd(below, above));
     }
+    ok = _mm_movemask_pd(both) == 3;
+#endif
+    for (; k < kN; ++k) ok = ok & (a.lo[k] <= b.hi[k]) & (b.lo[k] <= a.hi[k]);
     return ok;
   }
 
