@@ -41,8 +41,8 @@ CcdResult conservative_after_aabbs(
     }
     return 4;
   };
-  const auto quartics_x4 = [&](detail::BernsteinQuartic* g) {
-    return detail::inside_quartics_x4(
+  const auto quartics_x4 = [&](detail::QuarticLanes& g) {
+    return detail::inside_quartic_lanes(
         detail::InsideQuartics::edge_edge,
         {&q.ea0_t0, &q.ea1_t0, &q.eb0_t0, &q.eb1_t0},
         {&q.ea0_t1, &q.ea1_t1, &q.eb0_t1, &q.eb1_t1},

@@ -42,8 +42,8 @@ CcdResult conservative_after_aabbs(
     }
     return 3;
   };
-  const auto quartics_x4 = [&](detail::BernsteinQuartic* g) {
-    return detail::inside_quartics_x4(
+  const auto quartics_x4 = [&](detail::QuarticLanes& g) {
+    return detail::inside_quartic_lanes(
         detail::InsideQuartics::vertex_face,
         {&q.v_t0, &q.f0_t0, &q.f1_t0, &q.f2_t0},
         {&q.v_t1, &q.f0_t1, &q.f1_t1, &q.f2_t1},

@@ -8,7 +8,9 @@
 #include <cassert>
 #include <cmath>
 #include <cstdint>
+#include <cstring>
 #include <limits>
+#include <type_traits>
 
 #include "ccd/detail/float_bounds.hpp"
 #include "ccd/detail/lanes.hpp"
@@ -407,7 +409,7 @@ template <InsideQuartics kWhich>
 [[gnu::target("avx2")]] void inside_quartics_avx2(
     const std::array<const Eigen::Vector3d*, 4>& at_t0,
     const std::array<const Eigen::Vector3d*, 4>& at_t1,
-    BernsteinQuartic* g) {
+    QuarticLanes& g) {
   using L = Lanes4;
   using L3 = LaneVec3<L>;
   const auto in_lanes =
@@ -485,7 +487,18 @@ template <InsideQuartics kWhich>
         std::max(shared_m, std::max(s1[t].cwiseAbs().maxCoeff(), s2[t].cwiseAbs().maxCoeff()));
   }
   m = lane_max(m, L{shared_m, shared_m, shared_m, shared_m});
-  store_quartics<L, 4>(sum, perm, m, [&](std::size_t k) -> BernsteinQuartic& { return g[k]; });
+  // store_quartics into lanes: the coefficients as vectors, the bounds lane by lane.
+  static constexpr double kTerms[5] = {1.0, 4.0, 6.0, 4.0, 1.0};
+  L p{};
+  for (std::size_t i = 0; i < 5; ++i) {
+    const L value = sum[i] / kTerms[i];
+    std::memcpy(g.coefficients[i].data(), &value, sizeof value);
+    p = lane_max(p, perm[i] / kTerms[i]);
+  }
+  for (std::size_t k = 0; k < 4; ++k) {
+    g.error[k] =
+        add_up(rounding_bound(18, p[k]), times_subnormal_power_of_two<1068>(1.0 + m[k] * m[k]));
+  }
 }
 #endif
 
@@ -516,6 +529,28 @@ void force_baseline_quartics(bool baseline) {
   quartics_baseline_forced.store(baseline, std::memory_order_relaxed);
 }
 
+int inside_quartic_lanes(
+    InsideQuartics which,
+    const std::array<const Eigen::Vector3d*, 4>& at_t0,
+    const std::array<const Eigen::Vector3d*, 4>& at_t1,
+    QuarticLanes& g) {
+  assert(cross_dot_quartics_x4_wide());
+#if defined(SKELCD_QUARTICS_AVX2)
+  if (which == InsideQuartics::edge_edge) {
+    inside_quartics_avx2<InsideQuartics::edge_edge>(at_t0, at_t1, g);
+    return 4;
+  }
+  inside_quartics_avx2<InsideQuartics::vertex_face>(at_t0, at_t1, g);
+  return 3;
+#else
+  (void)which;
+  (void)at_t0;
+  (void)at_t1;
+  (void)g;
+  return 0;
+#endif
+}
+
 int inside_quartics_x4(
     InsideQuartics which,
     const std::array<const Eigen::Vector3d*, 4>& at_t0,
@@ -523,12 +558,13 @@ int inside_quartics_x4(
     BernsteinQuartic* g) {
 #if defined(SKELCD_QUARTICS_AVX2)
   if (cross_dot_quartics_x4_wide()) {
-    if (which == InsideQuartics::edge_edge) {
-      inside_quartics_avx2<InsideQuartics::edge_edge>(at_t0, at_t1, g);
-      return 4;
+    QuarticLanes lanes;
+    const int count = inside_quartic_lanes(which, at_t0, at_t1, lanes);
+    for (std::size_t k = 0; k < 4; ++k) {
+      for (std::size_t i = 0; i < 5; ++i) g[k].coefficients[i] = lanes.coefficients[i][k];
+      g[k].error = lanes.error[k];
     }
-    inside_quartics_avx2<InsideQuartics::vertex_face>(at_t0, at_t1, g);
-    return 3;
+    return count;
   }
 #endif
   // The quadruples as the kernels build them, two quartics at a time.
@@ -582,9 +618,9 @@ namespace {
 /// last quartic and never looked at (not zeros: halving a zero error would make a subnormal
 /// product each time, a microcode assist). The nodes, their order and each lane's operations do
 /// not depend on the grouping, so neither does the verdict.
-template <class L, class B, std::size_t W, std::size_t kGroups>
+template <class L, class B, std::size_t W, std::size_t kGroups, class Quartics>
 [[gnu::always_inline]] inline AlgebraicVerdict filter_body(
-    const BernsteinCubic& c, const BernsteinQuartic* g, int count, double toi_tolerance) {
+    const BernsteinCubic& c, const Quartics& g, int count, double toi_tolerance) {
   // Depth first, earlier half first: the left half is processed next, the right half waits.
   using N = Node<L, kGroups>;
   std::array<N, kMaxDepth + 2> waiting;
@@ -598,12 +634,20 @@ template <class L, class B, std::size_t W, std::size_t kGroups>
   constexpr int kWidth = static_cast<int>(W);
   // Groups that hold a quartic (one, with four lanes: the caller has three or four).
   const int groups = kGroups == 1 ? 1 : (count + kWidth - 1) / kWidth;
-  for (int i = 0; i < kWidth * groups; ++i) {
-    const BernsteinQuartic& q = g[std::min(i, count - 1)];
-    const auto p = static_cast<std::size_t>(i / kWidth);
-    const auto lane = static_cast<std::size_t>(i % kWidth);
-    for (std::size_t k = 0; k < 5; ++k) node.g[p][k][lane] = q.coefficients[k];
-    node.g_err[p][lane] = q.error;
+  if constexpr (std::is_same_v<Quartics, QuarticLanes>) {
+    // Already in lanes (lane 3 repeating lane 2 when there are three).
+    static_assert(kGroups == 1 && W == 4);
+    for (std::size_t k = 0; k < 5; ++k)
+      std::memcpy(&node.g[0][k], g.coefficients[k].data(), sizeof(L));
+    std::memcpy(&node.g_err[0], g.error.data(), sizeof(L));
+  } else {
+    for (int i = 0; i < kWidth * groups; ++i) {
+      const BernsteinQuartic& q = g[std::min(i, count - 1)];
+      const auto p = static_cast<std::size_t>(i / kWidth);
+      const auto lane = static_cast<std::size_t>(i % kWidth);
+      for (std::size_t k = 0; k < 5; ++k) node.g[p][k][lane] = q.coefficients[k];
+      node.g_err[p][lane] = q.error;
+    }
   }
   // Lanes that hold a quartic.
   std::array<B, kGroups> used;
@@ -666,6 +710,12 @@ template <class L, class B, std::size_t W, std::size_t kGroups>
     const BernsteinCubic& c, const BernsteinQuartic* g, int count, double toi_tolerance) {
   return filter_body<Lanes4, LaneBits4, 4, 1>(c, g, count, toi_tolerance);
 }
+
+/// The same on quartics already in lanes.
+[[gnu::target("avx2")]] AlgebraicVerdict filter_lanes_avx2(
+    const BernsteinCubic& c, const QuarticLanes& g, int count, double toi_tolerance) {
+  return filter_body<Lanes4, LaneBits4, 4, 1>(c, g, count, toi_tolerance);
+}
 #endif
 
 }  // namespace
@@ -682,6 +732,21 @@ AlgebraicVerdict algebraic_filter(
   if (count >= 3 && cross_dot_quartics_x4_wide()) return filter_x4_avx2(c, g, count, toi_tolerance);
 #endif
   return filter_body<Lanes, LaneBits, 2, kMaxQuartics / 2>(c, g, count, toi_tolerance);
+}
+
+AlgebraicVerdict algebraic_filter_lanes(
+    const BernsteinCubic& c, const QuarticLanes& g, int count, double toi_tolerance) {
+  assert((count == 3 || count == 4) && cross_dot_quartics_x4_wide());
+  bool finite = std::isfinite(c.error);
+  for (int i = 0; i < count; ++i)
+    finite = finite && std::isfinite(g.error[static_cast<std::size_t>(i)]);
+  if (!finite) return {AlgebraicOutcome::undecided, 0.0, 1.0};
+#if defined(SKELCD_QUARTICS_AVX2)
+  return filter_lanes_avx2(c, g, count, toi_tolerance);
+#else
+  (void)toi_tolerance;
+  return {AlgebraicOutcome::undecided, 0.0, 1.0};
+#endif
 }
 
 }  // namespace skelcd::ccd::detail

@@ -76,6 +76,23 @@ int inside_quartics_x4(
     const std::array<const Eigen::Vector3d*, 4>& at_t1,
     BernsteinQuartic* g);
 
+/// Four quartics side by side, as the four-lane code holds them: coefficient k of quartic `lane`
+/// in coefficients[k][lane], its bound in error[lane].
+struct QuarticLanes {
+  alignas(32) std::array<std::array<double, 4>, 5> coefficients;
+  alignas(32) std::array<double, 4> error;
+};
+
+/// inside_quartics_x4's AVX2 evaluation, its quartics left in lanes for algebraic_filter_lanes
+/// (no scattering into BernsteinQuartic records and gathering back). Returns the count (3 or 4;
+/// with 3, lane 3 repeats lane 2). @pre cross_dot_quartics_x4_wide(), and the coordinates as for
+/// inside_quartics_x4.
+int inside_quartic_lanes(
+    InsideQuartics which,
+    const std::array<const Eigen::Vector3d*, 4>& at_t0,
+    const std::array<const Eigen::Vector3d*, 4>& at_t1,
+    QuarticLanes& g);
+
 /// Whether cross_dot_quartic_x4 computes its four quartics at once (AVX2, and not forced to the
 /// baseline): four then cost what two do.
 [[nodiscard]] bool cross_dot_quartics_x4_wide();
@@ -101,5 +118,11 @@ struct AlgebraicVerdict {
     const BernsteinQuartic* g,
     int count,
     double toi_tolerance);
+
+/// algebraic_filter on quartics in lanes (inside_quartic_lanes): the same verdict, bit for bit,
+/// as on the same quartics as records. @pre cross_dot_quartics_x4_wide(), count 3 or 4, and with
+/// 3 lane 3 repeating lane 2.
+[[nodiscard]] AlgebraicVerdict algebraic_filter_lanes(
+    const BernsteinCubic& c, const QuarticLanes& g, int count, double toi_tolerance);
 
 }  // namespace skelcd::ccd::detail

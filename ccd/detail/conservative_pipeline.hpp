@@ -46,6 +46,13 @@ inline bool certified_negative(const BernsteinQuartic& g) {
   const double e = g.error;
   return -b[0] > e && -b[1] > e && -b[2] > e && -b[3] > e && -b[4] > e;
 }
+/// The same for the quartic in lane `lane`.
+inline bool certified_negative(const QuarticLanes& g, std::size_t lane) {
+  const auto& b = g.coefficients;
+  const double e = g.error[lane];
+  return -b[0][lane] > e && -b[1][lane] > e && -b[2][lane] > e && -b[3][lane] > e &&
+         -b[4][lane] > e;
+}
 
 // Largest coordinate magnitude of the coplanarity differences under which every difference of the
 // query's points has magnitude <= 2^192 (docs/ccd.md), so that every quartic's error bound is
@@ -100,42 +107,57 @@ CcdResult pipeline_after_screen(
   // The differences as QuadrupleDifferences only where they are read: the quartics one or two at
   // a time, or the edge lengths (min_separation).
   int count = wide && s == 0.0 ? 0 : make_quartic_inputs(inputs, s > 0.0 ? lengths : nullptr);
+  AlgebraicVerdict v;
   if (wide) {
-    // All at once from the query's points, the shared factor pair crossed once (a third
-    // quartic's query fills the fourth lane, which is not read); then the early exit below on
-    // the first two, as the pairs take it.
-    const int computed = quartics_x4(g);
+    // All at once from the query's points, the shared factor pair crossed once, left in lanes
+    // for the filter (a third quartic's query fills the fourth lane, which is not read); then
+    // the early exit below on the first two, as the pairs take it.
+    QuarticLanes lanes;
+    const int computed = quartics_x4(lanes);
     assert(count == 0 || count == computed);
     count = computed;
-    if (s == 0.0 && std::isfinite(c.error) && std::isfinite(g[0].error) &&
-        std::isfinite(g[1].error) && (certified_negative(g[0]) || certified_negative(g[1]))) {
+    if (s == 0.0 && std::isfinite(c.error) && std::isfinite(lanes.error[0]) &&
+        std::isfinite(lanes.error[1]) &&
+        (certified_negative(lanes, 0) || certified_negative(lanes, 1))) {
       ++stats.algebraic_rejected;
       return {};
     }
-  } else if (screened) {
-    cross_dot_quartic_pair(inputs[0], inputs[1], g[0], g[1]);
-    // algebraic_filter's first step, on the first two: with every error finite, a quartic
-    // certified negative on [0,1] excludes the root interval and the answer is "separated". The
-    // others need not be computed.
-    if (s == 0.0 && std::isfinite(c.error) && std::isfinite(g[0].error) &&
-        std::isfinite(g[1].error) && (certified_negative(g[0]) || certified_negative(g[1]))) {
-      ++stats.algebraic_rejected;
-      return {};
+    if (s > 0.0) {
+      // Within s of contact, g_i >= -s |n| L_i >= -s N L_i: widen each error by that.
+      for (int i = 0; i < count; ++i) {
+        auto& e = lanes.error[static_cast<std::size_t>(i)];
+        e = add_up(e, s * normal_bound * lengths[i] * kRoundUp * kRoundUp);
+      }
+      if (count == 3) lanes.error[3] = lanes.error[2];
     }
-    if (count == 4) {
-      cross_dot_quartic_pair(inputs[2], inputs[3], g[2], g[3]);
-    } else {
-      BernsteinQuartic unused;
-      cross_dot_quartic_pair(inputs[2], inputs[2], g[2], unused);
-    }
+    v = algebraic_filter_lanes(c, lanes, count, options.toi_tolerance);
   } else {
-    for (int i = 0; i < count; ++i) g[i] = cross_dot_quartic(inputs[i]);
+    if (screened) {
+      cross_dot_quartic_pair(inputs[0], inputs[1], g[0], g[1]);
+      // algebraic_filter's first step, on the first two: with every error finite, a quartic
+      // certified negative on [0,1] excludes the root interval and the answer is "separated".
+      // The others need not be computed.
+      if (s == 0.0 && std::isfinite(c.error) && std::isfinite(g[0].error) &&
+          std::isfinite(g[1].error) && (certified_negative(g[0]) || certified_negative(g[1]))) {
+        ++stats.algebraic_rejected;
+        return {};
+      }
+      if (count == 4) {
+        cross_dot_quartic_pair(inputs[2], inputs[3], g[2], g[3]);
+      } else {
+        BernsteinQuartic unused;
+        cross_dot_quartic_pair(inputs[2], inputs[2], g[2], unused);
+      }
+    } else {
+      for (int i = 0; i < count; ++i) g[i] = cross_dot_quartic(inputs[i]);
+    }
+    if (s > 0.0) {
+      // Within s of contact, g_i >= -s |n| L_i >= -s N L_i: widen each error by that.
+      for (int i = 0; i < count; ++i)
+        g[i].error = add_up(g[i].error, s * normal_bound * lengths[i] * kRoundUp * kRoundUp);
+    }
+    v = algebraic_filter(c, g, count, options.toi_tolerance);
   }
-  if (s > 0.0) {
-    // Within s of contact, g_i >= -s |n| L_i >= -s N L_i: widen each error by that.
-    for (int i = 0; i < count; ++i) g[i].error = add_up(g[i].error, s * normal_bound * lengths[i] * kRoundUp * kRoundUp);
-  }
-  const AlgebraicVerdict v = algebraic_filter(c, g, count, options.toi_tolerance);
   if (v.outcome == AlgebraicOutcome::separated) {
     ++stats.algebraic_rejected;
     return {};
@@ -160,8 +182,8 @@ CcdResult pipeline_after_screen(
 /// and returns how many (3 or 4): at a point within distance s of contact, g_i >= -s |n| L_i
 /// (docs/ccd.md). Every vector is a difference of two of the query's points. `lengths` is null
 /// when min_separation is 0 (they are not needed).
-/// @param quartics_x4 fills g[0..4) with the quartics of those inputs, bit for bit, and returns
-/// their count (inside_quartics_x4); called only where cross_dot_quartics_x4_wide().
+/// @param quartics_x4 fills a QuarticLanes with the quartics of those inputs, bit for bit, and
+/// returns their count (inside_quartic_lanes); called only where cross_dot_quartics_x4_wide().
 /// @param make_problem returns the solver's InclusionProblem (only the few queries that reach it
 /// pay for it).
 /// @param relative_apart returns relative_boxes_apart for the query (asked only with

@@ -840,6 +840,7 @@ TEST(KernelEquivalence, AlgebraicFilterGivesTheSameVerdictWithItsQuarticsInFourL
   std::mt19937_64 rng(15);
   std::uniform_real_distribution<double> u(-1.0, 1.0);
   int outcomes[3] = {0, 0, 0};
+  int handed_over = 0;
   for (int i = 0; i < 40000; ++i) {
     const double scale =
         i % 4 == 0 ? std::ldexp(1.0, std::uniform_int_distribution<int>(-1060, 300)(rng)) : 1.0;
@@ -862,8 +863,26 @@ TEST(KernelEquivalence, AlgebraicFilterGivesTheSameVerdictWithItsQuarticsInFourL
     ASSERT_TRUE(same_bits(lanes.t_lo, pairs.t_lo)) << i;
     ASSERT_TRUE(same_bits(lanes.t_hi, pairs.t_hi)) << i;
     ++outcomes[static_cast<int>(lanes.outcome)];
+    if (detail::cross_dot_quartics_x4_wide()) {
+      // The quartics handed over in lanes, as the pipeline's four-lane path does (a third
+      // quartic's lane repeated in the fourth): the same again.
+      detail::QuarticLanes in_lanes;
+      for (std::size_t k = 0; k < 4; ++k) {
+        const BernsteinQuartic& q =
+            g[std::min<std::size_t>(k, static_cast<std::size_t>(count) - 1)];
+        for (std::size_t j = 0; j < 5; ++j) in_lanes.coefficients[j][k] = q.coefficients[j];
+        in_lanes.error[k] = q.error;
+      }
+      const AlgebraicVerdict handed = detail::algebraic_filter_lanes(c, in_lanes, count, tolerance);
+      ASSERT_EQ(handed.outcome, pairs.outcome) << i;
+      ASSERT_TRUE(same_bits(handed.t_lo, pairs.t_lo)) << i;
+      ASSERT_TRUE(same_bits(handed.t_hi, pairs.t_hi)) << i;
+      ++handed_over;
+    }
   }
   for (const int n : outcomes) EXPECT_GT(n, 100);
+  // Where the CPU has AVX2 (CI's does) every polynomial went through the lanes too.
+  EXPECT_TRUE(handed_over == 40000 || !detail::cross_dot_quartics_x4_wide());
 }
 
 // Exact cubics (error 0) with a certain sign change on [0, 1] and no quartic: the filter reports
