@@ -96,7 +96,6 @@ CcdResult pipeline_after_screen(
   }
   // Stage 2, the inside quartics, two at a time when the coordinates allow.
   QuadrupleDifferences inputs[4];
-  BernsteinQuartic g[4];
   double lengths[4] = {0.0, 0.0, 0.0, 0.0};
   // Finite end coefficients mean finite X, Y, Z at both times (each coordinate reaches b_0 or b_3
   // through products and sums, which keep inf and NaN), hence finite points; with the magnitude
@@ -132,6 +131,7 @@ CcdResult pipeline_after_screen(
     }
     v = algebraic_filter_lanes(c, lanes, count, options.toi_tolerance);
   } else {
+    BernsteinQuartic g[4];
     if (screened) {
       cross_dot_quartic_pair(inputs[0], inputs[1], g[0], g[1]);
       // algebraic_filter's first step, on the first two: with every error finite, a quartic
