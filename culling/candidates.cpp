@@ -5,7 +5,9 @@
 #include <atomic>
 #include <bit>
 #include <cstddef>
+#include <cstring>
 #include <initializer_list>
+#include <memory>
 #include <type_traits>
 
 #if defined(__SSE2__)
@@ -409,10 +411,12 @@ using M4 = std::int64_t __attribute__((vector_size(32)));
 /// and (x − y, y − z, z − x, z − x) — each the same single rounding as EndPositions', so that
 /// both decide every pair alike. Written with GCC's vector extensions and inlined only into
 /// owned_feature_pairs_avx2, where each operation is one AVX2 instruction.
-struct EndPositionsWide {
+template <bool kPacked>
+struct EndPositionsWideAs {
   static constexpr bool kTrianglesFirst = true;
   const double* x0;
   const double* x1;
+  const double* packed;  ///< PackedEnds::data() when kPacked
 
   struct Point {
     V4 at0, at1;
@@ -428,7 +432,15 @@ struct EndPositionsWide {
   [[gnu::always_inline]] static V4 min(const V4& a, const V4& b) { return a < b ? a : b; }
   [[gnu::always_inline]] static V4 max(const V4& a, const V4& b) { return a > b ? a : b; }
   [[gnu::always_inline]] [[nodiscard]] Point vertex(std::int32_t v) const {
-    return {load(x0 + 3 * at(v)), load(x1 + 3 * at(v))};
+    if constexpr (kPacked) {
+      const double* line = std::assume_aligned<64>(packed + 8 * at(v));
+      V4 a, b;
+      std::memcpy(&a, line, sizeof a);
+      std::memcpy(&b, line + 4, sizeof b);
+      return {a, b};
+    } else {
+      return {load(x0 + 3 * at(v)), load(x1 + 3 * at(v))};
+    }
   }
   [[gnu::always_inline]] static void widen(Box& b, const Point& p) {
     b.lo0 = min(b.lo0, p.at0);
@@ -523,13 +535,18 @@ struct EndPositionsWide {
   [[gnu::always_inline]] void prefetch(
       std::int32_t, const std::array<std::int32_t, 3>& corners) const {
     for (const std::int32_t v : corners) {
-      for (const double* x : {x0, x1}) {
-        __builtin_prefetch(x + 3 * at(v));
-        __builtin_prefetch(x + 3 * at(v) + 2);
+      if constexpr (kPacked) {
+        __builtin_prefetch(packed + 8 * at(v));
+      } else {
+        for (const double* x : {x0, x1}) {
+          __builtin_prefetch(x + 3 * at(v));
+          __builtin_prefetch(x + 3 * at(v) + 2);
+        }
       }
     }
   }
 };
+using EndPositionsWide = EndPositionsWideAs<false>;
 
 std::atomic<bool> baseline_forced{false};
 
@@ -819,11 +836,11 @@ template <bool kExclusions, bool kFans, class Boxes>
 
 #if defined(SKELCD_FEATURE_AVX2)
 /// owned_feature_pairs built for AVX2 (EndPositionsWide): the same pairs, rules and order.
-template <bool kExclusions, bool kFans>
+template <bool kExclusions, bool kFans, bool kPacked>
 [[gnu::target("avx2")]] void owned_feature_pairs_avx2(
     const FeatureTopology& topology,
     std::span<const TrianglePair> pairs,
-    const EndPositionsWide& boxes,
+    const EndPositionsWideAs<kPacked>& boxes,
     IntervalFans* fans,
     FeatureCandidates& out,
     std::int64_t& feature_bv_tests,
@@ -862,14 +879,25 @@ void ccd_candidates_from_triangle_pairs(
 #if defined(SKELCD_FEATURE_AVX2)
       if constexpr (std::is_same_v<std::decay_t<decltype(boxes)>, EndPositions>) {
         if (use_avx2()) {
-          owned_feature_pairs_avx2<kExclusions, kFans>(
-              topology,
-              pairs,
-              EndPositionsWide{boxes.x0, boxes.x1},
-              fans,
-              out,
-              feature_bv_tests,
-              candidate_pairs);
+          if (ends.packed != nullptr) {
+            owned_feature_pairs_avx2<kExclusions, kFans, true>(
+                topology,
+                pairs,
+                EndPositionsWideAs<true>{boxes.x0, boxes.x1, ends.packed},
+                fans,
+                out,
+                feature_bv_tests,
+                candidate_pairs);
+          } else {
+            owned_feature_pairs_avx2<kExclusions, kFans, false>(
+                topology,
+                pairs,
+                EndPositionsWide{boxes.x0, boxes.x1, nullptr},
+                fans,
+                out,
+                feature_bv_tests,
+                candidate_pairs);
+          }
           return;
         }
       }
@@ -995,6 +1023,30 @@ void dcd_candidates_brute_force(
   }
   counters.bv_tests += tests;
   counters.candidate_pairs += static_cast<std::int64_t>(num_faces) * (num_faces - 1) / 2;
+}
+
+bool feature_stage_reads_packed_ends() {
+#if defined(SKELCD_FEATURE_AVX2)
+  return use_avx2();
+#else
+  return false;
+#endif
+}
+
+void PackedEnds::pack(const skinning::Positions& x_t0, const skinning::Positions& x_t1) {
+  const auto n = static_cast<std::size_t>(x_t0.rows());
+  lines_.resize(n);
+  const double* a = x_t0.data();
+  const double* b = x_t1.data();
+  for (std::size_t v = 0; v < n; ++v) {
+    double* line = lines_[v].v;
+    line[0] = a[3 * v];
+    line[1] = a[3 * v + 1];
+    line[2] = line[3] = a[3 * v + 2];
+    line[4] = b[3 * v];
+    line[5] = b[3 * v + 1];
+    line[6] = line[7] = b[3 * v + 2];
+  }
 }
 
 namespace detail {

@@ -113,7 +113,32 @@ struct IntervalFans {
 struct IntervalEnds {
   const skinning::Positions* x_t0 = nullptr;
   const skinning::Positions* x_t1 = nullptr;
+  /// Optional: the same positions as PackedEnds::pack lays them out (PackedEnds::data), which
+  /// the feature stage's AVX2 build then reads instead (one aligned cache line per vertex).
+  const double* packed = nullptr;
 };
+
+/// Both ends of every vertex in one 64-byte line, as the feature stage's AVX2 build loads them:
+/// vertex v's (x, y, z, z) at t0 in doubles 8 v … 8 v + 3 and at t1 in 8 v + 4 … 8 v + 7. The
+/// stage then reads a corner with two aligned loads from one line where the positions' rows take
+/// two loads and a shuffle each from up to four lines. Written once per interval by the methods
+/// (PairBlocks::start_ccd); 64 bytes a vertex.
+class PackedEnds {
+ public:
+  /// Lays out x_t0 and x_t1 (#W × 3 each, the same rows).
+  void pack(const skinning::Positions& x_t0, const skinning::Positions& x_t1);
+  [[nodiscard]] const double* data() const { return lines_.empty() ? nullptr : lines_.front().v; }
+
+ private:
+  struct alignas(64) Line {
+    double v[8];
+  };
+  std::vector<Line> lines_;
+};
+
+/// Whether the feature stage reads IntervalEnds::packed when given: its AVX2 build runs (this
+/// CPU has AVX2 and the tests have not forced the baseline build).
+[[nodiscard]] bool feature_stage_reads_packed_ends();
 
 /// True when the feature stage tests at both ends (no contact distance): its first test of a
 /// triangle pair is then the relative pair filters' (RelativeAabbFilter), so a method runs those

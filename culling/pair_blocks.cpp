@@ -84,6 +84,12 @@ void PairBlocks<N>::start_ccd(
   // (ccd_uses_fans says when), each decided when a pair first shares it: a query may have few.
   use_fans_ = ccd_uses_fans(topology, tests, options);
   if (use_fans_) interval_fans_.start(topology.fans(), x_t0, x_t1, topology.num_vertices());
+  // The positions at both ends, and packed for the feature stage when it reads them so.
+  ends_ = interval_ends(options.min_separation, x_t0, x_t1);
+  if (ends_.x_t0 != nullptr && feature_stage_reads_packed_ends()) {
+    packed_ends_.pack(x_t0, x_t1);
+    ends_.packed = packed_ends_.data();
+  }
 }
 
 template <int N>
@@ -167,7 +173,7 @@ void PairBlocks<N>::flush_block(std::vector<TrianglePair>& block) {
         features_,
         out.counters,
         use_fans_ ? &interval_fans_ : nullptr,
-        interval_ends(ccd_options_->min_separation, *x_t0_, *x_t1_));
+        ends_);
     const auto t1 = Clock::now();
     run_ccd_tests(
         *topology_,

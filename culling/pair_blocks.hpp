@@ -166,6 +166,8 @@ class PairBlocks {
   const FeatureBounds<N>* bounds_ = nullptr;
   const skinning::Positions* x_t0_ = nullptr;
   const skinning::Positions* x_t1_ = nullptr;
+  IntervalEnds ends_;       ///< what the feature stage tests at both ends (CCD)
+  PackedEnds packed_ends_;  ///< both ends packed for it, when it reads them so
   ccd::Accuracy accuracy_ = ccd::Accuracy::conservative;
   const ccd::CcdOptions* ccd_options_ = nullptr;
   std::span<const std::uint8_t> fans_;

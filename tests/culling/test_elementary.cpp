@@ -218,16 +218,20 @@ TEST(FeatureStage, BothBuildsGiveTheSamePairsInTheSameOrderOnTheClothFunnelStep)
   // ccd_candidates_from_triangle_pairs runs an AVX2 build of its feature stage where the CPU has
   // it (EndPositionsWide) and its SSE2 build elsewhere: the same pairs in the same order and the
   // same counters, with and without the interval's vertex fans, on a real step whose triangle
-  // pairs the face diagonals drop in numbers. On a CPU without AVX2 both runs take the baseline.
+  // pairs the face diagonals drop in numbers; the AVX2 build also from the positions packed a
+  // line per vertex (PackedEnds, as the methods hand them over). On a CPU without AVX2 every run
+  // takes the baseline.
   const test::OpenScene s = test::cloth_funnel_scene(test::asset("cloth-funnel/frames"));
   const FeatureTopology features(s.mesh, s.topo);
   const skinning::Positions& x_t0 = s.frames[0];
   const skinning::Positions& x_t1 = s.frames[1];
   const std::vector<TrianglePair> pairs = swept_box_pairs(features, x_t0, x_t1);
   ASSERT_GT(pairs.size(), 50000u);
+  PackedEnds packed;
+  packed.pack(x_t0, x_t1);
   for (const bool with_fans : {false, true}) {
     SCOPED_TRACE(with_fans ? "with fans" : "without fans");
-    const auto run = [&](bool baseline) {
+    const auto run = [&](bool baseline, const double* packed_ends = nullptr) {
       detail::force_baseline_feature_stage(baseline);
       IntervalFans fans;
       fans.start(features.fans(), x_t0, x_t1, features.num_vertices());
@@ -240,17 +244,42 @@ TEST(FeatureStage, BothBuildsGiveTheSamePairsInTheSameOrderOnTheClothFunnelStep)
           out,
           counters,
           with_fans ? &fans : nullptr,
-          {&x_t0, &x_t1});
+          {&x_t0, &x_t1, packed_ends});
       detail::force_baseline_feature_stage(false);
       return std::make_pair(std::move(out), counters);
     };
     const auto [wide, wide_counters] = run(false);
     const auto [baseline, baseline_counters] = run(true);
+    const auto [from_packed, packed_counters] = run(false, packed.data());
     EXPECT_GT(wide.ee.size(), 2000u);
     EXPECT_TRUE(wide.vf == baseline.vf);
     EXPECT_TRUE(wide.ee == baseline.ee);
+    EXPECT_TRUE(from_packed.vf == baseline.vf);
+    EXPECT_TRUE(from_packed.ee == baseline.ee);
     EXPECT_EQ(wide_counters.candidate_pairs, baseline_counters.candidate_pairs);
     EXPECT_EQ(wide_counters.feature_bv_tests, baseline_counters.feature_bv_tests);
+    EXPECT_EQ(packed_counters.candidate_pairs, baseline_counters.candidate_pairs);
+    EXPECT_EQ(packed_counters.feature_bv_tests, baseline_counters.feature_bv_tests);
+  }
+}
+
+TEST(FeatureStage, PackedEndsHoldEachVertexAtBothEndsInOneAlignedLine) {
+  // The layout the AVX2 feature stage loads: (x, y, z, z) at t0, then at t1, 64-byte aligned.
+  const test::OpenScene s = test::cloth_funnel_scene(test::asset("cloth-funnel/frames"));
+  PackedEnds packed;
+  EXPECT_EQ(packed.data(), nullptr);
+  packed.pack(s.frames[0], s.frames[1]);
+  const double* d = packed.data();
+  ASSERT_NE(d, nullptr);
+  EXPECT_EQ(reinterpret_cast<std::uintptr_t>(d) % 64, 0u);
+  for (Eigen::Index v = 0; v < s.frames[0].rows(); ++v) {
+    const double* line = d + 8 * v;
+    for (Eigen::Index k = 0; k < 3; ++k) {
+      ASSERT_EQ(line[k], s.frames[0](v, k)) << v;
+      ASSERT_EQ(line[4 + k], s.frames[1](v, k)) << v;
+    }
+    ASSERT_EQ(line[3], s.frames[0](v, 2)) << v;
+    ASSERT_EQ(line[7], s.frames[1](v, 2)) << v;
   }
 }
 
