@@ -13,6 +13,11 @@
 #include <cstddef>
 #include <cstdint>
 
+#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__)
+#define SKELCD_LANES_PTEST 1
+#include <immintrin.h>
+#endif
+
 #pragma GCC diagnostic push
 #pragma GCC diagnostic ignored "-Wpsabi"
 
@@ -62,11 +67,26 @@ inline Lanes lane_max(Lanes a, Lanes b) { return a < b ? b : a; }
 /// Some lane set, every lane set.
 inline bool any_lane(const LaneBits& b) { return (b[0] | b[1]) != 0; }
 inline bool all_lanes(const LaneBits& b) { return (b[0] & b[1]) != 0; }
+// On four lanes (each all ones or all zeros), one vptest with GCC on x86-64: its code for the
+// plain expressions extracts and combines the lanes one by one. The builtins are declared by
+// <immintrin.h>'s target pragmas and expanded in the target("avx2") functions these are inlined
+// into (the only callers: a call from code built for the baseline does not compile).
 [[gnu::always_inline]] inline bool any_lane(const LaneBits4& b) {
+#if defined(SKELCD_LANES_PTEST)
+  using V4di = long long __attribute__((vector_size(32)));
+  return __builtin_ia32_ptestz256(reinterpret_cast<V4di>(b), reinterpret_cast<V4di>(b)) == 0;
+#else
   return (b[0] | b[1] | b[2] | b[3]) != 0;
+#endif
 }
 [[gnu::always_inline]] inline bool all_lanes(const LaneBits4& b) {
+#if defined(SKELCD_LANES_PTEST)
+  using V4di = long long __attribute__((vector_size(32)));
+  // CF: no bit of the all-ones mask outside b.
+  return __builtin_ia32_ptestc256(reinterpret_cast<V4di>(b), V4di{-1, -1, -1, -1}) != 0;
+#else
   return (b[0] & b[1] & b[2] & b[3]) != 0;
+#endif
 }
 
 /// A 3-vector per lane.
