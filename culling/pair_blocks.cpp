@@ -86,7 +86,8 @@ void PairBlocks<N>::start_ccd(
   if (use_fans_) interval_fans_.start(topology.fans(), x_t0, x_t1, topology.num_vertices());
   // The positions at both ends, and packed for the feature stage when it reads them so.
   ends_ = interval_ends(options.min_separation, x_t0, x_t1);
-  if (ends_.x_t0 != nullptr && feature_stage_reads_packed_ends()) {
+  if (ends_.x_t0 != nullptr && topology.num_triangles() >= kPackedEndsFrom &&
+      feature_stage_reads_packed_ends()) {
     packed_ends_.pack(x_t0, x_t1);
     ends_.packed = packed_ends_.data();
   }
