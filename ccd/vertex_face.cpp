@@ -67,22 +67,8 @@ CcdResult conservative_after_aabbs(
         {&q.v_t1, &q.f0_t1, &q.f1_t1, &q.f2_t1},
         0.5 * options.min_separation);
   };
-  if (known != nullptr) {
-    return detail::pipeline_after_screen(
-        t0,
-        t1,
-        *known,
-        0.0,
-        0.0,
-        quartic_inputs,
-        quartics_x4,
-        problem,
-        relative_apart,
-        options,
-        stats);
-  }
   return detail::conservative_pipeline(
-      t0, t1, quartic_inputs, quartics_x4, problem, relative_apart, options, stats);
+      t0, t1, known, quartic_inputs, quartics_x4, problem, relative_apart, options, stats);
 }
 
 // conservative: swept AABBs, then the rest of the pipeline.

@@ -314,6 +314,46 @@ template <class L, std::size_t W, class Target>
   }
 }
 
+/// The four factor products of A x B over the pairs of end times, lane by lane: product k takes
+/// A at time k & 1 and B at time k >> 1 (`x`, `y` the factors at t0 and t1), with its permanent.
+template <class L>
+[[gnu::always_inline]] inline void factor_products(
+    const LaneVec3<L> (&x)[2],
+    const LaneVec3<L> (&y)[2],
+    LaneVec3<L> (&product)[4],
+    LaneVec3<L> (&permanent)[4]) {
+  const LaneVec3<L> ax[2] = {lane_abs(x[0]), lane_abs(x[1])};
+  const LaneVec3<L> ay[2] = {lane_abs(y[0]), lane_abs(y[1])};
+  for (int k = 0; k < 4; ++k) {
+    const int i = k & 1, j = k >> 1;
+    product[k] = cross(x[i], y[j]);
+    permanent[k] = cross_permanent(ax[i], ay[j]);
+  }
+}
+
+/// The blossom's level sums of (A x B) . (C x D) from the factor products (factor_products):
+/// sum[l] adds ab[i] . cd[j] over the (i, j) whose times add up to l, i outer, j inner (the
+/// order every build keeps, for the same bits); perm the same on the permanents.
+template <class L>
+[[gnu::always_inline]] inline void level_sums(
+    const LaneVec3<L> (&ab)[4],
+    const LaneVec3<L> (&ab_perm)[4],
+    const LaneVec3<L> (&cd)[4],
+    const LaneVec3<L> (&cd_perm)[4],
+    L (&sum)[5],
+    L (&perm)[5]) {
+  static constexpr int kBits[4] = {0, 1, 1, 2};
+#pragma GCC unroll 4
+  for (int i = 0; i < 4; ++i) {
+#pragma GCC unroll 4
+    for (int j = 0; j < 4; ++j) {
+      const int level = kBits[i] + kBits[j];
+      sum[level] += dot(ab[i], cd[j]);
+      perm[level] += dot(ab_perm[i], cd_perm[j]);
+    }
+  }
+}
+
 /// cross_dot_quartic of q(k) into g(k) for the W = 2 or 4 lanes of L: lane k goes through the
 /// scalar code's operations in the same order (detail/lanes.hpp).
 template <class L, std::size_t W, class Source, class Target>
@@ -331,31 +371,13 @@ template <class L, std::size_t W, class Source, class Target>
   const L3 b[2] = {gather(&Q::b_t0), gather(&Q::b_t1)};
   const L3 c[2] = {gather(&Q::c_t0), gather(&Q::c_t1)};
   const L3 d[2] = {gather(&Q::d_t0), gather(&Q::d_t1)};
-  const L3 aa[2] = {lane_abs(a[0]), lane_abs(a[1])};
-  const L3 ab_[2] = {lane_abs(b[0]), lane_abs(b[1])};
-  const L3 ac[2] = {lane_abs(c[0]), lane_abs(c[1])};
-  const L3 ad[2] = {lane_abs(d[0]), lane_abs(d[1])};
   // Factor pairs: A x B with (A, B) at times (mask & 1, mask & 2), C x D at (mask & 4, mask & 8).
   L3 ab[4], ab_perm[4], cd[4], cd_perm[4];
-  for (int k = 0; k < 4; ++k) {
-    const int i = k & 1, j = k >> 1;
-    ab[k] = cross(a[i], b[j]);
-    ab_perm[k] = cross_permanent(aa[i], ab_[j]);
-    cd[k] = cross(c[i], d[j]);
-    cd_perm[k] = cross_permanent(ac[i], ad[j]);
-  }
-  static constexpr int kBits[4] = {0, 1, 1, 2};
+  factor_products(a, b, ab, ab_perm);
+  factor_products(c, d, cd, cd_perm);
   L sum[5] = {};
   L perm[5] = {};
-#pragma GCC unroll 4
-  for (int i = 0; i < 4; ++i) {
-#pragma GCC unroll 4
-    for (int j = 0; j < 4; ++j) {
-      const int level = kBits[i] + kBits[j];
-      sum[level] += dot(ab[i], cd[j]);
-      perm[level] += dot(ab_perm[i], cd_perm[j]);
-    }
-  }
+  level_sums(ab, ab_perm, cd, cd_perm, sum, perm);
   // The largest coordinate magnitude of each quadruple (finite by the precondition, so any order
   // of comparisons finds the same value).
   L m{};
@@ -454,30 +476,14 @@ template <InsideQuartics kWhich>
       splat<1>(shared_perm_all),
       splat<2>(shared_perm_all),
       splat<3>(shared_perm_all)};
-  const L3 first_abs[2] = {lane_abs(first[0]), lane_abs(first[1])};
-  const L3 second_abs[2] = {lane_abs(second[0]), lane_abs(second[1])};
   L3 own[4], own_perm[4];
-  for (int k = 0; k < 4; ++k) {
-    const int i = k & 1, j = k >> 1;
-    own[k] = cross(first[i], second[j]);
-    own_perm[k] = cross_permanent(first_abs[i], second_abs[j]);
-  }
-  static constexpr int kBits[4] = {0, 1, 1, 2};
+  factor_products(first, second, own, own_perm);
   L sum[5] = {};
   L perm[5] = {};
-#pragma GCC unroll 4
-  for (int i = 0; i < 4; ++i) {
-#pragma GCC unroll 4
-    for (int j = 0; j < 4; ++j) {
-      const int level = kBits[i] + kBits[j];
-      if constexpr (kEdgeEdge) {
-        sum[level] += dot(own[i], shared[j]);
-        perm[level] += dot(own_perm[i], shared_perm[j]);
-      } else {
-        sum[level] += dot(shared[i], own[j]);
-        perm[level] += dot(shared_perm[i], own_perm[j]);
-      }
-    }
+  if constexpr (kEdgeEdge) {
+    level_sums(own, own_perm, shared, shared_perm, sum, perm);
+  } else {
+    level_sums(shared, shared_perm, own, own_perm, sum, perm);
   }
   L m{};
   double shared_m = 0.0;

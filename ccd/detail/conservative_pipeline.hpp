@@ -178,6 +178,9 @@ CcdResult pipeline_after_screen(
 
 /// @param coplanarity_t0/_t1 X, Y, Z with c(t) = X . (Y x Z) and n = Y x Z; every point of the
 /// query appears in one of them.
+/// @param known the query's coplanarity screen when it has already been computed (beside three
+/// others, without a contact distance) and certified nothing: the pipeline goes on from there.
+/// Null otherwise.
 /// @param make_quartic_inputs fills arrays of QuadrupleDifferences and of edge-length bounds L_i
 /// and returns how many (3 or 4): at a point within distance s of contact, g_i >= -s |n| L_i
 /// (docs/ccd.md). Every vector is a difference of two of the query's points. `lengths` is null
@@ -196,6 +199,7 @@ template <
 CcdResult conservative_pipeline(
     const DifferenceTriple& coplanarity_t0,
     const DifferenceTriple& coplanarity_t1,
+    const TrilinearScreen* known,
     MakeQuarticInputs&& make_quartic_inputs,
     QuarticsX4&& quartics_x4,
     MakeProblem&& make_problem,
@@ -206,24 +210,32 @@ CcdResult conservative_pipeline(
   // Stage 1, the coplanarity cubic. First with an error bound from the largest coordinate
   // magnitudes, >= the exact bound of trilinear_error: when that certifies a sign, so would
   // cubic_sign (same coefficients, smaller error, no subdivision needed). Otherwise the exact
-  // bound and cubic_sign as before.
-  const TrilinearScreen screen = trilinear_screen(coplanarity_t0, coplanarity_t1);
+  // bound and cubic_sign as before. A screen computed beside three others (`known`) has certified
+  // nothing: on from stage 1½.
   double normal_bound = 0.0;
   double margin = 0.0;
-  if (s > 0.0) {
-    // |c(t)| <= s |n(t)| <= s N at any time within s: widen the error by s N (docs/ccd.md).
-    normal_bound = cross_norm_bound(coplanarity_t0, coplanarity_t1);
-    margin = s * normal_bound * kRoundUp;
-  }
-  if (certified_sign(
-          screen.coefficients, s > 0.0 ? add_up(screen.error_upper, margin) : screen.error_upper)) {
-    ++stats.coplanarity_rejected;
-    return {};
+  TrilinearScreen fresh;
+  const TrilinearScreen* screen = known;
+  if (screen != nullptr) {
+    assert(s == 0.0);
+  } else {
+    fresh = trilinear_screen(coplanarity_t0, coplanarity_t1);
+    screen = &fresh;
+    if (s > 0.0) {
+      // |c(t)| <= s |n(t)| <= s N at any time within s: widen the error by s N (docs/ccd.md).
+      normal_bound = cross_norm_bound(coplanarity_t0, coplanarity_t1);
+      margin = s * normal_bound * kRoundUp;
+    }
+    if (certified_sign(
+            fresh.coefficients, s > 0.0 ? add_up(fresh.error_upper, margin) : fresh.error_upper)) {
+      ++stats.coplanarity_rejected;
+      return {};
+    }
   }
   return pipeline_after_screen(
       coplanarity_t0,
       coplanarity_t1,
-      screen,
+      *screen,
       normal_bound,
       margin,
       make_quartic_inputs,
