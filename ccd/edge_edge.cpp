@@ -29,24 +29,19 @@ CcdResult conservative_after_aabbs(
   const detail::DifferenceTriple t1{q.eb0_t1 - q.ea0_t1, q.ea1_t1 - q.ea0_t1, q.eb1_t1 - q.eb0_t1};
   // With w = b0 - a0: the segment parameters are u / nn and v / nn, nn = n . n, where
   // u = (w x d_b) . n, nn - u = ((a1 - b0) x d_b) . n, v = (w x d_a) . n, nn - v = (d_a x (b1 - a0)) . n.
+  const std::array<const Eigen::Vector3d*, 4> at_t0{&q.ea0_t0, &q.ea1_t0, &q.eb0_t0, &q.eb1_t0};
+  const std::array<const Eigen::Vector3d*, 4> at_t1{&q.ea0_t1, &q.ea1_t1, &q.eb0_t1, &q.eb1_t1};
   const auto quartic_inputs = [&](detail::QuadrupleDifferences* g, double* lengths) {
-    g[0] = {t0.x, t0.z, t0.y, t0.z, t1.x, t1.z, t1.y, t1.z};
-    g[1] = {q.ea1_t0 - q.eb0_t0, t0.z, t0.y, t0.z, q.ea1_t1 - q.eb0_t1, t1.z, t1.y, t1.z};
-    g[2] = {t0.x, t0.y, t0.y, t0.z, t1.x, t1.y, t1.y, t1.z};
-    g[3] = {t0.y, q.eb1_t0 - q.ea0_t0, t0.y, t0.z, t1.y, q.eb1_t1 - q.ea0_t1, t1.y, t1.z};
+    const int count = detail::inside_quadruples(detail::InsideQuartics::edge_edge, at_t0, at_t1, g);
     // Within s of contact: u, nn - u >= -s |n| |d_b|; v, nn - v >= -s |n| |d_a| (docs/ccd.md).
     if (lengths != nullptr) {
       lengths[0] = lengths[1] = detail::norm_bound(t0.z, t1.z);
       lengths[2] = lengths[3] = detail::norm_bound(t0.y, t1.y);
     }
-    return 4;
+    return count;
   };
   const auto quartics_x4 = [&](detail::QuarticLanes& g) {
-    return detail::inside_quartic_lanes(
-        detail::InsideQuartics::edge_edge,
-        {&q.ea0_t0, &q.ea1_t0, &q.eb0_t0, &q.eb1_t0},
-        {&q.ea0_t1, &q.ea1_t1, &q.eb0_t1, &q.eb1_t1},
-        g);
+    return detail::inside_quartic_lanes(detail::InsideQuartics::edge_edge, at_t0, at_t1, g);
   };
   // F(t, u, v) = (a0 + u (a1 - a0)) - (b0 + v (b1 - b0)) = (a0 - b0) + u (a1 - a0) + v (b0 - b1).
   const auto problem = [&] {
@@ -61,10 +56,7 @@ CcdResult conservative_after_aabbs(
     return p;
   };
   const auto relative_apart = [&] {
-    return detail::relative_stage_apart<2>(
-        {&q.ea0_t0, &q.ea1_t0, &q.eb0_t0, &q.eb1_t0},
-        {&q.ea0_t1, &q.ea1_t1, &q.eb0_t1, &q.eb1_t1},
-        0.5 * options.min_separation);
+    return detail::relative_stage_apart<2>(at_t0, at_t1, 0.5 * options.min_separation);
   };
   return detail::conservative_pipeline(
       t0, t1, known, quartic_inputs, quartics_x4, problem, relative_apart, options, stats);

@@ -29,25 +29,22 @@ CcdResult conservative_after_aabbs(
   const detail::DifferenceTriple t1{q.v_t1 - q.f0_t1, q.f1_t1 - q.f0_t1, q.f2_t1 - q.f0_t1};
   // Inside conditions n . ((b - a) x (p - a)), n . ((c - b) x (p - b)), n . ((a - c) x (p - c)),
   // n = (b - a) x (c - a): each (A x B) . (C x D) of single differences.
+  const std::array<const Eigen::Vector3d*, 4> at_t0{&q.v_t0, &q.f0_t0, &q.f1_t0, &q.f2_t0};
+  const std::array<const Eigen::Vector3d*, 4> at_t1{&q.v_t1, &q.f0_t1, &q.f1_t1, &q.f2_t1};
   const auto quartic_inputs = [&](detail::QuadrupleDifferences* g, double* lengths) {
-    const Eigen::Vector3d bc_t0 = q.f2_t0 - q.f1_t0, bc_t1 = q.f2_t1 - q.f1_t1;
-    const Eigen::Vector3d ca_t0 = q.f0_t0 - q.f2_t0, ca_t1 = q.f0_t1 - q.f2_t1;
-    g[0] = {t0.y, t0.z, t0.y, t0.x, t1.y, t1.z, t1.y, t1.x};
-    g[1] = {t0.y, t0.z, bc_t0, q.v_t0 - q.f1_t0, t1.y, t1.z, bc_t1, q.v_t1 - q.f1_t1};
-    g[2] = {t0.y, t0.z, ca_t0, q.v_t0 - q.f2_t0, t1.y, t1.z, ca_t1, q.v_t1 - q.f2_t1};
+    const int count =
+        detail::inside_quadruples(detail::InsideQuartics::vertex_face, at_t0, at_t1, g);
+    // Within s of contact the inside conditions are >= -s |n| times the length of their edge
+    // (b - a, c - b, a - c): the C factors of quadruples 1 and 2, y of quadruple 0.
     if (lengths != nullptr) {
       lengths[0] = detail::norm_bound(t0.y, t1.y);
-      lengths[1] = detail::norm_bound(bc_t0, bc_t1);
-      lengths[2] = detail::norm_bound(ca_t0, ca_t1);
+      lengths[1] = detail::norm_bound(g[1].c_t0, g[1].c_t1);
+      lengths[2] = detail::norm_bound(g[2].c_t0, g[2].c_t1);
     }
-    return 3;
+    return count;
   };
   const auto quartics_x4 = [&](detail::QuarticLanes& g) {
-    return detail::inside_quartic_lanes(
-        detail::InsideQuartics::vertex_face,
-        {&q.v_t0, &q.f0_t0, &q.f1_t0, &q.f2_t0},
-        {&q.v_t1, &q.f0_t1, &q.f1_t1, &q.f2_t1},
-        g);
+    return detail::inside_quartic_lanes(detail::InsideQuartics::vertex_face, at_t0, at_t1, g);
   };
   // F(t, u, v) = p - (a + u (b - a) + v (c - a)) = (p - a) + u (a - b) + v (a - c).
   const auto problem = [&] {
@@ -62,10 +59,7 @@ CcdResult conservative_after_aabbs(
     return p;
   };
   const auto relative_apart = [&] {
-    return detail::relative_stage_apart<1>(
-        {&q.v_t0, &q.f0_t0, &q.f1_t0, &q.f2_t0},
-        {&q.v_t1, &q.f0_t1, &q.f1_t1, &q.f2_t1},
-        0.5 * options.min_separation);
+    return detail::relative_stage_apart<1>(at_t0, at_t1, 0.5 * options.min_separation);
   };
   return detail::conservative_pipeline(
       t0, t1, known, quartic_inputs, quartics_x4, problem, relative_apart, options, stats);

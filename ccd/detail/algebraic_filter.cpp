@@ -249,6 +249,24 @@ CrossPerm cross_perm(const Eigen::Vector3d& x, const Eigen::Vector3d& y) {
 
 }  // namespace
 
+namespace {
+
+/// C(4, i): b_i is the average of that many blossom evaluations.
+constexpr double kQuarticTerms[5] = {1.0, 4.0, 6.0, 4.0, 1.0};
+
+/// cross_dot_quartic's error bound from the largest level average of the permanents `p` and the
+/// largest coordinate magnitude `m` of the quadruple. Rounding count per product term:
+/// differences 1; a_y b_z 3; cross difference 4; product of two cross components 9; the dot's two
+/// sums 11; the running sum of at most 6 terms (from 0) 17; the division 18. Underflow: a cross
+/// component may lose 2 units, then be multiplied by another one (at most 2 m^2), plus one unit
+/// per product and the division: 64 kUnderflowUnit (1 + m^2) = 2^-1068 (1 + m^2), computed
+/// without a subnormal product.
+inline double quartic_bound(double p, double m) {
+  return add_up(rounding_bound(18, p), times_subnormal_power_of_two<1068>(1.0 + m * m));
+}
+
+}  // namespace
+
 BernsteinQuartic cross_dot_quartic(const QuadrupleDifferences& q) {
   // Blossom: b_i is the average of the C(4, i) evaluations with i of the 4 factors at t = 1.
   // Factor pairs: A x B with (A, B) at times (mask & 1, mask & 2), C x D at (mask & 4, mask & 8).
@@ -270,48 +288,38 @@ BernsteinQuartic cross_dot_quartic(const QuadrupleDifferences& q) {
       perm[level] += (px[0] * py[0] + px[1] * py[1]) + px[2] * py[2];
     }
   }
-  static constexpr double kTerms[5] = {1.0, 4.0, 6.0, 4.0, 1.0};
   BernsteinQuartic out;
   double p = 0.0;
   for (std::size_t i = 0; i < 5; ++i) {
-    out.coefficients[i] = sum[i] / kTerms[i];
-    p = std::max(p, perm[i] / kTerms[i]);
+    out.coefficients[i] = sum[i] / kQuarticTerms[i];
+    p = std::max(p, perm[i] / kQuarticTerms[i]);
   }
-  // Rounding count per product term: differences 1; a_y b_z 3; cross difference 4; product of two
-  // cross components 9; the dot's two sums 11; the running sum of at most 6 terms (from 0) 17;
-  // the division 18.
-  const double relative = rounding_bound(18, p);
-  // Underflow: a cross component may lose 2 units, then be multiplied by another one (at most
-  // 2 M^2, M the largest difference coordinate), plus one unit per product and the division.
   double m = 0.0;
   for (const auto* v : {&q.a_t0, &q.b_t0, &q.c_t0, &q.d_t0, &q.a_t1, &q.b_t1, &q.c_t1, &q.d_t1}) {
     m = std::max(m, v->cwiseAbs().maxCoeff());
   }
-  // 64 kUnderflowUnit (1 + m^2) = 2^-1068 (1 + m^2), computed without a subnormal product.
-  const double underflow = times_subnormal_power_of_two<1068>(1.0 + m * m);
-  out.error = add_up(relative, underflow);
+  out.error = quartic_bound(p, m);
   return out;
 }
 
 namespace {
 
-/// The end of cross_dot_quartic for W lanes: the coefficients from the level sums `sum`, the
-/// error bound from the permanents' level sums `perm` and the largest coordinate magnitude `m`.
-template <class L, std::size_t W, class Target>
+/// The end of cross_dot_quartic for the W lanes of L: coefficient i of every lane from the level
+/// sums `sum` (coefficient(i, value)), and lane k's bound from the permanents' level sums `perm`
+/// and its largest coordinate magnitude m[k] (bound(k, e)).
+template <class L, std::size_t W, class Coefficient, class Bound>
 [[gnu::always_inline]] inline void store_quartics(
-    const L (&sum)[5], const L (&perm)[5], const L& m, const Target& g) {
-  static constexpr double kTerms[5] = {1.0, 4.0, 6.0, 4.0, 1.0};
+    const L (&sum)[5],
+    const L (&perm)[5],
+    const L& m,
+    const Coefficient& coefficient,
+    const Bound& bound) {
   L p{};
   for (std::size_t i = 0; i < 5; ++i) {
-    const L value = sum[i] / kTerms[i];
-    for (std::size_t k = 0; k < W; ++k) g(k).coefficients[i] = value[k];
-    p = lane_max(p, perm[i] / kTerms[i]);
+    coefficient(i, sum[i] / kQuarticTerms[i]);
+    p = lane_max(p, perm[i] / kQuarticTerms[i]);
   }
-  // As in cross_dot_quartic.
-  for (std::size_t k = 0; k < W; ++k) {
-    g(k).error =
-        add_up(rounding_bound(18, p[k]), times_subnormal_power_of_two<1068>(1.0 + m[k] * m[k]));
-  }
+  for (std::size_t k = 0; k < W; ++k) bound(k, quartic_bound(p[k], m[k]));
 }
 
 /// The four factor products of A x B over the pairs of end times, lane by lane: product k takes
@@ -386,7 +394,14 @@ template <class L, std::size_t W, class Source, class Target>
         m,
         lane_max(lane_max(max_abs(a[t]), max_abs(b[t])), lane_max(max_abs(c[t]), max_abs(d[t]))));
   }
-  store_quartics<L, W>(sum, perm, m, g);
+  store_quartics<L, W>(
+      sum,
+      perm,
+      m,
+      [&](std::size_t i, const L& value) __attribute__((always_inline)) {
+        for (std::size_t k = 0; k < W; ++k) g(k).coefficients[i] = value[k];
+      },
+      [&](std::size_t k, double e) __attribute__((always_inline)) { g(k).error = e; });
 }
 
 #if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
@@ -493,18 +508,15 @@ template <InsideQuartics kWhich>
         std::max(shared_m, std::max(s1[t].cwiseAbs().maxCoeff(), s2[t].cwiseAbs().maxCoeff()));
   }
   m = lane_max(m, L{shared_m, shared_m, shared_m, shared_m});
-  // store_quartics into lanes: the coefficients as vectors, the bounds lane by lane.
-  static constexpr double kTerms[5] = {1.0, 4.0, 6.0, 4.0, 1.0};
-  L p{};
-  for (std::size_t i = 0; i < 5; ++i) {
-    const L value = sum[i] / kTerms[i];
-    std::memcpy(g.coefficients[i].data(), &value, sizeof value);
-    p = lane_max(p, perm[i] / kTerms[i]);
-  }
-  for (std::size_t k = 0; k < 4; ++k) {
-    g.error[k] =
-        add_up(rounding_bound(18, p[k]), times_subnormal_power_of_two<1068>(1.0 + m[k] * m[k]));
-  }
+  // Into lanes: the coefficients as vectors, the bounds lane by lane.
+  store_quartics<L, 4>(
+      sum,
+      perm,
+      m,
+      [&](std::size_t i, const L& value) __attribute__((always_inline)) {
+        std::memcpy(g.coefficients[i].data(), &value, sizeof value);
+      },
+      [&](std::size_t k, double e) __attribute__((always_inline)) { g.error[k] = e; });
 }
 #endif
 
@@ -533,6 +545,41 @@ bool cross_dot_quartics_x4_wide() {
 
 void force_baseline_quartics(bool baseline) {
   quartics_baseline_forced.store(baseline, std::memory_order_relaxed);
+}
+
+int inside_quadruples(
+    InsideQuartics which,
+    const std::array<const Eigen::Vector3d*, 4>& at_t0,
+    const std::array<const Eigen::Vector3d*, 4>& at_t1,
+    QuadrupleDifferences* q) {
+  for (int t = 0; t < 2; ++t) {
+    const auto& p = t == 0 ? at_t0 : at_t1;
+    const auto set = [&](QuadrupleDifferences& x,
+                         const Eigen::Vector3d& a,
+                         const Eigen::Vector3d& b,
+                         const Eigen::Vector3d& c,
+                         const Eigen::Vector3d& d) {
+      (t == 0 ? x.a_t0 : x.a_t1) = a;
+      (t == 0 ? x.b_t0 : x.b_t1) = b;
+      (t == 0 ? x.c_t0 : x.c_t1) = c;
+      (t == 0 ? x.d_t0 : x.d_t1) = d;
+    };
+    if (which == InsideQuartics::edge_edge) {
+      const Eigen::Vector3d w = *p[2] - *p[0], da = *p[1] - *p[0], db = *p[3] - *p[2];
+      set(q[0], w, db, da, db);
+      set(q[1], *p[1] - *p[2], db, da, db);
+      set(q[2], w, da, da, db);
+      set(q[3], da, *p[3] - *p[0], da, db);
+    } else {
+      const Eigen::Vector3d y = *p[2] - *p[1], z = *p[3] - *p[1];
+      set(q[0], y, z, y, *p[0] - *p[1]);
+      set(q[1], y, z, *p[3] - *p[2], *p[0] - *p[2]);
+      set(q[2], y, z, *p[1] - *p[3], *p[0] - *p[3]);
+    }
+  }
+  if (which == InsideQuartics::edge_edge) return 4;
+  q[3] = q[2];
+  return 3;
 }
 
 int inside_quartic_lanes(
@@ -573,37 +620,12 @@ int inside_quartics_x4(
     return count;
   }
 #endif
-  // The quadruples as the kernels build them, two quartics at a time.
+  // The quadruples, two quartics at a time.
   QuadrupleDifferences q[4];
-  for (int t = 0; t < 2; ++t) {
-    const auto& p = t == 0 ? at_t0 : at_t1;
-    const auto set = [&](QuadrupleDifferences& x,
-                         const Eigen::Vector3d& a,
-                         const Eigen::Vector3d& b,
-                         const Eigen::Vector3d& c,
-                         const Eigen::Vector3d& d) {
-      (t == 0 ? x.a_t0 : x.a_t1) = a;
-      (t == 0 ? x.b_t0 : x.b_t1) = b;
-      (t == 0 ? x.c_t0 : x.c_t1) = c;
-      (t == 0 ? x.d_t0 : x.d_t1) = d;
-    };
-    if (which == InsideQuartics::edge_edge) {
-      const Eigen::Vector3d w = *p[2] - *p[0], da = *p[1] - *p[0], db = *p[3] - *p[2];
-      set(q[0], w, db, da, db);
-      set(q[1], *p[1] - *p[2], db, da, db);
-      set(q[2], w, da, da, db);
-      set(q[3], da, *p[3] - *p[0], da, db);
-    } else {
-      const Eigen::Vector3d y = *p[2] - *p[1], z = *p[3] - *p[1];
-      set(q[0], y, z, y, *p[0] - *p[1]);
-      set(q[1], y, z, *p[3] - *p[2], *p[0] - *p[2]);
-      set(q[2], y, z, *p[1] - *p[3], *p[0] - *p[3]);
-      q[3] = q[2];
-    }
-  }
+  const int count = inside_quadruples(which, at_t0, at_t1, q);
   cross_dot_quartic_pair(q[0], q[1], g[0], g[1]);
   cross_dot_quartic_pair(q[2], q[3], g[2], g[3]);
-  return which == InsideQuartics::edge_edge ? 4 : 3;
+  return count;
 }
 
 void cross_dot_quartic_x4(const QuadrupleDifferences* q, BernsteinQuartic* g) {

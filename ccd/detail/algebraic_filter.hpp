@@ -63,6 +63,16 @@ enum class InsideQuartics : std::uint8_t {
   edge_edge,
 };
 
+/// The quadruples named above from the query's four points at t = 0 (`at_t0`) and t = 1, each
+/// difference one subtraction of two points, into q[0..4) (with three, q[3] repeats q[2]).
+/// Returns how many quartics the query has (3 or 4). The one definition the kernels and
+/// inside_quartics_x4 build them from.
+int inside_quadruples(
+    InsideQuartics which,
+    const std::array<const Eigen::Vector3d*, 4>& at_t0,
+    const std::array<const Eigen::Vector3d*, 4>& at_t1,
+    QuadrupleDifferences* q);
+
 /// The inside quartics of one query straight from its four points at t = 0 (`at_t0`) and t = 1,
 /// bit for bit cross_dot_quartic of the QuadrupleDifferences named above (each difference the
 /// same single subtraction). Where cross_dot_quartics_x4_wide(), one AVX2 evaluation: the
