@@ -111,12 +111,15 @@ class BvhMethod final : public MethodBase {
     }
     // Without a contact distance the feature stage first drops the triangle pairs apart at both
     // ends (candidates.hpp): the leaves drop them instead, four at a time, before they are
-    // emitted (docs/culling.md, "Apart at both ends in the leaves"). The slots' end boxes cost
-    // about as much per triangle as two such pairs cost the feature stage: they are built when
-    // the last interval saw that many, or once this one has (between two installments of the
-    // traversal). Only the time depends on it: the rows are the same either way.
+    // emitted (docs/culling.md, "Apart at both ends in the leaves"). The slots' end boxes are
+    // built from the start when the last interval saw two such pairs per triangle; within an
+    // interval (between two installments of the traversal) once the feature stage has dropped
+    // one per two triangles: by then those pairs have cost what the build costs (ski rental:
+    // the build takes 40–50 instructions a triangle, a pair the feature stage drops about 140 on
+    // the cloth-ball step). Only the time depends on it: the rows are the same either way.
     const bool ends_tested = feature_stage_tests_ends(options_.min_separation);
     const std::int64_t pays = kSlotEndsPayPerTriangle * topology_.num_triangles();
+    const std::int64_t pays_within = topology_.num_triangles() / 2;
     bool slot_ends = false;
     const auto build_slot_ends = [&] {
       if (!node_ends) vertex_end_boxes(x_t0, x_t1, 0.0, vertex_ends_);
@@ -152,7 +155,7 @@ class BvhMethod final : public MethodBase {
     // (PairBlocks::drain_overlapped), which reads what they kept through candidates_kept() only.
     blocks_.drain_overlapped([&](std::vector<TrianglePair>& pairs, std::size_t max_pairs) {
       // The pairs so far that the feature stage found apart at both ends.
-      if (ends_tested && !slot_ends && emitted - blocks_.candidates_kept() >= pays) {
+      if (ends_tested && !slot_ends && emitted - blocks_.candidates_kept() >= pays_within) {
         build_slot_ends();
       }
       const std::size_t first = pairs.size();
