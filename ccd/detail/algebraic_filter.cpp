@@ -362,16 +362,14 @@ template <class L>
   }
 }
 
-/// cross_dot_quartic of q(k) into g(k) for the W = 2 or 4 lanes of L: lane k goes through the
-/// scalar code's operations in the same order (detail/lanes.hpp).
+/// cross_dot_quartic of q(k) into g(k) for the W = 2 lanes of L: lane k goes through the scalar
+/// code's operations in the same order (detail/lanes.hpp). (Four quadruples in four lanes were
+/// gathered here too until the quartics came from the points, inside_quartics_x4.)
 template <class L, std::size_t W, class Source, class Target>
 [[gnu::always_inline]] inline void quartics_body(const Source& q, const Target& g) {
+  static_assert(W == 2);
   const auto gather = [&](Eigen::Vector3d QuadrupleDifferences::*m) {
-    if constexpr (W == 2) {
-      return lanes_of<L, 2>({&(q(0).*m), &(q(1).*m)});
-    } else {
-      return lanes_of<L, 4>({&(q(0).*m), &(q(1).*m), &(q(2).*m), &(q(3).*m)});
-    }
+    return lanes_of<L, 2>({&(q(0).*m), &(q(1).*m)});
   };
   using Q = QuadrupleDifferences;
   using L3 = LaneVec3<L>;
@@ -406,12 +404,6 @@ template <class L, std::size_t W, class Source, class Target>
 
 #if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
 #define SKELCD_QUARTICS_AVX2 1
-/// The four lanes built for AVX2: one instruction per operation on the four quartics.
-[[gnu::target("avx2")]] void quartics_x4_avx2(const QuadrupleDifferences* q, BernsteinQuartic* g) {
-  quartics_body<Lanes4, 4>(
-      [&](std::size_t k) -> const QuadrupleDifferences& { return q[k]; },
-      [&](std::size_t k) -> BernsteinQuartic& { return g[k]; });
-}
 
 using LaneIndex4 = std::int64_t __attribute__((vector_size(32)));
 
@@ -626,17 +618,6 @@ int inside_quartics_x4(
   cross_dot_quartic_pair(q[0], q[1], g[0], g[1]);
   cross_dot_quartic_pair(q[2], q[3], g[2], g[3]);
   return count;
-}
-
-void cross_dot_quartic_x4(const QuadrupleDifferences* q, BernsteinQuartic* g) {
-#if defined(SKELCD_QUARTICS_AVX2)
-  if (cross_dot_quartics_x4_wide()) {
-    quartics_x4_avx2(q, g);
-    return;
-  }
-#endif
-  cross_dot_quartic_pair(q[0], q[1], g[0], g[1]);
-  cross_dot_quartic_pair(q[2], q[3], g[2], g[3]);
 }
 
 namespace {

@@ -46,11 +46,6 @@ void cross_dot_quartic_pair(
     BernsteinQuartic& g0,
     BernsteinQuartic& g1);
 
-/// cross_dot_quartic of q[k] into g[k], k < 4, bit for bit: one AVX2 evaluation of the four on a
-/// CPU that has it (cross_dot_quartics_x4_wide), else two cross_dot_quartic_pair.
-/// @pre every coordinate of q[0..3] is finite.
-void cross_dot_quartic_x4(const QuadrupleDifferences* q, BernsteinQuartic* g);
-
 /// The inside quartics of a query, for inside_quartics_x4.
 enum class InsideQuartics : std::uint8_t {
   /// Points (v, f0, f1, f2): (y x z) . (y x x), (y x z) . ((f2 - f1) x (v - f1)),
@@ -103,12 +98,12 @@ int inside_quartic_lanes(
     const std::array<const Eigen::Vector3d*, 4>& at_t1,
     QuarticLanes& g);
 
-/// Whether cross_dot_quartic_x4 computes its four quartics at once (AVX2, and not forced to the
-/// baseline): four then cost what two do.
+/// Whether the quartics are computed four at once (inside_quartics_x4, inside_quartic_lanes and
+/// the four-lane filter: AVX2, and not forced to the baseline): four then cost what two do.
 [[nodiscard]] bool cross_dot_quartics_x4_wide();
 
-/// For the tests: true makes cross_dot_quartic_x4 take its baseline path even on a CPU with AVX2;
-/// false lets it choose again.
+/// For the tests: true makes the quartics and their filter take the baseline paths even on a CPU
+/// with AVX2; false lets them choose again.
 void force_baseline_quartics(bool baseline);
 
 enum class AlgebraicOutcome : std::uint8_t { separated, contact, undecided };

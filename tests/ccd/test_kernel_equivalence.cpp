@@ -631,34 +631,6 @@ TEST(KernelEquivalence, PairedQuarticsAreCrossDotQuarticBitForBit) {
   }
 }
 
-TEST(KernelEquivalence, FourQuarticsAtOnceAreCrossDotQuarticBitForBit) {
-  // cross_dot_quartic_x4 in both of its builds (one AVX2 evaluation where the CPU has it, two
-  // pairs otherwise) on random quadruples, each lane at its own scale (the lanes must not mix),
-  // some negated.
-  RandomQuadruples random(14);
-  for (const bool baseline : {false, true}) {
-    detail::force_baseline_quartics(baseline);
-    for (int i = 0; i < 20000; ++i) {
-      detail::QuadrupleDifferences q[4];
-      for (auto& x : q) {
-        x = random.next(i, random.scale());
-        if (i % 11 == 0) x.b_t0 = -x.b_t0;
-      }
-      BernsteinQuartic g[4];
-      detail::cross_dot_quartic_x4(q, g);
-      for (std::size_t lane = 0; lane < 4; ++lane) {
-        const BernsteinQuartic r = detail::cross_dot_quartic(q[lane]);
-        for (std::size_t k = 0; k < 5; ++k) {
-          ASSERT_TRUE(same_bits(g[lane].coefficients[k], r.coefficients[k]))
-              << i << " lane " << lane << (baseline ? " baseline" : "");
-        }
-        ASSERT_TRUE(same_bits(g[lane].error, r.error)) << i << " lane " << lane;
-      }
-    }
-  }
-  detail::force_baseline_quartics(false);
-}
-
 TEST(KernelEquivalence, InsideQuarticsFromThePointsAreCrossDotQuarticBitForBit) {
   // inside_quartics_x4 in both of its builds takes the differences and the shared factor pair
   // its own way: each quartic must still be cross_dot_quartic of the quadruple the kernels
@@ -730,10 +702,10 @@ TEST(KernelEquivalence, InsideQuarticsFromThePointsAreCrossDotQuarticBitForBit) 
 }
 
 TEST(KernelEquivalence, KernelsGiveTheSameAnswersWithFourQuarticsAtOnce) {
-  // The conservative pipeline computes its four inside quartics at once where cross_dot_quartic_x4
-  // is wide, and two pairs (the second only past the early exit) otherwise: the same answers, bit
-  // for bit, and the same stage counts, on the random mix, the hard cases and the cloth-funnel
-  // step. On a CPU without AVX2 both runs take the pairs.
+  // The conservative pipeline computes its four inside quartics at once where
+  // cross_dot_quartics_x4_wide() holds, and two pairs (the second only past the early exit)
+  // otherwise: the same answers, bit for bit, and the same stage counts, on the random mix, the
+  // hard cases and the cloth-funnel step. On a CPU without AVX2 both runs take the pairs.
   struct Item {
     bool vertex_face;
     std::array<Eigen::Vector3d, 8> points;
