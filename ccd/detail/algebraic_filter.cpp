@@ -362,12 +362,12 @@ template <class L>
   }
 }
 
-/// cross_dot_quartic of q(k) into g(k) for the W = 2 lanes of L: lane k goes through the scalar
-/// code's operations in the same order (detail/lanes.hpp). (Four quadruples in four lanes were
-/// gathered here too until the quartics came from the points, inside_quartics_x4.)
-template <class L, std::size_t W, class Source, class Target>
+/// cross_dot_quartic of q(k) into g(k) for the two lanes of L (k < 2): lane k goes through the
+/// scalar code's operations in the same order (detail/lanes.hpp). (Four quadruples in four lanes
+/// were gathered here too until the quartics came from the points, inside_quartics_x4.)
+template <class L, class Source, class Target>
 [[gnu::always_inline]] inline void quartics_body(const Source& q, const Target& g) {
-  static_assert(W == 2);
+  constexpr std::size_t W = 2;
   const auto gather = [&](Eigen::Vector3d QuadrupleDifferences::*m) {
     return lanes_of<L, 2>({&(q(0).*m), &(q(1).*m)});
   };
@@ -521,7 +521,7 @@ void cross_dot_quartic_pair(
     const QuadrupleDifferences& q1,
     BernsteinQuartic& g0,
     BernsteinQuartic& g1) {
-  quartics_body<Lanes, 2>(
+  quartics_body<Lanes>(
       [&](std::size_t k) -> const QuadrupleDifferences& { return k == 0 ? q0 : q1; },
       [&](std::size_t k) -> BernsteinQuartic& { return k == 0 ? g0 : g1; });
 }
