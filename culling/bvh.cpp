@@ -603,6 +603,19 @@ inline void merge_ends(NodeEndBoxes& a, const NodeEndBoxes& b) {
 #endif
 }
 
+/// Slots ahead for which refit_end_boxes and refit_slot_ends ask for the corners' end boxes.
+constexpr std::size_t kAheadEnds = 16;
+
+/// Asks for the end boxes of triangle f's corners (scattered over the vertices).
+inline void prefetch_corner_ends(
+    const skinning::Triangles& triangles,
+    std::span<const NodeEndBoxes> vertex_ends,
+    std::int32_t f) {
+  for (Eigen::Index j = 0; j < 3; ++j) {
+    __builtin_prefetch(&vertex_ends[static_cast<std::size_t>(triangles(f, j))]);
+  }
+}
+
 }  // namespace
 
 void vertex_end_boxes(
@@ -619,6 +632,29 @@ void vertex_end_boxes(
   };
   const auto rows = static_cast<std::size_t>(std::min(x_t0.rows(), x_t1.rows()));
   out.resize(rows);
+#if defined(__SSE2__)
+  if (half_width == 0.0) {
+    // Without a width, float_below and float_above of the coordinates themselves: one
+    // detail::float_below4 per end and side (x, y | z and a 0 lane), bit for bit the scalar
+    // conversions below; float_above(x) is −float_below(−x).
+    const __m128d sign = _mm_set1_pd(-0.0);
+    const __m128 sign_f = _mm_set1_ps(-0.0f);
+    const auto ends = [&](const double* p, float* lo, float* hi) {
+      const __m128d xy = _mm_loadu_pd(p);
+      const __m128d z0 = _mm_set_sd(p[2]);
+      _mm_store_ps(lo, detail::float_below4(xy, z0));
+      _mm_store_ps(
+          hi, _mm_xor_ps(detail::float_below4(_mm_xor_pd(xy, sign), _mm_xor_pd(z0, sign)), sign_f));
+      lo[3] = hi[3] = 0.0f;
+    };
+    for (std::size_t v = 0; v < rows; ++v) {
+      NodeEndBoxes& e = out[v];
+      ends(x_t0.data() + 3 * v, e.lo0, e.hi0);
+      ends(x_t1.data() + 3 * v, e.lo1, e.hi1);
+    }
+    return;
+  }
+#endif
   for (std::size_t v = 0; v < rows; ++v) {
     const double* p0 = x_t0.data() + 3 * v;  // row-major #W × 3
     const double* p1 = x_t1.data() + 3 * v;
@@ -640,6 +676,11 @@ void Bvh<N>::refit_end_boxes(
   // The union of the triangles' corners' end boxes in slots [begin, end): float_below and
   // float_above are monotone, so it is the rounding of the exact union.
   const auto slot_boxes = [&](std::size_t begin, std::size_t end, NodeEndBoxes& out) {
+    // The sweep meets the buckets in nearly decreasing slot order, the corners are scattered:
+    // ask for the corners' boxes kAheadEnds slots below now (as refit_wide_only).
+    for (std::size_t s = begin; s < end && s >= kAheadEnds; ++s) {
+      prefetch_corner_ends(triangles, vertex_ends, order_[s - kAheadEnds]);
+    }
     out = vertex_ends[static_cast<std::size_t>(triangles(order_[begin], 0))];
     for (std::size_t s = begin; s < end; ++s) {
       const auto f = static_cast<Eigen::Index>(order_[s]);
@@ -700,6 +741,9 @@ void Bvh<N>::refit_slot_ends(
   if (slot_ends_.size() != 12 * stride) slot_ends_.assign(12 * stride, 0.0f);
   float* const rows = slot_ends_.data();
   for (std::size_t s = 0; s < order_.size(); ++s) {
+    if (s + kAheadEnds < order_.size()) {
+      prefetch_corner_ends(triangles, vertex_ends, order_[s + kAheadEnds]);
+    }
     const auto f = static_cast<Eigen::Index>(order_[s]);
     NodeEndBoxes box = vertex_ends[static_cast<std::size_t>(triangles(f, 0))];
     merge_ends(box, vertex_ends[static_cast<std::size_t>(triangles(f, 1))]);

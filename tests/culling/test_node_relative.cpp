@@ -75,6 +75,76 @@ struct SweptCesium {
   }
 };
 
+// Without a half width the vertices' end boxes are each coordinate's float_below and float_above
+// bit for bit (the SSE2 path converts four lanes at once): on CesiumMan's moving samples and on
+// coordinates where the rounding has edges — zeros of both signs, subnormals and the smallest
+// normals, halfway and just-off float values, beyond the float range.
+TEST(NodeRelative, VertexEndBoxesAreTheScalarRoundingsBitForBit) {
+  const auto bits = [](float f) {
+    std::uint32_t b = 0;
+    std::memcpy(&b, &f, sizeof b);
+    return b;
+  };
+  const auto check = [&](const skinning::Positions& x0, const skinning::Positions& x1) {
+    std::vector<NodeEndBoxes> ends;
+    vertex_end_boxes(x0, x1, 0.0, ends);
+    ASSERT_EQ(ends.size(), static_cast<std::size_t>(x0.rows()));
+    for (Eigen::Index v = 0; v < x0.rows(); ++v) {
+      const NodeEndBoxes& e = ends[static_cast<std::size_t>(v)];
+      for (int k = 0; k < 3; ++k) {
+        ASSERT_EQ(bits(e.lo0[k]), bits(float_below(x0(v, k)))) << v << " " << k << " " << x0(v, k);
+        ASSERT_EQ(bits(e.hi0[k]), bits(float_above(x0(v, k)))) << v << " " << k << " " << x0(v, k);
+        ASSERT_EQ(bits(e.lo1[k]), bits(float_below(x1(v, k)))) << v << " " << k << " " << x1(v, k);
+        ASSERT_EQ(bits(e.hi1[k]), bits(float_above(x1(v, k)))) << v << " " << k << " " << x1(v, k);
+      }
+      EXPECT_EQ(e.lo0[3], 0.0f);
+      EXPECT_EQ(e.hi1[3], 0.0f);
+    }
+  };
+  Model m{"CesiumMan.glb"};
+  check(m.sample(0), m.sample(20));
+  const double fmin = std::numeric_limits<float>::min();
+  const double fmax = std::numeric_limits<float>::max();
+  const double f1 = 1.0 + std::ldexp(1.0, -23);  // the float after 1
+  const std::vector<double> edges{
+      0.0,
+      -0.0,
+      1e-310,
+      -1e-310,
+      std::ldexp(fmin, -3),
+      -std::ldexp(fmin, -3),
+      fmin,
+      -fmin,
+      std::nextafter(fmin, 0.0),
+      -std::nextafter(fmin, 0.0),
+      1.0,
+      -1.0,
+      0.5 * (1.0 + f1),
+      -0.5 * (1.0 + f1),
+      std::nextafter(0.5 * (1.0 + f1), 2.0),
+      0.1,
+      -0.1,
+      1.0 / 3.0,
+      -1e7 / 3.0,
+      fmax,
+      -fmax,
+      2.0 * fmax,
+      -2.0 * fmax,
+      1e300,
+      -1e300,
+      std::nextafter(fmax, 1e300)};
+  std::mt19937 rng(7);
+  std::uniform_int_distribution<std::size_t> pick(0, edges.size() - 1);
+  skinning::Positions x0(64, 3), x1(64, 3);
+  for (Eigen::Index v = 0; v < 64; ++v) {
+    for (int k = 0; k < 3; ++k) {
+      x0(v, k) = edges[pick(rng)];
+      x1(v, k) = edges[pick(rng)];
+    }
+  }
+  check(x0, x1);
+}
+
 // Every lane's boxes hold its triangles' corners at t = 0 and t = 1, grown by the half width;
 // the next refit drops them (a traversal of another interval must not read them).
 TEST(NodeRelative, EndBoxesHoldEveryCornerAndARefitDropsThem) {
