@@ -270,6 +270,24 @@ RadialViewMethod::RadialViewMethod(
       }
     }
   }
+  // Each triangle's neighbour across each side, for build_patches' walk: the edge's other face
+  // when it has two, kNoNeighbour for a boundary edge, kNeighboursListed when it has more (the
+  // walk then reads the edge's faces).
+  face_neighbours_.assign(3 * num_faces, kNoNeighbour);
+  for (std::int32_t f = 0; f < topology_.num_triangles(); ++f) {
+    for (int side = 0; side < 3; ++side) {
+      const std::int32_t e = topology_.face_edge(f, side);
+      const std::int32_t begin = edge_face_offsets_[at(e)];
+      const std::int32_t end = edge_face_offsets_[at(e) + 1];
+      std::int32_t& n = face_neighbours_[3 * at(f) + at(side)];
+      if (end - begin > 2) {
+        n = kNeighboursListed;
+      } else if (end - begin == 2) {
+        const std::int32_t g0 = edge_faces_[at(begin)];
+        n = g0 != f ? g0 : edge_faces_[at(begin + 1)];
+      }
+    }
+  }
   if (ghosts_) {  // everything is built: keep only the loops and the edge map
     ghosts_->mesh = skinning::Mesh{};
     ghosts_->topology = skinning::Topology{};
@@ -416,15 +434,23 @@ void RadialViewMethod::build_patches() {
       std::size_t head = patch_order_.size();
       patch_order_.push_back(seed);
       patch_[at(seed)] = id;
+      const auto join = [&](std::int32_t g) {
+        if (cut_[at(g)] != 0 || patch_[at(g)] >= 0) return;
+        patch_[at(g)] = id;
+        patch_order_.push_back(g);
+      };
       while (head < patch_order_.size()) {
         const std::int32_t f = patch_order_[head++];
         for (int s = 0; s < 3; ++s) {
-          const std::int32_t e = topology_.face_edge(f, s);
-          for (auto j = edge_face_offsets_[at(e)]; j < edge_face_offsets_[at(e) + 1]; ++j) {
-            const std::int32_t g = edge_faces_[at(j)];
-            if (cut_[at(g)] != 0 || patch_[at(g)] >= 0) continue;
-            patch_[at(g)] = id;
-            patch_order_.push_back(g);
+          // The faces of f's side s in the edge's order (f itself is in the patch already).
+          const std::int32_t n = face_neighbours_[3 * at(f) + at(s)];
+          if (n >= 0) {
+            join(n);
+          } else if (n == kNeighboursListed) {
+            const std::int32_t e = topology_.face_edge(f, s);
+            for (auto j = edge_face_offsets_[at(e)]; j < edge_face_offsets_[at(e) + 1]; ++j) {
+              join(edge_faces_[at(j)]);
+            }
           }
         }
       }

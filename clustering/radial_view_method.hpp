@@ -197,6 +197,9 @@ class RadialViewMethod final : public culling::CullingMethod {
   std::unique_ptr<culling::CullingMethod> bvh_;  // DCD
   MegaClusterBuilder builder_;
   std::vector<std::int32_t> edge_face_offsets_, edge_faces_;
+  std::vector<std::int32_t> face_neighbours_;  // 3 per triangle (built with them): build_patches'
+  static constexpr std::int32_t kNoNeighbour = -1;
+  static constexpr std::int32_t kNeighboursListed = -2;
   std::vector<std::int32_t> component_offsets_, component_triangles_;  // CSR component → triangles
 
   // Per interval.
