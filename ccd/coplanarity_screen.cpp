@@ -144,6 +144,36 @@ template <bool kVertexFace>
   }
 }
 
+/// Face k's corner `role` at one end, lane k.
+[[gnu::always_inline]] inline V3 gather(const FaceCorners& f, std::size_t role) {
+  const double* p0 = f[0][role];
+  const double* p1 = f[1][role];
+  const double* p2 = f[2][role];
+  const double* p3 = f[3][role];
+  return {
+      V{p0[0], p1[0], p2[0], p3[0]}, V{p0[1], p1[1], p2[1], p3[1]}, V{p0[2], p1[2], p2[2], p3[2]}};
+}
+
+/// body<true> for one point against four faces given by their corners.
+[[gnu::always_inline]] inline CoplanarityScreens point_faces_body(
+    const double* v_t0, const double* v_t1, const FaceCorners& f_t0, const FaceCorners& f_t1) {
+  const auto broadcast = [](const double* p) __attribute__((always_inline)) {
+    return V3{V{p[0], p[0], p[0], p[0]}, V{p[1], p[1], p[1], p[1]}, V{p[2], p[2], p[2], p[2]}};
+  };
+  const V3 v0 = broadcast(v_t0), v1 = broadcast(v_t1);
+  const V3 a0 = gather(f_t0, 0), b0 = gather(f_t0, 1), c0 = gather(f_t0, 2);
+  const V3 a1 = gather(f_t1, 0), b1 = gather(f_t1, 1), c1 = gather(f_t1, 2);
+  return screen(
+      minus(v0, a0), minus(b0, a0), minus(c0, a0), minus(v1, a1), minus(b1, a1), minus(c1, a1));
+}
+
+#if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
+[[gnu::target("avx2")]] CoplanarityScreens point_faces_body_avx2(
+    const double* v_t0, const double* v_t1, const FaceCorners& f_t0, const FaceCorners& f_t1) {
+  return point_faces_body(v_t0, v_t1, f_t0, f_t1);
+}
+#endif
+
 #if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
 /// body compiled for AVX2: one instruction per operation on the four lanes.
 template <bool kVertexFace>
@@ -173,11 +203,24 @@ CoplanarityScreens edge_edge_screen_x4(
   return dispatch<false>(x_t0, x_t1, queries);
 }
 
+CoplanarityScreens point_faces_screen_x4(
+    const double* v_t0, const double* v_t1, const FaceCorners& f_t0, const FaceCorners& f_t1) {
+#if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
+  if (detail::cpu_has_avx2()) return point_faces_body_avx2(v_t0, v_t1, f_t0, f_t1);
+#endif
+  return point_faces_body(v_t0, v_t1, f_t0, f_t1);
+}
+
 namespace detail {
 
 CoplanarityScreens vertex_face_screen_x4_baseline(
     const double* x_t0, const double* x_t1, ScreenQuads queries) {
   return body<true>(x_t0, x_t1, queries);
+}
+
+CoplanarityScreens point_faces_screen_x4_baseline(
+    const double* v_t0, const double* v_t1, const FaceCorners& f_t0, const FaceCorners& f_t1) {
+  return point_faces_body(v_t0, v_t1, f_t0, f_t1);
 }
 
 CoplanarityScreens edge_edge_screen_x4_baseline(

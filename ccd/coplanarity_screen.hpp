@@ -42,6 +42,15 @@ struct CoplanarityScreens {
 [[nodiscard]] CoplanarityScreens vertex_face_screen_x4(
     const double* x_t0, const double* x_t1, ScreenQuads queries);
 
+/// Four triangles' corners at one end: face k's f0, f1, f2, three doubles each.
+using FaceCorners = std::array<std::array<const double*, 3>, 4>;
+
+/// vertex_face_screen_x4 of one point moving from v_t0 to v_t1 (three doubles each) against four
+/// faces given by their corners, without position arrays: the same differences, roundings and
+/// results as the queries (v; face k) would have there.
+[[nodiscard]] CoplanarityScreens point_faces_screen_x4(
+    const double* v_t0, const double* v_t1, const FaceCorners& f_t0, const FaceCorners& f_t1);
+
 /// vertex_face_screen_x4 for edge-edge queries (edge_edge_ccd).
 [[nodiscard]] CoplanarityScreens edge_edge_screen_x4(
     const double* x_t0, const double* x_t1, ScreenQuads queries);

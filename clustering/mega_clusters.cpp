@@ -1,5 +1,7 @@
 #include "clustering/mega_clusters.hpp"
 
+#include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <limits>
@@ -109,24 +111,61 @@ bool MegaClusterBuilder::evaluate(
   std::int64_t non_positive = 0;
   std::int64_t classified = 0;
   bool below = true;
-  const auto classify_one = [&](std::int32_t f) {
+  const auto classify_scalar = [&](std::int32_t f) {
     const Eigen::Index i = f;
     const MovingTriangle t{x0.row(F(i, 0)).transpose(), x0.row(F(i, 1)).transpose(),
                            x0.row(F(i, 2)).transpose(), x1.row(F(i, 0)).transpose(),
                            x1.row(F(i, 1)).transpose(), x1.row(F(i, 2)).transpose()};
-    const OrientationClass c = observer.kind == segmentation::ObserverKind::point
-                                   ? classify(t, observer.point)
-                                   : classify(t, observer.segment);
+    return observer.kind == segmentation::ObserverKind::point ? classify(t, observer.point)
+                                                              : classify(t, observer.segment);
+  };
+  const auto record = [&](std::int32_t f, OrientationClass c) {
     out.triangle_class[at(f)] = c;
     stamp_[at(f)] = evaluation_;
     ++classified;
     if (c != OrientationClass::positive) ++non_positive;
     return non_positive < limit;
   };
+  // A point observer's triangles are screened four at a time (screen_classes_x4: the classes
+  // classify gives where the screen settles them, classify itself for the others) and recorded
+  // one by one in the same order, up to the same one: what is recorded is what one at a time
+  // records.
+  const bool batched = observer.kind == segmentation::ObserverKind::point;
+  std::array<std::int32_t, 4> batch{};
+  std::size_t in_batch = 0;
+  const auto flush = [&] {
+    if (in_batch == 0) return true;
+    std::array<std::array<const double*, 3>, 4> c0{}, c1{};
+    for (std::size_t k = 0; k < 4; ++k) {
+      const Eigen::Index i = batch[std::min(k, in_batch - 1)];  // spare lanes repeat the last
+      for (std::size_t j = 0; j < 3; ++j) {
+        const Eigen::Index row = F(i, static_cast<Eigen::Index>(j));
+        c0[k][j] = x0.data() + 3 * row;
+        c1[k][j] = x1.data() + 3 * row;
+      }
+    }
+    const ScreenedClasses screened = screen_classes_x4(c0, c1, observer.point);
+    const std::size_t n = in_batch;
+    in_batch = 0;
+    for (std::size_t k = 0; k < n; ++k) {
+      const std::int32_t f = batch[k];
+      const OrientationClass c =
+          ((screened.settled >> k) & 1u) != 0 ? screened.classes[k] : classify_scalar(f);
+      if (!record(f, c)) return false;
+    }
+    return true;
+  };
+  const auto classify_one = [&](std::int32_t f) {
+    if (!batched) return record(f, classify_scalar(f));
+    batch[in_batch++] = f;
+    return in_batch < 4 || flush();
+  };
   // Last interval's non-positive triangles first: they decide most failing merges early.
   const auto p_begin = previous_offsets_[at(a)];
   const auto p_end = previous_offsets_[at(a) + 1];
   for (auto i = p_begin; i < p_end && below; ++i) below = classify_one(previous_[at(i)]);
+  // Their stamps are set before the cluster's own triangles are looked at.
+  below = below && flush();
   if (below) {
     for (const std::int32_t f : clusters_.triangles(a)) {
       if (stamp_[at(f)] == evaluation_) continue;
@@ -135,6 +174,7 @@ bool MegaClusterBuilder::evaluate(
         break;
       }
     }
+    below = below && flush();
   }
   out.classifications += classified;
   out.classify_us += micros(start, Clock::now());

@@ -3,8 +3,10 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdint>
 #include <limits>
 
+#include "ccd/coplanarity_screen.hpp"
 #include "ccd/polynomial_sign.hpp"
 #include "culling/dop.hpp"
 
@@ -110,6 +112,22 @@ PolynomialSign orientation_sign(
 
 OrientationClass classify(const MovingTriangle& triangle, const MovingPoint& observer) {
   return to_class(orientation_sign(triangle, observer.t0, observer.t1));
+}
+
+ScreenedClasses screen_classes_x4(
+    const std::array<std::array<const double*, 3>, 4>& corners_t0,
+    const std::array<std::array<const double*, 3>, 4>& corners_t1,
+    const MovingPoint& observer) {
+  const ccd::CoplanarityScreens screens =
+      ccd::point_faces_screen_x4(observer.t0.data(), observer.t1.data(), corners_t0, corners_t1);
+  ScreenedClasses out;
+  out.settled = screens.apart;
+  for (std::size_t lane = 0; lane < 4; ++lane) {
+    // Settled: all four coefficients of one sign; classify's cubic is this one negated.
+    out.classes[lane] = screens.coefficients[lane][0] < 0.0 ? OrientationClass::positive
+                                                            : OrientationClass::negative;
+  }
+  return out;
 }
 
 ProjectionRange projection_range(const MovingTriangle& t, const MovingSegment& s) {

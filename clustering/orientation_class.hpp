@@ -6,10 +6,10 @@
 // answer. docs/radial-view.md says why these classes let the intra-cluster check skip pairs, and
 // how a line observer is handled so that the argument still holds.
 
+#include <Eigen/Core>
+#include <array>
 #include <cstdint>
 #include <string_view>
-
-#include <Eigen/Core>
 
 namespace skelcd::clustering {
 
@@ -45,6 +45,23 @@ struct MovingSegment {
 /// f(t) = (a(t) − q(t)) · n(t), n = (b − a) × (c − a).
 /// @note positive/negative are never wrong (any finite input); non-finite input is uncertain.
 [[nodiscard]] OrientationClass classify(const MovingTriangle& triangle, const MovingPoint& observer);
+
+/// classify(triangle k, observer) for four triangles at once where the screen of their cubics
+/// settles them: bit k of `settled` set, classes[k] what classify gives. The cubics are the
+/// vertex-face coplanarity cubics of (observer; a, b, c) screened four to a vector
+/// (ccd::vertex_face_screen_x4): their first difference is q − a where classify's is a − q, so each
+/// is classify's cubic negated exactly — every product and sum flips its sign without changing
+/// its magnitude — with the same error bound, and a settled lane is exactly a triangle whose
+/// screen classify finds certain. Lanes not settled need classify itself.
+/// @param corners_t0,corners_t1 triangle k's corners a, b, c at each end: 3 × 3 doubles.
+struct ScreenedClasses {
+  unsigned settled = 0;
+  std::array<OrientationClass, 4> classes{};
+};
+[[nodiscard]] ScreenedClasses screen_classes_x4(
+    const std::array<std::array<const double*, 3>, 4>& corners_t0,
+    const std::array<std::array<const double*, 3>, 4>& corners_t1,
+    const MovingPoint& observer);
 
 /// Class of `triangle` seen from a moving segment, each point x of the triangle viewed from its
 /// nearest point c(x) on the segment (the vertex projected onto the bone and clamped, §4.2):

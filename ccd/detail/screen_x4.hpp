@@ -24,6 +24,8 @@ namespace skelcd::ccd::detail {
 [[nodiscard]] CoplanarityScreens vertex_face_screen_x4_baseline(
     const double* x_t0, const double* x_t1, ScreenQuads queries);
 
+[[nodiscard]] CoplanarityScreens point_faces_screen_x4_baseline(
+    const double* v_t0, const double* v_t1, const FaceCorners& f_t0, const FaceCorners& f_t1);
 [[nodiscard]] CoplanarityScreens edge_edge_screen_x4_baseline(
     const double* x_t0, const double* x_t1, ScreenQuads queries);
 

@@ -2,15 +2,21 @@
 // (f < 0) at every densely sampled instant, with f evaluated in exact rational arithmetic; line
 // observers likewise at every corner and at interior points, each viewed from its exact nearest
 // point of the segment. Plus hand-made cases with known classes.
-#include "clustering/orientation_class.hpp"
-
-#include <algorithm>
-#include <array>
-#include <random>
-
-#include <Eigen/Geometry>
 #include <gmpxx.h>
 #include <gtest/gtest.h>
+
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <array>
+#include <bit>
+#include <cstdint>
+#include <random>
+
+#include "ccd/coplanarity_screen.hpp"
+#include "ccd/detail/conservative_pipeline.hpp"
+#include "ccd/detail/screen_x4.hpp"
+#include "ccd/detail/trilinear_cubic.hpp"
+#include "clustering/orientation_class.hpp"
 
 namespace skelcd::clustering {
 namespace {
@@ -171,6 +177,67 @@ TEST(OrientationClass, PointClassesHoldAtEveryExactSample) {
   EXPECT_GT(positives, 100);
   EXPECT_GT(negatives, 100);
   EXPECT_LT(proven, 800);  // and some uncertain ones
+}
+
+// screen_classes_x4 (a point observer's four triangles screened in one vector): a lane is settled
+// exactly when classify's own screen (the cubic of a − q, b − a, c − a) is certain, and then its
+// class is classify's; the AVX2 and baseline builds of the screen agree bit for bit. On random
+// triangles seen from near and far, and from observers passing close to their planes.
+TEST(OrientationClass, FourPointClassesAtOnceAreClassifysBitForBit) {
+  std::mt19937_64 rng(4242);
+  int settled = 0, unsettled = 0, positives = 0, negatives = 0;
+  for (int batch = 0; batch < 1500; ++batch) {
+    std::array<MovingTriangle, 4> tris;
+    for (auto& t : tris) t = random_triangle(rng);
+    MovingPoint q{random_point(rng, batch % 3 == 0 ? 0.5 : 3.0), V3::Zero()};
+    q.t1 = q.t0 + random_point(rng, 0.3);
+    if (batch % 5 == 0) {
+      // Close to the first triangle's plane at the start.
+      const MovingTriangle& t = tris[0];
+      const V3 n = (t.b_t0 - t.a_t0).cross(t.c_t0 - t.a_t0).normalized();
+      q.t0 = t.a_t0 + 0.3 * (t.b_t0 - t.a_t0) + 1e-9 * n;
+    }
+    std::array<std::array<const double*, 3>, 4> c0{}, c1{};
+    for (std::size_t k = 0; k < 4; ++k) {
+      c0[k] = {tris[k].a_t0.data(), tris[k].b_t0.data(), tris[k].c_t0.data()};
+      c1[k] = {tris[k].a_t1.data(), tris[k].b_t1.data(), tris[k].c_t1.data()};
+    }
+    const ccd::CoplanarityScreens fast =
+        ccd::point_faces_screen_x4(q.t0.data(), q.t1.data(), c0, c1);
+    const ccd::CoplanarityScreens base =
+        ccd::detail::point_faces_screen_x4_baseline(q.t0.data(), q.t1.data(), c0, c1);
+    ASSERT_EQ(fast.apart, base.apart) << batch;
+    for (std::size_t k = 0; k < 4; ++k) {
+      for (std::size_t i = 0; i < 4; ++i) {
+        ASSERT_EQ(
+            std::bit_cast<std::uint64_t>(fast.coefficients[k][i]),
+            std::bit_cast<std::uint64_t>(base.coefficients[k][i]))
+            << batch;
+      }
+    }
+    const ScreenedClasses got = screen_classes_x4(c0, c1, q);
+    for (std::size_t k = 0; k < 4; ++k) {
+      const MovingTriangle& t = tris[k];
+      const ccd::detail::TrilinearScreen own = ccd::detail::trilinear_screen(
+          {t.a_t0 - q.t0, t.b_t0 - t.a_t0, t.c_t0 - t.a_t0},
+          {t.a_t1 - q.t1, t.b_t1 - t.a_t1, t.c_t1 - t.a_t1});
+      const bool certain = ccd::detail::certified_sign(own.coefficients, own.error_upper);
+      const bool lane_settled = ((got.settled >> k) & 1u) != 0;
+      ASSERT_EQ(lane_settled, certain) << "batch " << batch << " lane " << k;
+      if (!lane_settled) {
+        ++unsettled;
+        continue;
+      }
+      ++settled;
+      const OrientationClass c = classify(t, q);
+      ASSERT_EQ(got.classes[k], c) << "batch " << batch << " lane " << k;
+      (c == OrientationClass::positive ? positives : negatives)++;
+    }
+  }
+  EXPECT_GT(positives, 500);
+  EXPECT_GT(negatives, 500);
+  EXPECT_GT(unsettled, 200);
+  EXPECT_GT(settled, 2000);
 }
 
 TEST(OrientationClass, PointClassesNearTangency) {
