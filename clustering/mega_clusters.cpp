@@ -111,13 +111,13 @@ bool MegaClusterBuilder::evaluate(
   std::int64_t non_positive = 0;
   std::int64_t classified = 0;
   bool below = true;
+  const bool point = observer.kind == segmentation::ObserverKind::point;
   const auto classify_scalar = [&](std::int32_t f) {
     const Eigen::Index i = f;
     const MovingTriangle t{x0.row(F(i, 0)).transpose(), x0.row(F(i, 1)).transpose(),
                            x0.row(F(i, 2)).transpose(), x1.row(F(i, 0)).transpose(),
                            x1.row(F(i, 1)).transpose(), x1.row(F(i, 2)).transpose()};
-    return observer.kind == segmentation::ObserverKind::point ? classify(t, observer.point)
-                                                              : classify(t, observer.segment);
+    return point ? classify(t, observer.point) : classify(t, observer.segment);
   };
   const auto record = [&](std::int32_t f, OrientationClass c) {
     out.triangle_class[at(f)] = c;
@@ -126,11 +126,9 @@ bool MegaClusterBuilder::evaluate(
     if (c != OrientationClass::positive) ++non_positive;
     return non_positive < limit;
   };
-  // A point observer's triangles are screened four at a time (screen_classes_x4: the classes
-  // classify gives where the screen settles them, classify itself for the others) and recorded
-  // one by one in the same order, up to the same one: what is recorded is what one at a time
-  // records.
-  const bool batched = observer.kind == segmentation::ObserverKind::point;
+  // The triangles are screened four at a time (screen_classes_x4: the classes classify gives
+  // where the screens settle them, classify itself for the others) and recorded one by one in
+  // the same order, up to the same one: what is recorded is what one at a time records.
   std::array<std::int32_t, 4> batch{};
   std::size_t in_batch = 0;
   const auto flush = [&] {
@@ -144,7 +142,8 @@ bool MegaClusterBuilder::evaluate(
         c1[k][j] = x1.data() + 3 * row;
       }
     }
-    const ScreenedClasses screened = screen_classes_x4(c0, c1, observer.point);
+    const ScreenedClasses screened = point ? screen_classes_x4(c0, c1, observer.point)
+                                           : screen_classes_x4(c0, c1, observer.segment);
     const std::size_t n = in_batch;
     in_batch = 0;
     for (std::size_t k = 0; k < n; ++k) {
@@ -156,7 +155,6 @@ bool MegaClusterBuilder::evaluate(
     return true;
   };
   const auto classify_one = [&](std::int32_t f) {
-    if (!batched) return record(f, classify_scalar(f));
     batch[in_batch++] = f;
     return in_batch < 4 || flush();
   };

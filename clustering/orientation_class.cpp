@@ -130,6 +130,24 @@ ScreenedClasses screen_classes_x4(
   return out;
 }
 
+ScreenedClasses screen_classes_x4(
+    const std::array<std::array<const double*, 3>, 4>& corners_t0,
+    const std::array<std::array<const double*, 3>, 4>& corners_t1,
+    const MovingSegment& observer) {
+  // classify's two endpoint cubics: one sign for both and it is the class (no blending needed).
+  const ScreenedClasses one =
+      screen_classes_x4(corners_t0, corners_t1, MovingPoint{observer.q1_t0, observer.q1_t1});
+  const ScreenedClasses two =
+      screen_classes_x4(corners_t0, corners_t1, MovingPoint{observer.q2_t0, observer.q2_t1});
+  ScreenedClasses out;
+  out.settled = one.settled & two.settled;
+  for (std::size_t lane = 0; lane < 4; ++lane) {
+    out.classes[lane] = one.classes[lane];
+    if (one.classes[lane] != two.classes[lane]) out.settled &= ~(1u << lane);
+  }
+  return out;
+}
+
 ProjectionRange projection_range(const MovingTriangle& t, const MovingSegment& s) {
   // σ(x, t) = clamp(N(t) / D(t)) with N = (x(t) − q1(t)) · d(t), D = |d(t)|², d = q2 − q1: both
   // quadratics in t. Enclose D first; if it may vanish the segment may degenerate to a point in

@@ -63,6 +63,15 @@ struct ScreenedClasses {
     const std::array<std::array<const double*, 3>, 4>& corners_t1,
     const MovingPoint& observer);
 
+/// classify(triangle k, observer) for a segment observer, four triangles at once, where the
+/// screens of both endpoints' cubics (as screen_classes_x4 screens a point's) settle them with
+/// one and the same sign — classify's answer then, from its own two screens. Lanes not settled
+/// need classify itself.
+[[nodiscard]] ScreenedClasses screen_classes_x4(
+    const std::array<std::array<const double*, 3>, 4>& corners_t0,
+    const std::array<std::array<const double*, 3>, 4>& corners_t1,
+    const MovingSegment& observer);
+
 /// Class of `triangle` seen from a moving segment, each point x of the triangle viewed from its
 /// nearest point c(x) on the segment (the vertex projected onto the bone and clamped, §4.2):
 /// positive when h(x, t) = (x − c(x)) · n(t) > 0 for every x of the triangle and every t in [0,1].

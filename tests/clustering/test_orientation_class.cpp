@@ -240,6 +240,53 @@ TEST(OrientationClass, FourPointClassesAtOnceAreClassifysBitForBit) {
   EXPECT_GT(settled, 2000);
 }
 
+// The segment observers' four at a time: a lane is settled exactly when both endpoints' screens
+// are certain with one sign, and then its class is classify's.
+TEST(OrientationClass, FourSegmentClassesAtOnceAreClassifysBitForBit) {
+  std::mt19937_64 rng(977);
+  int settled = 0, unsettled = 0;
+  for (int batch = 0; batch < 1500; ++batch) {
+    std::array<MovingTriangle, 4> tris;
+    for (auto& t : tris) t = random_triangle(rng);
+    const double reach = batch % 3 == 0 ? 0.5 : 3.0;
+    MovingSegment q;
+    q.q1_t0 = random_point(rng, reach);
+    q.q2_t0 = q.q1_t0 + random_point(rng, 0.5);
+    q.q1_t1 = q.q1_t0 + random_point(rng, 0.2);
+    q.q2_t1 = q.q2_t0 + random_point(rng, 0.2);
+    std::array<std::array<const double*, 3>, 4> c0{}, c1{};
+    for (std::size_t k = 0; k < 4; ++k) {
+      c0[k] = {tris[k].a_t0.data(), tris[k].b_t0.data(), tris[k].c_t0.data()};
+      c1[k] = {tris[k].a_t1.data(), tris[k].b_t1.data(), tris[k].c_t1.data()};
+    }
+    const ScreenedClasses got = screen_classes_x4(c0, c1, q);
+    for (std::size_t k = 0; k < 4; ++k) {
+      const MovingTriangle& t = tris[k];
+      int signs[2] = {0, 0};
+      for (int e = 0; e < 2; ++e) {
+        const V3& p0 = e == 0 ? q.q1_t0 : q.q2_t0;
+        const V3& p1 = e == 0 ? q.q1_t1 : q.q2_t1;
+        const ccd::detail::TrilinearScreen own = ccd::detail::trilinear_screen(
+            {t.a_t0 - p0, t.b_t0 - t.a_t0, t.c_t0 - t.a_t0},
+            {t.a_t1 - p1, t.b_t1 - t.a_t1, t.c_t1 - t.a_t1});
+        if (ccd::detail::certified_sign(own.coefficients, own.error_upper)) {
+          signs[e] = own.coefficients[0] > 0.0 ? 1 : -1;
+        }
+      }
+      const bool lane_settled = ((got.settled >> k) & 1u) != 0;
+      ASSERT_EQ(lane_settled, signs[0] != 0 && signs[0] == signs[1]) << batch << " " << k;
+      if (!lane_settled) {
+        ++unsettled;
+        continue;
+      }
+      ++settled;
+      ASSERT_EQ(got.classes[k], classify(t, q)) << "batch " << batch << " lane " << k;
+    }
+  }
+  EXPECT_GT(settled, 1500);
+  EXPECT_GT(unsettled, 500);
+}
+
 TEST(OrientationClass, PointClassesNearTangency) {
   // Observers placed so that f has a double root near [0,1]: an observer passing close to the
   // plane at mid-interval. Proven classes must still hold at every sample.
