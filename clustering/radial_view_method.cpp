@@ -239,8 +239,6 @@ RadialViewMethod::RadialViewMethod(
       4 * static_cast<std::size_t>(clusters_.global_bvh().depth()) + 4));
   node_stack_.reserve(2 * deepest + 2);
   triangle_label_.resize(at(topology_.num_triangles()));
-  vertex_label_.resize(at(topology_.num_vertices()));
-  edge_label_.resize(at(topology_.num_edges()));
   status_.assign(num_components, Status::unknown);
   culled_.assign(num_components, 0);
   component_escalated_.assign(num_components, 0);
@@ -584,26 +582,20 @@ void RadialViewMethod::compute_masks() {
   };
   const std::int32_t num_faces = topology_.num_triangles();
   for (std::int32_t f = 0; f < num_faces; ++f) triangle_label_[at(f)] = label(f);
-  const std::int32_t num_vertices = topology_.num_vertices();
-  for (std::int32_t w = 0; w < num_vertices; ++w) {
-    std::int64_t l = -2;
+  // A feature is pure with label l when every triangle at it has label l. Only the features a
+  // labelled triangle owns are asked about, each by its one owner: decided there.
+  const auto vertex_pure = [&](std::int32_t w, std::int64_t l) {
     for (const std::int32_t f : clusters_.vertex_triangles(w)) {
-      const std::int64_t lf = triangle_label_[at(f)];
-      l = (l == -2 || l == lf) ? lf : -1;
-      if (l == -1) break;
+      if (triangle_label_[at(f)] != l) return false;
     }
-    vertex_label_[at(w)] = l < 0 ? -1 : l;
-  }
-  const std::int32_t num_edges = topology_.num_edges();
-  for (std::int32_t e = 0; e < num_edges; ++e) {
-    std::int64_t l = -2;
+    return true;
+  };
+  const auto edge_pure = [&](std::int32_t e, std::int64_t l) {
     for (auto i = edge_face_offsets_[at(e)]; i < edge_face_offsets_[at(e) + 1]; ++i) {
-      const std::int64_t lf = triangle_label_[at(edge_faces_[at(i)])];
-      l = (l == -2 || l == lf) ? lf : -1;
-      if (l == -1) break;
+      if (triangle_label_[at(edge_faces_[at(i)])] != l) return false;
     }
-    edge_label_[at(e)] = l < 0 ? -1 : l;
-  }
+    return true;
+  };
   for (std::int32_t f = 0; f < num_faces; ++f) {
     const std::int64_t l = triangle_label_[at(f)];
     std::uint8_t mask = culling::kMaskOther;
@@ -612,8 +604,8 @@ void RadialViewMethod::compute_masks() {
       const auto& corners = topology_.triangle(f);
       bool pure = true;
       for (int k = 0; k < 3 && pure; ++k) {
-        if ((owned & (1u << k)) != 0 && vertex_label_[at(corners[at(k)])] != l) pure = false;
-        if ((owned & (1u << (3 + k))) != 0 && edge_label_[at(topology_.face_edge(f, k))] != l) {
+        if ((owned & (1u << k)) != 0 && !vertex_pure(corners[at(k)], l)) pure = false;
+        if (pure && (owned & (1u << (3 + k))) != 0 && !edge_pure(topology_.face_edge(f, k), l)) {
           pure = false;
         }
       }
