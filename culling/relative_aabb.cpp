@@ -8,6 +8,10 @@
 
 #include "culling/dop.hpp"
 
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
+
 namespace skelcd::culling {
 namespace {
 
@@ -169,13 +173,38 @@ double motion_scale(
   const std::int32_t num_triangles = topology.num_triangles();
   if (num_vertices == 0 || num_triangles == 0) return 0.0;
   double moved = 0.0;
+  double size = 0.0;
+#if defined(__SSE2__)
+  // The same terms, summed in the same order: each is a max of exact differences (or of absolute
+  // values of one rounded difference each), which the lanes compute alike. Positions are
+  // finite (the methods check them), so max and min need no NaN rule.
+  const double* p0 = x_t0.data();  // row-major #W × 3
+  const double* p1 = x_t1.data();
+  const __m128d sign = _mm_set1_pd(-0.0);
+  for (Eigen::Index v = 0; v < num_vertices; ++v) {
+    const __m128d d =
+        _mm_andnot_pd(sign, _mm_sub_pd(_mm_loadu_pd(p1 + 3 * v), _mm_loadu_pd(p0 + 3 * v)));
+    const double dz = std::abs(p1[3 * v + 2] - p0[3 * v + 2]);
+    moved += std::max(_mm_cvtsd_f64(_mm_max_sd(d, _mm_unpackhi_pd(d, d))), dz);
+  }
+  for (std::int32_t f = 0; f < num_triangles; ++f) {
+    const auto& t = topology.triangle(f);
+    const double* a = p0 + 3 * static_cast<std::ptrdiff_t>(t[0]);
+    const double* b = p0 + 3 * static_cast<std::ptrdiff_t>(t[1]);
+    const double* c = p0 + 3 * static_cast<std::ptrdiff_t>(t[2]);
+    const __m128d axy = _mm_loadu_pd(a), bxy = _mm_loadu_pd(b), cxy = _mm_loadu_pd(c);
+    const __m128d dxy =
+        _mm_sub_pd(_mm_max_pd(_mm_max_pd(axy, bxy), cxy), _mm_min_pd(_mm_min_pd(axy, bxy), cxy));
+    const double dz = std::max({a[2], b[2], c[2]}) - std::min({a[2], b[2], c[2]});
+    size += std::max(std::max(_mm_cvtsd_f64(dxy), _mm_cvtsd_f64(_mm_unpackhi_pd(dxy, dxy))), dz);
+  }
+#else
   for (Eigen::Index v = 0; v < num_vertices; ++v) {
     moved += std::max(
         {std::abs(x_t1(v, 0) - x_t0(v, 0)),
          std::abs(x_t1(v, 1) - x_t0(v, 1)),
          std::abs(x_t1(v, 2) - x_t0(v, 2))});
   }
-  double size = 0.0;
   for (std::int32_t f = 0; f < num_triangles; ++f) {
     const auto& t = topology.triangle(f);
     const auto a = static_cast<Eigen::Index>(t[0]);
@@ -190,6 +219,7 @@ double motion_scale(
     }
     size += side;
   }
+#endif
   const double scale =
       (moved / static_cast<double>(num_vertices)) / (size / static_cast<double>(num_triangles));
   return std::isfinite(scale) ? scale : 0.0;
