@@ -133,7 +133,7 @@ bool MegaClusterBuilder::evaluate(
   std::size_t in_batch = 0;
   const auto flush = [&] {
     if (in_batch == 0) return true;
-    std::array<std::array<const double*, 3>, 4> c0{}, c1{};
+    ccd::FaceCorners c0{}, c1{};
     for (std::size_t k = 0; k < 4; ++k) {
       const Eigen::Index i = batch[std::min(k, in_batch - 1)];  // spare lanes repeat the last
       for (std::size_t j = 0; j < 3; ++j) {

@@ -6,7 +6,6 @@
 #include <cstdint>
 #include <limits>
 
-#include "ccd/coplanarity_screen.hpp"
 #include "ccd/polynomial_sign.hpp"
 #include "culling/dop.hpp"
 
@@ -114,12 +113,16 @@ OrientationClass classify(const MovingTriangle& triangle, const MovingPoint& obs
   return to_class(orientation_sign(triangle, observer.t0, observer.t1));
 }
 
-ScreenedClasses screen_classes_x4(
-    const std::array<std::array<const double*, 3>, 4>& corners_t0,
-    const std::array<std::array<const double*, 3>, 4>& corners_t1,
-    const MovingPoint& observer) {
+namespace {
+
+/// screen_classes_x4 for an observer point moving from q_t0 to q_t1 (three doubles each).
+ScreenedClasses screened_from(
+    const double* q_t0,
+    const double* q_t1,
+    const ccd::FaceCorners& corners_t0,
+    const ccd::FaceCorners& corners_t1) {
   const ccd::CoplanarityScreens screens =
-      ccd::point_faces_screen_x4(observer.t0.data(), observer.t1.data(), corners_t0, corners_t1);
+      ccd::point_faces_screen_x4(q_t0, q_t1, corners_t0, corners_t1);
   ScreenedClasses out;
   out.settled = screens.apart;
   for (std::size_t lane = 0; lane < 4; ++lane) {
@@ -130,15 +133,24 @@ ScreenedClasses screen_classes_x4(
   return out;
 }
 
+}  // namespace
+
 ScreenedClasses screen_classes_x4(
-    const std::array<std::array<const double*, 3>, 4>& corners_t0,
-    const std::array<std::array<const double*, 3>, 4>& corners_t1,
+    const ccd::FaceCorners& corners_t0,
+    const ccd::FaceCorners& corners_t1,
+    const MovingPoint& observer) {
+  return screened_from(observer.t0.data(), observer.t1.data(), corners_t0, corners_t1);
+}
+
+ScreenedClasses screen_classes_x4(
+    const ccd::FaceCorners& corners_t0,
+    const ccd::FaceCorners& corners_t1,
     const MovingSegment& observer) {
   // classify's two endpoint cubics: one sign for both and it is the class (no blending needed).
   const ScreenedClasses one =
-      screen_classes_x4(corners_t0, corners_t1, MovingPoint{observer.q1_t0, observer.q1_t1});
+      screened_from(observer.q1_t0.data(), observer.q1_t1.data(), corners_t0, corners_t1);
   const ScreenedClasses two =
-      screen_classes_x4(corners_t0, corners_t1, MovingPoint{observer.q2_t0, observer.q2_t1});
+      screened_from(observer.q2_t0.data(), observer.q2_t1.data(), corners_t0, corners_t1);
   ScreenedClasses out;
   out.settled = one.settled & two.settled;
   for (std::size_t lane = 0; lane < 4; ++lane) {

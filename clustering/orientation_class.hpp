@@ -11,6 +11,8 @@
 #include <cstdint>
 #include <string_view>
 
+#include "ccd/coplanarity_screen.hpp"
+
 namespace skelcd::clustering {
 
 /// H⁺, H⁻, Hᵘ. The values are bit positions of a class mask (culling/cluster_checks.hpp).
@@ -53,14 +55,14 @@ struct MovingSegment {
 /// is classify's cubic negated exactly — every product and sum flips its sign without changing
 /// its magnitude — with the same error bound, and a settled lane is exactly a triangle whose
 /// screen classify finds certain. Lanes not settled need classify itself.
-/// @param corners_t0,corners_t1 triangle k's corners a, b, c at each end: 3 × 3 doubles.
+/// @param corners_t0,corners_t1 triangle k's corners a, b, c at each end (three doubles each).
 struct ScreenedClasses {
   unsigned settled = 0;
   std::array<OrientationClass, 4> classes{};
 };
 [[nodiscard]] ScreenedClasses screen_classes_x4(
-    const std::array<std::array<const double*, 3>, 4>& corners_t0,
-    const std::array<std::array<const double*, 3>, 4>& corners_t1,
+    const ccd::FaceCorners& corners_t0,
+    const ccd::FaceCorners& corners_t1,
     const MovingPoint& observer);
 
 /// classify(triangle k, observer) for a segment observer, four triangles at once, where the
@@ -68,8 +70,8 @@ struct ScreenedClasses {
 /// one and the same sign — classify's answer then, from its own two screens. Lanes not settled
 /// need classify itself.
 [[nodiscard]] ScreenedClasses screen_classes_x4(
-    const std::array<std::array<const double*, 3>, 4>& corners_t0,
-    const std::array<std::array<const double*, 3>, 4>& corners_t1,
+    const ccd::FaceCorners& corners_t0,
+    const ccd::FaceCorners& corners_t1,
     const MovingSegment& observer);
 
 /// Class of `triangle` seen from a moving segment, each point x of the triangle viewed from its

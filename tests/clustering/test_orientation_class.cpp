@@ -197,7 +197,7 @@ TEST(OrientationClass, FourPointClassesAtOnceAreClassifysBitForBit) {
       const V3 n = (t.b_t0 - t.a_t0).cross(t.c_t0 - t.a_t0).normalized();
       q.t0 = t.a_t0 + 0.3 * (t.b_t0 - t.a_t0) + 1e-9 * n;
     }
-    std::array<std::array<const double*, 3>, 4> c0{}, c1{};
+    ccd::FaceCorners c0{}, c1{};
     for (std::size_t k = 0; k < 4; ++k) {
       c0[k] = {tris[k].a_t0.data(), tris[k].b_t0.data(), tris[k].c_t0.data()};
       c1[k] = {tris[k].a_t1.data(), tris[k].b_t1.data(), tris[k].c_t1.data()};
@@ -254,7 +254,7 @@ TEST(OrientationClass, FourSegmentClassesAtOnceAreClassifysBitForBit) {
     q.q2_t0 = q.q1_t0 + random_point(rng, 0.5);
     q.q1_t1 = q.q1_t0 + random_point(rng, 0.2);
     q.q2_t1 = q.q2_t0 + random_point(rng, 0.2);
-    std::array<std::array<const double*, 3>, 4> c0{}, c1{};
+    ccd::FaceCorners c0{}, c1{};
     for (std::size_t k = 0; k < 4; ++k) {
       c0[k] = {tris[k].a_t0.data(), tris[k].b_t0.data(), tris[k].c_t0.data()};
       c1[k] = {tris[k].a_t1.data(), tris[k].b_t1.data(), tris[k].c_t1.data()};
