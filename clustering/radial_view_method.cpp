@@ -849,12 +849,13 @@ void RadialViewMethod::ccd(const culling::Interval& interval, culling::FrameResu
     }
     local.refit(bounds_.triangles);
     if (node_relative) {
-      local.refit_end_boxes(topology_.welded_triangles(), vertex_ends_);
       // And the slots' (docs/culling.md "Apart at both ends in the leaves"): on an interval that
-      // moves this much, many pairs the swept volumes pass lie apart at both ends.
-      if (culling::feature_stage_tests_ends(method_options_.min_separation)) {
-        local.refit_slot_ends(topology_.welded_triangles(), vertex_ends_);
-      }
+      // moves this much, many pairs the swept volumes pass lie apart at both ends. Both from one
+      // gather of the corners.
+      local.refit_end_boxes(
+          topology_.welded_triangles(),
+          vertex_ends_,
+          culling::feature_stage_tests_ends(method_options_.min_separation));
     }
     cluster_bounds_[at(a)] = local.node_bounds()[0];
   }

@@ -616,6 +616,29 @@ inline void prefetch_corner_ends(
   }
 }
 
+/// Triangle f's end boxes: the union of its corners'.
+inline NodeEndBoxes triangle_ends(
+    const skinning::Triangles& triangles,
+    std::span<const NodeEndBoxes> vertex_ends,
+    std::int32_t f) {
+  const auto i = static_cast<Eigen::Index>(f);
+  NodeEndBoxes box = vertex_ends[static_cast<std::size_t>(triangles(i, 0))];
+  merge_ends(box, vertex_ends[static_cast<std::size_t>(triangles(i, 1))]);
+  merge_ends(box, vertex_ends[static_cast<std::size_t>(triangles(i, 2))]);
+  return box;
+}
+
+/// Slot s of the 12 rows of slot end boxes (Bvh::refit_slot_ends), `stride` floats a row.
+inline void write_slot_ends(
+    float* rows, std::size_t stride, std::size_t s, const NodeEndBoxes& box) {
+  for (std::size_t k = 0; k < 3; ++k) {
+    rows[k * stride + s] = box.lo0[k];
+    rows[(3 + k) * stride + s] = box.hi0[k];
+    rows[(6 + k) * stride + s] = box.lo1[k];
+    rows[(9 + k) * stride + s] = box.hi1[k];
+  }
+}
+
 }  // namespace
 
 void vertex_end_boxes(
@@ -671,21 +694,40 @@ void vertex_end_boxes(
 
 template <int N>
 void Bvh<N>::refit_end_boxes(
-    const skinning::Triangles& triangles, std::span<const NodeEndBoxes> vertex_ends) {
+    const skinning::Triangles& triangles,
+    std::span<const NodeEndBoxes> vertex_ends,
+    bool with_slot_ends) {
   constexpr float kInf = std::numeric_limits<float>::infinity();
+  const std::size_t stride = slot_stride();
+  if (with_slot_ends && slot_ends_.size() != 12 * stride) slot_ends_.assign(12 * stride, 0.0f);
+  float* const rows = slot_ends_.data();
   // The union of the triangles' corners' end boxes in slots [begin, end): float_below and
-  // float_above are monotone, so it is the rounding of the exact union.
+  // float_above are monotone, so it is the rounding of the exact union. With the slots' end
+  // boxes, each triangle's box is written to its slot (refit_slot_ends' rows) on the way: the
+  // corners are gathered once for both.
   const auto slot_boxes = [&](std::size_t begin, std::size_t end, NodeEndBoxes& out) {
     // The sweep meets the buckets in nearly decreasing slot order, the corners are scattered:
     // ask for the corners' boxes kAheadEnds slots below now (as refit_wide_only).
     for (std::size_t s = begin; s < end && s >= kAheadEnds; ++s) {
       prefetch_corner_ends(triangles, vertex_ends, order_[s - kAheadEnds]);
     }
-    out = vertex_ends[static_cast<std::size_t>(triangles(order_[begin], 0))];
+    if (!with_slot_ends) {
+      out = vertex_ends[static_cast<std::size_t>(triangles(order_[begin], 0))];
+      for (std::size_t s = begin; s < end; ++s) {
+        const auto f = static_cast<Eigen::Index>(order_[s]);
+        for (Eigen::Index j = s == begin ? 1 : 0; j < 3; ++j) {
+          merge_ends(out, vertex_ends[static_cast<std::size_t>(triangles(f, j))]);
+        }
+      }
+      return;
+    }
     for (std::size_t s = begin; s < end; ++s) {
-      const auto f = static_cast<Eigen::Index>(order_[s]);
-      for (Eigen::Index j = s == begin ? 1 : 0; j < 3; ++j) {
-        merge_ends(out, vertex_ends[static_cast<std::size_t>(triangles(f, j))]);
+      const NodeEndBoxes box = triangle_ends(triangles, vertex_ends, order_[s]);
+      write_slot_ends(rows, stride, s, box);
+      if (s == begin) {
+        out = box;
+      } else {
+        merge_ends(out, box);
       }
     }
   };
@@ -731,6 +773,7 @@ void Bvh<N>::refit_end_boxes(
     }
   }
   end_boxes_ready_ = true;
+  if (with_slot_ends) slot_ends_ready_ = true;
 }
 
 template <int N>
@@ -744,16 +787,7 @@ void Bvh<N>::refit_slot_ends(
     if (s + kAheadEnds < order_.size()) {
       prefetch_corner_ends(triangles, vertex_ends, order_[s + kAheadEnds]);
     }
-    const auto f = static_cast<Eigen::Index>(order_[s]);
-    NodeEndBoxes box = vertex_ends[static_cast<std::size_t>(triangles(f, 0))];
-    merge_ends(box, vertex_ends[static_cast<std::size_t>(triangles(f, 1))]);
-    merge_ends(box, vertex_ends[static_cast<std::size_t>(triangles(f, 2))]);
-    for (std::size_t k = 0; k < 3; ++k) {
-      rows[k * stride + s] = box.lo0[k];
-      rows[(3 + k) * stride + s] = box.hi0[k];
-      rows[(6 + k) * stride + s] = box.lo1[k];
-      rows[(9 + k) * stride + s] = box.hi1[k];
-    }
+    write_slot_ends(rows, stride, s, triangle_ends(triangles, vertex_ends, order_[s]));
   }
   slot_ends_ready_ = true;
 }

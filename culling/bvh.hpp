@@ -219,9 +219,12 @@ class Bvh {
   /// the vertex ids of `triangles`, the triangles the tree was built from). Valid until the next
   /// refit() (which drops them), so that a traversal never reads boxes of another interval.
   /// Allocates once (#wide nodes × 192 bytes). Every traversal walks the wide nodes (the masked
-  /// ones too), so the binary nodes get none.
+  /// ones too), so the binary nodes get none. With `with_slot_ends`, also what refit_slot_ends
+  /// fills, bit for bit, from one gather of each triangle's corners for both.
   void refit_end_boxes(
-      const skinning::Triangles& triangles, std::span<const NodeEndBoxes> vertex_ends);
+      const skinning::Triangles& triangles,
+      std::span<const NodeEndBoxes> vertex_ends,
+      bool with_slot_ends = false);
   /// The triangles' own end boxes by slot, from their corners' (vertex_end_boxes): 12 rows of
   /// slot_stride() floats — lo at t = 0 on x, y, z, then hi at t = 0, lo at t = 1, hi at t = 1 —
   /// so that the traversals drop a triangle pair whose boxes lie apart on an axis at both ends

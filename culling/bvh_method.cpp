@@ -105,10 +105,7 @@ class BvhMethod final : public MethodBase {
     // to prune (docs/culling.md "Relative boxes at the nodes").
     const bool node_ends =
         relative_pairs_ && motion_scale(topology_, x_t0, x_t1) >= kNodeRelativeMotion;
-    if (node_ends) {
-      vertex_end_boxes(x_t0, x_t1, 0.5 * options_.min_separation, vertex_ends_);
-      bvh_.refit_end_boxes(topology_.welded_triangles(), vertex_ends_);
-    }
+    const bool ends_tested = feature_stage_tests_ends(options_.min_separation);
     // Without a contact distance the feature stage first drops the triangle pairs apart at both
     // ends (candidates.hpp): the leaves drop them instead, four at a time, before they are
     // emitted (docs/culling.md, "Apart at both ends in the leaves"). The slots' end boxes are
@@ -117,7 +114,6 @@ class BvhMethod final : public MethodBase {
     // one per two triangles: by then those pairs have cost what the build costs (ski rental:
     // the build takes 40–50 instructions a triangle, a pair the feature stage drops about 140 on
     // the cloth-ball step). Only the time depends on it: the rows are the same either way.
-    const bool ends_tested = feature_stage_tests_ends(options_.min_separation);
     const std::int64_t pays = kSlotEndsPayPerTriangle * topology_.num_triangles();
     const std::int64_t pays_within = topology_.num_triangles() / 2;
     bool slot_ends = false;
@@ -126,7 +122,14 @@ class BvhMethod final : public MethodBase {
       bvh_.refit_slot_ends(topology_.welded_triangles(), vertex_ends_);
       slot_ends = true;
     };
-    if (ends_tested && slot_ends_pay_) build_slot_ends();
+    if (node_ends) {
+      // With the slots' end boxes when they are wanted from the start: the corners gathered once.
+      vertex_end_boxes(x_t0, x_t1, 0.5 * options_.min_separation, vertex_ends_);
+      slot_ends = ends_tested && slot_ends_pay_;
+      bvh_.refit_end_boxes(topology_.welded_triangles(), vertex_ends_, slot_ends);
+    } else if (ends_tested && slot_ends_pay_) {
+      build_slot_ends();
+    }
     const auto t1 = Clock::now();
     // Self traversal → triangle pairs → de-duplicated feature pairs → tests, in blocks of
     // block_pairs triangle pairs: the candidates held at once stay bounded on any motion (the

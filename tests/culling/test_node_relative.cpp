@@ -246,6 +246,60 @@ TEST(NodeRelative, EndBoxesHoldEveryCornerAndARefitDropsThem) {
   EXPECT_TRUE(bvh.end_boxes().empty());
 }
 
+// The nodes' and the slots' end boxes from one gather of the corners (refit_end_boxes with
+// with_slot_ends, which `dynamic` and `kdop` use when they want both) are what the two refits
+// give apart, bit for bit, on a tree with binary node volumes and on a traversal-only one; and
+// without with_slot_ends the slots' rows stay as they were (absent after a refit).
+TEST(NodeRelative, NodeAndSlotEndBoxesFromOneGatherAreTheTwoRefitsBitForBit) {
+  SweptCesium c;
+  auto& [m, ft, x0, x1, bvh, bounds] = c;
+  const auto rows = [&](const Bvh<3>& tree) {
+    std::vector<float> r;
+    for (int k = 0; k < 12; ++k) {
+      const float* row = tree.slot_ends(k);
+      EXPECT_NE(row, nullptr);
+      if (row == nullptr) return r;
+      r.insert(r.end(), row, row + tree.triangle_order().size());
+    }
+    return r;
+  };
+  for (const bool node_volumes : {true, false}) {
+    for (const double half_width : {0.0, 1e-3}) {
+      std::vector<NodeEndBoxes> vertices;
+      vertex_end_boxes(x0, x1, half_width, vertices);
+      // Two fresh trees: neither has rows left from an earlier interval.
+      const BvhOptions options{.node_volumes = node_volumes};
+      Bvh<3> apart(ft.welded_triangles(), m.rest, options);
+      Bvh<3> together(ft.welded_triangles(), m.rest, options);
+      apart.refit(bounds.triangles);
+      apart.refit_end_boxes(ft.welded_triangles(), vertices);
+      EXPECT_EQ(apart.slot_ends(0), nullptr);
+      apart.refit_slot_ends(ft.welded_triangles(), vertices);
+      together.refit(bounds.triangles);
+      together.refit_end_boxes(ft.welded_triangles(), vertices, /*with_slot_ends=*/true);
+      ASSERT_EQ(together.end_boxes().size(), apart.end_boxes().size());
+      ASSERT_GT(apart.end_boxes().size(), 1u);
+      EXPECT_EQ(
+          std::memcmp(
+              together.end_boxes().data(),
+              apart.end_boxes().data(),
+              apart.end_boxes().size() * sizeof(WideEndBoxes)),
+          0)
+          << node_volumes << " " << half_width;
+      const std::vector<float> apart_rows = rows(apart);
+      const std::vector<float> together_rows = rows(together);
+      ASSERT_EQ(apart_rows.size(), 12 * static_cast<std::size_t>(ft.num_triangles()));
+      ASSERT_EQ(together_rows.size(), apart_rows.size());
+      EXPECT_EQ(
+          std::memcmp(together_rows.data(), apart_rows.data(), apart_rows.size() * sizeof(float)),
+          0)
+          << node_volumes << " " << half_width;
+      together.refit(bounds.triangles);
+      EXPECT_EQ(together.slot_ends(0), nullptr) << "a refit drops them";
+    }
+  }
+}
+
 // Two points that meet at t = 1/2, each the only content of a lane, on top of a common motion of
 // up to 2^20 and with coordinates from 2^-30 to 2^20 (all sums exact in double): their lanes
 // always meet (the rounding of the shifted ends is outwards), whatever the common motion and which
