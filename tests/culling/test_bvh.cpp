@@ -468,6 +468,22 @@ void check_without_node_volumes(
       }
     }
   };
+  // Each wide lane of a is its binary node's exact volume rounded outwards, bit for bit (refit()
+  // forms the lanes from the slots' floats where those hold every axis, else by rounding).
+  const auto expect_rounded_lanes = [&](const std::string& when) {
+    std::int64_t lanes = 0;
+    for (const WideBvhNode<N>& w : a.wide_nodes()) {
+      for (int i = 0; i < w.num_children; ++i) {
+        const auto& exact = a.node_bounds()[static_cast<std::size_t>(w.node[i])];
+        for (std::size_t k = 0; k < static_cast<std::size_t>(N); ++k) {
+          ASSERT_EQ(w.lo[k][i], float_below(exact.lo[k])) << what << when << " lane " << i;
+          ASSERT_EQ(w.hi[k][i], float_above(exact.hi[k])) << what << when << " lane " << i;
+        }
+        ++lanes;
+      }
+    }
+    EXPECT_GT(lanes, 0) << what << when;
+  };
   // Two refits in a row (the second must not keep anything of the first): an instant, then an
   // interval with a contact distance.
   FeatureBounds<N> bounds;
@@ -482,6 +498,7 @@ void check_without_node_volumes(
   expect_slot_volumes<N>(b, bounds.triangles, what + ", static, without");
   expect_slot_volumes<N>(c, bounds.triangles, what + ", static, float node volumes");
   expect_rounded_nodes(", static");
+  expect_rounded_lanes(", static");
   swept_vertex_bounds<N>(x_t0, x_t1, 0.005, bounds.vertices);
   bounds.derive(topology);
   a.refit(bounds.triangles);
@@ -493,6 +510,7 @@ void check_without_node_volumes(
   expect_slot_volumes<N>(b, bounds.triangles, what + ", swept, without");
   expect_slot_volumes<N>(c, bounds.triangles, what + ", swept, float node volumes");
   expect_rounded_nodes(", swept");
+  expect_rounded_lanes(", swept");
 }
 
 TEST(Bvh, WithoutNodeVolumesRefitGivesTheWideNodesTheSameBits) {
