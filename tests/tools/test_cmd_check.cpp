@@ -147,6 +147,41 @@ TEST(CmdCheck, JsonSummaryMatchesTheLogItWrote) {
   EXPECT_NE(text.out.find("ms per interval"), std::string::npos) << text.out;
 }
 
+// `--no-reuse` reaches the runner: on a clip that holds one pose (Debian's unnamed_bones.mdl) the
+// default hands most CCD rows on without a query (no stage time in the log), `--no-reuse` queries
+// every one, and the two logs hold the same counters and contacts row by row.
+TEST(CmdCheck, NoReuseQueriesEveryIntervalOfAHeldPoseAndFindsTheSame) {
+  const auto dir = skelcd::test::temp_dir("check-no-reuse");
+  const std::string model = skelcd::test::assimp_model("MDL/MDL (HL1)/unnamed_bones.mdl").string();
+  std::vector<LogData> logs;
+  for (const bool no_reuse : {false, true}) {
+    const auto log_path = (dir / (no_reuse ? "each.h5" : "held.h5")).string();
+    std::vector<std::string> args{
+        "check", model, "--frames", "0:8", "--query", "ccd", "--method", "bvh", "-o", log_path};
+    if (no_reuse) args.emplace_back("--no-reuse");
+    const auto r = run_skelcd(args);
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    logs.push_back(read_log(log_path));
+  }
+  ASSERT_EQ(logs[0].frames.size(), 8u);
+  ASSERT_EQ(logs[1].frames.size(), 8u);
+  int handed_on = 0;
+  for (std::size_t i = 0; i < 8; ++i) {
+    const auto& held = logs[0].frames[i];
+    const auto& each = logs[1].frames[i];
+    EXPECT_EQ(held.counters.bv_tests, each.counters.bv_tests) << i;
+    EXPECT_EQ(held.counters.candidate_pairs, each.counters.candidate_pairs) << i;
+    EXPECT_EQ(held.counters.ee_tests, each.counters.ee_tests) << i;
+    EXPECT_EQ(held.counters.vf_contacts + held.counters.ee_contacts, 1852) << i;
+    EXPECT_EQ(held.counters.ee_contacts, each.counters.ee_contacts) << i;
+    EXPECT_GT(each.times.elementary_us, 0.0) << i;
+    handed_on += held.times.elementary_us == 0.0 ? 1 : 0;
+  }
+  EXPECT_GE(handed_on, 4);
+  EXPECT_EQ(logs[0].contacts, logs[1].contacts);
+  EXPECT_NE(logs[1].header.command_line.find("--no-reuse"), std::string::npos);
+}
+
 TEST(CmdCheck, BvhAndBruteFindTheSameContactsOnARealCharacter) {
   // The full clip comparison is scripts/check_methods_agree.sh; one interval here keeps ctest fast.
   const auto dir = skelcd::test::temp_dir("check-agree");

@@ -120,6 +120,53 @@ std::pair<std::vector<FrameReport>, std::vector<FrameReport>> serial_and_paralle
   return {std::move(out[0]), std::move(out[1])};
 }
 
+// A real clip that holds one pose: Debian's MDL (HL1)/unnamed_bones.mdl, 76 samples of one pose
+// with 1,852 contacts an interval (eight stacked slabs within float noise of each other). With
+// RunOptions::reuse_static_intervals most CCD rows are handed on (no stage time) and every row
+// equals the queried one; `dynamic` with `--query ccd` carries
+// state between intervals, so there nothing is handed on.
+TEST(RunnerStatic, UnnamedBonesRowsAreTheQueriedOnes) {
+  const auto l = load(test::assimp_model("MDL/MDL (HL1)/unnamed_bones.mdl").string());
+  const auto run = [&](const char* method, QuerySet query, bool reuse) {
+    RunOptions options;
+    options.method = method;
+    options.frames = parse_frame_range("0:12");
+    options.query = query;
+    options.reuse_static_intervals = reuse;
+    (void)setup_radial_view(RadialViewArguments{}, l.model, *l.motion, options);
+    ClipRunner runner(*l.motion, options);
+    return collect(runner);
+  };
+  // CCD rows queried (their stages took time) and handed on (none did).
+  const auto count = [](const std::vector<FrameReport>& rows, int& queried, int& handed_on) {
+    queried = handed_on = 0;
+    for (const auto& r : rows) {
+      if (r.row.kind != QueryKind::ccd) continue;
+      EXPECT_EQ(r.row.counters.vf_contacts + r.row.counters.ee_contacts, 1852);
+      (r.row.times.elementary_us > 0.0 ? queried : handed_on) += 1;
+    }
+  };
+  for (const char* method : {"bvh", "kdop", "dynamic"}) {
+    SCOPED_TRACE(method);
+    const std::vector<FrameReport> each = run(method, QuerySet::both, false);
+    const std::vector<FrameReport> held = run(method, QuerySet::both, true);
+    EXPECT_GE(expect_same_rows(each, held), 12u * 1852);
+    int queried = 0;
+    int handed_on = 0;
+    count(each, queried, handed_on);
+    EXPECT_EQ(queried, 12);
+    // Held bit for bit at both ends on most intervals (a few samples differ from the others in
+    // their last bits — the keys' interpolation — and are queried).
+    count(held, queried, handed_on);
+    EXPECT_EQ(queried + handed_on, 12);
+    EXPECT_GE(handed_on, 6);
+  }
+  int queried = 0;
+  int handed_on = 0;
+  count(run("dynamic", QuerySet::ccd, true), queried, handed_on);
+  EXPECT_EQ(queried, 12) << "a method that carries state is queried every time";
+}
+
 TEST(ParallelRunner, RealCharacterRowsEqualSerialForBvhDynamicAndAuto) {
   const auto l = load(kCharacter);
   for (const char* method : {"bvh", "dynamic", "auto"}) {

@@ -376,4 +376,92 @@ TEST(Runner, RealMethodsFindTheHandCountedContactsInFileNumbering) {
   }
 }
 
+/// The two-part mesh lowered by 0.5 per step; sample i takes step kHoldSteps[i]: a pose held
+/// over samples 0-2, a move, then another pose held over samples 4-6.
+class HoldMotion : public skinning::Motion {
+ public:
+  static constexpr int kHoldSteps[] = {0, 0, 0, 1, 2, 2, 2};
+  HoldMotion() : mesh_(two_part_mesh()) {}
+  const skinning::Mesh& mesh() const override { return mesh_; }
+  int num_samples() const override { return 7; }
+  double sample_time(int i) const override { return 0.25 * i; }
+  std::string name() const override { return "hold-clip"; }
+  void positions(int i, Positions& out) const override {
+    out = mesh_.rest_positions;
+    out.col(2).array() -= 0.5 * kHoldSteps[i];
+  }
+
+ private:
+  skinning::Mesh mesh_;
+};
+
+/// A method without state whose answer depends on the query's positions only: a VF contact of
+/// the quad's seam vertex against the triangle at a time taken from the depth at t0, counters
+/// from the depths at both ends. Counts the CCD queries it was asked.
+class PoseMethod : public culling::CullingMethod {
+ public:
+  explicit PoseMethod(int& ccd_queries) : ccd_queries_(ccd_queries) {}
+  std::string_view name() const override { return "pose"; }
+  void dcd(const culling::Instant&, culling::FrameResult&) override {}
+  void ccd(const culling::Interval& interval, culling::FrameResult& out) override {
+    ++ccd_queries_;
+    const double z0 = interval.x_t0(0, 2);
+    const double z1 = interval.x_t1(0, 2);
+    out.contacts = {{culling::CcdContact::Kind::vf, 4, 0, -z0 / 8, -z0 / 8 + 0.125}};
+    out.counters.vf_tests = std::llround(-1000 * z0) + 7;
+    out.counters.ee_tests = std::llround(-1000 * z1) + 3;
+    out.times.elementary_us = 2.5;
+  }
+
+ private:
+  int& ccd_queries_;
+};
+
+// A held pose asks its question once: of the intervals 0-1, 1-2 (the pose of samples 0-2) and
+// 4-5, 5-6 (that of 4-6) only the first of each reaches a method declared stateless, and every
+// row — its counters and contacts — is the one querying each interval gives. Rows handed on have
+// no stage times. A factory not declared stateless, or reuse turned off, queries every interval.
+TEST(Runner, AHeldPoseIsQueriedOnceAndItsRowsStayTheSame) {
+  const HoldMotion motion;
+  const auto run = [&](bool reuse, bool stateless, int& queries) {
+    RunOptions options;
+    options.query = QuerySet::ccd;
+    options.reuse_static_intervals = reuse;
+    options.factory_methods_stateless = stateless;
+    ClipRunner runner(
+        motion,
+        options,
+        [&](const skinning::Mesh&, const skinning::Topology&, const culling::MethodOptions&) {
+          return std::make_unique<PoseMethod>(queries);
+        });
+    std::vector<FrameReport> reports;
+    runner.run([&](const FrameReport& r) { reports.push_back(r); });
+    return reports;
+  };
+  int queried_each = 0;
+  const std::vector<FrameReport> each = run(false, true, queried_each);
+  EXPECT_EQ(queried_each, 6);
+  int queried_stateful = 0;
+  (void)run(true, false, queried_stateful);
+  EXPECT_EQ(queried_stateful, 6);
+  int queried_held = 0;
+  const std::vector<FrameReport> held = run(true, true, queried_held);
+  EXPECT_EQ(queried_held, 4);  // intervals 0, 2, 3, 4
+  ASSERT_EQ(held.size(), 6u);
+  ASSERT_EQ(each.size(), 6u);
+  for (std::size_t i = 0; i < held.size(); ++i) {
+    SCOPED_TRACE(i);
+    EXPECT_EQ(held[i].row.sample, static_cast<std::int32_t>(i));
+    EXPECT_EQ(held[i].row.counters.vf_tests, each[i].row.counters.vf_tests);
+    EXPECT_EQ(held[i].row.counters.ee_tests, each[i].row.counters.ee_tests);
+    EXPECT_EQ(held[i].row.counters.vf_contacts, 1);
+    EXPECT_EQ(held[i].contacts, each[i].contacts);
+    const bool handed_on = i == 1 || i == 5;
+    EXPECT_EQ(held[i].row.times.elementary_us, handed_on ? 0.0 : 2.5);
+  }
+  // The rows differ between the two held poses: what is handed on is the pose's own answer.
+  EXPECT_NE(held[1].row.counters.vf_tests, held[5].row.counters.vf_tests);
+  EXPECT_NE(held[1].contacts, held[5].contacts);
+}
+
 }  // namespace

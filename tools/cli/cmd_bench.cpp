@@ -69,6 +69,9 @@ BenchOptions to_bench_options(const BenchArguments& a) {
   // Every method and accuracy pays a full DCD at every sample: `check` updates it from the CCD
   // contacts except with `fast`, which would make the accuracies' times incomparable.
   o.run.incremental_dcd = false;
+  // And every interval is queried: a held pose would cost the methods that carry no state
+  // nothing, the others their full time.
+  o.run.reuse_static_intervals = false;
   const auto reference = parse_reference_choice(a.reference);
   if (!reference) {
     throw InvalidInput("--reference '" + a.reference + "': expected auto, brute or bvh");

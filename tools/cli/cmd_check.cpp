@@ -61,6 +61,7 @@ struct CheckArguments {
   bool json = false;
   std::int32_t threads = 0;
   bool full_dcd = false;
+  bool no_reuse = false;
   std::string baseline = "rest";
   std::int32_t baseline_slack = kDefaultBaselineSlack;
   Allowances allow;
@@ -124,6 +125,7 @@ RunOptions to_run_options(const CheckArguments& a) {
   }
   o.threads = a.threads;
   o.incremental_dcd = !a.full_dcd;
+  o.reuse_static_intervals = !a.no_reuse;
   return o;
 }
 
@@ -330,6 +332,7 @@ CheckedClip check_clip(
       .min_separation = options.min_separation,
       .threads = options.threads,
       .incremental_dcd = options.incremental_dcd,
+      .reuse_static_intervals = options.reuse_static_intervals,
       .radial_view = args.radial_view,
       .baseline = parse_baseline(args.baseline),
       .baseline_slack = args.baseline_slack,
@@ -631,6 +634,12 @@ void add_check_command(CLI::App& app) {
       "test every candidate pair at every sample; by default, with --query both, the DCD at a "
       "sample updates the previous one from the interval's CCD contacts (the same pairs, "
       "docs/culling.md \"Incremental DCD\")");
+  cmd->add_flag(
+      "--no-reuse",
+      args->no_reuse,
+      "query every CCD interval; by default an interval that holds the pose of the last held one "
+      "(the same positions at both ends) gets that one's row without a query, where the method "
+      "keeps no state between queries (docs/check.md \"Static intervals\")");
   cmd->add_flag("--json", args->json, "print the summary as one JSON object");
   cmd->add_option(
          "--baseline",

@@ -43,6 +43,7 @@ RunOptions run_options(const CheckRequest& r) {
   o.min_separation = r.min_separation;
   o.threads = r.threads;
   o.incremental_dcd = r.incremental_dcd;
+  o.reuse_static_intervals = r.reuse_static_intervals;
   o.elementary_tests_done = r.tests_done;
   return o;
 }

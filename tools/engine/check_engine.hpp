@@ -33,6 +33,9 @@ struct CheckRequest {
   /// With both queries, each DCD after the first updates the previous one from the interval's
   /// CCD contacts (RunOptions::incremental_dcd); false: full DCD at every sample.
   bool incremental_dcd = true;
+  /// An interval holding the last held pose gets that interval's row
+  /// (RunOptions::reuse_static_intervals); false: every interval is queried (`--no-reuse`).
+  bool reuse_static_intervals = true;
   RadialViewArguments radial_view;  ///< γ, seed, segmentation file of rvbc/dynamic/auto
   /// What findings are compared with (docs/events.md): the rig's rest pose by default.
   BaselineSpec baseline;

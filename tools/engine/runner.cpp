@@ -12,6 +12,7 @@
 #include <charconv>
 #include <chrono>
 #include <cmath>
+#include <cstring>
 #include <exception>
 #include <limits>
 #include <mutex>
@@ -78,6 +79,8 @@ struct RowContext {
   const culling::ElementaryTests* incremental_dcd = nullptr;
   /// The mesh's FeatureTopology that the runner's methods share, lent to the DCD updaters.
   std::shared_ptr<const culling::FeatureTopology> features{};
+  /// RunOptions::reuse_static_intervals, where the method allows it.
+  bool reuse_static = false;
 };
 
 /// One posed sample: welded positions and, when the method needs them, the bone transforms.
@@ -200,7 +203,27 @@ struct Worker {
   std::int32_t previous_sample = -2;
   std::vector<culling::CcdContact> contacts;
   std::int32_t contacts_interval = -2;
+  // The last static interval this worker queried (its pose, held at both ends) and its result,
+  // for an identical one later (RunOptions::reuse_static_intervals).
+  bool has_static = false;
+  PosedSample static_pose;
+  culling::FrameResult static_result;
 };
+
+/// The same positions and bone transforms, bit for bit (−0 and +0 differ: a method could tell).
+bool same_pose(const PosedSample& a, const PosedSample& b) {
+  const auto same = [](const double* x, const double* y, std::size_t n) {
+    return n == 0 || std::memcmp(x, y, n * sizeof(double)) == 0;
+  };
+  if (a.welded.rows() != b.welded.rows() || a.bones.size() != b.bones.size()) return false;
+  static_assert(
+      sizeof(skinning::BoneTransform) ==
+      skinning::BoneTransform::SizeAtCompileTime * sizeof(double));  // no padding
+  const auto bone_doubles = static_cast<std::size_t>(skinning::BoneTransform::SizeAtCompileTime);
+  return same(a.welded.data(), b.welded.data(), static_cast<std::size_t>(a.welded.size())) &&
+         (a.bones.empty() ||
+          same(a.bones.front().data(), b.bones.front().data(), a.bones.size() * bone_doubles));
+}
 
 /// Runs the rows of `sequence` with `w`, passing each completed row to `emit`, in order.
 template <class Emit>
@@ -241,15 +264,29 @@ void check_samples(
         w.result.clear();
         const PosedSample& a = w.samples[slot_t0];
         const PosedSample& b = w.samples[slot_t1];
-        w.method->detect_ccd(
-            culling::Interval{
-                .x_t0 = a.welded,
-                .x_t1 = b.welded,
-                .bones_t0 = a.bones,
-                .bones_t1 = b.bones,
-                .sample_t0 = k,
-                .sample_t1 = k + 1},
-            w.result);
+        // A held pose: the same query as the last held one gets its answer (no stage ran: the
+        // row's stage times stay 0).
+        const bool held = context.reuse_static && same_pose(a, b);
+        if (held && w.has_static && same_pose(a, w.static_pose)) {
+          w.result.counters = w.static_result.counters;
+          w.result.contacts = w.static_result.contacts;
+          w.result.dcd_pairs = w.static_result.dcd_pairs;
+        } else {
+          w.method->detect_ccd(
+              culling::Interval{
+                  .x_t0 = a.welded,
+                  .x_t1 = b.welded,
+                  .bones_t0 = a.bones,
+                  .bones_t1 = b.bones,
+                  .sample_t0 = k,
+                  .sample_t1 = k + 1},
+              w.result);
+          if (held) {
+            w.static_pose = a;
+            w.static_result = w.result;
+            w.has_static = true;
+          }
+        }
         if (w.updater) {
           w.contacts.assign(w.result.contacts.begin(), w.result.contacts.end());
           w.contacts_interval = k;
@@ -431,6 +468,18 @@ ClipRunner::ClipRunner(
                      method_options_.elementary.edge_edge == nullptr &&
                      method_options_.elementary.triangles == nullptr;
   bones_ = motion.num_bones() > 0 && needs_bone_poses(options.method, method_options_);
+  // Reusing a static interval's row needs a method whose rows depend on the query alone: what
+  // lets a run split into blocks on threads (RunPlan::serial_reason) lets it reuse rows.
+  if (options.reuse_static_intervals) {
+    if (factory_) {
+      reuse_static_ = options.factory_methods_stateless;
+    } else {
+      const culling::MethodInfo* m = culling::find_method(options.method);
+      reuse_static_ = m != nullptr &&
+                      (!m->serial_reason ||
+                       m->serial_reason(method_options_, options.query != QuerySet::ccd).empty());
+    }
+  }
 
   // Threads: blocks of consecutive samples (a DCD at k, then the CCD k → k+1) go to workers. The
   // blocks do not depend on the thread count: with incremental DCD each block starts with a full
@@ -558,7 +607,8 @@ void ClipRunner::run_queries_in_order(const FrameCallback& on_frame) {
       numbering,
       bones_,
       incremental_dcd_ ? &method_options_.elementary : nullptr,
-      method_options_.features};
+      method_options_.features,
+      reuse_static_};
   const bool dcd = options_.query != QuerySet::ccd;
   const SampleSequence all{
       .first = plan_.first_sample,
@@ -588,7 +638,8 @@ void ClipRunner::run_parallel(const FrameCallback& on_frame) {
       numbering,
       bones_,
       incremental_dcd_ ? &method_options_.elementary : nullptr,
-      method_options_.features};
+      method_options_.features,
+      reuse_static_};
   const bool dcd = options_.query != QuerySet::ccd;
   const bool ccd = options_.query != QuerySet::dcd;
   const std::int32_t last = plan_.last_sample;

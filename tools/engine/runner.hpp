@@ -67,6 +67,13 @@ struct RunOptions {
   /// docs/culling.md "Incremental DCD"). Only for registered methods (no factory) and accuracies
   /// that never miss; false: every DCD is a full query (`--full-dcd`).
   bool incremental_dcd = true;
+  /// A CCD interval whose positions and bone transforms are the same at both ends, bit for bit,
+  /// and the same as those of the last such interval the worker checked, gets that interval's
+  /// findings and counters instead of a query: a method that keeps no state between queries
+  /// answers an identical query identically (docs/check.md, "Static intervals"). Only where the
+  /// method is known to be stateless for the run (RunPlan::serial_reason would be empty; a
+  /// factory's only with factory_methods_stateless). False: every interval is queried.
+  bool reuse_static_intervals = true;
 };
 
 /// What a run will do, resolved against the motion's sample count.
@@ -151,6 +158,8 @@ class ClipRunner {
   bool bones_ = false;  ///< the queries carry the bones' transforms (the method needs them)
   /// DCD updated from the CCD contacts (RunOptions::incremental_dcd).
   bool incremental_dcd_ = false;
+  /// Identical static intervals reuse the last one's row (RunOptions::reuse_static_intervals).
+  bool reuse_static_ = false;
   /// Block i's sample units [first, end) (a unit: the DCD at k, then the CCD k → k+1), whatever
   /// the thread count: RunOptions::block_samples each, or large blocks first and smaller ones at
   /// the end (docs/check.md, "Threads").
