@@ -468,18 +468,19 @@ ClipRunner::ClipRunner(
                      method_options_.elementary.edge_edge == nullptr &&
                      method_options_.elementary.triangles == nullptr;
   bones_ = motion.num_bones() > 0 && needs_bone_poses(options.method, method_options_);
-  // Reusing a static interval's row needs a method whose rows depend on the query alone: what
-  // lets a run split into blocks on threads (RunPlan::serial_reason) lets it reuse rows.
-  if (options.reuse_static_intervals) {
-    if (factory_) {
-      reuse_static_ = options.factory_methods_stateless;
-    } else {
-      const culling::MethodInfo* m = culling::find_method(options.method);
-      reuse_static_ = m != nullptr &&
-                      (!m->serial_reason ||
-                       m->serial_reason(method_options_, options.query != QuerySet::ccd).empty());
+  // What the method carries from one query to the next that would change its rows (empty:
+  // nothing). It keeps a run serial (RunPlan::serial_reason) and, for the same reason, keeps a
+  // held interval from reusing the last held one's row.
+  std::string carried;
+  if (!factory_) {
+    const culling::MethodInfo* m = culling::find_method(options.method);
+    if (m != nullptr && m->serial_reason) {
+      carried = m->serial_reason(method_options_, options.query != QuerySet::ccd);
     }
+  } else if (!options.factory_methods_stateless) {
+    carried = "the method factory's methods are not known to be stateless";
   }
+  reuse_static_ = options.reuse_static_intervals && carried.empty();
 
   // Threads: blocks of consecutive samples (a DCD at k, then the CCD k → k+1) go to workers. The
   // blocks do not depend on the thread count: with incremental DCD each block starts with a full
@@ -489,14 +490,7 @@ ClipRunner::ClipRunner(
   block_starts_ = block_layout(units_, std::max(options.block_samples, std::int32_t{0}));
   const auto blocks = static_cast<std::int32_t>(block_starts_.size()) - 1;
   if (wanted > 1) {
-    if (!factory_) {
-      const culling::MethodInfo* m = culling::find_method(options.method);
-      if (m != nullptr && m->serial_reason) {
-        plan_.serial_reason = m->serial_reason(method_options_, options.query != QuerySet::ccd);
-      }
-    } else if (!options.factory_methods_stateless) {
-      plan_.serial_reason = "the method factory's methods are not known to be stateless";
-    }
+    plan_.serial_reason = carried;
     if (plan_.serial_reason.empty() && blocks > 1) {
       plan_.threads = std::min(wanted, blocks);
       plan_.blocks = blocks;
