@@ -1,5 +1,7 @@
 #include "ccd/orientation.hpp"
 
+#include <array>
+
 #include "ccd/detail/filtered.hpp"
 
 namespace skelcd::ccd {
@@ -41,17 +43,66 @@ int orient3d_exact(
       // A zero row of the determinant: the four points lie in the plane x_k = a_k.
       if (u[k] == 0.0 && v[k] == 0.0 && w[k] == 0.0) return 0;
     }
-    return detail::exact_sign([&]<typename T>() -> T {
+    const auto triple = [&]<typename T>() -> T {
       const detail::Point3<T> pu{lift<T>(u[0]), lift<T>(u[1]), lift<T>(u[2])};
       const detail::Point3<T> pv{lift<T>(v[0]), lift<T>(v[1]), lift<T>(v[2])};
       const detail::Point3<T> pw{lift<T>(w[0]), lift<T>(w[1]), lift<T>(w[2])};
       return detail::dot(detail::cross(pu, pv), pw);
-    });
+    };
+    // The expansion on fixed arrays first (detail::triple_product_sign: the same sign as
+    // exact_sign's, both being exact, without its heap and copies); exact_sign where a product
+    // may not be exact. No dynamic filter before it: orient3d's static filter, which failed before
+    // any call here, bounds the same products no looser.
+    bool unsafe = false;
+    for (int k = 0; k < 3; ++k) {
+      unsafe = unsafe || detail::expansion_steps::unsafe_leaf(u[k]) ||
+               detail::expansion_steps::unsafe_leaf(v[k]) ||
+               detail::expansion_steps::unsafe_leaf(w[k]);
+    }
+    if (!unsafe) {
+      std::array<detail::Difference, 3> du, dv, dw;
+      for (std::size_t k = 0; k < 3; ++k) {
+        du[k] = detail::difference(u[k], 0.0);
+        dv[k] = detail::difference(v[k], 0.0);
+        dw[k] = detail::difference(w[k], 0.0);
+      }
+      const int s = detail::triple_product_sign(du.data(), dv.data(), dw.data(), unsafe);
+      if (!unsafe) return s;
+    }
+    return detail::exact_sign(triple);
   }
-  return detail::exact_sign([&]<typename T>() -> T {
+  const auto general = [&]<typename T>() -> T {
     const auto pa = lift<T>(a);
     return detail::dot(detail::cross(lift<T>(b) - pa, lift<T>(c) - pa), lift<T>(d) - pa);
-  });
+  };
+  // Two points that coincide, or the four in one axis plane (a zero row, its differences exact
+  // zeros however the others round): 0 without an expansion.
+  if (b == c || b == d || c == d) return 0;
+  for (Eigen::Index k = 0; k < 3; ++k) {
+    if (b[k] == a[k] && c[k] == a[k] && d[k] == a[k]) return 0;
+  }
+  // As above, on the differences as two-component expansions (the dynamic filter on the
+  // coordinates would bound the error by their magnitudes, looser than the static filter's bound
+  // on the differences).
+  bool unsafe = false;
+  for (int k = 0; k < 3; ++k) {
+    unsafe = unsafe || detail::expansion_steps::unsafe_leaf(a[k]) ||
+             detail::expansion_steps::unsafe_leaf(b[k]) ||
+             detail::expansion_steps::unsafe_leaf(c[k]) ||
+             detail::expansion_steps::unsafe_leaf(d[k]);
+  }
+  if (!unsafe) {
+    std::array<detail::Difference, 3> du, dv, dw;
+    for (std::size_t k = 0; k < 3; ++k) {
+      const auto i = static_cast<Eigen::Index>(k);
+      du[k] = detail::difference(b[i], a[i]);
+      dv[k] = detail::difference(c[i], a[i]);
+      dw[k] = detail::difference(d[i], a[i]);
+    }
+    const int s = detail::triple_product_sign(du.data(), dv.data(), dw.data(), unsafe);
+    if (!unsafe) return s;
+  }
+  return detail::exact_sign(general);
 }
 
 }  // namespace skelcd::ccd

@@ -80,6 +80,72 @@ TEST(Expansion, OrientationSignsAgreeWithRationals) {
   EXPECT_GT(nonzeros, 10000);
 }
 
+// The fixed-size triple product (triple_product_sign, which orient3d_exact takes before
+// exact_sign) against GMP rationals, on the two kinds of differences it is given: exact ones (one
+// component: grid points, coplanar or one ulp off) and rounded ones (two components: points far
+// from the origin relative to their spread, nearly coplanar, some exactly so after rounding), and
+// on coordinates mixed from 2^-1074 to 2^495 — every sign it gives without raising `unsafe` is
+// the rational one, and orient3d_exact's sign is the rational one on every case.
+TEST(Expansion, FixedSizeTripleProductIsTheRationalSign) {
+  std::mt19937_64 rng(59);
+  std::uniform_real_distribution<double> unit(-1.0, 1.0);
+  std::uniform_int_distribution<int> grid(-3, 3);
+  std::uniform_int_distribution<int> scale_exp(-60, 60);
+  std::uniform_int_distribution<int> pick(0, 11);
+  const int exponents[] = {-1074, -1060, -1022, -700, -540, -401, -100, 0, 100, 300, 495, 0};
+  int fixed = 0, zeros = 0, rounded = 0, flagged = 0;
+  for (int n = 0; n < 30000; ++n) {
+    const double s = std::ldexp(1.0, scale_exp(rng));
+    Eigen::Vector3d p[4];
+    const int kind = n % 3;
+    for (auto& v : p) {
+      if (kind == 0) {
+        v = s * Eigen::Vector3d(grid(rng), grid(rng), n % 4 == 0 ? 0 : grid(rng));
+      } else if (kind == 1) {
+        // Far from the origin relative to the spread: the differences round.
+        v = s * (Eigen::Vector3d(1000.0 / 3.0, -700.0 / 7.0, 50.0 / 11.0) +
+                 Eigen::Vector3d(unit(rng), unit(rng), unit(rng)));
+      } else {
+        for (int k = 0; k < 3; ++k) {
+          v[k] = pick(rng) < 3 ? 0.0 : std::ldexp(unit(rng), exponents[pick(rng)]);
+        }
+      }
+    }
+    if (kind == 1 && n % 2 == 0) p[3] = p[0] + (p[1] - p[0]) * 0.5 + (p[2] - p[0]) * 0.25;
+    if (kind != 2 && n % 5 == 0) {
+      double& c = p[n % 4][n % 3];
+      c = std::nextafter(c, n % 7 ? 1e300 : -1e300);
+    }
+    const int expected = rational_sign_of(orient<mpq_class>(p[0], p[1], p[2], p[3]));
+    // orient<T> is (u × v) · w with u = b − a, v = c − a, w = d − a: the product
+    // triple_product_sign takes, and det[u; v; w], whose sign orient3d_exact gives.
+    Difference u[3], v[3], w[3];
+    for (int k = 0; k < 3; ++k) {
+      u[k] = difference(p[1][k], p[0][k]);
+      v[k] = difference(p[2][k], p[0][k]);
+      w[k] = difference(p[3][k], p[0][k]);
+      rounded += u[k].n == 2 || v[k].n == 2 || w[k].n == 2;
+    }
+    bool unsafe = false;
+    for (const auto& q : p) {
+      for (int k = 0; k < 3; ++k) unsafe = unsafe || expansion_steps::unsafe_leaf(q[k]);
+    }
+    const int sign = triple_product_sign(u, v, w, unsafe);
+    if (unsafe) {
+      ++flagged;
+    } else {
+      ++fixed;
+      zeros += expected == 0;
+      ASSERT_EQ(sign, expected) << "case " << n;
+    }
+    ASSERT_EQ(orient3d_exact(p[0], p[1], p[2], p[3]), expected) << "case " << n;
+  }
+  EXPECT_GT(fixed, 18000);
+  EXPECT_GT(zeros, 2000);
+  EXPECT_GT(rounded, 5000);
+  EXPECT_GT(flagged, 1000);
+}
+
 // orient3d's static filter (ccd/orientation.hpp) on coordinates mixed from the subnormals to
 // 2^495 within one query, where products underflow and are multiplied by huge differences: every
 // sign it decides is the rational one (it used to take a wrong sign from an underflowed product).
