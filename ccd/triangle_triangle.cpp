@@ -128,14 +128,41 @@ struct Triangle {
 // products (which sent such pairs to rational arithmetic).
 
 // Sign of the 2D orientation of (a, b, c) in coordinates (i, j): static filter, then exact.
-int orient2d(const Vector3d& a, const Vector3d& b, const Vector3d& c, int i, int j) {
-  const int s = detail::cross_component_static(a, b, c, i, j);
-  if (s != detail::kUndecided) return s;
+/// orient2d where the static filter could not decide, out of line (inlined, its arrays would cost
+/// its callers' frames on every call). As orient3d_exact (ccd/orientation.cpp): two coincident
+/// points answer 0; otherwise the expansion on fixed arrays, exact_sign (which may end in GMP) only
+/// where a leaf or a product leaves the range where its steps are exact. No dynamic filter: the
+/// static one failed with a bound on the differences, no looser than the dynamic one's on the
+/// coordinates.
+[[gnu::noinline]] int orient2d_exact(
+    const Vector3d& a, const Vector3d& b, const Vector3d& c, int i, int j) {
+  if ((a[i] == b[i] && a[j] == b[j]) || (a[i] == c[i] && a[j] == c[j]) ||
+      (b[i] == c[i] && b[j] == c[j])) {
+    return 0;
+  }
+  using detail::expansion_steps::unsafe_leaf;
+  bool unsafe = unsafe_leaf(a[i]) || unsafe_leaf(a[j]) || unsafe_leaf(b[i]) || unsafe_leaf(b[j]) ||
+                unsafe_leaf(c[i]) || unsafe_leaf(c[j]);
+  if (!unsafe) {
+    const int e = detail::cross2_sign(
+        detail::difference(b[i], a[i]),
+        detail::difference(b[j], a[j]),
+        detail::difference(c[i], a[i]),
+        detail::difference(c[j], a[j]),
+        unsafe);
+    if (!unsafe) return e;
+  }
   return exact_sign([&]<typename T>() -> T {
     const T ai = lift<T>(a[i]), aj = lift<T>(a[j]);
     return T(
         (lift<T>(b[i]) - ai) * (lift<T>(c[j]) - aj) - (lift<T>(b[j]) - aj) * (lift<T>(c[i]) - ai));
   });
+}
+
+int orient2d(const Vector3d& a, const Vector3d& b, const Vector3d& c, int i, int j) {
+  const int s = detail::cross_component_static(a, b, c, i, j);
+  if (s != detail::kUndecided) return s;
+  return orient2d_exact(a, b, c, i, j);
 }
 
 struct Projection {

@@ -196,6 +196,30 @@ struct Difference {
 #pragma GCC diagnostic pop
 }
 
+/// The sign of bx cy − by cx, exactly, for coordinates that are expansions of at most two
+/// components (differences of coordinates), on fixed arrays: at most 16 components. Raises
+/// `unsafe` as triple_product_top.
+[[nodiscard]] inline int cross2_sign(
+    const Difference& bx,
+    const Difference& by,
+    const Difference& cx,
+    const Difference& cy,
+    bool& unsafe) {
+  using namespace expansion_steps;
+  double left[8], right[8], all[16], scratch[16];
+  const int nl =
+      bx.n != 0 && cy.n != 0 ? product_into(bx.c, bx.n, cy.c, cy.n, left, scratch, unsafe) : 0;
+  const int nr =
+      by.n != 0 && cx.n != 0 ? product_into(by.c, by.n, cx.c, cx.n, right, scratch, unsafe) : 0;
+  const int n = add_into(left, nl, right, nr, -1.0, all);
+  if (n == 0) return 0;
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
+  const double top = all[n - 1];
+#pragma GCC diagnostic pop
+  return (top > 0.0) - (top < 0.0);
+}
+
 /// The sign of (u × v) · w, exactly (triple_product_top's arguments and `unsafe`).
 [[nodiscard]] inline int triple_product_sign(
     const Difference* u, const Difference* v, const Difference* w, bool& unsafe) {

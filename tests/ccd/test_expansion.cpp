@@ -85,7 +85,8 @@ TEST(Expansion, OrientationSignsAgreeWithRationals) {
 // component: grid points, coplanar or one ulp off) and rounded ones (two components: points far
 // from the origin relative to their spread, nearly coplanar, some exactly so after rounding), and
 // on coordinates mixed from 2^-1074 to 2^495 — every sign it gives without raising `unsafe` is
-// the rational one, and orient3d_exact's sign is the rational one on every case.
+// the rational one, and orient3d_exact's sign is the rational one on every case; and the same for
+// the 2-D cross product cross2_sign.
 TEST(Expansion, FixedSizeTripleProductIsTheRationalSign) {
   std::mt19937_64 rng(59);
   std::uniform_real_distribution<double> unit(-1.0, 1.0);
@@ -93,7 +94,7 @@ TEST(Expansion, FixedSizeTripleProductIsTheRationalSign) {
   std::uniform_int_distribution<int> scale_exp(-60, 60);
   std::uniform_int_distribution<int> pick(0, 11);
   const int exponents[] = {-1074, -1060, -1022, -700, -540, -401, -100, 0, 100, 300, 495, 0};
-  int fixed = 0, zeros = 0, rounded = 0, flagged = 0;
+  int fixed = 0, zeros = 0, rounded = 0, flagged = 0, crosses = 0;
   for (int n = 0; n < 30000; ++n) {
     const double s = std::ldexp(1.0, scale_exp(rng));
     Eigen::Vector3d p[4];
@@ -139,7 +140,20 @@ TEST(Expansion, FixedSizeTripleProductIsTheRationalSign) {
       ASSERT_EQ(sign, expected) << "case " << n;
     }
     ASSERT_EQ(orient3d_exact(p[0], p[1], p[2], p[3]), expected) << "case " << n;
+    // The 2-D cross product of the same differences in the plane (x, y) (cross2_sign, which
+    // triangles_intersect's coplanar tests take).
+    bool unsafe2 = unsafe;
+    const int sign2 = cross2_sign(u[0], u[1], v[0], v[1], unsafe2);
+    if (!unsafe2) {
+      const mpq_class cross2 =
+          (mpq_class(p[1].x()) - mpq_class(p[0].x())) *
+              (mpq_class(p[2].y()) - mpq_class(p[0].y())) -
+          (mpq_class(p[1].y()) - mpq_class(p[0].y())) * (mpq_class(p[2].x()) - mpq_class(p[0].x()));
+      ASSERT_EQ(sign2, rational_sign_of(cross2)) << "case " << n;
+      ++crosses;
+    }
   }
+  EXPECT_GT(crosses, 18000);
   EXPECT_GT(fixed, 18000);
   EXPECT_GT(zeros, 2000);
   EXPECT_GT(rounded, 5000);
