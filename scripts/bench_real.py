@@ -281,13 +281,15 @@ def main():
         tri = r.get("triangles", 0)
         ccd = r["ccd"]
         if dcd:
-            speed = [d["speedup"] for d in dcd]
-            inc_speed = [d["speedup"] for d in inc]
+            # dcd_vs_cgal gives a null speed-up where a time is below its clock's resolution.
+            speed = [d["speedup"] for d in dcd if d["speedup"] is not None]
+            inc_speed = [d["speedup"] for d in inc if d["speedup"] is not None]
             inc_cols = (f"{sum(d['skelcd_ms'] for d in inc) / len(inc):.4f} | "
-                        f"{geomean(inc_speed):.0f} ({min(inc_speed):.0f})") if inc else "– | –"
+                        f"{geomean(inc_speed):.0f} ({min(inc_speed):.0f})") if inc_speed else "– | –"
+            speed_cols = f"{geomean(speed):.2f} ({min(speed):.2f})" if speed else "–"
             dcd_cols = (f"{len(dcd)} | {sum(d['skelcd_ms'] for d in dcd) / len(dcd):.2f} | "
                         f"{sum(d['cgal_ms'] for d in dcd) / len(dcd):.2f} | "
-                        f"{geomean(speed):.2f} ({min(speed):.2f}) | {inc_cols} | "
+                        f"{speed_cols} | {inc_cols} | "
                         f"{max(d['skelcd_pairs'] for d in dcd)}")
             if tri >= args.min_triangles:
                 all_frames += speed

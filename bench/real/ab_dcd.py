@@ -70,14 +70,21 @@ def main():
             old, new = best
             if sorted(old) != sorted(new):
                 raise RuntimeError(f"{model}: the two binaries posed other samples")
-            ratios = [old[s]["skelcd_ms"] / new[s]["skelcd_ms"] for s in sorted(new)]
+            # A frame timed at 0 ms (below the clock: a model with no pair to test) has no ratio.
+            ratios = [old[s]["skelcd_ms"] / new[s]["skelcd_ms"] for s in sorted(new)
+                      if old[s]["skelcd_ms"] > 0 and new[s]["skelcd_ms"] > 0]
             tests = [sum(side[s].get("tt_tests", 0) for s in side) for side in best]
-            vs_cgal = [geometric_mean([side[s]["cgal_ms"] / side[s]["skelcd_ms"] for s in side])
-                       for side in best]
+            vs_cgal = [[side[s]["cgal_ms"] / side[s]["skelcd_ms"] for s in side
+                        if side[s]["cgal_ms"] > 0 and side[s]["skelcd_ms"] > 0] for side in best]
+            if not ratios or not all(vs_cgal):
+                print(f"{model}: frames below the clock's resolution, no ratio; "
+                      f"triangle tests {tests[0]} -> {tests[1]}", flush=True)
+                continue
             print(f"{model}: old/new ms {geometric_mean(ratios):.3f} "
                   f"(min {min(ratios):.3f}, max {max(ratios):.3f}); "
                   f"triangle tests {tests[0]} -> {tests[1]}; "
-                  f"x CGAL old {vs_cgal[0]:.2f}, new {vs_cgal[1]:.2f}", flush=True)
+                  f"x CGAL old {geometric_mean(vs_cgal[0]):.2f}, "
+                  f"new {geometric_mean(vs_cgal[1]):.2f}", flush=True)
     except (RuntimeError, OSError, json.JSONDecodeError, KeyError) as error:
         print(f"ab_dcd: {error}", file=sys.stderr)
         return 1

@@ -348,6 +348,16 @@ Comparison compare(
   return c;
 }
 
+/// a / b for the JSON output, or null where it is not a number (a time below the clock's
+/// resolution: JSON has no infinity).
+std::string json_ratio(double a, double b) {
+  const double r = a / b;
+  if (!std::isfinite(r)) return "null";
+  char text[32];
+  std::snprintf(text, sizeof text, "%.4f", r);
+  return text;
+}
+
 std::string quoted(const std::string& s) {
   std::string out = "\"";
   for (const char ch : s) {
@@ -432,7 +442,7 @@ int run(const Arguments& args) {
       if (args.json) {
         std::printf(
             "{\"model\": %s, \"sample\": %d, \"triangles\": %lld, \"method\": %s, "
-            "\"skelcd_ms\": %.4f, \"cgal_ms\": %.4f, \"speedup\": %.4f, \"skelcd_pairs\": %zu, "
+            "\"skelcd_ms\": %.4f, \"cgal_ms\": %.4f, \"speedup\": %s, \"skelcd_pairs\": %zu, "
             "\"cgal_pairs\": %zu, \"same\": %zu, \"skelcd_only\": %zu, \"cgal_only\": %zu, "
             "\"cgal_extra_at_duplicated\": %zu, \"cgal_duplicated_vertices\": %zu, "
             "\"removed_excluded\": %zu, \"removed_duplicate_faces\": %zu, \"tt_tests\": %lld, "
@@ -443,7 +453,7 @@ int run(const Arguments& args) {
             quoted(args.methods[m]).c_str(),
             ms,
             cgal_ms,
-            cgal_ms / ms,
+            json_ratio(cgal_ms, ms).c_str(),
             result.dcd_pairs.size(),
             c.cgal_pairs,
             c.same,
