@@ -16,6 +16,26 @@ inline bool exact_difference(double x, double y, double& d) {
   return (x - a_virtual) + (b_virtual - y) == 0.0;
 }
 
+/// The sign of (b − a) × (c − a) · (d − a) by detail::triple_product_sign, each difference a
+/// two-component expansion; `unsafe` raised (and the result meaningless) where a coordinate or a
+/// product leaves the range where the expansion's steps are exact, as Expansion's checks would.
+int fixed_triple_sign(
+    const double* a, const double* b, const double* c, const double* d, bool& unsafe) {
+  using detail::expansion_steps::unsafe_leaf;
+  for (int k = 0; k < 3; ++k) {
+    unsafe =
+        unsafe || unsafe_leaf(a[k]) || unsafe_leaf(b[k]) || unsafe_leaf(c[k]) || unsafe_leaf(d[k]);
+  }
+  if (unsafe) return 0;
+  std::array<detail::Difference, 3> u, v, w;
+  for (std::size_t k = 0; k < 3; ++k) {
+    u[k] = detail::difference(b[k], a[k]);
+    v[k] = detail::difference(c[k], a[k]);
+    w[k] = detail::difference(d[k], a[k]);
+  }
+  return detail::triple_product_sign(u.data(), v.data(), w.data(), unsafe);
+}
+
 }  // namespace
 
 int orient3d_exact(
@@ -53,22 +73,10 @@ int orient3d_exact(
     // exact_sign's, both being exact, without its heap and copies); exact_sign where a product
     // may not be exact. No dynamic filter before it: orient3d's static filter, which failed before
     // any call here, bounds the same products no looser.
+    constexpr double kOrigin[3] = {0.0, 0.0, 0.0};
     bool unsafe = false;
-    for (int k = 0; k < 3; ++k) {
-      unsafe = unsafe || detail::expansion_steps::unsafe_leaf(u[k]) ||
-               detail::expansion_steps::unsafe_leaf(v[k]) ||
-               detail::expansion_steps::unsafe_leaf(w[k]);
-    }
-    if (!unsafe) {
-      std::array<detail::Difference, 3> du, dv, dw;
-      for (std::size_t k = 0; k < 3; ++k) {
-        du[k] = detail::difference(u[k], 0.0);
-        dv[k] = detail::difference(v[k], 0.0);
-        dw[k] = detail::difference(w[k], 0.0);
-      }
-      const int s = detail::triple_product_sign(du.data(), dv.data(), dw.data(), unsafe);
-      if (!unsafe) return s;
-    }
+    const int s = fixed_triple_sign(kOrigin, u, v, w, unsafe);
+    if (!unsafe) return s;
     return detail::exact_sign(triple);
   }
   const auto general = [&]<typename T>() -> T {
@@ -85,23 +93,8 @@ int orient3d_exact(
   // coordinates would bound the error by their magnitudes, looser than the static filter's bound
   // on the differences).
   bool unsafe = false;
-  for (int k = 0; k < 3; ++k) {
-    unsafe = unsafe || detail::expansion_steps::unsafe_leaf(a[k]) ||
-             detail::expansion_steps::unsafe_leaf(b[k]) ||
-             detail::expansion_steps::unsafe_leaf(c[k]) ||
-             detail::expansion_steps::unsafe_leaf(d[k]);
-  }
-  if (!unsafe) {
-    std::array<detail::Difference, 3> du, dv, dw;
-    for (std::size_t k = 0; k < 3; ++k) {
-      const auto i = static_cast<Eigen::Index>(k);
-      du[k] = detail::difference(b[i], a[i]);
-      dv[k] = detail::difference(c[i], a[i]);
-      dw[k] = detail::difference(d[i], a[i]);
-    }
-    const int s = detail::triple_product_sign(du.data(), dv.data(), dw.data(), unsafe);
-    if (!unsafe) return s;
-  }
+  const int s = fixed_triple_sign(a.data(), b.data(), c.data(), d.data(), unsafe);
+  if (!unsafe) return s;
   return detail::exact_sign(general);
 }
 
