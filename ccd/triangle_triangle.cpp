@@ -127,7 +127,6 @@ struct Triangle {
 // not run into the exact zeros that a plane parallel to a coordinate plane gives 3D cross
 // products (which sent such pairs to rational arithmetic).
 
-// Sign of the 2D orientation of (a, b, c) in coordinates (i, j): static filter, then exact.
 /// orient2d where the static filter could not decide, out of line (inlined, its arrays would cost
 /// its callers' frames on every call). As orient3d_exact (ccd/orientation.cpp): two coincident
 /// points answer 0; otherwise the expansion on fixed arrays, exact_sign (which may end in GMP) only
@@ -159,6 +158,7 @@ struct Triangle {
   });
 }
 
+// Sign of the 2D orientation of (a, b, c) in coordinates (i, j): static filter, then exact.
 int orient2d(const Vector3d& a, const Vector3d& b, const Vector3d& c, int i, int j) {
   const int s = detail::cross_component_static(a, b, c, i, j);
   if (s != detail::kUndecided) return s;

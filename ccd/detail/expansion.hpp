@@ -155,14 +155,13 @@ struct Difference {
   return d;
 }
 
-/// The largest component of (u × v) · w computed exactly as an expansion on fixed arrays (no
-/// allocation; 0 when the value is 0), for vectors whose coordinates are expansions of at most two
-/// components (differences of coordinates; one component where the difference is exact) — at
-/// most 192 components, which an Expansion would build on the heap. Its sign is the value's, and
-/// the value lies within 2^-52 of it relatively (the components below it are nonoverlapping).
-/// Raises `unsafe` (the result is then meaningless) where a product leaves two-product's exact
-/// range (expansion_steps::two_product); the callers check the leaves as Expansion does.
-[[nodiscard]] inline double triple_product_top(
+/// The sign of (u × v) · w computed exactly as an expansion on fixed arrays (no allocation), for
+/// vectors whose coordinates are expansions of at most two components (differences of
+/// coordinates; one component where the difference is exact) — at most 192 components, which an
+/// Expansion would build on the heap. Raises `unsafe` (the sign is then meaningless) where a
+/// product leaves two-product's exact range (expansion_steps::two_product); the callers check the
+/// leaves as Expansion does.
+[[nodiscard]] inline int triple_product_sign(
     const Difference* u, const Difference* v, const Difference* w, bool& unsafe) {
   using namespace expansion_steps;
   // (u × v)_k = u_i v_j − u_j v_i (i = k + 1, j = k + 2): up to 8 + 8 components; times w_k.
@@ -188,17 +187,18 @@ struct Difference {
   double all[192];
   const int np = add_into(terms[0], sizes[0], terms[1], sizes[1], 1.0, pair);
   const int n = add_into(pair, np, terms[2], sizes[2], 1.0, all);
-  if (n == 0) return 0.0;
+  if (n == 0) return 0;
     // all[0 .. n) is written (add_into returns what it wrote); GCC cannot see it through the calls.
 #pragma GCC diagnostic push
 #pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
-  return all[n - 1];
+  const double top = all[n - 1];
 #pragma GCC diagnostic pop
+  return (top > 0.0) - (top < 0.0);
 }
 
 /// The sign of bx cy − by cx, exactly, for coordinates that are expansions of at most two
 /// components (differences of coordinates), on fixed arrays: at most 16 components. Raises
-/// `unsafe` as triple_product_top.
+/// `unsafe` as triple_product_sign.
 [[nodiscard]] inline int cross2_sign(
     const Difference& bx,
     const Difference& by,
@@ -217,13 +217,6 @@ struct Difference {
 #pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
   const double top = all[n - 1];
 #pragma GCC diagnostic pop
-  return (top > 0.0) - (top < 0.0);
-}
-
-/// The sign of (u × v) · w, exactly (triple_product_top's arguments and `unsafe`).
-[[nodiscard]] inline int triple_product_sign(
-    const Difference* u, const Difference* v, const Difference* w, bool& unsafe) {
-  const double top = triple_product_top(u, v, w, unsafe);
   return (top > 0.0) - (top < 0.0);
 }
 
