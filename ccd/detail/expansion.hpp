@@ -120,6 +120,17 @@ inline int add_into(const double* e, int m, const double* f, int n, double s, do
   return sum_into(e, m, f, n, s, h);
 }
 
+/// The sign of an expansion of n components (its largest, the last; 0 when n is 0).
+[[nodiscard]] inline int sign_of(const double* e, int n) {
+  if (n == 0) return 0;
+    // e[0 .. n) was written by the step that returned n; GCC cannot see it through the calls.
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
+  const double top = e[n - 1];
+#pragma GCC diagnostic pop
+  return (top > 0.0) - (top < 0.0);
+}
+
 }  // namespace expansion_steps
 
 /// h = e f (e of m > 0 components, f of n > 0, nonzero; each of f's components times e, summed):
@@ -187,13 +198,7 @@ struct Difference {
   double all[192];
   const int np = add_into(terms[0], sizes[0], terms[1], sizes[1], 1.0, pair);
   const int n = add_into(pair, np, terms[2], sizes[2], 1.0, all);
-  if (n == 0) return 0;
-    // all[0 .. n) is written (add_into returns what it wrote); GCC cannot see it through the calls.
-#pragma GCC diagnostic push
-#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
-  const double top = all[n - 1];
-#pragma GCC diagnostic pop
-  return (top > 0.0) - (top < 0.0);
+  return sign_of(all, n);
 }
 
 /// The sign of bx cy − by cx, exactly, for coordinates that are expansions of at most two
@@ -211,13 +216,7 @@ struct Difference {
       bx.n != 0 && cy.n != 0 ? product_into(bx.c, bx.n, cy.c, cy.n, left, scratch, unsafe) : 0;
   const int nr =
       by.n != 0 && cx.n != 0 ? product_into(by.c, by.n, cx.c, cx.n, right, scratch, unsafe) : 0;
-  const int n = add_into(left, nl, right, nr, -1.0, all);
-  if (n == 0) return 0;
-#pragma GCC diagnostic push
-#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
-  const double top = all[n - 1];
-#pragma GCC diagnostic pop
-  return (top > 0.0) - (top < 0.0);
+  return sign_of(all, add_into(left, nl, right, nr, -1.0, all));
 }
 
 class Expansion {
