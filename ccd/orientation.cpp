@@ -5,38 +5,6 @@
 #include "ccd/detail/filtered.hpp"
 
 namespace skelcd::ccd {
-namespace {
-
-/// d = fl(x − y); true when that is x − y exactly: the tail of Knuth's two-difference is zero.
-/// False for infinities and NaN (the tail is then NaN).
-inline bool exact_difference(double x, double y, double& d) {
-  d = x - y;
-  const double b_virtual = x - d;
-  const double a_virtual = d + b_virtual;
-  return (x - a_virtual) + (b_virtual - y) == 0.0;
-}
-
-/// The sign of (b − a) × (c − a) · (d − a) by detail::triple_product_sign, each difference a
-/// two-component expansion; `unsafe` raised (and the result meaningless) where a coordinate or a
-/// product leaves the range where the expansion's steps are exact, as Expansion's checks would.
-int fixed_triple_sign(
-    const double* a, const double* b, const double* c, const double* d, bool& unsafe) {
-  using detail::expansion_steps::unsafe_leaf;
-  for (int k = 0; k < 3; ++k) {
-    unsafe =
-        unsafe || unsafe_leaf(a[k]) || unsafe_leaf(b[k]) || unsafe_leaf(c[k]) || unsafe_leaf(d[k]);
-  }
-  if (unsafe) return 0;
-  std::array<detail::Difference, 3> u, v, w;
-  for (std::size_t k = 0; k < 3; ++k) {
-    u[k] = detail::difference(b[k], a[k]);
-    v[k] = detail::difference(c[k], a[k]);
-    w[k] = detail::difference(d[k], a[k]);
-  }
-  return detail::triple_product_sign(u.data(), v.data(), w.data(), unsafe);
-}
-
-}  // namespace
 
 int orient3d_exact(
     const Eigen::Vector3d& a,
@@ -44,58 +12,62 @@ int orient3d_exact(
     const Eigen::Vector3d& c,
     const Eigen::Vector3d& d) {
   using detail::lift;
-  // The coordinates of a real mesh mostly differ exactly in double (those read from 32-bit
-  // files always do, unless their exponents are more than 28 apart): the determinant is then a
+  using detail::expansion_steps::unsafe_leaf;
+  // The differences b − a, c − a, d − a, each as an expansion of at most two components (Knuth's
+  // two-difference; one when it is exact, none when it is zero; NaN and infinities leave two).
+  // The coordinates of a real mesh mostly differ exactly in double (those read from 32-bit files
+  // always do, unless their exponents are more than 28 apart): the determinant is then a
   // polynomial in three exact difference vectors, and what reaches this call — the filter could
   // not decide — is mostly an exact zero, often of corners in one axis plane (a flat cloth, a
   // mesh's flat parts).
-  double u[3];
-  double v[3];
-  double w[3];
+  std::array<detail::Difference, 3> u, v, w;
   bool exact = true;
-  for (int k = 0; k < 3; ++k) {
-    exact &= exact_difference(b[k], a[k], u[k]);
-    exact &= exact_difference(c[k], a[k], v[k]);
-    exact &= exact_difference(d[k], a[k], w[k]);
+  for (std::size_t k = 0; k < 3; ++k) {
+    const auto i = static_cast<Eigen::Index>(k);
+    u[k] = detail::difference(b[i], a[i]);
+    v[k] = detail::difference(c[i], a[i]);
+    w[k] = detail::difference(d[i], a[i]);
+    exact = exact && u[k].n <= 1 && v[k].n <= 1 && w[k].n <= 1;
+  }
+  // A zero row of the determinant (the four points in the plane x_k = a_k: those three
+  // differences are exact zeros however the others round), or two points that coincide: 0
+  // without an expansion.
+  for (std::size_t k = 0; k < 3; ++k) {
+    if (u[k].n == 0 && v[k].n == 0 && w[k].n == 0) return 0;
+  }
+  if (b == c || b == d || c == d) return 0;
+  // The expansion on fixed arrays (detail::triple_product_sign: the same sign as exact_sign's,
+  // both being exact, without its heap and copies), its leaves checked as exact_sign's Expansion
+  // checks them — the exact differences where they are exact, else the coordinates; exact_sign
+  // where a leaf or a product may not be exact. No dynamic filter before it: orient3d's static
+  // filter, which failed before any call here, bounds the same products by the differences'
+  // magnitudes, no looser (the dynamic filter on the coordinates would bound them by the
+  // coordinates').
+  const auto value = [](const detail::Difference& e) { return e.n == 0 ? 0.0 : e.c[0]; };
+  bool unsafe = false;
+  for (std::size_t k = 0; k < 3; ++k) {
+    const auto i = static_cast<Eigen::Index>(k);
+    unsafe =
+        unsafe ||
+        (exact ? unsafe_leaf(value(u[k])) || unsafe_leaf(value(v[k])) || unsafe_leaf(value(w[k]))
+               : unsafe_leaf(a[i]) || unsafe_leaf(b[i]) || unsafe_leaf(c[i]) || unsafe_leaf(d[i]));
+  }
+  if (!unsafe) {
+    const int s = detail::triple_product_sign(u.data(), v.data(), w.data(), unsafe);
+    if (!unsafe) return s;
   }
   if (exact) {
-    for (int k = 0; k < 3; ++k) {
-      // A zero row of the determinant: the four points lie in the plane x_k = a_k.
-      if (u[k] == 0.0 && v[k] == 0.0 && w[k] == 0.0) return 0;
-    }
-    const auto triple = [&]<typename T>() -> T {
-      const detail::Point3<T> pu{lift<T>(u[0]), lift<T>(u[1]), lift<T>(u[2])};
-      const detail::Point3<T> pv{lift<T>(v[0]), lift<T>(v[1]), lift<T>(v[2])};
-      const detail::Point3<T> pw{lift<T>(w[0]), lift<T>(w[1]), lift<T>(w[2])};
+    return detail::exact_sign([&]<typename T>() -> T {
+      const detail::Point3<T> pu{lift<T>(value(u[0])), lift<T>(value(u[1])), lift<T>(value(u[2]))};
+      const detail::Point3<T> pv{lift<T>(value(v[0])), lift<T>(value(v[1])), lift<T>(value(v[2]))};
+      const detail::Point3<T> pw{lift<T>(value(w[0])), lift<T>(value(w[1])), lift<T>(value(w[2]))};
       return detail::dot(detail::cross(pu, pv), pw);
-    };
-    // The expansion on fixed arrays first (detail::triple_product_sign: the same sign as
-    // exact_sign's, both being exact, without its heap and copies); exact_sign where a product
-    // may not be exact. No dynamic filter before it: orient3d's static filter, which failed before
-    // any call here, bounds the same products no looser.
-    constexpr double kOrigin[3] = {0.0, 0.0, 0.0};
-    bool unsafe = false;
-    const int s = fixed_triple_sign(kOrigin, u, v, w, unsafe);
-    if (!unsafe) return s;
-    return detail::exact_sign(triple);
+    });
   }
-  const auto general = [&]<typename T>() -> T {
+  return detail::exact_sign([&]<typename T>() -> T {
     const auto pa = lift<T>(a);
     return detail::dot(detail::cross(lift<T>(b) - pa, lift<T>(c) - pa), lift<T>(d) - pa);
-  };
-  // Two points that coincide, or the four in one axis plane (a zero row, its differences exact
-  // zeros however the others round): 0 without an expansion.
-  if (b == c || b == d || c == d) return 0;
-  for (Eigen::Index k = 0; k < 3; ++k) {
-    if (b[k] == a[k] && c[k] == a[k] && d[k] == a[k]) return 0;
-  }
-  // As above, on the differences as two-component expansions (the dynamic filter on the
-  // coordinates would bound the error by their magnitudes, looser than the static filter's bound
-  // on the differences).
-  bool unsafe = false;
-  const int s = fixed_triple_sign(a.data(), b.data(), c.data(), d.data(), unsafe);
-  if (!unsafe) return s;
-  return detail::exact_sign(general);
+  });
 }
 
 }  // namespace skelcd::ccd
