@@ -1,0 +1,105 @@
+// The skelcd executable's operator new (tools/cli/large_pages.hpp), linked into this test binary as
+// into the executable: where large allocations land and what the kernel was told about them.
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cstdint>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <memory>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "tools/cli/large_pages.hpp"
+
+namespace skelcd::tools {
+namespace {
+
+/// The VmFlags line of the mapping of /proc/self/smaps that holds `address` ("" when none does).
+std::string vm_flags_at(const void* address) {
+  const auto a = reinterpret_cast<std::uintptr_t>(address);
+  std::ifstream smaps("/proc/self/smaps");
+  std::string line;
+  bool inside = false;
+  while (std::getline(smaps, line)) {
+    std::uintptr_t lo = 0;
+    std::uintptr_t hi = 0;
+    char dash = 0;
+    std::istringstream head(line);
+    if (head >> std::hex >> lo >> dash >> hi && dash == '-') {
+      inside = lo <= a && a < hi;
+    } else if (inside && line.rfind("VmFlags:", 0) == 0) {
+      return line;
+    }
+  }
+  return "";
+}
+
+bool kernel_has_huge_pages() {
+  return std::filesystem::exists("/sys/kernel/mm/transparent_hugepage/enabled");
+}
+
+TEST(LargePages, OnlyZeroOffAndNoTurnThemOff) {
+  EXPECT_TRUE(large_pages_wanted(nullptr));
+  EXPECT_TRUE(large_pages_wanted("1"));
+  EXPECT_TRUE(large_pages_wanted(""));
+  EXPECT_FALSE(large_pages_wanted("0"));
+  EXPECT_FALSE(large_pages_wanted("off"));
+  EXPECT_FALSE(large_pages_wanted("no"));
+}
+
+TEST(LargePages, OnlyWholeHugePagesOfAnAlignedBlockAreAdvised) {
+  const auto* aligned = reinterpret_cast<const void*>(std::uintptr_t{7} * kHugePage);
+  EXPECT_EQ(advised_length(aligned, 3 * kHugePage + 17), 3 * kHugePage);
+  EXPECT_EQ(advised_length(aligned, kHugePage), kHugePage);
+  EXPECT_EQ(advised_length(aligned, kHugePage - 1), 0U);
+  const auto* off = reinterpret_cast<const void*>(std::uintptr_t{7} * kHugePage + 4096);
+  EXPECT_EQ(advised_length(off, 3 * kHugePage), 0U);
+}
+
+// Run in this process (SKELCD_LARGE_PAGES unset: on) and again by the next test in a child with
+// SKELCD_LARGE_PAGES=0 (off): what a large vector gets must follow the setting either way.
+TEST(LargePages, ALargeVectorFollowsTheSetting) {
+  const bool on = large_pages_wanted(std::getenv("SKELCD_LARGE_PAGES"));
+  std::vector<float> large(3 * kHugePage / sizeof(float) + 5, 1.0F);  // 6 MiB and a little
+  const void* data = large.data();
+  const bool aligned = reinterpret_cast<std::uintptr_t>(data) % kHugePage == 0;
+  const std::string flags = vm_flags_at(data);
+  ASSERT_FALSE(flags.empty()) << "no mapping of /proc/self/smaps holds the vector";
+  const bool advised = flags.find(" hg") != std::string::npos;
+  if (on) {
+    EXPECT_TRUE(aligned) << data;
+    EXPECT_EQ(advised, kernel_has_huge_pages()) << flags;
+    // The array form goes the same way.
+    const std::unique_ptr<double[]> array(new double[kHugePage / sizeof(double) * 2]);
+    EXPECT_EQ(reinterpret_cast<std::uintptr_t>(array.get()) % kHugePage, 0U);
+  } else {
+    // malloc's own mapping: its block starts past the chunk's header, never on a boundary.
+    EXPECT_FALSE(aligned) << data;
+    EXPECT_FALSE(advised) << flags;
+  }
+}
+
+TEST(LargePages, TheEnvironmentTurnsThemOff) {
+  const pid_t child = fork();
+  ASSERT_GE(child, 0);
+  if (child == 0) {
+    setenv("SKELCD_LARGE_PAGES", "0", 1);
+    execl(
+        "/proc/self/exe",
+        "large_pages_child",
+        "--gtest_filter=LargePages.ALargeVectorFollowsTheSetting",
+        static_cast<char*>(nullptr));
+    _exit(127);
+  }
+  int status = 0;
+  ASSERT_EQ(waitpid(child, &status, 0), child);
+  ASSERT_TRUE(WIFEXITED(status));
+  EXPECT_EQ(WEXITSTATUS(status), 0);
+}
+
+}  // namespace
+}  // namespace skelcd::tools

@@ -1,0 +1,59 @@
+// The skelcd executable's global `operator new` (large_pages.hpp): linked into the executable and
+// its own test only, never into the libraries (python/ and the other tests keep the default one).
+#include "tools/cli/large_pages.hpp"
+
+#include <sys/mman.h>
+
+#include <cstdlib>
+#include <cstring>
+#include <new>
+
+namespace skelcd::tools {
+
+bool large_pages_wanted(const char* env) noexcept {
+  if (env == nullptr) return true;
+  return std::strcmp(env, "0") != 0 && std::strcmp(env, "off") != 0 && std::strcmp(env, "no") != 0;
+}
+
+std::size_t advised_length(const void* begin, std::size_t bytes) noexcept {
+  if (reinterpret_cast<std::uintptr_t>(begin) % kHugePage != 0) return 0;
+  return bytes - bytes % kHugePage;
+}
+
+namespace {
+
+bool large_pages_on() noexcept {
+  static const bool on = large_pages_wanted(std::getenv("SKELCD_LARGE_PAGES"));
+  return on;
+}
+
+/// A large allocation on a huge-page boundary, its whole huge pages advised; nullptr when
+/// posix_memalign fails (the caller then goes the ordinary way, new_handler included).
+void* allocate_large(std::size_t bytes) noexcept {
+  void* p = nullptr;
+  if (posix_memalign(&p, kHugePage, bytes) != 0) return nullptr;
+  // Advice only: a kernel without transparent huge pages answers EINVAL and the pages stay small.
+  if (const std::size_t length = advised_length(p, bytes); length != 0) {
+    madvise(p, length, MADV_HUGEPAGE);
+  }
+  return p;
+}
+
+}  // namespace
+}  // namespace skelcd::tools
+
+// The replaceable allocation functions ([new.delete.single]): the nothrow and array forms of
+// libstdc++ call this one, and its operator delete calls free(), which releases both kinds.
+void* operator new(std::size_t bytes) {
+  if (bytes >= skelcd::tools::kLargePageMin && skelcd::tools::large_pages_on()) {
+    if (void* p = skelcd::tools::allocate_large(bytes)) return p;
+  }
+  for (;;) {
+    if (void* p = std::malloc(bytes == 0 ? 1 : bytes)) return p;
+    const std::new_handler handler = std::get_new_handler();
+    if (handler == nullptr) throw std::bad_alloc();
+    handler();
+  }
+}
+
+void* operator new[](std::size_t bytes) { return ::operator new(bytes); }

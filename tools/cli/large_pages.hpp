@@ -1,0 +1,30 @@
+// Large allocations on transparent huge pages (docs/cli.md, "Large allocations"). The skelcd
+// executable replaces the global `operator new`: an allocation of at least kLargePageMin bytes is
+// placed on a 2 MiB boundary and the whole huge pages inside it are advised MADV_HUGEPAGE, so that
+// its first touch costs one fault per 2 MiB instead of one per 4 KiB (on a VM a fault is dear:
+// docs/benchmarks.md, "Page faults, and malloc on transparent huge pages"). Everything else is
+// malloc's as before, and every allocation is still released by free(). SKELCD_LARGE_PAGES=0 in the
+// environment turns it off for the process.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+
+namespace skelcd::tools {
+
+/// The size of one transparent huge page on x86-64 (the kernel's PMD size).
+inline constexpr std::size_t kHugePage = std::size_t{1} << 21;
+
+/// Allocations from this size on are placed and advised (smaller ones hold no whole huge page).
+inline constexpr std::size_t kLargePageMin = kHugePage;
+
+/// Whether the environment's SKELCD_LARGE_PAGES value (nullptr when unset) leaves large pages on:
+/// only "0", "off" and "no" turn them off.
+bool large_pages_wanted(const char* env) noexcept;
+
+/// The whole huge pages of an allocation of `bytes` bytes at `begin`: the bytes to advise from
+/// `begin` (rounded down to kHugePage; the tail stays on small pages, so nothing beyond the
+/// allocation is advised). `begin` is expected on a kHugePage boundary; 0 when it is not.
+std::size_t advised_length(const void* begin, std::size_t bytes) noexcept;
+
+}  // namespace skelcd::tools
