@@ -38,6 +38,11 @@ std::string vm_flags_at(const void* address) {
   return "";
 }
 
+/// A cache line, as the feature stage's over-aligned records.
+struct alignas(64) Line64 {
+  double x[8];
+};
+
 bool kernel_has_huge_pages() {
   return std::filesystem::exists("/sys/kernel/mm/transparent_hugepage/enabled");
 }
@@ -64,23 +69,31 @@ TEST(LargePages, OnlyWholeHugePagesOfAnAlignedBlockAreAdvised) {
 // SKELCD_LARGE_PAGES=0 (off): what a large vector gets must follow the setting either way.
 TEST(LargePages, ALargeVectorFollowsTheSetting) {
   const bool on = large_pages_wanted(std::getenv("SKELCD_LARGE_PAGES"));
-  std::vector<float> large(3 * kHugePage / sizeof(float) + 5, 1.0F);  // 6 MiB and a little
-  const void* data = large.data();
-  const bool aligned = reinterpret_cast<std::uintptr_t>(data) % kHugePage == 0;
-  const std::string flags = vm_flags_at(data);
-  ASSERT_FALSE(flags.empty()) << "no mapping of /proc/self/smaps holds the vector";
-  const bool advised = flags.find(" hg") != std::string::npos;
-  if (on) {
-    EXPECT_TRUE(aligned) << data;
-    EXPECT_EQ(advised, kernel_has_huge_pages()) << flags;
-    // The array form goes the same way.
-    const std::unique_ptr<double[]> array(new double[kHugePage / sizeof(double) * 2]);
-    EXPECT_EQ(reinterpret_cast<std::uintptr_t>(array.get()) % kHugePage, 0U);
-  } else {
-    // malloc's own mapping: its block starts past the chunk's header, never on a boundary.
-    EXPECT_FALSE(aligned) << data;
-    EXPECT_FALSE(advised) << flags;
-  }
+  // Placed (on a 2 MiB boundary) and advised ("hg" in its mapping's VmFlags, where the kernel
+  // has transparent huge pages), or neither.
+  const auto expect_follows = [on](const void* data) {
+    const bool aligned = reinterpret_cast<std::uintptr_t>(data) % kHugePage == 0;
+    const std::string flags = vm_flags_at(data);
+    ASSERT_FALSE(flags.empty()) << "no mapping of /proc/self/smaps holds " << data;
+    const bool advised = flags.find(" hg") != std::string::npos;
+    if (on) {
+      EXPECT_TRUE(aligned) << data;
+      EXPECT_EQ(advised, kernel_has_huge_pages()) << flags;
+    } else {
+      // malloc's own mapping: its block starts past the chunk's header, never on a boundary.
+      EXPECT_FALSE(aligned) << data;
+      EXPECT_FALSE(advised) << flags;
+    }
+  };
+  const std::vector<float> large(3 * kHugePage / sizeof(float) + 5, 1.0F);  // 6 MiB and a little
+  expect_follows(large.data());
+  // An over-aligned type's vector (operator new with std::align_val_t), aligned either way.
+  const std::vector<Line64> lines(3 * kHugePage / sizeof(Line64));
+  EXPECT_EQ(reinterpret_cast<std::uintptr_t>(lines.data()) % alignof(Line64), 0U);
+  expect_follows(lines.data());
+  // The array form.
+  const std::unique_ptr<double[]> array(new double[kHugePage / sizeof(double) * 2]);
+  expect_follows(array.get());
 }
 
 TEST(LargePages, TheEnvironmentTurnsThemOff) {

@@ -4,6 +4,7 @@
 
 #include <sys/mman.h>
 
+#include <algorithm>
 #include <cstdlib>
 #include <cstring>
 #include <new>
@@ -43,7 +44,7 @@ void* allocate_large(std::size_t bytes) noexcept {
 }  // namespace skelcd::tools
 
 // The replaceable allocation functions ([new.delete.single]): the nothrow and array forms of
-// libstdc++ call this one, and its operator delete calls free(), which releases both kinds.
+// libstdc++ call these, and its operator delete calls free(), which releases both kinds.
 void* operator new(std::size_t bytes) {
   if (bytes >= skelcd::tools::kLargePageMin && skelcd::tools::large_pages_on()) {
     if (void* p = skelcd::tools::allocate_large(bytes)) return p;
@@ -57,3 +58,25 @@ void* operator new(std::size_t bytes) {
 }
 
 void* operator new[](std::size_t bytes) { return ::operator new(bytes); }
+
+// The over-aligned forms (types declared alignas(64): the feature stage's per-triangle records and
+// per-vertex end positions) the same way; below 2 MiB as libstdc++'s own, whose aligned delete
+// calls free() too.
+void* operator new(std::size_t bytes, std::align_val_t alignment) {
+  const auto align = std::max(static_cast<std::size_t>(alignment), sizeof(void*));
+  if (bytes >= skelcd::tools::kLargePageMin && align <= skelcd::tools::kHugePage &&
+      skelcd::tools::large_pages_on()) {
+    if (void* p = skelcd::tools::allocate_large(bytes)) return p;
+  }
+  for (;;) {
+    void* p = nullptr;
+    if (posix_memalign(&p, align, bytes == 0 ? 1 : bytes) == 0) return p;
+    const std::new_handler handler = std::get_new_handler();
+    if (handler == nullptr) throw std::bad_alloc();
+    handler();
+  }
+}
+
+void* operator new[](std::size_t bytes, std::align_val_t alignment) {
+  return ::operator new(bytes, alignment);
+}
