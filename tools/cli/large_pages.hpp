@@ -2,9 +2,9 @@
 // executable replaces the global `operator new`: an allocation of at least kLargePageMin bytes is
 // placed on a 2 MiB boundary and the whole huge pages inside it are advised MADV_HUGEPAGE, so that
 // its first touch costs one fault per 2 MiB instead of one per 4 KiB (on a VM a fault is dear:
-// docs/benchmarks.md, "Page faults, and malloc on transparent huge pages"). Everything else is
-// malloc's as before, and every allocation is still released by free(). SKELCD_LARGE_PAGES=0 in the
-// environment turns it off for the process.
+// docs/benchmarks.md, "Large allocations on huge pages"), in both forms, plain and over-aligned.
+// Everything else is allocated as before, and every block is still released by free().
+// SKELCD_LARGE_PAGES=0 in the environment turns it off for the process.
 #pragma once
 
 #include <cstddef>
