@@ -28,9 +28,11 @@ bool large_pages_on() noexcept {
   return on;
 }
 
-/// A large allocation on a huge-page boundary, its whole huge pages advised; nullptr when
-/// posix_memalign fails (the caller then goes the ordinary way, new_handler included).
-void* allocate_large(std::size_t bytes) noexcept {
+/// A block of `bytes` (alignment `align`, a power of two) on a huge-page boundary with its whole
+/// huge pages advised, when it is large, its alignment allows it and large pages are on; nullptr
+/// otherwise or when posix_memalign fails (the caller then goes the ordinary way).
+void* allocate_large(std::size_t bytes, std::size_t align) noexcept {
+  if (bytes < kLargePageMin || align > kHugePage || !large_pages_on()) return nullptr;
   void* p = nullptr;
   if (posix_memalign(&p, kHugePage, bytes) != 0) return nullptr;
   // Advice only: a kernel without transparent huge pages answers EINVAL and the pages stay small.
@@ -40,21 +42,26 @@ void* allocate_large(std::size_t bytes) noexcept {
   return p;
 }
 
+/// `allocate()` until it gives a block, calling the new_handler between tries; bad_alloc when
+/// there is none ([new.delete.single]).
+template <class Allocate>
+void* allocate_or_throw(Allocate allocate) {
+  for (;;) {
+    if (void* p = allocate()) return p;
+    const std::new_handler handler = std::get_new_handler();
+    if (handler == nullptr) throw std::bad_alloc();
+    handler();
+  }
+}
+
 }  // namespace
 }  // namespace skelcd::tools
 
 // The replaceable allocation functions ([new.delete.single]): the nothrow and array forms of
 // libstdc++ call these, and its operator delete calls free(), which releases both kinds.
 void* operator new(std::size_t bytes) {
-  if (bytes >= skelcd::tools::kLargePageMin && skelcd::tools::large_pages_on()) {
-    if (void* p = skelcd::tools::allocate_large(bytes)) return p;
-  }
-  for (;;) {
-    if (void* p = std::malloc(bytes == 0 ? 1 : bytes)) return p;
-    const std::new_handler handler = std::get_new_handler();
-    if (handler == nullptr) throw std::bad_alloc();
-    handler();
-  }
+  if (void* p = skelcd::tools::allocate_large(bytes, 0)) return p;
+  return skelcd::tools::allocate_or_throw([bytes] { return std::malloc(bytes == 0 ? 1 : bytes); });
 }
 
 void* operator new[](std::size_t bytes) { return ::operator new(bytes); }
@@ -64,17 +71,11 @@ void* operator new[](std::size_t bytes) { return ::operator new(bytes); }
 // calls free() too.
 void* operator new(std::size_t bytes, std::align_val_t alignment) {
   const auto align = std::max(static_cast<std::size_t>(alignment), sizeof(void*));
-  if (bytes >= skelcd::tools::kLargePageMin && align <= skelcd::tools::kHugePage &&
-      skelcd::tools::large_pages_on()) {
-    if (void* p = skelcd::tools::allocate_large(bytes)) return p;
-  }
-  for (;;) {
+  if (void* p = skelcd::tools::allocate_large(bytes, align)) return p;
+  return skelcd::tools::allocate_or_throw([bytes, align]() -> void* {
     void* p = nullptr;
-    if (posix_memalign(&p, align, bytes == 0 ? 1 : bytes) == 0) return p;
-    const std::new_handler handler = std::get_new_handler();
-    if (handler == nullptr) throw std::bad_alloc();
-    handler();
-  }
+    return posix_memalign(&p, align, bytes == 0 ? 1 : bytes) == 0 ? p : nullptr;
+  });
 }
 
 void* operator new[](std::size_t bytes, std::align_val_t alignment) {
