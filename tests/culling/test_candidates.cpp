@@ -8,10 +8,13 @@
 #include <bit>
 #include <cmath>
 #include <cstdint>
+#include <cstring>
 #include <limits>
 #include <numbers>
+#include <random>
 #include <set>
 #include <string>
+#include <tuple>
 #include <utility>
 
 #include "ccd/detail/relative_boxes.hpp"
@@ -20,6 +23,7 @@
 #include "culling/bvh.hpp"
 #include "culling/candidates.hpp"
 #include "culling/elementary.hpp"
+#include "culling/method.hpp"
 #include "culling/traversal.hpp"
 #include "culling/vertex_bounds.hpp"
 #include "skinning/errors.hpp"
@@ -521,6 +525,392 @@ TEST(CcdCandidates, EndsOnTheAxesAndDiagonalsDropOnlyPairsThatNeverTouchAndMatch
   EXPECT_GT(dropped, 0);
   EXPECT_GT(dropped_by_diagonal, 0);
   EXPECT_GT(dropped_by_feature_diagonal, 0);
+}
+
+/// The generated scenes, the same moved far from the origin (coordinates near 2^24, where a
+/// projection's rounding is about 2^-28: the planes' margin is what keeps their answers exact),
+/// and two real characters between two samples.
+std::vector<Scene> plane_scenes() {
+  std::vector<Scene> out = scenes();
+  const std::size_t generated = out.size();
+  for (std::size_t i = 0; i < generated; ++i) {
+    Scene far = out[i];
+    far.name += ", moved to 2^24";
+    const Eigen::Vector3d offset(0x1p24 * 1.37, -0x1p24 * 1.11, 0x1p23 * 1.73);
+    far.x_t0 = test::translated(far.x_t0, offset);
+    far.x_t1 = test::translated(far.x_t1, offset);
+    out.push_back(std::move(far));
+  }
+  for (const auto& [file, k] :
+       {std::pair{"stormtrooper/stormtrooper.dae", 7}, std::pair{"CesiumMan.glb", 10}}) {
+    const test::WeldedCharacter c(file);
+    out.push_back(Scene{file, *c.loaded.mesh, c.topology, c.sample(k), c.sample(k + 3)});
+  }
+  return out;
+}
+
+/// The exact projection x · d of a point on a plane's direction (its floats, exactly).
+mpq_class exact_projection_on(const double* x, const IntervalPlanes::Plane& p) {
+  mpq_class s = 0;
+  for (std::size_t c = 0; c < 3; ++c) s += mpq_class(x[c]) * mpq_class(static_cast<double>(p.d[c]));
+  return s;
+}
+
+/// Whether direction `p.d` holds the corners `a` (its own triangle's) and `b` strictly apart
+/// at t0 and at t1, the same way round, in exact arithmetic.
+bool exactly_apart_along(
+    const IntervalPlanes::Plane& p,
+    const Scene& s,
+    const std::array<std::int32_t, 3>& a,
+    const std::array<std::int32_t, 3>& b) {
+  int side = 0;
+  for (const skinning::Positions* x : {&s.x_t0, &s.x_t1}) {
+    std::vector<mpq_class> pa, pb;
+    for (const std::int32_t v : a) pa.push_back(exact_projection_on(&(*x)(v, 0), p));
+    for (const std::int32_t v : b) pb.push_back(exact_projection_on(&(*x)(v, 0), p));
+    const mpq_class a_lo = *std::min_element(pa.begin(), pa.end());
+    const mpq_class a_hi = *std::max_element(pa.begin(), pa.end());
+    const mpq_class b_lo = *std::min_element(pb.begin(), pb.end());
+    const mpq_class b_hi = *std::max_element(pb.begin(), pb.end());
+    const int here = a_hi < b_lo ? 1 : (b_hi < a_lo ? 2 : 0);
+    if (here == 0 || (side != 0 && here != side)) return false;
+    side = here;
+  }
+  return true;
+}
+
+TEST(IntervalPlanes, ExtentsHoldTheExactProjectionsAndApartIsExactlyApart) {
+  // Every triangle's extents hold its corners' exact projections at both ends, and every pair
+  // the planes call apart lies strictly apart in exact arithmetic along one of the two
+  // directions at both ends, the same way round — which is what makes the pair never touch
+  // (the projected difference of each corner pair is linear in t).
+  std::int64_t planes_checked = 0;
+  std::int64_t pairs_apart = 0;
+  std::int64_t pairs_asked = 0;
+  for (const Scene& s : plane_scenes()) {
+    SCOPED_TRACE(s.name);
+    const FeatureTopology t(s.mesh, s.topology);
+    IntervalPlanes planes;
+    planes.start(t, s.x_t0, s.x_t1);
+    // The same planes from the packed ends, bit for bit.
+    PackedEnds packed;
+    packed.pack(s.x_t0, s.x_t1);
+    IntervalPlanes from_packed;
+    from_packed.start(t, s.x_t0, s.x_t1, packed.data());
+    for (std::int32_t f = 0; f < t.num_triangles(); ++f) {
+      const IntervalPlanes::Plane& p = planes.plane(f);
+      ASSERT_EQ(std::memcmp(&p, &from_packed.plane(f), sizeof p), 0) << "triangle " << f;
+      if (std::isnan(p.e)) continue;  // no direction: never apart
+      ++planes_checked;
+      const auto& tri = t.triangle(f);
+      for (const auto& [x, lo, hi] :
+           {std::tuple{&s.x_t0, p.lo0, p.hi0}, std::tuple{&s.x_t1, p.lo1, p.hi1}}) {
+        for (const std::int32_t v : tri) {
+          const mpq_class e = exact_projection_on(&(*x)(v, 0), p);
+          ASSERT_LE(mpq_class(lo), e) << "triangle " << f;
+          ASSERT_LE(e, mpq_class(hi)) << "triangle " << f;
+        }
+      }
+    }
+    // The pairs a hierarchy hands over (their swept boxes overlap): where the planes matter.
+    const Built<3> b = bounds_of<3>(s, 0.0);
+    Bvh<3> bvh(t.welded_triangles(), s.x_t0, BvhOptions{4});
+    bvh.refit(b.bounds.triangles);
+    TraversalScratch scratch;
+    std::vector<TrianglePair> pairs;
+    std::int64_t bv_tests = 0;
+    self_traverse<3>(bvh, b.bounds.triangles, scratch, pairs, bv_tests);
+    // Every third pair: the rationals take their time.
+    for (std::size_t i = 0; i < pairs.size(); i += 3) {
+      const TrianglePair& pair = pairs[i];
+      ++pairs_asked;
+      const bool apart = planes.apart(pair.a, pair.b);
+      EXPECT_EQ(apart, planes.apart(pair.b, pair.a));
+      if (!apart) continue;
+      ++pairs_apart;
+      EXPECT_TRUE(
+          exactly_apart_along(planes.plane(pair.a), s, t.triangle(pair.a), t.triangle(pair.b)) ||
+          exactly_apart_along(planes.plane(pair.b), s, t.triangle(pair.b), t.triangle(pair.a)))
+          << "triangles " << pair.a << " and " << pair.b;
+    }
+  }
+  EXPECT_GT(planes_checked, 10000);
+  EXPECT_GT(pairs_apart, 10000);
+  EXPECT_LT(pairs_apart, pairs_asked);
+}
+
+TEST(IntervalPlanes, TheRoundingMarginKeepsTouchingTrianglesTogether) {
+  // Triangle B touches triangle A at the midpoint q of one of A's edges (exact in doubles), and
+  // its other corners lie well to one side of A. Far from the origin the rounded projections
+  // put q on either side of A's rounded extent; without the margin the test would call such
+  // pairs apart (counted below with the same roundings, to show the case bites), with it never.
+  std::mt19937_64 rng(14);
+  std::uniform_real_distribution<double> unit(-1.0, 1.0);
+  const int n = 2000;
+  skinning::Positions x(6 * n, 3);
+  skinning::Triangles f(2 * n, 3);
+  for (int i = 0; i < n; ++i) {
+    const Eigen::Vector3d origin(
+        0x1p30 * (1.5 + 0.4 * unit(rng)),
+        0x1p29 * (1.5 + 0.4 * unit(rng)),
+        -0x1p30 * (1.5 + 0.4 * unit(rng)));
+    const Eigen::Vector3d p0 = origin + Eigen::Vector3d(unit(rng), unit(rng), unit(rng));
+    const Eigen::Vector3d p1 = origin + Eigen::Vector3d(unit(rng), unit(rng), unit(rng)) * 0.5;
+    // p2 = p1 + 2 δ and q = p1 + δ, δ a whole number of p1's ulps in each coordinate: exact.
+    Eigen::Vector3d delta;
+    for (int c = 0; c < 3; ++c) {
+      const double ulp = std::nextafter(std::abs(p1[c]), INFINITY) - std::abs(p1[c]);
+      delta[c] = ulp * std::round(unit(rng) * 0x1p21);
+    }
+    const Eigen::Vector3d p2 = p1 + 2.0 * delta;
+    const Eigen::Vector3d q = p1 + delta;
+    ASSERT_EQ(q, 0.5 * (p1 + p2));
+    Eigen::Vector3d normal = (p1 - p0).cross(p2 - p0);
+    ASSERT_GT(normal.norm(), 0.0);
+    normal.normalize();
+    const Eigen::Vector3d along = (p2 - p1).normalized();
+    const Eigen::Vector3d b1 = q - 2.0 * normal + along;
+    const Eigen::Vector3d b2 = q - 2.0 * normal - along;
+    for (const auto& [k, p] :
+         {std::pair{0, p0},
+          std::pair{1, p1},
+          std::pair{2, p2},
+          std::pair{3, q},
+          std::pair{4, b1},
+          std::pair{5, b2}}) {
+      x.row(6 * i + k) = p.transpose();
+    }
+    f.row(2 * i) << 6 * i, 6 * i + 1, 6 * i + 2;
+    f.row(2 * i + 1) << 6 * i + 3, 6 * i + 4, 6 * i + 5;
+  }
+  const skinning::Mesh mesh = test::single_part_mesh(x, f, "touching");
+  const skinning::Topology topology = test::simple_topology(mesh);
+  const skinning::Positions welded = test::welded(topology, x);
+  ASSERT_EQ(welded.rows(), x.rows());
+  const FeatureTopology t(mesh, topology);
+  IntervalPlanes planes;
+  planes.start(t, welded, welded);  // at rest over the interval: touching throughout
+  int without_margin = 0;
+  for (int i = 0; i < n; ++i) {
+    const std::int32_t a = 2 * i;
+    const std::int32_t b = 2 * i + 1;
+    EXPECT_FALSE(planes.apart(a, b)) << "pair " << i;
+    // A's extent and B's on A's direction, with the same roundings and no margin.
+    const IntervalPlanes::Plane& p = planes.plane(a);
+    const auto project = [&](std::int32_t v) {
+      return (welded(v, 0) * static_cast<double>(p.d[0]) +
+              welded(v, 1) * static_cast<double>(p.d[1])) +
+             welded(v, 2) * static_cast<double>(p.d[2]);
+    };
+    double a_lo = INFINITY, a_hi = -INFINITY, b_lo = INFINITY, b_hi = -INFINITY;
+    for (const std::int32_t v : t.triangle(a)) {
+      a_lo = std::min(a_lo, project(v));
+      a_hi = std::max(a_hi, project(v));
+    }
+    for (const std::int32_t v : t.triangle(b)) {
+      b_lo = std::min(b_lo, project(v));
+      b_hi = std::max(b_hi, project(v));
+    }
+    without_margin += (a_hi < b_lo || b_hi < a_lo) ? 1 : 0;
+  }
+  EXPECT_GT(without_margin, 20) << "the case does not exercise the margin";
+}
+
+TEST(IntervalPlanes, ANonFiniteOrHugeCoordinateHoldsNothingApart) {
+  // One vertex at NaN, at infinity, or at 2^1021 (where a projection could overflow) anywhere in
+  // the mesh makes every extent unbounded: no pair is apart, not even the far ones.
+  const Scene s = scenes().front();
+  const FeatureTopology t(s.mesh, s.topology);
+  IntervalPlanes planes;
+  planes.start(t, s.x_t0, s.x_t1);
+  std::int64_t apart_before = 0;
+  const std::int32_t n = t.num_triangles();
+  for (std::int32_t a = 0; a < n; ++a) {
+    for (std::int32_t b = a + 1; b < n; ++b) apart_before += planes.apart(a, b) ? 1 : 0;
+  }
+  ASSERT_GT(apart_before, 100);
+  for (const double bad :
+       {std::numeric_limits<double>::quiet_NaN(),
+        std::numeric_limits<double>::infinity(),
+        -0x1p1021}) {
+    SCOPED_TRACE(bad);
+    skinning::Positions x_t1 = s.x_t1;
+    x_t1(x_t1.rows() - 1, 1) = bad;
+    planes.start(t, s.x_t0, x_t1);
+    for (std::int32_t a = 0; a < n; ++a) {
+      for (std::int32_t b = a + 1; b < n; ++b) ASSERT_FALSE(planes.apart(a, b)) << a << ", " << b;
+    }
+  }
+}
+
+TEST(CcdCandidates, TrianglePlanesDropOnlyPairsThatNeverTouchAndMatchBruteForce) {
+  // With IntervalPlanes the feature stage drops the triangle pairs a plane holds apart, brute
+  // force the feature pairs whose owners they hold apart: the same feature pairs, a subset of
+  // those without the planes, and every one left out checked by the exact kernels. In both
+  // builds of the stage, from the positions or from the packed ends.
+  std::int64_t dropped = 0;
+  std::int64_t fewer_candidates = 0;
+  for (const Scene& s : plane_scenes()) {
+    SCOPED_TRACE(s.name);
+    const Built<3> b = bounds_of<3>(s, 0.0);
+    const FeatureTopology& t = b.topology;
+    const IntervalEnds ends = interval_ends(0.0, s.x_t0, s.x_t1);
+    IntervalPlanes planes;
+    planes.start(t, s.x_t0, s.x_t1);
+    IntervalEnds with_planes = ends;
+    with_planes.planes = &planes;
+    Counters axes_counters, planes_counters;
+    FeatureCandidates axes, kept;
+    ccd_candidates_brute_force<3>(t, b.bounds, axes, axes_counters, nullptr, ends);
+    ccd_candidates_brute_force<3>(t, b.bounds, kept, planes_counters, nullptr, with_planes);
+    EXPECT_EQ(planes_counters.feature_bv_tests, axes_counters.feature_bv_tests);
+    EXPECT_TRUE(std::includes(axes.vf.begin(), axes.vf.end(), kept.vf.begin(), kept.vf.end()));
+    EXPECT_TRUE(std::includes(axes.ee.begin(), axes.ee.end(), kept.ee.begin(), kept.ee.end()));
+    const std::set<VertexFacePair> kept_vf(kept.vf.begin(), kept.vf.end());
+    const std::set<EdgeEdgePair> kept_ee(kept.ee.begin(), kept.ee.end());
+    const ccd::CcdOptions options;
+    for (const VertexFacePair& p : axes.vf) {
+      if (kept_vf.count(p)) continue;
+      ++dropped;
+      EXPECT_TRUE(planes.apart(t.vertex_owner(p.vertex), p.face));
+      const auto q =
+          vertex_face_query(s.x_t0, s.x_t1, p.vertex, s.x_t0, s.x_t1, t.triangle(p.face));
+      EXPECT_FALSE(ccd::vertex_face_ccd(q, ccd::Accuracy::exact, options).hit)
+          << "VF (" << p.vertex << ", " << p.face << ") was dropped but touches";
+    }
+    for (const EdgeEdgePair& p : axes.ee) {
+      if (kept_ee.count(p)) continue;
+      ++dropped;
+      EXPECT_TRUE(planes.apart(t.edge_owner(p.a), t.edge_owner(p.b)));
+      const auto q = edge_edge_query(s.x_t0, s.x_t1, t.edge(p.a), s.x_t0, s.x_t1, t.edge(p.b));
+      EXPECT_FALSE(ccd::edge_edge_ccd(q, ccd::Accuracy::exact, options).hit)
+          << "EE (" << p.a << ", " << p.b << ") was dropped but touches";
+    }
+    // A hierarchy hands over the owners of exactly these pairs, each once.
+    PackedEnds packed;
+    packed.pack(s.x_t0, s.x_t1);
+    IntervalPlanes packed_planes;
+    packed_planes.start(t, s.x_t0, s.x_t1, packed.data());
+    IntervalEnds with_packed = with_planes;
+    with_packed.packed = packed.data();
+    with_packed.planes = &packed_planes;
+    for (const int leaf : {1, 4}) {
+      Bvh<3> bvh(t.welded_triangles(), s.x_t0, BvhOptions{leaf});
+      bvh.refit(b.bounds.triangles);
+      TraversalScratch scratch;
+      std::vector<TrianglePair> pairs;
+      Counters counters;
+      self_traverse<3>(bvh, b.bounds.triangles, scratch, pairs, counters.bv_tests);
+      Counters without;
+      FeatureCandidates all;
+      ccd_candidates_from_triangle_pairs<3>(t, pairs, b.bounds, all, without, nullptr, ends);
+      for (const bool baseline : {false, true}) {
+        for (const IntervalEnds* e : {&with_planes, &with_packed}) {
+          SCOPED_TRACE(
+              std::string(baseline ? "baseline build" : "as the CPU allows") +
+              (e == &with_packed ? ", packed ends" : ""));
+          detail::force_baseline_feature_stage(baseline);
+          FeatureCandidates got;
+          Counters c;
+          ccd_candidates_from_triangle_pairs<3>(t, pairs, b.bounds, got, c, nullptr, *e);
+          detail::force_baseline_feature_stage(false);
+          EXPECT_FALSE(has_duplicates(got.vf));
+          EXPECT_FALSE(has_duplicates(got.ee));
+          EXPECT_EQ(sorted(got.vf), kept.vf);
+          EXPECT_EQ(sorted(got.ee), kept.ee);
+          EXPECT_LE(c.candidate_pairs, without.candidate_pairs);
+          fewer_candidates += without.candidate_pairs - c.candidate_pairs;
+        }
+      }
+    }
+  }
+  EXPECT_GT(dropped, 100);
+  EXPECT_GT(fewer_candidates, 100);
+}
+
+TEST(CcdCandidates, TrianglePlanesInTheMethodsChangeNoContactOnALargeMesh) {
+  // The hierarchy methods give their feature stage the planes where they pack the ends (from
+  // kPackedEndsFrom triangles on, on a CPU with AVX2): two stacked sheets of 16,900 triangles
+  // each, the upper one waving down through the lower in places — the layers the planes hold
+  // apart, with contacts between them. `kdop` and `bvh` find exactly the contacts, with the same
+  // times, that the feature stage without the planes hands the same kernels.
+  auto lower = test::sheet(130, 65, 2.0, 1.0);
+  auto upper = test::sheet(130, 65, 2.0, 1.0);
+  upper.rest_positions =
+      test::translated(upper.rest_positions, Eigen::Vector3d(0.003, 0.002, 0.01));
+  const Scene s = make_scene("stacked sheets", test::combine(lower, upper), [](const auto& x) {
+    skinning::Positions y = x;
+    for (Eigen::Index v = 0; v < y.rows(); ++v) {
+      if (x(v, 2) > 0.005) {
+        y(v, 2) -= 0.02 * std::max(0.0, std::sin(6.0 * x(v, 0) + 4.0 * x(v, 1)));
+      } else {
+        y(v, 2) += 0.002 * std::sin(9.0 * x(v, 1));
+      }
+    }
+    return y;
+  });
+  const Built<8> b = bounds_of<8>(s, 0.0);
+  const FeatureTopology& t = b.topology;
+  ASSERT_GE(t.num_triangles(), kPackedEndsFrom);
+  // The references: every pair of the swept volumes through the feature stage (with the
+  // methods' fan rule), without the planes and with them.
+  Bvh<8> bvh(t.welded_triangles(), s.x_t0);
+  bvh.refit(b.bounds.triangles);
+  TraversalScratch scratch;
+  std::vector<TrianglePair> pairs;
+  std::int64_t bv_tests = 0;
+  self_traverse<8>(bvh, b.bounds.triangles, scratch, pairs, bv_tests);
+  PackedEnds packed;
+  packed.pack(s.x_t0, s.x_t1);
+  IntervalPlanes planes;
+  planes.start(t, s.x_t0, s.x_t1, packed.data());
+  const auto reference = [&](bool with_planes) {
+    IntervalEnds ends = interval_ends(0.0, s.x_t0, s.x_t1);
+    if (with_planes) {
+      ends.packed = packed.data();
+      ends.planes = &planes;
+    }
+    IntervalFans fans;
+    fans.start(t.fans(), s.x_t0, s.x_t1, t.num_vertices());
+    FeatureCandidates candidates;
+    FrameResult r;
+    ccd_candidates_from_triangle_pairs<8>(t, pairs, b.bounds, candidates, r.counters, &fans, ends);
+    run_ccd_tests(
+        t,
+        candidates,
+        s.x_t0,
+        s.x_t1,
+        with_ccd_defaults({}),
+        ccd::Accuracy::conservative,
+        ccd::CcdOptions{},
+        r);
+    return r;
+  };
+  const FrameResult plain = reference(false);
+  const FrameResult with_planes = reference(true);
+  ASSERT_GT(plain.contacts.size(), 100u);
+  const auto tests = [](const FrameResult& r) { return r.counters.vf_tests + r.counters.ee_tests; };
+  EXPECT_LT(tests(with_planes), tests(plain));
+  const auto expect_same_contacts = [](const FrameResult& got, const FrameResult& want) {
+    ASSERT_EQ(got.contacts.size(), want.contacts.size());
+    for (std::size_t i = 0; i < got.contacts.size(); ++i) {
+      const CcdContact& g = got.contacts[i];
+      const CcdContact& w = want.contacts[i];
+      ASSERT_TRUE(g.same_pair(w)) << "contact " << i;
+      EXPECT_EQ(g.toi_lower, w.toi_lower) << "contact " << i;
+      EXPECT_EQ(g.toi_upper, w.toi_upper) << "contact " << i;
+    }
+  };
+  expect_same_contacts(with_planes, plain);
+  for (const char* name : {"kdop", "bvh"}) {
+    SCOPED_TRACE(name);
+    auto m = make_method(name, s.mesh, s.topology, MethodOptions{});
+    FrameResult got;
+    m->detect_ccd(s.x_t0, s.x_t1, got);
+    expect_same_contacts(got, plain);
+    // The method tested the feature pairs the planes leave, where it packs the ends.
+    EXPECT_EQ(tests(got), tests(feature_stage_reads_packed_ends() ? with_planes : plain));
+  }
 }
 
 /// The kernels' relative stage on every feature pair of `kept` and of `swept` (the same scene's
