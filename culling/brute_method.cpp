@@ -53,14 +53,13 @@ class BruteMethod final : public MethodBase {
     // The hierarchy methods' fan rule (pair_blocks.cpp).
     const bool fans = ccd_uses_fans(topology_, tests_, ccd_options_);
     if (fans) fans_.start(topology_.fans(), x_t0, x_t1, topology_.num_vertices());
-    // And their plane rule, on the same meshes (the same feature pairs, the same counters).
-    IntervalEnds ends = interval_ends(ccd_options_.min_separation, x_t0, x_t1);
-    if (ends.x_t0 != nullptr && feature_stage_uses_planes(topology_)) {
-      planes_.start(topology_, x_t0, x_t1);
-      ends.planes = &planes_;
-    }
     ccd_candidates_brute_force<3>(
-        topology_, bounds_, features_, out.counters, fans ? &fans_ : nullptr, ends);
+        topology_,
+        bounds_,
+        features_,
+        out.counters,
+        fans ? &fans_ : nullptr,
+        interval_ends(ccd_options_.min_separation, x_t0, x_t1));
     const auto t2 = Clock::now();
     run_ccd_tests(topology_, features_, x_t0, x_t1, tests_, options_.accuracy, ccd_options_, out);
     const auto t3 = Clock::now();
@@ -73,8 +72,7 @@ class BruteMethod final : public MethodBase {
   FeatureBounds<3> bounds_;
   std::vector<TrianglePair> pairs_;
   FeatureCandidates features_;
-  IntervalFans fans_;      ///< the CCD query's fans over its interval
-  IntervalPlanes planes_;  ///< the CCD query's triangle planes over its interval
+  IntervalFans fans_;  ///< the CCD query's fans over its interval
 };
 
 }  // namespace

@@ -4,11 +4,9 @@
 #include <array>
 #include <atomic>
 #include <bit>
-#include <cmath>
 #include <cstddef>
 #include <cstring>
 #include <initializer_list>
-#include <limits>
 #include <memory>
 #include <type_traits>
 
@@ -94,142 +92,6 @@ void FeatureBounds<N>::static_triangles(
 
 namespace {
 
-/// fl(fl(fl(x d0) + fl(y d1)) + fl(z d2)): within γ3 (|x d0| + |y d1| + |z d2|), and 3 · 2⁻¹⁰⁷⁵
-/// for products that underflow, of x · d. The AVX2 feature stage rounds the same operations in
-/// the same order (planes_apart_wide).
-inline double project(const double* x, const double (&d)[3]) {
-  return (x[0] * d[0] + x[1] * d[1]) + x[2] * d[2];
-}
-
-/// The extents of three points (pointers at t0 and t1) on d at both ends, widened by e: the
-/// order of IntervalPlanes::Plane's bounds.
-struct Extents {
-  double lo0, lo1, hi0, hi1;
-};
-
-inline Extents extents(
-    const std::array<const double*, 3>& at0,
-    const std::array<const double*, 3>& at1,
-    const double (&d)[3],
-    double e) {
-  double lo0 = project(at0[0], d);
-  double hi0 = lo0;
-  double lo1 = project(at1[0], d);
-  double hi1 = lo1;
-  for (std::size_t k = 1; k < 3; ++k) {
-    const double s0 = project(at0[k], d);
-    const double s1 = project(at1[k], d);
-    lo0 = std::min(lo0, s0);
-    hi0 = std::max(hi0, s0);
-    lo1 = std::min(lo1, s1);
-    hi1 = std::max(hi1, s1);
-  }
-  return {lo0 - e, lo1 - e, hi0 + e, hi1 + e};
-}
-
-}  // namespace
-
-void IntervalPlanes::start(
-    const FeatureTopology& topology,
-    const skinning::Positions& x_t0,
-    const skinning::Positions& x_t1,
-    const double* packed) {
-  topology_ = &topology;
-  x0_ = x_t0.data();
-  x1_ = x_t1.data();
-  packed_ = packed;
-  // The bound of every projection's rounding scales with the largest coordinate. A non-finite
-  // coordinate, or one so large that a projection could overflow, makes it infinite: then
-  // every extent is unbounded and nothing is apart.
-  const auto largest = [](const skinning::Positions& x) {
-    return x.size() == 0 ? 0.0 : x.cwiseAbs().maxCoeff<Eigen::PropagateNaN>();
-  };
-  const double m0 = largest(x_t0);
-  const double m1 = largest(x_t1);
-  magnitude_ = m0 < 0x1p1020 && m1 < 0x1p1020 ? std::max(m0, m1)  // NaN is not below
-                                              : std::numeric_limits<double>::infinity();
-  const auto num_faces = static_cast<std::size_t>(topology.num_triangles());
-  planes_.resize(num_faces);
-  known_.assign(num_faces, 0);
-}
-
-// Out of line: both builds of the feature stage make each plane with this one code.
-[[gnu::noinline]] void IntervalPlanes::make_plane(std::int32_t f) {
-  known_[at(f)] = 1;
-  Plane& p = planes_[at(f)];
-  const auto& t = topology_->triangle(f);
-  std::array<const double*, 3> at0{};
-  std::array<const double*, 3> at1{};
-  for (std::size_t k = 0; k < 3; ++k) corner(t[k], at0[k], at1[k]);
-  // The normal at the middle of the interval: any fixed direction is sound; this one holds
-  // apart what lies on either side of the triangle while it moves little.
-  double q[3][3];
-  for (std::size_t k = 0; k < 3; ++k) {
-    for (std::size_t c = 0; c < 3; ++c) q[k][c] = 0.5 * (at0[k][c] + at1[k][c]);
-  }
-  const double u[3] = {q[1][0] - q[0][0], q[1][1] - q[0][1], q[1][2] - q[0][2]};
-  const double w[3] = {q[2][0] - q[0][0], q[2][1] - q[0][1], q[2][2] - q[0][2]};
-  const double n[3] = {
-      u[1] * w[2] - u[2] * w[1], u[2] * w[0] - u[0] * w[2], u[0] * w[1] - u[1] * w[0]};
-  const double largest = std::max({std::abs(n[0]), std::abs(n[1]), std::abs(n[2])});
-  if (!(largest > 0.0 && largest <= std::numeric_limits<double>::max())) {
-    // No direction (a degenerate or non-finite triangle): NaN extents, never apart.
-    const double nan = std::numeric_limits<double>::quiet_NaN();
-    p = {nan, nan, nan, nan, {0.0F, 0.0F, 0.0F}, std::numeric_limits<float>::quiet_NaN()};
-    return;
-  }
-  // largest = m 2^k with m in [0.5, 1): scaled by 2^-k (exactly: a power of two), d's largest
-  // component is m. From the exponent's bits where 2^-k is a normal double, else by ldexp.
-  const auto biased = static_cast<int>(std::bit_cast<std::uint64_t>(largest) >> 52);
-  const double scale = biased >= 1 && biased <= 2044
-                           ? std::bit_cast<double>(static_cast<std::uint64_t>(2045 - biased) << 52)
-                           : std::ldexp(1.0, -std::ilogb(largest) - 1);
-  double d[3];
-  for (std::size_t c = 0; c < 3; ++c) {
-    p.d[c] = static_cast<float>(n[c] * scale);
-    d[c] = p.d[c];
-  }
-  // |fl(x · d) − x · d| ≤ γ3 M |d|₁ + 3 · 2⁻¹⁰⁷⁵ for |x|∞ ≤ M, and the widening by e rounds
-  // once more: e = 16 u M |d|₁ + 2⁻¹⁰⁷⁰, rounded up to a float, covers both (docs/culling.md).
-  const double l1 = std::abs(d[0]) + std::abs(d[1]) + std::abs(d[2]);
-  const double e = magnitude_ * l1 * 0x1p-49 + 0x1p-1070;
-  // To a float no smaller: rounding to nearest moves a normal float by at most 2⁻²⁴ of it and a
-  // subnormal one by at most 2⁻¹⁵⁰, which the factor and the added 2⁻¹⁴⁹ cover.
-  p.e = static_cast<float>(e * (1.0 + 0x1p-20) + 0x1p-149);
-  const Extents x = extents(at0, at1, d, static_cast<double>(p.e));
-  p.lo0 = x.lo0;
-  p.lo1 = x.lo1;
-  p.hi0 = x.hi0;
-  p.hi1 = x.hi1;
-}
-
-void IntervalPlanes::corner(std::int32_t v, const double*& at0, const double*& at1) const {
-  if (packed_ != nullptr) {
-    at0 = packed_ + 8 * at(v);  // PackedEnds: (x, y, z, z) at t0, then at t1
-    at1 = at0 + 4;
-  } else {
-    at0 = x0_ + 3 * at(v);
-    at1 = x1_ + 3 * at(v);
-  }
-}
-
-bool IntervalPlanes::corners_apart(const Plane& p, const std::array<std::int32_t, 3>& t) const {
-  std::array<const double*, 3> at0{};
-  std::array<const double*, 3> at1{};
-  for (std::size_t k = 0; k < 3; ++k) corner(t[k], at0[k], at1[k]);
-  const double d[3] = {p.d[0], p.d[1], p.d[2]};
-  const Extents x = extents(at0, at1, d, static_cast<double>(p.e));
-  // NaN anywhere makes every comparison false: never apart.
-  return (p.hi0 < x.lo0 && p.hi1 < x.lo1) || (x.hi0 < p.lo0 && x.hi1 < p.lo1);
-}
-
-bool IntervalPlanes::apart(std::int32_t a, std::int32_t b) {
-  return corners_apart(plane(a), topology_->triangle(b)) ||
-         corners_apart(plane(b), topology_->triangle(a));
-}
-
-namespace {
-
 /// What the feature stage tests a feature pair on: the swept volumes of the interval
 /// (FeatureBounds). A face's is its triangle's; an edge's the union of its endpoints' (bit for bit
 /// what FeatureBounds::derive stores), formed from corner volumes the VF pairs have just read, so
@@ -301,13 +163,6 @@ struct EndPositions {
   static constexpr bool kTrianglesFirst = true;
   const double* x0;
   const double* x1;
-
-  /// IntervalPlanes::apart (its scalar code, which the AVX2 build's rounds alike).
-  template <class Corners>
-  [[nodiscard]] static bool planes_apart(
-      IntervalPlanes& planes, std::int32_t a, const Corners&, std::int32_t b, const Corners&) {
-    return planes.apart(a, b);
-  }
 
 #if defined(__SSE2__)
   // Two registers per coordinate triple: (x, y) and (z, z).
@@ -682,55 +537,6 @@ struct EndPositionsWideAs {
       const DiagonalPoint& p, const DiagonalBox& b) {
     return meet(p.sums, b.sums) & meet(p.differences, b.differences);
   }
-  /// Whether `p`'s direction holds the corners `c` apart from its triangle at both ends: what
-  /// IntervalPlanes::apart computes for one direction, on the loaded corners, each projection
-  /// (x d0 + y d1) + z d2 as there (the fourth lane adds z · 0, exact), both ends in the two
-  /// lanes of one vector.
-  [[gnu::always_inline]] [[nodiscard]] static bool plane_holds_apart(
-      const IntervalPlanes::Plane& p, const Corners& c) {
-    using F4 = float __attribute__((vector_size(16)));
-    using V2 = double __attribute__((vector_size(16)));
-    F4 de_float;
-    std::memcpy(&de_float, p.d, sizeof de_float);  // d0, d1, d2, e
-    const V4 de = __builtin_convertvector(de_float, V4);
-    const V4 d = V4{de[0], de[1], de[2], 0.0};
-    const V2 e = V2{de[3], de[3]};
-    // (x d0 + y d1) + z d2 at t0 and at t1, in the lanes of one vector.
-    const auto both_ends = [&](const Point& q) __attribute__((always_inline)) {
-      const V4 m0 = q.at0 * d;
-      const V4 m1 = q.at1 * d;
-      const V4 h =
-          __builtin_shuffle(m0, m1, M4{0, 4, 2, 6}) + __builtin_shuffle(m0, m1, M4{1, 5, 3, 7});
-      return V2{h[0], h[1]} + V2{h[2], h[3]};
-    };
-    const auto min2 = [](const V2& a, const V2& b) __attribute__((always_inline)) {
-      return a < b ? a : b;
-    };
-    const auto max2 = [](const V2& a, const V2& b) __attribute__((always_inline)) {
-      return a > b ? a : b;
-    };
-    const V2 s0 = both_ends(c[0]);
-    const V2 s1 = both_ends(c[1]);
-    const V2 s2 = both_ends(c[2]);
-    const V2 lo = min2(min2(s0, s1), s2) - e;
-    const V2 hi = max2(max2(s0, s1), s2) + e;
-    V2 p_lo;
-    V2 p_hi;
-    std::memcpy(&p_lo, &p.lo0, sizeof p_lo);  // lo0, lo1
-    std::memcpy(&p_hi, &p.hi0, sizeof p_hi);  // hi0, hi1
-    const auto below = p_hi < lo;
-    const auto above = hi < p_lo;
-    return (below[0] & below[1]) != 0 || (above[0] & above[1]) != 0;
-  }
-  [[gnu::always_inline]] [[nodiscard]] static bool planes_apart(
-      IntervalPlanes& planes,
-      std::int32_t a,
-      const Corners& corners_a,
-      std::int32_t b,
-      const Corners& corners_b) {
-    return plane_holds_apart(planes.plane(a), corners_b) ||
-           plane_holds_apart(planes.plane(b), corners_a);
-  }
   [[gnu::always_inline]] void prefetch(
       std::int32_t, const std::array<std::int32_t, 3>& corners) const {
     for (const std::int32_t v : corners) {
@@ -865,7 +671,6 @@ template <bool kExclusions, bool kFans, class Boxes>
     std::span<const TrianglePair> pairs,
     const Boxes& boxes,
     IntervalFans* fans,
-    IntervalPlanes* planes,
     FeatureCandidates& out,
     std::int64_t& feature_bv_tests,
     std::int64_t& candidate_pairs) {
@@ -901,13 +706,6 @@ template <bool kExclusions, bool kFans, class Boxes>
     if (prefetch && at_pair + kFeatureNear < num_pairs) {
       const TrianglePair& f = pairs[at_pair + kFeatureNear];
       boxes.prefetch(f.b, topology.owned_features(f.b).corners);
-      if (planes != nullptr) {
-        for (const std::int32_t t : {f.a, f.b}) {
-          const auto* line = reinterpret_cast<const char*>(planes->record(t));
-          __builtin_prefetch(line);
-          __builtin_prefetch(line + sizeof(IntervalPlanes::Plane) - 1);
-        }
-      }
     }
     const TrianglePair& p = pairs[at_pair];
     if constexpr (kExclusions) {
@@ -937,12 +735,6 @@ template <bool kExclusions, bool kFans, class Boxes>
       // Triangles apart hold features apart: no pair of theirs can meet, and the pair is culled
       // (not a candidate, as the relative filter's pairs were not).
       if (!Boxes::meet(face_a, face_b)) continue;
-      // Nor can two that a triangle's plane holds apart at both ends (IntervalPlanes; never two
-      // that share a corner: its projections lie in both extents, so they are not asked).
-      if (planes != nullptr && shared.a_on_b == 0 &&
-          Boxes::planes_apart(*planes, p.a, corners_a, p.b, corners_b)) {
-        continue;
-      }
     }
     ++candidate_pairs;
     const std::size_t vf_before = num_vf;
@@ -1055,12 +847,11 @@ template <bool kExclusions, bool kFans, bool kPacked>
     std::span<const TrianglePair> pairs,
     const EndPositionsWideAs<kPacked>& boxes,
     IntervalFans* fans,
-    IntervalPlanes* planes,
     FeatureCandidates& out,
     std::int64_t& feature_bv_tests,
     std::int64_t& candidate_pairs) {
   owned_feature_pairs<kExclusions, kFans>(
-      topology, pairs, boxes, fans, planes, out, feature_bv_tests, candidate_pairs);
+      topology, pairs, boxes, fans, out, feature_bv_tests, candidate_pairs);
 }
 #endif
 
@@ -1099,7 +890,6 @@ void ccd_candidates_from_triangle_pairs(
                 pairs,
                 EndPositionsWideAs<true>{boxes.x0, boxes.x1, ends.packed},
                 fans,
-                ends.planes,
                 out,
                 feature_bv_tests,
                 candidate_pairs);
@@ -1109,7 +899,6 @@ void ccd_candidates_from_triangle_pairs(
                 pairs,
                 EndPositionsWide{boxes.x0, boxes.x1, nullptr},
                 fans,
-                ends.planes,
                 out,
                 feature_bv_tests,
                 candidate_pairs);
@@ -1119,14 +908,7 @@ void ccd_candidates_from_triangle_pairs(
       }
 #endif
       owned_feature_pairs<kExclusions, kFans>(
-          topology,
-          pairs,
-          boxes,
-          fans,
-          ends.x_t0 != nullptr ? ends.planes : nullptr,
-          out,
-          feature_bv_tests,
-          candidate_pairs);
+          topology, pairs, boxes, fans, out, feature_bv_tests, candidate_pairs);
     };
     if (topology.has_exclusions()) {
       fans == nullptr ? run.template operator()<true, false>()
@@ -1149,8 +931,7 @@ void brute_feature_pairs(
     const Boxes& boxes,
     FeatureCandidates& out,
     std::int64_t& tests,
-    IntervalFans* fans,
-    IntervalPlanes* planes) {
+    IntervalFans* fans) {
   const std::int32_t num_faces = topology.num_triangles();
   const std::int32_t num_vertices = topology.num_vertices();
   const std::int32_t num_edges = topology.num_edges();
@@ -1171,15 +952,6 @@ void brute_feature_pairs(
       return false;
     }
   };
-  // The plane rule of ccd_candidates_from_triangle_pairs, likewise on the owners (tested but not
-  // kept, as the diagonals').
-  const auto planes_apart = [&](std::int32_t a, std::int32_t b) {
-    if constexpr (Boxes::kTrianglesFirst) {
-      return planes != nullptr && planes->apart(a, b);
-    } else {
-      return false;
-    }
-  };
   // Every vertex that lies on a triangle against every face it is not a corner of.
   for (std::int32_t v = 0; v < num_vertices; ++v) {
     if (topology.vertex_owner(v) < 0) continue;
@@ -1189,8 +961,7 @@ void brute_feature_pairs(
       if (is_corner(v, t) || topology.vertex_face_excluded(v, f)) continue;
       if (settled(topology.vertex_owner(v), f)) continue;
       ++tests;
-      if (Boxes::meet(bv, boxes.face(f, t)) && !diagonal_apart({v}, {t[0], t[1], t[2]}) &&
-          !planes_apart(topology.vertex_owner(v), f))
+      if (Boxes::meet(bv, boxes.face(f, t)) && !diagonal_apart({v}, {t[0], t[1], t[2]}))
         out.vf.push_back({v, f});
     }
   }
@@ -1204,8 +975,7 @@ void brute_feature_pairs(
       ++tests;
       const auto& ends_b = topology.edge(b);
       if (Boxes::meet(ba, boxes.edge(ends_b)) &&
-          !diagonal_apart({ends_a[0], ends_a[1]}, {ends_b[0], ends_b[1]}) &&
-          !planes_apart(topology.edge_owner(a), topology.edge_owner(b)))
+          !diagonal_apart({ends_a[0], ends_a[1]}, {ends_b[0], ends_b[1]}))
         out.ee.push_back({a, b});
     }
   }
@@ -1223,7 +993,7 @@ void ccd_candidates_brute_force(
     const IntervalEnds& ends) {
   std::int64_t tests = 0;
   with_boxes(bounds, ends, [&](const auto& boxes) {
-    brute_feature_pairs(topology, boxes, out, tests, fans, ends.planes);
+    brute_feature_pairs(topology, boxes, out, tests, fans);
   });
   const std::int32_t num_faces = topology.num_triangles();
   counters.feature_bv_tests += tests;

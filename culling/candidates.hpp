@@ -16,7 +16,6 @@
 // pair only: each feature pair is produced at most once and never missed. Adjacent triangle pairs
 // are therefore *not* skipped for CCD: only their feature pairs that share a vertex are.
 
-#include <array>
 #include <compare>
 #include <cstddef>
 #include <cstdint>
@@ -106,60 +105,6 @@ struct IntervalFans {
   }
 };
 
-/// Each triangle's plane over one CCD interval, for the feature stage without a contact distance
-/// (docs/culling.md, "Apart along a triangle's normal"): a fixed direction d_f (the normal of the
-/// triangle at the interval's middle, its corners' midpoints) and the triangle's extent along it
-/// at t0 and at t1, widened by a bound on the rounding of any vertex's projection. Two triangles
-/// whose extents along d_a or d_b lie strictly apart at t0 and at t1, the same way round, never
-/// touch in between (each corner pair's projected difference is linear in t), so no feature pair
-/// of theirs can. 49 bytes a triangle; reused across queries.
-class IntervalPlanes {
- public:
-  /// Starts an interval x_t0 → x_t1 (row-major #W × 3) of `topology`'s triangles, reading the
-  /// corners from `packed` (PackedEnds::data) when given; all three must outlive the interval.
-  /// O(#W + #F), allocation-free once sized. Each plane is made when first asked for.
-  void start(
-      const FeatureTopology& topology,
-      const skinning::Positions& x_t0,
-      const skinning::Positions& x_t1,
-      const double* packed = nullptr);
-  /// True when d_a or d_b holds triangles a and b strictly apart at both ends, the same way
-  /// round (never for two that share a corner, nor with a non-finite position).
-  [[nodiscard]] bool apart(std::int32_t a, std::int32_t b);
-
-  /// One triangle's plane: d (scaled to a largest component in [0.5, 1)), the bound e of a
-  /// projection's rounding on it, and the corners' extents on it at t0 and t1 widened by e.
-  struct Plane {
-    double lo0, lo1, hi0, hi1;
-    float d[3];
-    float e;
-  };
-  /// Triangle f's plane for this interval (made now if not yet).
-  [[nodiscard]] const Plane& plane(std::int32_t f) {
-    const auto i = static_cast<std::size_t>(f);
-    if (known_[i] == 0) make_plane(f);
-    return planes_[i];
-  }
-  /// Where triangle f's plane is kept (made or not), for a prefetch.
-  [[nodiscard]] const Plane* record(std::int32_t f) const {
-    return planes_.data() + static_cast<std::size_t>(f);
-  }
-
- private:
-  void make_plane(std::int32_t f);
-  /// Whether the corners of `t` lie strictly apart from `p`'s extents at both ends, the same way.
-  [[nodiscard]] bool corners_apart(const Plane& p, const std::array<std::int32_t, 3>& t) const;
-  void corner(std::int32_t v, const double*& at0, const double*& at1) const;
-
-  const FeatureTopology* topology_ = nullptr;
-  const double* x0_ = nullptr;
-  const double* x1_ = nullptr;
-  const double* packed_ = nullptr;
-  double magnitude_ = 0.0;  ///< the largest |coordinate| at either end (infinite: none finite)
-  std::vector<Plane> planes_;
-  std::vector<std::uint8_t> known_;  ///< per triangle: its plane is made for this interval
-};
-
 /// The positions at the two ends of a CCD interval, for the feature stage without a contact
 /// distance: a triangle pair, then each feature pair, is dropped when a coordinate axis separates
 /// the two strictly at t = 0 and at t = 1, the same way round (they never touch in between), in
@@ -171,9 +116,6 @@ struct IntervalEnds {
   /// Optional: the same positions as PackedEnds::pack lays them out (PackedEnds::data), which
   /// the feature stage's AVX2 build then reads instead (one aligned cache line per vertex).
   const double* packed = nullptr;
-  /// Optional: the triangles' planes over the interval (IntervalPlanes::start with the same
-  /// positions), which then drop the triangle pairs they hold apart before their features.
-  IntervalPlanes* planes = nullptr;
 };
 
 /// Both ends of every vertex in one 64-byte line, as the feature stage's AVX2 build loads them:
@@ -203,13 +145,6 @@ class PackedEnds {
 /// and 64 bytes a vertex.
 inline constexpr std::int32_t kPackedEndsFrom = 32768;
 
-/// Whether the methods give their feature stage the triangles' planes (IntervalEnds::planes): where
-/// they pack the ends (from kPackedEndsFrom triangles, on a CPU whose feature stage reads them),
-/// on a mesh that large (docs/benchmarks.md, "Apart along a triangle's normal").
-[[nodiscard]] inline bool feature_stage_uses_planes(const FeatureTopology& topology) {
-  return topology.num_triangles() >= kPackedEndsFrom && feature_stage_reads_packed_ends();
-}
-
 /// True when the feature stage tests at both ends (no contact distance): its first test of a
 /// triangle pair is then the relative pair filters' (RelativeAabbFilter), so a method runs those
 /// only when this is false.
@@ -236,7 +171,7 @@ inline constexpr std::size_t kCcdBlockPairs = std::size_t{1} << 15;
 /// an edge's volume is formed as the union of its endpoints' (bit for bit what derive() stores),
 /// so the caller need not hold #E edge volumes.
 /// Counts counters.candidate_pairs (triangle pairs not wholly part-excluded, less those the ends
-/// test below or the planes find apart) and counters.feature_bv_tests.
+/// test below finds apart) and counters.feature_bv_tests.
 /// `fans`: when not null, the query's fans over its interval: a triangle pair sharing a certified
 /// corner is a candidate with no feature pairs — none of them can come into contact
 /// (docs/culling.md, "Vertex fans over an interval").
@@ -244,8 +179,7 @@ inline constexpr std::size_t kCcdBlockPairs = std::size_t{1} << 15;
 /// `bounds`: the two triangles are tested first, then each feature pair (IntervalEnds), and the
 /// feature pairs a triangle pair kept are dropped again when a face diagonal (x ± y, y ± z,
 /// z ± x) separates the two features at both ends (counted as tested; docs/culling.md, "The
-/// triangles on the face diagonals", "Each feature pair on the diagonals"); with ends.planes, a
-/// triangle pair the planes hold apart (IntervalPlanes::apart) is dropped before its features.
+/// triangles on the face diagonals", "Each feature pair on the diagonals").
 template <int N>
 void ccd_candidates_from_triangle_pairs(
     const FeatureTopology& topology,
@@ -270,7 +204,7 @@ void force_baseline_feature_stage(bool baseline);
 /// `fans` as for ccd_candidates_from_triangle_pairs: a feature pair whose owners (vertex_owner,
 /// edge_owner) share a certified corner is skipped, as the hierarchy methods skip their pair.
 /// `ends` as for ccd_candidates_from_triangle_pairs (each feature pair on the axes, then on the
-/// diagonals, then its owners on the planes: the same pairs result).
+/// diagonals: the same pairs result).
 template <int N>
 void ccd_candidates_brute_force(
     const FeatureTopology& topology,

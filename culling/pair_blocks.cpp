@@ -91,11 +91,6 @@ void PairBlocks<N>::start_ccd(
     packed_ends_.pack(x_t0, x_t1);
     ends_.packed = packed_ends_.data();
   }
-  // And the triangles' planes, which drop pairs their features' boxes cannot (IntervalPlanes).
-  if (ends_.x_t0 != nullptr && feature_stage_uses_planes(topology)) {
-    interval_planes_.start(topology, x_t0, x_t1, ends_.packed);
-    ends_.planes = &interval_planes_;
-  }
 }
 
 template <int N>

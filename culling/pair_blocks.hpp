@@ -173,7 +173,6 @@ class PairBlocks {
   std::span<const std::uint8_t> fans_;
   bool use_fans_ = false;                     ///< CCD: ccd_uses_fans for this query
   IntervalFans interval_fans_;                ///< CCD: the query's fans, decided on demand
-  IntervalPlanes interval_planes_;            ///< CCD: the triangles' planes, made on demand
   std::vector<std::uint8_t> interval_flags_;  ///< CCD: certify_interval_fans' flags
   std::vector<ccd::TrianglePlane> planes_;  ///< the DCD instant's (dcd_planes); kept across queries
   bool use_planes_ = false;  ///< planes_ holds this instant's planes (the first block decides)
