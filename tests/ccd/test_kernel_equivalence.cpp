@@ -857,21 +857,25 @@ TEST(KernelEquivalence, AlgebraicFilterGivesTheSameVerdictWithItsQuarticsInFourL
   EXPECT_TRUE(handed_over == 40000 || !detail::cross_dot_quartics_x4_wide());
 }
 
-// Exact cubics (error 0) with a certain sign change on [0, 1] and no quartic: the filter reports
-// a contact whose bracket must hold a root, checked in rational arithmetic: the exact Bernstein
-// polynomial's signs at t_lo and t_hi differ or one of them is 0. A monotone cubic has one root,
-// the first: its bracket must be narrowed to the tolerance. Monotone and not, steep and nearly
-// flat at the root (the middle coefficients on the chord).
+// Cubics with a certain sign change on [0, 1] and no quartic: the filter reports a contact whose
+// bracket must hold a root, checked in rational arithmetic: the exact Bernstein polynomial's signs
+// at t_lo and t_hi differ or one of them is 0. A monotone cubic has one root, the first: with
+// error 0 its bracket must be narrowed to the tolerance (and, from Newton's guess, mostly to a
+// 32nd of it); with an error bound (2^-10 … 2^-49) the narrowing falls back where signs near the
+// root are not certain, and the bracket must still start at no later root. Monotone and not,
+// steep and nearly flat at the root (the middle coefficients on the chord).
 TEST(KernelEquivalence, NarrowingHoldsTheExactFirstRoot) {
   std::mt19937_64 rng(20261130);
   std::uniform_real_distribution<double> u(-1.0, 1.0);
-  const auto exact_at = [](const std::array<double, 4>& c, const mpq_class& t) -> mpq_class {
+  std::uniform_int_distribution<int> offset(-2, 2);
+  using Exact = std::array<mpq_class, 4>;
+  const auto exact_at = [](const Exact& c, const mpq_class& t) -> mpq_class {
     const mpq_class a = 1 - t;
-    return mpq_class(mpq_class(c[0]) * a * a * a + 3 * mpq_class(c[1]) * a * a * t) +
-           mpq_class(3 * mpq_class(c[2]) * a * t * t + mpq_class(c[3]) * t * t * t);
+    return mpq_class(c[0] * a * a * a + 3 * c[1] * a * a * t) +
+           mpq_class(3 * c[2] * a * t * t + c[3] * t * t * t);
   };
-  int monotone = 0, checked = 0;
-  for (int i = 0; i < 20000; ++i) {
+  int monotone = 0, checked = 0, fine = 0, with_error = 0;
+  for (int i = 0; i < 30000; ++i) {
     BernsteinCubic c;
     for (double& b : c.coefficients) b = u(rng);
     if (i % 3 == 0) {
@@ -881,31 +885,47 @@ TEST(KernelEquivalence, NarrowingHoldsTheExactFirstRoot) {
     }
     if (i % 5 == 0)
       c.coefficients[1] = c.coefficients[2] = 0.5 * (c.coefficients[0] + c.coefficients[3]);
-    c.error = 0.0;
+    // The last third carries an error bound e (2^-10 … 2^-49), and the exact cubic is another
+    // one within it: each coefficient moved by -e, -e/2, 0, e/2 or e. Near the root signs are
+    // then not certain, and a guess taken for a bound (Newton's, uncertified) would miss the
+    // exact root; the narrowing must fall back to regula falsi or halving from what it certified.
+    c.error = i >= 20000 ? std::ldexp(1.0, -10 - i % 40) : 0.0;
     const auto& b = c.coefficients;
+    Exact x;
+    for (std::size_t k = 0; k < 4; ++k)
+      x[k] = mpq_class(b[k]) + mpq_class(c.error) * offset(rng) / 2;
     if (!((b[0] > 0.0 && b[3] < 0.0) || (b[0] < 0.0 && b[3] > 0.0))) continue;
+    // A sign change certain despite the error (the filter's bound at the root is c.error).
+    if (!(std::min(std::abs(b[0]), std::abs(b[3])) > 4.0 * c.error)) continue;
     const double tolerance = i % 2 == 0 ? 1e-6 : 1e-3;
     const AlgebraicVerdict v = detail::algebraic_filter(c, nullptr, 0, tolerance);
     ASSERT_EQ(v.outcome, AlgebraicOutcome::contact) << i;
     ASSERT_LE(v.t_lo, v.t_hi) << i;
     const mpq_class lo(v.t_lo), hi(v.t_hi);
-    const int s_lo = sgn(exact_at(b, lo));
-    const int s_hi = sgn(exact_at(b, hi));
+    const int s_lo = sgn(exact_at(x, lo));
+    const int s_hi = sgn(exact_at(x, hi));
     ASSERT_TRUE(s_lo == 0 || s_hi == 0 || s_lo != s_hi)
         << i << ": no root in [" << v.t_lo << ", " << v.t_hi << "]";
     // No earlier root: for a monotone cubic the sign at t_lo is the sign at 0 (or 0 there).
-    const bool increasing = b[0] < b[1] && b[1] < b[2] && b[2] < b[3];
-    const bool decreasing = b[0] > b[1] && b[1] > b[2] && b[2] > b[3];
-    if (increasing || decreasing) {
-      // Monotone (exactly, with error 0): narrowed all the way.
+    const bool increasing = x[0] < x[1] && x[1] < x[2] && x[2] < x[3];
+    const bool decreasing = x[0] > x[1] && x[1] > x[2] && x[2] > x[3];
+    if (!(increasing || decreasing)) continue;
+    ASSERT_TRUE(s_lo == 0 || s_lo == sgn(exact_at(x, 0))) << i << ": a root before " << v.t_lo;
+    if (c.error == 0.0) {
+      // Monotone with error 0: narrowed all the way, and (Newton's guess certified a 64th of the
+      // tolerance either side) mostly to a 32nd of it.
       ++monotone;
       ASSERT_LE(v.t_hi - v.t_lo, tolerance) << i;
-      ASSERT_TRUE(s_lo == 0 || s_lo == sgn(exact_at(b, 0))) << i << ": a root before " << v.t_lo;
+      fine += v.t_hi - v.t_lo <= tolerance / 30.0 ? 1 : 0;
+    } else {
+      ++with_error;
     }
     ++checked;
   }
-  EXPECT_GT(checked, 5000);
+  EXPECT_GT(checked, 3000);
   EXPECT_GT(monotone, 2000);
+  EXPECT_GT(fine, monotone * 9 / 10);
+  EXPECT_GT(with_error, 1000);
 }
 
 }  // namespace
