@@ -116,10 +116,25 @@ struct Node {
   std::array<L, kGroups> g_err;
 };
 
-/// Bisection of narrow(): the sign change kept by halving the Bernstein coefficients.
+AlgebraicVerdict narrow(
+    double lo, double hi, std::array<double, 4> c, double e, double toi_tolerance);
+int monotone(const std::array<double, 4>& c, double e);
+
+/// Bisection of narrow(): the sign change kept by halving the Bernstein coefficients. With
+/// `until_monotone`, as soon as the half kept is certified monotone, narrow() takes over on it
+/// (it holds the first root and a certain sign change, as every half kept does); narrow() itself
+/// halves without it, so the two never call each other twice.
 AlgebraicVerdict narrow_by_halving(
-    double lo, double hi, std::array<double, 4> c, double e, double toi_tolerance) {
+    double lo,
+    double hi,
+    std::array<double, 4> c,
+    double e,
+    double toi_tolerance,
+    bool until_monotone = false) {
   for (int step = 0; step < 64 && hi - lo > toi_tolerance; ++step) {
+    if (until_monotone && step != 0 && monotone(c, e) != 0) {
+      return narrow(lo, hi, c, e, toi_tolerance);
+    }
     std::array<double, 4> left, right;
     const double e2 = halve(c, e, left, right);
     const double mid = 0.5 * (lo + hi);
@@ -223,9 +238,8 @@ double newton_guess(
 /// lo + s (hi − lo), with hi − lo a power of two, is rounded outwards.
 AlgebraicVerdict narrow(
     double lo, double hi, std::array<double, 4> c, double e, double toi_tolerance) {
-  if (!(hi - lo > toi_tolerance) || monotone(c, e) == 0) {
-    return narrow_by_halving(lo, hi, c, e, toi_tolerance);
-  }
+  if (!(hi - lo > toi_tolerance)) return {AlgebraicOutcome::contact, lo, hi};
+  if (monotone(c, e) == 0) return narrow_by_halving(lo, hi, c, e, toi_tolerance, true);
   const double width = hi - lo;
   // The signs at the two ends are certain (certain_sign_change): s_lo keeps c's sign at 0.
   double s_lo = 0.0, s_hi = 1.0;
