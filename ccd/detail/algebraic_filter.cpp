@@ -170,6 +170,23 @@ int monotone(const std::array<double, 4>& c, double e) {
   return up == 3 ? 1 : (down == 3 ? -1 : 0);
 }
 
+/// de Casteljau's scheme for the Bernstein cubic c at s, with a = fl(1 − s) for 1 − s: the value
+/// and the two points of the level below it (b012, b123), whose difference times 3 is the
+/// derivative there.
+struct CubicAt {
+  double value, b012, b123;
+};
+
+[[gnu::always_inline]] inline CubicAt de_casteljau(const std::array<double, 4>& c, double s) {
+  const double a = 1.0 - s;
+  const double b01 = a * c[0] + s * c[1];
+  const double b12 = a * c[1] + s * c[2];
+  const double b23 = a * c[2] + s * c[3];
+  const double b012 = a * b01 + s * b12;
+  const double b123 = a * b12 + s * b23;
+  return {a * b012 + s * b123, b012, b123};
+}
+
 /// The certified sign of every exact cubic within e of the Bernstein coefficients c at parameter
 /// s in (0, 1) (0: not certified), and the computed value. de Casteljau with a = fl(1 − s): a
 /// differs from 1 − s by at most eps (1 − s), which moves each weight a^(3−i) s^i by at most
@@ -180,13 +197,7 @@ int monotone(const std::array<double, 4>& c, double e) {
 /// most (1 + eps)³; and each of the 12 products may add kUnderflowUnit. 16 eps M covers the first
 /// two with room, and 16 kUnderflowUnit the last.
 int certified_sign_at(const std::array<double, 4>& c, double e, double s, double& value) {
-  const double a = 1.0 - s;
-  const double b01 = a * c[0] + s * c[1];
-  const double b12 = a * c[1] + s * c[2];
-  const double b23 = a * c[2] + s * c[3];
-  const double b012 = a * b01 + s * b12;
-  const double b123 = a * b12 + s * b23;
-  value = a * b012 + s * b123;
+  value = de_casteljau(c, s).value;
   const double m =
       std::max(std::max(std::abs(c[0]), std::abs(c[1])), std::max(std::abs(c[2]), std::abs(c[3])));
   const double bound =
@@ -206,16 +217,10 @@ double newton_guess(
     double s_hi,
     double settle) {
   for (int step = 0; step < 8; ++step) {
-    const double a = 1.0 - s;
-    const double b01 = a * c[0] + s * c[1];
-    const double b12 = a * c[1] + s * c[2];
-    const double b23 = a * c[2] + s * c[3];
-    const double b012 = a * b01 + s * b12;
-    const double b123 = a * b12 + s * b23;
-    const double value = a * b012 + s * b123;
-    if (value == 0.0) return s;
-    ((value > 0.0) == positive_first ? s_lo : s_hi) = s;
-    double next = s - value / (3.0 * (b123 - b012));
+    const CubicAt at = de_casteljau(c, s);
+    if (at.value == 0.0) return s;
+    ((at.value > 0.0) == positive_first ? s_lo : s_hi) = s;
+    double next = s - at.value / (3.0 * (at.b123 - at.b012));
     if (!(next > s_lo && next < s_hi)) next = 0.5 * (s_lo + s_hi);  // NaN too
     const bool settled = std::abs(next - s) <= settle;
     s = next;
