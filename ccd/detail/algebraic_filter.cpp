@@ -206,16 +206,11 @@ int certified_sign_at(const std::array<double, 4>& c, double e, double s, double
 }
 
 /// Where safeguarded Newton iteration in plain double puts the root of the Bernstein cubic c on
-/// (0, 1), starting from s (strictly between s_lo and s_hi): a guess only, never a bound. Each
-/// step evaluates c and its derivative by de Casteljau; a step that leaves the bracket the signs
-/// keep, or a derivative of 0, halves it instead. Stops once a step moves by at most `settle`.
-double newton_guess(
-    const std::array<double, 4>& c,
-    bool positive_first,
-    double s,
-    double s_lo,
-    double s_hi,
-    double settle) {
+/// (0, 1), starting from s in (0, 1): a guess only, never a bound. Each step evaluates c and its
+/// derivative by de Casteljau; a step that leaves the bracket the signs keep (from (0, 1)), or a
+/// derivative of 0, halves it instead. Stops once a step moves by at most `settle`.
+double newton_guess(const std::array<double, 4>& c, bool positive_first, double s, double settle) {
+  double s_lo = 0.0, s_hi = 1.0;
   for (int step = 0; step < 8; ++step) {
     const CubicAt at = de_casteljau(c, s);
     if (at.value == 0.0) return s;
@@ -275,7 +270,7 @@ AlgebraicVerdict narrow(
     const double half = (toi_tolerance / width) * (1.0 / 64.0);
     double guess = v_lo / (v_lo - v_hi);  // regula falsi's first point
     if (!(guess > 0.0 && guess < 1.0)) guess = 0.5;
-    guess = newton_guess(c, positive_first, guess, 0.0, 1.0, 0.125 * half);
+    guess = newton_guess(c, positive_first, guess, 0.125 * half);
     const double below = guess - half;
     const double above = guess + half;
     const bool certified_below = !(below > 0.0) || certify(below);
