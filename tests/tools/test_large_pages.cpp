@@ -65,6 +65,22 @@ TEST(LargePages, OnlyWholeHugePagesOfAnAlignedBlockAreAdvised) {
   EXPECT_EQ(advised_length(off, 3 * kHugePage), 0U);
 }
 
+TEST(LargePages, ABlockEndsOnAHugePageWhereThatAddsAQuarterAtMost) {
+  EXPECT_EQ(large_block_size(kHugePage), kHugePage);
+  EXPECT_EQ(large_block_size(3 * kHugePage), 3 * kHugePage);
+  // 3.5 MiB: 0.5 MiB more (a seventh) ends it on its second huge page.
+  EXPECT_EQ(large_block_size(7 * kHugePage / 4), 2 * kHugePage);
+  // 5 MiB: 1 MiB more (a fifth).
+  EXPECT_EQ(large_block_size(5 * kHugePage / 2), 3 * kHugePage);
+  // 2.8 MiB (the cloth-ball step's per-vertex records): 1.2 MiB more would be 43 %; as asked.
+  EXPECT_EQ(large_block_size(7 * kHugePage / 5), 7 * kHugePage / 5);
+  EXPECT_EQ(large_block_size(kHugePage + 1), kHugePage + 1);
+  // Either side of a quarter, about 6.4 MiB: e more bytes to 8 MiB with 4 e <= 8 MiB − e.
+  const std::size_t e = 4 * kHugePage / 5;  // 1,677,721
+  EXPECT_EQ(large_block_size(4 * kHugePage - e), 4 * kHugePage);
+  EXPECT_EQ(large_block_size(4 * kHugePage - e - 1), 4 * kHugePage - e - 1);
+}
+
 // Run in this process (SKELCD_LARGE_PAGES unset: on) and again by the next test in a child with
 // SKELCD_LARGE_PAGES=0 (off): what a large vector gets must follow the setting either way.
 TEST(LargePages, ALargeVectorFollowsTheSetting) {
@@ -94,6 +110,15 @@ TEST(LargePages, ALargeVectorFollowsTheSetting) {
   // The array form.
   const std::unique_ptr<double[]> array(new double[kHugePage / sizeof(double) * 2]);
   expect_follows(array.get());
+  // A block that ends a seventh short of a huge page ends on it: its last byte is advised too;
+  // one that would need 43 % more keeps its tail on small pages.
+  const std::vector<char> rounded(7 * kHugePage / 4, 'r');
+  const std::string rounded_end = vm_flags_at(&rounded.back());
+  EXPECT_EQ(rounded_end.find(" hg") != std::string::npos, on && kernel_has_huge_pages())
+      << rounded_end;
+  const std::vector<char> as_asked(7 * kHugePage / 5, 'a');
+  const std::string as_asked_end = vm_flags_at(&as_asked.back());
+  EXPECT_EQ(as_asked_end.find(" hg"), std::string::npos) << as_asked_end;
 }
 
 TEST(LargePages, TheEnvironmentTurnsThemOff) {

@@ -21,6 +21,13 @@ std::size_t advised_length(const void* begin, std::size_t bytes) noexcept {
   return bytes - bytes % kHugePage;
 }
 
+std::size_t large_block_size(std::size_t bytes) noexcept {
+  const std::size_t tail = bytes % kHugePage;
+  if (tail == 0) return bytes;
+  const std::size_t extra = kHugePage - tail;
+  return extra <= bytes / kMaxRoundingShare ? bytes + extra : bytes;
+}
+
 namespace {
 
 bool large_pages_on() noexcept {
@@ -34,9 +41,10 @@ bool large_pages_on() noexcept {
 void* allocate_large(std::size_t bytes, std::size_t align) noexcept {
   if (bytes < kLargePageMin || align > kHugePage || !large_pages_on()) return nullptr;
   void* p = nullptr;
-  if (posix_memalign(&p, kHugePage, bytes) != 0) return nullptr;
+  const std::size_t size = large_block_size(bytes);
+  if (posix_memalign(&p, kHugePage, size) != 0) return nullptr;
   // Advice only: a kernel without transparent huge pages answers EINVAL and the pages stay small.
-  if (const std::size_t length = advised_length(p, bytes); length != 0) {
+  if (const std::size_t length = advised_length(p, size); length != 0) {
     madvise(p, length, MADV_HUGEPAGE);
   }
   return p;

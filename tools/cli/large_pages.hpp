@@ -18,6 +18,14 @@ inline constexpr std::size_t kHugePage = std::size_t{1} << 21;
 /// Allocations from this size on are placed and advised (smaller ones hold no whole huge page).
 inline constexpr std::size_t kLargePageMin = kHugePage;
 
+/// The rounding a block may take on to end on a huge page: at most a quarter of what was asked.
+inline constexpr std::size_t kMaxRoundingShare = 4;
+
+/// The bytes to take for an allocation of `bytes` (at least kLargePageMin): rounded up to whole
+/// huge pages when that adds at most bytes / kMaxRoundingShare, so that its last huge page is
+/// advised too instead of up to 511 small pages faulted one by one; else `bytes`.
+std::size_t large_block_size(std::size_t bytes) noexcept;
+
 /// Whether the environment's SKELCD_LARGE_PAGES value (nullptr when unset) leaves large pages on:
 /// only "0", "off" and "no" turn them off.
 bool large_pages_wanted(const char* env) noexcept;
