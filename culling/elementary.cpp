@@ -251,6 +251,7 @@ void run_ccd_tests(
         if (!o.hit) return;
         ++c.vf_contacts;
         const VertexFacePair& p = candidates.vf[i];
+        room_for_one_more(out.contacts);
         out.contacts.push_back({CcdContact::Kind::vf, p.vertex, p.face, o.toi_lower, o.toi_upper});
       });
   // Edge-edge queries, likewise.
@@ -293,6 +294,7 @@ void run_ccd_tests(
         if (!o.hit) return;
         ++c.ee_contacts;
         const EdgeEdgePair& p = candidates.ee[i];
+        room_for_one_more(out.contacts);
         out.contacts.push_back({CcdContact::Kind::ee, p.a, p.b, o.toi_lower, o.toi_upper});
       });
   if (order == ContactOrder::sorted) sort_contacts(std::span(out.contacts).subspan(first));
@@ -455,6 +457,7 @@ void dcd_tests(
         if (o.tested) ++out.counters.tt_tests;
         if (!o.hit) return;
         ++out.counters.dcd_pairs;
+        room_for_one_more(out.dcd_pairs);
         out.dcd_pairs.push_back(pairs[i]);
       });
   if (sorted) {

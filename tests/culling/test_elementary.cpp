@@ -126,6 +126,46 @@ TEST(Elementary, DcdCallsLargerThanTheWindowKeepEveryOutcomeAndAWindowOfScratch)
 // The thread's outcome buffer grown in two steps — a call of 13/16 of a window, then one larger
 // than a window — is still one window: a vector's own growth would have doubled 6,656 to 13,312
 // (what a test process running a DCD before these tests showed).
+// Findings double up to 256 KiB and then grow by whole 2 MiB blocks (frame_result.hpp), which
+// the executable places on huge pages whole; what was pushed stays as pushed.
+template <class T, class Make>
+void expect_grown_in_whole_huge_pages(std::size_t n, const Make& make) {
+  constexpr std::size_t kQuarterMiB = std::size_t{256} << 10;
+  constexpr std::size_t kTwoMiB = std::size_t{2} << 20;
+  std::vector<T> v;
+  std::vector<std::size_t> capacities;
+  for (std::size_t i = 0; i < n; ++i) {
+    room_for_one_more(v);
+    v.push_back(make(i));
+    if (capacities.empty() || capacities.back() != v.capacity()) capacities.push_back(v.capacity());
+  }
+  ASSERT_EQ(v.size(), n);
+  for (std::size_t i = 0; i < n; ++i) ASSERT_TRUE(v[i] == make(i)) << i;
+  std::size_t past = 0;
+  for (std::size_t k = 0; k < capacities.size(); ++k) {
+    const std::size_t bytes = capacities[k] * sizeof(T);
+    if (k > 0 && capacities[k - 1] * sizeof(T) >= kQuarterMiB) {
+      EXPECT_EQ(bytes % kTwoMiB, 0U) << capacities[k];
+      EXPECT_GE(capacities[k], 2 * capacities[k - 1]);  // still geometric: few moves
+      ++past;
+    } else if (k > 0) {
+      EXPECT_LE(bytes, 2 * kQuarterMiB) << capacities[k];  // push_back's own growth
+    }
+  }
+  EXPECT_GE(past, 2U);
+}
+
+TEST(Elementary, FindingsGrowByWholeHugePagesPastAQuarterMebibyte) {
+  expect_grown_in_whole_huge_pages<CcdContact>(300'000, [](std::size_t i) {
+    const auto id = static_cast<std::int32_t>(i);
+    return CcdContact{CcdContact::Kind::ee, id, id + 1, 0.25, 0.5};
+  });
+  expect_grown_in_whole_huge_pages<TrianglePair>(1'200'000, [](std::size_t i) {
+    const auto id = static_cast<std::int32_t>(i);
+    return TrianglePair{id, id + 7};
+  });
+}
+
 TEST(Elementary, ScratchGrownInTwoStepsStaysOneWindow) {
   const Strip s(200);
   std::vector<TrianglePair> pairs;
