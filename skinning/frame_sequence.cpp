@@ -760,6 +760,11 @@ void FrameSequenceMotion::positions(int i, Positions& out) const {
   out = parse_frame_mesh(file, bytes).positions;
 }
 
+const Positions* FrameSequenceMotion::held_positions(int i) const {
+  assert(i >= 0 && i < num_samples());
+  return data_->frames.empty() ? nullptr : &data_->frames[static_cast<std::size_t>(i)];
+}
+
 FrameSequenceMotion load_frame_sequence(const fs::path& spec, const FrameSequenceOptions& options) {
   const bool is_glob = spec.string().find_first_of("*?[") != std::string::npos;
   const std::string name = is_glob ? spec.filename().string() : fs::absolute(spec).lexically_normal().filename().string();

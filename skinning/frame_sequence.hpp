@@ -83,6 +83,8 @@ class FrameSequenceMotion final : public Motion {
   /// @throws IoError naming the file when it cannot be read again or its bytes are no longer
   ///   those read at construction.
   void positions(int i, Positions& out) const override;
+  /// Frame i as held in memory (frames_in_memory()), else nullptr.
+  [[nodiscard]] const Positions* held_positions(int i) const override;
   /// True when every frame is held in memory (else each but the first is read when asked for).
   [[nodiscard]] bool frames_in_memory() const { return !data_->frames.empty(); }
 

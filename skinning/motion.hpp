@@ -28,6 +28,14 @@ class Motion {
   /// Writes the #V × 3 positions at sample i into `out` (resized if needed).
   /// @pre 0 <= i < num_samples()
   virtual void positions(int i, Positions& out) const = 0;
+  /// Sample i's positions where the motion holds them in memory as they are (a frame sequence
+  /// whose frames it keeps), else nullptr: then a caller reads them there instead of copying them
+  /// through positions(). Valid while the motion lives.
+  /// @pre 0 <= i < num_samples()
+  [[nodiscard]] virtual const Positions* held_positions(int i) const {
+    (void)i;
+    return nullptr;
+  }
 
   /// Positions at time t (seconds). A motion defined between its samples (a rig's clip)
   /// evaluates it there (clamped to the clip); the others answer at a sample time only, within

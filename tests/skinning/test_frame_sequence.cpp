@@ -359,6 +359,16 @@ TEST(FrameSequence, FramesBeyondTheBudgetAreReadAgainBitExactly) {
     EXPECT_EQ(
         0, std::memcmp(a.data(), b.data(), sizeof(double) * static_cast<std::size_t>(a.size())))
         << "frame " << i;
+    // Kept frames are lent where they are (the runner reads them without a copy); frames read
+    // again are not held, so there is nothing to lend.
+    const Positions* held = kept.held_positions(i);
+    ASSERT_NE(held, nullptr) << "frame " << i;
+    EXPECT_EQ(held, kept.held_positions(i));
+    ASSERT_EQ(held->rows(), a.rows());
+    EXPECT_EQ(
+        0, std::memcmp(held->data(), a.data(), sizeof(double) * static_cast<std::size_t>(a.size())))
+        << "frame " << i;
+    EXPECT_EQ(read_again.held_positions(i), nullptr) << "frame " << i;
   }
   // A budget just below the two frames' size reads them again too; at it, they are kept.
   const std::size_t per_triangle = (2 * 9450 * 24) / 18484;  // 24 (24.54 rounded down)

@@ -63,10 +63,34 @@ class ShiftMotion : public skinning::Motion {
   int samples_;
 };
 
+/// ShiftMotion's samples held in memory, lent through held_positions() as a frame sequence's.
+class HeldShiftMotion : public skinning::Motion {
+ public:
+  HeldShiftMotion(skinning::Mesh mesh, int samples) : mesh_(std::move(mesh)) {
+    for (int i = 0; i < samples; ++i) {
+      frames_.push_back(mesh_.rest_positions);
+      frames_.back().col(2).array() -= 0.5 * i;
+    }
+  }
+  const skinning::Mesh& mesh() const override { return mesh_; }
+  int num_samples() const override { return static_cast<int>(frames_.size()); }
+  double sample_time(int i) const override { return 0.25 * i; }
+  std::string name() const override { return "held-clip"; }
+  void positions(int i, Positions& out) const override { out = *held_positions(i); }
+  const Positions* held_positions(int i) const override {
+    return &frames_[static_cast<std::size_t>(i)];
+  }
+
+ private:
+  skinning::Mesh mesh_;
+  std::vector<Positions> frames_;
+};
+
 /// A method that records what it was given and reports fixed findings in welded numbering.
 struct Recorded {
   std::vector<Positions> dcd_inputs;
   std::vector<std::pair<Positions, Positions>> ccd_inputs;
+  std::vector<std::pair<const double*, const double*>> ccd_addresses;  // where they were read
 };
 
 class FakeMethod : public culling::CullingMethod {
@@ -87,6 +111,7 @@ class FakeMethod : public culling::CullingMethod {
     const skinning::Positions& x_t0 = interval.x_t0;
     const skinning::Positions& x_t1 = interval.x_t1;
     record_.ccd_inputs.emplace_back(x_t0, x_t1);
+    record_.ccd_addresses.emplace_back(x_t0.data(), x_t1.data());
     out.contacts = contacts_;
     out.counters.vf_tests = 11;
     out.times.elementary_us = 2.5;
@@ -224,6 +249,48 @@ TEST(Runner, MethodSeesWeldedPositionsOfConsecutiveSamples) {
       const auto v = topology.representative_vertex[static_cast<std::size_t>(w)];
       EXPECT_EQ(w0.row(w), x0.row(v)) << "sample " << i << " welded " << w;
       EXPECT_EQ(w1.row(w), x1.row(v)) << "sample " << i + 1 << " welded " << w;
+    }
+  }
+}
+
+// A held frame is handed to the method where the motion holds it when welding leaves every
+// vertex as it is, and welded into the worker's own buffer when it merges some; the positions
+// the method sees are the welded ones either way.
+TEST(Runner, HeldFramesAreLentWhereWeldingIsTheIdentity) {
+  skinning::Mesh seamless = two_part_mesh();  // the quad on 4 vertices: nothing to weld
+  seamless.rest_positions.conservativeResize(7, 3);
+  seamless.rest_positions.row(6) << 0, 1, 0;
+  seamless.triangles << 0, 1, 2, 3, 4, 5, 3, 5, 6;
+  seamless.vertex_part.resize(7);
+  seamless.vertex_index_in_part.resize(7);
+  for (const bool welds : {false, true}) {
+    const HeldShiftMotion motion(welds ? two_part_mesh() : seamless, 3);
+    const auto topology = skinning::build_topology(motion.mesh());
+    ASSERT_EQ(topology.num_welded_vertices() < motion.mesh().num_vertices(), welds);
+    Recorded record;
+    RunOptions options;
+    options.query = QuerySet::ccd;
+    ClipRunner runner(
+        motion,
+        options,
+        [&](const skinning::Mesh&, const skinning::Topology&, const culling::MethodOptions&) {
+          return std::make_unique<FakeMethod>(
+              record, std::vector<culling::CcdContact>{}, std::vector<culling::TrianglePair>{});
+        });
+    runner.run([](const FrameReport&) {});
+    ASSERT_EQ(record.ccd_inputs.size(), 2U);
+    for (std::size_t i = 0; i < 2; ++i) {
+      const auto k = static_cast<int>(i);
+      const auto& [a0, a1] = record.ccd_addresses[i];
+      EXPECT_EQ(a0 == motion.held_positions(k)->data(), !welds) << "interval " << i;
+      EXPECT_EQ(a1 == motion.held_positions(k + 1)->data(), !welds) << "interval " << i;
+      const auto& [w0, w1] = record.ccd_inputs[i];
+      ASSERT_EQ(w0.rows(), topology.num_welded_vertices());
+      for (Eigen::Index w = 0; w < w0.rows(); ++w) {
+        const auto v = topology.representative_vertex[static_cast<std::size_t>(w)];
+        EXPECT_EQ(w0.row(w), motion.held_positions(k)->row(v)) << i << " welded " << w;
+        EXPECT_EQ(w1.row(w), motion.held_positions(k + 1)->row(v)) << i << " welded " << w;
+      }
     }
   }
 }

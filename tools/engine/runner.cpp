@@ -81,11 +81,26 @@ struct RowContext {
   std::shared_ptr<const culling::FeatureTopology> features{};
   /// RunOptions::reuse_static_intervals, where the method allows it.
   bool reuse_static = false;
+  /// Every vertex is its own welded vertex (identity_welding): a sample's positions are its
+  /// welded positions as they are.
+  bool identity_welding = false;
 };
+
+/// True when welding keeps every vertex as it is, in its place (no duplicates merged).
+bool identity_welding(const skinning::Topology& t) {
+  if (t.representative_vertex.size() != t.welded_of_vertex.size()) return false;
+  for (std::size_t w = 0; w < t.representative_vertex.size(); ++w) {
+    if (t.representative_vertex[w] != static_cast<std::int32_t>(w)) return false;
+  }
+  return true;
+}
 
 /// One posed sample: welded positions and, when the method needs them, the bone transforms.
 struct PosedSample {
-  skinning::Positions welded;
+  /// The welded positions: `lent` (a held frame, where welding is the identity) or `own`.
+  [[nodiscard]] const skinning::Positions& welded() const { return lent != nullptr ? *lent : own; }
+  skinning::Positions own;
+  const skinning::Positions* lent = nullptr;  ///< the motion's, valid while it lives
   std::vector<skinning::BoneTransform> bones;
 };
 
@@ -94,24 +109,32 @@ struct PosedSample {
 double pose_sample(
     const RowContext& c, std::int32_t i, skinning::Positions& posed, PosedSample& out) {
   const auto start = Clock::now();
-  skinning::Positions& welded = out.welded;
   if (c.bones) c.motion.bone_transforms(i, out.bones);
   const auto& mesh = c.motion.mesh();
-  c.motion.positions(i, posed);
-  if (posed.rows() != mesh.num_vertices()) {
+  // Held frames are read where they are (a copy would cost a sample's worth of fresh pages).
+  const skinning::Positions* held = c.motion.held_positions(i);
+  if (held == nullptr) {
+    c.motion.positions(i, posed);
+    held = &posed;
+  }
+  const skinning::Positions& x = *held;
+  if (x.rows() != mesh.num_vertices()) {
     throw InvalidInput(
-        c.motion.name() + ": sample " + std::to_string(i) + " has " + std::to_string(posed.rows()) +
+        c.motion.name() + ": sample " + std::to_string(i) + " has " + std::to_string(x.rows()) +
         " positions, expected " + std::to_string(mesh.num_vertices()));
   }
-  if (!posed.allFinite()) {
+  if (!x.allFinite()) {
     Eigen::Index bad = 0;
-    while (bad < posed.rows() && posed.row(bad).allFinite()) ++bad;
+    while (bad < x.rows() && x.row(bad).allFinite()) ++bad;
     throw InvalidInput(
         c.motion.name() + ": sample " + std::to_string(i) +
         " (t = " + std::to_string(c.motion.sample_time(i)) + " s): vertex " + std::to_string(bad) +
         " has a non-finite position");
   }
-  skinning::gather_welded(c.topology, posed, welded);
+  // A held frame that welding leaves as it is is lent, not copied (a sample's worth of fresh pages
+  // and a copy less).
+  out.lent = held != &posed && c.identity_welding ? held : nullptr;
+  if (out.lent == nullptr) skinning::gather_welded(c.topology, x, out.own);
   return microseconds_since(start);
 }
 
@@ -215,12 +238,14 @@ bool same_pose(const PosedSample& a, const PosedSample& b) {
   const auto same = [](const double* x, const double* y, std::size_t n) {
     return n == 0 || std::memcmp(x, y, n * sizeof(double)) == 0;
   };
-  if (a.welded.rows() != b.welded.rows() || a.bones.size() != b.bones.size()) return false;
+  const skinning::Positions& xa = a.welded();
+  const skinning::Positions& xb = b.welded();
+  if (xa.rows() != xb.rows() || a.bones.size() != b.bones.size()) return false;
   static_assert(
       sizeof(skinning::BoneTransform) ==
       skinning::BoneTransform::SizeAtCompileTime * sizeof(double));  // no padding
   const auto bone_doubles = static_cast<std::size_t>(skinning::BoneTransform::SizeAtCompileTime);
-  return same(a.welded.data(), b.welded.data(), static_cast<std::size_t>(a.welded.size())) &&
+  return same(xa.data(), xb.data(), static_cast<std::size_t>(xa.size())) &&
          (a.bones.empty() ||
           same(a.bones.front().data(), b.bones.front().data(), a.bones.size() * bone_doubles));
 }
@@ -247,10 +272,10 @@ void check_samples(
         const PosedSample& x = w.samples[slot];
         if (w.updater && w.previous_sample == k - 1 && w.contacts_interval == k - 1) {
           w.updater->update(
-              w.previous_pairs, w.contacts, x.welded, *context.incremental_dcd, w.result);
+              w.previous_pairs, w.contacts, x.welded(), *context.incremental_dcd, w.result);
         } else {
           w.method->detect_dcd(
-              culling::Instant{.x = x.welded, .bones = x.bones, .sample = k}, w.result);
+              culling::Instant{.x = x.welded(), .bones = x.bones, .sample = k}, w.result);
         }
         if (w.updater) {
           w.previous_pairs.assign(w.result.dcd_pairs.begin(), w.result.dcd_pairs.end());
@@ -274,8 +299,8 @@ void check_samples(
         } else {
           w.method->detect_ccd(
               culling::Interval{
-                  .x_t0 = a.welded,
-                  .x_t1 = b.welded,
+                  .x_t0 = a.welded(),
+                  .x_t1 = b.welded(),
                   .bones_t0 = a.bones,
                   .bones_t1 = b.bones,
                   .sample_t0 = k,
@@ -602,7 +627,8 @@ void ClipRunner::run_queries_in_order(const FrameCallback& on_frame) {
       bones_,
       incremental_dcd_ ? &method_options_.elementary : nullptr,
       method_options_.features,
-      reuse_static_};
+      reuse_static_,
+      identity_welding(topology_)};
   const bool dcd = options_.query != QuerySet::ccd;
   const SampleSequence all{
       .first = plan_.first_sample,
@@ -633,7 +659,8 @@ void ClipRunner::run_parallel(const FrameCallback& on_frame) {
       bones_,
       incremental_dcd_ ? &method_options_.elementary : nullptr,
       method_options_.features,
-      reuse_static_};
+      reuse_static_,
+      identity_welding(topology_)};
   const bool dcd = options_.query != QuerySet::ccd;
   const bool ccd = options_.query != QuerySet::dcd;
   const std::int32_t last = plan_.last_sample;
