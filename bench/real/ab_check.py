@@ -6,7 +6,13 @@ largest peak RSS, and its least in-process times from the summary (`ms_per_inter
 own; `setup_ms.total`, before the first row) — steadier than the whole process's — and whether
 the two JSON summaries agree once the timings are left out (exit 1 when they do not).
 
-    python3 bench/real/ab_check.py OLD_SKELCD NEW_SKELCD REPEAT -- MODEL [check options…]
+    python3 bench/real/ab_check.py OLD_SKELCD NEW_SKELCD REPEAT [--rows] -- MODEL [check options…]
+
+With --rows each check also writes its log (to a temporary folder: do not pass -o) and the least of
+each row's own stage times over the rounds is printed per row (`skelcd inspect --frames`: total,
+skin, refit, traverse, elementary ms) with old/new of the totals — on this project's VMs the steadier
+reading (a clip's first interval, which pays its buffers' first touches, apart from the later
+ones; one-step least-of-N wall times moved by ±5 % between runs of the same pair).
 
 Example (set-up alone: one sample, docs/benchmarks.md "parallel"):
     python3 bench/real/ab_check.py /tmp/skelcd-old build/tools/skelcd 9 -- \\
@@ -48,21 +54,54 @@ def run(exe, args):
     return wall, usage.ru_utime + usage.ru_stime, usage.ru_maxrss, json.loads(out)
 
 
+ROW_STAGES = ("total_ms", "skin_ms", "refit_ms", "traverse_ms", "elementary_ms")
+
+
+def row_times(exe, log):
+    """Each row's stage times (ROW_STAGES) of a check's log, in row order."""
+    p = subprocess.run([exe, "inspect", "--frames", "--json", log], capture_output=True,
+                       text=True)
+    if p.returncode != 0:
+        sys.exit(f"ab_check.py: {exe} inspect --frames {log} failed ({p.returncode}): "
+                 f"{p.stderr.strip()}")
+    return [tuple(row[k] for k in ROW_STAGES) for row in json.loads(p.stdout)["rows"]]
+
+
+def print_rows(rows):
+    """The least of each row's stage times per side, and old/new of the totals."""
+    print("row: least over the rounds, ms (" + ", ".join(k[:-3] for k in ROW_STAGES) + ")")
+    least = {side: [tuple(min(run[i][k] for run in runs) for k in range(len(ROW_STAGES)))
+                    for i in range(len(runs[0]))] for side, runs in rows.items()}
+    for i, (o, n) in enumerate(zip(least["old"], least["new"])):
+        print(f"  {i:4d}  old " + " ".join(f"{v:8.2f}" for v in o) + "   new " +
+              " ".join(f"{v:8.2f}" for v in n) + f"   old/new {o[0] / n[0]:.3f}")
+
+
 def main():
-    if len(sys.argv) < 6 or sys.argv[4] != "--":
+    with_rows = len(sys.argv) > 4 and sys.argv[4] == "--rows"
+    dash = 5 if with_rows else 4
+    if len(sys.argv) < dash + 2 or sys.argv[dash] != "--":
         sys.exit(__doc__)
     sides = {"old": sys.argv[1], "new": sys.argv[2]}
     repeat = int(sys.argv[3])
-    args = sys.argv[5:]
+    args = sys.argv[dash + 1:]
+    if with_rows and any(a in ("-o", "--output") or a.startswith("--output=") for a in args):
+        sys.exit("ab_check.py: --rows writes the logs itself: leave -o out")
     runs = {side: [] for side in sides}
+    rows = {side: [] for side in sides}
     summaries = {}
+    logs = tempfile.TemporaryDirectory()
     for round_index in range(repeat):
         order = ["old", "new"] if round_index % 2 == 0 else ["new", "old"]
         for side in order:
-            wall, cpu, rss, summary = run(sides[side], args)
+            # One path for both sides: the summaries name the log, and must not differ by it.
+            log = os.path.join(logs.name, "check.h5")
+            wall, cpu, rss, summary = run(sides[side], args + (["-o", log] if with_rows else []))
             runs[side].append(
                 (wall, cpu, rss, summary["ms_per_interval"], summary["setup_ms"]["total"]))
             summaries[side] = without_timings(summary)
+            if with_rows:
+                rows[side].append(row_times(sides[side], log))
     best = {
         side: (min(r[0] for r in rs), min(r[1] for r in rs), max(r[2] for r in rs),
                min(r[3] for r in rs), min(r[4] for r in rs))
@@ -74,6 +113,11 @@ def main():
     o, n = best["old"], best["new"]
     print(f"old/new: wall {o[0] / n[0]:.3f}  cpu {o[1] / n[1]:.3f}  peak RSS {o[2] / n[2]:.3f}  "
           f"ms_per_interval {o[3] / n[3]:.3f}  set-up {o[4] / n[4]:.3f}")
+    if with_rows:
+        if len(rows["old"][0]) != len(rows["new"][0]):
+            sys.exit("ab_check.py: the two logs have different numbers of rows")
+        print_rows(rows)
+    logs.cleanup()
     same = summaries["old"] == summaries["new"]
     print("summaries (timings left out): " + ("identical" if same else "DIFFERENT"))
     sys.exit(0 if same else 1)
