@@ -49,9 +49,16 @@ class BvhMethod final : public MethodBase {
       const skinning::Mesh& mesh,
       const skinning::Topology& topology,
       const MethodOptions& options,
-      bool relative_pairs)
+      bool relative_pairs,
+      bool rigid_rows)
       : MethodBase(name, mesh, topology, options),
         relative_pairs_(relative_pairs),
+        rigid_rows_(
+            rigid_rows && options.rigid_rows != nullptr &&
+                    static_cast<std::int64_t>(options.rigid_rows->triangle_row.size()) ==
+                        topology.welded_triangles.rows()
+                ? options.rigid_rows
+                : nullptr),
         bvh_(build_hierarchy<N>(
             options.hierarchies.get(),
             topology_.welded_triangles(),
@@ -67,6 +74,11 @@ class BvhMethod final : public MethodBase {
     bounds_.triangles.reserve(num_faces);
     scratch_.reserve_self(bvh_);
     full_slots_.reserve(num_faces);
+    if (rigid_rows_) {
+      row_skip_.nodes.reserve(bvh_.nodes().size());
+      row_skip_.slots.reserve(bvh_.triangle_order().size());
+      rest_pairs_.reserve(rigid_rows_->rest_pairs.size());
+    }
   }
 
   void dcd(const Instant& at, FrameResult& out) override {
@@ -146,6 +158,11 @@ class BvhMethod final : public MethodBase {
         full_slots_,
         topology_);
     FanSieve* const sieving = sieve.certified.empty() ? nullptr : &sieve;
+    // Rigid rows (docs/culling.md "Rigid rows"): the pairs of two triangles of one row this
+    // interval certifies are skipped in the walk; the row's rest pairs go to the feature stage
+    // first instead.
+    const RowSkip* const rows = certify_rows(interval);
+    std::size_t rest_next = 0;
     start_self_traversal<N>(bvh_, scratch_);
     scratch_.apart_at_both_ends = 0;
     const std::int64_t candidates_before = out.counters.candidate_pairs;
@@ -162,8 +179,28 @@ class BvhMethod final : public MethodBase {
         build_slot_ends();
       }
       const std::size_t first = pairs.size();
-      const bool done = self_traverse_some<N>(
-          bvh_, bounds_.triangles, scratch_, pairs, out.counters.bv_tests, max_pairs, sieving);
+      if (rest_next < rest_pairs_.size()) {
+        // At most an installment's worth at a time, so that a block stays bounded.
+        const std::size_t take = std::min(
+            rest_pairs_.size() - rest_next, max_pairs > first ? max_pairs - first : std::size_t{1});
+        pairs.insert(
+            pairs.end(),
+            rest_pairs_.begin() + static_cast<std::ptrdiff_t>(rest_next),
+            rest_pairs_.begin() + static_cast<std::ptrdiff_t>(rest_next + take));
+        rest_next += take;
+      }
+      const bool done = (pairs.size() >= max_pairs && rest_next < rest_pairs_.size())
+                            ? false
+                            : self_traverse_some<N>(
+                                  bvh_,
+                                  bounds_.triangles,
+                                  scratch_,
+                                  pairs,
+                                  out.counters.bv_tests,
+                                  max_pairs,
+                                  sieving,
+                                  rows) &&
+                                  rest_next == rest_pairs_.size();
       emitted += static_cast<std::int64_t>(pairs.size() - first);
       if (filter_pairs) {
         relative_.filter(topology_, x_t0, x_t1, 0.5 * options_.min_separation, pairs, first);
@@ -184,7 +221,28 @@ class BvhMethod final : public MethodBase {
   }
 
  private:
+  /// Certifies the rigid rows for `interval` and fills row_skip_ and rest_pairs_; the skip to
+  /// walk with, or null (no rows, no bone transforms, or no row certified on any node).
+  const RowSkip* certify_rows(const Interval& interval) {
+    rest_pairs_.clear();
+    if (!rigid_rows_ || interval.bones_t0.empty() || interval.bones_t1.empty()) return nullptr;
+    certify_rigid_rows(
+        *rigid_rows_, interval.bones_t0, interval.bones_t1, options_.min_separation, certified_);
+    if (!row_skip<N>(bvh_, rigid_rows_->triangle_row, certified_, row_skip_)) return nullptr;
+    for (const TrianglePair& p : rigid_rows_->rest_pairs) {
+      if (certified_[static_cast<std::size_t>(
+              rigid_rows_->triangle_row[static_cast<std::size_t>(p.a)])] != 0) {
+        rest_pairs_.push_back(p);
+      }
+    }
+    return &row_skip_;
+  }
+
   bool relative_pairs_;
+  std::shared_ptr<const RigidRows> rigid_rows_;  // null: none (`bvh` itself)
+  std::vector<std::uint8_t> certified_;          // per row, this interval
+  RowSkip row_skip_;
+  std::vector<TrianglePair> rest_pairs_;  // the certified rows' rest pairs, this interval
   RelativePairTrial relative_;
   Bvh<N> bvh_;
   SlotAdjacency slots_{topology_, bvh_.triangle_order()};
@@ -209,13 +267,24 @@ std::unique_ptr<CullingMethod> make_bvh_method(
     const skinning::Mesh& mesh,
     const skinning::Topology& topology,
     const MethodOptions& options,
-    bool relative_pairs) {
-  return std::make_unique<BvhMethod<N>>(name, mesh, topology, options, relative_pairs);
+    bool relative_pairs,
+    bool rigid_rows) {
+  return std::make_unique<BvhMethod<N>>(name, mesh, topology, options, relative_pairs, rigid_rows);
 }
 
 template std::unique_ptr<CullingMethod> make_bvh_method<3>(
-    std::string_view, const skinning::Mesh&, const skinning::Topology&, const MethodOptions&, bool);
+    std::string_view,
+    const skinning::Mesh&,
+    const skinning::Topology&,
+    const MethodOptions&,
+    bool,
+    bool);
 template std::unique_ptr<CullingMethod> make_bvh_method<8>(
-    std::string_view, const skinning::Mesh&, const skinning::Topology&, const MethodOptions&, bool);
+    std::string_view,
+    const skinning::Mesh&,
+    const skinning::Topology&,
+    const MethodOptions&,
+    bool,
+    bool);
 
 }  // namespace skelcd::culling::detail

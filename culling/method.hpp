@@ -16,6 +16,7 @@
 #include "culling/candidates.hpp"
 #include "culling/elementary.hpp"
 #include "culling/frame_result.hpp"
+#include "culling/rigid_rows.hpp"
 #include "skinning/mesh.hpp"
 #include "skinning/pose.hpp"
 #include "skinning/topology.hpp"
@@ -51,6 +52,11 @@ struct MethodOptions {
   /// when it is > 0.
   std::int32_t num_bones = 0;
   MethodParameters parameters{};
+  /// The mesh's rigid rows (culling/rigid_rows.hpp), for methods that take them
+  /// (MethodInfo::takes_rigid_rows): their CCD skips the pairs of two triangles of one row the
+  /// interval certifies, from the bone transforms it carries, and tests the row's rest pairs
+  /// instead. Null, or an interval without bone transforms: no pair is skipped.
+  std::shared_ptr<const RigidRows> rigid_rows{};
   /// Triangle pairs per block of the feature and elementary stages (docs/culling.md "Bounded
   /// memory"): what a query holds at once grows with it, not with the motion. The findings do not
   /// depend on it; tests make it small to cut a query into many blocks. ≥ 1.

@@ -53,13 +53,16 @@ void add_culling_methods(Registry& r) {
        }});
   add(r,
       {.name = "kdop",
-       .description = "16-DOP hierarchy; CCD pairs through relative AABBs when that pays",
+       .description =
+           "16-DOP hierarchy; CCD pairs through relative AABBs when that pays, and skipped "
+           "where skinning moves both triangles by one matrix",
+       .takes_rigid_rows = true,
        .order = 30,
        .make = [](const skinning::Mesh& mesh,
                   const skinning::Topology& topology,
                   const MethodOptions& options) {
          return detail::make_bvh_method<8>(
-             "kdop", mesh, topology, options, /*relative_pairs=*/true);
+             "kdop", mesh, topology, options, /*relative_pairs=*/true, /*rigid_rows=*/true);
        }});
   add(r,
       {.name = "normal-cone",
@@ -99,6 +102,8 @@ void add_culling_methods(Registry& r) {
            "connected part: closed parts to the best closed-part method whose needs are met "
            "(dynamic on a rig, else bvh), and with them open parts it caps or under 256 "
            "triangles; other open parts to enhanced-dual-cone",
+       // Its `bvh` for a whole mesh skips the pairs skinning moves as one (docs/culling.md).
+       .takes_rigid_rows = true,
        // `auto` carries what the methods it routes to carry.
        .serial_reason =
            [](const MethodOptions& options, bool dcd_before_each_ccd) {

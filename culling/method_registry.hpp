@@ -44,6 +44,9 @@ struct MethodInfo {
   MethodNeeds needs{};
   /// Reports fewer contacts than `brute` by design (kept to show what a method misses).
   bool may_miss = false;
+  /// Uses MethodOptions::rigid_rows when given (with the intervals' bone transforms): a runner
+  /// builds them for such a method when the motion is linear blend skinning.
+  bool takes_rigid_rows = false;
   /// Why a run of this method must keep one method object for all its queries under `options`
   /// (its state between queries changes its rows), given whether a DCD query precedes every
   /// CCD interval; empty or unset: blocks of samples may go to several workers with the rows of a

@@ -415,7 +415,9 @@ class AutoMethod final : public detail::MethodBase {
     for (auto& r : routes_) r.method = "bvh";
     MethodOptions shared = options;
     shared.features = features_;
-    closed_method_ = make_method("bvh", mesh, topology, shared);
+    // `bvh` with the rigid rows, when the runner gave them (docs/culling.md "Rigid rows").
+    closed_method_ = detail::make_bvh_method<3>(
+        "bvh", mesh, topology, shared, /*relative_pairs=*/false, /*rigid_rows=*/true);
     return true;
   }
 

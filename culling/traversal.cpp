@@ -172,7 +172,8 @@ class Walk {
       std::int64_t& bv_tests,
       std::size_t max_pairs,
       FanSieve* sieve = nullptr,
-      const WalkMasks& masks = {})
+      const WalkMasks& masks = {},
+      const RowSkip* rows = nullptr)
       : sieve_(sieve),
         masks_(masks),
         a_(a),
@@ -203,6 +204,10 @@ class Walk {
         ends_rows_a_[r] = a.slot_ends(static_cast<int>(r));
         ends_rows_b_[r] = b.slot_ends(static_cast<int>(r));
       }
+    }
+    if (rows != nullptr) {
+      node_row_ = rows->nodes.data();
+      slot_row_ = rows->slots.data();
     }
     if (sieve != nullptr) {
       corners_ = sieve->slots->corners.data();
@@ -239,12 +244,14 @@ class Walk {
     const WideBvhNode<N>& parent = wide_a_[node_of(s)];
     const std::int32_t c = parent.child[lane_of(s)];
     if (c < 0) {
+      if (node_row_ != nullptr && node_row_[to_size(parent.node[lane_of(s)])] >= 0) return;
       if (parent.count[lane_of(s)] > 1) leaf_pairs(s, s);  // popped: the installment has room
       return;
     }
     const WideBvhNode<N>& w = wide_a_[to_size(c)];
     const int m = w.num_children;
     for (int i = 0; i < m; ++i) {
+      if (node_row_ != nullptr && node_row_[to_size(w.node[i])] >= 0) continue;  // one rigid row
       if constexpr (kMasked) {
         const std::uint8_t mi = masks_.node_a[to_size(w.node[i])];
         if (!node_pair_wanted(mi, mi, masks_.which)) continue;
@@ -255,6 +262,7 @@ class Walk {
       // Children i < j: lanes above i (a masked walk: only those that may hold a wanted pair
       // with i, and none tested when there are none).
       unsigned wanted = ~((2u << i) - 1u);
+      if (node_row_ != nullptr) wanted &= ~same_row_lanes(w, node_row_[to_size(w.node[i])]);
       if constexpr (kMasked) {
         wanted &= wanted_children(w, masks_.node_a, masks_.node_a[to_size(w.node[i])]);
         if (wanted == 0) continue;
@@ -292,6 +300,7 @@ class Walk {
     if (cb < 0 || (ca >= 0 && pa.count[la] >= pb.count[lb])) {
       const WideBvhNode<N>& w = wide_a_[to_size(ca)];
       unsigned mask = overlap_lanes<N>(w, pb, lb);
+      if (node_row_ != nullptr) mask &= ~same_row_lanes(w, node_row_[to_size(pb.node[lb])]);
       if constexpr (kMasked) {
         mask &= wanted_children(w, masks_.node_a, masks_.node_b[to_size(pb.node[lb])]);
       }
@@ -311,6 +320,7 @@ class Walk {
     } else {
       const WideBvhNode<N>& w = wide_b_[to_size(cb)];
       unsigned mask = overlap_lanes<N>(w, pa, la);
+      if (node_row_ != nullptr) mask &= ~same_row_lanes(w, node_row_[to_size(pa.node[la])]);
       if constexpr (kMasked) {
         mask &= wanted_children(w, masks_.node_b, masks_.node_a[to_size(pa.node[la])]);
       }
@@ -420,6 +430,10 @@ class Walk {
             const std::int32_t sj = j0 + std::countr_zero(mask);
             const std::int32_t tj = order_b_[to_size(sj)];
             mask &= mask - 1;
+            if (slot_row_ != nullptr && slot_row_[to_size(i)] >= 0 &&
+                slot_row_[to_size(i)] == slot_row_[to_size(sj)]) {
+              continue;  // one certified rigid row: its rest pairs are tested instead
+            }
             // Two triangles that share a vertex always overlap (both volumes hold it): a settled
             // pair needs no exact volume test.
             if constexpr (kSieve) {
@@ -476,6 +490,17 @@ class Walk {
     }
     return bits;
 #endif
+  }
+
+  /// Bit i set when child i of `w` has the rigid row `row` ≥ 0 (none when row < 0): a pair of it
+  /// and a node of that row holds no pair to emit.
+  [[nodiscard]] unsigned same_row_lanes(const WideBvhNode<N>& w, std::int32_t row) const {
+    if (row < 0) return 0;
+    unsigned bits = 0;
+    for (int i = 0; i < w.num_children; ++i) {
+      bits |= static_cast<unsigned>(node_row_[to_size(w.node[i])] == row) << i;
+    }
+    return bits;
   }
 
   /// Bit i set when child i of `w` (node masks `node_masks`) and a node with mask `other` may hold
@@ -620,9 +645,45 @@ class Walk {
   const std::uint64_t* window_ = nullptr;
   const std::uint8_t* full_ = nullptr;
   const std::uint8_t* certified_ = nullptr;
+  // RowSkip's rows (self walks only), null when none.
+  const std::int32_t* node_row_ = nullptr;
+  const std::int32_t* slot_row_ = nullptr;
 };
 
 }  // namespace
+
+template <int N>
+bool row_skip(
+    const Bvh<N>& bvh,
+    std::span<const std::int32_t> triangle_row,
+    std::span<const std::uint8_t> certified,
+    RowSkip& out) {
+  const auto order = bvh.triangle_order();
+  const auto nodes = bvh.nodes();
+  out.slots.resize(order.size());
+  for (std::size_t s = 0; s < order.size(); ++s) {
+    const std::int32_t r = triangle_row[to_size(order[s])];
+    out.slots[s] = r >= 0 && certified[to_size(r)] != 0 ? r : -1;
+  }
+  out.nodes.resize(nodes.size());
+  bool any = false;
+  // Children follow their parent in depth-first order: one backward sweep is bottom-up.
+  for (std::size_t n = nodes.size(); n-- > 0;) {
+    const BvhNode& node = nodes[n];
+    std::int32_t r = -1;
+    if (node.is_leaf()) {
+      r = node.end > node.begin ? out.slots[to_size(node.begin)] : -1;
+      for (std::int32_t s = node.begin + 1; s < node.end && r >= 0; ++s) {
+        if (out.slots[to_size(s)] != r) r = -1;
+      }
+    } else {
+      r = out.nodes[n + 1] == out.nodes[to_size(node.right)] ? out.nodes[n + 1] : -1;
+    }
+    out.nodes[n] = r;
+    any = any || r >= 0;
+  }
+  return any;
+}
 
 template <int N>
 void start_self_traversal(const Bvh<N>& bvh, TraversalScratch& scratch) {
@@ -639,11 +700,22 @@ bool self_traverse_some(
     std::vector<TrianglePair>& out,
     std::int64_t& bv_tests,
     std::size_t max_pairs,
-    FanSieve* sieve) {
+    FanSieve* sieve,
+    const RowSkip* rows) {
   if (bvh.empty()) return true;
   if (sieve == nullptr || sieve->certified.empty()) {
     Walk<N, true> walk(
-        bvh, triangle_bounds, bvh, triangle_bounds, scratch.stack, out, bv_tests, max_pairs);
+        bvh,
+        triangle_bounds,
+        bvh,
+        triangle_bounds,
+        scratch.stack,
+        out,
+        bv_tests,
+        max_pairs,
+        nullptr,
+        {},
+        rows);
     const bool done = walk.run();
     scratch.apart_at_both_ends += walk.apart_at_both_ends();
     return done;
@@ -652,7 +724,17 @@ bool self_traverse_some(
   assert(sieve->slots->corners.size() == bvh.triangle_order().size());
   assert(sieve->full.size() == sieve->slots->corners.size());
   Walk<N, true, true> walk(
-      bvh, triangle_bounds, bvh, triangle_bounds, scratch.stack, out, bv_tests, max_pairs, sieve);
+      bvh,
+      triangle_bounds,
+      bvh,
+      triangle_bounds,
+      scratch.stack,
+      out,
+      bv_tests,
+      max_pairs,
+      sieve,
+      {},
+      rows);
   const bool done = walk.run();
   scratch.apart_at_both_ends += walk.apart_at_both_ends();
   return done;
@@ -898,6 +980,10 @@ template bool masked_pair_traverse_some<8>(
     std::vector<TrianglePair>&,
     std::int64_t&,
     std::size_t);
+template bool row_skip<3>(
+    const Bvh<3>&, std::span<const std::int32_t>, std::span<const std::uint8_t>, RowSkip&);
+template bool row_skip<8>(
+    const Bvh<8>&, std::span<const std::int32_t>, std::span<const std::uint8_t>, RowSkip&);
 template bool self_traverse_some<3>(
     const Bvh<3>&,
     std::span<const Dop<3>>,
@@ -905,7 +991,8 @@ template bool self_traverse_some<3>(
     std::vector<TrianglePair>&,
     std::int64_t&,
     std::size_t,
-    FanSieve*);
+    FanSieve*,
+    const RowSkip*);
 template bool self_traverse_some<8>(
     const Bvh<8>&,
     std::span<const Dop<8>>,
@@ -913,7 +1000,8 @@ template bool self_traverse_some<8>(
     std::vector<TrianglePair>&,
     std::int64_t&,
     std::size_t,
-    FanSieve*);
+    FanSieve*,
+    const RowSkip*);
 template void self_traverse<3>(
     const Bvh<3>&,
     std::span<const Dop<3>>,

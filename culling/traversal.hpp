@@ -117,6 +117,24 @@ struct TraversalScratch {
   }
 };
 
+/// The rigid rows a self traversal skips this interval (culling/rigid_rows.hpp): per binary node
+/// and per slot of one hierarchy, the certified row that all its triangles share, else -1. A node
+/// pair or slot pair of one row ≥ 0 holds no pair to emit, and a node of a row ≥ 0 none within
+/// itself.
+struct RowSkip {
+  std::vector<std::int32_t> nodes;  ///< #nodes (Bvh::nodes)
+  std::vector<std::int32_t> slots;  ///< #slots (Bvh::triangle_order)
+};
+
+/// Fills `out` for `bvh` from each triangle's row (-1: none) and each row's certificate; returns
+/// whether any node has a row (else the skip has nothing to do).
+template <int N>
+bool row_skip(
+    const Bvh<N>& bvh,
+    std::span<const std::int32_t> triangle_row,
+    std::span<const std::uint8_t> certified,
+    RowSkip& out);
+
 /// Self traversal: appends to `out` every pair of distinct triangles (a < b) of `bvh` whose
 /// volumes in `triangle_bounds` overlap — exactly those, each once (tests/culling prove it against
 /// all pairs). Over the wide nodes (Bvh::wide_nodes): a node against itself → each child against
@@ -144,6 +162,8 @@ void self_traverse(
 /// anything else in between.
 /// @param sieve (DCD) when given with certificates, the pairs it settles are counted in it instead
 /// of appended: the pairs appended plus those settled or excluded are exactly self_traverse's.
+/// @param rows when given, no pair of two triangles of one certified rigid row is appended, and
+/// node pairs of one such row are not descended into (RowSkip).
 template <int N>
 void start_self_traversal(const Bvh<N>& bvh, TraversalScratch& scratch);
 template <int N>
@@ -154,7 +174,8 @@ bool self_traverse_some(
     std::vector<TrianglePair>& out,
     std::int64_t& bv_tests,
     std::size_t max_pairs,
-    FanSieve* sieve = nullptr);
+    FanSieve* sieve = nullptr,
+    const RowSkip* rows = nullptr);
 
 /// Pair traversal: appends to `out` every (triangle of a, triangle of b) whose volumes overlap,
 /// each once; `TrianglePair::a` is a triangle id of `a`'s triangles, `TrianglePair::b` of `b`'s.

@@ -10,6 +10,7 @@
 
 #include "skinning/mesh.hpp"
 #include "skinning/pose.hpp"
+#include "skinning/rig.hpp"
 
 namespace skelcd::skinning {
 
@@ -71,6 +72,10 @@ class Motion {
     (void)i;
     out.clear();
   }
+  /// The weights by which positions(i) is exactly linear_blend_skinning(mesh().rest_positions,
+  /// weights, bone_transforms(i)) at every sample (#V × the transforms' count), else nullptr (a
+  /// frame sequence; a motion that moves its vertices otherwise). Valid while the motion lives.
+  [[nodiscard]] virtual const SkinWeights* skin_weights() const { return nullptr; }
 };
 
 }  // namespace skelcd::skinning

@@ -59,6 +59,8 @@ class RigMotion final : public Motion {
   [[nodiscard]] std::int32_t num_bones() const override;
   /// The pose's transforms at sample i: #B bones, then one per part attachment (Pose::transforms).
   void bone_transforms(int i, std::vector<BoneTransform>& out) const override;
+  /// The skinning's weights (LinearBlendSkinning::weights): positions(i) blends them exactly.
+  [[nodiscard]] const SkinWeights* skin_weights() const override { return &skinning_.weights(); }
   [[nodiscard]] double duration_s() const { return duration_s_; }
   [[nodiscard]] const PoseEvaluator& evaluator() const { return evaluator_; }
   [[nodiscard]] const LinearBlendSkinning& skinning() const { return skinning_; }

@@ -54,13 +54,16 @@ class MethodBase : public CullingMethod {
 
 /// `bvh` (N = 3) and `kdop` (N = 8). With `relative_pairs` a CCD query also sends its triangle
 /// pairs through the relative AABB filter (culling/relative_aabb.hpp) whenever a trial on its first
-/// pairs shows that it pays (docs/culling.md "Relative boxes in `kdop`").
+/// pairs shows that it pays (docs/culling.md "Relative boxes in `kdop`"). With `rigid_rows` its
+/// CCD skips the pairs of certified rows of MethodOptions::rigid_rows when given (docs/culling.md
+/// "Rigid rows"): `kdop`, and `auto`'s `bvh` for a whole mesh; never the `bvh` method itself.
 template <int N>
 [[nodiscard]] std::unique_ptr<CullingMethod> make_bvh_method(
     std::string_view name,
     const skinning::Mesh& mesh,
     const skinning::Topology& topology,
     const MethodOptions& options,
-    bool relative_pairs = false);
+    bool relative_pairs = false,
+    bool rigid_rows = false);
 
 }  // namespace skelcd::culling::detail

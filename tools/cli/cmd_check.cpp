@@ -62,6 +62,7 @@ struct CheckArguments {
   std::int32_t threads = 0;
   bool full_dcd = false;
   bool no_reuse = false;
+  bool no_rigid_rows = false;
   std::string baseline = "rest";
   std::int32_t baseline_slack = kDefaultBaselineSlack;
   Allowances allow;
@@ -126,6 +127,7 @@ RunOptions to_run_options(const CheckArguments& a) {
   o.threads = a.threads;
   o.incremental_dcd = !a.full_dcd;
   o.reuse_static_intervals = !a.no_reuse;
+  o.rigid_rows = !a.no_rigid_rows;
   return o;
 }
 
@@ -333,6 +335,7 @@ CheckedClip check_clip(
       .threads = options.threads,
       .incremental_dcd = options.incremental_dcd,
       .reuse_static_intervals = options.reuse_static_intervals,
+      .rigid_rows = options.rigid_rows,
       .radial_view = args.radial_view,
       .baseline = parse_baseline(args.baseline),
       .baseline_slack = args.baseline_slack,
@@ -640,6 +643,12 @@ void add_check_command(CLI::App& app) {
       "query every CCD interval; by default an interval that holds the pose of the last held one "
       "(the same positions at both ends) gets that one's row without a query, where the method "
       "keeps no state between queries (docs/check.md \"Static intervals\")");
+  cmd->add_flag(
+      "--no-rigid-rows",
+      args->no_rigid_rows,
+      "kdop: test the pairs that skinning moves by one matrix too; by default its CCD skips "
+      "them where the interval certifies their row (the same contacts, docs/culling.md "
+      "\"Rigid rows\")");
   cmd->add_flag("--json", args->json, "print the summary as one JSON object");
   cmd->add_option(
          "--baseline",

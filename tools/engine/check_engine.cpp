@@ -44,6 +44,7 @@ RunOptions run_options(const CheckRequest& r) {
   o.threads = r.threads;
   o.incremental_dcd = r.incremental_dcd;
   o.reuse_static_intervals = r.reuse_static_intervals;
+  o.rigid_rows = r.rigid_rows;
   o.elementary_tests_done = r.tests_done;
   return o;
 }

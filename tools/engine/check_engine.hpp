@@ -36,6 +36,8 @@ struct CheckRequest {
   /// An interval holding the last held pose gets that interval's row
   /// (RunOptions::reuse_static_intervals); false: every interval is queried (`--no-reuse`).
   bool reuse_static_intervals = true;
+  /// Rigid rows for a method that takes them (RunOptions::rigid_rows); false: `--no-rigid-rows`.
+  bool rigid_rows = true;
   RadialViewArguments radial_view;  ///< γ, seed, segmentation file of rvbc/dynamic/auto
   /// What findings are compared with (docs/events.md): the rig's rest pose by default.
   BaselineSpec baseline;

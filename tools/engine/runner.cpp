@@ -213,6 +213,12 @@ bool needs_bone_poses(std::string_view name, const culling::MethodOptions& optio
   return false;
 }
 
+/// True when `name` takes rigid rows (`auto` for the `bvh` it may send a whole mesh to).
+bool takes_rigid_rows(std::string_view name) {
+  const auto* m = culling::find_method(name);
+  return m != nullptr && m->takes_rigid_rows;
+}
+
 /// One method and the buffers of the samples it checks: the serial run's, or a parallel worker's.
 struct Worker {
   std::unique_ptr<culling::CullingMethod> owned;
@@ -492,7 +498,17 @@ ClipRunner::ClipRunner(
                      method_options_.elementary.vertex_face == nullptr &&
                      method_options_.elementary.edge_edge == nullptr &&
                      method_options_.elementary.triangles == nullptr;
-  bones_ = motion.num_bones() > 0 && needs_bone_poses(options.method, method_options_);
+  // Rigid rows for a method that takes them, when the motion is linear blend skinning (their
+  // intervals then carry the bone transforms that certify them).
+  if (!factory_ && options.rigid_rows && motion.skin_weights() != nullptr &&
+      takes_rigid_rows(options.method)) {
+    const skinning::SkinWeights& weights = *motion.skin_weights();
+    method_options_.rigid_rows =
+        std::make_shared<const culling::RigidRows>(culling::build_rigid_rows(
+            motion.mesh(), topology_, weights, static_cast<std::int32_t>(weights.cols())));
+  }
+  bones_ = motion.num_bones() > 0 && (needs_bone_poses(options.method, method_options_) ||
+                                      method_options_.rigid_rows != nullptr);
   // What the method carries from one query to the next that would change its rows (empty:
   // nothing). It keeps a run serial (RunPlan::serial_reason) and, for the same reason, keeps a
   // held interval from reusing the last held one's row.

@@ -1,0 +1,241 @@
+#include "culling/rigid_rows.hpp"
+
+#include <Eigen/Eigenvalues>
+#include <Eigen/LU>
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <limits>
+#include <map>
+#include <string>
+
+#include "ccd/edge_edge.hpp"
+#include "ccd/vertex_face.hpp"
+#include "skinning/errors.hpp"
+
+namespace skelcd::culling {
+namespace {
+
+using Influences = std::vector<std::pair<std::int32_t, double>>;
+
+/// The largest ‖L₀⁻¹ L₁ − I‖₂ a certified row may have: a turn of up to 2 asin(0.45) ≈ 53° within
+/// the interval (‖R − I‖₂ = 2 sin(θ/2)); the blend's σ_min then stays above a tenth of L₀'s.
+constexpr double kMaxBeta = 0.9;
+
+[[nodiscard]] std::size_t at(std::int32_t i) { return static_cast<std::size_t>(i); }
+
+/// Whether triangles a and b (welded corners) have a vertex-face or edge-edge pair sharing no
+/// vertex that the conservative CCD test of the held pose `x` finds within `distance`.
+bool features_within(
+    const skinning::Positions& x,
+    const std::array<std::int32_t, 3>& a,
+    const std::array<std::int32_t, 3>& b,
+    const ccd::CcdOptions& options) {
+  const auto p = [&](std::int32_t v) -> Eigen::Vector3d { return x.row(v).transpose(); };
+  const auto in = [](std::int32_t v, const std::array<std::int32_t, 3>& t) {
+    return v == t[0] || v == t[1] || v == t[2];
+  };
+  const auto vertex_face = [&](std::int32_t v, const std::array<std::int32_t, 3>& f) {
+    const ccd::VertexFaceQuery q{p(v), p(f[0]), p(f[1]), p(f[2]), p(v), p(f[0]), p(f[1]), p(f[2])};
+    return ccd::vertex_face_ccd(q, ccd::Accuracy::conservative, options).hit;
+  };
+  for (const std::int32_t v : a) {
+    if (!in(v, b) && vertex_face(v, b)) return true;
+  }
+  for (const std::int32_t v : b) {
+    if (!in(v, a) && vertex_face(v, a)) return true;
+  }
+  for (std::size_t i = 0; i < 3; ++i) {
+    const std::int32_t a0 = a[i];
+    const std::int32_t a1 = a[(i + 1) % 3];
+    for (std::size_t j = 0; j < 3; ++j) {
+      const std::int32_t b0 = b[j];
+      const std::int32_t b1 = b[(j + 1) % 3];
+      if (a0 == b0 || a0 == b1 || a1 == b0 || a1 == b1) continue;
+      const ccd::EdgeEdgeQuery q{p(a0), p(a1), p(b0), p(b1), p(a0), p(a1), p(b0), p(b1)};
+      if (ccd::edge_edge_ccd(q, ccd::Accuracy::conservative, options).hit) return true;
+    }
+  }
+  return false;
+}
+
+/// The row's blended matrix, as linear_blend_skinning forms it (the same products and sums in the
+/// same order), and the size that bounds its rounding and the posed corners': per output row,
+/// Σ over influences of |w| times that row of |T| (linear part and translation apart).
+struct Blend {
+  skinning::BoneTransform m;
+  double linear_size = 0.0;       ///< max over rows i of Σ_k |w_k| Σ_j |T_k(i, j)|, j < 3
+  double translation_size = 0.0;  ///< max over rows i of Σ_k |w_k| |T_k(i, 3)|
+};
+
+Blend blend(const Influences& row, std::span<const skinning::BoneTransform> t) {
+  Blend b;
+  b.m = row.front().second * t[at(row.front().first)];
+  for (std::size_t k = 1; k < row.size(); ++k) b.m.noalias() += row[k].second * t[at(row[k].first)];
+  for (int i = 0; i < 3; ++i) {
+    double linear = 0.0;
+    double translation = 0.0;
+    for (const auto& [index, w] : row) {
+      const auto& tk = t[at(index)];
+      linear += std::abs(w) * (std::abs(tk(i, 0)) + std::abs(tk(i, 1)) + std::abs(tk(i, 2)));
+      translation += std::abs(w) * std::abs(tk(i, 3));
+    }
+    b.linear_size = std::max(b.linear_size, linear);
+    b.translation_size = std::max(b.translation_size, translation);
+  }
+  return b;
+}
+
+}  // namespace
+
+RigidRows build_rigid_rows(
+    const skinning::Mesh& mesh,
+    const skinning::Topology& topology,
+    const skinning::SkinWeights& weights,
+    std::int32_t num_transforms) {
+  const auto fail = [](const std::string& what) {
+    throw InvalidInput("culling::rigid_rows: " + what);
+  };
+  if (weights.rows() != mesh.rest_positions.rows()) {
+    fail(
+        "the weights have " + std::to_string(weights.rows()) + " rows for " +
+        std::to_string(mesh.rest_positions.rows()) + " vertices");
+  }
+  if (weights.cols() > num_transforms) {
+    fail(
+        "the weights have " + std::to_string(weights.cols()) + " columns for " +
+        std::to_string(num_transforms) + " transforms");
+  }
+  const std::int32_t nw = topology.num_welded_vertices();
+  const auto nf = static_cast<std::int32_t>(topology.welded_triangles.rows());
+  RigidRows out;
+  out.num_transforms = num_transforms;
+  // Each welded vertex's row: its representative's influences, exactly as stored.
+  std::map<Influences, std::int32_t> index;
+  std::vector<std::int32_t> vertex_row(at(nw), -1);
+  skinning::Positions rest(nw, 3);
+  double extent = 0.0;
+  for (std::int32_t w = 0; w < nw; ++w) {
+    const std::int32_t v = topology.representative_vertex[at(w)];
+    if (v < 0 || v >= mesh.rest_positions.rows()) {
+      fail("representative_vertex[" + std::to_string(w) + "] is not a mesh vertex");
+    }
+    rest.row(w) = mesh.rest_positions.row(v);
+    if (!rest.row(w).allFinite()) fail("vertex " + std::to_string(v) + " is not finite at rest");
+    extent = std::max(extent, rest.row(w).cwiseAbs().maxCoeff());
+    Influences row;
+    for (skinning::SkinWeights::InnerIterator it(weights, v); it; ++it) {
+      if (!std::isfinite(it.value()))
+        fail("vertex " + std::to_string(v) + " has a non-finite weight");
+      row.emplace_back(static_cast<std::int32_t>(it.col()), it.value());
+    }
+    if (row.empty()) continue;  // a vertex that skinning leaves at rest: not a blend
+    const auto [it, added] = index.emplace(row, static_cast<std::int32_t>(out.rows.size()));
+    if (added) out.rows.push_back(std::move(row));
+    vertex_row[at(w)] = it->second;
+  }
+  out.rest_extent = std::max(extent, 1e-300);
+  out.rest_tolerance = 1e-6 * out.rest_extent;
+  out.triangle_row.assign(at(nf), -1);
+  const auto& tris = topology.welded_triangles;
+  const auto corners = [&](std::int32_t f) {
+    return std::array<std::int32_t, 3>{tris(f, 0), tris(f, 1), tris(f, 2)};
+  };
+  for (std::int32_t f = 0; f < nf; ++f) {
+    const auto c = corners(f);
+    if (c[0] == c[1] || c[1] == c[2] || c[0] == c[2]) continue;
+    const std::int32_t r = vertex_row[at(c[0])];
+    if (r >= 0 && r == vertex_row[at(c[1])] && r == vertex_row[at(c[2])])
+      out.triangle_row[at(f)] = r;
+  }
+  // Rest pairs: the triangles of each row by the low end of their rest boxes on x (grown by the
+  // tolerance), swept; a pair whose grown boxes overlap is kept when a feature pair of it lies
+  // within the tolerance.
+  struct Item {
+    std::int32_t row;
+    std::int32_t f;
+    std::array<double, 6> box;  // lo x, y, z, hi x, y, z
+  };
+  std::vector<Item> items;
+  for (std::int32_t f = 0; f < nf; ++f) {
+    const std::int32_t r = out.triangle_row[at(f)];
+    if (r < 0) continue;
+    Item item{r, f, {}};
+    for (int d = 0; d < 3; ++d) {
+      const double a = rest(tris(f, 0), d);
+      const double b = rest(tris(f, 1), d);
+      const double c = rest(tris(f, 2), d);
+      item.box[at(d)] = std::min({a, b, c}) - out.rest_tolerance;
+      item.box[at(3 + d)] = std::max({a, b, c}) + out.rest_tolerance;
+    }
+    items.push_back(item);
+  }
+  std::sort(items.begin(), items.end(), [](const Item& a, const Item& b) {
+    return a.row != b.row ? a.row < b.row : a.box[0] < b.box[0];
+  });
+  ccd::CcdOptions within;
+  within.min_separation = out.rest_tolerance;
+  for (std::size_t i = 0; i < items.size(); ++i) {
+    const Item& a = items[i];
+    for (std::size_t j = i + 1; j < items.size() && items[j].row == a.row; ++j) {
+      const Item& b = items[j];
+      if (b.box[0] > a.box[3]) break;
+      if (b.box[1] > a.box[4] || a.box[1] > b.box[4] || b.box[2] > a.box[5] ||
+          a.box[2] > b.box[5]) {
+        continue;
+      }
+      if (features_within(rest, corners(a.f), corners(b.f), within)) {
+        out.rest_pairs.push_back({std::min(a.f, b.f), std::max(a.f, b.f)});
+      }
+    }
+  }
+  std::sort(out.rest_pairs.begin(), out.rest_pairs.end());
+  return out;
+}
+
+void certify_rigid_rows(
+    const RigidRows& rows,
+    std::span<const skinning::BoneTransform> t0,
+    std::span<const skinning::BoneTransform> t1,
+    double min_separation,
+    std::vector<std::uint8_t>& certified) {
+  certified.assign(at(rows.num_rows()), 0);
+  const auto needed = static_cast<std::size_t>(rows.num_transforms);
+  if (t0.size() < needed || t1.size() < needed || !std::isfinite(min_separation)) return;
+  // Unit roundoff, times a slack that covers the blend's sums (one per influence) and the
+  // matrix-vector product (three products and three sums a coordinate) many times over.
+  constexpr double kU = std::numeric_limits<double>::epsilon() / 2;
+  for (std::int32_t r = 0; r < rows.num_rows(); ++r) {
+    const Influences& row = rows.rows[at(r)];
+    const Blend b0 = blend(row, t0);
+    const Blend b1 = blend(row, t1);
+    if (!b0.m.allFinite() || !b1.m.allFinite()) continue;
+    const Eigen::Matrix3d l0 = b0.m.leftCols<3>();
+    const Eigen::Matrix3d l1 = b1.m.leftCols<3>();
+    Eigen::Matrix3d inverse;
+    bool invertible = false;
+    double determinant = 0.0;
+    l0.computeInverseAndDetWithCheck(inverse, determinant, invertible, 0.0);
+    if (!invertible || !inverse.allFinite()) continue;
+    // β ≥ ‖B − I‖₂: the largest eigenvalue of (B − I)ᵀ(B − I), closed form, grown for its
+    // rounding (relative 1e-15 of ‖B − I‖², absolute a few ulps of it).
+    const Eigen::Matrix3d d = inverse * l1 - Eigen::Matrix3d::Identity();
+    if (!d.allFinite()) continue;
+    Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eigen;
+    eigen.computeDirect(d.transpose() * d, Eigen::EigenvaluesOnly);
+    const double largest = std::max(eigen.eigenvalues().maxCoeff(), 0.0);
+    const double beta = std::sqrt(largest * (1.0 + 1e-9) + 1e-12 * d.squaredNorm());
+    if (!(beta < kMaxBeta)) continue;
+    // σ_min of every blend between the two ends, shrunk by 1 % for the rounding of this bound.
+    const double sigma = 0.99 * (1.0 - beta) / inverse.norm();
+    const double slack = 64.0 * kU * (static_cast<double>(row.size()) + 3.0) * std::sqrt(3.0);
+    const double e0 = slack * (b0.linear_size * rows.rest_extent + b0.translation_size);
+    const double e1 = slack * (b1.linear_size * rows.rest_extent + b1.translation_size);
+    const double reach = min_separation + 2.0 * std::max(e0, e1);
+    if (std::isfinite(sigma) && sigma > 0.0 && reach < sigma * rows.rest_tolerance) {
+      certified[at(r)] = 1;
+    }
+  }
+}
+
+}  // namespace skelcd::culling
