@@ -97,8 +97,9 @@ void add_culling_methods(Registry& r) {
   add(r,
       {.name = "auto",
        .description =
-           "bvh for a mesh whose every part is closed, under 256 triangles or open only at "
-           "holes dynamic caps; otherwise per "
+           "bvh (skipping the CCD pairs skinning moves by one matrix) for a mesh whose every "
+           "part is closed, under 256 triangles or open only at holes dynamic caps; otherwise "
+           "per "
            "connected part: closed parts to the best closed-part method whose needs are met "
            "(dynamic on a rig, else bvh), and with them open parts it caps or under 256 "
            "triangles; other open parts to enhanced-dual-cone",

@@ -92,7 +92,8 @@ RigidRows build_rigid_rows(
     const skinning::Mesh& mesh,
     const skinning::Topology& topology,
     const skinning::SkinWeights& weights,
-    std::int32_t num_transforms) {
+    std::int32_t num_transforms,
+    double min_share) {
   const auto fail = [](const std::string& what) {
     throw InvalidInput("culling::rigid_rows: " + what);
   };
@@ -141,12 +142,35 @@ RigidRows build_rigid_rows(
   const auto corners = [&](std::int32_t f) {
     return std::array<std::int32_t, 3>{tris(f, 0), tris(f, 1), tris(f, 2)};
   };
+  std::vector<std::int32_t> triangles_in(out.rows.size(), 0);
   for (std::int32_t f = 0; f < nf; ++f) {
     const auto c = corners(f);
     if (c[0] == c[1] || c[1] == c[2] || c[0] == c[2]) continue;
     const std::int32_t r = vertex_row[at(c[0])];
-    if (r >= 0 && r == vertex_row[at(c[1])] && r == vertex_row[at(c[2])])
+    if (r >= 0 && r == vertex_row[at(c[1])] && r == vertex_row[at(c[2])]) {
       out.triangle_row[at(f)] = r;
+      ++triangles_in[at(r)];
+    }
+  }
+  // Only rows of two triangles or more have a pair to skip: the others are dropped (each would
+  // cost a certificate per interval), the rest renumbered in order.
+  std::vector<std::int32_t> renumbered(out.rows.size(), -1);
+  std::vector<Influences> kept;
+  for (std::size_t r = 0; r < out.rows.size(); ++r) {
+    if (triangles_in[r] < 2) continue;
+    renumbered[r] = static_cast<std::int32_t>(kept.size());
+    kept.push_back(std::move(out.rows[r]));
+  }
+  out.rows = std::move(kept);
+  for (std::int32_t& r : out.triangle_row) {
+    if (r >= 0) r = renumbered[at(r)];
+    if (r >= 0) ++out.triangles_in_rows;
+  }
+  if (static_cast<double>(out.triangles_in_rows) < min_share * static_cast<double>(nf)) {
+    out.rows.clear();
+    out.triangle_row.assign(at(nf), -1);
+    out.triangles_in_rows = 0;
+    return out;
   }
   // Rest pairs: the triangles of each row by the low end of their rest boxes on x (grown by the
   // tolerance), swept; a pair whose grown boxes overlap is kept when a feature pair of it lies

@@ -23,10 +23,12 @@ namespace skelcd::culling {
 
 struct RigidRows {
   /// #F (welded triangles, Topology order): the weight row of all three corners, or -1 when the
-  /// corners' rows differ or the triangle repeats a welded vertex.
+  /// corners' rows differ, the triangle repeats a welded vertex, or no other triangle has its row.
   std::vector<std::int32_t> triangle_row;
+  /// Triangles with a row (triangle_row ≥ 0).
+  std::int64_t triangles_in_rows = 0;
   /// Each row's influences as linear blend skinning blends them: (transform index, weight), in
-  /// the weights' stored order.
+  /// the weights' stored order; every row has two triangles or more.
   std::vector<std::vector<std::pair<std::int32_t, double>>> rows;
   /// Pairs (a < b) of triangles of one row with a vertex-face or edge-edge pair that shares no
   /// vertex and lies within rest_tolerance at rest (conservatively: the CCD kernel's conservative
@@ -44,14 +46,17 @@ struct RigidRows {
 
 /// The rigid rows of `mesh` moved by `weights` (#V × num_transforms, the weights
 /// skinning::linear_blend_skinning applies to mesh.rest_positions), welded by `topology`: a welded
-/// vertex moves as its representative file vertex.
+/// vertex moves as its representative file vertex. When fewer than `min_share` of the triangles
+/// would have a row, none is kept (no rest pair is sought): too few pairs to pay for the rows'
+/// certificates and the walk's checks.
 /// @throws InvalidInput naming "culling::rigid_rows" when the sizes disagree or a weight or rest
 ///         coordinate is not finite.
 [[nodiscard]] RigidRows build_rigid_rows(
     const skinning::Mesh& mesh,
     const skinning::Topology& topology,
     const skinning::SkinWeights& weights,
-    std::int32_t num_transforms);
+    std::int32_t num_transforms,
+    double min_share = 0.0);
 
 /// Certifies each row for the interval between two samples with transforms `t0` and `t1`
 /// (Motion::bone_transforms; a row is certified when every corner pair of its triangles that

@@ -5,8 +5,10 @@
 
 #include <Eigen/Geometry>
 #include <cmath>
+#include <map>
 #include <memory>
 #include <numbers>
+#include <optional>
 #include <set>
 #include <string>
 #include <vector>
@@ -56,10 +58,13 @@ TEST(RigidRows, EachRowIsOneWeightRowAndItsRestPairsLieWithinTheTolerance) {
       static_cast<std::int64_t>(rows.triangle_row.size()), r.topology.welded_triangles.rows());
   EXPECT_GT(rows.num_rows(), 1);
   EXPECT_DOUBLE_EQ(rows.rest_tolerance, 1e-6 * rows.rest_extent);
-  std::int64_t in_rows = 0;
-  for (Eigen::Index f = 0; f < r.topology.welded_triangles.rows(); ++f) {
-    const std::int32_t row = rows.triangle_row[static_cast<std::size_t>(f)];
-    std::set<std::vector<std::pair<std::int32_t, double>>> corner_rows;
+  // Each triangle's weight row when its three (welded) corners share one, and how many share it.
+  using Row = std::vector<std::pair<std::int32_t, double>>;
+  const auto nf = r.topology.welded_triangles.rows();
+  std::vector<std::optional<Row>> one_row(static_cast<std::size_t>(nf));
+  std::map<Row, std::int64_t> triangles_of;
+  for (Eigen::Index f = 0; f < nf; ++f) {
+    std::set<Row> corner_rows;
     for (int k = 0; k < 3; ++k) {
       const std::int32_t v =
           r.topology
@@ -69,12 +74,29 @@ TEST(RigidRows, EachRowIsOneWeightRowAndItsRestPairsLieWithinTheTolerance) {
     const bool repeated = r.topology.welded_triangles(f, 0) == r.topology.welded_triangles(f, 1) ||
                           r.topology.welded_triangles(f, 1) == r.topology.welded_triangles(f, 2) ||
                           r.topology.welded_triangles(f, 0) == r.topology.welded_triangles(f, 2);
-    EXPECT_EQ(row >= 0, corner_rows.size() == 1 && !repeated) << "triangle " << f;
-    if (row >= 0) {
-      EXPECT_EQ(rows.rows[static_cast<std::size_t>(row)], *corner_rows.begin()) << "triangle " << f;
+    if (corner_rows.size() == 1 && !repeated) {
+      one_row[static_cast<std::size_t>(f)] = *corner_rows.begin();
+      ++triangles_of[*corner_rows.begin()];
+    }
+  }
+  std::int64_t in_rows = 0;
+  for (Eigen::Index f = 0; f < nf; ++f) {
+    const std::int32_t row = rows.triangle_row[static_cast<std::size_t>(f)];
+    const auto& expected = one_row[static_cast<std::size_t>(f)];
+    const bool kept = expected.has_value() && triangles_of[*expected] >= 2;
+    EXPECT_EQ(row >= 0, kept) << "triangle " << f;
+    if (row >= 0 && kept) {
+      EXPECT_EQ(rows.rows[static_cast<std::size_t>(row)], *expected) << "triangle " << f;
       ++in_rows;
     }
   }
+  // A row is kept for two triangles or more; every one-row triangle of a kept row has it.
+  std::vector<std::int64_t> per_row(static_cast<std::size_t>(rows.num_rows()), 0);
+  for (const std::int32_t row : rows.triangle_row) {
+    if (row >= 0) ++per_row[static_cast<std::size_t>(row)];
+  }
+  for (const std::int64_t n : per_row) EXPECT_GE(n, 2);
+  EXPECT_EQ(rows.triangles_in_rows, in_rows);
   // Most of the ninja hangs from single bones (docs/benchmarks.md, "Pairs that skinning moves as
   // one"); a few of its shells touch at rest, within one row.
   EXPECT_GT(2 * in_rows, r.topology.welded_triangles.rows());

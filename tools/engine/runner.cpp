@@ -213,6 +213,10 @@ bool needs_bone_poses(std::string_view name, const culling::MethodOptions& optio
   return false;
 }
 
+/// The least share of a mesh's triangles its rigid rows must hold to be used
+/// (RunOptions::rigid_rows).
+constexpr double kMinRigidRowShare = 0.05;
+
 /// True when `name` takes rigid rows (`auto` for the `bvh` it may send a whole mesh to).
 bool takes_rigid_rows(std::string_view name) {
   const auto* m = culling::find_method(name);
@@ -498,14 +502,20 @@ ClipRunner::ClipRunner(
                      method_options_.elementary.vertex_face == nullptr &&
                      method_options_.elementary.edge_edge == nullptr &&
                      method_options_.elementary.triangles == nullptr;
-  // Rigid rows for a method that takes them, when the motion is linear blend skinning (their
-  // intervals then carry the bone transforms that certify them).
+  // Rigid rows for a method that takes them, when the motion is linear blend skinning and they
+  // hold a twentieth of the triangles at least (fewer did not pay for their certificates: the
+  // stormtrooper's 2 %, docs/benchmarks.md "Rigid rows in `kdop`"); their intervals then carry the
+  // bone transforms that certify them.
   if (!factory_ && options.rigid_rows && motion.skin_weights() != nullptr &&
       takes_rigid_rows(options.method)) {
     const skinning::SkinWeights& weights = *motion.skin_weights();
-    method_options_.rigid_rows =
-        std::make_shared<const culling::RigidRows>(culling::build_rigid_rows(
-            motion.mesh(), topology_, weights, static_cast<std::int32_t>(weights.cols())));
+    auto rows = std::make_shared<const culling::RigidRows>(culling::build_rigid_rows(
+        motion.mesh(),
+        topology_,
+        weights,
+        static_cast<std::int32_t>(weights.cols()),
+        kMinRigidRowShare));
+    if (rows->num_rows() > 0) method_options_.rigid_rows = std::move(rows);
   }
   bones_ = motion.num_bones() > 0 && (needs_bone_poses(options.method, method_options_) ||
                                       method_options_.rigid_rows != nullptr);
