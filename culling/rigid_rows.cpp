@@ -11,6 +11,7 @@
 
 #include "ccd/edge_edge.hpp"
 #include "ccd/vertex_face.hpp"
+#include "culling/elementary.hpp"
 #include "skinning/errors.hpp"
 
 namespace skelcd::culling {
@@ -31,13 +32,13 @@ bool features_within(
     const std::array<std::int32_t, 3>& a,
     const std::array<std::int32_t, 3>& b,
     const ccd::CcdOptions& options) {
-  const auto p = [&](std::int32_t v) -> Eigen::Vector3d { return x.row(v).transpose(); };
   const auto in = [](std::int32_t v, const std::array<std::int32_t, 3>& t) {
     return v == t[0] || v == t[1] || v == t[2];
   };
   const auto vertex_face = [&](std::int32_t v, const std::array<std::int32_t, 3>& f) {
-    const ccd::VertexFaceQuery q{p(v), p(f[0]), p(f[1]), p(f[2]), p(v), p(f[0]), p(f[1]), p(f[2])};
-    return ccd::vertex_face_ccd(q, ccd::Accuracy::conservative, options).hit;
+    return ccd::vertex_face_ccd(
+               vertex_face_query(x, x, v, x, x, f), ccd::Accuracy::conservative, options)
+        .hit;
   };
   for (const std::int32_t v : a) {
     if (!in(v, b) && vertex_face(v, b)) return true;
@@ -52,7 +53,7 @@ bool features_within(
       const std::int32_t b0 = b[j];
       const std::int32_t b1 = b[(j + 1) % 3];
       if (a0 == b0 || a0 == b1 || a1 == b0 || a1 == b1) continue;
-      const ccd::EdgeEdgeQuery q{p(a0), p(a1), p(b0), p(b1), p(a0), p(a1), p(b0), p(b1)};
+      const ccd::EdgeEdgeQuery q = edge_edge_query(x, x, {a0, a1}, x, x, {b0, b1});
       if (ccd::edge_edge_ccd(q, ccd::Accuracy::conservative, options).hit) return true;
     }
   }

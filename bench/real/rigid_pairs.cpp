@@ -27,6 +27,7 @@
 
 #include "ccd/edge_edge.hpp"
 #include "ccd/vertex_face.hpp"
+#include "culling/elementary.hpp"
 #include "skinning/lbs.hpp"
 #include "skinning/load.hpp"
 #include "skinning/motion.hpp"
@@ -53,10 +54,6 @@ struct Tests {
   std::int64_t hits = 0;  ///< conservative hits
   double seconds = 0.0;   ///< conservative tests' time
 };
-
-using Vec = Eigen::Vector3d;
-
-Vec row_of_positions(const Positions& x, int v) { return x.row(v).transpose(); }
 
 /// Feature pairs (no shared vertex) of triangles a and b, both ways: VF (vertex, face) and EE.
 template <typename Vf, typename Ee>
@@ -85,15 +82,7 @@ void for_each_feature_pair(
 
 skelcd::ccd::VertexFaceQuery vf_query(
     const Positions& x0, const Positions& x1, int v, const std::array<int, 3>& f) {
-  return {
-      row_of_positions(x0, v),
-      row_of_positions(x0, f[0]),
-      row_of_positions(x0, f[1]),
-      row_of_positions(x0, f[2]),
-      row_of_positions(x1, v),
-      row_of_positions(x1, f[0]),
-      row_of_positions(x1, f[1]),
-      row_of_positions(x1, f[2])};
+  return skelcd::culling::vertex_face_query(x0, x1, v, x0, x1, f);
 }
 
 skelcd::ccd::EdgeEdgeQuery ee_query(
@@ -101,15 +90,7 @@ skelcd::ccd::EdgeEdgeQuery ee_query(
     const Positions& x1,
     const std::array<int, 2>& a,
     const std::array<int, 2>& b) {
-  return {
-      row_of_positions(x0, a[0]),
-      row_of_positions(x0, a[1]),
-      row_of_positions(x0, b[0]),
-      row_of_positions(x0, b[1]),
-      row_of_positions(x1, a[0]),
-      row_of_positions(x1, a[1]),
-      row_of_positions(x1, b[0]),
-      row_of_positions(x1, b[1])};
+  return skelcd::culling::edge_edge_query(x0, x1, a, x0, x1, b);
 }
 
 int run(const std::string& path, int stride, bool ccd) {
