@@ -198,6 +198,18 @@ RigidRows build_rigid_rows(
   std::sort(items.begin(), items.end(), [](const Item& a, const Item& b) {
     return a.row != b.row ? a.row < b.row : a.box[0] < b.box[0];
   });
+  // Pairs of parts never checked against each other (a robot's link against itself) have no
+  // feature pair to test: no rest pair needed.
+  const auto part = [&](std::int32_t f) {
+    return mesh.face_part.empty() ? 0 : mesh.face_part[at(f)];
+  };
+  std::vector<std::pair<std::int32_t, std::int32_t>> excluded_parts;
+  for (const auto& [a, b] : mesh.excluded_part_pairs) excluded_parts.push_back(std::minmax(a, b));
+  std::sort(excluded_parts.begin(), excluded_parts.end());
+  const auto excluded = [&](std::int32_t fa, std::int32_t fb) {
+    const std::pair<std::int32_t, std::int32_t> parts = std::minmax(part(fa), part(fb));
+    return std::binary_search(excluded_parts.begin(), excluded_parts.end(), parts);
+  };
   ccd::CcdOptions within;
   within.min_separation = out.rest_tolerance;
   for (std::size_t i = 0; i < items.size(); ++i) {
@@ -209,7 +221,7 @@ RigidRows build_rigid_rows(
           a.box[2] > b.box[5]) {
         continue;
       }
-      if (features_within(rest, corners(a.f), corners(b.f), within)) {
+      if (!excluded(a.f, b.f) && features_within(rest, corners(a.f), corners(b.f), within)) {
         out.rest_pairs.push_back({std::min(a.f, b.f), std::max(a.f, b.f)});
       }
     }

@@ -29,8 +29,8 @@ struct Rig {
   std::shared_ptr<const RigidRows> rows;
 };
 
-Rig load(const std::filesystem::path& path) {
-  Rig r{skinning::load_model(path), {}, nullptr, nullptr};
+Rig load(const std::filesystem::path& path, const skinning::LoadOptions& options = {}) {
+  Rig r{skinning::load_model(path, options), {}, nullptr, nullptr};
   r.topology = skinning::build_topology(*r.model.mesh);
   r.motion = r.model.motion();
   const skinning::SkinWeights* w = r.motion->skin_weights();
@@ -260,6 +260,27 @@ TEST(RigidRows, TheExactContactsAreBruteForcesOnTheNinja) {
   const ClipRun reference = run(r, *brute, 10, 16);
   ASSERT_FALSE(reference.contacts.empty());
   EXPECT_EQ(run(r, *kdop_rows, 10, 16).contacts, reference.contacts);
+}
+
+TEST(RigidRows, ARobotsLinksAreRowsWithoutRestPairs) {
+  // The Panda's weights are one-hot, a link each: every triangle of a link of two triangles or more
+  // has a row, and a link is excluded against itself (docs/robots.md), so no rest pair is sought.
+  skinning::LoadOptions options;
+  options.trajectory = test::asset("trajectories/panda_reach.csv");
+  const Rig r = load(
+      test::asset("robots/example-robot-data/robots/panda_description/urdf/panda.urdf"), options);
+  ASSERT_NE(r.rows, nullptr);
+  EXPECT_GT(r.rows->num_rows(), 5);
+  EXPECT_GT(10 * r.rows->triangles_in_rows, 9 * r.topology.welded_triangles.rows());
+  EXPECT_TRUE(r.rows->rest_pairs.empty());
+  MethodOptions with;
+  with.rigid_rows = r.rows;
+  auto kdop = make_method("kdop", *r.model.mesh, r.topology, {});
+  auto kdop_rows = make_method("kdop", *r.model.mesh, r.topology, with);
+  const int last = r.motion->num_samples() - 1;
+  const ClipRun plain = run(r, *kdop, 0, last);
+  ASSERT_FALSE(plain.contacts.empty());
+  EXPECT_EQ(run(r, *kdop_rows, 0, last).contacts, plain.contacts);
 }
 
 TEST(RigidRows, AFrameSequenceHasNoWeights) {
