@@ -189,18 +189,16 @@ class BvhMethod final : public MethodBase {
             rest_pairs_.begin() + static_cast<std::ptrdiff_t>(rest_next + take));
         rest_next += take;
       }
-      const bool done = (pairs.size() >= max_pairs && rest_next < rest_pairs_.size())
-                            ? false
-                            : self_traverse_some<N>(
-                                  bvh_,
-                                  bounds_.triangles,
-                                  scratch_,
-                                  pairs,
-                                  out.counters.bv_tests,
-                                  max_pairs,
-                                  sieving,
-                                  rows) &&
-                                  rest_next == rest_pairs_.size();
+      // Rest pairs left over: this installment is full, the walk waits for the next one.
+      const bool done = rest_next == rest_pairs_.size() && self_traverse_some<N>(
+                                                               bvh_,
+                                                               bounds_.triangles,
+                                                               scratch_,
+                                                               pairs,
+                                                               out.counters.bv_tests,
+                                                               max_pairs,
+                                                               sieving,
+                                                               rows);
       emitted += static_cast<std::int64_t>(pairs.size() - first);
       if (filter_pairs) {
         relative_.filter(topology_, x_t0, x_t1, 0.5 * options_.min_separation, pairs, first);

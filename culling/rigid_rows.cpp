@@ -26,7 +26,8 @@ constexpr double kMaxBeta = 0.9;
 [[nodiscard]] std::size_t at(std::int32_t i) { return static_cast<std::size_t>(i); }
 
 /// Whether triangles a and b (welded corners) have a vertex-face or edge-edge pair sharing no
-/// vertex that the conservative CCD test of the held pose `x` finds within `distance`.
+/// vertex that the conservative CCD test of the held pose `x` finds within
+/// options.min_separation.
 bool features_within(
     const skinning::Positions& x,
     const std::array<std::int32_t, 3>& a,
