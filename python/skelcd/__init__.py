@@ -176,7 +176,7 @@ def check(model_or_path: Union[Model, str, os.PathLike], clip: Optional[str] = N
           log: Union[str, os.PathLike, None] = None, gamma: float = 0.05, seed: int = 1,
           segmentation: Union[str, os.PathLike, None] = None, baseline: str = "rest",
           baseline_slack: int = 2, allow=(), allow_adjacent_bones: bool = False,
-          full_dcd: bool = False) -> CheckResult:
+          full_dcd: bool = False, reuse: bool = True, rigid_rows: bool = True) -> CheckResult:
     """Checks one clip for self-collision, as ``skelcd check MODEL -o LOG`` does.
 
     model_or_path: a Model from ``load``, or a path loaded with default options.
@@ -195,6 +195,11 @@ def check(model_or_path: Union[Model, str, os.PathLike], clip: Optional[str] = N
     full_dcd: test every candidate at every sample (``--full-dcd``); by default, with both
         queries, each DCD updates the previous one from the interval's CCD contacts (the same
         pairs; docs/culling.md "Incremental DCD").
+    reuse: False queries every CCD interval (``--no-reuse``); by default an interval that holds
+        the last held pose gets that one's row (docs/check.md "Static intervals").
+    rigid_rows: False tests the CCD pairs that skinning moves by one matrix too
+        (``--no-rigid-rows``); by default kdop and auto's whole-mesh bvh skip them where the
+        interval certifies their row (the same contacts; docs/culling.md "Rigid rows").
     The GIL is released while checking; Ctrl-C stops a serial check between rows.
     Raises InvalidInput (bad option, clip, frame range, method) or IoError (unreadable file, a
     log that cannot be written), with the command line's messages.
@@ -212,6 +217,10 @@ def check(model_or_path: Union[Model, str, os.PathLike], clip: Optional[str] = N
         arguments["allow_adjacent_bones"] = True
     if full_dcd:
         arguments["full_dcd"] = True
+    if not reuse:
+        arguments["reuse"] = False
+    if not rigid_rows:
+        arguments["rigid_rows"] = False
     if method in ("rvbc", "dynamic", "auto"):
         arguments.update(gamma=gamma, seed=seed, segmentation=segmentation)
     command_line = _call_text("check", {"model": model.argument,
@@ -222,7 +231,7 @@ def check(model_or_path: Union[Model, str, os.PathLike], clip: Optional[str] = N
         int(seed), "" if segmentation is None else os.fspath(segmentation), command_line,
         os.fspath(baseline) if isinstance(baseline, os.PathLike) else str(baseline),
         int(baseline_slack), [str(a) for a in allow], bool(allow_adjacent_bones),
-        bool(full_dcd))
+        bool(full_dcd), bool(reuse), bool(rigid_rows))
     return _result(raw)
 
 

@@ -323,7 +323,9 @@ py::dict check(
     std::int32_t baseline_slack,
     const std::vector<std::string>& allow,
     bool allow_adjacent_bones,
-    bool full_dcd) {
+    bool full_dcd,
+    bool reuse,
+    bool rigid_rows) {
   // Options refused with the CLI's own messages (tools/cli/cmd_check.cpp).
   const auto parsed_accuracy = ccd::parse_accuracy(accuracy);
   if (!parsed_accuracy)
@@ -344,6 +346,8 @@ py::dict check(
   request.min_separation = min_separation;
   request.threads = threads;
   request.incremental_dcd = !full_dcd;
+  request.reuse_static_intervals = reuse;
+  request.rigid_rows = rigid_rows;
   request.radial_view =
       tools::RadialViewArguments{.gamma = gamma, .seed = seed, .segmentation = segmentation};
   request.baseline = tools::parse_baseline(baseline);
@@ -546,7 +550,9 @@ PYBIND11_MODULE(_skelcd, m) {
       py::arg("baseline_slack"),
       py::arg("allow"),
       py::arg("allow_adjacent_bones"),
-      py::arg("full_dcd") = false);
+      py::arg("full_dcd") = false,
+      py::arg("reuse") = true,
+      py::arg("rigid_rows") = true);
   m.def("read_log", &read_log, py::arg("path"));
   m.def("method_names", &skelcd::tools::check_method_names);
   // The /frames columns' counters and stages, in the log's order (FRAME_DTYPE is built from them).

@@ -106,6 +106,32 @@ def test_full_dcd_finds_the_same_pairs_with_more_tests():
     assert incremental.rows["tt_tests"][dcd].sum() * 2 < full.rows["tt_tests"][dcd].sum()
 
 
+def test_rigid_rows_and_reuse_switches_keep_the_findings(tmp_path):
+    # kdop skips the CCD pairs of certified rigid rows (docs/culling.md "Rigid rows"): the same
+    # contacts as with the switch off, from fewer candidate pairs; the log records the call.
+    args = dict(frames="0:12", method="kdop", query="ccd")
+    rows = skelcd.check("assets/characters/RobotExpressive.glb", **args)
+    every = skelcd.check("assets/characters/RobotExpressive.glb", rigid_rows=False,
+                         log=tmp_path / "every.h5", **args)
+    assert np.array_equal(rows.contacts, every.contacts)
+    assert rows.rows["candidate_pairs"].sum() * 4 < every.rows["candidate_pairs"].sum() * 3
+    assert "rigid_rows=False" in skelcd.read_log(tmp_path / "every.h5").header["command_line"]
+    # An interval that holds the pose of the last held one gets its row without a query (no stage
+    # time) by default; reuse=False queries every one: the same rows' findings and counters
+    # (docs/check.md "Static intervals"; Debian's unnamed_bones.mdl holds one pose).
+    model = "/usr/share/assimp/models/MDL/MDL (HL1)/unnamed_bones.mdl"
+    held = skelcd.check(model, frames="0:8", query="ccd", method="bvh")
+    each = skelcd.check(model, frames="0:8", query="ccd", method="bvh", reuse=False)
+    assert np.array_equal(held.contacts, each.contacts) and len(held.contacts) > 0
+    counters = [n for n in skelcd.FRAME_DTYPE.names if n in ("candidate_pairs", "vf_tests",
+                                                             "ee_tests", "bv_tests")]
+    for name in counters:
+        assert np.array_equal(held.rows[name], each.rows[name]), name
+    stages = held.rows["traverse_us"] + held.rows["elementary_us"] + held.rows["refit_us"]
+    queried = each.rows["traverse_us"] + each.rows["elementary_us"] + each.rows["refit_us"]
+    assert (stages == 0).sum() >= 4 and (queried == 0).sum() == 0
+
+
 def test_one_sample_is_dcd_only():
     result = skelcd.check("assets/characters/Fox.glb", clip="Walk", frames=4)
     assert list(result.rows["sample"]) == [4] and list(result.rows["kind"]) == [0]
