@@ -41,6 +41,7 @@ from pathlib import Path
 REPO = Path(__file__).resolve().parent.parent
 BUNDLED = [
     "assets/characters/CesiumMan.glb",
+    "assets/characters/CesiumMan-dense.glb",
     "assets/characters/Fox.glb",
     "assets/characters/RiggedFigure.glb",
     "assets/characters/RobotExpressive.glb",
