@@ -692,8 +692,11 @@ void start_self_traversal(const Bvh<N>& bvh, TraversalScratch& scratch) {
   if (!bvh.empty()) push(scratch.stack, 0, 0);  // the virtual root's one child against itself
 }
 
-template <int N>
-bool self_traverse_some(
+namespace {
+
+/// One installment of a self walk, with the fan sieve compiled in or out (`kSieve`).
+template <int N, bool kSieve>
+bool self_walk_some(
     const Bvh<N>& bvh,
     std::span<const Dop<N>> triangle_bounds,
     TraversalScratch& scratch,
@@ -702,28 +705,7 @@ bool self_traverse_some(
     std::size_t max_pairs,
     FanSieve* sieve,
     const RowSkip* rows) {
-  if (bvh.empty()) return true;
-  if (sieve == nullptr || sieve->certified.empty()) {
-    Walk<N, true> walk(
-        bvh,
-        triangle_bounds,
-        bvh,
-        triangle_bounds,
-        scratch.stack,
-        out,
-        bv_tests,
-        max_pairs,
-        nullptr,
-        {},
-        rows);
-    const bool done = walk.run();
-    scratch.apart_at_both_ends += walk.apart_at_both_ends();
-    return done;
-  }
-  assert(sieve->slots != nullptr && sieve->topology != nullptr);
-  assert(sieve->slots->corners.size() == bvh.triangle_order().size());
-  assert(sieve->full.size() == sieve->slots->corners.size());
-  Walk<N, true, true> walk(
+  Walk<N, true, kSieve> walk(
       bvh,
       triangle_bounds,
       bvh,
@@ -738,6 +720,30 @@ bool self_traverse_some(
   const bool done = walk.run();
   scratch.apart_at_both_ends += walk.apart_at_both_ends();
   return done;
+}
+
+}  // namespace
+
+template <int N>
+bool self_traverse_some(
+    const Bvh<N>& bvh,
+    std::span<const Dop<N>> triangle_bounds,
+    TraversalScratch& scratch,
+    std::vector<TrianglePair>& out,
+    std::int64_t& bv_tests,
+    std::size_t max_pairs,
+    FanSieve* sieve,
+    const RowSkip* rows) {
+  if (bvh.empty()) return true;
+  if (sieve == nullptr || sieve->certified.empty()) {
+    return self_walk_some<N, false>(
+        bvh, triangle_bounds, scratch, out, bv_tests, max_pairs, nullptr, rows);
+  }
+  assert(sieve->slots != nullptr && sieve->topology != nullptr);
+  assert(sieve->slots->corners.size() == bvh.triangle_order().size());
+  assert(sieve->full.size() == sieve->slots->corners.size());
+  return self_walk_some<N, true>(
+      bvh, triangle_bounds, scratch, out, bv_tests, max_pairs, sieve, rows);
 }
 
 SlotAdjacency::SlotAdjacency(const FeatureTopology& topology, std::span<const std::int32_t> order)

@@ -502,12 +502,12 @@ ClipRunner::ClipRunner(
                      method_options_.elementary.vertex_face == nullptr &&
                      method_options_.elementary.edge_edge == nullptr &&
                      method_options_.elementary.triangles == nullptr;
-  // Rigid rows for a method that takes them, when the motion is linear blend skinning and they
-  // hold a twentieth of the triangles at least (fewer did not pay for their certificates: the
-  // stormtrooper's 2 %, docs/benchmarks.md "Rigid rows in `kdop`"); their intervals then carry the
-  // bone transforms that certify them.
-  if (!factory_ && options.rigid_rows && motion.skin_weights() != nullptr &&
-      takes_rigid_rows(options.method)) {
+  // Rigid rows for a method that takes them, when the run has CCD intervals (only those skip
+  // pairs), the motion is linear blend skinning and they hold a twentieth of the triangles at
+  // least (fewer did not pay for their certificates: the stormtrooper's 2 %, docs/benchmarks.md
+  // "Rigid rows in `kdop`"); their intervals then carry the bone transforms that certify them.
+  if (!factory_ && options.rigid_rows && options.query != QuerySet::dcd &&
+      motion.skin_weights() != nullptr && takes_rigid_rows(options.method)) {
     const skinning::SkinWeights& weights = *motion.skin_weights();
     auto rows = std::make_shared<const culling::RigidRows>(culling::build_rigid_rows(
         motion.mesh(),

@@ -74,8 +74,9 @@ struct RunOptions {
   /// method is known to be stateless for the run (RunPlan::serial_reason would be empty; a
   /// factory's only with factory_methods_stateless). False: every interval is queried.
   bool reuse_static_intervals = true;
-  /// A method that takes rigid rows (culling::MethodInfo::takes_rigid_rows: `kdop`) gets them
-  /// when the motion is linear blend skinning (skinning::Motion::skin_weights): its CCD skips
+  /// A method that takes rigid rows (culling::MethodInfo::takes_rigid_rows: `kdop`, `auto`) gets
+  /// them when the run has CCD intervals and the motion is linear blend skinning
+  /// (skinning::Motion::skin_weights): its CCD skips
   /// the pairs that skinning moves by one matrix (docs/culling.md "Rigid rows"; the same
   /// contacts). False: none (`--no-rigid-rows`).
   bool rigid_rows = true;
