@@ -628,6 +628,88 @@ inline NodeEndBoxes triangle_ends(
   return box;
 }
 
+/// Where refit_end_boxes and refit_slot_ends read a triangle's end boxes: the corners' boxes of
+/// vertex_end_boxes ...
+struct CornerEndsSource {
+  const skinning::Triangles& triangles;
+  std::span<const NodeEndBoxes> vertex_ends;
+  void prefetch(std::int32_t f) const { prefetch_corner_ends(triangles, vertex_ends, f); }
+  [[nodiscard]] NodeEndBoxes triangle(std::int32_t f) const {
+    return triangle_ends(triangles, vertex_ends, f);
+  }
+};
+
+/// ... or the corners' positions, bounded per triangle first and rounded once: bit for bit the
+/// same boxes (a coordinate's lower end float_below(next_down(x − w)) is monotone in x, so the
+/// rounding of the least corner is the least of the corners' roundings), and no #W boxes held.
+struct PositionEndsSource {
+  const skinning::Triangles& triangles;
+  const skinning::Positions& x_t0;
+  const skinning::Positions& x_t1;
+  double half_width;
+  void prefetch(std::int32_t f) const {
+    for (Eigen::Index j = 0; j < 3; ++j) {
+      const auto v = static_cast<std::size_t>(triangles(f, j));
+      __builtin_prefetch(x_t0.data() + 3 * v);
+      __builtin_prefetch(x_t1.data() + 3 * v);
+    }
+  }
+  [[nodiscard]] NodeEndBoxes triangle(std::int32_t f) const {
+    const auto i = static_cast<Eigen::Index>(f);
+    const std::array<std::size_t, 3> c{
+        3 * static_cast<std::size_t>(triangles(i, 0)),
+        3 * static_cast<std::size_t>(triangles(i, 1)),
+        3 * static_cast<std::size_t>(triangles(i, 2))};
+    NodeEndBoxes box;
+#if defined(__SSE2__)
+    if (half_width == 0.0) {
+      // As vertex_end_boxes without a width: detail::float_below4 on (x, y | z, 0), bit for bit
+      // the scalar conversions below; float_above(x) is −float_below(−x).
+      const __m128d sign = _mm_set1_pd(-0.0);
+      const __m128 sign_f = _mm_set1_ps(-0.0f);
+      const auto end = [&](const double* p, float* lo, float* hi) {
+        __m128d lo_xy = _mm_loadu_pd(p + c[0]);
+        __m128d lo_z = _mm_set_sd(p[c[0] + 2]);
+        __m128d hi_xy = lo_xy;
+        __m128d hi_z = lo_z;
+        for (std::size_t j = 1; j < 3; ++j) {
+          const __m128d xy = _mm_loadu_pd(p + c[j]);
+          const __m128d z = _mm_set_sd(p[c[j] + 2]);
+          lo_xy = _mm_min_pd(lo_xy, xy);
+          hi_xy = _mm_max_pd(hi_xy, xy);
+          lo_z = _mm_min_sd(lo_z, z);
+          hi_z = _mm_max_sd(hi_z, z);
+        }
+        _mm_store_ps(lo, detail::float_below4(lo_xy, lo_z));
+        _mm_store_ps(
+            hi,
+            _mm_xor_ps(
+                detail::float_below4(_mm_xor_pd(hi_xy, sign), _mm_xor_pd(hi_z, sign)), sign_f));
+        lo[3] = hi[3] = 0.0f;
+      };
+      end(x_t0.data(), box.lo0, box.hi0);
+      end(x_t1.data(), box.lo1, box.hi1);
+      return box;
+    }
+#endif
+    const auto end = [&](const double* p, float* lo, float* hi) {
+      for (std::size_t k = 0; k < 3; ++k) {
+        const double a = p[c[0] + k];
+        const double b = p[c[1] + k];
+        const double d = p[c[2] + k];
+        const double l = std::min(std::min(a, b), d);
+        const double h = std::max(std::max(a, b), d);
+        lo[k] = float_below(half_width > 0.0 ? next_down(l - half_width) : l);
+        hi[k] = float_above(half_width > 0.0 ? next_up(h + half_width) : h);
+      }
+      lo[3] = hi[3] = 0.0f;
+    };
+    end(x_t0.data(), box.lo0, box.hi0);
+    end(x_t1.data(), box.lo1, box.hi1);
+    return box;
+  }
+};
+
 /// Slot s of the 12 rows of slot end boxes (Bvh::refit_slot_ends), `stride` floats a row.
 inline void write_slot_ends(
     float* rows, std::size_t stride, std::size_t s, const NodeEndBoxes& box) {
@@ -697,6 +779,22 @@ void Bvh<N>::refit_end_boxes(
     const skinning::Triangles& triangles,
     std::span<const NodeEndBoxes> vertex_ends,
     bool with_slot_ends) {
+  fill_end_boxes(CornerEndsSource{triangles, vertex_ends}, with_slot_ends);
+}
+
+template <int N>
+void Bvh<N>::refit_end_boxes(
+    const skinning::Triangles& triangles,
+    const skinning::Positions& x_t0,
+    const skinning::Positions& x_t1,
+    double half_width,
+    bool with_slot_ends) {
+  fill_end_boxes(PositionEndsSource{triangles, x_t0, x_t1, half_width}, with_slot_ends);
+}
+
+template <int N>
+template <class Source>
+void Bvh<N>::fill_end_boxes(const Source& source, bool with_slot_ends) {
   constexpr float kInf = std::numeric_limits<float>::infinity();
   const std::size_t stride = slot_stride();
   if (with_slot_ends && slot_ends_.size() != 12 * stride) slot_ends_.assign(12 * stride, 0.0f);
@@ -709,21 +807,11 @@ void Bvh<N>::refit_end_boxes(
     // The sweep meets the buckets in nearly decreasing slot order, the corners are scattered:
     // ask for the corners' boxes kAheadEnds slots below now (as refit_wide_only).
     for (std::size_t s = begin; s < end && s >= kAheadEnds; ++s) {
-      prefetch_corner_ends(triangles, vertex_ends, order_[s - kAheadEnds]);
-    }
-    if (!with_slot_ends) {
-      out = vertex_ends[static_cast<std::size_t>(triangles(order_[begin], 0))];
-      for (std::size_t s = begin; s < end; ++s) {
-        const auto f = static_cast<Eigen::Index>(order_[s]);
-        for (Eigen::Index j = s == begin ? 1 : 0; j < 3; ++j) {
-          merge_ends(out, vertex_ends[static_cast<std::size_t>(triangles(f, j))]);
-        }
-      }
-      return;
+      source.prefetch(order_[s - kAheadEnds]);
     }
     for (std::size_t s = begin; s < end; ++s) {
-      const NodeEndBoxes box = triangle_ends(triangles, vertex_ends, order_[s]);
-      write_slot_ends(rows, stride, s, box);
+      const NodeEndBoxes box = source.triangle(order_[s]);
+      if (with_slot_ends) write_slot_ends(rows, stride, s, box);
       if (s == begin) {
         out = box;
       } else {
@@ -779,15 +867,29 @@ void Bvh<N>::refit_end_boxes(
 template <int N>
 void Bvh<N>::refit_slot_ends(
     const skinning::Triangles& triangles, std::span<const NodeEndBoxes> vertex_ends) {
+  fill_slot_ends(CornerEndsSource{triangles, vertex_ends});
+}
+
+template <int N>
+void Bvh<N>::refit_slot_ends(
+    const skinning::Triangles& triangles,
+    const skinning::Positions& x_t0,
+    const skinning::Positions& x_t1) {
+  fill_slot_ends(PositionEndsSource{triangles, x_t0, x_t1, 0.0});
+}
+
+template <int N>
+template <class Source>
+void Bvh<N>::fill_slot_ends(const Source& source) {
   const std::size_t stride = slot_stride();
   // The padding slots are never read for a pair (their lanes are masked off): zeros.
   if (slot_ends_.size() != 12 * stride) slot_ends_.assign(12 * stride, 0.0f);
   float* const rows = slot_ends_.data();
   for (std::size_t s = 0; s < order_.size(); ++s) {
     if (s + kAheadEnds < order_.size()) {
-      prefetch_corner_ends(triangles, vertex_ends, order_[s + kAheadEnds]);
+      source.prefetch(order_[s + kAheadEnds]);
     }
-    write_slot_ends(rows, stride, s, triangle_ends(triangles, vertex_ends, order_[s]));
+    write_slot_ends(rows, stride, s, source.triangle(order_[s]));
   }
   slot_ends_ready_ = true;
 }

@@ -225,6 +225,15 @@ class Bvh {
       const skinning::Triangles& triangles,
       std::span<const NodeEndBoxes> vertex_ends,
       bool with_slot_ends = false);
+  /// The same boxes, bit for bit, from the corners' positions at the two ends grown by
+  /// half_width (what vertex_end_boxes reads), bounded per triangle before the rounding: for one
+  /// tree over a mesh, without #W vertex boxes held (64 bytes a vertex; bounded memory).
+  void refit_end_boxes(
+      const skinning::Triangles& triangles,
+      const skinning::Positions& x_t0,
+      const skinning::Positions& x_t1,
+      double half_width,
+      bool with_slot_ends);
   /// The triangles' own end boxes by slot, from their corners' (vertex_end_boxes): 12 rows of
   /// slot_stride() floats — lo at t = 0 on x, y, z, then hi at t = 0, lo at t = 1, hi at t = 1 —
   /// so that the traversals drop a triangle pair whose boxes lie apart on an axis at both ends
@@ -233,6 +242,12 @@ class Bvh {
   /// bytes).
   void refit_slot_ends(
       const skinning::Triangles& triangles, std::span<const NodeEndBoxes> vertex_ends);
+  /// The same rows, bit for bit, from the corners' positions (no width), as refit_end_boxes'
+  /// overload on positions.
+  void refit_slot_ends(
+      const skinning::Triangles& triangles,
+      const skinning::Positions& x_t0,
+      const skinning::Positions& x_t1);
   /// Row r of the slot end boxes (refit_slot_ends), or null unless it ran after the last refit().
   [[nodiscard]] const float* slot_ends(int r) const {
     return slot_ends_ready_ ? slot_ends_.data() + static_cast<std::size_t>(r) * slot_stride()
@@ -257,6 +272,11 @@ class Bvh {
   std::int32_t build_wide_node(std::int32_t node, int depth);
   void refit_wide_only(std::span<const Volume> triangle_bounds);
   void refit_float_nodes(std::span<const Volume> triangle_bounds);
+  /// refit_end_boxes and refit_slot_ends over a source of triangles' end boxes (bvh.cpp).
+  template <class Source>
+  void fill_end_boxes(const Source& source, bool with_slot_ends);
+  template <class Source>
+  void fill_slot_ends(const Source& source);
   using FloatBounds = std::array<float, static_cast<std::size_t>(N)>;
   /// The volume t of the triangle in slot s rounded outwards into (lo, hi), its slot volume
   /// (slot_lo / slot_hi) written.

@@ -70,7 +70,8 @@ class BvhMethod final : public MethodBase {
     // `kdop`'s relative boxes (#F × 120 bytes), sized by the first query whose trial keeps them:
     // a clip that never needs them never holds them (docs/benchmarks.md, bounded memory).
     const auto num_faces = static_cast<std::size_t>(topology_.num_triangles());
-    bounds_.vertices.reserve(static_cast<std::size_t>(topology_.num_vertices()));
+    if (!feature_stage_tests_ends(options_.min_separation))
+      bounds_.vertices.reserve(static_cast<std::size_t>(topology_.num_vertices()));
     bounds_.triangles.reserve(num_faces);
     scratch_.reserve_self(bvh_);
     full_slots_.reserve(num_faces);
@@ -109,15 +110,21 @@ class BvhMethod final : public MethodBase {
     check_positions(x_t1, "detect_ccd", "x_t1");
     const auto t0 = Clock::now();
     // Refit over the swept volumes of the interval, grown by half the contact distance. No edge
-    // volumes: the feature stage forms them from the vertices' (bounded memory).
-    swept_vertex_bounds<N>(x_t0, x_t1, 0.5 * options_.min_separation, bounds_.vertices);
-    bounds_.derive(topology_, /*with_edges=*/false);
+    // volumes: the feature stage forms them from the vertices' (bounded memory). Without a
+    // contact distance it reads the positions at both ends instead, and no vertex volumes are
+    // held: the triangles' come from their corners directly.
+    const bool ends_tested = feature_stage_tests_ends(options_.min_separation);
+    if (ends_tested) {
+      bounds_.swept_triangles(topology_, x_t0, x_t1);
+    } else {
+      swept_vertex_bounds<N>(x_t0, x_t1, 0.5 * options_.min_separation, bounds_.vertices);
+      bounds_.derive(topology_, /*with_edges=*/false);
+    }
     bvh_.refit(bounds_.triangles);
     // `kdop`: node pairs tested in the relative motion too when the interval moves enough for it
     // to prune (docs/culling.md "Relative boxes at the nodes").
     const bool node_ends =
         relative_pairs_ && motion_scale(topology_, x_t0, x_t1) >= kNodeRelativeMotion;
-    const bool ends_tested = feature_stage_tests_ends(options_.min_separation);
     // Without a contact distance the feature stage first drops the triangle pairs apart at both
     // ends (candidates.hpp): the leaves drop them instead, four at a time, before they are
     // emitted (docs/culling.md, "Apart at both ends in the leaves"). The slots' end boxes are
@@ -129,16 +136,16 @@ class BvhMethod final : public MethodBase {
     const std::int64_t pays = kSlotEndsPayPerTriangle * topology_.num_triangles();
     const std::int64_t pays_within = topology_.num_triangles() / 2;
     bool slot_ends = false;
+    // The end boxes come from the corners' positions, bounded per triangle (no #W vertex boxes).
     const auto build_slot_ends = [&] {
-      if (!node_ends) vertex_end_boxes(x_t0, x_t1, 0.0, vertex_ends_);
-      bvh_.refit_slot_ends(topology_.welded_triangles(), vertex_ends_);
+      bvh_.refit_slot_ends(topology_.welded_triangles(), x_t0, x_t1);
       slot_ends = true;
     };
     if (node_ends) {
       // With the slots' end boxes when they are wanted from the start: the corners gathered once.
-      vertex_end_boxes(x_t0, x_t1, 0.5 * options_.min_separation, vertex_ends_);
       slot_ends = ends_tested && slot_ends_pay_;
-      bvh_.refit_end_boxes(topology_.welded_triangles(), vertex_ends_, slot_ends);
+      bvh_.refit_end_boxes(
+          topology_.welded_triangles(), x_t0, x_t1, 0.5 * options_.min_separation, slot_ends);
     } else if (ends_tested && slot_ends_pay_) {
       build_slot_ends();
     }
@@ -245,7 +252,6 @@ class BvhMethod final : public MethodBase {
   Bvh<N> bvh_;
   SlotAdjacency slots_{topology_, bvh_.triangle_order()};
   std::vector<std::uint8_t> full_slots_;
-  std::vector<NodeEndBoxes> vertex_ends_;  // sized by the first interval that moves enough
   // Whether the last interval had enough pairs apart at both ends for the slot end boxes to pay
   // (pairs per triangle), when ccd builds them.
   static constexpr std::int64_t kSlotEndsPayPerTriangle = 2;

@@ -90,6 +90,58 @@ void FeatureBounds<N>::static_triangles(
   }
 }
 
+template <int N>
+void FeatureBounds<N>::swept_triangles(
+    const FeatureTopology& topology,
+    const skinning::Positions& x_t0,
+    const skinning::Positions& x_t1) {
+  // Every axis past the coordinate ones has exactly two non-zero components, each ±1.
+  static_assert(N == 3 || N == 8, "the axes below are Dop<3>'s and Dop<8>'s");
+  vertices.clear();
+  const auto num_faces = static_cast<std::size_t>(topology.num_triangles());
+  triangles.resize(num_faces);
+  const double* const p0 = x_t0.data();  // row-major: vertex v at p + 3 v
+  const double* const p1 = x_t1.data();
+  for (std::size_t f = 0; f < num_faces; ++f) {
+    const auto& t = topology.triangle(static_cast<std::int32_t>(f));
+    std::array<const double*, 6> c{};
+    for (std::size_t k = 0; k < 3; ++k) {
+      c[2 * k] = p0 + 3 * at(t[k]);
+      c[2 * k + 1] = p1 + 3 * at(t[k]);
+    }
+    Dop<N> d;
+    for (std::size_t a = 0; a < 3; ++a) {
+      double lo = c[0][a];
+      double hi = lo;
+      for (std::size_t k = 1; k < 6; ++k) {
+        lo = std::min(lo, c[k][a]);
+        hi = std::max(hi, c[k][a]);
+      }
+      d.lo[a] = lo;
+      d.hi[a] = hi;
+    }
+    // The other axes (Dop<8>'s diagonals) are sums or differences of two coordinates: one
+    // rounding each, so the exact value lies within one ulp of the rounded one.
+    for (std::size_t k = 3; k < static_cast<std::size_t>(N); ++k) {
+      const auto& axis = DopAxes<N>::kAxes[k];
+      const std::size_t i = axis[0] != 0 ? 0 : 1;
+      const std::size_t j = axis[2] != 0 ? 2 : 1;
+      const double si = axis[i];
+      const double sj = axis[j];
+      double lo = si * c[0][i] + sj * c[0][j];
+      double hi = lo;
+      for (std::size_t m = 1; m < 6; ++m) {
+        const double s = si * c[m][i] + sj * c[m][j];
+        lo = std::min(lo, s);
+        hi = std::max(hi, s);
+      }
+      d.lo[k] = next_down(lo);
+      d.hi[k] = next_up(hi);
+    }
+    triangles[f] = d;
+  }
+}
+
 namespace {
 
 /// What the feature stage tests a feature pair on: the swept volumes of the interval

@@ -71,6 +71,17 @@ struct FeatureBounds {
   /// vertices) then derive(topology, false) give, read from the corners' positions directly: the
   /// DCD needs no vertex volumes. `vertices` is cleared (its capacity kept).
   void static_triangles(const FeatureTopology& topology, const skinning::Positions& x);
+  /// triangles = a volume of each triangle's linear motion from x_t0 to x_t1 (no contact
+  /// distance), read from the six corner positions directly, so that no #W vertex volumes are
+  /// held (bounded memory: 128 bytes a vertex for the 16-DOP). The coordinate slabs are those
+  /// of derive(); a diagonal slab is the rounded sums' range moved one ulp outwards, which holds
+  /// the exact sums (round to nearest errs by at most half an ulp) and may be one ulp wider than
+  /// derive()'s. Only for a feature stage that reads the interval's ends instead of the vertex
+  /// volumes (feature_stage_tests_ends): `vertices` is cleared (its capacity kept).
+  void swept_triangles(
+      const FeatureTopology& topology,
+      const skinning::Positions& x_t0,
+      const skinning::Positions& x_t1);
 };
 
 /// Vertex fans over one CCD query's interval (VertexFans::certified_over), each decided the first

@@ -329,7 +329,8 @@ class AutoMethod final : public detail::MethodBase {
     if (open_hierarchy_ == nullptr && closed_hierarchy_ == nullptr)
       return;  // nothing traversed here but maybe a cone group without its cones
     if (cone == nullptr) {
-      own_bounds_.vertices.reserve(static_cast<std::size_t>(topology_.num_vertices()));
+      if (!feature_stage_tests_ends(options_.min_separation))
+        own_bounds_.vertices.reserve(static_cast<std::size_t>(topology_.num_vertices()));
       own_bounds_.triangles.reserve(nf);
       bounds_ = &own_bounds_;
     }
@@ -505,7 +506,9 @@ class AutoMethod final : public detail::MethodBase {
     const bool between = traverses_between();
     if (groups[0] == nullptr && groups[1] == nullptr && !between) return;
     const auto t0 = Clock::now();
-    if (bounds_ == &own_bounds_) {
+    if (bounds_ == &own_bounds_ && feature_stage_tests_ends(options_.min_separation)) {
+      own_bounds_.swept_triangles(topology_, x_t0, x_t1);  // as `bvh`: no vertex volumes held
+    } else if (bounds_ == &own_bounds_) {
       swept_vertex_bounds<3>(x_t0, x_t1, 0.5 * options_.min_separation, own_bounds_.vertices);
       own_bounds_.derive(topology_, /*with_edges=*/false);
     }

@@ -859,6 +859,57 @@ TEST(FeatureBounds, StaticTrianglesFromTheCornersAreTheDerivedVolumesBitForBit) 
   expect_static_triangles_equal_derived<8>(t, x, "stormtrooper");
 }
 
+// The CCD's triangle volumes straight from the six corners (no contact distance; `bvh` and
+// `kdop` without vertex volumes): on the coordinate axes the derived volumes bit for bit; on the
+// 16-DOP's diagonals never inside them (so they hold the motion wherever those do) and at most
+// one step wider at each end — on every generated scene and on a real character's interval.
+template <int N>
+void expect_swept_triangles_hold_derived(
+    const FeatureTopology& t,
+    const skinning::Positions& x0,
+    const skinning::Positions& x1,
+    const std::string& what) {
+  FeatureBounds<N> derived;
+  swept_vertex_bounds<N>(x0, x1, 0.0, derived.vertices);
+  derived.derive(t, false);
+  FeatureBounds<N> direct;
+  direct.vertices.assign(3, Dop<N>::empty());
+  direct.swept_triangles(t, x0, x1);
+  EXPECT_TRUE(direct.vertices.empty()) << what;
+  ASSERT_EQ(direct.triangles.size(), derived.triangles.size()) << what;
+  for (std::size_t f = 0; f < derived.triangles.size(); ++f) {
+    const Dop<N>& d = direct.triangles[f];
+    const Dop<N>& e = derived.triangles[f];
+    for (std::size_t k = 0; k < static_cast<std::size_t>(N); ++k) {
+      if (k < 3) {
+        ASSERT_EQ(std::bit_cast<std::uint64_t>(d.lo[k]), std::bit_cast<std::uint64_t>(e.lo[k]))
+            << what << " triangle " << f;
+        ASSERT_EQ(std::bit_cast<std::uint64_t>(d.hi[k]), std::bit_cast<std::uint64_t>(e.hi[k]))
+            << what << " triangle " << f;
+        continue;
+      }
+      ASSERT_LE(d.lo[k], e.lo[k]) << what << " triangle " << f << " axis " << k;
+      ASSERT_GE(d.lo[k], next_down(e.lo[k])) << what << " triangle " << f << " axis " << k;
+      ASSERT_GE(d.hi[k], e.hi[k]) << what << " triangle " << f << " axis " << k;
+      ASSERT_LE(d.hi[k], next_up(e.hi[k])) << what << " triangle " << f << " axis " << k;
+    }
+  }
+}
+
+TEST(FeatureBounds, SweptTrianglesFromTheCornersHoldTheDerivedVolumes) {
+  for (const Scene& s : scenes()) {
+    const FeatureTopology t(s.mesh, s.topology);
+    expect_swept_triangles_hold_derived<3>(t, s.x_t0, s.x_t1, s.name);
+    expect_swept_triangles_hold_derived<8>(t, s.x_t0, s.x_t1, s.name);
+  }
+  const test::WeldedCharacter trooper("stormtrooper/stormtrooper.dae");
+  const FeatureTopology t(*trooper.loaded.mesh, trooper.topology);
+  const skinning::Positions x0 = trooper.sample(7);
+  const skinning::Positions x1 = trooper.sample(8);
+  expect_swept_triangles_hold_derived<3>(t, x0, x1, "stormtrooper");
+  expect_swept_triangles_hold_derived<8>(t, x0, x1, "stormtrooper");
+}
+
 TEST(FeatureTopology, SharedCornersMapCornersAndCountDistinctVertices) {
   skinning::Positions x(5, 3);
   x << 0, 0, 0, 1, 0, 0, 0, 1, 0, 1, 1, 0, 2, 2, 0;

@@ -300,6 +300,83 @@ TEST(NodeRelative, NodeAndSlotEndBoxesFromOneGatherAreTheTwoRefitsBitForBit) {
   }
 }
 
+// The end boxes read from the corners' positions (the overloads `bvh` and `kdop` use: no #W
+// vertex boxes held) are the vertex boxes' bit for bit — nodes and slots, with and without a
+// half width — on CesiumMan's motion and with some coordinates set to zeros of both signs,
+// subnormals and values beyond the float range, where the rounding has edges.
+TEST(NodeRelative, EndBoxesFromPositionsAreTheVertexBoxesBitForBit) {
+  SweptCesium c;
+  auto& [m, ft, x0, x1, bvh, bounds] = c;
+  skinning::Positions edgy0 = x0;
+  skinning::Positions edgy1 = x1;
+  const std::array<double, 6> edges{0.0, -0.0, 1e-310, -1e-41, 1e39, -3.4028235e38};
+  for (Eigen::Index v = 0; v < edgy0.rows(); v += 7) {
+    edgy0(v, v % 3) = edges[static_cast<std::size_t>(v % 6)];
+    edgy1((v + 1) % edgy1.rows(), (v + 2) % 3) = edges[static_cast<std::size_t>((v + 3) % 6)];
+  }
+  const auto rows = [&](const Bvh<3>& tree) {
+    std::vector<float> r;
+    for (int k = 0; k < 12; ++k) {
+      const float* row = tree.slot_ends(k);
+      EXPECT_NE(row, nullptr);
+      if (row == nullptr) return r;
+      r.insert(r.end(), row, row + tree.triangle_order().size());
+    }
+    return r;
+  };
+  const auto same_nodes = [](const Bvh<3>& a, const Bvh<3>& b) {
+    return a.end_boxes().size() == b.end_boxes().size() && !a.end_boxes().empty() &&
+           std::memcmp(
+               a.end_boxes().data(),
+               b.end_boxes().data(),
+               a.end_boxes().size() * sizeof(WideEndBoxes)) == 0;
+  };
+  for (const bool edgy : {false, true}) {
+    const skinning::Positions& p0 = edgy ? edgy0 : x0;
+    const skinning::Positions& p1 = edgy ? edgy1 : x1;
+    FeatureBounds<3> b;
+    swept_vertex_bounds<3>(p0, p1, 0.0, b.vertices);
+    b.derive(ft, /*with_edges=*/false);
+    for (const double half_width : {0.0, 1e-3}) {
+      for (const bool with_slots : {false, true}) {
+        std::vector<NodeEndBoxes> vertices;
+        vertex_end_boxes(p0, p1, half_width, vertices);
+        Bvh<3> from_vertices(ft.welded_triangles(), m.rest);
+        Bvh<3> from_positions(ft.welded_triangles(), m.rest);
+        from_vertices.refit(b.triangles);
+        from_positions.refit(b.triangles);
+        from_vertices.refit_end_boxes(ft.welded_triangles(), vertices, with_slots);
+        from_positions.refit_end_boxes(ft.welded_triangles(), p0, p1, half_width, with_slots);
+        EXPECT_TRUE(same_nodes(from_vertices, from_positions))
+            << edgy << " " << half_width << " " << with_slots;
+        if (with_slots) {
+          const std::vector<float> a = rows(from_vertices);
+          const std::vector<float> b_rows = rows(from_positions);
+          ASSERT_EQ(a.size(), b_rows.size());
+          EXPECT_EQ(std::memcmp(a.data(), b_rows.data(), a.size() * sizeof(float)), 0)
+              << edgy << " " << half_width;
+        } else {
+          EXPECT_EQ(from_positions.slot_ends(0), nullptr);
+        }
+      }
+    }
+    // The slots' rows alone (no width: the leaves' test).
+    std::vector<NodeEndBoxes> vertices;
+    vertex_end_boxes(p0, p1, 0.0, vertices);
+    Bvh<3> from_vertices(ft.welded_triangles(), m.rest);
+    Bvh<3> from_positions(ft.welded_triangles(), m.rest);
+    from_vertices.refit(b.triangles);
+    from_positions.refit(b.triangles);
+    from_vertices.refit_slot_ends(ft.welded_triangles(), vertices);
+    from_positions.refit_slot_ends(ft.welded_triangles(), p0, p1);
+    const std::vector<float> expected = rows(from_vertices);
+    ASSERT_EQ(expected.size(), 12 * static_cast<std::size_t>(ft.num_triangles()));
+    const std::vector<float> got = rows(from_positions);
+    ASSERT_EQ(got.size(), expected.size());
+    EXPECT_EQ(std::memcmp(expected.data(), got.data(), expected.size() * sizeof(float)), 0) << edgy;
+  }
+}
+
 // Two points that meet at t = 1/2, each the only content of a lane, on top of a common motion of
 // up to 2^20 and with coordinates from 2^-30 to 2^20 (all sums exact in double): their lanes
 // always meet (the rounding of the shifted ends is outwards), whatever the common motion and which
