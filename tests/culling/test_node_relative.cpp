@@ -64,6 +64,19 @@ Traversed traverse(
 
 /// CesiumMan's samples 0 → 20 (its walk moves every part), its tree over the rest pose and the
 /// triangles' swept volumes of that interval (the tree not refit yet).
+/// The 12 rows of a tree's slot end boxes (Bvh::slot_ends) one after the other; fewer when a row
+/// is missing (a failure is recorded).
+std::vector<float> slot_end_rows(const Bvh<3>& tree) {
+  std::vector<float> r;
+  for (int k = 0; k < 12; ++k) {
+    const float* row = tree.slot_ends(k);
+    EXPECT_NE(row, nullptr);
+    if (row == nullptr) return r;
+    r.insert(r.end(), row, row + tree.triangle_order().size());
+  }
+  return r;
+}
+
 struct SweptCesium {
   Model m{"CesiumMan.glb"};
   FeatureTopology ft{*m.loaded.mesh, m.topology};
@@ -253,16 +266,6 @@ TEST(NodeRelative, EndBoxesHoldEveryCornerAndARefitDropsThem) {
 TEST(NodeRelative, NodeAndSlotEndBoxesFromOneGatherAreTheTwoRefitsBitForBit) {
   SweptCesium c;
   auto& [m, ft, x0, x1, bvh, bounds] = c;
-  const auto rows = [&](const Bvh<3>& tree) {
-    std::vector<float> r;
-    for (int k = 0; k < 12; ++k) {
-      const float* row = tree.slot_ends(k);
-      EXPECT_NE(row, nullptr);
-      if (row == nullptr) return r;
-      r.insert(r.end(), row, row + tree.triangle_order().size());
-    }
-    return r;
-  };
   for (const bool node_volumes : {true, false}) {
     for (const double half_width : {0.0, 1e-3}) {
       std::vector<NodeEndBoxes> vertices;
@@ -286,8 +289,8 @@ TEST(NodeRelative, NodeAndSlotEndBoxesFromOneGatherAreTheTwoRefitsBitForBit) {
               apart.end_boxes().size() * sizeof(WideEndBoxes)),
           0)
           << node_volumes << " " << half_width;
-      const std::vector<float> apart_rows = rows(apart);
-      const std::vector<float> together_rows = rows(together);
+      const std::vector<float> apart_rows = slot_end_rows(apart);
+      const std::vector<float> together_rows = slot_end_rows(together);
       ASSERT_EQ(apart_rows.size(), 12 * static_cast<std::size_t>(ft.num_triangles()));
       ASSERT_EQ(together_rows.size(), apart_rows.size());
       EXPECT_EQ(
@@ -314,16 +317,6 @@ TEST(NodeRelative, EndBoxesFromPositionsAreTheVertexBoxesBitForBit) {
     edgy0(v, v % 3) = edges[static_cast<std::size_t>(v % 6)];
     edgy1((v + 1) % edgy1.rows(), (v + 2) % 3) = edges[static_cast<std::size_t>((v + 3) % 6)];
   }
-  const auto rows = [&](const Bvh<3>& tree) {
-    std::vector<float> r;
-    for (int k = 0; k < 12; ++k) {
-      const float* row = tree.slot_ends(k);
-      EXPECT_NE(row, nullptr);
-      if (row == nullptr) return r;
-      r.insert(r.end(), row, row + tree.triangle_order().size());
-    }
-    return r;
-  };
   const auto same_nodes = [](const Bvh<3>& a, const Bvh<3>& b) {
     return a.end_boxes().size() == b.end_boxes().size() && !a.end_boxes().empty() &&
            std::memcmp(
@@ -350,8 +343,8 @@ TEST(NodeRelative, EndBoxesFromPositionsAreTheVertexBoxesBitForBit) {
         EXPECT_TRUE(same_nodes(from_vertices, from_positions))
             << edgy << " " << half_width << " " << with_slots;
         if (with_slots) {
-          const std::vector<float> a = rows(from_vertices);
-          const std::vector<float> b_rows = rows(from_positions);
+          const std::vector<float> a = slot_end_rows(from_vertices);
+          const std::vector<float> b_rows = slot_end_rows(from_positions);
           ASSERT_EQ(a.size(), b_rows.size());
           EXPECT_EQ(std::memcmp(a.data(), b_rows.data(), a.size() * sizeof(float)), 0)
               << edgy << " " << half_width;
@@ -369,9 +362,9 @@ TEST(NodeRelative, EndBoxesFromPositionsAreTheVertexBoxesBitForBit) {
     from_positions.refit(b.triangles);
     from_vertices.refit_slot_ends(ft.welded_triangles(), vertices);
     from_positions.refit_slot_ends(ft.welded_triangles(), p0, p1);
-    const std::vector<float> expected = rows(from_vertices);
+    const std::vector<float> expected = slot_end_rows(from_vertices);
     ASSERT_EQ(expected.size(), 12 * static_cast<std::size_t>(ft.num_triangles()));
-    const std::vector<float> got = rows(from_positions);
+    const std::vector<float> got = slot_end_rows(from_positions);
     ASSERT_EQ(got.size(), expected.size());
     EXPECT_EQ(std::memcmp(expected.data(), got.data(), expected.size() * sizeof(float)), 0) << edgy;
   }
