@@ -639,6 +639,23 @@ struct CornerEndsSource {
   }
 };
 
+#if defined(__SSE2__)
+/// The float box around [lo, hi] in lanes (x, y | z, 0): detail::float_below4 of the lower ends,
+/// float_above of the upper ones as −float_below(−x), bit for bit the scalar float_below and
+/// float_above; lane 3 zero.
+inline void store_outward(
+    __m128d lo_xy, __m128d lo_z, __m128d hi_xy, __m128d hi_z, float* lo, float* hi) {
+  const __m128d sign = _mm_set1_pd(-0.0);
+  _mm_store_ps(lo, detail::float_below4(lo_xy, lo_z));
+  _mm_store_ps(
+      hi,
+      _mm_xor_ps(
+          detail::float_below4(_mm_xor_pd(hi_xy, sign), _mm_xor_pd(hi_z, sign)),
+          _mm_set1_ps(-0.0f)));
+  lo[3] = hi[3] = 0.0f;
+}
+#endif
+
 /// ... or the corners' positions, bounded per triangle first and rounded once: bit for bit the
 /// same boxes (a coordinate's lower end float_below(next_down(x − w)) is monotone in x, so the
 /// rounding of the least corner is the least of the corners' roundings), and no #W boxes held.
@@ -663,10 +680,7 @@ struct PositionEndsSource {
     NodeEndBoxes box;
 #if defined(__SSE2__)
     if (half_width == 0.0) {
-      // As vertex_end_boxes without a width: detail::float_below4 on (x, y | z, 0), bit for bit
-      // the scalar conversions below; float_above(x) is −float_below(−x).
-      const __m128d sign = _mm_set1_pd(-0.0);
-      const __m128 sign_f = _mm_set1_ps(-0.0f);
+      // As vertex_end_boxes without a width, on the corners' least and greatest coordinates.
       const auto end = [&](const double* p, float* lo, float* hi) {
         __m128d lo_xy = _mm_loadu_pd(p + c[0]);
         __m128d lo_z = _mm_set_sd(p[c[0] + 2]);
@@ -680,12 +694,7 @@ struct PositionEndsSource {
           lo_z = _mm_min_sd(lo_z, z);
           hi_z = _mm_max_sd(hi_z, z);
         }
-        _mm_store_ps(lo, detail::float_below4(lo_xy, lo_z));
-        _mm_store_ps(
-            hi,
-            _mm_xor_ps(
-                detail::float_below4(_mm_xor_pd(hi_xy, sign), _mm_xor_pd(hi_z, sign)), sign_f));
-        lo[3] = hi[3] = 0.0f;
+        store_outward(lo_xy, lo_z, hi_xy, hi_z, lo, hi);
       };
       end(x_t0.data(), box.lo0, box.hi0);
       end(x_t1.data(), box.lo1, box.hi1);
@@ -739,18 +748,12 @@ void vertex_end_boxes(
   out.resize(rows);
 #if defined(__SSE2__)
   if (half_width == 0.0) {
-    // Without a width, float_below and float_above of the coordinates themselves: one
-    // detail::float_below4 per end and side (x, y | z and a 0 lane), bit for bit the scalar
-    // conversions below; float_above(x) is −float_below(−x).
-    const __m128d sign = _mm_set1_pd(-0.0);
-    const __m128 sign_f = _mm_set1_ps(-0.0f);
+    // Without a width, float_below and float_above of the coordinates themselves (one
+    // store_outward per end).
     const auto ends = [&](const double* p, float* lo, float* hi) {
       const __m128d xy = _mm_loadu_pd(p);
       const __m128d z0 = _mm_set_sd(p[2]);
-      _mm_store_ps(lo, detail::float_below4(xy, z0));
-      _mm_store_ps(
-          hi, _mm_xor_ps(detail::float_below4(_mm_xor_pd(xy, sign), _mm_xor_pd(z0, sign)), sign_f));
-      lo[3] = hi[3] = 0.0f;
+      store_outward(xy, z0, xy, z0, lo, hi);
     };
     for (std::size_t v = 0; v < rows; ++v) {
       NodeEndBoxes& e = out[v];

@@ -506,11 +506,13 @@ class AutoMethod final : public detail::MethodBase {
     const bool between = traverses_between();
     if (groups[0] == nullptr && groups[1] == nullptr && !between) return;
     const auto t0 = Clock::now();
-    if (bounds_ == &own_bounds_ && feature_stage_tests_ends(options_.min_separation)) {
-      own_bounds_.swept_triangles(topology_, x_t0, x_t1);  // as `bvh`: no vertex volumes held
-    } else if (bounds_ == &own_bounds_) {
-      swept_vertex_bounds<3>(x_t0, x_t1, 0.5 * options_.min_separation, own_bounds_.vertices);
-      own_bounds_.derive(topology_, /*with_edges=*/false);
+    if (bounds_ == &own_bounds_) {
+      if (feature_stage_tests_ends(options_.min_separation)) {
+        own_bounds_.swept_triangles(topology_, x_t0, x_t1);  // as `bvh`: no vertex volumes held
+      } else {
+        swept_vertex_bounds<3>(x_t0, x_t1, 0.5 * options_.min_separation, own_bounds_.vertices);
+        own_bounds_.derive(topology_, /*with_edges=*/false);
+      }
     }
     refit_groups();
     const auto t1 = Clock::now();
