@@ -126,10 +126,10 @@ const skinning::Topology& used_topology(
   return ghosts ? ghosts->topology : real;
 }
 
-culling::MethodOptions with_features(
-    culling::MethodOptions options, std::shared_ptr<const culling::FeatureTopology> features) {
-  options.features = std::move(features);
-  return options;
+skinning::Positions welded_rest(const skinning::Mesh& mesh, const skinning::Topology& topology) {
+  skinning::Positions rest;
+  skinning::gather_welded(topology, mesh.rest_positions, rest);
+  return rest;
 }
 
 /// Patches smaller than this are not classified (their triangles are tested as Hᵘ): a ray costs
@@ -178,7 +178,7 @@ RadialViewMethod::RadialViewMethod(
       real_triangles_(static_cast<std::int32_t>(real_topology.welded_triangles.rows())),
       segmentation_(ghosts_ ? ghosts_->segmentation : std::move(segmentation)),
       poses_(std::move(poses)),
-      topology_(
+      features_(std::make_shared<const culling::FeatureTopology>(
           used_mesh(ghosts_, real_mesh),
           used_topology(ghosts_, real_topology),
           segmentation_ && options.rims_first ? rim_first_order(
@@ -186,7 +186,8 @@ RadialViewMethod::RadialViewMethod(
                                                     used_topology(ghosts_, real_topology),
                                                     *segmentation_,
                                                     real_triangles_)
-                                              : std::vector<std::int32_t>{}),
+                                              : std::vector<std::int32_t>{})),
+      topology_(*features_),
       clusters_(
           used_mesh(ghosts_, real_mesh),
           used_topology(ghosts_, real_topology),
@@ -196,16 +197,10 @@ RadialViewMethod::RadialViewMethod(
       method_options_(method_options),
       options_(options),
       tests_(culling::with_ccd_defaults(method_options.elementary)),
-      updater_(
-          used_mesh(ghosts_, real_mesh),
-          used_topology(ghosts_, real_topology),
-          method_options.features),
-      // The bvh method checks the method options (min_separation, accuracy) as every method does.
-      bvh_(culling::make_method(
-          "bvh",
-          used_mesh(ghosts_, real_mesh),
-          used_topology(ghosts_, real_topology),
-          with_features(method_options_, updater_.shared_features()))),
+      updater_(used_mesh(ghosts_, real_mesh), used_topology(ghosts_, real_topology), features_),
+      dcd_rest_(welded_rest(used_mesh(ghosts_, real_mesh), used_topology(ghosts_, real_topology))),
+      // It checks the method options as every method does.
+      dcd_(culling::make_dcd_method(features_, dcd_rest_, method_options_)),
       builder_(clusters_, options.clusters),
       edge_face_offsets_(used_topology(ghosts_, real_topology).edge_face_offsets),
       edge_faces_(used_topology(ghosts_, real_topology).edge_faces),
@@ -349,9 +344,19 @@ void RadialViewMethod::record_dcd(
 void RadialViewMethod::dcd(const culling::Instant& at, culling::FrameResult& out) {
   check_positions(at.x, "detect_dcd", "x");
   const skinning::Positions& x = with_ghosts(at.x, capped_x0_);
-  bvh_->detect_dcd(x, out);
+  culling::CullingMethod& dcd = dcd_method();
+  if (!dcd_queried_) {
+    dcd_queried_ = true;
+    dcd_rest_ = skinning::Positions();  // dcd_ is kept from now on: see dcd_
+  }
+  dcd.detect_dcd(x, out);
   record_dcd(x, out);  // with the ghosts' pairs: the next interval's cuts need them
   drop_ghosts(out);
+}
+
+culling::CullingMethod& RadialViewMethod::dcd_method() {
+  if (!dcd_) dcd_ = culling::make_dcd_method(features_, dcd_rest_, method_options_);
+  return *dcd_;
 }
 
 // --- preconditions at the interval's start ------------------------------------------------------
@@ -376,7 +381,12 @@ void RadialViewMethod::start_status(const skinning::Positions& x_t0, culling::Fr
     start_pairs_.swap(carry_pairs_);
   } else {
     scratch_result_.clear();
-    bvh_->detect_dcd(x_t0, scratch_result_);
+    dcd_method().detect_dcd(x_t0, scratch_result_);
+    // See dcd_: dropped after a first start DCD, kept (and its build positions freed) after a
+    // second.
+    ++start_dcds_;
+    if (!dcd_queried_ && start_dcds_ == 1) dcd_.reset();
+    if (start_dcds_ == 2) dcd_rest_ = skinning::Positions();
     start_pairs_.assign(scratch_result_.dcd_pairs.begin(), scratch_result_.dcd_pairs.end());
     out.counters.bv_tests += scratch_result_.counters.bv_tests;
     out.counters.tt_tests += scratch_result_.counters.tt_tests;

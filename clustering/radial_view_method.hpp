@@ -121,6 +121,9 @@ class RadialViewMethod final : public culling::CullingMethod {
   [[nodiscard]] const IntervalClasses& last_classes() const { return classes_; }
   [[nodiscard]] const RadialViewStats& last_stats() const { return stats_; }
   [[nodiscard]] const RadialViewOptions& options() const { return options_; }
+  /// Whether it holds its DCD hierarchy now (dropped after a clip's first start DCD when it was
+  /// never asked for a DCD; see dcd_); for tests.
+  [[nodiscard]] bool holds_dcd() const { return dcd_ != nullptr; }
 
  private:
   enum class Status : std::uint8_t { unknown, clean, dirty };
@@ -173,6 +176,8 @@ class RadialViewMethod final : public culling::CullingMethod {
   /// triangle of an earlier round), through the relative AABB filter; returns the pairs found.
   std::int64_t retest_frontier(std::int32_t round, double half_width, culling::FrameResult& out);
   void record_dcd(const skinning::Positions& x, const culling::FrameResult& result);
+  /// dcd_, built again when it was dropped.
+  culling::CullingMethod& dcd_method();
 
   std::string name_;
   // Ghost caps (built before everything below, which works on the capped mesh); the capped
@@ -185,16 +190,27 @@ class RadialViewMethod final : public culling::CullingMethod {
   std::shared_ptr<const segmentation::Segmentation> segmentation_;
   std::shared_ptr<const BonePoses> poses_;
   std::int32_t num_bones_ = 0;
-  culling::FeatureTopology topology_;
+  // The features in rim-first owner order, shared with the DCD updater and the DCD hierarchy
+  // (neither reads ownership).
+  std::shared_ptr<const culling::FeatureTopology> features_;
+  const culling::FeatureTopology& topology_;  // *features_
   ClusterSet clusters_;
   culling::MethodOptions method_options_;
   RadialViewOptions options_;
   culling::ElementaryTests tests_;
   ccd::CcdOptions ccd_options_;
-  // The intersecting pairs from one end to the next; built before bvh_, which takes its
-  // FeatureTopology (the method options' when built from the mesh used here, else its own).
+  // The intersecting pairs from one end to the next.
   culling::DcdUpdater updater_;
-  std::unique_ptr<culling::CullingMethod> bvh_;  // DCD
+  // The DCD (detect_dcd, and an interval's start that neither a DCD nor the previous interval
+  // left the pairs of): a `bvh` (culling::make_dcd_method) over the used mesh's welded rest
+  // positions (dcd_rest_). A method that has run one start DCD and no detect_dcd (a clip's first
+  // interval in a CCD-only check) drops it: a whole-mesh hierarchy and its blocks it would
+  // otherwise hold for the rest of the run (docs/radial-view.md, "Memory"). Built again from
+  // dcd_rest_ if needed after all, then kept, and dcd_rest_ freed.
+  skinning::Positions dcd_rest_;
+  std::unique_ptr<culling::CullingMethod> dcd_;
+  bool dcd_queried_ = false;     // detect_dcd was called: keep dcd_
+  std::int32_t start_dcds_ = 0;  // DCDs run at an interval's start
   MegaClusterBuilder builder_;
   std::vector<std::int32_t> edge_face_offsets_, edge_faces_;
   std::vector<std::int32_t> face_neighbours_;  // 3 per triangle (built with them): build_patches'

@@ -65,21 +65,21 @@ class BvhMethod final : public MethodBase {
             welded_rest_positions(mesh, topology),
             nullptr,
             traversal_only(options.bvh))) {
-    // Everything an interval touches is sized here; only the blocks' feature candidates and the
-    // caller's findings may still grow (with the motion), and they keep their capacity — and
-    // `kdop`'s relative boxes (#F × 120 bytes), sized by the first query whose trial keeps them:
-    // a clip that never needs them never holds them (docs/benchmarks.md, bounded memory).
-    const auto num_faces = static_cast<std::size_t>(topology_.num_triangles());
-    if (!feature_stage_tests_ends(options_.min_separation))
-      bounds_.vertices.reserve(static_cast<std::size_t>(topology_.num_vertices()));
-    bounds_.triangles.reserve(num_faces);
-    scratch_.reserve_self(bvh_);
-    full_slots_.reserve(num_faces);
-    if (rigid_rows_) {
-      row_skip_.nodes.reserve(bvh_.nodes().size());
-      row_skip_.slots.reserve(bvh_.triangle_order().size());
-      rest_pairs_.reserve(rigid_rows_->rest_pairs.size());
-    }
+    reserve();
+  }
+
+  /// make_dcd_method's: over `features` its caller holds (any owner order), the hierarchy built
+  /// over the welded positions `x`, no rigid rows, no relative pairs.
+  BvhMethod(
+      std::string_view name,
+      std::shared_ptr<const FeatureTopology> features,
+      const skinning::Positions& x,
+      const MethodOptions& options)
+      : MethodBase(name, std::move(features), options),
+        relative_pairs_(false),
+        rigid_rows_(nullptr),
+        bvh_(topology_.welded_triangles(), checked(x), traversal_only(options.bvh)) {
+    reserve();
   }
 
   void dcd(const Instant& at, FrameResult& out) override {
@@ -226,6 +226,31 @@ class BvhMethod final : public MethodBase {
   }
 
  private:
+  /// `x` once it has one row per vertex of the features (the hierarchy's build positions).
+  const skinning::Positions& checked(const skinning::Positions& x) const {
+    check_positions(x, "make_dcd_method", "x");
+    return x;
+  }
+
+  /// What both constructors do once the hierarchy is built.
+  void reserve() {
+    // Everything an interval touches is sized here; only the blocks' feature candidates and the
+    // caller's findings may still grow (with the motion), and they keep their capacity — and
+    // `kdop`'s relative boxes (#F × 120 bytes), sized by the first query whose trial keeps them:
+    // a clip that never needs them never holds them (docs/benchmarks.md, bounded memory).
+    const auto num_faces = static_cast<std::size_t>(topology_.num_triangles());
+    if (!feature_stage_tests_ends(options_.min_separation))
+      bounds_.vertices.reserve(static_cast<std::size_t>(topology_.num_vertices()));
+    bounds_.triangles.reserve(num_faces);
+    scratch_.reserve_self(bvh_);
+    full_slots_.reserve(num_faces);
+    if (rigid_rows_) {
+      row_skip_.nodes.reserve(bvh_.nodes().size());
+      row_skip_.slots.reserve(bvh_.triangle_order().size());
+      rest_pairs_.reserve(rigid_rows_->rest_pairs.size());
+    }
+  }
+
   /// Certifies the rigid rows for `interval` and fills row_skip_ and rest_pairs_; the skip to
   /// walk with, or null (no rows, no bone transforms, or no row certified on any node).
   const RowSkip* certify_rows(const Interval& interval) {
@@ -292,3 +317,17 @@ template std::unique_ptr<CullingMethod> make_bvh_method<8>(
     bool);
 
 }  // namespace skelcd::culling::detail
+
+namespace skelcd::culling {
+
+std::unique_ptr<CullingMethod> make_dcd_method(
+    std::shared_ptr<const FeatureTopology> features,
+    const skinning::Positions& x,
+    const MethodOptions& options) {
+  if (features == nullptr) {
+    throw InvalidInput("culling::make_dcd_method: no feature topology given");
+  }
+  return std::make_unique<detail::BvhMethod<3>>("bvh", std::move(features), x, options);
+}
+
+}  // namespace skelcd::culling

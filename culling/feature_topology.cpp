@@ -275,8 +275,12 @@ ccd::SharedCorners FeatureTopology::shared_corners(
 std::shared_ptr<const FeatureTopology> shared_or_built(
     std::shared_ptr<const FeatureTopology> offered,
     const skinning::Mesh& mesh,
-    const skinning::Topology& topology) {
-  if (offered != nullptr && offered->built_from(mesh, topology)) return offered;
+    const skinning::Topology& topology,
+    OwnerOrder accepted) {
+  if (offered != nullptr && (accepted == OwnerOrder::any ? offered->describes(mesh, topology)
+                                                         : offered->built_from(mesh, topology))) {
+    return offered;
+  }
   return std::make_shared<const FeatureTopology>(mesh, topology);
 }
 

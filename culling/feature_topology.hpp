@@ -46,7 +46,13 @@ class FeatureTopology {
   /// and by its own address when that array is empty.
   [[nodiscard]] bool built_from(
       const skinning::Mesh& mesh, const skinning::Topology& topology) const {
-    return triangle_order_ && mesh_ == &mesh && topology_ == identity(topology);
+    return triangle_order_ && describes(mesh, topology);
+  }
+  /// True when this was built from these very objects, in any owner order: what a user that
+  /// reads no ownership may take (the DCD, culling::DcdUpdater).
+  [[nodiscard]] bool describes(
+      const skinning::Mesh& mesh, const skinning::Topology& topology) const {
+    return mesh_ == &mesh && topology_ == identity(topology);
   }
 
   [[nodiscard]] std::int32_t num_vertices() const { return num_vertices_; }
@@ -181,12 +187,17 @@ class FeatureTopology {
   VertexFans fans_;
 };
 
-/// `offered` when it was built from these very objects in triangle order (built_from), else a new
-/// FeatureTopology(mesh, topology): how a method or a DCD updater takes the one its caller shares
-/// (MethodOptions::features) without ever taking one of another mesh.
+/// Which owner orders a FeatureTopology's user accepts: `triangle` (a method: what it tests
+/// follows the ownership) or `any` (a user that reads no ownership: the DCD).
+enum class OwnerOrder { triangle, any };
+
+/// `offered` when it was built from these very objects (built_from; with OwnerOrder::any,
+/// describes), else a new FeatureTopology(mesh, topology): how a method or a DCD updater takes
+/// the one its caller shares (MethodOptions::features) without ever taking one of another mesh.
 [[nodiscard]] std::shared_ptr<const FeatureTopology> shared_or_built(
     std::shared_ptr<const FeatureTopology> offered,
     const skinning::Mesh& mesh,
-    const skinning::Topology& topology);
+    const skinning::Topology& topology,
+    OwnerOrder accepted = OwnerOrder::triangle);
 
 }  // namespace skelcd::culling

@@ -17,7 +17,7 @@ DcdUpdater::DcdUpdater(
     const skinning::Mesh& mesh,
     const skinning::Topology& topology,
     std::shared_ptr<const FeatureTopology> features)
-    : shared_(shared_or_built(std::move(features), mesh, topology)),
+    : shared_(shared_or_built(std::move(features), mesh, topology, OwnerOrder::any)),
       features_(*shared_),
       edge_face_offsets_(topology.edge_face_offsets),
       edge_faces_(topology.edge_faces) {

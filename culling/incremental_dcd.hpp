@@ -30,8 +30,9 @@ class DcdUpdater {
   /// Builds the incidences (vertex → triangles, edge → triangles) and the DCD rules of `mesh`
   /// (excluded parts, duplicate faces) for its welded `topology`.
   /// @param features the mesh's FeatureTopology when the caller has one built from these very
-  ///        objects (FeatureTopology::built_from; the runner's, shared by its methods): used, not
-  ///        built again. Null or built from other objects: one is built here.
+  ///        objects, in any owner order (FeatureTopology::describes: the updater reads no
+  ///        ownership; the runner's, shared by its methods, or `dynamic`'s own): used, not built
+  ///        again. Null or built from other objects: one is built here.
   /// @throws InvalidInput as FeatureTopology's constructor.
   DcdUpdater(
       const skinning::Mesh& mesh,

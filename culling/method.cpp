@@ -14,25 +14,7 @@
 namespace skelcd::culling {
 namespace detail {
 
-MethodBase::MethodBase(
-    std::string_view name,
-    const skinning::Mesh& mesh,
-    const skinning::Topology& topology,
-    const MethodOptions& options,
-    std::shared_ptr<const FeatureTopology> features)
-    : name_(name),
-      features_(
-          features != nullptr ? std::move(features)
-                              : shared_or_built(options.features, mesh, topology)),
-      topology_(*features_),
-      options_(options),
-      tests_(with_ccd_defaults(options.elementary)) {
-  if (topology_.num_triangles() != topology.welded_triangles.rows()) {
-    throw InvalidInput(
-        "culling::make_method: the shared feature topology has " +
-        std::to_string(topology_.num_triangles()) + " triangles, the topology " +
-        std::to_string(topology.welded_triangles.rows()));
-  }
+void check_method_options(const MethodOptions& options) {
   if (!std::isfinite(options.min_separation) || options.min_separation < 0.0) {
     throw InvalidInput(
         "culling::make_method: min_separation must be finite and >= 0, got " +
@@ -46,6 +28,37 @@ MethodBase::MethodBase(
   if (options.block_pairs == 0) {
     throw InvalidInput("culling::make_method: block_pairs must be >= 1, got 0");
   }
+}
+
+MethodBase::MethodBase(
+    std::string_view name,
+    const skinning::Mesh& mesh,
+    const skinning::Topology& topology,
+    const MethodOptions& options,
+    std::shared_ptr<const FeatureTopology> features)
+    : MethodBase(
+          name,
+          features != nullptr ? std::move(features)
+                              : shared_or_built(options.features, mesh, topology),
+          options) {
+  if (topology_.num_triangles() != topology.welded_triangles.rows()) {
+    throw InvalidInput(
+        "culling::make_method: the shared feature topology has " +
+        std::to_string(topology_.num_triangles()) + " triangles, the topology " +
+        std::to_string(topology.welded_triangles.rows()));
+  }
+}
+
+MethodBase::MethodBase(
+    std::string_view name,
+    std::shared_ptr<const FeatureTopology> features,
+    const MethodOptions& options)
+    : name_(name),
+      features_(std::move(features)),
+      topology_(*features_),
+      options_(options),
+      tests_(with_ccd_defaults(options.elementary)) {
+  check_method_options(options);
   ccd_options_.min_separation = options.min_separation;
   // The kernels' relative stage (docs/ccd.md, "Relative boxes"): with a contact distance, the
   // relative boxes. Without one its test, nine directions apart at both ends, is the one the

@@ -167,4 +167,16 @@ class CullingMethod {
     const skinning::Topology& topology,
     const MethodOptions& options = {});
 
+/// A `bvh` method over `features`, a FeatureTopology its caller holds and shares, in any owner
+/// order: its DCD reads no ownership (its CCD follows that order; any order gives each feature
+/// one owner, docs/culling.md). Its hierarchy is built over the welded positions `x` (one row
+/// per vertex of `features`), without options.hierarchies; options.features and
+/// options.rigid_rows are not used. For a method that needs a DCD now and then beside features
+/// of its own order, and holds it only while it needs it (clustering::RadialViewMethod).
+/// @throws InvalidInput for null features, `x` of another vertex count, or bad options.
+[[nodiscard]] std::unique_ptr<CullingMethod> make_dcd_method(
+    std::shared_ptr<const FeatureTopology> features,
+    const skinning::Positions& x,
+    const MethodOptions& options = {});
+
 }  // namespace skelcd::culling

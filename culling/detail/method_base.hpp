@@ -12,6 +12,11 @@
 
 namespace skelcd::culling::detail {
 
+/// The options checks every method makes when it is built.
+/// @throws InvalidInput for a negative or non-finite min_separation, min_separation > 0 with the
+///         `exact` accuracy, or block_pairs = 0.
+void check_method_options(const MethodOptions& options);
+
 class MethodBase : public CullingMethod {
  public:
   [[nodiscard]] std::string_view name() const override { return name_; }
@@ -32,6 +37,12 @@ class MethodBase : public CullingMethod {
       const skinning::Topology& topology,
       const MethodOptions& options,
       std::shared_ptr<const FeatureTopology> features = {});
+  /// Over `features` (not null), which its caller built or holds (make_dcd_method).
+  /// @throws InvalidInput for bad options.
+  MethodBase(
+      std::string_view name,
+      std::shared_ptr<const FeatureTopology> features,
+      const MethodOptions& options);
 
   /// @throws InvalidInput when `x` does not have one row per welded vertex.
   void check_positions(const skinning::Positions& x, const char* call, const char* which) const;

@@ -11,6 +11,7 @@
 #include "culling/detail/method_base.hpp"
 #include "culling/incremental_dcd.hpp"
 #include "culling/method.hpp"
+#include "skinning/errors.hpp"
 #include "tests/culling/procedural_meshes.hpp"
 
 namespace skelcd::culling {
@@ -61,7 +62,15 @@ TEST(SharedFeatures, MethodsTakeTheOptionsFeaturesOnlyWhenBuiltFromTheirMeshAndT
   for (auto f = static_cast<std::int32_t>(topology.welded_triangles.rows()) - 1; f >= 0; --f) {
     reversed.push_back(f);
   }
-  EXPECT_FALSE(FeatureTopology(mesh, topology, reversed).built_from(mesh, topology));
+  const auto in_reverse = std::make_shared<const FeatureTopology>(mesh, topology, reversed);
+  EXPECT_FALSE(in_reverse->built_from(mesh, topology));
+  // Another owner order is still these objects' features: what a user that reads no ownership
+  // (the DCD) may take, and a method may not.
+  EXPECT_TRUE(in_reverse->describes(mesh, topology));
+  EXPECT_FALSE(in_reverse->describes(excluded, topology));
+  EXPECT_NE(shared_or_built(in_reverse, mesh, topology), in_reverse);
+  EXPECT_EQ(shared_or_built(in_reverse, mesh, topology, OwnerOrder::any), in_reverse);
+  EXPECT_NE(shared_or_built(in_reverse, excluded, topology, OwnerOrder::any), in_reverse);
   EXPECT_EQ(shared_or_built(options.features, mesh, topology), options.features);
   const auto built = shared_or_built(options.features, excluded, topology);
   ASSERT_NE(built, nullptr);
@@ -108,6 +117,14 @@ TEST(SharedFeatures, DcdUpdaterTakesTheFeaturesOnlyWhenBuiltFromItsMeshAndTopolo
   EXPECT_EQ(shared.shared_features(), features);
   const DcdUpdater other(excluded, topology, features);
   EXPECT_NE(other.shared_features(), features);
+  // Any owner order (the updater reads no ownership): `dynamic` lends its rim-first features.
+  std::vector<std::int32_t> reversed;
+  for (auto f = static_cast<std::int32_t>(topology.welded_triangles.rows()) - 1; f >= 0; --f) {
+    reversed.push_back(f);
+  }
+  const auto in_reverse = std::make_shared<const FeatureTopology>(mesh, topology, reversed);
+  const DcdUpdater reversed_order(mesh, topology, in_reverse);
+  EXPECT_EQ(reversed_order.shared_features(), in_reverse);
   // Every pair of one triangle of each sheet, as the updater's rules see it.
   std::vector<CcdContact> contacts;
   CcdContact c;
@@ -120,6 +137,60 @@ TEST(SharedFeatures, DcdUpdaterTakesTheFeaturesOnlyWhenBuiltFromItsMeshAndTopolo
   other.affected_pairs(contacts, with_other);
   EXPECT_FALSE(with_shared.empty());
   EXPECT_TRUE(with_other.empty());  // the excluded mesh's rule
+  std::vector<TrianglePair> with_reversed;
+  reversed_order.affected_pairs(contacts, with_reversed);
+  EXPECT_EQ(with_reversed, with_shared);
+}
+
+TEST(SharedFeatures, DcdMethodOverFeaturesOfAnyOwnerOrderFindsBvhsPairsAndCounts) {
+  const skinning::Mesh mesh = crossing_sheets();
+  const auto topology = test::simple_topology(mesh);
+  const auto rest = test::welded(topology, mesh.rest_positions);
+  skinning::Positions moved = mesh.rest_positions;  // the standing sheet 0.4 higher
+  for (Eigen::Index v = 0; v < moved.rows(); ++v) {
+    if (mesh.vertex_part[static_cast<std::size_t>(v)] == 1) moved(v, 2) += 0.4;
+  }
+  const auto x = test::welded(topology, moved);
+  std::vector<std::int32_t> reversed;
+  for (auto f = static_cast<std::int32_t>(topology.welded_triangles.rows()) - 1; f >= 0; --f) {
+    reversed.push_back(f);
+  }
+  const auto in_reverse = std::make_shared<const FeatureTopology>(mesh, topology, reversed);
+  const auto bvh = make_method("bvh", mesh, topology);
+  // Built over the rest positions, as `bvh` builds its own: the same tree, so the same counts.
+  const auto dcd = make_dcd_method(in_reverse, rest);
+  EXPECT_EQ(features_of(*dcd), in_reverse.get());
+  for (const auto* at : {&rest, &x}) {
+    FrameResult a, b;
+    bvh->detect_dcd(*at, a);
+    dcd->detect_dcd(*at, b);
+    EXPECT_EQ(b.dcd_pairs, a.dcd_pairs);
+    EXPECT_EQ(b.counters.bv_tests, a.counters.bv_tests);
+    EXPECT_EQ(b.counters.tt_tests, a.counters.tt_tests);
+  }
+  FrameResult rest_pairs;
+  bvh->detect_dcd(rest, rest_pairs);
+  EXPECT_FALSE(rest_pairs.dcd_pairs.empty());  // the sheets cut each other at rest
+
+  // Its CCD follows the reversed ownership and finds the same contacts (any order gives each
+  // feature one owner).
+  FrameResult ca, cb;
+  bvh->detect_ccd(x, rest, ca);
+  dcd->detect_ccd(x, rest, cb);
+  ASSERT_FALSE(ca.contacts.empty());
+  ASSERT_EQ(cb.contacts.size(), ca.contacts.size());
+  for (std::size_t i = 0; i < ca.contacts.size(); ++i) {
+    EXPECT_EQ(cb.contacts[i].kind, ca.contacts[i].kind);
+    EXPECT_EQ(cb.contacts[i].a, ca.contacts[i].a);
+    EXPECT_EQ(cb.contacts[i].b, ca.contacts[i].b);
+  }
+
+  EXPECT_THROW((void)make_dcd_method(nullptr, rest), InvalidInput);
+  const skinning::Positions short_rows = rest.topRows(rest.rows() - 1);
+  EXPECT_THROW((void)make_dcd_method(in_reverse, short_rows), InvalidInput);
+  MethodOptions bad;
+  bad.block_pairs = 0;
+  EXPECT_THROW((void)make_dcd_method(in_reverse, rest, bad), InvalidInput);
 }
 
 }  // namespace
