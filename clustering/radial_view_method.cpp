@@ -199,8 +199,6 @@ RadialViewMethod::RadialViewMethod(
       tests_(culling::with_ccd_defaults(method_options.elementary)),
       updater_(used_mesh(ghosts_, real_mesh), used_topology(ghosts_, real_topology), features_),
       dcd_rest_(welded_rest(used_mesh(ghosts_, real_mesh), used_topology(ghosts_, real_topology))),
-      // It checks the method options as every method does.
-      dcd_(culling::make_dcd_method(features_, dcd_rest_, method_options_)),
       builder_(clusters_, options.clusters),
       edge_face_offsets_(used_topology(ghosts_, real_topology).edge_face_offsets),
       edge_faces_(used_topology(ghosts_, real_topology).edge_faces),
@@ -210,6 +208,11 @@ RadialViewMethod::RadialViewMethod(
               method_options.block_pairs,
               method_options.bvh.leaf_size,
               topology_.num_triangles())) {
+  // What every method refuses at once (the DCD, which checks them too, is built when needed).
+  culling::check_method_options(method_options);
+  // Not held: the method works on features_ (its own owner order), and a caller's features kept
+  // here would outlive the caller's need for them (ClipRunner::adopt_method_features).
+  method_options_.features.reset();
   num_bones_ = num_bones;
   ccd_options_.min_separation = method_options.min_separation;
   ccd_options_.relative_boxes = true;  // docs/ccd.md, "Relative boxes"

@@ -107,6 +107,10 @@ class RadialViewMethod final : public culling::CullingMethod {
       const RadialViewOptions& options);
 
   [[nodiscard]] std::string_view name() const override { return name_; }
+  /// Its features in rim-first owner order (of the capped mesh when it has ghost caps).
+  [[nodiscard]] std::shared_ptr<const culling::FeatureTopology> shared_features() const override {
+    return features_;
+  }
 
   /// The `bvh` method's DCD (recorded: a following detect_ccd from the same positions knows which
   /// components are free of self-intersection without a pass of its own).
@@ -121,8 +125,8 @@ class RadialViewMethod final : public culling::CullingMethod {
   [[nodiscard]] const IntervalClasses& last_classes() const { return classes_; }
   [[nodiscard]] const RadialViewStats& last_stats() const { return stats_; }
   [[nodiscard]] const RadialViewOptions& options() const { return options_; }
-  /// Whether it holds its DCD hierarchy now (dropped after a clip's first start DCD when it was
-  /// never asked for a DCD; see dcd_); for tests.
+  /// Whether it holds its DCD hierarchy now (built at the first query that needs it, dropped
+  /// after a clip's first start DCD when it was never asked for a DCD; see dcd_); for tests.
   [[nodiscard]] bool holds_dcd() const { return dcd_ != nullptr; }
 
  private:
@@ -176,7 +180,7 @@ class RadialViewMethod final : public culling::CullingMethod {
   /// triangle of an earlier round), through the relative AABB filter; returns the pairs found.
   std::int64_t retest_frontier(std::int32_t round, double half_width, culling::FrameResult& out);
   void record_dcd(const skinning::Positions& x, const culling::FrameResult& result);
-  /// dcd_, built again when it was dropped.
+  /// dcd_, built when there is none.
   culling::CullingMethod& dcd_method();
 
   std::string name_;
@@ -203,10 +207,12 @@ class RadialViewMethod final : public culling::CullingMethod {
   culling::DcdUpdater updater_;
   // The DCD (detect_dcd, and an interval's start that neither a DCD nor the previous interval
   // left the pairs of): a `bvh` (culling::make_dcd_method) over the used mesh's welded rest
-  // positions (dcd_rest_). A method that has run one start DCD and no detect_dcd (a clip's first
-  // interval in a CCD-only check) drops it: a whole-mesh hierarchy and its blocks it would
-  // otherwise hold for the rest of the run (docs/radial-view.md, "Memory"). Built again from
-  // dcd_rest_ if needed after all, then kept, and dcd_rest_ freed.
+  // positions (dcd_rest_), built at the first query that needs it — after the runner has freed
+  // what it no longer needs (ClipRunner::adopt_method_features). A method that has run one start
+  // DCD and no detect_dcd (a clip's first interval in a CCD-only check) drops it: a whole-mesh
+  // hierarchy and its blocks it would otherwise hold for the rest of the run
+  // (docs/radial-view.md, "Memory"). Built again if needed after all, then kept, and dcd_rest_
+  // freed.
   skinning::Positions dcd_rest_;
   std::unique_ptr<culling::CullingMethod> dcd_;
   bool dcd_queried_ = false;     // detect_dcd was called: keep dcd_

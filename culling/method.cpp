@@ -14,22 +14,6 @@
 namespace skelcd::culling {
 namespace detail {
 
-void check_method_options(const MethodOptions& options) {
-  if (!std::isfinite(options.min_separation) || options.min_separation < 0.0) {
-    throw InvalidInput(
-        "culling::make_method: min_separation must be finite and >= 0, got " +
-        std::to_string(options.min_separation));
-  }
-  if (options.accuracy == ccd::Accuracy::exact && options.min_separation > 0.0) {
-    throw InvalidInput(
-        "culling::make_method: the exact accuracy supports only min_separation = 0, got " +
-        std::to_string(options.min_separation));
-  }
-  if (options.block_pairs == 0) {
-    throw InvalidInput("culling::make_method: block_pairs must be >= 1, got 0");
-  }
-}
-
 MethodBase::MethodBase(
     std::string_view name,
     const skinning::Mesh& mesh,
@@ -80,6 +64,22 @@ void MethodBase::check_positions(
 }
 
 }  // namespace detail
+
+void check_method_options(const MethodOptions& options) {
+  if (!std::isfinite(options.min_separation) || options.min_separation < 0.0) {
+    throw InvalidInput(
+        "culling::make_method: min_separation must be finite and >= 0, got " +
+        std::to_string(options.min_separation));
+  }
+  if (options.accuracy == ccd::Accuracy::exact && options.min_separation > 0.0) {
+    throw InvalidInput(
+        "culling::make_method: the exact accuracy supports only min_separation = 0, got " +
+        std::to_string(options.min_separation));
+  }
+  if (options.block_pairs == 0) {
+    throw InvalidInput("culling::make_method: block_pairs must be >= 1, got 0");
+  }
+}
 
 std::vector<std::string> method_names() {
   std::vector<std::string> names;

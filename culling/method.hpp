@@ -122,6 +122,12 @@ class CullingMethod {
   /// methods' culling statistics of the last query (null for the others).
   [[nodiscard]] virtual std::span<const ComponentRoute> component_routes() const { return {}; }
   [[nodiscard]] virtual const ConeStatistics* cone_statistics() const { return nullptr; }
+  /// The FeatureTopology the method works on, when it has one to share, in whatever owner order
+  /// it chose (`dynamic`: rims first): what a user that reads no ownership (the runner's DCD
+  /// updaters) may take instead of holding another. Null: none to share.
+  [[nodiscard]] virtual std::shared_ptr<const FeatureTopology> shared_features() const {
+    return {};
+  }
 
   /// Intersecting triangle pairs at one instant: every pair of distinct triangles with a common
   /// point beyond the vertices or edge they share (exact), except part-excluded pairs and
@@ -166,6 +172,12 @@ class CullingMethod {
     const skinning::Mesh& mesh,
     const skinning::Topology& topology,
     const MethodOptions& options = {});
+
+/// The options checks every method makes when it is built (make_method's), for a method that
+/// builds a part later (clustering::RadialViewMethod's DCD) and must refuse bad options at once.
+/// @throws InvalidInput for a negative or non-finite min_separation, min_separation > 0 with the
+///         `exact` accuracy, or block_pairs = 0.
+void check_method_options(const MethodOptions& options);
 
 /// A `bvh` method over `features`, a FeatureTopology its caller holds and shares, in any owner
 /// order: its DCD reads no ownership (its CCD follows that order; any order gives each feature

@@ -12,11 +12,6 @@
 
 namespace skelcd::culling::detail {
 
-/// The options checks every method makes when it is built.
-/// @throws InvalidInput for a negative or non-finite min_separation, min_separation > 0 with the
-///         `exact` accuracy, or block_pairs = 0.
-void check_method_options(const MethodOptions& options);
-
 class MethodBase : public CullingMethod {
  public:
   [[nodiscard]] std::string_view name() const override { return name_; }
@@ -24,6 +19,9 @@ class MethodBase : public CullingMethod {
   /// The method's feature topology, which another method of the same mesh and topology may share
   /// (`auto` lends its own to its cone group methods: docs/culling.md "Bounded memory").
   [[nodiscard]] const std::shared_ptr<const FeatureTopology>& feature_topology() const {
+    return features_;
+  }
+  [[nodiscard]] std::shared_ptr<const FeatureTopology> shared_features() const override {
     return features_;
   }
 

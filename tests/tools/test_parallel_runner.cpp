@@ -19,6 +19,7 @@
 #include <vector>
 
 #include "clustering/bone_poses.hpp"
+#include "culling/feature_topology.hpp"
 #include "culling/hierarchy_cache.hpp"
 #include "culling/method_registry.hpp"
 #include "culling/routed_method.hpp"
@@ -26,6 +27,7 @@
 #include "skinning/errors.hpp"
 #include "skinning/load.hpp"
 #include "skinning/rig_motion.hpp"
+#include "skinning/topology.hpp"
 #include "tests/support/test_support.hpp"
 #include "tools/engine/radial_view_setup.hpp"
 #include "tools/engine/runner.hpp"
@@ -268,6 +270,45 @@ TEST(ParallelRunner, AutosRoutedMethodRowsEqualSerial) {
 // Incremental DCD (RunOptions::incremental_dcd, the default with both queries) against full DCD at
 // every sample: the same contacts and DCD pairs in every row, far fewer triangle tests, and each
 // block (serial or parallel) starting with a full DCD.
+TEST(ParallelRunner, DynamicsFeaturesServeTheDcdUpdatersAndTheRunnersAreFreed) {
+  // `dynamic` works on features of its own owner order (rims first) and does not take the
+  // runner's; the runner's incremental-DCD updaters read no ownership and take the method's, so
+  // the runner's own is freed. `bvh` takes the runner's, which stays. The DCD rows (from the
+  // updaters over the rim-first features) are `bvh`'s, serial and on two threads.
+  const auto l = load(test::asset("characters/CesiumMan.glb").string());
+  std::vector<FrameReport> rows[2][2];  // [method][threads − 1]
+  const char* methods[2] = {"bvh", "dynamic"};
+  for (const int m : {0, 1}) {
+    for (const int threads : {1, 2}) {
+      SCOPED_TRACE(std::string(methods[m]) + " on " + std::to_string(threads));
+      RunOptions options;
+      options.method = methods[m];
+      options.frames = parse_frame_range("0:20");
+      options.threads = threads;
+      options.block_samples = 6;
+      (void)setup_radial_view(RadialViewArguments{}, l.model, *l.motion, options);
+      skinning::Topology topology = skinning::build_topology(l.motion->mesh());
+      auto features = std::make_shared<const culling::FeatureTopology>(l.motion->mesh(), topology);
+      const std::weak_ptr<const culling::FeatureTopology> given = features;
+      ClipRunner runner(*l.motion, options, std::move(topology), {}, std::move(features));
+      EXPECT_EQ(given.expired(), m == 1);
+      rows[m][threads - 1] = collect(runner);
+    }
+  }
+  for (const int threads : {0, 1}) {
+    const auto& bvh = rows[0][threads];
+    const auto& dynamic = rows[1][threads];
+    ASSERT_EQ(bvh.size(), dynamic.size());
+    std::size_t pairs = 0;
+    for (std::size_t i = 0; i < bvh.size(); ++i) {
+      EXPECT_EQ(bvh[i].dcd_pairs, dynamic[i].dcd_pairs) << "row " << i;
+      EXPECT_EQ(bvh[i].contacts, dynamic[i].contacts) << "row " << i;
+      pairs += bvh[i].dcd_pairs.size();
+    }
+    EXPECT_GT(pairs, 0u) << "CesiumMan's walk intersects itself: the rows must hold pairs";
+  }
+}
+
 TEST(ParallelRunner, IncrementalDcdRowsHoldTheFullDcdsPairsWithFewerTests) {
   const auto l = load(kCharacter);
   for (const char* method : {"bvh", "auto"}) {

@@ -571,6 +571,7 @@ ClipRunner::ClipRunner(
   if (plan_.threads <= 1) {
     if (hierarchies) hierarchies->close();  // one method: nothing to share; the caller's freed
     method_ = build_method();
+    adopt_method_features();
     return;
   }
   // The workers' methods are alike: each hierarchy is built once (by the first thread to ask,
@@ -603,6 +604,20 @@ ClipRunner::ClipRunner(
     }
     others.wait();  // rethrows the first failure of the others
   });
+  adopt_method_features();
+}
+
+void ClipRunner::adopt_method_features() {
+  // A method that works on features of its own owner order (`dynamic`: rims first) does not take
+  // the runner's, which would then be held for the DCD updaters alone. They read no ownership:
+  // they take the method's, and the runner's is freed (unless the caller still holds it) — one
+  // FeatureTopology of the mesh where there were two (docs/culling.md "Bounded memory"). Not
+  // one of a capped mesh (ghost caps): that one does not describe this mesh.
+  std::shared_ptr<const culling::FeatureTopology> own = method_->shared_features();
+  if (own != nullptr && own != method_options_.features &&
+      own->describes(motion_.mesh(), topology_)) {
+    method_options_.features = std::move(own);
+  }
 }
 
 std::unique_ptr<culling::CullingMethod> ClipRunner::build_method() const {
