@@ -347,18 +347,66 @@ void RadialViewMethod::record_dcd(
 void RadialViewMethod::dcd(const culling::Instant& at, culling::FrameResult& out) {
   check_positions(at.x, "detect_dcd", "x");
   const skinning::Positions& x = with_ghosts(at.x, capped_x0_);
-  culling::CullingMethod& dcd = dcd_method();
-  if (!dcd_queried_) {
-    dcd_queried_ = true;
-    dcd_rest_ = skinning::Positions();  // dcd_ is kept from now on: see dcd_
-  }
-  dcd.detect_dcd(x, out);
+  dcd_method().detect_dcd(x, out);
   record_dcd(x, out);  // with the ghosts' pairs: the next interval's cuts need them
   drop_ghosts(out);
 }
 
+void RadialViewMethod::start_dcd(const skinning::Positions& x, culling::FrameResult& out) {
+  // The triangles' static volumes, the local hierarchies and the global one over their roots
+  // (step 2 of the interval refits them over the swept volumes afterwards).
+  const auto t0 = Clock::now();
+  bounds_.static_triangles(topology_, x);
+  for (std::int32_t a = 0; a < clusters_.num_atomic(); ++a) {
+    auto& local = clusters_.local_bvh(a);
+    if (local.empty()) {
+      cluster_bounds_[at(a)] = culling::Aabb::empty();
+      continue;
+    }
+    local.refit(bounds_.triangles);  // drops the last interval's end boxes
+    cluster_bounds_[at(a)] = local.node_bounds()[0];
+  }
+  clusters_.global_bvh().refit(cluster_bounds_);
+  const auto t1 = Clock::now();
+  // Every pair of triangles whose boxes meet: each atomic cluster with itself, then the cluster
+  // pairs whose boxes meet — what `bvh`'s self traversal finds, through this method's trees — in
+  // blocks through the DCD rules and tests.
+  const std::span<const culling::Aabb> tri(bounds_.triangles);
+  std::int64_t& bv_tests = out.counters.bv_tests;
+  cluster_pairs_.clear();
+  culling::self_traverse<3>(
+      clusters_.global_bvh(), cluster_bounds_, scratch_, cluster_pairs_, bv_tests);
+  blocks_.start_dcd(topology_, x, tests_, out);
+  for (std::int32_t a = 0; a < clusters_.num_atomic(); ++a) {
+    const auto& local = clusters_.local_bvh(a);
+    if (local.empty()) continue;
+    culling::start_self_traversal<3>(local, scratch_);
+    blocks_.drain([&](std::vector<culling::TrianglePair>& pairs, std::size_t max_pairs) {
+      return culling::self_traverse_some<3>(local, tri, scratch_, pairs, bv_tests, max_pairs);
+    });
+  }
+  for (const auto& cp : cluster_pairs_) {
+    const auto& local_a = clusters_.local_bvh(cp.a);
+    const auto& local_b = clusters_.local_bvh(cp.b);
+    culling::start_pair_traversal<3>(local_a, local_b, scratch_);
+    blocks_.drain([&](std::vector<culling::TrianglePair>& pairs, std::size_t max_pairs) {
+      return culling::pair_traverse_some<3>(
+          local_a, tri, local_b, tri, scratch_, pairs, bv_tests, max_pairs);
+    });
+  }
+  blocks_.finish();
+  blocks_.release_dcd_planes();  // rare here: not held for the run
+  const auto t2 = Clock::now();
+  out.times.refit_us += micros(t0, t1);
+  out.times.traverse_us += micros(t1, t2) - blocks_.test_us();
+  out.times.elementary_us += blocks_.test_us();
+}
+
 culling::CullingMethod& RadialViewMethod::dcd_method() {
-  if (!dcd_) dcd_ = culling::make_dcd_method(features_, dcd_rest_, method_options_);
+  if (!dcd_) {
+    dcd_ = culling::make_dcd_method(features_, dcd_rest_, method_options_);
+    dcd_rest_ = skinning::Positions();  // built: dcd_ is kept (see dcd_)
+  }
   return *dcd_;
 }
 
@@ -384,12 +432,7 @@ void RadialViewMethod::start_status(const skinning::Positions& x_t0, culling::Fr
     start_pairs_.swap(carry_pairs_);
   } else {
     scratch_result_.clear();
-    dcd_method().detect_dcd(x_t0, scratch_result_);
-    // See dcd_: dropped after a first start DCD, kept (and its build positions freed) after a
-    // second.
-    ++start_dcds_;
-    if (!dcd_queried_ && start_dcds_ == 1) dcd_.reset();
-    if (start_dcds_ == 2) dcd_rest_ = skinning::Positions();
+    start_dcd(x_t0, scratch_result_);
     start_pairs_.assign(scratch_result_.dcd_pairs.begin(), scratch_result_.dcd_pairs.end());
     out.counters.bv_tests += scratch_result_.counters.bv_tests;
     out.counters.tt_tests += scratch_result_.counters.tt_tests;

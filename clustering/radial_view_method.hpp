@@ -125,8 +125,13 @@ class RadialViewMethod final : public culling::CullingMethod {
   [[nodiscard]] const IntervalClasses& last_classes() const { return classes_; }
   [[nodiscard]] const RadialViewStats& last_stats() const { return stats_; }
   [[nodiscard]] const RadialViewOptions& options() const { return options_; }
-  /// Whether it holds its DCD hierarchy now (built at the first query that needs it, dropped
-  /// after a clip's first start DCD when it was never asked for a DCD; see dcd_); for tests.
+  /// The intersecting pairs at the last interval's start (of the capped mesh when it has ghost
+  /// caps), however they were found: recorded, carried or from start_dcd; for tests.
+  [[nodiscard]] const std::vector<culling::TrianglePair>& start_pairs() const {
+    return start_pairs_;
+  }
+  /// Whether it holds a whole-mesh DCD hierarchy (built at the first detect_dcd; see dcd_); for
+  /// tests.
   [[nodiscard]] bool holds_dcd() const { return dcd_ != nullptr; }
 
  private:
@@ -182,6 +187,11 @@ class RadialViewMethod final : public culling::CullingMethod {
   void record_dcd(const skinning::Positions& x, const culling::FrameResult& result);
   /// dcd_, built when there is none.
   culling::CullingMethod& dcd_method();
+  /// The DCD at an interval's start that no DCD or previous interval left the pairs of: through
+  /// the method's own hierarchies (the atomic clusters' and the global one, refit over the static
+  /// volumes at x) and blocks_, into out (dcd_pairs sorted, counters, times) — no whole-mesh
+  /// hierarchy built or held for it.
+  void start_dcd(const skinning::Positions& x, culling::FrameResult& out);
 
   std::string name_;
   // Ghost caps (built before everything below, which works on the capped mesh); the capped
@@ -205,18 +215,13 @@ class RadialViewMethod final : public culling::CullingMethod {
   ccd::CcdOptions ccd_options_;
   // The intersecting pairs from one end to the next.
   culling::DcdUpdater updater_;
-  // The DCD (detect_dcd, and an interval's start that neither a DCD nor the previous interval
-  // left the pairs of): a `bvh` (culling::make_dcd_method) over the used mesh's welded rest
-  // positions (dcd_rest_), built at the first query that needs it — after the runner has freed
-  // what it no longer needs (ClipRunner::adopt_method_features). A method that has run one start
-  // DCD and no detect_dcd (a clip's first interval in a CCD-only check) drops it: a whole-mesh
-  // hierarchy and its blocks it would otherwise hold for the rest of the run
-  // (docs/radial-view.md, "Memory"). Built again if needed after all, then kept, and dcd_rest_
-  // freed.
+  // detect_dcd's DCD: a `bvh` (culling::make_dcd_method) over the used mesh's welded rest
+  // positions (dcd_rest_, freed once it is built), built at the first detect_dcd — after the
+  // runner has freed what it no longer needs (ClipRunner::adopt_method_features). A CCD-only
+  // check never builds it: an interval's start DCD goes through the method's own hierarchies
+  // (start_dcd; docs/radial-view.md, "Memory").
   skinning::Positions dcd_rest_;
   std::unique_ptr<culling::CullingMethod> dcd_;
-  bool dcd_queried_ = false;     // detect_dcd was called: keep dcd_
-  std::int32_t start_dcds_ = 0;  // DCDs run at an interval's start
   MegaClusterBuilder builder_;
   std::vector<std::int32_t> edge_face_offsets_, edge_faces_;
   std::vector<std::int32_t> face_neighbours_;  // 3 per triangle (built with them): build_patches'

@@ -131,6 +131,12 @@ class PairBlocks {
   /// Tests what is pending, then sorts the findings appended since start_* canonically (contacts
   /// by (kind, a, b), DCD pairs by (a, b)) in place. Ends the query.
   void finish();
+  /// Frees the triangles' planes a DCD query keeps for the next one (#F × 48 bytes), between
+  /// queries: for a holder whose DCD queries are rare (clustering::RadialViewMethod's start DCD).
+  void release_dcd_planes() {
+    std::vector<ccd::TrianglePlane>().swap(planes_);
+    use_planes_ = false;
+  }
 
   /// Blocks tested in this query (at least 1 once anything was tested).
   [[nodiscard]] std::int64_t blocks() const { return blocks_; }
