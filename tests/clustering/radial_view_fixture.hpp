@@ -99,6 +99,27 @@ enum class DcdQueries : std::uint8_t {
   every,  ///< a DCD at every interval's start sample (`check --query both`)
 };
 
+/// `method`'s CCD of the interval from x0 (sample i) to x1 (sample i + 1), the bone poses of the
+/// two samples selected first, into `out`.
+inline void interval_ccd(
+    RadialViewScene& scene,
+    culling::CullingMethod& method,
+    std::int32_t i,
+    const skinning::Positions& x0,
+    const skinning::Positions& x1,
+    culling::FrameResult& out) {
+  scene.poses->select_samples(i, i + 1);
+  method.detect_ccd(
+      culling::Interval{
+          .x_t0 = x0,
+          .x_t1 = x1,
+          .bones_t0 = scene.poses->t0(),
+          .bones_t1 = scene.poses->t1(),
+          .sample_t0 = i,
+          .sample_t1 = i + 1},
+      out);
+}
+
 /// Runs `method` over intervals [first, last) of the scene's motion.
 inline ClipRun run_clip(
     RadialViewScene& scene,
@@ -118,17 +139,8 @@ inline ClipRun run_clip(
       method.detect_dcd(x0, out);
       out.clear();
     }
-    scene.poses->select_samples(i, i + 1);
     const auto start = std::chrono::steady_clock::now();
-    method.detect_ccd(
-        culling::Interval{
-            .x_t0 = x0,
-            .x_t1 = x1,
-            .bones_t0 = scene.poses->t0(),
-            .bones_t1 = scene.poses->t1(),
-            .sample_t0 = i,
-            .sample_t1 = i + 1},
-        out);
+    interval_ccd(scene, method, i, x0, x1, out);
     run.ccd_ms.push_back(
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count());
     for (const auto& c : out.contacts) run.contacts.push_back({i, c.kind, c.a, c.b});

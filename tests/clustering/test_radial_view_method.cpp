@@ -413,17 +413,8 @@ TEST(RadialViewMethod, StartDcdThroughItsOwnTreesFindsBvhsPairsAndBuildsNoOtherT
       skinning::Positions x0, x1;
       scene.welded(i, x0);
       scene.welded(i + 1, x1);
-      scene.poses->select_samples(i, i + 1);
       culling::FrameResult out;
-      m.detect_ccd(
-          culling::Interval{
-              .x_t0 = x0,
-              .x_t1 = x1,
-              .bones_t0 = scene.poses->t0(),
-              .bones_t1 = scene.poses->t1(),
-              .sample_t0 = i,
-              .sample_t1 = i + 1},
-          out);
+      test::interval_ccd(scene, m, i, x0, x1, out);
       return out;
     };
     const auto rv = [](const culling::CullingMethod& m) -> const RadialViewMethod& {

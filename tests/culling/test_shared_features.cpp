@@ -30,6 +30,24 @@ skinning::Mesh crossing_sheets() {
   return test::combine(flat, standing);
 }
 
+/// The sheets' rest positions with the standing sheet (part 1) 0.4 higher.
+skinning::Positions standing_sheet_raised(const skinning::Mesh& mesh) {
+  skinning::Positions raised = mesh.rest_positions;
+  for (Eigen::Index v = 0; v < raised.rows(); ++v) {
+    if (mesh.vertex_part[static_cast<std::size_t>(v)] == 1) raised(v, 2) += 0.4;
+  }
+  return raised;
+}
+
+/// The triangles last to first: an owner order other than triangle order.
+std::vector<std::int32_t> reversed_triangles(const skinning::Topology& topology) {
+  std::vector<std::int32_t> reversed;
+  for (auto f = static_cast<std::int32_t>(topology.welded_triangles.rows()) - 1; f >= 0; --f) {
+    reversed.push_back(f);
+  }
+  return reversed;
+}
+
 const FeatureTopology* features_of(const CullingMethod& m) {
   const auto* base = dynamic_cast<const detail::MethodBase*>(&m);
   return base == nullptr ? nullptr : base->feature_topology().get();
@@ -41,11 +59,7 @@ TEST(SharedFeatures, MethodsTakeTheOptionsFeaturesOnlyWhenBuiltFromTheirMeshAndT
   excluded.excluded_part_pairs = {{0, 1}};
   const auto topology = test::simple_topology(mesh);
   const auto x = test::welded(topology, mesh.rest_positions);
-  skinning::Positions raised = mesh.rest_positions;  // the standing sheet 0.4 higher
-  for (Eigen::Index v = 0; v < raised.rows(); ++v) {
-    if (mesh.vertex_part[static_cast<std::size_t>(v)] == 1) raised(v, 2) += 0.4;
-  }
-  const auto x_t0 = test::welded(topology, raised);
+  const auto x_t0 = test::welded(topology, standing_sheet_raised(mesh));
 
   MethodOptions options;
   options.features = std::make_shared<const FeatureTopology>(mesh, topology);
@@ -58,10 +72,7 @@ TEST(SharedFeatures, MethodsTakeTheOptionsFeaturesOnlyWhenBuiltFromTheirMeshAndT
   const skinning::Topology moved = std::move(copy);
   EXPECT_TRUE(of_copy->built_from(mesh, moved));
   EXPECT_FALSE(of_copy->built_from(mesh, topology));
-  std::vector<std::int32_t> reversed;
-  for (auto f = static_cast<std::int32_t>(topology.welded_triangles.rows()) - 1; f >= 0; --f) {
-    reversed.push_back(f);
-  }
+  const std::vector<std::int32_t> reversed = reversed_triangles(topology);
   const auto in_reverse = std::make_shared<const FeatureTopology>(mesh, topology, reversed);
   EXPECT_FALSE(in_reverse->built_from(mesh, topology));
   // Another owner order is still these objects' features: what a user that reads no ownership
@@ -118,10 +129,7 @@ TEST(SharedFeatures, DcdUpdaterTakesTheFeaturesOnlyWhenBuiltFromItsMeshAndTopolo
   const DcdUpdater other(excluded, topology, features);
   EXPECT_NE(other.shared_features(), features);
   // Any owner order (the updater reads no ownership): `dynamic` lends its rim-first features.
-  std::vector<std::int32_t> reversed;
-  for (auto f = static_cast<std::int32_t>(topology.welded_triangles.rows()) - 1; f >= 0; --f) {
-    reversed.push_back(f);
-  }
+  const std::vector<std::int32_t> reversed = reversed_triangles(topology);
   const auto in_reverse = std::make_shared<const FeatureTopology>(mesh, topology, reversed);
   const DcdUpdater reversed_order(mesh, topology, in_reverse);
   EXPECT_EQ(reversed_order.shared_features(), in_reverse);
@@ -146,15 +154,8 @@ TEST(SharedFeatures, DcdMethodOverFeaturesOfAnyOwnerOrderFindsBvhsPairsAndCounts
   const skinning::Mesh mesh = crossing_sheets();
   const auto topology = test::simple_topology(mesh);
   const auto rest = test::welded(topology, mesh.rest_positions);
-  skinning::Positions moved = mesh.rest_positions;  // the standing sheet 0.4 higher
-  for (Eigen::Index v = 0; v < moved.rows(); ++v) {
-    if (mesh.vertex_part[static_cast<std::size_t>(v)] == 1) moved(v, 2) += 0.4;
-  }
-  const auto x = test::welded(topology, moved);
-  std::vector<std::int32_t> reversed;
-  for (auto f = static_cast<std::int32_t>(topology.welded_triangles.rows()) - 1; f >= 0; --f) {
-    reversed.push_back(f);
-  }
+  const auto x = test::welded(topology, standing_sheet_raised(mesh));
+  const std::vector<std::int32_t> reversed = reversed_triangles(topology);
   const auto in_reverse = std::make_shared<const FeatureTopology>(mesh, topology, reversed);
   const auto bvh = make_method("bvh", mesh, topology);
   // Built over the rest positions, as `bvh` builds its own: the same tree, so the same counts.
