@@ -183,8 +183,8 @@ void check_method_options(const MethodOptions& options);
 /// order: its DCD reads no ownership (its CCD follows that order; any order gives each feature
 /// one owner, docs/culling.md). Its hierarchy is built over the welded positions `x` (one row
 /// per vertex of `features`), without options.hierarchies; options.features and
-/// options.rigid_rows are not used. For a method that needs a DCD now and then beside features
-/// of its own order, and holds it only while it needs it (clustering::RadialViewMethod).
+/// options.rigid_rows are not used. For a method with features of its own order that builds a
+/// DCD only when asked for one (clustering::RadialViewMethod's detect_dcd).
 /// @throws InvalidInput for null features, `x` of another vertex count, or bad options.
 [[nodiscard]] std::unique_ptr<CullingMethod> make_dcd_method(
     std::shared_ptr<const FeatureTopology> features,

@@ -435,8 +435,8 @@ class AutoMethod final : public detail::MethodBase {
     for (const CullingMethod* m : {open_method_.get(), closed_method_.get()}) {
       const auto* base = dynamic_cast<const detail::MethodBase*>(m);
       if (base != nullptr &&
-          std::find(held.begin(), held.end(), base->feature_topology().get()) == held.end()) {
-        held.push_back(base->feature_topology().get());
+          std::find(held.begin(), held.end(), base->shared_features().get()) == held.end()) {
+        held.push_back(base->shared_features().get());
       }
     }
     r.feature_topologies = static_cast<std::int32_t>(held.size());

@@ -18,9 +18,6 @@ class MethodBase : public CullingMethod {
 
   /// The method's feature topology, which another method of the same mesh and topology may share
   /// (`auto` lends its own to its cone group methods: docs/culling.md "Bounded memory").
-  [[nodiscard]] const std::shared_ptr<const FeatureTopology>& feature_topology() const {
-    return features_;
-  }
   [[nodiscard]] std::shared_ptr<const FeatureTopology> shared_features() const override {
     return features_;
   }

@@ -50,7 +50,7 @@ std::vector<std::int32_t> reversed_triangles(const skinning::Topology& topology)
 
 const FeatureTopology* features_of(const CullingMethod& m) {
   const auto* base = dynamic_cast<const detail::MethodBase*>(&m);
-  return base == nullptr ? nullptr : base->feature_topology().get();
+  return base == nullptr ? nullptr : base->shared_features().get();
 }
 
 TEST(SharedFeatures, MethodsTakeTheOptionsFeaturesOnlyWhenBuiltFromTheirMeshAndTopology) {
