@@ -13,6 +13,7 @@
 #include "culling/candidates.hpp"
 #include "culling/cluster_checks.hpp"
 #include "culling/relative_aabb.hpp"
+#include "culling/sieved_dcd.hpp"
 #include "culling/vertex_bounds.hpp"
 #include "skinning/errors.hpp"
 
@@ -347,7 +348,22 @@ void RadialViewMethod::record_dcd(
 void RadialViewMethod::dcd(const culling::Instant& at, culling::FrameResult& out) {
   check_positions(at.x, "detect_dcd", "x");
   const skinning::Positions& x = with_ghosts(at.x, capped_x0_);
-  dcd_method().detect_dcd(x, out);
+  DcdTree& tree = dcd_tree();
+  // `bvh`'s DCD (the same tree, refit over the static volumes at x, the same sieved traversal
+  // and tests) through this method's volumes and blocks, which the CCD refills.
+  const auto t0 = Clock::now();
+  bounds_.static_triangles(topology_, x);
+  tree.bvh.refit(bounds_.triangles);
+  const auto t1 = Clock::now();
+  blocks_.start_dcd(topology_, x, tests_, out);
+  culling::sieved_self_dcd<3>(
+      tree.bvh, bounds_.triangles, topology_, tree.slots, tree.full_slots, scratch_, blocks_, out);
+  blocks_.finish();
+  blocks_.release_dcd_planes();  // not held between queries: the CCD's blocks need none
+  const auto t2 = Clock::now();
+  out.times.refit_us += micros(t0, t1);
+  out.times.traverse_us += micros(t1, t2) - blocks_.test_us();
+  out.times.elementary_us += blocks_.test_us();
   record_dcd(x, out);  // with the ghosts' pairs: the next interval's cuts need them
   drop_ghosts(out);
 }
@@ -402,10 +418,22 @@ void RadialViewMethod::start_dcd(const skinning::Positions& x, culling::FrameRes
   out.times.elementary_us += blocks_.test_us();
 }
 
-culling::CullingMethod& RadialViewMethod::dcd_method() {
+RadialViewMethod::DcdTree::DcdTree(
+    const culling::FeatureTopology& features,
+    const skinning::Positions& rest,
+    const culling::BvhOptions& options)
+    : bvh(features.welded_triangles(), rest, options), slots(features, bvh.triangle_order()) {
+  full_slots.reserve(at(features.num_triangles()));
+}
+
+RadialViewMethod::DcdTree& RadialViewMethod::dcd_tree() {
   if (!dcd_) {
-    dcd_ = culling::make_dcd_method(features_, dcd_rest_, method_options_);
+    // Traversed through the wide copy only, as `bvh`'s: no binary node volumes.
+    culling::BvhOptions options = method_options_.bvh;
+    options.node_volumes = false;
+    dcd_ = std::make_unique<DcdTree>(topology_, dcd_rest_, options);
     dcd_rest_ = skinning::Positions();  // built: dcd_ is kept (see dcd_)
+    scratch_.reserve_self(dcd_->bvh);
   }
   return *dcd_;
 }

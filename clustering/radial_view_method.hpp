@@ -185,8 +185,19 @@ class RadialViewMethod final : public culling::CullingMethod {
   /// triangle of an earlier round), through the relative AABB filter; returns the pairs found.
   std::int64_t retest_frontier(std::int32_t round, double half_width, culling::FrameResult& out);
   void record_dcd(const skinning::Positions& x, const culling::FrameResult& result);
+  /// detect_dcd's hierarchy (dcd_): `bvh`'s tree over the welded triangles and the slots its fan
+  /// sieve reads (culling/sieved_dcd.hpp).
+  struct DcdTree {
+    DcdTree(
+        const culling::FeatureTopology& features,
+        const skinning::Positions& rest,
+        const culling::BvhOptions& options);
+    culling::AabbBvh bvh;
+    culling::SlotAdjacency slots;
+    std::vector<std::uint8_t> full_slots;  // the sieve's per slot, at each detect_dcd
+  };
   /// dcd_, built when there is none.
-  culling::CullingMethod& dcd_method();
+  DcdTree& dcd_tree();
   /// The DCD at an interval's start that no DCD or previous interval left the pairs of: through
   /// the method's own hierarchies (the atomic clusters' and the global one, refit over the static
   /// volumes at x) and blocks_, into out (dcd_pairs sorted, counters, times) — no whole-mesh
@@ -215,13 +226,13 @@ class RadialViewMethod final : public culling::CullingMethod {
   ccd::CcdOptions ccd_options_;
   // The intersecting pairs from one end to the next.
   culling::DcdUpdater updater_;
-  // detect_dcd's DCD: a `bvh` (culling::make_dcd_method) over the used mesh's welded rest
-  // positions (dcd_rest_, freed once it is built), built at the first detect_dcd — after the
-  // runner has freed what it no longer needs (ClipRunner::adopt_method_features). A CCD-only
-  // check never builds it: an interval's start DCD goes through the method's own hierarchies
-  // (start_dcd; docs/radial-view.md, "Memory").
+  // detect_dcd's hierarchy: `bvh`'s (its tree and the slots its fan sieve reads) over the used
+  // mesh's welded rest positions (dcd_rest_, freed once it is built), built at the first
+  // detect_dcd, which traverses it into the method's own volumes (bounds_) and blocks (blocks_).
+  // A CCD-only check never builds it: an interval's start DCD goes through the method's own
+  // hierarchies (start_dcd; docs/radial-view.md, "Memory").
   skinning::Positions dcd_rest_;
-  std::unique_ptr<culling::CullingMethod> dcd_;
+  std::unique_ptr<DcdTree> dcd_;
   MegaClusterBuilder builder_;
   std::vector<std::int32_t> edge_face_offsets_, edge_faces_;
   std::vector<std::int32_t> face_neighbours_;  // 3 per triangle (built with them): build_patches'

@@ -7,10 +7,10 @@
 #include "culling/bvh.hpp"
 #include "culling/candidates.hpp"
 #include "culling/detail/method_base.hpp"
-#include "culling/detail/sieved_dcd.hpp"
 #include "culling/hierarchy_cache.hpp"
 #include "culling/pair_blocks.hpp"
 #include "culling/relative_aabb.hpp"
+#include "culling/sieved_dcd.hpp"
 #include "culling/traversal.hpp"
 #include "culling/vertex_bounds.hpp"
 #include "skinning/errors.hpp"
@@ -65,20 +65,6 @@ class BvhMethod final : public MethodBase {
             welded_rest_positions(mesh, topology),
             nullptr,
             traversal_only(options.bvh))) {
-    reserve();
-  }
-
-  /// make_dcd_method's: over `features` its caller holds (any owner order), the hierarchy built
-  /// over the welded positions `x`, no rigid rows, no relative pairs.
-  BvhMethod(
-      std::string_view name,
-      std::shared_ptr<const FeatureTopology> features,
-      const skinning::Positions& x,
-      const MethodOptions& options)
-      : MethodBase(name, std::move(features), options),
-        relative_pairs_(false),
-        rigid_rows_(nullptr),
-        bvh_(topology_.welded_triangles(), checked(x), traversal_only(options.bvh)) {
     reserve();
   }
 
@@ -226,13 +212,7 @@ class BvhMethod final : public MethodBase {
   }
 
  private:
-  /// `x` once it has one row per vertex of the features (the hierarchy's build positions).
-  const skinning::Positions& checked(const skinning::Positions& x) const {
-    check_positions(x, "make_dcd_method", "x");
-    return x;
-  }
-
-  /// What both constructors do once the hierarchy is built.
+  /// What the constructor does once the hierarchy is built.
   void reserve() {
     // Everything an interval touches is sized here; only the blocks' feature candidates and the
     // caller's findings may still grow (with the motion), and they keep their capacity — and
@@ -317,17 +297,3 @@ template std::unique_ptr<CullingMethod> make_bvh_method<8>(
     bool);
 
 }  // namespace skelcd::culling::detail
-
-namespace skelcd::culling {
-
-std::unique_ptr<CullingMethod> make_dcd_method(
-    std::shared_ptr<const FeatureTopology> features,
-    const skinning::Positions& x,
-    const MethodOptions& options) {
-  if (features == nullptr) {
-    throw InvalidInput("culling::make_dcd_method: no feature topology given");
-  }
-  return std::make_unique<detail::BvhMethod<3>>("bvh", std::move(features), x, options);
-}
-
-}  // namespace skelcd::culling

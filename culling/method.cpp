@@ -20,28 +20,19 @@ MethodBase::MethodBase(
     const skinning::Topology& topology,
     const MethodOptions& options,
     std::shared_ptr<const FeatureTopology> features)
-    : MethodBase(
-          name,
+    : name_(name),
+      features_(
           features != nullptr ? std::move(features)
-                              : shared_or_built(options.features, mesh, topology),
-          options) {
+                              : shared_or_built(options.features, mesh, topology)),
+      topology_(*features_),
+      options_(options),
+      tests_(with_ccd_defaults(options.elementary)) {
   if (topology_.num_triangles() != topology.welded_triangles.rows()) {
     throw InvalidInput(
         "culling::make_method: the shared feature topology has " +
         std::to_string(topology_.num_triangles()) + " triangles, the topology " +
         std::to_string(topology.welded_triangles.rows()));
   }
-}
-
-MethodBase::MethodBase(
-    std::string_view name,
-    std::shared_ptr<const FeatureTopology> features,
-    const MethodOptions& options)
-    : name_(name),
-      features_(std::move(features)),
-      topology_(*features_),
-      options_(options),
-      tests_(with_ccd_defaults(options.elementary)) {
   check_method_options(options);
   ccd_options_.min_separation = options.min_separation;
   // The kernels' relative stage (docs/ccd.md, "Relative boxes"): with a contact distance, the

@@ -174,21 +174,10 @@ class CullingMethod {
     const MethodOptions& options = {});
 
 /// The options checks every method makes when it is built (make_method's), for a method that
-/// builds a part later (clustering::RadialViewMethod's DCD) and must refuse bad options at once.
+/// builds a part later (clustering::RadialViewMethod's DCD tree) and must refuse bad options at
+/// once.
 /// @throws InvalidInput for a negative or non-finite min_separation, min_separation > 0 with the
 ///         `exact` accuracy, or block_pairs = 0.
 void check_method_options(const MethodOptions& options);
-
-/// A `bvh` method over `features`, a FeatureTopology its caller holds and shares, in any owner
-/// order: its DCD reads no ownership (its CCD follows that order; any order gives each feature
-/// one owner, docs/culling.md). Its hierarchy is built over the welded positions `x` (one row
-/// per vertex of `features`), without options.hierarchies; options.features and
-/// options.rigid_rows are not used. For a method with features of its own order that builds a
-/// DCD only when asked for one (clustering::RadialViewMethod's detect_dcd).
-/// @throws InvalidInput for null features, `x` of another vertex count, or bad options.
-[[nodiscard]] std::unique_ptr<CullingMethod> make_dcd_method(
-    std::shared_ptr<const FeatureTopology> features,
-    const skinning::Positions& x,
-    const MethodOptions& options = {});
 
 }  // namespace skelcd::culling

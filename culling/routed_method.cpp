@@ -12,7 +12,6 @@
 #include "culling/candidates.hpp"
 #include "culling/cones_method_base.hpp"
 #include "culling/detail/method_base.hpp"
-#include "culling/detail/sieved_dcd.hpp"
 #include "culling/dual_cone.hpp"
 #include "culling/enhanced_dual_cone.hpp"
 #include "culling/method_registry.hpp"
@@ -20,6 +19,7 @@
 #include "culling/pair_blocks.hpp"
 #include "culling/pair_sort.hpp"
 #include "culling/relative_aabb.hpp"
+#include "culling/sieved_dcd.hpp"
 #include "culling/traversal.hpp"
 #include "culling/vertex_bounds.hpp"
 #include "skinning/errors.hpp"
@@ -473,7 +473,7 @@ class AutoMethod final : public detail::MethodBase {
     for (std::size_t g = 0; g < groups.size(); ++g) {
       const AabbBvh* h = groups[g];
       if (h == nullptr || h->empty()) continue;
-      detail::sieved_self_dcd<3>(
+      sieved_self_dcd<3>(
           *h, tri, topology_, slots_of(g, *h), full_slots_, scratch_, blocks_, out);
     }
     if (between)

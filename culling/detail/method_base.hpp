@@ -32,12 +32,6 @@ class MethodBase : public CullingMethod {
       const skinning::Topology& topology,
       const MethodOptions& options,
       std::shared_ptr<const FeatureTopology> features = {});
-  /// Over `features` (not null), which its caller built or holds (make_dcd_method).
-  /// @throws InvalidInput for bad options.
-  MethodBase(
-      std::string_view name,
-      std::shared_ptr<const FeatureTopology> features,
-      const MethodOptions& options);
 
   /// @throws InvalidInput when `x` does not have one row per welded vertex.
   void check_positions(const skinning::Positions& x, const char* call, const char* which) const;

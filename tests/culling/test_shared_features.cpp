@@ -11,6 +11,9 @@
 #include "culling/detail/method_base.hpp"
 #include "culling/incremental_dcd.hpp"
 #include "culling/method.hpp"
+#include "culling/pair_blocks.hpp"
+#include "culling/sieved_dcd.hpp"
+#include "culling/traversal.hpp"
 #include "skinning/errors.hpp"
 #include "tests/culling/procedural_meshes.hpp"
 
@@ -150,48 +153,44 @@ TEST(SharedFeatures, DcdUpdaterTakesTheFeaturesOnlyWhenBuiltFromItsMeshAndTopolo
   EXPECT_EQ(with_reversed, with_shared);
 }
 
-TEST(SharedFeatures, DcdMethodOverFeaturesOfAnyOwnerOrderFindsBvhsPairsAndCounts) {
+TEST(SharedFeatures, SievedDcdOverFeaturesOfAnyOwnerOrderFindsBvhsPairsAndCounts) {
+  // `dynamic`'s detect_dcd: `bvh`'s tree and fan-sieved traversal over features of its own
+  // (rim-first) owner order, into its own volumes and blocks. The DCD reads no ownership: over
+  // reversed features it finds `bvh`'s pairs with `bvh`'s counts, the tree built over the rest
+  // positions as `bvh` builds its own.
   const skinning::Mesh mesh = crossing_sheets();
   const auto topology = test::simple_topology(mesh);
   const auto rest = test::welded(topology, mesh.rest_positions);
   const auto x = test::welded(topology, standing_sheet_raised(mesh));
   const std::vector<std::int32_t> reversed = reversed_triangles(topology);
-  const auto in_reverse = std::make_shared<const FeatureTopology>(mesh, topology, reversed);
+  const FeatureTopology in_reverse(mesh, topology, reversed);
+  ASSERT_TRUE(in_reverse.describes(mesh, topology));
+  ASSERT_FALSE(in_reverse.built_from(mesh, topology));
   const auto bvh = make_method("bvh", mesh, topology);
-  // Built over the rest positions, as `bvh` builds its own: the same tree, so the same counts.
-  const auto dcd = make_dcd_method(in_reverse, rest);
-  EXPECT_EQ(features_of(*dcd), in_reverse.get());
+  AabbBvh tree(in_reverse.welded_triangles(), rest, BvhOptions{.node_volumes = false});
+  const SlotAdjacency slots(in_reverse, tree.triangle_order());
+  std::vector<std::uint8_t> full_slots;
+  FeatureBounds<3> bounds;
+  TraversalScratch scratch;
+  scratch.reserve_self(tree);
+  PairBlocks<3> blocks;
+  const ElementaryTests tests = with_ccd_defaults({});
   for (const auto* at : {&rest, &x}) {
     FrameResult a, b;
     bvh->detect_dcd(*at, a);
-    dcd->detect_dcd(*at, b);
+    bounds.static_triangles(in_reverse, *at);
+    tree.refit(bounds.triangles);
+    blocks.start_dcd(in_reverse, *at, tests, b);
+    sieved_self_dcd<3>(tree, bounds.triangles, in_reverse, slots, full_slots, scratch, blocks, b);
+    blocks.finish();
     EXPECT_EQ(b.dcd_pairs, a.dcd_pairs);
     EXPECT_EQ(b.counters.bv_tests, a.counters.bv_tests);
     EXPECT_EQ(b.counters.tt_tests, a.counters.tt_tests);
+    EXPECT_EQ(b.counters.candidate_pairs, a.counters.candidate_pairs);
   }
   FrameResult rest_pairs;
   bvh->detect_dcd(rest, rest_pairs);
   EXPECT_FALSE(rest_pairs.dcd_pairs.empty());  // the sheets cut each other at rest
-
-  // Its CCD follows the reversed ownership and finds the same contacts (any order gives each
-  // feature one owner).
-  FrameResult ca, cb;
-  bvh->detect_ccd(x, rest, ca);
-  dcd->detect_ccd(x, rest, cb);
-  ASSERT_FALSE(ca.contacts.empty());
-  ASSERT_EQ(cb.contacts.size(), ca.contacts.size());
-  for (std::size_t i = 0; i < ca.contacts.size(); ++i) {
-    EXPECT_EQ(cb.contacts[i].kind, ca.contacts[i].kind);
-    EXPECT_EQ(cb.contacts[i].a, ca.contacts[i].a);
-    EXPECT_EQ(cb.contacts[i].b, ca.contacts[i].b);
-  }
-
-  EXPECT_THROW((void)make_dcd_method(nullptr, rest), InvalidInput);
-  const skinning::Positions short_rows = rest.topRows(rest.rows() - 1);
-  EXPECT_THROW((void)make_dcd_method(in_reverse, short_rows), InvalidInput);
-  MethodOptions bad;
-  bad.block_pairs = 0;
-  EXPECT_THROW((void)make_dcd_method(in_reverse, rest, bad), InvalidInput);
 }
 
 }  // namespace

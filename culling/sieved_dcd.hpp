@@ -1,8 +1,8 @@
 #pragma once
-// The DCD self traversal of one hierarchy shared by `bvh`, `kdop` and `auto`: the tree against
-// itself in installments into a DCD query's blocks, the pairs that share a vertex whose fan is
-// certified at the instant settled where the traversal meets them (FanSieve,
-// culling/traversal.hpp; docs/culling.md "DCD"). Internal to culling/.
+// The DCD self traversal of one hierarchy shared by `bvh`, `kdop`, `auto` and `dynamic`'s
+// detect_dcd: the tree against itself in installments into a DCD query's blocks, the pairs that
+// share a vertex whose fan is certified at the instant settled where the traversal meets them
+// (FanSieve, culling/traversal.hpp; docs/culling.md "DCD").
 
 #include <cstdint>
 #include <span>
@@ -14,7 +14,7 @@
 #include "culling/pair_blocks.hpp"
 #include "culling/traversal.hpp"
 
-namespace skelcd::culling::detail {
+namespace skelcd::culling {
 
 /// The pairs of `bvh` (refit to the instant's static volumes `triangle_bounds`) into `blocks`,
 /// which start_dcd has started at that instant (its certified fans drive the sieve; none: no
@@ -42,4 +42,4 @@ void sieved_self_dcd(
   out.counters.candidate_pairs += sieve.settled;
 }
 
-}  // namespace skelcd::culling::detail
+}  // namespace skelcd::culling
