@@ -191,9 +191,13 @@ ClusterSet::ClusterSet(
   for (std::int32_t w = 0; w < num_welded; ++w) {
     rest.row(w) = mesh.rest_positions.row(topology.representative_vertex[at(w)]);
   }
+  // Their node volumes as floats (half the bytes): the traversals read the wide copy, the rest
+  // tests the triangles' own volumes after a node's (radial_view_method.cpp).
+  culling::BvhOptions local_options = bvh;
+  local_options.float_node_volumes = true;
   local_.reserve(at(num_clusters));
   for (std::int32_t c = 0; c < num_clusters; ++c) {
-    local_.emplace_back(topology.welded_triangles, rest, triangles(c), bvh);
+    local_.emplace_back(topology.welded_triangles, rest, triangles(c), local_options);
   }
   // The global hierarchy reuses Bvh over "triangles" (c, c, c) whose one point is the cluster's
   // centroid: the median split then orders clusters by centroid, and its leaves are the clusters.

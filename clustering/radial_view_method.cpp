@@ -29,6 +29,20 @@ double micros(Clock::time_point from, Clock::time_point to) {
   return std::chrono::duration<double, std::micro>(to - from).count();
 }
 
+/// Node n's box in a hierarchy with node volumes: the exact one, or its float one (the local
+/// hierarchies', ClusterSet), which contains it — a test on it only prunes less.
+culling::Aabb node_box(const culling::AabbBvh& bvh, std::int32_t n) {
+  const auto floats = bvh.float_node_bounds();
+  if (floats.empty()) return bvh.node_bounds()[at(n)];
+  const culling::FloatDop<3>& f = floats[at(n)];
+  culling::Aabb box;
+  for (std::size_t k = 0; k < 3; ++k) {
+    box.lo[k] = f.lo[k];
+    box.hi[k] = f.hi[k];
+  }
+  return box;
+}
+
 /// The order in which the triangles take their features (culling::FeatureTopology): the rims
 /// first, one side of each. A triangle's rest label is its atomic cluster and its class at rest,
 /// seen from the cluster's observer (positive or not); a rim is a side between two labels. A
@@ -380,7 +394,7 @@ void RadialViewMethod::start_dcd(const skinning::Positions& x, culling::FrameRes
       continue;
     }
     local.refit(bounds_.triangles);  // drops the last interval's end boxes
-    cluster_bounds_[at(a)] = local.node_bounds()[0];
+    cluster_bounds_[at(a)] = local.root_bounds();
   }
   clusters_.global_bvh().refit(cluster_bounds_);
   const auto t1 = Clock::now();
@@ -617,15 +631,17 @@ void RadialViewMethod::gather_ray_candidates(std::int32_t k, const WindingRay& r
     return segment_meets_box(ray.front, ray.far, b) || segment_meets_box(ray.back, ray.front, b);
   };
   // The items (ids in triangle_order) of the leaves whose boxes may meet a segment; `single`
-  // when the leaf holds only that item, whose box was then the one just tested.
+  // when the leaf holds only that item and its box, the one just tested, is the item's own (the
+  // global hierarchy's exact volumes; a local one's float volumes contain its triangles').
   const auto walk =
       [&](const culling::AabbBvh& bvh, std::vector<std::int32_t>& stack, auto&& item) {
         if (bvh.empty()) return;
+        const bool exact = bvh.float_node_bounds().empty();
         stack.assign(1, 0);
         while (!stack.empty()) {
           const std::int32_t n = stack.back();
           stack.pop_back();
-          if (!may_meet(bvh.node_bounds()[at(n)])) continue;
+          if (!may_meet(node_box(bvh, n))) continue;
           const auto& node = bvh.nodes()[at(n)];
           if (!node.is_leaf()) {
             stack.push_back(node.right);
@@ -633,7 +649,7 @@ void RadialViewMethod::gather_ray_candidates(std::int32_t k, const WindingRay& r
             continue;
           }
           for (std::int32_t i = node.begin; i < node.end; ++i) {
-            item(bvh.triangle_order()[at(i)], node.size() == 1);
+            item(bvh.triangle_order()[at(i)], exact && node.size() == 1);
           }
         }
       };
@@ -838,7 +854,6 @@ std::int64_t RadialViewMethod::retest_frontier(
         if (!cluster_bounds_[at(a)].overlaps(box)) continue;
         const auto& local = clusters_.local_bvh(a);
         const auto nodes = local.nodes();
-        const auto node_bounds = local.node_bounds();
         const auto order = local.triangle_order();
         const auto& masks = node_masks_[at(a)].nodes;
         node_stack_.clear();
@@ -848,7 +863,7 @@ std::int64_t RadialViewMethod::retest_frontier(
           node_stack_.pop_back();
           if ((masks[at(n)] & mask) == 0) continue;
           ++bv_tests;
-          if (!node_bounds[at(n)].overlaps(box)) continue;
+          if (!node_box(local, n).overlaps(box)) continue;
           const auto& node = nodes[at(n)];
           if (!node.is_leaf()) {
             node_stack_.push_back(node.right);
@@ -941,7 +956,7 @@ void RadialViewMethod::ccd(const culling::Interval& interval, culling::FrameResu
           vertex_ends_,
           culling::feature_stage_tests_ends(method_options_.min_separation));
     }
-    cluster_bounds_[at(a)] = local.node_bounds()[0];
+    cluster_bounds_[at(a)] = local.root_bounds();
   }
   clusters_.global_bvh().refit(cluster_bounds_);
   if (filters_pairs()) relative_filter_.prepare(topology_, x_t0, x_t1);

@@ -494,6 +494,8 @@ void Bvh<N>::refit_float_nodes(std::span<const Volume> triangle_bounds) {
   // As refit(), bottom-up in one backward sweep, on the rounded volumes: float_below and
   // float_above are monotone, so the union of rounded volumes is the rounded exact union, and the
   // wide copy below gets the bits refit() gives it.
+  // The root's exact volume beside them (root_bounds).
+  root_bounds_ = Volume::empty();
   for (std::size_t n = nodes_.size(); n-- > 0;) {
     const BvhNode& node = nodes_[n];
     FloatDop<N>& v = float_node_bounds_[n];
@@ -504,7 +506,9 @@ void Bvh<N>::refit_float_nodes(std::span<const Volume> triangle_bounds) {
            ++s) {
         FloatBounds tl;
         FloatBounds th;
-        round_slot(s, triangle_bounds[static_cast<std::size_t>(order_[s])], tl, th);
+        const Volume& t = triangle_bounds[static_cast<std::size_t>(order_[s])];
+        root_bounds_.merge(t);
+        round_slot(s, t, tl, th);
         for (std::size_t k = 0; k < kN; ++k) {
           v.lo[k] = std::min(v.lo[k], tl[k]);
           v.hi[k] = std::max(v.hi[k], th[k]);
