@@ -39,7 +39,8 @@ class ClusterSet {
   /// @param mesh, topology the mesh the method runs on (welded as build_topology welds it).
   /// @param segmentation of the same mesh: one cluster per triangle (Mesh::triangles order).
   /// @param num_bones bones of the rig whose transforms will move the observers.
-  /// @param bvh leaf size of the local hierarchies (which keep their node volumes as floats).
+  /// @param bvh leaf size of the local hierarchies (which keep no binary node volumes: they are
+  ///   walked through their wide copy).
   /// @throws InvalidInput naming "clustering" and the offending index when the segmentation does
   ///   not fit the mesh (triangle count, cluster or bone ids out of range, a graph entry between
   ///   unknown clusters).

@@ -29,16 +29,13 @@ double micros(Clock::time_point from, Clock::time_point to) {
   return std::chrono::duration<double, std::micro>(to - from).count();
 }
 
-/// Node n's box in a hierarchy with node volumes: the exact one, or its float one (the local
-/// hierarchies', ClusterSet), which contains it — a test on it only prunes less.
-culling::Aabb node_box(const culling::AabbBvh& bvh, std::int32_t n) {
-  const auto floats = bvh.float_node_bounds();
-  if (floats.empty()) return bvh.node_bounds()[at(n)];
-  const culling::FloatDop<3>& f = floats[at(n)];
+/// Lane i's box in wide node w: the float volume of its triangles, rounded outwards (it contains
+/// their exact volume: a test on it only prunes less).
+culling::Aabb lane_box(const culling::WideBvhNode<3>& w, int i) {
   culling::Aabb box;
   for (std::size_t k = 0; k < 3; ++k) {
-    box.lo[k] = f.lo[k];
-    box.hi[k] = f.hi[k];
+    box.lo[k] = w.lo[k][static_cast<std::size_t>(i)];
+    box.hi[k] = w.hi[k][static_cast<std::size_t>(i)];
   }
   return box;
 }
@@ -630,36 +627,52 @@ void RadialViewMethod::gather_ray_candidates(std::int32_t k, const WindingRay& r
   const auto may_meet = [&](const culling::Aabb& b) {
     return segment_meets_box(ray.front, ray.far, b) || segment_meets_box(ray.back, ray.front, b);
   };
-  // The items (ids in triangle_order) of the leaves whose boxes may meet a segment; `single`
-  // when the leaf holds only that item and its box, the one just tested, is the item's own (the
-  // global hierarchy's exact volumes; a local one's float volumes contain its triangles').
-  const auto walk =
-      [&](const culling::AabbBvh& bvh, std::vector<std::int32_t>& stack, auto&& item) {
-        if (bvh.empty()) return;
-        const bool exact = bvh.float_node_bounds().empty();
-        stack.assign(1, 0);
-        while (!stack.empty()) {
-          const std::int32_t n = stack.back();
-          stack.pop_back();
-          if (!may_meet(node_box(bvh, n))) continue;
-          const auto& node = bvh.nodes()[at(n)];
-          if (!node.is_leaf()) {
-            stack.push_back(node.right);
-            stack.push_back(n + 1);
-            continue;
-          }
-          for (std::int32_t i = node.begin; i < node.end; ++i) {
-            item(bvh.triangle_order()[at(i)], exact && node.size() == 1);
-          }
-        }
-      };
+  // The atomic clusters whose boxes may meet a segment: the global hierarchy's leaves (one
+  // cluster each, whose exact box is then the one just tested).
   ray_candidates_.clear();
-  walk(clusters_.global_bvh(), ray_stack_, [&](std::int32_t a, bool) {
-    if (clusters_.component_of_atomic(a) != k) return;
-    walk(clusters_.local_bvh(a), ray_local_stack_, [&](std::int32_t t, bool single) {
-      if (single || may_meet(bounds_.triangles[at(t)])) ray_candidates_.push_back(t);
-    });
-  });
+  const auto& global = clusters_.global_bvh();
+  if (global.empty()) return;
+  ray_stack_.assign(1, 0);
+  while (!ray_stack_.empty()) {
+    const std::int32_t n = ray_stack_.back();
+    ray_stack_.pop_back();
+    if (!may_meet(global.node_bounds()[at(n)])) continue;
+    const auto& node = global.nodes()[at(n)];
+    if (!node.is_leaf()) {
+      ray_stack_.push_back(node.right);
+      ray_stack_.push_back(n + 1);
+      continue;
+    }
+    for (std::int32_t i = node.begin; i < node.end; ++i) {
+      const std::int32_t a = global.triangle_order()[at(i)];
+      if (clusters_.component_of_atomic(a) == k) gather_ray_cluster(a, may_meet);
+    }
+  }
+}
+
+template <class MayMeet>
+void RadialViewMethod::gather_ray_cluster(std::int32_t a, const MayMeet& may_meet) {
+  // Down the cluster's wide copy (its lanes' float boxes), then each triangle's exact box.
+  const auto& local = clusters_.local_bvh(a);
+  if (local.empty()) return;
+  const auto wide = local.wide_nodes();
+  const auto order = local.triangle_order();
+  ray_local_stack_.assign(1, 0);
+  while (!ray_local_stack_.empty()) {
+    const auto& w = wide[at(ray_local_stack_.back())];
+    ray_local_stack_.pop_back();
+    for (int i = 0; i < w.num_children; ++i) {
+      if (!may_meet(lane_box(w, i))) continue;
+      if (w.child[i] >= 0) {
+        ray_local_stack_.push_back(w.child[i]);
+        continue;
+      }
+      for (std::int32_t s = ~w.child[i]; s < ~w.child[i] + w.count[i]; ++s) {
+        const std::int32_t t = order[at(s)];
+        if (may_meet(bounds_.triangles[at(t)])) ray_candidates_.push_back(t);
+      }
+    }
+  }
 }
 
 // --- class masks: which pairs of a mega cluster may be skipped -----------------------------------
@@ -852,31 +865,33 @@ std::int64_t RadialViewMethod::retest_frontier(
         if (classes_.atomic_mega[at(a)] != mega) continue;
         ++bv_tests;
         if (!cluster_bounds_[at(a)].overlaps(box)) continue;
+        // Down the cluster's wide copy: a lane whose node holds no triangle of t's mask, or
+        // whose float box misses t's, holds no pair to re-test.
         const auto& local = clusters_.local_bvh(a);
-        const auto nodes = local.nodes();
+        const auto wide = local.wide_nodes();
         const auto order = local.triangle_order();
         const auto& masks = node_masks_[at(a)].nodes;
         node_stack_.clear();
         node_stack_.push_back(0);
         while (!node_stack_.empty()) {
-          const std::int32_t n = node_stack_.back();
+          const auto& w = wide[at(node_stack_.back())];
           node_stack_.pop_back();
-          if ((masks[at(n)] & mask) == 0) continue;
-          ++bv_tests;
-          if (!node_box(local, n).overlaps(box)) continue;
-          const auto& node = nodes[at(n)];
-          if (!node.is_leaf()) {
-            node_stack_.push_back(node.right);
-            node_stack_.push_back(n + 1);
-            continue;
-          }
-          for (std::int32_t i = node.begin; i < node.end; ++i) {
-            const std::int32_t u = order[at(i)];
-            if (u == t || triangle_mask_[at(u)] != mask) continue;
-            const std::int32_t r = escalated_[at(u)];
-            if ((r != 0 && r < round) || (r == round && u < t)) continue;
-            if (!tri_bounds[at(u)].overlaps(box)) continue;
-            pairs.push_back(culling::TrianglePair{std::min(t, u), std::max(t, u)});
+          for (int i = 0; i < w.num_children; ++i) {
+            if ((masks[at(w.node[i])] & mask) == 0) continue;
+            ++bv_tests;
+            if (!lane_box(w, i).overlaps(box)) continue;
+            if (w.child[i] >= 0) {
+              node_stack_.push_back(w.child[i]);
+              continue;
+            }
+            for (std::int32_t s = ~w.child[i]; s < ~w.child[i] + w.count[i]; ++s) {
+              const std::int32_t u = order[at(s)];
+              if (u == t || triangle_mask_[at(u)] != mask) continue;
+              const std::int32_t r = escalated_[at(u)];
+              if ((r != 0 && r < round) || (r == round && u < t)) continue;
+              if (!tri_bounds[at(u)].overlaps(box)) continue;
+              pairs.push_back(culling::TrianglePair{std::min(t, u), std::max(t, u)});
+            }
           }
         }
       }

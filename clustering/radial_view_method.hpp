@@ -174,6 +174,9 @@ class RadialViewMethod final : public culling::CullingMethod {
   /// The triangles of component k whose swept boxes either segment of `ray` may meet, into
   /// ray_candidates_: every triangle of k that can meet them (count_winding's precondition).
   void gather_ray_candidates(std::int32_t k, const WindingRay& ray);
+  /// gather_ray_candidates' for atomic cluster a: its triangles whose boxes may_meet the ray.
+  template <class MayMeet>
+  void gather_ray_cluster(std::int32_t a, const MayMeet& may_meet);
   void compute_masks();
   /// Streams the pairs the masks do not skip into blocks_ (a query started there), each
   /// installment through the relative AABB filter; returns the pairs found before the filter.

@@ -541,7 +541,9 @@ void Bvh<N>::refit_wide_only(std::span<const Volume> triangle_bounds) {
   // A wide node's inner children come after it (built depth first), so one backward sweep is
   // bottom-up. A bucket lane is its triangles' union, rounded outwards; an inner lane the union of
   // the lanes of its wide node, which partition its triangles. float_below and float_above are
-  // monotone, so the min of rounded ends is the rounded min: the bits refit() gives.
+  // monotone, so the min of rounded ends is the rounded min: the bits refit() gives. The root's
+  // exact volume beside them (root_bounds).
+  root_bounds_ = Volume::empty();
   for (std::size_t n = wide_.size(); n-- > 0;) {
     WideBvhNode<N>& w = wide_[n];
     for (int i = 0; i < w.num_children; ++i) {
@@ -561,7 +563,9 @@ void Bvh<N>::refit_wide_only(std::span<const Volume> triangle_bounds) {
         for (std::size_t s = begin; s < end; ++s) {
           FloatBounds tl;
           FloatBounds th;
-          round_slot(s, triangle_bounds[static_cast<std::size_t>(order_[s])], tl, th);
+          const Volume& t = triangle_bounds[static_cast<std::size_t>(order_[s])];
+          root_bounds_.merge(t);
+          round_slot(s, t, tl, th);
           for (std::size_t k = 0; k < kN; ++k) {
             lo[k] = std::min(lo[k], tl[k]);
             hi[k] = std::max(hi[k], th[k]);

@@ -39,9 +39,7 @@ struct BvhOptions {
   /// With node_volumes: keep them as floats rounded outwards (Bvh::float_node_bounds, half the
   /// bytes) instead of doubles. A traversal on them is conservative (volumes that overlap in
   /// double overlap in float) and tests its triangle pairs with the triangles' exact volumes: the
-  /// cone methods, whose binary tree is their traversal's, and `dynamic`'s atomic clusters
-  /// (clustering::ClusterSet), whose rays and re-tests walk it. The root's exact volume is kept
-  /// (Bvh::root_bounds).
+  /// cone methods, whose binary tree is their traversal's.
   bool float_node_volumes = false;
   BvhSplit split = BvhSplit::surface_area;
 
@@ -184,8 +182,8 @@ class Bvh {
   [[nodiscard]] std::span<const FloatDop<N>> float_node_bounds() const {
     return float_node_bounds_;
   }
-  /// The root's exact volume, the union of the triangles' volumes of the last refit(), when built
-  /// with node volumes (double or float; empty for an empty tree, unspecified without them).
+  /// The root's exact volume: the union of the triangles' volumes of the last refit() (empty for
+  /// an empty tree). refit_wide() leaves it as it was on a tree with double node volumes.
   [[nodiscard]] const Volume& root_bounds() const {
     return float_node_volumes_ || node_bounds_.empty() ? root_bounds_ : node_bounds_[0];
   }
@@ -292,7 +290,7 @@ class Bvh {
   std::vector<BvhNode> nodes_;
   std::vector<Volume> node_bounds_;
   std::vector<FloatDop<N>> float_node_bounds_;
-  Volume root_bounds_ = Volume::empty();  // with float node volumes: root_bounds()
+  Volume root_bounds_ = Volume::empty();  // root_bounds() without double node volumes
   std::vector<std::int32_t> order_;
   std::vector<WideBvhNode<N>> wide_;
   std::vector<WideEndBoxes> end_boxes_;
