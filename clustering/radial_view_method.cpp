@@ -232,8 +232,10 @@ RadialViewMethod::RadialViewMethod(
   const auto num_atomic = at(clusters_.num_atomic());
   const auto num_components = at(clusters_.num_components());
   // Everything an interval touches is sized here (the candidates' blocks by blocks_).
-  // No edge volumes: the feature stage forms them from the vertices' (bounded memory).
-  bounds_.vertices.reserve(at(topology_.num_vertices()));
+  // No edge volumes, and vertex volumes only with a contact distance (bounded memory; ccd).
+  if (!culling::feature_stage_tests_ends(method_options.min_separation)) {
+    bounds_.vertices.reserve(at(topology_.num_vertices()));
+  }
   bounds_.triangles.reserve(num_faces);
   cluster_bounds_.resize(num_atomic);
   triangle_mask_.assign(num_faces, culling::kMaskOther);
@@ -947,8 +949,15 @@ void RadialViewMethod::ccd(const culling::Interval& interval, culling::FrameResu
   // 2. Swept volumes of the interval, local hierarchies, then the global one over their roots.
   const auto t_refit = Clock::now();
   const double half_width = 0.5 * method_options_.min_separation;
-  culling::swept_vertex_bounds<3>(x_t0, x_t1, half_width, bounds_.vertices);
-  bounds_.derive(topology_, /*with_edges=*/false);
+  // No edge volumes: the feature stage forms them from the vertices'. Without a contact distance
+  // it reads the positions at both ends instead, and no vertex volumes are held: the triangles'
+  // come from their corners directly (as in `bvh`).
+  if (culling::feature_stage_tests_ends(method_options_.min_separation)) {
+    bounds_.swept_triangles(topology_, x_t0, x_t1);
+  } else {
+    culling::swept_vertex_bounds<3>(x_t0, x_t1, half_width, bounds_.vertices);
+    bounds_.derive(topology_, /*with_edges=*/false);
+  }
   // The unmasked pair traversals test node pairs in the relative motion too when the interval
   // moves enough for it to prune (docs/culling.md "Relative boxes at the nodes").
   const bool node_relative =
