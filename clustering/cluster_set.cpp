@@ -165,24 +165,11 @@ ClusterSet::ClusterSet(
     }
   }
 
-  // --- vertex → triangles (CSR) and vertex components ---------------------------------------------
-  vertex_face_offsets_.assign(at(num_welded) + 1, 0);
-  for (std::int32_t f = 0; f < num_faces; ++f) {
-    for (int k = 0; k < 3; ++k) ++vertex_face_offsets_[at(topology.welded_triangles(f, k)) + 1];
-  }
-  for (std::size_t w = 0; w < at(num_welded); ++w) {
-    vertex_face_offsets_[w + 1] += vertex_face_offsets_[w];
-  }
-  vertex_faces_.resize(at(vertex_face_offsets_.back()));
+  // --- vertex components -------------------------------------------------------------------------
   vertex_component_.assign(at(num_welded), -1);
-  {
-    std::vector<std::int32_t> fill(vertex_face_offsets_.begin(), vertex_face_offsets_.end() - 1);
-    for (std::int32_t f = 0; f < num_faces; ++f) {
-      for (int k = 0; k < 3; ++k) {
-        const std::int32_t w = topology.welded_triangles(f, k);
-        vertex_faces_[at(fill[at(w)]++)] = f;
-        vertex_component_[at(w)] = triangle_component_[at(f)];
-      }
+  for (std::int32_t f = 0; f < num_faces; ++f) {
+    for (int k = 0; k < 3; ++k) {
+      vertex_component_[at(topology.welded_triangles(f, k))] = triangle_component_[at(f)];
     }
   }
 

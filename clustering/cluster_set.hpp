@@ -104,13 +104,6 @@ class ClusterSet {
   [[nodiscard]] std::int32_t component_of_vertex(std::int32_t w) const {
     return vertex_component_[static_cast<std::size_t>(w)];
   }
-  /// Triangles incident to welded vertex w.
-  [[nodiscard]] std::span<const std::int32_t> vertex_triangles(std::int32_t w) const {
-    const auto i = static_cast<std::size_t>(w);
-    return std::span(vertex_faces_).subspan(
-        static_cast<std::size_t>(vertex_face_offsets_[i]),
-        static_cast<std::size_t>(vertex_face_offsets_[i + 1] - vertex_face_offsets_[i]));
-  }
 
   /// Local AABB hierarchy of atomic cluster a over its triangles (global triangle ids).
   [[nodiscard]] const culling::AabbBvh& local_bvh(std::int32_t a) const {
@@ -134,7 +127,6 @@ class ClusterSet {
   std::vector<ClusterJoint> joints_;
   std::vector<std::int32_t> triangle_component_, atomic_component_, vertex_component_;
   std::vector<std::uint8_t> component_ok_;
-  std::vector<std::int32_t> vertex_face_offsets_, vertex_faces_;
   std::vector<culling::AabbBvh> local_;
   culling::AabbBvh global_;
 };

@@ -212,8 +212,6 @@ RadialViewMethod::RadialViewMethod(
       updater_(used_mesh(ghosts_, real_mesh), used_topology(ghosts_, real_topology), features_),
       dcd_rest_(welded_rest(used_mesh(ghosts_, real_mesh), used_topology(ghosts_, real_topology))),
       builder_(clusters_, options.clusters),
-      edge_face_offsets_(used_topology(ghosts_, real_topology).edge_face_offsets),
-      edge_faces_(used_topology(ghosts_, real_topology).edge_faces),
       blocks_(
           method_options.block_pairs,
           culling::block_reserve(
@@ -286,15 +284,12 @@ RadialViewMethod::RadialViewMethod(
   face_neighbours_.assign(3 * num_faces, kNoNeighbour);
   for (std::int32_t f = 0; f < topology_.num_triangles(); ++f) {
     for (int side = 0; side < 3; ++side) {
-      const std::int32_t e = topology_.face_edge(f, side);
-      const std::int32_t begin = edge_face_offsets_[at(e)];
-      const std::int32_t end = edge_face_offsets_[at(e) + 1];
+      const auto faces = updater_.edge_triangles(topology_.face_edge(f, side));
       std::int32_t& n = face_neighbours_[3 * at(f) + at(side)];
-      if (end - begin > 2) {
+      if (faces.size() > 2) {
         n = kNeighboursListed;
-      } else if (end - begin == 2) {
-        const std::int32_t g0 = edge_faces_[at(begin)];
-        n = g0 != f ? g0 : edge_faces_[at(begin + 1)];
+      } else if (faces.size() == 2) {
+        n = faces[0] != f ? faces[0] : faces[1];
       }
     }
   }
@@ -542,10 +537,7 @@ void RadialViewMethod::build_patches() {
           if (n >= 0) {
             join(n);
           } else if (n == kNeighboursListed) {
-            const std::int32_t e = topology_.face_edge(f, s);
-            for (auto j = edge_face_offsets_[at(e)]; j < edge_face_offsets_[at(e) + 1]; ++j) {
-              join(edge_faces_[at(j)]);
-            }
+            for (const std::int32_t g : updater_.edge_triangles(topology_.face_edge(f, s))) join(g);
           }
         }
       }
@@ -700,14 +692,14 @@ void RadialViewMethod::compute_masks() {
   // A feature is pure with label l when every triangle at it has label l. Only the features a
   // labelled triangle owns are asked about, each by its one owner: decided there.
   const auto vertex_pure = [&](std::int32_t w, std::int64_t l) {
-    for (const std::int32_t f : clusters_.vertex_triangles(w)) {
+    for (const std::int32_t f : updater_.vertex_triangles(w)) {
       if (triangle_label_[at(f)] != l) return false;
     }
     return true;
   };
   const auto edge_pure = [&](std::int32_t e, std::int64_t l) {
-    for (auto i = edge_face_offsets_[at(e)]; i < edge_face_offsets_[at(e) + 1]; ++i) {
-      if (triangle_label_[at(edge_faces_[at(i)])] != l) return false;
+    for (const std::int32_t f : updater_.edge_triangles(e)) {
+      if (triangle_label_[at(f)] != l) return false;
     }
     return true;
   };
@@ -821,7 +813,7 @@ void RadialViewMethod::escalate(const culling::FrameResult& out, std::int32_t ro
   // owners of their features (docs/radial-view.md, "The local guard": re-testing their skipped
   // pairs re-tests every skipped feature pair at those triangles).
   const auto mark_vertex = [&](std::int32_t w) {
-    for (const std::int32_t f : clusters_.vertex_triangles(w)) {
+    for (const std::int32_t f : updater_.vertex_triangles(w)) {
       const std::uint8_t m = triangle_mask_[at(f)];
       if (escalated_[at(f)] != 0 || (m != culling::kMaskPositive && m != culling::kMaskNegative)) {
         continue;

@@ -227,7 +227,8 @@ class RadialViewMethod final : public culling::CullingMethod {
   RadialViewOptions options_;
   culling::ElementaryTests tests_;
   ccd::CcdOptions ccd_options_;
-  // The intersecting pairs from one end to the next.
+  // The intersecting pairs from one end to the next; its incidences (vertex → triangles, edge →
+  // triangles) serve the patches and masks too.
   culling::DcdUpdater updater_;
   // detect_dcd's hierarchy: `bvh`'s (its tree and the slots its fan sieve reads) over the used
   // mesh's welded rest positions (dcd_rest_, freed once it is built), built at the first
@@ -237,7 +238,6 @@ class RadialViewMethod final : public culling::CullingMethod {
   skinning::Positions dcd_rest_;
   std::unique_ptr<DcdTree> dcd_;
   MegaClusterBuilder builder_;
-  std::vector<std::int32_t> edge_face_offsets_, edge_faces_;
   std::vector<std::int32_t> face_neighbours_;  // 3 per triangle (built with them): build_patches'
   static constexpr std::int32_t kNoNeighbour = -1;
   static constexpr std::int32_t kNeighboursListed = -2;

@@ -59,12 +59,29 @@ class DcdUpdater {
       FrameResult& out);
 
   [[nodiscard]] const FeatureTopology& features() const { return features_; }
+  /// The triangles at welded vertex v, each once, ascending.
+  [[nodiscard]] std::span<const std::int32_t> vertex_triangles(std::int32_t v) const {
+    return csr_row(vertex_face_offsets_, vertex_faces_, v);
+  }
+  /// The triangles at edge e, in Topology::edge_faces' order.
+  [[nodiscard]] std::span<const std::int32_t> edge_triangles(std::int32_t e) const {
+    return csr_row(edge_face_offsets_, edge_faces_, e);
+  }
   /// The FeatureTopology it uses (built here or lent), for a method to share.
   [[nodiscard]] const std::shared_ptr<const FeatureTopology>& shared_features() const {
     return shared_;
   }
 
  private:
+  static std::span<const std::int32_t> csr_row(
+      const std::vector<std::int32_t>& offsets,
+      const std::vector<std::int32_t>& items,
+      std::int32_t i) {
+    const auto begin = static_cast<std::size_t>(offsets[static_cast<std::size_t>(i)]);
+    const auto end = static_cast<std::size_t>(offsets[static_cast<std::size_t>(i) + 1]);
+    return std::span(items).subspan(begin, end - begin);
+  }
+
   std::shared_ptr<const FeatureTopology> shared_;
   const FeatureTopology& features_;                // *shared_
   std::vector<std::int32_t> vertex_face_offsets_;  // CSR welded vertex → triangles

@@ -167,6 +167,40 @@ TEST(IncrementalDcd, GridMotionsAgreeWithTheFullDcd) {
 // Real characters: consecutive samples of their clips, and the rest pose to a posed sample (one
 // large motion): the update equals the full DCD at every end, tests far fewer pairs, and the
 // clips do change pairs' status.
+TEST(IncrementalDcd, IncidencesAreTheTopologysEdgeFacesAndEachVertexsDistinctTriangles) {
+  // `dynamic` walks its patches and decides its masks on the updater's incidences instead of
+  // copies of its own: an edge's triangles are Topology::edge_faces', a vertex's every triangle
+  // with it as a corner, once (a degenerate triangle repeats a corner), ascending.
+  for (const std::string file : {"CesiumMan.glb", "stormtrooper/stormtrooper.dae"}) {
+    SCOPED_TRACE(file);
+    const auto model = skinning::load_model(test::asset("characters/" + file));
+    const skinning::Topology topology = skinning::build_topology(*model.mesh);
+    const DcdUpdater updater(*model.mesh, topology);
+    const auto num_edges = static_cast<std::int32_t>(topology.edge_face_offsets.size()) - 1;
+    ASSERT_GT(num_edges, 0);
+    for (std::int32_t e = 0; e < num_edges; ++e) {
+      const auto i = static_cast<std::size_t>(e);
+      const auto begin = topology.edge_faces.begin() + topology.edge_face_offsets[i];
+      const auto end = topology.edge_faces.begin() + topology.edge_face_offsets[i + 1];
+      const auto got = updater.edge_triangles(e);
+      ASSERT_TRUE(std::equal(got.begin(), got.end(), begin, end)) << "edge " << e;
+    }
+    std::vector<std::vector<std::int32_t>> at(
+        static_cast<std::size_t>(topology.num_welded_vertices()));
+    for (std::int32_t f = 0; f < topology.welded_triangles.rows(); ++f) {
+      for (int k = 0; k < 3; ++k) {
+        auto& list = at[static_cast<std::size_t>(topology.welded_triangles(f, k))];
+        if (list.empty() || list.back() != f) list.push_back(f);
+      }
+    }
+    for (std::int32_t v = 0; v < topology.num_welded_vertices(); ++v) {
+      const auto got = updater.vertex_triangles(v);
+      const auto& want = at[static_cast<std::size_t>(v)];
+      ASSERT_TRUE(std::equal(got.begin(), got.end(), want.begin(), want.end())) << "vertex " << v;
+    }
+  }
+}
+
 TEST(IncrementalDcd, RealCharactersAgreeWithTheFullDcd) {
   struct Clip {
     std::string file;
