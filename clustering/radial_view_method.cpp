@@ -955,7 +955,6 @@ void RadialViewMethod::ccd(const culling::Interval& interval, culling::FrameResu
   const bool node_relative =
       options_.relative_aabb &&
       culling::motion_scale(topology_, x_t0, x_t1) >= culling::kNodeRelativeMotion;
-  if (node_relative) culling::vertex_end_boxes(x_t0, x_t1, half_width, vertex_ends_);
   for (std::int32_t a = 0; a < clusters_.num_atomic(); ++a) {
     auto& local = clusters_.local_bvh(a);
     if (local.empty()) {
@@ -966,10 +965,12 @@ void RadialViewMethod::ccd(const culling::Interval& interval, culling::FrameResu
     if (node_relative) {
       // And the slots' (docs/culling.md "Apart at both ends in the leaves"): on an interval that
       // moves this much, many pairs the swept volumes pass lie apart at both ends. Both from one
-      // gather of the corners.
+      // gather of the corners' positions (no per-vertex end boxes held: 64 bytes a vertex).
       local.refit_end_boxes(
           topology_.welded_triangles(),
-          vertex_ends_,
+          x_t0,
+          x_t1,
+          half_width,
           culling::feature_stage_tests_ends(method_options_.min_separation));
     }
     cluster_bounds_[at(a)] = local.root_bounds();

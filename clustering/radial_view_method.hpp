@@ -249,7 +249,6 @@ class RadialViewMethod final : public culling::CullingMethod {
   RadialViewStats stats_;
   culling::FeatureBounds<3> bounds_;
   culling::RelativeAabbFilter relative_filter_;
-  std::vector<culling::NodeEndBoxes> vertex_ends_;  // per interval that moves enough
   std::vector<culling::Aabb> cluster_bounds_;
   std::vector<std::uint8_t> triangle_mask_;
   std::vector<culling::ClassMasks> node_masks_;  // per atomic cluster
