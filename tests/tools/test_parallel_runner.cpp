@@ -309,6 +309,33 @@ TEST(ParallelRunner, DynamicsFeaturesServeTheDcdUpdatersAndTheRunnersAreFreed) {
   }
 }
 
+TEST(ParallelRunner, WithoutIncrementalDcdTheRunnerHoldsNoFeaturesOfItsOwn) {
+  // Only the incremental-DCD updaters read the runner's features once the methods are built.
+  // BCN_Epileptic is open: `dynamic` caps it with ghost triangles, and its features describe the
+  // capped mesh, so it does not take the runner's and they cannot serve the updaters either. A
+  // CCD-only run frees them; a run with both queries keeps them for its updaters.
+  const auto l = load(kCharacter);
+  for (const QuerySet query : {QuerySet::ccd, QuerySet::both}) {
+    for (const int threads : {1, 2}) {
+      SCOPED_TRACE(std::to_string(static_cast<int>(query)) + " on " + std::to_string(threads));
+      RunOptions options;
+      options.method = "dynamic";
+      options.query = query;
+      options.frames = parse_frame_range("0:6");
+      options.threads = threads;
+      options.block_samples = 3;
+      (void)setup_radial_view(RadialViewArguments{}, l.model, *l.motion, options);
+      skinning::Topology topology = skinning::build_topology(l.motion->mesh());
+      auto features = std::make_shared<const culling::FeatureTopology>(l.motion->mesh(), topology);
+      const std::weak_ptr<const culling::FeatureTopology> given = features;
+      ClipRunner runner(*l.motion, options, std::move(topology), {}, std::move(features));
+      EXPECT_EQ(given.expired(), query == QuerySet::ccd);
+      const auto rows = collect(runner);
+      EXPECT_FALSE(rows.empty());
+    }
+  }
+}
+
 TEST(ParallelRunner, IncrementalDcdRowsHoldTheFullDcdsPairsWithFewerTests) {
   const auto l = load(kCharacter);
   for (const char* method : {"bvh", "auto"}) {

@@ -148,8 +148,9 @@ class ClipRunner {
   /// The run's method, as the factory or culling::make_method builds it.
   /// @throws InvalidInput when it cannot be built.
   [[nodiscard]] std::unique_ptr<culling::CullingMethod> build_method() const;
-  /// method_options_.features becomes the method's own when the method did not take the runner's
-  /// and its own describes this mesh and topology (any owner order): for the DCD updaters.
+  /// method_options_.features, which only the DCD updaters read once the methods are built:
+  /// released without incremental DCD; else the method's own when the method did not take the
+  /// runner's and its own describes this mesh and topology (any owner order).
   void adopt_method_features();
   void run_serial(const FrameCallback& on_frame);
   void run_queries_in_order(const FrameCallback& on_frame);
