@@ -473,8 +473,7 @@ class AutoMethod final : public detail::MethodBase {
     for (std::size_t g = 0; g < groups.size(); ++g) {
       const AabbBvh* h = groups[g];
       if (h == nullptr || h->empty()) continue;
-      sieved_self_dcd<3>(
-          *h, tri, topology_, slots_of(g, *h), full_slots_, scratch_, blocks_, out);
+      sieved_self_dcd<3>(*h, tri, topology_, slots_of(g, *h), full_slots_, scratch_, blocks_, out);
     }
     if (between)
       traverse_between(out.counters.bv_tests, [](std::vector<TrianglePair>&, std::size_t) {});
