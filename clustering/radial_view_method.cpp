@@ -359,19 +359,9 @@ void RadialViewMethod::dcd(const culling::Instant& at, culling::FrameResult& out
   DcdTree& tree = dcd_tree();
   // `bvh`'s DCD (the same tree, refit over the static volumes at x, the same sieved traversal
   // and tests) through this method's volumes and blocks, which the CCD refills.
-  const auto t0 = Clock::now();
-  bounds_.static_triangles(topology_, x);
-  tree.bvh.refit(bounds_.triangles);
-  const auto t1 = Clock::now();
-  blocks_.start_dcd(topology_, x, tests_, out);
-  culling::sieved_self_dcd<3>(
-      tree.bvh, bounds_.triangles, topology_, tree.slots, tree.full_slots, scratch_, blocks_, out);
-  blocks_.finish();
+  culling::sieved_dcd_at<3>(
+      x, tree.bvh, bounds_, topology_, tree.slots, tree.full_slots, scratch_, blocks_, tests_, out);
   blocks_.release_dcd_planes();  // not held between queries: the CCD's blocks need none
-  const auto t2 = Clock::now();
-  out.times.refit_us += micros(t0, t1);
-  out.times.traverse_us += micros(t1, t2) - blocks_.test_us();
-  out.times.elementary_us += blocks_.test_us();
   record_dcd(x, out);  // with the ghosts' pairs: the next interval's cuts need them
   drop_ghosts(out);
 }

@@ -69,24 +69,10 @@ class BvhMethod final : public MethodBase {
   }
 
   void dcd(const Instant& at, FrameResult& out) override {
-    const skinning::Positions& x = at.x;
-    check_positions(x, "detect_dcd", "x");
-    const auto t0 = Clock::now();
-    // Refit over the static volumes of the instant (the triangles' only).
-    bounds_.static_triangles(topology_, x);
-    bvh_.refit(bounds_.triangles);
-    const auto t1 = Clock::now();
-    // Self traversal → overlapping triangle pairs → the DCD rules → tests, in blocks as the CCD
-    // (bounded memory), the vertex fans certified once for the instant.
+    check_positions(at.x, "detect_dcd", "x");
     // Pairs sharing a certified vertex are settled where the traversal finds them (FanSieve).
-    blocks_.start_dcd(topology_, x, tests_, out);
-    sieved_self_dcd<N>(
-        bvh_, bounds_.triangles, topology_, slots_, full_slots_, scratch_, blocks_, out);
-    blocks_.finish();
-    const auto t2 = Clock::now();
-    out.times.refit_us += micros(t0, t1);
-    out.times.traverse_us += micros(t1, t2) - blocks_.test_us();
-    out.times.elementary_us += blocks_.test_us();
+    sieved_dcd_at<N>(
+        at.x, bvh_, bounds_, topology_, slots_, full_slots_, scratch_, blocks_, tests_, out);
   }
 
   void ccd(const Interval& interval, FrameResult& out) override {

@@ -54,16 +54,10 @@ void DcdUpdater::affected_pairs(
   };
   for (const CcdContact& c : contacts) {
     if (c.kind == CcdContact::Kind::vf) {
-      for (std::int32_t i = vertex_face_offsets_[at(c.a)]; i < vertex_face_offsets_[at(c.a) + 1];
-           ++i) {
-        add(vertex_faces_[at(i)], c.b);
-      }
+      for (const std::int32_t f : vertex_triangles(c.a)) add(f, c.b);
     } else {
-      for (std::int32_t i = edge_face_offsets_[at(c.a)]; i < edge_face_offsets_[at(c.a) + 1]; ++i) {
-        for (std::int32_t j = edge_face_offsets_[at(c.b)]; j < edge_face_offsets_[at(c.b) + 1];
-             ++j) {
-          add(edge_faces_[at(i)], edge_faces_[at(j)]);
-        }
+      for (const std::int32_t f : edge_triangles(c.a)) {
+        for (const std::int32_t g : edge_triangles(c.b)) add(f, g);
       }
     }
   }

@@ -97,6 +97,19 @@ Loaded load(const std::string& spec) {
   return l;
 }
 
+/// The rows of a runner of `options` (radial view set up) handed a FeatureTopology of the mesh
+/// that the caller does not keep; `freed`: whether it was gone once the runner was built.
+std::vector<FrameReport> run_with_given_features(
+    const Loaded& l, RunOptions options, bool& freed) {
+  (void)setup_radial_view(RadialViewArguments{}, l.model, *l.motion, options);
+  skinning::Topology topology = skinning::build_topology(l.motion->mesh());
+  auto features = std::make_shared<const culling::FeatureTopology>(l.motion->mesh(), topology);
+  const std::weak_ptr<const culling::FeatureTopology> given = features;
+  ClipRunner runner(*l.motion, options, std::move(topology), {}, std::move(features));
+  freed = given.expired();
+  return collect(runner);
+}
+
 /// Runs `method` over `frames` serially and with `threads` workers in blocks of `block` samples.
 std::pair<std::vector<FrameReport>, std::vector<FrameReport>> serial_and_parallel(
     const Loaded& l, const std::string& method, const std::string& frames, std::int32_t threads,
@@ -286,13 +299,9 @@ TEST(ParallelRunner, DynamicsFeaturesServeTheDcdUpdatersAndTheRunnersAreFreed) {
       options.frames = parse_frame_range("0:20");
       options.threads = threads;
       options.block_samples = 6;
-      (void)setup_radial_view(RadialViewArguments{}, l.model, *l.motion, options);
-      skinning::Topology topology = skinning::build_topology(l.motion->mesh());
-      auto features = std::make_shared<const culling::FeatureTopology>(l.motion->mesh(), topology);
-      const std::weak_ptr<const culling::FeatureTopology> given = features;
-      ClipRunner runner(*l.motion, options, std::move(topology), {}, std::move(features));
-      EXPECT_EQ(given.expired(), m == 1);
-      rows[m][threads - 1] = collect(runner);
+      bool freed = false;
+      rows[m][threads - 1] = run_with_given_features(l, options, freed);
+      EXPECT_EQ(freed, m == 1);
     }
   }
   for (const int threads : {0, 1}) {
@@ -324,14 +333,9 @@ TEST(ParallelRunner, WithoutIncrementalDcdTheRunnerHoldsNoFeaturesOfItsOwn) {
       options.frames = parse_frame_range("0:6");
       options.threads = threads;
       options.block_samples = 3;
-      (void)setup_radial_view(RadialViewArguments{}, l.model, *l.motion, options);
-      skinning::Topology topology = skinning::build_topology(l.motion->mesh());
-      auto features = std::make_shared<const culling::FeatureTopology>(l.motion->mesh(), topology);
-      const std::weak_ptr<const culling::FeatureTopology> given = features;
-      ClipRunner runner(*l.motion, options, std::move(topology), {}, std::move(features));
-      EXPECT_EQ(given.expired(), query == QuerySet::ccd);
-      const auto rows = collect(runner);
-      EXPECT_FALSE(rows.empty());
+      bool freed = false;
+      EXPECT_FALSE(run_with_given_features(l, options, freed).empty());
+      EXPECT_EQ(freed, query == QuerySet::ccd);
     }
   }
 }
