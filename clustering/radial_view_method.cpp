@@ -362,6 +362,7 @@ void RadialViewMethod::dcd(const culling::Instant& at, culling::FrameResult& out
   culling::sieved_dcd_at<3>(
       x, tree.bvh, bounds_, topology_, tree.slots, tree.full_slots, scratch_, blocks_, tests_, out);
   blocks_.release_dcd_planes();  // not held between queries: the CCD's blocks need none
+
   record_dcd(x, out);  // with the ghosts' pairs: the next interval's cuts need them
   drop_ghosts(out);
 }

@@ -99,8 +99,7 @@ Loaded load(const std::string& spec) {
 
 /// The rows of a runner of `options` (radial view set up) handed a FeatureTopology of the mesh
 /// that the caller does not keep; `freed`: whether it was gone once the runner was built.
-std::vector<FrameReport> run_with_given_features(
-    const Loaded& l, RunOptions options, bool& freed) {
+std::vector<FrameReport> run_with_given_features(const Loaded& l, RunOptions options, bool& freed) {
   (void)setup_radial_view(RadialViewArguments{}, l.model, *l.motion, options);
   skinning::Topology topology = skinning::build_topology(l.motion->mesh());
   auto features = std::make_shared<const culling::FeatureTopology>(l.motion->mesh(), topology);
