@@ -994,6 +994,89 @@ void check_raw_numbers(const aiScene* scene, const Context& ctx) {
   }
 }
 
+// assimp's JoinIdenticalVertices with the bones set aside, then each bone's weights moved to the
+// joined vertices here. assimp 5.2.4 moves them itself with a linear search of a bone's new
+// weights for each of its weights — quadratic in a bone's weights: 52 of the 58 ms the step took
+// on the 56k-triangle CesiumMan copy (assets/characters/CesiumMan-dense.glb), in the import that
+// every check waits for. The same result, linear: a weight goes to the vertex its vertex was
+// joined into, of a bone's weights on one joined vertex the first is kept, the weights of a
+// vertex in no face are dropped (assimp drops the vertex), and a bone left with none keeps those
+// it had (as assimp's step). Which old vertex became which is read off the faces, which the step
+// renumbers in place. ImportOptions::assimp_moves_weights runs assimp's own step instead, for
+// the test that the two agree (SkinnedImport.JoiningMovesTheWeightsAsAssimpDoes).
+const aiScene* join_identical_vertices(Assimp::Importer& importer, const aiScene* scene) {
+  struct SetAside {
+    aiMesh* mesh = nullptr;
+    aiBone** bones = nullptr;
+    unsigned num_bones = 0;
+    unsigned num_vertices = 0;
+    std::vector<unsigned> corners;  // every face's vertices, before the step
+  };
+  std::vector<SetAside> aside;
+  // Freed here if the step fails: assimp then frees the scene, which no longer holds them.
+  struct Owner {
+    std::vector<SetAside>& aside;
+    ~Owner() {
+      for (SetAside& a : aside) {
+        for (unsigned b = 0; b < a.num_bones; ++b) delete a.bones[b];
+        delete[] a.bones;
+      }
+    }
+  } owner{aside};
+  for (unsigned m = 0; m < scene->mNumMeshes; ++m) {
+    aiMesh* mesh = scene->mMeshes[m];
+    if (mesh == nullptr || mesh->mNumBones == 0 || mesh->mBones == nullptr) continue;
+    SetAside a{.mesh = mesh, .bones = mesh->mBones, .num_bones = mesh->mNumBones,
+               .num_vertices = mesh->mNumVertices, .corners = {}};
+    for (unsigned f = 0; f < mesh->mNumFaces; ++f) {
+      const aiFace& face = mesh->mFaces[f];
+      a.corners.insert(a.corners.end(), face.mIndices, face.mIndices + face.mNumIndices);
+    }
+    aside.push_back(std::move(a));
+    mesh->mBones = nullptr;
+    mesh->mNumBones = 0;
+  }
+  scene = importer.ApplyPostProcessing(aiProcess_JoinIdenticalVertices);
+  if (scene == nullptr) return nullptr;
+  constexpr unsigned kNone = std::numeric_limits<unsigned>::max();
+  std::vector<unsigned> joined_into;
+  std::vector<unsigned> last_bone;  // per joined vertex: the last bone that took a weight of it
+  std::vector<aiVertexWeight> moved;
+  for (SetAside& a : aside) {
+    aiMesh* mesh = a.mesh;
+    mesh->mBones = std::exchange(a.bones, nullptr);
+    mesh->mNumBones = std::exchange(a.num_bones, 0u);
+    joined_into.assign(a.num_vertices, kNone);
+    std::size_t k = 0;
+    for (unsigned f = 0; f < mesh->mNumFaces; ++f) {
+      const aiFace& face = mesh->mFaces[f];
+      for (unsigned i = 0; i < face.mNumIndices && k < a.corners.size(); ++i, ++k) {
+        joined_into[a.corners[k]] = face.mIndices[i];
+      }
+    }
+    last_bone.assign(mesh->mNumVertices, kNone);
+    for (unsigned b = 0; b < mesh->mNumBones; ++b) {
+      aiBone* bone = mesh->mBones[b];
+      if (bone == nullptr || bone->mWeights == nullptr) continue;
+      moved.clear();
+      for (unsigned w = 0; w < bone->mNumWeights; ++w) {
+        const aiVertexWeight& old = bone->mWeights[w];
+        // (ids in range: the read's ValidateDataStructure checked them)
+        const unsigned into = old.mVertexId < a.num_vertices ? joined_into[old.mVertexId] : kNone;
+        if (into == kNone || last_bone[into] == b) continue;
+        last_bone[into] = b;
+        moved.push_back(aiVertexWeight(into, old.mWeight));
+      }
+      if (moved.empty()) continue;
+      delete[] bone->mWeights;
+      bone->mWeights = new aiVertexWeight[moved.size()];
+      std::copy(moved.begin(), moved.end(), bone->mWeights);
+      bone->mNumWeights = static_cast<unsigned>(moved.size());
+    }
+  }
+  return scene;
+}
+
 // The import proper; the caller holds import_mutex().
 ImportedRig import_locked(const std::filesystem::path& file, const ImportOptions& options) {
   Context ctx;
@@ -1013,9 +1096,14 @@ ImportedRig import_locked(const std::filesystem::path& file, const ImportOptions
   };
   if (scene == nullptr) fail_read();
   check_raw_numbers(scene, ctx);
-  unsigned flags = aiProcess_Triangulate;
-  if (options.join_identical_vertices) flags |= aiProcess_JoinIdenticalVertices;
-  scene = importer.ApplyPostProcessing(flags);
+  if (options.join_identical_vertices && options.assimp_moves_weights) {
+    scene = importer.ApplyPostProcessing(aiProcess_Triangulate | aiProcess_JoinIdenticalVertices);
+  } else {
+    scene = importer.ApplyPostProcessing(aiProcess_Triangulate);
+    if (scene != nullptr && options.join_identical_vertices) {
+      scene = join_identical_vertices(importer, scene);
+    }
+  }
   for (auto& line : printed.finish()) ctx.problems.push_back("assimp printed: " + line);
   if (scene == nullptr) fail_read();
   // assimp recovers from some broken data by dropping it with a warning; for us that is a

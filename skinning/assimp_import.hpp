@@ -20,6 +20,10 @@ struct ImportOptions {
   /// Merge identical vertices within each mesh of the file (assimp's JoinIdenticalVertices:
   /// same position, normal, UV, …). Never merges across meshes: parts stay apart.
   bool join_identical_vertices = true;
+  /// With join_identical_vertices: let assimp's step move the bones' weights itself (quadratic in
+  /// a bone's weights in assimp 5.2.4) instead of moving them here, linearly, to the same result.
+  /// For the test that the two agree.
+  bool assimp_moves_weights = false;
   /// Convert the file's unit to metres when the file declares one assimp does not apply itself
   /// (FBX: GlobalSettings UnitScaleFactor, in centimetres). glTF is in metres by definition and
   /// assimp applies Collada's <unit>; other formats carry no unit and are taken as they are.
