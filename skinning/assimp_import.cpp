@@ -1026,8 +1026,12 @@ const aiScene* join_identical_vertices(Assimp::Importer& importer, const aiScene
   for (unsigned m = 0; m < scene->mNumMeshes; ++m) {
     aiMesh* mesh = scene->mMeshes[m];
     if (mesh == nullptr || mesh->mNumBones == 0 || mesh->mBones == nullptr) continue;
-    SetAside a{.mesh = mesh, .bones = mesh->mBones, .num_bones = mesh->mNumBones,
-               .num_vertices = mesh->mNumVertices, .corners = {}};
+    SetAside a{
+        .mesh = mesh,
+        .bones = mesh->mBones,
+        .num_bones = mesh->mNumBones,
+        .num_vertices = mesh->mNumVertices,
+        .corners = {}};
     for (unsigned f = 0; f < mesh->mNumFaces; ++f) {
       const aiFace& face = mesh->mFaces[f];
       a.corners.insert(a.corners.end(), face.mIndices, face.mIndices + face.mNumIndices);

@@ -18,7 +18,7 @@
 // for every file here except RobotExpressive, whose four skinned meshes share one 43-joint
 // skeleton (two skins of the same 43 joints in the glTF).
 
-#include "skinning/assimp_import.hpp"
+#include <gtest/gtest.h>
 
 #include <cmath>
 #include <fstream>
@@ -28,8 +28,7 @@
 #include <utility>
 #include <vector>
 
-#include <gtest/gtest.h>
-
+#include "skinning/assimp_import.hpp"
 #include "skinning/errors.hpp"
 #include "skinning/lbs.hpp"
 #include "skinning/pose.hpp"
@@ -162,9 +161,9 @@ TEST(AssimpImport, JoiningMovesTheWeightsAsAssimpDoes) {
   for (const std::string& file : files) {
     const auto import = [&](bool assimp_moves_weights) -> std::pair<ImportedRig, std::string> {
       try {
-        return {import_rig(
-                    resolve(file), ImportOptions{.assimp_moves_weights = assimp_moves_weights}),
-                ""};
+        return {
+            import_rig(resolve(file), ImportOptions{.assimp_moves_weights = assimp_moves_weights}),
+            ""};
       } catch (const std::exception& e) {
         return {ImportedRig{}, e.what()};
       }
