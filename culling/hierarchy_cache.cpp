@@ -81,12 +81,44 @@ Bvh<N> HierarchyCache::get(
   }
 }
 
+std::shared_ptr<const void> HierarchyCache::shared_object(
+    const std::string& key, const std::function<std::shared_ptr<const void>()>& build) {
+  std::promise<std::shared_ptr<const void>> promise;       // set when this call builds
+  std::shared_future<std::shared_ptr<const void>> theirs;  // valid when another call did
+  {
+    std::lock_guard lock(mutex_);
+    if (closed_) return build();
+    for (const auto& [k, object] : objects_) {
+      if (k == key) {
+        theirs = object;
+        ++reuses_;
+        break;
+      }
+    }
+    if (!theirs.valid()) {
+      objects_.emplace_back(key, promise.get_future().share());
+      ++builds_;
+    }
+  }
+  if (theirs.valid()) return theirs.get();  // rethrows its build's failure
+  try {
+    std::shared_ptr<const void> built = build();
+    promise.set_value(built);
+    return built;
+  } catch (...) {
+    promise.set_exception(std::current_exception());
+    throw;
+  }
+}
+
 void HierarchyCache::close() {
   std::list<Entry> freed;
+  std::list<std::pair<std::string, std::shared_future<std::shared_ptr<const void>>>> shared;
   {
     std::lock_guard lock(mutex_);
     closed_ = true;
     freed.swap(entries_);
+    shared.swap(objects_);
   }
   // Freed outside the lock; a caller still waiting on an entry holds its future, which keeps
   // the tree it waits for.

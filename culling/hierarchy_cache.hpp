@@ -5,8 +5,13 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <functional>
+#include <future>
 #include <list>
+#include <memory>
 #include <mutex>
+#include <string>
+#include <utility>
 #include <vector>
 
 #include "culling/bvh.hpp"
@@ -43,16 +48,31 @@ class HierarchyCache {
       const std::vector<std::int32_t>* subset,
       const BvhOptions& options);
 
-  /// Frees every tree held; later calls build without keeping what they build.
+  /// An immutable object that the methods built at the same time share instead of each building
+  /// its own (`dynamic`'s rim-first FeatureTopology): the first caller of `key` builds it,
+  /// callers asking while it builds wait for it (and get its build's exception), every caller
+  /// gets the same object. `key` names what it is built from; callers build from the same
+  /// objects (the runner's mesh, weld and segmentation), so their addresses may stand for them
+  /// while the cache is open. After close(), each caller builds its own.
+  template <class T, class Build>
+  [[nodiscard]] std::shared_ptr<const T> shared(const std::string& key, Build&& build) {
+    return std::static_pointer_cast<const T>(
+        shared_object(key, [&]() -> std::shared_ptr<const void> { return build(); }));
+  }
+
+  /// Frees every tree and object held; later calls build without keeping what they build.
   void close();
 
-  /// Trees built here (not copies), since construction; for tests.
+  /// Trees and shared objects built here (not copies), since construction; for tests.
   [[nodiscard]] std::size_t builds() const;
-  /// Copies handed out of a tree another call built; for tests.
+  /// Copies handed out of a tree, or objects shared, that another call built; for tests.
   [[nodiscard]] std::size_t reuses() const;
 
  private:
   struct Entry;
+  std::shared_ptr<const void> shared_object(
+      const std::string& key, const std::function<std::shared_ptr<const void>()>& build);
+  std::list<std::pair<std::string, std::shared_future<std::shared_ptr<const void>>>> objects_;
   mutable std::mutex mutex_;
   std::list<Entry> entries_;  // a list: an entry stays where it is while callers wait on it
   bool closed_ = false;

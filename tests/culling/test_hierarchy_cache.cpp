@@ -6,8 +6,10 @@
 
 #include <algorithm>
 #include <atomic>
+#include <chrono>
 #include <cmath>
 #include <cstring>
+#include <memory>
 #include <string>
 #include <thread>
 #include <vector>
@@ -156,6 +158,61 @@ TEST(HierarchyCache, TreesAreSharedOnlyBetweenCallersThatWouldBuildTheSameOne) {
       cache.get<8>(triangles, fox.rest, nullptr, options), Bvh<8>(triangles, fox.rest, options));
   EXPECT_EQ(cache.builds(), builds);
   EXPECT_EQ(cache.reuses(), 2u);
+}
+
+// Shared objects (HierarchyCache::shared: `dynamic`'s rim-first FeatureTopology in a parallel
+// run): four threads asking at once for one key run one build and hold the same object; another
+// key builds its own; a failing build fails every caller of its key; once closed, each caller
+// builds its own and the cache keeps nothing.
+TEST(HierarchyCache, CallersOfOneKeyShareOneObjectAndOneBuild) {
+  HierarchyCache cache;
+  std::atomic<int> built{0};
+  const auto build = [&built] {
+    ++built;
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));  // the others ask meanwhile
+    return std::make_shared<const std::vector<int>>(std::vector<int>{1, 2, 3});
+  };
+  std::vector<std::shared_ptr<const std::vector<int>>> got(4);
+  std::vector<std::thread> threads;
+  std::atomic<int> ready{0};
+  for (std::size_t i = 0; i < got.size(); ++i) {
+    threads.emplace_back([&, i] {
+      ++ready;
+      while (ready.load() < 4) std::this_thread::yield();
+      got[i] = cache.shared<std::vector<int>>("numbers", build);
+    });
+  }
+  for (auto& t : threads) t.join();
+  EXPECT_EQ(built.load(), 1);
+  EXPECT_EQ(cache.builds(), 1u);
+  EXPECT_EQ(cache.reuses(), 3u);
+  for (const auto& g : got) {
+    ASSERT_NE(g, nullptr);
+    EXPECT_EQ(g.get(), got[0].get());
+    EXPECT_EQ(*g, (std::vector<int>{1, 2, 3}));
+  }
+  const auto other = cache.shared<std::vector<int>>("other numbers", build);
+  EXPECT_NE(other.get(), got[0].get());
+  EXPECT_EQ(built.load(), 2);
+
+  const auto fail = []() -> std::shared_ptr<const std::vector<int>> {
+    throw InvalidInput("no numbers here");
+  };
+  for (int i = 0; i < 2; ++i) {
+    EXPECT_THROW_MESSAGE(
+        (void)cache.shared<std::vector<int>>("failing", fail), InvalidInput, "no numbers here");
+  }
+  EXPECT_EQ(cache.builds(), 3u);
+  EXPECT_EQ(cache.reuses(), 4u);
+
+  cache.close();
+  const auto after = cache.shared<std::vector<int>>("numbers", build);
+  const auto again = cache.shared<std::vector<int>>("numbers", build);
+  EXPECT_EQ(built.load(), 4);
+  EXPECT_NE(after.get(), again.get());
+  EXPECT_NE(after.get(), got[0].get());
+  EXPECT_EQ(cache.builds(), 3u);
+  EXPECT_EQ(cache.reuses(), 4u);
 }
 
 TEST(HierarchyCache, AFailingBuildFailsEveryCallerWithItsMessage) {

@@ -240,6 +240,35 @@ TEST(ParallelRunner, WorkersShareOneBuildOfEachHierarchyAndTheCacheIsClosedAfter
   EXPECT_EQ(cache->builds(), 0u);
 }
 
+TEST(ParallelRunner, DynamicsWorkersShareOneRimFirstFeatureTopology) {
+  // `dynamic` on CesiumMan, which has no boundary loop to cap (ghost caps would give each
+  // method a mesh of its own): four workers' methods, one build of their rim-first
+  // FeatureTopology through the runner's cache, shared by the other three. Their rows are the
+  // serial run's (RealCharacterRowsEqualSerialForBvhDynamicAndAuto, and here below).
+  const auto l = load(test::asset("characters/CesiumMan.glb").string());
+  RunOptions options;
+  options.method = "dynamic";
+  options.frames = parse_frame_range("0:12");
+  options.block_samples = 2;
+  (void)setup_radial_view(RadialViewArguments{}, l.model, *l.motion, options);
+  std::vector<FrameReport> rows[2];
+  for (const int k : {0, 1}) {
+    options.threads = k == 0 ? 1 : 4;
+    auto cache = std::make_shared<culling::HierarchyCache>();
+    ClipRunner runner(
+        *l.motion, options, skinning::build_topology(l.motion->mesh()), {}, {}, cache);
+    if (k == 1) {
+      ASSERT_EQ(runner.plan().threads, 4) << runner.plan().serial_reason;
+      EXPECT_EQ(cache->builds(), 1u);
+      EXPECT_EQ(cache->reuses(), 3u);
+    } else {
+      EXPECT_EQ(cache->builds(), 0u);  // one method: the cache closed unused
+    }
+    rows[k] = collect(runner);
+  }
+  EXPECT_GT(expect_same_rows(rows[0], rows[1]), 0u) << "no findings: the clip proves nothing";
+}
+
 TEST(ParallelRunner, AutosRoutedMethodRowsEqualSerial) {
   // `auto` sends BCN_Epileptic whole to `bvh` (every part capped or small: RoutingOptions::
   // all_closed_method). Without that rule, and with the segmentation `dynamic` needs, its routed
