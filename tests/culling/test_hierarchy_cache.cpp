@@ -50,6 +50,21 @@ void expect_same_tree(const Bvh<N>& a, const Bvh<N>& b) {
   EXPECT_EQ(a.node_bounds().size(), b.node_bounds().size());
 }
 
+/// Runs ask(0) … ask(n − 1) on n threads that start asking together (each waits for all).
+template <class Ask>
+void at_once(std::size_t n, Ask&& ask) {
+  std::vector<std::thread> threads;
+  std::atomic<std::size_t> ready{0};
+  for (std::size_t i = 0; i < n; ++i) {
+    threads.emplace_back([&, i] {
+      ++ready;
+      while (ready.load() < n) std::this_thread::yield();
+      ask(i);
+    });
+  }
+  for (auto& t : threads) t.join();
+}
+
 TEST(HierarchyCache, CallersOfOneTreeShareOneBuildAndGetTheTreeTheirOwnBuildGives) {
   const test::WeldedCharacter fox("Fox.glb");
   const auto& triangles = fox.topology.welded_triangles;
@@ -59,16 +74,9 @@ TEST(HierarchyCache, CallersOfOneTreeShareOneBuildAndGetTheTreeTheirOwnBuildGive
   // Four threads ask at once: one builds, three wait for it and copy.
   HierarchyCache cache;
   std::vector<Bvh<3>> got(4);
-  std::vector<std::thread> threads;
-  std::atomic<int> ready{0};
-  for (std::size_t i = 0; i < got.size(); ++i) {
-    threads.emplace_back([&, i] {
-      ++ready;
-      while (ready.load() < 4) std::this_thread::yield();
-      got[i] = cache.get<3>(triangles, fox.rest, nullptr, options);
-    });
-  }
-  for (auto& t : threads) t.join();
+  at_once(got.size(), [&](std::size_t i) {
+    got[i] = cache.get<3>(triangles, fox.rest, nullptr, options);
+  });
   EXPECT_EQ(cache.builds(), 1u);
   EXPECT_EQ(cache.reuses(), 3u);
   for (const auto& tree : got) expect_same_tree(tree, own);
@@ -173,16 +181,9 @@ TEST(HierarchyCache, CallersOfOneKeyShareOneObjectAndOneBuild) {
     return std::make_shared<const std::vector<int>>(std::vector<int>{1, 2, 3});
   };
   std::vector<std::shared_ptr<const std::vector<int>>> got(4);
-  std::vector<std::thread> threads;
-  std::atomic<int> ready{0};
-  for (std::size_t i = 0; i < got.size(); ++i) {
-    threads.emplace_back([&, i] {
-      ++ready;
-      while (ready.load() < 4) std::this_thread::yield();
-      got[i] = cache.shared<std::vector<int>>("numbers", build);
-    });
-  }
-  for (auto& t : threads) t.join();
+  at_once(got.size(), [&](std::size_t i) {
+    got[i] = cache.shared<std::vector<int>>("numbers", build);
+  });
   EXPECT_EQ(built.load(), 1);
   EXPECT_EQ(cache.builds(), 1u);
   EXPECT_EQ(cache.reuses(), 3u);
