@@ -997,7 +997,7 @@ void check_raw_numbers(const aiScene* scene, const Context& ctx) {
 // assimp's JoinIdenticalVertices with the bones set aside, then each bone's weights moved to the
 // joined vertices here. assimp 5.2.4 moves them itself with a linear search of a bone's new
 // weights for each of its weights — quadratic in a bone's weights: 52 of the 58 ms the step took
-// on the 56k-triangle CesiumMan copy (assets/characters/CesiumMan-dense.glb), in the import that
+// on the 28k-triangle CesiumMan copy (assets/characters/CesiumMan-dense.glb), in the import that
 // every check waits for. The same result, linear: a weight goes to the vertex its vertex was
 // joined into, of a bone's weights on one joined vertex the first is kept, the weights of a
 // vertex in no face are dropped (assimp drops the vertex), and a bone left with none keeps those

@@ -136,7 +136,7 @@ INSTANTIATE_TEST_SUITE_P(
 // assimp's own step gives, bit for bit — the vertices, the triangles, the weights after
 // normalising (a weight moved twice onto one joined vertex would double that bone's share), the
 // problems — or the same refusal, on every rigged real model at hand: the Debian models with
-// bones and the bundled characters, up to the 56k-triangle CesiumMan copy.
+// bones and the bundled characters, up to the 28k-triangle CesiumMan copy.
 TEST(AssimpImport, JoiningMovesTheWeightsAsAssimpDoes) {
   const std::vector<std::string> files = {
       "X/BCN_Epileptic.X",

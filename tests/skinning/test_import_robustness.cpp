@@ -337,7 +337,7 @@ TEST(ImportGuard, AnAnswerLargerThanTheMemoryLimitIsRefused) {
 // In a process of its own (gtest's "threadsafe" death-test style runs the test binary anew for
 // the statement): heap that earlier tests freed in this process is room the import's child
 // allocates in without adding address space (import_guard.cpp counts at most the limit of it),
-// and after the 56k-triangle CesiumMan copy's import there is more of it than CesiumMan needs.
+// and after the 28k-triangle CesiumMan copy's import there is more of it than CesiumMan needs.
 TEST(ImportRobustness, ATinyImportMemoryLimitRefusesARealCharacter) {
   GTEST_FLAG_SET(death_test_style, "threadsafe");
   EXPECT_EXIT(
