@@ -1003,7 +1003,7 @@ void check_raw_numbers(const aiScene* scene, const Context& ctx) {
 // vertex in no face are dropped (assimp drops the vertex), and a bone left with none keeps those
 // it had (as assimp's step). Which old vertex became which is read off the faces, which the step
 // renumbers in place. ImportOptions::assimp_moves_weights runs assimp's own step instead, for
-// the test that the two agree (SkinnedImport.JoiningMovesTheWeightsAsAssimpDoes).
+// the test that the two agree (AssimpImport.JoiningMovesTheWeightsAsAssimpDoes).
 const aiScene* join_identical_vertices(Assimp::Importer& importer, const aiScene* scene) {
   struct SetAside {
     aiMesh* mesh = nullptr;
@@ -1055,7 +1055,10 @@ const aiScene* join_identical_vertices(Assimp::Importer& importer, const aiScene
     for (unsigned f = 0; f < mesh->mNumFaces; ++f) {
       const aiFace& face = mesh->mFaces[f];
       for (unsigned i = 0; i < face.mNumIndices && k < a.corners.size(); ++i, ++k) {
-        joined_into[a.corners[k]] = face.mIndices[i];
+        // (in range both: ValidateDataStructure checked the read, the step renumbers within)
+        if (a.corners[k] < a.num_vertices && face.mIndices[i] < mesh->mNumVertices) {
+          joined_into[a.corners[k]] = face.mIndices[i];
+        }
       }
     }
     last_bone.assign(mesh->mNumVertices, kNone);
@@ -1065,7 +1068,6 @@ const aiScene* join_identical_vertices(Assimp::Importer& importer, const aiScene
       moved.clear();
       for (unsigned w = 0; w < bone->mNumWeights; ++w) {
         const aiVertexWeight& old = bone->mWeights[w];
-        // (ids in range: the read's ValidateDataStructure checked them)
         const unsigned into = old.mVertexId < a.num_vertices ? joined_into[old.mVertexId] : kNone;
         if (into == kNone || last_bone[into] == b) continue;
         last_bone[into] = b;
