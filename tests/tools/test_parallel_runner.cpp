@@ -269,6 +269,41 @@ TEST(ParallelRunner, DynamicsWorkersShareOneRimFirstFeatureTopology) {
   EXPECT_GT(expect_same_rows(rows[0], rows[1]), 0u) << "no findings: the clip proves nothing";
 }
 
+TEST(ParallelRunner, ATopologyTheCallerKeepsReadingServesTheCallersFeatures) {
+  // A parallel check's baseline thread reads the weld and builds the mesh's FeatureTopology while
+  // the runner is built: given the same topology object, the runner and its workers' `bvh`s take
+  // those features (they stay held once the caller lets go) and read that very topology; given
+  // a copy of it, as before, they cannot take them (FeatureTopology::built_from) and build a
+  // second FeatureTopology. The rows are the serial run's either way.
+  const auto l = load(test::asset("characters/CesiumMan.glb").string());
+  RunOptions options;
+  options.method = "bvh";
+  options.frames = parse_frame_range("0:20");
+  options.block_samples = 6;
+  std::vector<FrameReport> rows[3];
+  for (const int k : {0, 1, 2}) {
+    SCOPED_TRACE(k);
+    options.threads = k == 0 ? 1 : 2;
+    const auto topology =
+        std::make_shared<const skinning::Topology>(skinning::build_topology(l.motion->mesh()));
+    auto features = std::make_shared<const culling::FeatureTopology>(l.motion->mesh(), *topology);
+    const std::weak_ptr<const culling::FeatureTopology> given = features;
+    const bool copy = k == 2;
+    const auto runner =
+        copy
+            ? std::make_unique<ClipRunner>(
+                  *l.motion, options, skinning::Topology(*topology), MethodFactory{}, features)
+            : std::make_unique<ClipRunner>(*l.motion, options, topology, MethodFactory{}, features);
+    features.reset();
+    EXPECT_EQ(runner->plan().threads, k == 0 ? 1 : 2) << runner->plan().serial_reason;
+    EXPECT_EQ(&runner->topology() == topology.get(), !copy);
+    EXPECT_EQ(given.expired(), copy);  // `bvh` with incremental DCD holds the features it took
+    rows[k] = collect(*runner);
+  }
+  EXPECT_GT(expect_same_rows(rows[0], rows[1]), 0u) << "no findings: the clip proves nothing";
+  expect_same_rows(rows[0], rows[2]);
+}
+
 TEST(ParallelRunner, AutosRoutedMethodRowsEqualSerial) {
   // `auto` sends BCN_Epileptic whole to `bvh` (every part capped or small: RoutingOptions::
   // all_closed_method). Without that rule, and with the segmentation `dynamic` needs, its routed

@@ -484,12 +484,29 @@ ClipRunner::ClipRunner(
     MethodFactory factory,
     std::shared_ptr<const culling::FeatureTopology> features,
     std::shared_ptr<culling::HierarchyCache> hierarchies)
+    : ClipRunner(
+          motion,
+          options,
+          std::make_shared<const skinning::Topology>(
+              std::move(topology)),  // a move: built_from holds
+          std::move(factory),
+          std::move(features),
+          std::move(hierarchies)) {}
+
+ClipRunner::ClipRunner(
+    const skinning::Motion& motion,
+    const RunOptions& options,
+    std::shared_ptr<const skinning::Topology> topology,
+    MethodFactory factory,
+    std::shared_ptr<const culling::FeatureTopology> features,
+    std::shared_ptr<culling::HierarchyCache> hierarchies)
     : motion_(motion),
       options_(options),
       factory_(std::move(factory)),
       method_options_(method_options_of(options, motion)),
       plan_(make_plan(motion, options)),
       topology_(std::move(topology)) {
+  if (topology_ == nullptr) throw InvalidInput("ClipRunner: no topology given");
   // Within one query the elementary tests may split over the threads asked for (identical
   // output) when the run is serial across queries; otherwise blocks of samples go to workers
   // (below), each query on one thread.
@@ -511,7 +528,7 @@ ClipRunner::ClipRunner(
     const skinning::SkinWeights& weights = *motion.skin_weights();
     auto rows = std::make_shared<const culling::RigidRows>(culling::build_rigid_rows(
         motion.mesh(),
-        topology_,
+        *topology_,
         weights,
         static_cast<std::int32_t>(weights.cols()),
         kMinRigidRowShare));
@@ -560,7 +577,7 @@ ClipRunner::ClipRunner(
   // its own (`dynamic` on one thread: its `bvh`, its updater and the runner's updater, three).
   // The caller's, when built from the mesh and the topology moved in here.
   method_options_.features =
-      culling::shared_or_built(std::move(features), motion_.mesh(), topology_);
+      culling::shared_or_built(std::move(features), motion_.mesh(), *topology_);
 
   // The method; in a parallel run, the other workers' methods at the same time, so that every
   // worker starts checking with the first block instead of one waiting for its method (a serial
@@ -621,15 +638,15 @@ void ClipRunner::adopt_method_features() {
   }
   std::shared_ptr<const culling::FeatureTopology> own = method_->shared_features();
   if (own != nullptr && own != method_options_.features &&
-      own->describes(motion_.mesh(), topology_)) {
+      own->describes(motion_.mesh(), *topology_)) {
     method_options_.features = std::move(own);
   }
 }
 
 std::unique_ptr<culling::CullingMethod> ClipRunner::build_method() const {
   std::unique_ptr<culling::CullingMethod> m =
-      factory_ ? factory_(motion_.mesh(), topology_, method_options_)
-               : culling::make_method(options_.method, motion_.mesh(), topology_, method_options_);
+      factory_ ? factory_(motion_.mesh(), *topology_, method_options_)
+               : culling::make_method(options_.method, motion_.mesh(), *topology_, method_options_);
   if (!m) throw InvalidInput("method '" + options_.method + "' could not be built");
   return m;
 }
@@ -666,16 +683,16 @@ void ClipRunner::run_serial(const FrameCallback& on_frame) {
 }
 
 void ClipRunner::run_queries_in_order(const FrameCallback& on_frame) {
-  const FeatureNumbering numbering(motion_.mesh(), topology_);
+  const FeatureNumbering numbering(motion_.mesh(), *topology_);
   const RowContext context{
       motion_,
-      topology_,
+      *topology_,
       numbering,
       bones_,
       incremental_dcd_ ? &method_options_.elementary : nullptr,
       method_options_.features,
       reuse_static_,
-      identity_welding(topology_)};
+      identity_welding(*topology_)};
   const bool dcd = options_.query != QuerySet::ccd;
   const SampleSequence all{
       .first = plan_.first_sample,
@@ -698,16 +715,16 @@ void ClipRunner::run_queries_in_order(const FrameCallback& on_frame) {
 }
 
 void ClipRunner::run_parallel(const FrameCallback& on_frame) {
-  const FeatureNumbering numbering(motion_.mesh(), topology_);
+  const FeatureNumbering numbering(motion_.mesh(), *topology_);
   const RowContext context{
       motion_,
-      topology_,
+      *topology_,
       numbering,
       bones_,
       incremental_dcd_ ? &method_options_.elementary : nullptr,
       method_options_.features,
       reuse_static_,
-      identity_welding(topology_)};
+      identity_welding(*topology_)};
   const bool dcd = options_.query != QuerySet::ccd;
   const bool ccd = options_.query != QuerySet::dcd;
   const std::int32_t last = plan_.last_sample;

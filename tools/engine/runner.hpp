@@ -130,9 +130,20 @@ class ClipRunner {
       MethodFactory factory = {},
       std::shared_ptr<const culling::FeatureTopology> features = {},
       std::shared_ptr<culling::HierarchyCache> hierarchies = {});
+  /// The same on a topology the caller keeps reading while the runner is built (a parallel
+  /// check's baseline thread): one object, so that a FeatureTopology built from it
+  /// (culling::FeatureTopology::built_from) is the runner's too, where a copy would need a
+  /// second one.
+  ClipRunner(
+      const skinning::Motion& motion,
+      const RunOptions& options,
+      std::shared_ptr<const skinning::Topology> topology,
+      MethodFactory factory = {},
+      std::shared_ptr<const culling::FeatureTopology> features = {},
+      std::shared_ptr<culling::HierarchyCache> hierarchies = {});
 
   [[nodiscard]] const RunPlan& plan() const { return plan_; }
-  [[nodiscard]] const skinning::Topology& topology() const { return topology_; }
+  [[nodiscard]] const skinning::Topology& topology() const { return *topology_; }
   [[nodiscard]] std::string_view method_name() const { return method_->name(); }
   /// Under `auto`, where each connected component went (the log's /routes rows); empty for any
   /// other method. `part_offset` is added to each route's part id (a scene's object offset).
@@ -161,7 +172,7 @@ class ClipRunner {
   MethodFactory factory_;
   culling::MethodOptions method_options_;
   RunPlan plan_;
-  skinning::Topology topology_;
+  std::shared_ptr<const skinning::Topology> topology_;  ///< never null
   std::unique_ptr<culling::CullingMethod> method_;
   /// A parallel run's other workers' methods (plan_.threads − 1), built with method_.
   std::vector<std::unique_ptr<culling::CullingMethod>> spare_methods_;
