@@ -569,6 +569,15 @@ void run_check_command(const CheckArguments& args) {
   // ~17 MiB above the floor (docs/benchmarks.md, "Fixed costs"). Only here: `inspect` reads logs
   // under libhdf5's own allocation pattern (tests/tools/test_log.cpp, the fuzzed logs).
   mallopt(M_MMAP_THRESHOLD, 128 * 1024);
+  // When glibc trims the heap's free top it keeps this much mapped (default 128 KiB): a check
+  // frees and allocates its per-phase and per-query buffers over and over, and each page given
+  // back is a page fault the next time, which this project's VMs make dear. 4 MiB took a third of
+  // the page faults off CesiumMan-dense's check (`dynamic`, one thread: 17.5k -> 11.9k, 0.79 ->
+  // 0.70 s) with the same peak RSS on one thread; 16 MiB gave the worker threads' heaps 8 MiB
+  // more on two (docs/benchmarks.md, "The heap's top kept"). The import's child inherits it: an
+  // import that needs all but the last 4 MiB of its limit may be refused (the limit is 64 MiB at
+  // least on the command line).
+  mallopt(M_TOP_PAD, 4 << 20);
   if (args.models.size() == 1 && is_scene_path(args.models.front())) {  // a scene (docs/scenes.md)
     run_scene_check(
         args.models.front(),
