@@ -1263,7 +1263,9 @@ ImportedRig import_rig(const std::filesystem::path& file, const ImportOptions& o
     // A crash, a loop or a runaway allocation inside assimp ends the child, not this process. The
     // child's import is the only one: it sends the rig back, and this process decodes it.
     const detail::ImportLimits limits{
-        .memory_bytes = options.memory_limit_bytes, .time_s = options.time_limit_s};
+        .memory_bytes = options.memory_limit_bytes,
+        .time_s = options.time_limit_s,
+        .heap_on_huge_pages = true};
     detail::ChildAnswer answer =
         detail::run_isolated_with_answer(file, limits, [&](const detail::AnswerSink& send) {
           detail::write_imported_rig(import_locked(file, options), send);

@@ -750,9 +750,11 @@ void grow_heap_on_huge_pages(std::size_t bytes) {
 #if !defined(SKELCD_UNDER_ASAN)
   // 30 MiB, at most an eighth of the limit: a large block the top cannot hold is still mapped
   // apart, and the top's address space then counts against the limit beside it.
-  grow_heap_on_huge_pages(
-      limits.memory_bytes > 0 ? std::min(kHeapOnHugePages, limits.memory_bytes / 8)
-                              : kHeapOnHugePages);
+  if (limits.heap_on_huge_pages) {
+    grow_heap_on_huge_pages(
+        limits.memory_bytes > 0 ? std::min(kHeapOnHugePages, limits.memory_bytes / 8)
+                                : kHeapOnHugePages);
+  }
 #endif
   std::string report;
   try {

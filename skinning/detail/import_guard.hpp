@@ -20,6 +20,10 @@ struct ImportLimits {
   double time_s = 0.0;
   /// Who reads the file, for the messages ("the importer (assimp)", "HDF5").
   const char* reader = "the importer (assimp)";
+  /// Grow the child's heap at once and advise it as huge pages (import_guard.cpp): assimp's
+  /// imports only. A reader whose known crashes depend on the heap's layout (HDF5's fuzzed
+  /// logs) keeps the plain heap.
+  bool heap_on_huge_pages = false;
 };
 
 /// Refuses a file whose header declares more elements than its size can hold, before any

@@ -250,38 +250,19 @@ TEST(ImportGuard, ARunawayAllocationInTheChildIsRefusedWithTheLimit) {
 }
 
 #if !defined(__SANITIZE_ADDRESS__)  // the sanitizers' allocator has a heap of its own
-/// The VmFlags line of the mapping that holds `address` in this process (/proc/self/smaps).
-std::string vm_flags_at(const void* address) {
-  const auto at = reinterpret_cast<std::uintptr_t>(address);
-  std::ifstream smaps("/proc/self/smaps");
-  std::string line;
-  bool inside = false;
-  while (std::getline(smaps, line)) {
-    const std::string first = line.substr(0, line.find(' '));
-    if (first.find('-') != std::string::npos && first.find(':') == std::string::npos) {
-      const std::size_t dash = first.find('-');
-      const auto begin = std::stoull(first.substr(0, dash), nullptr, 16);
-      const auto end = std::stoull(first.substr(dash + 1), nullptr, 16);
-      inside = begin <= at && at < end;
-    } else if (inside && line.rfind("VmFlags:", 0) == 0) {
-      return line;
-    }
-  }
-  return {};
-}
-
 TEST(ImportGuard, TheChildsHeapIsAdvisedAsHugePagesWithinItsLimit) {
   // The child grows its heap by 30 MiB at once (at most an eighth of its limit) and advises it
   // as transparent huge pages ("hg" in the mapping's VmFlags, whatever the kernel's mode): 8 MiB
   // allocated there and touched is on that mapping. Under a 16 MiB limit (an eighth: 2 MiB) the
   // heap is left as it was, not advised.
   const auto flags_in_child = [](std::size_t limit) {
-    const detail::ImportLimits limits{.memory_bytes = limit, .time_s = 60};
+    const detail::ImportLimits limits{
+        .memory_bytes = limit, .time_s = 60, .heap_on_huge_pages = true};
     detail::ChildAnswer answer =
         detail::run_isolated_with_answer("model.glb", limits, [](const detail::AnswerSink& send) {
           constexpr std::size_t kBytes = std::size_t{8} << 20;
           std::vector<char> touched(kBytes, 'x');
-          const std::string flags = vm_flags_at(touched.data() + kBytes / 2);
+          const std::string flags = test::vm_flags_at(touched.data() + kBytes / 2);
           send(flags.data(), flags.size());
         });
     std::string flags(answer.size(), '\0');

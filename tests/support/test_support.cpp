@@ -1,8 +1,10 @@
 #include "tests/support/test_support.hpp"
 
-#include <sstream>
-
 #include <unistd.h>
+
+#include <cstdint>
+#include <fstream>
+#include <sstream>
 
 namespace skelcd::test {
 
@@ -12,6 +14,25 @@ std::filesystem::path asset(std::string_view relative) {
 
 std::filesystem::path assimp_model(std::string_view relative) {
   return std::filesystem::path(SKELCD_ASSIMP_MODELS) / relative;
+}
+
+std::string vm_flags_at(const void* address) {
+  const auto a = reinterpret_cast<std::uintptr_t>(address);
+  std::ifstream smaps("/proc/self/smaps");
+  std::string line;
+  bool inside = false;
+  while (std::getline(smaps, line)) {
+    std::uintptr_t lo = 0;
+    std::uintptr_t hi = 0;
+    char dash = 0;
+    std::istringstream head(line);
+    if (head >> std::hex >> lo >> dash >> hi && dash == '-') {
+      inside = lo <= a && a < hi;
+    } else if (inside && line.rfind("VmFlags:", 0) == 0) {
+      return line;
+    }
+  }
+  return "";
 }
 
 std::filesystem::path temp_dir(std::string_view name) {

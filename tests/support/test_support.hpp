@@ -16,6 +16,9 @@ namespace skelcd::test {
 [[nodiscard]] std::filesystem::path assimp_model(std::string_view relative);
 /// A fresh, empty temporary folder for one test (removed at the next call with the same name).
 [[nodiscard]] std::filesystem::path temp_dir(std::string_view name);
+/// The VmFlags line of the mapping of /proc/self/smaps that holds `address` ("" when none does):
+/// what the kernel was told about that memory (" hg": advised as transparent huge pages).
+[[nodiscard]] std::string vm_flags_at(const void* address);
 
 /// Succeeds when `a` and `b` have the same shape and max |a - b| <= tolerance.
 [[nodiscard]] ::testing::AssertionResult expect_matrix_near(

@@ -9,34 +9,14 @@
 #include <filesystem>
 #include <fstream>
 #include <memory>
-#include <sstream>
 #include <string>
 #include <vector>
 
+#include "tests/support/test_support.hpp"
 #include "tools/cli/large_pages.hpp"
 
 namespace skelcd::tools {
 namespace {
-
-/// The VmFlags line of the mapping of /proc/self/smaps that holds `address` ("" when none does).
-std::string vm_flags_at(const void* address) {
-  const auto a = reinterpret_cast<std::uintptr_t>(address);
-  std::ifstream smaps("/proc/self/smaps");
-  std::string line;
-  bool inside = false;
-  while (std::getline(smaps, line)) {
-    std::uintptr_t lo = 0;
-    std::uintptr_t hi = 0;
-    char dash = 0;
-    std::istringstream head(line);
-    if (head >> std::hex >> lo >> dash >> hi && dash == '-') {
-      inside = lo <= a && a < hi;
-    } else if (inside && line.rfind("VmFlags:", 0) == 0) {
-      return line;
-    }
-  }
-  return "";
-}
 
 /// A cache line, as the feature stage's over-aligned records.
 struct alignas(64) Line64 {
@@ -89,7 +69,7 @@ TEST(LargePages, ALargeVectorFollowsTheSetting) {
   // has transparent huge pages), or neither.
   const auto expect_follows = [on](const void* data) {
     const bool aligned = reinterpret_cast<std::uintptr_t>(data) % kHugePage == 0;
-    const std::string flags = vm_flags_at(data);
+    const std::string flags = test::vm_flags_at(data);
     ASSERT_FALSE(flags.empty()) << "no mapping of /proc/self/smaps holds " << data;
     const bool advised = flags.find(" hg") != std::string::npos;
     if (on) {
@@ -113,11 +93,11 @@ TEST(LargePages, ALargeVectorFollowsTheSetting) {
   // A block that ends a seventh short of a huge page ends on it: its last byte is advised too;
   // one that would need 43 % more keeps its tail on small pages.
   const std::vector<char> rounded(7 * kHugePage / 4, 'r');
-  const std::string rounded_end = vm_flags_at(&rounded.back());
+  const std::string rounded_end = test::vm_flags_at(&rounded.back());
   EXPECT_EQ(rounded_end.find(" hg") != std::string::npos, on && kernel_has_huge_pages())
       << rounded_end;
   const std::vector<char> as_asked(7 * kHugePage / 5, 'a');
-  const std::string as_asked_end = vm_flags_at(&as_asked.back());
+  const std::string as_asked_end = test::vm_flags_at(&as_asked.back());
   EXPECT_EQ(as_asked_end.find(" hg"), std::string::npos) << as_asked_end;
 }
 
