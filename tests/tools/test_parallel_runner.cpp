@@ -6,6 +6,7 @@
 
 #include <gtest/gtest.h>
 #include <tbb/info.h>
+#include <tbb/task_scheduler_observer.h>
 
 #include <algorithm>
 #include <atomic>
@@ -770,6 +771,35 @@ TEST(ParallelRunner, DynamicWithoutDcdCarriesStateSoBlocksWouldChangeItsCounters
   }
   EXPECT_TRUE(counters_differ) << "blocks of dynamic --query ccd matched serial: is the carried "
                                   "state gone? then serial_reason can allow it";
+}
+
+/// Counts the oneTBB worker threads that join the calling thread's arena while it lives.
+class WorkerEntries : public tbb::task_scheduler_observer {
+ public:
+  WorkerEntries() { observe(true); }
+  ~WorkerEntries() override { observe(false); }
+  void on_scheduler_entry(bool is_worker) override {
+    if (is_worker) ++entries;
+  }
+  std::atomic<int> entries{0};
+};
+
+TEST(ParallelRunner, ASerialRunSegmentsOnItsOwnThread) {
+  // CesiumMan-dense has 28,032 triangles: enough for segment_mesh to split its bones and clusters
+  // over oneTBB's threads, which `--threads 1` must keep to the calling thread (each test runs in
+  // a process of its own: no worker is in the arena before it).
+  const Loaded l = load(test::asset("characters/CesiumMan-dense.glb").string());
+  ASSERT_GT(l.motion->mesh().num_triangles(), 20000);
+  RunOptions options;
+  options.method = "dynamic";
+  options.threads = 1;
+  WorkerEntries workers;
+  const RadialViewSetup setup =
+      setup_radial_view(RadialViewArguments{}, l.model, *l.motion, options);
+  ASSERT_NE(options.segmentation, nullptr);
+  EXPECT_EQ(setup.segmentation_source, "computed (rig weights)");
+  EXPECT_GT(setup.atomic_clusters, 0);
+  EXPECT_EQ(workers.entries.load(), 0) << "a worker thread joined the segmentation of a serial run";
 }
 
 }  // namespace

@@ -1,5 +1,7 @@
 #include "tools/engine/radial_view_setup.hpp"
 
+#include <tbb/global_control.h>
+
 #include <cmath>
 #include <filesystem>
 #include <iostream>
@@ -9,6 +11,7 @@
 #include "culling/routed_method.hpp"
 #include "segmentation/segmentation.hpp"
 #include "skinning/errors.hpp"
+#include "tools/engine/runner.hpp"
 #include "tools/io/segmentation_file.hpp"
 
 namespace skelcd::tools {
@@ -99,6 +102,12 @@ RadialViewSetup setup_radial_view(
                                                   : segmentation::WeightSource::heat;
     // The caller's weld of the mesh when it is the rig's own (a rig's clip moves rig.mesh).
     const bool rig_mesh = topology != nullptr && &motion.mesh() == &model.rig->mesh;
+    // On the threads the run asked for: segment_mesh splits its bones and clusters over oneTBB's
+    // threads (from 20,000 triangles), which would otherwise take every core, `--threads 1`
+    // too (a second core for 8 of CesiumMan-dense's 40 ms; docs/check.md "Threads").
+    const tbb::global_control threads_asked(
+        tbb::global_control::max_allowed_parallelism,
+        static_cast<std::size_t>(resolve_threads(options.threads)));
     seg = std::make_shared<const segmentation::Segmentation>(
         rig_mesh ? segmentation::segment(*model.rig, o, *topology)
                  : segmentation::segment(*model.rig, o));
