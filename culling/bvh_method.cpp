@@ -2,6 +2,9 @@
 // refit per interval, traversed against itself; then the shared feature and elementary stages.
 #include <algorithm>
 #include <cstddef>
+#include <cstdint>
+#include <memory>
+#include <span>
 #include <string>
 
 #include "culling/bvh.hpp"
@@ -32,6 +35,30 @@ skinning::Positions welded_rest_positions(
     rest.row(w) = mesh.rest_positions.row(v);
   }
   return rest;
+}
+
+/// The fan sieve's slot adjacency of a hierarchy's triangle order. The methods of a parallel run
+/// (the baseline's `bvh` and the workers') copy one tree, so they share one, through `cache`
+/// (never written: FanSieve reads it), keyed by their FeatureTopology and the order's bytes; the
+/// object holds that FeatureTopology, so that no other takes its address while the cache keeps
+/// it. Built here without a cache.
+std::shared_ptr<const SlotAdjacency> shared_slots(
+    HierarchyCache* cache,
+    const std::shared_ptr<const FeatureTopology>& features,
+    std::span<const std::int32_t> order) {
+  struct Held {
+    std::shared_ptr<const FeatureTopology> features;
+    SlotAdjacency slots;
+  };
+  const auto build = [&] {
+    auto held = std::make_shared<const Held>(Held{features, SlotAdjacency(*features, order)});
+    return std::shared_ptr<const SlotAdjacency>(held, &held->slots);
+  };
+  if (cache == nullptr) return build();
+  std::string key =
+      "SlotAdjacency " + std::to_string(reinterpret_cast<std::uintptr_t>(features.get())) + ' ';
+  key.append(reinterpret_cast<const char*>(order.data()), order.size_bytes());
+  return cache->shared<SlotAdjacency>(key, build);
 }
 
 /// The hierarchy options of a method that traverses only the wide copy (culling/traversal.hpp):
@@ -72,7 +99,7 @@ class BvhMethod final : public MethodBase {
     check_positions(at.x, "detect_dcd", "x");
     // Pairs sharing a certified vertex are settled where the traversal finds them (FanSieve).
     sieved_dcd_at<N>(
-        at.x, bvh_, bounds_, topology_, slots_, full_slots_, scratch_, blocks_, tests_, out);
+        at.x, bvh_, bounds_, topology_, *slots_, full_slots_, scratch_, blocks_, tests_, out);
   }
 
   void ccd(const Interval& interval, FrameResult& out) override {
@@ -131,7 +158,7 @@ class BvhMethod final : public MethodBase {
     // through the relative filter and the feature stage (not with part exclusions, whose CCD rule
     // is per feature).
     FanSieve sieve = fan_sieve(
-        slots_,
+        *slots_,
         topology_.has_exclusions() ? std::span<const std::uint8_t>{}
                                    : blocks_.certify_interval_fans(),
         full_slots_,
@@ -241,7 +268,8 @@ class BvhMethod final : public MethodBase {
   std::vector<TrianglePair> rest_pairs_;  // the certified rows' rest pairs, this interval
   RelativePairTrial relative_;
   Bvh<N> bvh_;
-  SlotAdjacency slots_{topology_, bvh_.triangle_order()};
+  std::shared_ptr<const SlotAdjacency> slots_ =
+      shared_slots(options_.hierarchies.get(), features_, bvh_.triangle_order());
   std::vector<std::uint8_t> full_slots_;
   // Whether the last interval had enough pairs apart at both ends for the slot end boxes to pay
   // (pairs per triangle), when ccd builds them.
@@ -283,3 +311,21 @@ template std::unique_ptr<CullingMethod> make_bvh_method<8>(
     bool);
 
 }  // namespace skelcd::culling::detail
+
+namespace skelcd::culling {
+
+void prebuild_bvh_hierarchy(
+    HierarchyCache& cache,
+    const skinning::Mesh& mesh,
+    const skinning::Topology& topology,
+    const BvhOptions& options) {
+  // The key BvhMethod<3> asks the cache with (FeatureTopology::welded_triangles is a copy of the
+  // topology's: the same bytes).
+  cache.prebuild<3>(
+      topology.welded_triangles,
+      detail::welded_rest_positions(mesh, topology),
+      nullptr,
+      detail::traversal_only(options));
+}
+
+}  // namespace skelcd::culling

@@ -34,6 +34,40 @@ bool same_bytes(const Matrix& a, const Matrix& b) {
 HierarchyCache::HierarchyCache() = default;
 HierarchyCache::~HierarchyCache() = default;
 
+const HierarchyCache::Entry* HierarchyCache::find(
+    int volume_axes,
+    const skinning::Triangles& triangles,
+    const skinning::Positions& positions,
+    const std::vector<std::int32_t>* subset,
+    const BvhOptions& options) const {
+  for (const Entry& e : entries_) {
+    if (e.volume_axes == volume_axes && e.options == options && e.whole == (subset == nullptr) &&
+        (subset == nullptr || e.subset == *subset) && same_bytes(e.triangles, triangles) &&
+        same_bytes(e.positions, positions)) {
+      return &e;
+    }
+  }
+  return nullptr;
+}
+
+void HierarchyCache::add(
+    int volume_axes,
+    const skinning::Triangles& triangles,
+    const skinning::Positions& positions,
+    const std::vector<std::int32_t>* subset,
+    const BvhOptions& options,
+    std::shared_future<std::shared_ptr<const void>> tree) {
+  Entry& e = entries_.emplace_back();
+  e.volume_axes = volume_axes;
+  e.triangles = triangles;
+  e.positions = positions;
+  e.whole = subset == nullptr;
+  if (subset != nullptr) e.subset = *subset;
+  e.options = options;
+  e.tree = std::move(tree);
+  ++builds_;
+}
+
 template <int N>
 Bvh<N> HierarchyCache::get(
     const skinning::Triangles& triangles,
@@ -46,25 +80,12 @@ Bvh<N> HierarchyCache::get(
   {
     std::lock_guard lock(mutex_);
     keep = !closed_;
-    for (const Entry& e : entries_) {
-      if (e.volume_axes == N && e.options == options && e.whole == (subset == nullptr) &&
-          (subset == nullptr || e.subset == *subset) && same_bytes(e.triangles, triangles) &&
-          same_bytes(e.positions, positions)) {
-        theirs = e.tree;
-        ++reuses_;
-        break;
-      }
+    if (const Entry* e = find(N, triangles, positions, subset, options); e != nullptr) {
+      theirs = e->tree;
+      ++reuses_;
     }
     if (keep && !theirs.valid()) {  // this call builds it, outside the lock
-      Entry& e = entries_.emplace_back();
-      e.volume_axes = N;
-      e.triangles = triangles;
-      e.positions = positions;
-      e.whole = subset == nullptr;
-      if (subset != nullptr) e.subset = *subset;
-      e.options = options;
-      e.tree = promise.get_future().share();
-      ++builds_;
+      add(N, triangles, positions, subset, options, promise.get_future().share());
     }
   }
   // Another call's tree: its build waited for (get() rethrows its failure), then copied.
@@ -78,6 +99,27 @@ Bvh<N> HierarchyCache::get(
   } catch (...) {
     promise.set_exception(std::current_exception());
     throw;
+  }
+}
+
+template <int N>
+void HierarchyCache::prebuild(
+    const skinning::Triangles& triangles,
+    const skinning::Positions& positions,
+    const std::vector<std::int32_t>* subset,
+    const BvhOptions& options) {
+  std::promise<std::shared_ptr<const void>> promise;
+  {
+    std::lock_guard lock(mutex_);
+    // Asked for already: built, or being built by that call.
+    if (closed_ || find(N, triangles, positions, subset, options) != nullptr) return;
+    add(N, triangles, positions, subset, options, promise.get_future().share());
+  }
+  try {
+    promise.set_value(std::make_shared<const Bvh<N>>(
+        build_hierarchy<N>(nullptr, triangles, positions, subset, options)));
+  } catch (...) {
+    promise.set_exception(std::current_exception());  // for the callers that ask
   }
 }
 
@@ -140,6 +182,16 @@ template Bvh<3> HierarchyCache::get<3>(
     const std::vector<std::int32_t>*,
     const BvhOptions&);
 template Bvh<8> HierarchyCache::get<8>(
+    const skinning::Triangles&,
+    const skinning::Positions&,
+    const std::vector<std::int32_t>*,
+    const BvhOptions&);
+template void HierarchyCache::prebuild<3>(
+    const skinning::Triangles&,
+    const skinning::Positions&,
+    const std::vector<std::int32_t>*,
+    const BvhOptions&);
+template void HierarchyCache::prebuild<8>(
     const skinning::Triangles&,
     const skinning::Positions&,
     const std::vector<std::int32_t>*,

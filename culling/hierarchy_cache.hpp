@@ -16,6 +16,7 @@
 
 #include "culling/bvh.hpp"
 #include "skinning/mesh.hpp"
+#include "skinning/topology.hpp"
 
 namespace skelcd::culling {
 
@@ -48,6 +49,18 @@ class HierarchyCache {
       const std::vector<std::int32_t>* subset,
       const BvhOptions& options);
 
+  /// Builds the tree get<N>(triangles, positions, subset, options) would, and keeps it for the
+  /// callers that ask for it later, when no call has asked for it yet; returns at once when one
+  /// has (its tree built or being built) or when the cache is closed. For a thread that would
+  /// otherwise wait idle for another to ask (a parallel check's main thread while its baseline
+  /// thread builds the feature topology: docs/check.md "Threads"). A build that throws is not
+  /// reported here: the callers that ask get its exception, as from their own build.
+  template <int N>
+  void prebuild(
+      const skinning::Triangles& triangles,
+      const skinning::Positions& positions,
+      const std::vector<std::int32_t>* subset,
+      const BvhOptions& options);
   /// An immutable object that the methods built at the same time share instead of each building
   /// its own (`dynamic`'s rim-first FeatureTopology): the first caller of `key` builds it,
   /// callers asking while it builds wait for it (and get its build's exception), every caller
@@ -70,6 +83,21 @@ class HierarchyCache {
 
  private:
   struct Entry;
+  /// The entry of a tree of these inputs with `volume_axes` (N), or nullptr; under mutex_.
+  [[nodiscard]] const Entry* find(
+      int volume_axes,
+      const skinning::Triangles& triangles,
+      const skinning::Positions& positions,
+      const std::vector<std::int32_t>* subset,
+      const BvhOptions& options) const;
+  /// A new entry for these inputs, whose tree `tree` will hold; under mutex_.
+  void add(
+      int volume_axes,
+      const skinning::Triangles& triangles,
+      const skinning::Positions& positions,
+      const std::vector<std::int32_t>* subset,
+      const BvhOptions& options,
+      std::shared_future<std::shared_ptr<const void>> tree);
   std::shared_ptr<const void> shared_object(
       const std::string& key, const std::function<std::shared_ptr<const void>()>& build);
   std::list<std::pair<std::string, std::shared_future<std::shared_ptr<const void>>>> objects_;
@@ -79,6 +107,15 @@ class HierarchyCache {
   std::size_t builds_ = 0;
   std::size_t reuses_ = 0;
 };
+
+/// HierarchyCache::prebuild of the tree `bvh`'s method builds over `mesh` (and the `bvh` a baseline
+/// DCD builds): over its welded triangles at their rest positions, with `options` but no binary
+/// node volumes (its traversals read the wide copy only).
+void prebuild_bvh_hierarchy(
+    HierarchyCache& cache,
+    const skinning::Mesh& mesh,
+    const skinning::Topology& topology,
+    const BvhOptions& options);
 
 /// What a method builds its hierarchy with: a copy from `cache` when one is given
 /// (MethodOptions::hierarchies), its own build otherwise. `subset` as HierarchyCache::get.

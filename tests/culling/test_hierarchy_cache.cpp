@@ -14,7 +14,9 @@
 #include <thread>
 #include <vector>
 
+#include "culling/feature_topology.hpp"
 #include "culling/hierarchy_cache.hpp"
+#include "culling/method.hpp"
 #include "skinning/errors.hpp"
 #include "tests/culling/welded_character.hpp"
 #include "tests/support/test_support.hpp"
@@ -248,6 +250,64 @@ TEST(HierarchyCache, AClosedCacheBuildsForEachCallerAndKeepsNothing) {
   }
   EXPECT_EQ(cache.builds(), 1u);  // the one before close(); the others neither kept nor shared
   EXPECT_EQ(cache.reuses(), 0u);
+}
+
+TEST(HierarchyCache, APrebuiltTreeIsTheOneTheCallersGetAndIsBuiltOnce) {
+  const test::WeldedCharacter fox("Fox.glb");
+  const auto& triangles = fox.topology.welded_triangles;
+  const BvhOptions options{.leaf_size = 1, .node_volumes = false};
+  HierarchyCache cache;
+  cache.prebuild<3>(triangles, fox.rest, nullptr, options);
+  EXPECT_EQ(cache.builds(), 1u);
+  cache.prebuild<3>(triangles, fox.rest, nullptr, options);  // asked for already: nothing
+  EXPECT_EQ(cache.builds(), 1u);
+  expect_same_tree(
+      cache.get<3>(triangles, fox.rest, nullptr, options), Bvh<3>(triangles, fox.rest, options));
+  EXPECT_EQ(cache.builds(), 1u);
+  EXPECT_EQ(cache.reuses(), 1u);
+
+  // A failing build is not reported by prebuild; each caller that asks gets its message.
+  skinning::Triangles bad = triangles;
+  bad(5, 2) = static_cast<std::int32_t>(fox.rest.rows());
+  cache.prebuild<3>(bad, fox.rest, nullptr, options);
+  EXPECT_EQ(cache.builds(), 2u);
+  EXPECT_THROW_MESSAGE(
+      (void)cache.get<3>(bad, fox.rest, nullptr, options), InvalidInput, "triangle 5 corner 2");
+
+  // Closed: nothing is built or kept.
+  cache.close();
+  cache.prebuild<3>(triangles, fox.rest, nullptr, BvhOptions{});
+  EXPECT_EQ(cache.builds(), 2u);
+}
+
+TEST(HierarchyCache, BvhMethodsTakeThePrebuiltTreeAndShareOneSlotAdjacency) {
+  const test::WeldedCharacter fox("Fox.glb");
+  const skinning::Mesh& mesh = *fox.loaded.mesh;
+  auto cache = std::make_shared<HierarchyCache>();
+  prebuild_bvh_hierarchy(*cache, mesh, fox.topology, BvhOptions{});
+  ASSERT_EQ(cache->builds(), 1u);
+  MethodOptions options;
+  options.hierarchies = cache;
+  options.features = std::make_shared<const FeatureTopology>(mesh, fox.topology);
+  // The baseline's `bvh` and two workers' (one FeatureTopology, as in a parallel check): one
+  // tree (prebuilt, then copied three times) and one slot adjacency (built by the first, shared).
+  std::vector<std::unique_ptr<CullingMethod>> methods;
+  for (int i = 0; i < 3; ++i) methods.push_back(make_method("bvh", mesh, fox.topology, options));
+  EXPECT_EQ(cache->builds(), 2u);
+  EXPECT_EQ(cache->reuses(), 3u + 2u);
+  // The same DCD pairs as a method built without the cache, at a posed sample.
+  MethodOptions plain;
+  plain.features = options.features;
+  const auto alone = make_method("bvh", mesh, fox.topology, plain);
+  const skinning::Positions x = fox.sample(3);
+  FrameResult expected;
+  alone->detect_dcd(x, expected);
+  for (const auto& m : methods) {
+    FrameResult got;
+    m->detect_dcd(x, got);
+    EXPECT_EQ(got.dcd_pairs, expected.dcd_pairs);
+    EXPECT_EQ(got.counters.bv_tests, expected.counters.bv_tests);
+  }
 }
 
 }  // namespace

@@ -175,6 +175,16 @@ CheckOutcome check_model(
   outcome.radial_view =
       setup_radial_view(request.radial_view, model, *motion, options, topology.get());
   outcome.setup.segmentation = ms_since(phase);
+  // A parallel run with a DCD baseline: its `bvh` asks for the whole mesh's tree once the baseline
+  // thread has built the feature topology, and the workers' `bvh` (alone or under `auto`) ask for
+  // the same. This thread, which would otherwise wait for the feature topology (no segmentation
+  // to do: `bvh`, `kdop`, `auto` on a closed mesh), builds the tree meanwhile; after a
+  // segmentation the baseline thread has asked for it already, and this returns at once
+  // (docs/check.md "Threads").
+  if (parallel && (request.baseline.kind == BaselineSpec::Kind::rest ||
+                   request.baseline.kind == BaselineSpec::Kind::sample)) {
+    culling::prebuild_bvh_hierarchy(*hierarchies, motion->mesh(), *topology, culling::BvhOptions{});
+  }
   if (!parallel) {
     // Counted with the weld (`topology`): it is built whatever the baseline, also with `none`.
     phase = std::chrono::steady_clock::now();
