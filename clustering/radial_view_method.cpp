@@ -325,6 +325,14 @@ RadialViewMethod::RadialViewMethod(
     ghosts_->topology = skinning::Topology{};
     ghosts_->segmentation.reset();
   }
+  // A parallel run's workers (the cache) with DCD queries: each worker's first block starts
+  // with a full DCD, so its DCD tree is built now, a copy of the tree the baseline's `bvh` built
+  // (the same key: the welded triangles at rest, no node volumes), with one slot adjacency for
+  // all the workers — where each worker built both at its first block (docs/radial-view.md,
+  // "Memory"). Not with ghost caps: the tree is over the capped mesh, each method's own.
+  if (method_options.dcd_queries && method_options.hierarchies != nullptr && !ghosts_) {
+    (void)dcd_tree(method_options.hierarchies.get());
+  }
 }
 
 const skinning::Positions& RadialViewMethod::with_ghosts(
@@ -387,7 +395,16 @@ void RadialViewMethod::dcd(const culling::Instant& at, culling::FrameResult& out
   // `bvh`'s DCD (the same tree, refit over the static volumes at x, the same sieved traversal
   // and tests) through this method's volumes and blocks, which the CCD refills.
   culling::sieved_dcd_at<3>(
-      x, tree.bvh, bounds_, topology_, tree.slots, tree.full_slots, scratch_, blocks_, tests_, out);
+      x,
+      tree.bvh,
+      bounds_,
+      topology_,
+      *tree.slots,
+      tree.full_slots,
+      scratch_,
+      blocks_,
+      tests_,
+      out);
   blocks_.release_dcd_planes();  // not held between queries: the CCD's blocks need none
 
   record_dcd(x, out);  // with the ghosts' pairs: the next interval's cuts need them
@@ -445,19 +462,22 @@ void RadialViewMethod::start_dcd(const skinning::Positions& x, culling::FrameRes
 }
 
 RadialViewMethod::DcdTree::DcdTree(
-    const culling::FeatureTopology& features,
+    culling::HierarchyCache* cache,
+    const std::shared_ptr<const culling::FeatureTopology>& features,
     const skinning::Positions& rest,
     const culling::BvhOptions& options)
-    : bvh(features.welded_triangles(), rest, options), slots(features, bvh.triangle_order()) {
-  full_slots.reserve(at(features.num_triangles()));
+    : bvh(culling::build_hierarchy<3>(cache, features->welded_triangles(), rest, nullptr, options)),
+      slots(culling::shared_slot_adjacency(cache, features, bvh.triangle_order())) {
+  full_slots.reserve(at(features->num_triangles()));
 }
 
-RadialViewMethod::DcdTree& RadialViewMethod::dcd_tree() {
+RadialViewMethod::DcdTree& RadialViewMethod::dcd_tree(culling::HierarchyCache* cache) {
   if (!dcd_) {
-    // Traversed through the wide copy only, as `bvh`'s: no binary node volumes.
+    // Traversed through the wide copy only, as `bvh`'s: no binary node volumes (the key of the
+    // baseline's `bvh` tree, which `cache` may hold).
     culling::BvhOptions options = method_options_.bvh;
     options.node_volumes = false;
-    dcd_ = std::make_unique<DcdTree>(topology_, dcd_rest_, options);
+    dcd_ = std::make_unique<DcdTree>(cache, features_, dcd_rest_, options);
     dcd_rest_ = skinning::Positions();  // built: dcd_ is kept (see dcd_)
     scratch_.reserve_self(dcd_->bvh);
   }

@@ -191,16 +191,19 @@ class RadialViewMethod final : public culling::CullingMethod {
   /// detect_dcd's hierarchy (dcd_): `bvh`'s tree over the welded triangles and the slots its fan
   /// sieve reads (culling/sieved_dcd.hpp).
   struct DcdTree {
+    /// Through `cache` when not null: the tree a copy of the baseline's `bvh` (or another
+    /// worker's), the slots shared with the other workers.
     DcdTree(
-        const culling::FeatureTopology& features,
+        culling::HierarchyCache* cache,
+        const std::shared_ptr<const culling::FeatureTopology>& features,
         const skinning::Positions& rest,
         const culling::BvhOptions& options);
     culling::AabbBvh bvh;
-    culling::SlotAdjacency slots;
+    std::shared_ptr<const culling::SlotAdjacency> slots;
     std::vector<std::uint8_t> full_slots;  // the sieve's per slot, at each detect_dcd
   };
-  /// dcd_, built when there is none.
-  DcdTree& dcd_tree();
+  /// dcd_, built when there is none (through `cache` when not null).
+  DcdTree& dcd_tree(culling::HierarchyCache* cache = nullptr);
   /// The DCD at an interval's start that no DCD or previous interval left the pairs of: through
   /// the method's own hierarchies (the atomic clusters' and the global one, refit over the static
   /// volumes at x) and blocks_, into out (dcd_pairs sorted, counters, times) — no whole-mesh

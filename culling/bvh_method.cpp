@@ -37,30 +37,6 @@ skinning::Positions welded_rest_positions(
   return rest;
 }
 
-/// The fan sieve's slot adjacency of a hierarchy's triangle order. The methods of a parallel run
-/// (the baseline's `bvh` and the workers') copy one tree, so they share one, through `cache`
-/// (never written: FanSieve reads it), keyed by their FeatureTopology and the order's bytes; the
-/// object holds that FeatureTopology, so that no other takes its address while the cache keeps
-/// it. Built here without a cache.
-std::shared_ptr<const SlotAdjacency> shared_slots(
-    HierarchyCache* cache,
-    const std::shared_ptr<const FeatureTopology>& features,
-    std::span<const std::int32_t> order) {
-  struct Held {
-    std::shared_ptr<const FeatureTopology> features;
-    SlotAdjacency slots;
-  };
-  const auto build = [&] {
-    auto held = std::make_shared<const Held>(Held{features, SlotAdjacency(*features, order)});
-    return std::shared_ptr<const SlotAdjacency>(held, &held->slots);
-  };
-  if (cache == nullptr) return build();
-  std::string key =
-      "SlotAdjacency " + std::to_string(reinterpret_cast<std::uintptr_t>(features.get())) + ' ';
-  key.append(reinterpret_cast<const char*>(order.data()), order.size_bytes());
-  return cache->shared<SlotAdjacency>(key, build);
-}
-
 /// The hierarchy options of a method that traverses only the wide copy (culling/traversal.hpp):
 /// no binary node volumes, 2·#F·sizeof(Dop<N>) bytes less (docs/culling.md "Bounded memory").
 BvhOptions traversal_only(BvhOptions options) {
@@ -269,7 +245,7 @@ class BvhMethod final : public MethodBase {
   RelativePairTrial relative_;
   Bvh<N> bvh_;
   std::shared_ptr<const SlotAdjacency> slots_ =
-      shared_slots(options_.hierarchies.get(), features_, bvh_.triangle_order());
+      shared_slot_adjacency(options_.hierarchies.get(), features_, bvh_.triangle_order());
   std::vector<std::uint8_t> full_slots_;
   // Whether the last interval had enough pairs apart at both ends for the slot end boxes to pay
   // (pairs per triangle), when ccd builds them.

@@ -4,6 +4,10 @@
 #include <exception>
 #include <future>
 #include <memory>
+#include <string>
+
+#include "culling/feature_topology.hpp"
+#include "culling/traversal.hpp"
 
 namespace skelcd::culling {
 
@@ -151,6 +155,25 @@ std::shared_ptr<const void> HierarchyCache::shared_object(
     promise.set_exception(std::current_exception());
     throw;
   }
+}
+
+std::shared_ptr<const SlotAdjacency> shared_slot_adjacency(
+    HierarchyCache* cache,
+    const std::shared_ptr<const FeatureTopology>& features,
+    std::span<const std::int32_t> order) {
+  struct Held {
+    std::shared_ptr<const FeatureTopology> features;
+    SlotAdjacency slots;
+  };
+  const auto build = [&] {
+    auto held = std::make_shared<const Held>(Held{features, SlotAdjacency(*features, order)});
+    return std::shared_ptr<const SlotAdjacency>(held, &held->slots);
+  };
+  if (cache == nullptr) return build();
+  std::string key =
+      "SlotAdjacency " + std::to_string(reinterpret_cast<std::uintptr_t>(features.get())) + ' ';
+  key.append(reinterpret_cast<const char*>(order.data()), order.size_bytes());
+  return cache->shared<SlotAdjacency>(key, build);
 }
 
 void HierarchyCache::close() {

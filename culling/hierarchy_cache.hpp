@@ -10,6 +10,7 @@
 #include <list>
 #include <memory>
 #include <mutex>
+#include <span>
 #include <string>
 #include <utility>
 #include <vector>
@@ -19,6 +20,9 @@
 #include "skinning/topology.hpp"
 
 namespace skelcd::culling {
+
+class FeatureTopology;
+struct SlotAdjacency;
 
 /// Built hierarchies keyed by what they were built from: the first caller asking for one builds
 /// it, callers asking for the same while it builds wait for it, and every caller gets a copy —
@@ -107,6 +111,16 @@ class HierarchyCache {
   std::size_t builds_ = 0;
   std::size_t reuses_ = 0;
 };
+
+/// The fan sieve's slot adjacency (culling/traversal.hpp) of a tree's triangle order over
+/// `features`. Methods that copy one tree from `cache` (a parallel run's baseline `bvh` and its
+/// workers' methods) share one: it is never written (FanSieve reads it). Keyed by the
+/// FeatureTopology object and the order's bytes; the object holds that FeatureTopology, so that no
+/// other takes its address while the cache keeps it. Without a cache (null), built here.
+[[nodiscard]] std::shared_ptr<const SlotAdjacency> shared_slot_adjacency(
+    HierarchyCache* cache,
+    const std::shared_ptr<const FeatureTopology>& features,
+    std::span<const std::int32_t> order);
 
 /// HierarchyCache::prebuild of the tree `bvh`'s method builds over `mesh` (and the `bvh` a baseline
 /// DCD builds): over its welded triangles at their rest positions, with `options` but no binary

@@ -70,6 +70,10 @@ struct MethodOptions {
   /// builds, the others copy). Null: each method builds its own. The runner gives one to the
   /// methods of a parallel run's workers and closes it once they are built.
   std::shared_ptr<HierarchyCache> hierarchies{};
+  /// Whether the run asks this method for DCD queries (false: CCD only). A method may build what
+  /// only its DCD needs while `hierarchies` is open when true (`dynamic`'s DCD tree, a copy of the
+  /// baseline's), and never when false.
+  bool dcd_queries = true;
 };
 
 /// Where one connected component (Topology::components) goes under `auto` (routed_method.hpp).

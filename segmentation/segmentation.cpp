@@ -30,11 +30,11 @@ std::vector<std::vector<std::int32_t>> subtrees(const std::vector<BoneSegment>& 
   return out;
 }
 
-// Runs body(i) for i in [0, n), in parallel when there is enough work; each i writes only its own
-// result, so the outcome does not depend on the schedule.
+// Runs body(i) for i in [0, n), in parallel when allowed and there is enough work; each i writes
+// only its own result, so the outcome does not depend on the schedule.
 template <class Body>
-void for_each_index(std::size_t n, std::size_t work, Body&& body) {
-  if (work > 20000 && n > 1) {
+void for_each_index(std::size_t n, std::size_t work, bool parallel, Body&& body) {
+  if (parallel && work > 20000 && n > 1) {
     tbb::parallel_for(std::size_t{0}, n, [&](std::size_t i) { body(i); });
   } else {
     for (std::size_t i = 0; i < n; ++i) body(i);
@@ -108,24 +108,25 @@ Segmentation segment_mesh(
       per_bone[static_cast<std::size_t>(labels[static_cast<std::size_t>(f)])].push_back(f);
     }
     std::vector<Observer> observers(static_cast<std::size_t>(nb));
-    for_each_index(observers.size(), static_cast<std::size_t>(F.rows()), [&](std::size_t b) {
-      const auto& tris = per_bone[b];
-      observers[b].segment = bones[b];
-      if (tris.empty()) return;
-      // The bones' clusters are disjoint: each writes its own triangles' counts.
-      std::vector<PositiveCounts> mine(tris.size());
-      positive_counts(V, F, tris, bones[b], W, subtree[b], theta, mine);
-      std::int64_t point = 0;
-      std::int64_t line = 0;
-      for (std::size_t i = 0; i < tris.size(); ++i) {
-        const auto f = static_cast<std::size_t>(tris[i]);
-        counts[f] = mine[i];
-        counted_bone[f] = static_cast<std::int32_t>(b);
-        point += mine[i].point;
-        line += mine[i].line;
-      }
-      observers[b].kind = observer_choice(point, line).kind;
-    });
+    for_each_index(
+        observers.size(), static_cast<std::size_t>(F.rows()), options.parallel, [&](std::size_t b) {
+          const auto& tris = per_bone[b];
+          observers[b].segment = bones[b];
+          if (tris.empty()) return;
+          // The bones' clusters are disjoint: each writes its own triangles' counts.
+          std::vector<PositiveCounts> mine(tris.size());
+          positive_counts(V, F, tris, bones[b], W, subtree[b], theta, mine);
+          std::int64_t point = 0;
+          std::int64_t line = 0;
+          for (std::size_t i = 0; i < tris.size(); ++i) {
+            const auto f = static_cast<std::size_t>(tris[i]);
+            counts[f] = mine[i];
+            counted_bone[f] = static_cast<std::int32_t>(b);
+            point += mine[i].point;
+            line += mine[i].line;
+          }
+          observers[b].kind = observer_choice(point, line).kind;
+        });
     stats.refinement = refine_labels(V, F, graph, observers, W, labels);
   }
 
@@ -142,33 +143,37 @@ Segmentation segment_mesh(
   }
 
   // 4. The final observer of each atomic cluster, and the rest-pose orientation counts.
-  for_each_index(out.clusters.size(), static_cast<std::size_t>(F.rows()), [&](std::size_t c) {
-    auto& cluster = out.clusters[c];
-    const auto b = static_cast<std::size_t>(cluster.bone);
-    // Counts from step 2 where the triangle was observed from this bone; the others now (the
-    // clusters are disjoint: each fills its own triangles).
-    std::vector<std::int32_t> missing;
-    for (const auto f : cluster.triangles) {
-      if (counted_bone[static_cast<std::size_t>(f)] != cluster.bone) missing.push_back(f);
-    }
-    if (!missing.empty()) {
-      std::vector<PositiveCounts> fresh(missing.size());
-      positive_counts(V, F, missing, bones[b], W, subtree[b], theta, fresh);
-      for (std::size_t i = 0; i < missing.size(); ++i) {
-        counts[static_cast<std::size_t>(missing[i])] = fresh[i];
-      }
-    }
-    std::int64_t point = 0;
-    std::int64_t line = 0;
-    for (const auto f : cluster.triangles) {
-      point += counts[static_cast<std::size_t>(f)].point;
-      line += counts[static_cast<std::size_t>(f)].line;
-    }
-    const auto choice = observer_choice(point, line);
-    cluster.observer = Observer{choice.kind, bones[b]};
-    cluster.mean_positive_point = choice.mean_positive_point;
-    cluster.mean_positive_line = choice.mean_positive_line;
-  });
+  for_each_index(
+      out.clusters.size(),
+      static_cast<std::size_t>(F.rows()),
+      options.parallel,
+      [&](std::size_t c) {
+        auto& cluster = out.clusters[c];
+        const auto b = static_cast<std::size_t>(cluster.bone);
+        // Counts from step 2 where the triangle was observed from this bone; the others now (the
+        // clusters are disjoint: each fills its own triangles).
+        std::vector<std::int32_t> missing;
+        for (const auto f : cluster.triangles) {
+          if (counted_bone[static_cast<std::size_t>(f)] != cluster.bone) missing.push_back(f);
+        }
+        if (!missing.empty()) {
+          std::vector<PositiveCounts> fresh(missing.size());
+          positive_counts(V, F, missing, bones[b], W, subtree[b], theta, fresh);
+          for (std::size_t i = 0; i < missing.size(); ++i) {
+            counts[static_cast<std::size_t>(missing[i])] = fresh[i];
+          }
+        }
+        std::int64_t point = 0;
+        std::int64_t line = 0;
+        for (const auto f : cluster.triangles) {
+          point += counts[static_cast<std::size_t>(f)].point;
+          line += counts[static_cast<std::size_t>(f)].line;
+        }
+        const auto choice = observer_choice(point, line);
+        cluster.observer = Observer{choice.kind, bones[b]};
+        cluster.mean_positive_point = choice.mean_positive_point;
+        cluster.mean_positive_line = choice.mean_positive_line;
+      });
   std::vector<char> bone_used(static_cast<std::size_t>(nb), 0);
   for (auto& cluster : out.clusters) {
     bone_used[static_cast<std::size_t>(cluster.bone)] = 1;

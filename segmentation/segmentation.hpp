@@ -32,6 +32,9 @@ struct SegmentationOptions {
   /// Refine the clusters against their observers (§4.1); off = the plain largest-weight split
   /// (RVBC's), kept for comparison.
   bool refine = true;
+  /// The bones' observer tests and the clusters' run in parallel (oneTBB) on large meshes; the
+  /// results are identical. Off: on the calling thread alone (`check --threads 1`).
+  bool parallel = true;
 };
 
 struct AtomicCluster {

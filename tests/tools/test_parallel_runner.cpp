@@ -246,8 +246,9 @@ TEST(ParallelRunner, WorkersShareOneBuildOfEachHierarchyAndTheCacheIsClosedAfter
 TEST(ParallelRunner, DynamicsWorkersShareOneRimFirstFeatureTopology) {
   // `dynamic` on CesiumMan, which has no boundary loop to cap (ghost caps would give each
   // method a mesh of its own): four workers' methods, one build of their rim-first
-  // FeatureTopology through the runner's cache, shared by the other three. Their rows are the
-  // serial run's (RealCharacterRowsEqualSerialForBvhDynamicAndAuto, and here below).
+  // FeatureTopology through the runner's cache, shared by the other three, and of their DCD
+  // tree and its slot adjacency. Their rows are the serial run's
+  // (RealCharacterRowsEqualSerialForBvhDynamicAndAuto, and here below).
   const auto l = load(test::asset("characters/CesiumMan.glb").string());
   RunOptions options;
   options.method = "dynamic";
@@ -258,12 +259,17 @@ TEST(ParallelRunner, DynamicsWorkersShareOneRimFirstFeatureTopology) {
   for (const int k : {0, 1}) {
     options.threads = k == 0 ? 1 : 4;
     auto cache = std::make_shared<culling::HierarchyCache>();
-    ClipRunner runner(
-        *l.motion, options, skinning::build_topology(l.motion->mesh()), {}, {}, cache);
+    auto topology = skinning::build_topology(l.motion->mesh());
+    // A parallel check's baseline `bvh` first: its tree and its slot adjacency.
+    if (k == 1) bvh_through(cache, l.motion->mesh(), topology);
+    ClipRunner runner(*l.motion, options, std::move(topology), {}, {}, cache);
     if (k == 1) {
+      // The rim-first FeatureTopology, one build shared by the other three; the DCD trees (the
+      // run has DCD queries: built with the methods), four copies of the baseline's tree (the
+      // same key); their slot adjacency over the rim-first features, one build shared by three.
       ASSERT_EQ(runner.plan().threads, 4) << runner.plan().serial_reason;
-      EXPECT_EQ(cache->builds(), 1u);
-      EXPECT_EQ(cache->reuses(), 3u);
+      EXPECT_EQ(cache->builds(), 2u + 1u + 1u);
+      EXPECT_EQ(cache->reuses(), 3u + 4u + 3u);
     } else {
       EXPECT_EQ(cache->builds(), 0u);  // one method: the cache closed unused
     }
@@ -788,20 +794,32 @@ class WorkerEntries : public tbb::task_scheduler_observer {
 
 TEST(ParallelRunner, ASerialRunSegmentsOnItsOwnThread) {
   // CesiumMan-dense has 28,032 triangles: enough for segment_mesh to split its bones and clusters
-  // over oneTBB's threads, which `--threads 1` must keep to the calling thread (each test runs in
-  // a process of its own: no worker is in the arena before it).
+  // over oneTBB's threads, which `--threads 1` must keep to the calling thread: it hands oneTBB no
+  // task, so no worker joins (each test runs in a process of its own). With 2 threads the
+  // segmentation is the same.
   const Loaded l = load(test::asset("characters/CesiumMan-dense.glb").string());
   ASSERT_GT(l.motion->mesh().num_triangles(), 20000);
   RunOptions options;
   options.method = "dynamic";
   options.threads = 1;
-  WorkerEntries workers;
-  const RadialViewSetup setup =
-      setup_radial_view(RadialViewArguments{}, l.model, *l.motion, options);
-  ASSERT_NE(options.segmentation, nullptr);
-  EXPECT_EQ(setup.segmentation_source, "computed (rig weights)");
-  EXPECT_GT(setup.atomic_clusters, 0);
-  EXPECT_EQ(workers.entries.load(), 0) << "a worker thread joined the segmentation of a serial run";
+  std::shared_ptr<const segmentation::Segmentation> serial;
+  {
+    WorkerEntries workers;
+    const RadialViewSetup setup =
+        setup_radial_view(RadialViewArguments{}, l.model, *l.motion, options);
+    EXPECT_EQ(workers.entries.load(), 0) << "a worker joined the segmentation of a serial run";
+    ASSERT_NE(options.segmentation, nullptr);
+    EXPECT_EQ(setup.segmentation_source, "computed (rig weights)");
+    EXPECT_GT(setup.atomic_clusters, 0);
+    serial = options.segmentation;
+  }
+  options.threads = 2;
+  (void)setup_radial_view(RadialViewArguments{}, l.model, *l.motion, options);
+  ASSERT_EQ(options.segmentation->clusters.size(), serial->clusters.size());
+  for (std::size_t c = 0; c < serial->clusters.size(); ++c) {
+    EXPECT_EQ(options.segmentation->clusters[c].triangles, serial->clusters[c].triangles) << c;
+    EXPECT_EQ(options.segmentation->clusters[c].observer.kind, serial->clusters[c].observer.kind);
+  }
 }
 
 }  // namespace

@@ -102,12 +102,15 @@ RadialViewSetup setup_radial_view(
                                                   : segmentation::WeightSource::heat;
     // The caller's weld of the mesh when it is the rig's own (a rig's clip moves rig.mesh).
     const bool rig_mesh = topology != nullptr && &motion.mesh() == &model.rig->mesh;
-    // On the threads the run asked for: segment_mesh splits its bones and clusters over oneTBB's
-    // threads (from 20,000 triangles), which would otherwise take every core, `--threads 1`
-    // too (a second core for 8 of CesiumMan-dense's 40 ms; docs/check.md "Threads").
-    const tbb::global_control threads_asked(
-        tbb::global_control::max_allowed_parallelism,
-        static_cast<std::size_t>(resolve_threads(options.threads)));
+    // On the threads the run asked for: segment_mesh splits its bones and clusters (from 20,000
+    // triangles), and heat weights their solves, over oneTBB's threads, which would otherwise
+    // take every core, `--threads 1` too (a second core for 8 of CesiumMan-dense's 44 ms;
+    // docs/check.md "Threads"): on the calling thread alone when the run is serial, on at most
+    // the run's threads otherwise.
+    const auto threads = static_cast<std::size_t>(resolve_threads(options.threads));
+    o.parallel = threads > 1;
+    o.heat.parallel = threads > 1;
+    const tbb::global_control threads_asked(tbb::global_control::max_allowed_parallelism, threads);
     seg = std::make_shared<const segmentation::Segmentation>(
         rig_mesh ? segmentation::segment(*model.rig, o, *topology)
                  : segmentation::segment(*model.rig, o));

@@ -199,6 +199,7 @@ culling::MethodOptions method_options_of(
   o.segmentation = options.segmentation;
   o.num_bones = motion.num_bones();
   o.parameters = options.method_parameters;
+  o.dcd_queries = options.query != QuerySet::ccd;
   return o;
 }
 
