@@ -214,10 +214,5 @@ template void HierarchyCache::prebuild<3>(
     const skinning::Positions&,
     const std::vector<std::int32_t>*,
     const BvhOptions&);
-template void HierarchyCache::prebuild<8>(
-    const skinning::Triangles&,
-    const skinning::Positions&,
-    const std::vector<std::int32_t>*,
-    const BvhOptions&);
 
 }  // namespace skelcd::culling
