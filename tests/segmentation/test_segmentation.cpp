@@ -442,6 +442,84 @@ TEST_P(RealCharacters, TheFaceGraphFromTheTopologyIsTheFaceGraph) {
   EXPECT_GT(given.neighbours.size(), 0u);
 }
 
+// positive_counts decides most orientations with one cross product per triangle for both
+// observers (a floating-point filter): the counts are those of the exact orientation() on each
+// triangle of each test pose, posed here as the segmentation poses it (the LBS blend of R and the
+// identity about the bone's head), for every bone of a real character with its own weights.
+TEST_P(RealCharacters, PositiveCountsAreTheExactOrientationsOfEachPose) {
+  const auto model = skelcd::skinning::load_model(character_path(GetParam()));
+  ASSERT_TRUE(model.rig);
+  const Rig& rig = *model.rig;
+  const auto& V = rig.mesh.rest_positions;
+  const auto& F = rig.mesh.triangles;
+  const Eigen::MatrixXd W = Eigen::MatrixXd(rig.weights);
+  const auto bones = bone_segments(rig.skeleton);
+  ASSERT_EQ(W.cols(), static_cast<Eigen::Index>(bones.size()));
+  const double theta = 25.0 * std::numbers::pi / 180.0;
+  std::vector<std::int32_t> all(static_cast<std::size_t>(F.rows()));
+  std::iota(all.begin(), all.end(), 0);
+  std::int64_t compared = 0;
+  std::set<int> seen;
+  for (std::size_t b = 0; b < bones.size(); ++b) {
+    std::vector<std::int32_t> subtree;  // b and its descendants
+    for (std::size_t k = 0; k < bones.size(); ++k) {
+      for (auto j = static_cast<std::int32_t>(k); j >= 0;
+           j = bones[static_cast<std::size_t>(j)].parent) {
+        if (j == static_cast<std::int32_t>(b)) {
+          subtree.push_back(static_cast<std::int32_t>(k));
+          break;
+        }
+      }
+    }
+    std::vector<PositiveCounts> counts(all.size());
+    positive_counts(V, F, all, bones[b], W, subtree, theta, counts);
+    std::vector<PositiveCounts> expected(all.size());
+    std::vector<Eigen::Matrix3d> rotations = {Eigen::Matrix3d::Identity()};
+    for (int axis = 0; axis < 3; ++axis) {
+      for (const double sign : {1.0, -1.0}) {
+        rotations.push_back(
+            Eigen::AngleAxisd(sign * theta, Eigen::Vector3d::Unit(axis)).toRotationMatrix());
+      }
+    }
+    const Eigen::Vector3d q1 = bones[b].head;
+    for (std::size_t r = 0; r < rotations.size(); ++r) {
+      const Eigen::Matrix3d& R = rotations[r];
+      BoneSegment posed_bone = bones[b];
+      posed_bone.tail = q1 + R * (bones[b].tail - q1);
+      skelcd::skinning::Positions posed = V;
+      for (Eigen::Index v = 0; v < V.rows() && r > 0; ++v) {
+        double follow = 0.0;
+        for (const auto k : subtree) follow += W(v, k);
+        follow = std::min(1.0, follow);
+        const Eigen::Vector3d x = V.row(v).transpose();
+        posed.row(v) =
+            Eigen::Vector3d(q1 + follow * (R * (x - q1)) + (1.0 - follow) * (x - q1)).transpose();
+      }
+      for (std::size_t f = 0; f < all.size(); ++f) {
+        const auto i = static_cast<Eigen::Index>(f);
+        expected[f].point = static_cast<std::uint8_t>(
+            expected[f].point +
+            (orientation(Observer{ObserverKind::point, posed_bone}, posed, F, i) ==
+             Orientation::positive));
+        expected[f].line = static_cast<std::uint8_t>(
+            expected[f].line +
+            (orientation(Observer{ObserverKind::line, posed_bone}, posed, F, i) ==
+             Orientation::positive));
+      }
+    }
+    for (std::size_t f = 0; f < all.size(); ++f) {
+      ASSERT_EQ(counts[f].point, expected[f].point)
+          << GetParam() << " bone " << b << " triangle " << f;
+      ASSERT_EQ(counts[f].line, expected[f].line)
+          << GetParam() << " bone " << b << " triangle " << f;
+      seen.insert(counts[f].point);
+      ++compared;
+    }
+  }
+  EXPECT_GT(compared, 0);
+  EXPECT_GT(seen.size(), 2u) << "the poses change no orientation: they test nothing";
+}
+
 INSTANTIATE_TEST_SUITE_P(Models, RealCharacters,
                          ::testing::Values("CesiumMan.glb", "BCN_Epileptic.X", "Fox.glb"));
 
