@@ -30,50 +30,6 @@ namespace {
 /// The test poses: identity, then ±θ about x, y, z, all about the bone's head joint.
 constexpr int kPoses = 7;
 
-/// orientation()'s sign for one triangle seen from several q (its point and its line observer),
-/// when a floating-point filter can tell it: the sign of (a − q) · ((b − a) × (c − a)) =
-/// det[u; v; w] with u = b − a, v = c − a, w = a − q. This is ccd::detail::det3_sign_static (the
-/// static orient3d filter, underflow terms included) on the transposed rows (u_x, v_x, w_x),
-/// (u_y, v_y, w_y), (u_z, v_z, w_z), operation for operation: its 2 × 2 minors are then those of u
-/// and v alone, the cross product (b − a) × (c − a) and its permanent, taken once per triangle.
-/// 0 when the filter cannot tell: then orientation() decides exactly, on the same q.
-class FilteredCorner {
- public:
-  FilteredCorner(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::Vector3d& c)
-      : a_(a) {
-    const Eigen::Vector3d u = b - a;
-    const Eigen::Vector3d v = c - a;
-    const double yz = u.y() * v.z(), zy = u.z() * v.y();
-    const double zx = u.z() * v.x(), xz = u.x() * v.z();
-    const double xy = u.x() * v.y(), yx = u.y() * v.x();
-    minor_ = {yz - zy, zx - xz, xy - yx};
-    size_ = {std::abs(yz) + std::abs(zy), std::abs(zx) + std::abs(xz), std::abs(xy) + std::abs(yx)};
-  }
-  [[nodiscard]] int sign(const Eigen::Vector3d& q) const {
-    constexpr double kHalfUlp = std::numeric_limits<double>::epsilon() / 2.0;
-    constexpr double kErrBound = (7.0 + 56.0 * kHalfUlp) * kHalfUlp;
-    constexpr double kEta = std::numeric_limits<double>::denorm_min();
-    const double wx = a_.x() - q.x();
-    const double wy = a_.y() - q.y();
-    const double wz = a_.z() - q.z();
-    const double det = wx * minor_[0] + wy * minor_[1] + wz * minor_[2];
-    const double permanent =
-        size_[0] * std::abs(wx) + size_[1] * std::abs(wy) + size_[2] * std::abs(wz);
-    if (!(permanent > std::numeric_limits<double>::min() * 0x1p64) ||
-        !(permanent < std::numeric_limits<double>::infinity())) {
-      return 0;
-    }
-    const double bound = kErrBound * permanent +
-                         2.0 * kEta * (std::abs(wx) + std::abs(wy) + std::abs(wz)) + 4.0 * kEta;
-    return det > bound ? 1 : (-det > bound ? -1 : 0);
-  }
-
- private:
-  Eigen::Vector3d a_;
-  std::array<double, 3> minor_{};
-  std::array<double, 3> size_{};
-};
-
 }  // namespace
 
 void positive_counts(
@@ -135,17 +91,24 @@ void positive_counts(
       // The rest pose bit for bit; otherwise the LBS blend of R and the identity about q1.
       posed[k] = r == 0 ? x : Eigen::Vector3d(q1 + follow[k] * (R * (x - q1)) + (1.0 - follow[k]) * (x - q1));
     }
-    const Eigen::Vector3d midpoint = point.viewing_position(Eigen::Vector3d::Zero());
+    const Eigen::Vector3d midpoint = posed_bone.midpoint();  // the point observer's q
     for (std::size_t i = 0; i < local_triangles.size(); ++i) {
       const auto& t = local_triangles[i];
       const auto& a = posed[t[0]];
       const auto& b = posed[t[1]];
       const auto& c = posed[t[2]];
-      // One cross product for both observers; orientation() only when the filter cannot tell.
-      const FilteredCorner corner(a, b, c);
+      // orientation()'s sign, (a − q) · ((b − a) × (c − a)) = det[u; v; a − q], by the static
+      // orient3d filter on the transposed rows, whose 2 × 2 minors are those of u and v alone
+      // (the same for both observers); the exact orientation() when it cannot tell, on the same q.
+      const Eigen::Vector3d u = b - a;
+      const Eigen::Vector3d v = c - a;
       const auto positive = [&](const Observer& observer, const Eigen::Vector3d& q) {
-        const int s = corner.sign(q);
-        return s != 0 ? s > 0 : orientation(observer, a, b, c) == Orientation::positive;
+        const Eigen::Vector3d w = a - q;
+        const int s = ccd::detail::det3_sign_static(
+            u.x(), v.x(), w.x(), u.y(), v.y(), w.y(), u.z(), v.z(), w.z());
+        return s != ccd::detail::kUndecided
+                   ? s > 0
+                   : orientation(observer, a, b, c) == Orientation::positive;
       };
       out[i].point = static_cast<std::uint8_t>(out[i].point + positive(point, midpoint));
       out[i].line =
