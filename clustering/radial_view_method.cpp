@@ -329,7 +329,8 @@ RadialViewMethod::RadialViewMethod(
   // with a full DCD, so its DCD tree is built now, a copy of the tree the baseline's `bvh` built
   // (the same key: the welded triangles at rest, no node volumes), with one slot adjacency for
   // all the workers — where each worker built both at its first block (docs/radial-view.md,
-  // "Memory"). Not with ghost caps: the tree is over the capped mesh, each method's own.
+  // "Memory"). A serial run's (a hand-over cache): the baseline's tree itself, lent once its
+  // `bvh` is gone. Not with ghost caps: the tree is over the capped mesh, each method's own.
   if (method_options.dcd_queries && method_options.hierarchies != nullptr && !ghosts_) {
     (void)dcd_tree(method_options.hierarchies.get());
   }
@@ -466,7 +467,7 @@ RadialViewMethod::DcdTree::DcdTree(
     const std::shared_ptr<const culling::FeatureTopology>& features,
     const skinning::Positions& rest,
     const culling::BvhOptions& options)
-    : bvh(culling::build_hierarchy<3>(cache, features->welded_triangles(), rest, nullptr, options)),
+    : tree(culling::lend_hierarchy<3>(cache, features->welded_triangles(), rest, options)),
       slots(culling::shared_slot_adjacency(cache, features, bvh.triangle_order())) {
   full_slots.reserve(at(features->num_triangles()));
 }

@@ -198,7 +198,8 @@ class RadialViewMethod final : public culling::CullingMethod {
         const std::shared_ptr<const culling::FeatureTopology>& features,
         const skinning::Positions& rest,
         const culling::BvhOptions& options);
-    culling::AabbBvh bvh;
+    std::shared_ptr<culling::AabbBvh> tree;  // lent by the cache (a serial check's baseline)
+    culling::AabbBvh& bvh = *tree;
     std::shared_ptr<const culling::SlotAdjacency> slots;
     std::vector<std::uint8_t> full_slots;  // the sieve's per slot, at each detect_dcd
   };

@@ -62,11 +62,10 @@ class BvhMethod final : public MethodBase {
                         topology.welded_triangles.rows()
                 ? options.rigid_rows
                 : nullptr),
-        bvh_(build_hierarchy<N>(
+        tree_(lend_hierarchy<N>(
             options.hierarchies.get(),
             topology_.welded_triangles(),
             welded_rest_positions(mesh, topology),
-            nullptr,
             traversal_only(options.bvh))) {
     reserve();
   }
@@ -243,7 +242,10 @@ class BvhMethod final : public MethodBase {
   RowSkip row_skip_;
   std::vector<TrianglePair> rest_pairs_;  // the certified rows' rest pairs, this interval
   RelativePairTrial relative_;
-  Bvh<N> bvh_;
+  // Held, not copied: a serial check's baseline `bvh` lends it to the runner's method
+  // (HierarchyCache::Sharing::hand_over), which refits it at its first query.
+  std::shared_ptr<Bvh<N>> tree_;
+  Bvh<N>& bvh_ = *tree_;
   std::shared_ptr<const SlotAdjacency> slots_ =
       shared_slot_adjacency(options_.hierarchies.get(), features_, bvh_.triangle_order());
   std::vector<std::uint8_t> full_slots_;

@@ -20,6 +20,8 @@ struct HierarchyCache::Entry {
   BvhOptions options;
   /// The tree (a Bvh<volume_axes>), once built; its build's exception otherwise.
   std::shared_future<std::shared_ptr<const void>> tree;
+  /// A hand-over cache's tree instead (a Bvh<volume_axes>), lent while a caller holds it.
+  std::shared_ptr<void> lent;
 };
 
 namespace {
@@ -35,7 +37,7 @@ bool same_bytes(const Matrix& a, const Matrix& b) {
 
 }  // namespace
 
-HierarchyCache::HierarchyCache() = default;
+HierarchyCache::HierarchyCache(Sharing sharing) : sharing_(sharing) {}
 HierarchyCache::~HierarchyCache() = default;
 
 const HierarchyCache::Entry* HierarchyCache::find(
@@ -83,10 +85,12 @@ Bvh<N> HierarchyCache::get(
   bool keep = true;  // false once closed: built for this caller alone
   {
     std::lock_guard lock(mutex_);
-    keep = !closed_;
-    if (const Entry* e = find(N, triangles, positions, subset, options); e != nullptr) {
-      theirs = e->tree;
-      ++reuses_;
+    keep = !closed_ && sharing_ == Sharing::copies;
+    if (keep) {
+      if (const Entry* e = find(N, triangles, positions, subset, options); e != nullptr) {
+        theirs = e->tree;
+        ++reuses_;
+      }
     }
     if (keep && !theirs.valid()) {  // this call builds it, outside the lock
       add(N, triangles, positions, subset, options, promise.get_future().share());
@@ -107,6 +111,40 @@ Bvh<N> HierarchyCache::get(
 }
 
 template <int N>
+std::shared_ptr<Bvh<N>> HierarchyCache::lend(
+    const skinning::Triangles& triangles,
+    const skinning::Positions& positions,
+    const BvhOptions& options) {
+  if (sharing_ == Sharing::copies) {
+    return std::make_shared<Bvh<N>>(get<N>(triangles, positions, nullptr, options));
+  }
+  std::lock_guard lock(mutex_);  // one method at a time: the build under the lock costs nobody
+  // entries_ is this object's own: the entry found may be lent again.
+  auto* held =
+      const_cast<Entry*>(closed_ ? nullptr : find(N, triangles, positions, nullptr, options));
+  if (held != nullptr && held->lent.use_count() == 1) {  // the cache alone holds it
+    ++reuses_;
+    return std::static_pointer_cast<Bvh<N>>(held->lent);
+  }
+  // It keeps one tree at a time: one of other inputs that no caller holds is not wanted by the
+  // method being built, and goes before this build (a serial `kdop` after the baseline's `bvh`).
+  if (held == nullptr) entries_.remove_if([](const Entry& e) { return e.lent.use_count() == 1; });
+  auto built =
+      std::make_shared<Bvh<N>>(build_hierarchy<N>(nullptr, triangles, positions, nullptr, options));
+  // Kept for the next caller unless closed, or another caller holds the one kept already.
+  if (!closed_ && keeping_ && held == nullptr) {
+    ++builds_;
+    Entry& e = entries_.emplace_back();
+    e.volume_axes = N;
+    e.triangles = triangles;
+    e.positions = positions;
+    e.options = options;
+    e.lent = built;
+  }
+  return built;
+}
+
+template <int N>
 void HierarchyCache::prebuild(
     const skinning::Triangles& triangles,
     const skinning::Positions& positions,
@@ -115,8 +153,11 @@ void HierarchyCache::prebuild(
   std::promise<std::shared_ptr<const void>> promise;
   {
     std::lock_guard lock(mutex_);
-    // Asked for already: built, or being built by that call.
-    if (closed_ || find(N, triangles, positions, subset, options) != nullptr) return;
+    // Asked for already: built, or being built by that call. A hand-over cache lends what its
+    // callers built only.
+    if (closed_ || sharing_ == Sharing::hand_over ||
+        find(N, triangles, positions, subset, options) != nullptr)
+      return;
     add(N, triangles, positions, subset, options, promise.get_future().share());
   }
   try {
@@ -133,7 +174,10 @@ std::shared_ptr<const void> HierarchyCache::shared_object(
   std::shared_future<std::shared_ptr<const void>> theirs;  // valid when another call did
   {
     std::lock_guard lock(mutex_);
-    if (closed_) return build();
+    // A hand-over cache lends trees only: an object kept would be held through the next
+    // method's set-up, which would reuse it only when it is a `bvh` (its slot adjacency, 3 ms
+    // on CesiumMan-dense) — not a `kdop`, whose peak it would raise, nor `dynamic`.
+    if (closed_ || sharing_ == Sharing::hand_over) return build();
     for (const auto& [k, object] : objects_) {
       if (k == key) {
         theirs = object;
@@ -176,6 +220,11 @@ std::shared_ptr<const SlotAdjacency> shared_slot_adjacency(
   return cache->shared<SlotAdjacency>(key, build);
 }
 
+void HierarchyCache::keep_no_more() {
+  std::lock_guard lock(mutex_);
+  keeping_ = false;
+}
+
 void HierarchyCache::close() {
   std::list<Entry> freed;
   std::list<std::pair<std::string, std::shared_future<std::shared_ptr<const void>>>> shared;
@@ -209,6 +258,10 @@ template Bvh<8> HierarchyCache::get<8>(
     const skinning::Positions&,
     const std::vector<std::int32_t>*,
     const BvhOptions&);
+template std::shared_ptr<Bvh<3>> HierarchyCache::lend<3>(
+    const skinning::Triangles&, const skinning::Positions&, const BvhOptions&);
+template std::shared_ptr<Bvh<8>> HierarchyCache::lend<8>(
+    const skinning::Triangles&, const skinning::Positions&, const BvhOptions&);
 template void HierarchyCache::prebuild<3>(
     const skinning::Triangles&,
     const skinning::Positions&,

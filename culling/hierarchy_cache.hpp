@@ -38,7 +38,16 @@ struct SlotAdjacency;
 /// 58–314 KB of keys on the bundled characters and the Panda), not one per cluster.
 class HierarchyCache {
  public:
-  HierarchyCache();
+  /// How a tree reaches its callers.
+  enum class Sharing {
+    /// Every caller of get() gets a copy: methods built at the same time (a parallel run).
+    copies,
+    /// One method over the mesh at a time (a serial check's baseline `bvh`, then its runner's
+    /// method): lend() hands the one tree it holds to the next caller once the last one has let
+    /// go of it, instead of each building its own. get() builds for its caller alone.
+    hand_over,
+  };
+  explicit HierarchyCache(Sharing sharing = Sharing::copies);
   HierarchyCache(const HierarchyCache&) = delete;
   HierarchyCache& operator=(const HierarchyCache&) = delete;
   ~HierarchyCache();
@@ -52,6 +61,20 @@ class HierarchyCache {
       const skinning::Positions& positions,
       const std::vector<std::int32_t>* subset,
       const BvhOptions& options);
+
+  /// The whole mesh's Bvh<N>(triangles, positions, options), shared rather than copied. A
+  /// hand-over cache (Sharing::hand_over) keeps the tree it builds and lends that same object to
+  /// a later caller of the same inputs when no caller holds it any more — refit by its last
+  /// holder, which a caller's first query refits again (Bvh::refit writes every volume a
+  /// traversal reads). Held still, or closed: a tree of the caller's own, not kept. It keeps one
+  /// tree at a time: a caller of other inputs frees the one no caller holds before its build.
+  /// A copies cache: a copy, as get().
+  template <int N>
+  [[nodiscard]] std::shared_ptr<Bvh<N>> lend(
+      const skinning::Triangles& triangles,
+      const skinning::Positions& positions,
+      const BvhOptions& options);
+  [[nodiscard]] Sharing sharing() const { return sharing_; }
 
   /// Builds the tree get<N>(triangles, positions, subset, options) would, and keeps it for the
   /// callers that ask for it later, when no call has asked for it yet; returns at once when one
@@ -70,19 +93,24 @@ class HierarchyCache {
   /// callers asking while it builds wait for it (and get its build's exception), every caller
   /// gets the same object. `key` names what it is built from; callers build from the same
   /// objects (the runner's mesh, weld and segmentation), so their addresses may stand for them
-  /// while the cache is open. After close(), each caller builds its own.
+  /// while the cache is open. After close(), or in a hand-over cache, each caller builds its own.
   template <class T, class Build>
   [[nodiscard]] std::shared_ptr<const T> shared(const std::string& key, Build&& build) {
     return std::static_pointer_cast<const T>(
         shared_object(key, [&]() -> std::shared_ptr<const void> { return build(); }));
   }
 
+  /// The last caller over the mesh is next (a serial run's one method): lend() still lends the
+  /// tree held, and keeps no tree it builds (nor its key's copy) from now on.
+  void keep_no_more();
   /// Frees every tree and object held; later calls build without keeping what they build.
   void close();
 
-  /// Trees and shared objects built here (not copies), since construction; for tests.
+  /// Trees and shared objects built here and kept (not copies, nor a caller's own build after
+  /// close() or in a hand-over cache's get()), since construction; for tests.
   [[nodiscard]] std::size_t builds() const;
-  /// Copies handed out of a tree, or objects shared, that another call built; for tests.
+  /// Copies handed out of a tree, trees lent again, or objects shared, that another call built;
+  /// for tests.
   [[nodiscard]] std::size_t reuses() const;
 
  private:
@@ -107,6 +135,8 @@ class HierarchyCache {
   std::list<std::pair<std::string, std::shared_future<std::shared_ptr<const void>>>> objects_;
   mutable std::mutex mutex_;
   std::list<Entry> entries_;  // a list: an entry stays where it is while callers wait on it
+  Sharing sharing_ = Sharing::copies;
+  bool keeping_ = true;  // lend() keeps what it builds (keep_no_more)
   bool closed_ = false;
   std::size_t builds_ = 0;
   std::size_t reuses_ = 0;
@@ -130,6 +160,18 @@ void prebuild_bvh_hierarchy(
     const skinning::Mesh& mesh,
     const skinning::Topology& topology,
     const BvhOptions& options);
+
+/// The whole mesh's tree that a method keeps for its run (`bvh`'s, `dynamic`'s DCD tree):
+/// lent by `cache` when one is given (HierarchyCache::lend), its own build otherwise.
+template <int N>
+[[nodiscard]] std::shared_ptr<Bvh<N>> lend_hierarchy(
+    HierarchyCache* cache,
+    const skinning::Triangles& triangles,
+    const skinning::Positions& positions,
+    const BvhOptions& options) {
+  if (cache != nullptr) return cache->lend<N>(triangles, positions, options);
+  return std::make_shared<Bvh<N>>(triangles, positions, options);
+}
 
 /// What a method builds its hierarchy with: a copy from `cache` when one is given
 /// (MethodOptions::hierarchies), its own build otherwise. `subset` as HierarchyCache::get.

@@ -14,9 +14,11 @@
 #include <thread>
 #include <vector>
 
+#include "culling/candidates.hpp"
 #include "culling/feature_topology.hpp"
 #include "culling/hierarchy_cache.hpp"
 #include "culling/method.hpp"
+#include "culling/traversal.hpp"
 #include "skinning/errors.hpp"
 #include "tests/culling/welded_character.hpp"
 #include "tests/support/test_support.hpp"
@@ -308,6 +310,106 @@ TEST(HierarchyCache, BvhMethodsTakeThePrebuiltTreeAndShareOneSlotAdjacency) {
     EXPECT_EQ(got.dcd_pairs, expected.dcd_pairs);
     EXPECT_EQ(got.counters.bv_tests, expected.counters.bv_tests);
   }
+}
+
+/// The triangle pairs whose boxes meet at the welded positions `x` through `tree` refit there,
+/// and the volume tests it took.
+std::pair<std::vector<TrianglePair>, std::int64_t> pairs_at(
+    Bvh<3>& tree, const FeatureTopology& topology, const skinning::Positions& x) {
+  FeatureBounds<3> bounds;
+  bounds.static_triangles(topology, x);
+  tree.refit(bounds.triangles);
+  TraversalScratch scratch;
+  scratch.reserve_self(tree);
+  std::vector<TrianglePair> pairs;
+  std::int64_t bv_tests = 0;
+  self_traverse<3>(tree, bounds.triangles, scratch, pairs, bv_tests);
+  return {pairs, bv_tests};
+}
+
+TEST(HierarchyCache, AHandOverCacheLendsItsOneTreeToTheNextCallerOnceTheLastLetGo) {
+  // A serial check: the baseline's `bvh` lends the tree, refits it at its pose and lets go; the
+  // runner's method is lent that very object, and its queries see what a fresh build gives.
+  const test::WeldedCharacter fox("Fox.glb");
+  const FeatureTopology topology(*fox.loaded.mesh, fox.topology);
+  const auto& triangles = fox.topology.welded_triangles;
+  const BvhOptions options{.leaf_size = 1, .node_volumes = false};
+  Bvh<3> own(triangles, fox.rest, options);
+  HierarchyCache cache(HierarchyCache::Sharing::hand_over);
+
+  auto first = cache.lend<3>(triangles, fox.rest, options);
+  EXPECT_EQ(cache.builds(), 1u);
+  expect_same_tree(*first, own);
+  // Held still: the next caller builds its own, which the cache does not keep.
+  {
+    const auto second = cache.lend<3>(triangles, fox.rest, options);
+    EXPECT_NE(second.get(), first.get());
+    expect_same_tree(*second, own);
+    EXPECT_EQ(cache.builds(), 1u);
+    EXPECT_EQ(cache.reuses(), 0u);
+  }
+  // get() on a hand-over cache: the caller's own build, nothing kept or shared.
+  expect_same_tree(cache.get<3>(triangles, fox.rest, nullptr, options), own);
+  EXPECT_EQ(cache.builds(), 1u);
+
+  // Refit at one pose and let go: the next caller gets that object, and refit at another pose
+  // it finds what a fresh tree finds there, with the same volume tests.
+  (void)pairs_at(*first, topology, fox.sample(3));
+  const Bvh<3>* const lent = first.get();
+  first.reset();
+  auto next = cache.lend<3>(triangles, fox.rest, options);
+  EXPECT_EQ(next.get(), lent);
+  EXPECT_EQ(cache.reuses(), 1u);
+  const auto [pairs, tests] = pairs_at(*next, topology, fox.sample(11));
+  const auto [fresh_pairs, fresh_tests] = pairs_at(own, topology, fox.sample(11));
+  EXPECT_EQ(pairs, fresh_pairs);
+  EXPECT_EQ(tests, fresh_tests);
+  EXPECT_GT(pairs.size(), static_cast<std::size_t>(triangles.rows()));  // not a trivial walk
+  next.reset();
+
+  // A caller of other inputs frees the tree no one holds: one tree at a time.
+  skinning::Positions moved = fox.rest;
+  moved(7, 1) = std::nextafter(moved(7, 1), 1e300);
+  const std::weak_ptr<Bvh<3>> held = cache.lend<3>(triangles, fox.rest, options);
+  EXPECT_EQ(cache.reuses(), 2u);
+  EXPECT_FALSE(held.expired());  // the cache's
+  expect_same_tree(*cache.lend<3>(triangles, moved, options), Bvh<3>(triangles, moved, options));
+  EXPECT_TRUE(held.expired());
+  EXPECT_EQ(cache.builds(), 2u);
+
+  // The last caller next: what it builds is not kept; the tree held is still lent.
+  cache.keep_no_more();
+  const std::weak_ptr<Bvh<8>> other = cache.lend<8>(triangles, fox.rest, options);
+  EXPECT_TRUE(other.expired());
+  EXPECT_EQ(cache.builds(), 2u);
+  EXPECT_EQ(cache.reuses(), 2u);  // the 16-DOP tree freed the moved one: nothing left to lend
+  (void)cache.lend<3>(triangles, moved, options);
+  EXPECT_EQ(cache.builds(), 2u);
+  EXPECT_EQ(cache.reuses(), 2u);
+
+  // Objects are not shared: each caller builds its own.
+  int built = 0;
+  const auto build = [&] {
+    ++built;
+    return std::make_shared<const int>(built);
+  };
+  EXPECT_NE(cache.shared<int>("key", build), cache.shared<int>("key", build));
+  EXPECT_EQ(built, 2);
+}
+
+TEST(HierarchyCache, AHandOverCacheKeepsNothingOnceClosed) {
+  const test::WeldedCharacter fox("Fox.glb");
+  const auto& triangles = fox.topology.welded_triangles;
+  const BvhOptions options{.leaf_size = 1, .node_volumes = false};
+  HierarchyCache cache(HierarchyCache::Sharing::hand_over);
+  const std::weak_ptr<Bvh<3>> kept = cache.lend<3>(triangles, fox.rest, options);
+  EXPECT_FALSE(kept.expired());
+  cache.close();
+  EXPECT_TRUE(kept.expired());
+  const std::weak_ptr<Bvh<3>> after = cache.lend<3>(triangles, fox.rest, options);
+  EXPECT_TRUE(after.expired());
+  EXPECT_EQ(cache.builds(), 1u);
+  EXPECT_EQ(cache.reuses(), 0u);
 }
 
 }  // namespace

@@ -243,6 +243,40 @@ TEST(ParallelRunner, WorkersShareOneBuildOfEachHierarchyAndTheCacheIsClosedAfter
   EXPECT_EQ(cache->builds(), 0u);
 }
 
+TEST(ParallelRunner, ASerialRunIsLentTheBaselinesTreeThroughAHandOverCache) {
+  // A serial check: its baseline `bvh` builds the whole mesh's tree through a hand-over cache and
+  // is freed; the runner's one method — `bvh`, or `dynamic` for its DCD tree (the run has DCD
+  // queries) — is lent that tree, refit at the baseline's pose, instead of building its own.
+  // `kdop` (a 16-DOP tree) builds its own. The rows are those of a run without the cache.
+  const auto l = load(test::asset("characters/CesiumMan.glb").string());
+  for (const char* method : {"bvh", "dynamic", "kdop"}) {
+    SCOPED_TRACE(method);
+    RunOptions options;
+    options.method = method;
+    options.frames = parse_frame_range("0:12");
+    options.threads = 1;
+    (void)setup_radial_view(RadialViewArguments{}, l.model, *l.motion, options);
+    ClipRunner alone(*l.motion, options, skinning::build_topology(l.motion->mesh()));
+    const auto rows = collect(alone);
+
+    auto cache =
+        std::make_shared<culling::HierarchyCache>(culling::HierarchyCache::Sharing::hand_over);
+    auto topology = skinning::build_topology(l.motion->mesh());
+    bvh_through(cache, l.motion->mesh(), topology);
+    ASSERT_EQ(cache->builds(), 1u);  // its tree (no slot adjacency: objects are not kept)
+    ClipRunner runner(*l.motion, options, std::move(topology), {}, {}, cache);
+    const bool lent = std::string(method) != "kdop";
+    EXPECT_EQ(cache->reuses(), lent ? 1u : 0u);
+    EXPECT_EQ(cache->builds(), 1u);  // the runner's method keeps what it builds to itself
+    EXPECT_GT(expect_same_rows(rows, collect(runner)), 0u)
+        << "no findings: the clip proves nothing";
+    // Closed once the method is built: nothing held, nothing lent again.
+    bvh_through(cache, l.motion->mesh(), runner.topology());
+    EXPECT_EQ(cache->builds(), 1u);
+    EXPECT_EQ(cache->reuses(), lent ? 1u : 0u);
+  }
+}
+
 TEST(ParallelRunner, DynamicsWorkersShareOneRimFirstFeatureTopology) {
   // `dynamic` on CesiumMan, which has no boundary loop to cap (ghost caps would give each
   // method a mesh of its own): four workers' methods, one build of their rim-first

@@ -123,7 +123,8 @@ CheckOutcome check_model(
   CheckOutcome outcome;
   // The baseline and the allowances, refused (a bad sample, a log of another model, an unknown
   // part) before the log is created. The baseline's DCD builds its own `bvh`. A serial run frees
-  // it before the runner builds its method: the two would otherwise be the run's peak memory
+  // it before the runner builds its method — all but its tree, which the runner's method takes
+  // over when it has one of the same key: the two would otherwise be the run's peak memory
   // together (docs/benchmarks.md "Real assets"). A parallel run computes it on a thread of its
   // own while this one sets up the radial view and the runner builds the workers' methods: the
   // stretch before the workers start is serial, and it caps the speed-up (docs/check.md,
@@ -190,8 +191,16 @@ CheckOutcome check_model(
     phase = std::chrono::steady_clock::now();
     features = std::make_shared<const culling::FeatureTopology>(motion->mesh(), *topology);
     outcome.setup.topology += ms_since(phase);
+    // The baseline's `bvh` tree, kept for the runner's method (`bvh`, `dynamic`'s DCD tree: the
+    // same key) once the `bvh` is freed: lent, not copied, so that the two never hold it twice,
+    // and not built again (culling::HierarchyCache::Sharing::hand_over). The runner closes it.
+    if (request.baseline.kind == BaselineSpec::Kind::rest ||
+        request.baseline.kind == BaselineSpec::Kind::sample) {
+      hierarchies =
+          std::make_shared<culling::HierarchyCache>(culling::HierarchyCache::Sharing::hand_over);
+    }
     phase = std::chrono::steady_clock::now();
-    baseline = baseline_findings(request.baseline, *motion, *topology, features);
+    baseline = baseline_findings(request.baseline, *motion, *topology, features, hierarchies);
     outcome.setup.baseline = ms_since(phase);
   }
   phase = std::chrono::steady_clock::now();

@@ -580,6 +580,14 @@ ClipRunner::ClipRunner(
   method_options_.features =
       culling::shared_or_built(std::move(features), motion_.mesh(), *topology_);
 
+  // The cache the methods are built through, closed and let go once they are (or fail).
+  struct CloseWhenBuilt {
+    culling::MethodOptions& options;
+    ~CloseWhenBuilt() {
+      if (options.hierarchies) options.hierarchies->close();
+      options.hierarchies.reset();
+    }
+  };
   // The method; in a parallel run, the other workers' methods at the same time, so that every
   // worker starts checking with the first block instead of one waiting for its method (a serial
   // stretch of a parallel run: 20-40 ms of a 0.4-0.9 s check). They are built by oneTBB's
@@ -587,7 +595,17 @@ ClipRunner::ClipRunner(
   // running, where threads of their own left oneTBB to create its workers at the first block
   // (1.5-3 ms before the second thread took one, on this 2-core VM).
   if (plan_.threads <= 1) {
-    if (hierarchies) hierarchies->close();  // one method: nothing to share; the caller's freed
+    // One method: nothing to share. A hand-over cache lends it the tree the caller's baseline
+    // `bvh` built (the same key, refit at its first query) instead of a second build; closed
+    // once it is built, so that nothing else is held for the run. Any other cache is closed
+    // unused, and what the caller built through it freed.
+    if (hierarchies && hierarchies->sharing() == culling::HierarchyCache::Sharing::hand_over) {
+      hierarchies->keep_no_more();  // this method is the last: what it builds, it holds alone
+      method_options_.hierarchies = std::move(hierarchies);
+    } else if (hierarchies) {
+      hierarchies->close();
+    }
+    const CloseWhenBuilt close_when_built{method_options_};
     method_ = build_method();
     adopt_method_features();
     return;
@@ -597,13 +615,7 @@ ClipRunner::ClipRunner(
   // trees it holds are not kept for the run; the methods keep their own copies.
   method_options_.hierarchies =
       hierarchies ? std::move(hierarchies) : std::make_shared<culling::HierarchyCache>();
-  struct CloseWhenBuilt {
-    culling::MethodOptions& options;
-    ~CloseWhenBuilt() {
-      options.hierarchies->close();
-      options.hierarchies.reset();
-    }
-  } close_when_built{method_options_};
+  const CloseWhenBuilt close_when_built{method_options_};
   spare_methods_.resize(static_cast<std::size_t>(plan_.threads - 1));
   const tbb::global_control allowed(
       tbb::global_control::max_allowed_parallelism, static_cast<std::size_t>(plan_.threads));
