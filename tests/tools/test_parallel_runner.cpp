@@ -275,6 +275,25 @@ TEST(ParallelRunner, ASerialRunIsLentTheBaselinesTreeThroughAHandOverCache) {
     EXPECT_EQ(cache->builds(), 1u);
     EXPECT_EQ(cache->reuses(), lent ? 1u : 0u);
   }
+  // A parallel run given one does not lend through it (its workers would build one after
+  // another): closed, and its workers share a cache of copies; the serial run's rows.
+  RunOptions options;
+  options.method = "bvh";
+  options.frames = parse_frame_range("0:12");
+  options.block_samples = 2;
+  options.threads = 1;
+  ClipRunner alone(*l.motion, options, skinning::build_topology(l.motion->mesh()));
+  const auto rows = collect(alone);
+  options.threads = 2;
+  auto cache =
+      std::make_shared<culling::HierarchyCache>(culling::HierarchyCache::Sharing::hand_over);
+  auto topology = skinning::build_topology(l.motion->mesh());
+  bvh_through(cache, l.motion->mesh(), topology);
+  ClipRunner runner(*l.motion, options, std::move(topology), {}, {}, cache);
+  ASSERT_EQ(runner.plan().threads, 2) << runner.plan().serial_reason;
+  EXPECT_EQ(cache->builds(), 1u);
+  EXPECT_EQ(cache->reuses(), 0u);
+  expect_same_rows(rows, collect(runner));
 }
 
 TEST(ParallelRunner, DynamicsWorkersShareOneRimFirstFeatureTopology) {

@@ -613,6 +613,12 @@ ClipRunner::ClipRunner(
   // The workers' methods are alike: each hierarchy is built once (by the first thread to ask,
   // or by the caller's baseline), the others copy it. Closed when they are built, so that the
   // trees it holds are not kept for the run; the methods keep their own copies.
+  // A hand-over cache lends to one method at a time: the workers would build their trees one
+  // after another under its lock. Closed (its tree freed), and a cache of copies instead.
+  if (hierarchies && hierarchies->sharing() == culling::HierarchyCache::Sharing::hand_over) {
+    hierarchies->close();
+    hierarchies.reset();
+  }
   method_options_.hierarchies =
       hierarchies ? std::move(hierarchies) : std::make_shared<culling::HierarchyCache>();
   const CloseWhenBuilt close_when_built{method_options_};

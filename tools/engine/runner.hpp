@@ -120,8 +120,10 @@ class ClipRunner {
   /// instead of a new one (a serial check's baseline `bvh` used it first). `hierarchies`, in a
   /// parallel run, the cache its workers' methods build their hierarchies through (one build,
   /// copied: culling::HierarchyCache), shared with whatever the caller builds beside them (a
-  /// parallel check's baseline `bvh`); without one a parallel run makes its own. Closed once the
-  /// methods are built.
+  /// parallel check's baseline `bvh`); without one a parallel run makes its own. A hand-over cache
+  /// (culling::HierarchyCache::Sharing::hand_over, a serial check's) lends a serial run's one
+  /// method the tree the caller's baseline `bvh` built; a parallel run closes one unused. Closed
+  /// once the methods are built.
   /// @pre topology == skinning::build_topology(motion.mesh()).
   ClipRunner(
       const skinning::Motion& motion,
