@@ -307,11 +307,14 @@ RadialViewMethod::RadialViewMethod(
   }
   // Each triangle's neighbour across each side, for build_patches' walk: the edge's other face
   // when it has two, kNoNeighbour for a boundary edge, kNeighboursListed when it has more (the
-  // walk then reads the edge's faces).
+  // walk then reads the edge's faces). A collapsed side (two corners welded into one: no edge,
+  // face_edge −1) has no neighbour.
   face_neighbours_.assign(3 * num_faces, kNoNeighbour);
   for (std::int32_t f = 0; f < topology_.num_triangles(); ++f) {
     for (int side = 0; side < 3; ++side) {
-      const auto faces = updater_.edge_triangles(topology_.face_edge(f, side));
+      const std::int32_t e = topology_.face_edge(f, side);
+      if (e < 0) continue;
+      const auto faces = updater_.edge_triangles(e);
       std::int32_t& n = face_neighbours_[3 * at(f) + at(side)];
       if (faces.size() > 2) {
         n = kNeighboursListed;
