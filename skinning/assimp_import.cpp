@@ -1265,7 +1265,8 @@ ImportedRig import_rig(const std::filesystem::path& file, const ImportOptions& o
     const detail::ImportLimits limits{
         .memory_bytes = options.memory_limit_bytes,
         .time_s = options.time_limit_s,
-        .heap_on_huge_pages = true};
+        .heap_on_huge_pages = true,
+        .while_waiting = options.while_importing};
     detail::ChildAnswer answer =
         detail::run_isolated_with_answer(file, limits, [&](const detail::AnswerSink& send) {
           detail::write_imported_rig(import_locked(file, options), send);

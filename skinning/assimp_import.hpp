@@ -5,6 +5,7 @@
 
 #include <cstddef>
 #include <filesystem>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -37,6 +38,10 @@ struct ImportOptions {
   std::size_t memory_limit_bytes = kDefaultImportMemoryLimit;
   /// Time that importing one file may take in the child process, seconds.
   double time_limit_s = 120.0;
+  /// Work of this process's own, done while the child imports (with isolate; nothing without):
+  /// its wait for the child is otherwise idle. `skelcd check` starts its thread pool there
+  /// (tools::warm_up_workers). Must not throw: what it throws is dropped, the import goes on.
+  std::function<void()> while_importing{};
 };
 
 /// A clip of the file that could not be used (keys out of order, non-finite keys, …). The rest

@@ -869,6 +869,14 @@ ChildAnswer run_isolated_with_answer(
     child(fds[1], limits, probe);
   }
   ::close(fds[1]);
+  // The caller's own work beside the child's import. A failure of it is not the import's: dropped,
+  // and the child is read and reaped as always.
+  if (limits.while_waiting) {
+    try {
+      limits.while_waiting();
+    } catch (...) {
+    }
+  }
 
   // Read the child's report until it closes the pipe, within the time limit, while it writes (a
   // pipe holds 64 KiB: a child waiting for room would wait for ever). Pieces grow from 64 KiB to

@@ -24,6 +24,9 @@ struct ImportLimits {
   /// imports only. A reader whose known crashes depend on the heap's layout (HDF5's fuzzed
   /// logs) keeps the plain heap.
   bool heap_on_huge_pages = false;
+  /// Run by this process once the child has started, before it waits for the child's answer
+  /// (ImportOptions::while_importing); what it throws is dropped.
+  std::function<void()> while_waiting{};
 };
 
 /// Refuses a file whose header declares more elements than its size can hold, before any

@@ -3,6 +3,7 @@
 // allocations kept in a child process, OBJ vertex numbering, Collada bind shape matrices.
 
 #include <gtest/gtest.h>
+#include <poll.h>
 #include <unistd.h>
 
 #include <chrono>
@@ -12,6 +13,7 @@
 #include <fstream>
 #include <iostream>
 #include <iterator>
+#include <stdexcept>
 #include <string>
 #include <thread>
 #include <vector>
@@ -288,6 +290,44 @@ TEST(ImportGuard, AChildThatTakesTooLongIsStopped) {
       IoError,
       "model.glb: importing it took longer than 0.3 s");
   EXPECT_LT(std::chrono::steady_clock::now() - start, std::chrono::seconds(10));
+}
+
+TEST(ImportGuard, ThisProcessWorksWhileTheChildImportsAndItsFailureIsNotTheImports) {
+  // The child says it has started, then waits for a byte that only this process's work while
+  // waiting sends: run before the fork it would find no child (it waits 10 s, then sends all the
+  // same), run after the child's end, or not at all, the child would wait for the time limit.
+  int started[2];
+  int go[2];
+  ASSERT_EQ(::pipe(started), 0);
+  ASSERT_EQ(::pipe(go), 0);
+  const pid_t parent = ::getpid();
+  pid_t ran_in = 0;
+  bool saw_the_child = false;
+  detail::ImportLimits limits{.memory_bytes = std::size_t{1} << 30, .time_s = 30};
+  limits.while_waiting = [&] {
+    ran_in = ::getpid();
+    pollfd p{started[0], POLLIN, 0};
+    char byte = 0;
+    saw_the_child = ::poll(&p, 1, 10000) == 1 && ::read(started[0], &byte, 1) == 1 && byte == 's';
+    const char value = 42;
+    (void)!::write(go[1], &value, 1);
+    throw std::runtime_error("work beside the import failed");  // dropped: not the import's
+  };
+  auto answer =
+      detail::run_isolated_with_answer("model.glb", limits, [&](const detail::AnswerSink& send) {
+        const char s = 's';
+        if (::write(started[1], &s, 1) != 1) throw IoError("model.glb: cannot say it started");
+        char value = 0;
+        if (::read(go[0], &value, 1) != 1) throw IoError("model.glb: no byte from the parent");
+        send(&value, 1);
+      });
+  for (const int fd : {started[0], started[1], go[0], go[1]}) ::close(fd);
+  EXPECT_EQ(ran_in, parent);
+  EXPECT_TRUE(saw_the_child);
+  ASSERT_EQ(answer.size(), 1u);
+  char value = 0;
+  ASSERT_TRUE(answer.read(&value, 1));
+  EXPECT_EQ(value, 42);
 }
 
 // A probe's answer: `blocks` times the same 64 KiB of a pattern, sent as they are made.

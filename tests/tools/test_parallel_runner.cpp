@@ -12,6 +12,7 @@
 #include <atomic>
 #include <chrono>
 #include <cmath>
+#include <filesystem>
 #include <limits>
 #include <mutex>
 #include <set>
@@ -140,6 +141,26 @@ std::pair<std::vector<FrameReport>, std::vector<FrameReport>> serial_and_paralle
 // RunOptions::reuse_static_intervals most CCD rows are handed on (no stage time) and every row
 // equals the queried one; `dynamic` with `--query ccd` carries
 // state between intervals, so there nothing is handed on.
+// The threads of this process now (its entries in /proc/self/task).
+std::size_t threads_of_this_process() {
+  std::size_t n = 0;
+  for ([[maybe_unused]] const auto& entry : std::filesystem::directory_iterator("/proc/self/task"))
+    ++n;
+  return n;
+}
+
+TEST(ParallelRunner, WarmingUpTheWorkersStartsThemForAParallelRunOnly) {
+  // Nothing for a serial run, nor for a count the runner refuses (it reports that itself).
+  const std::size_t before = threads_of_this_process();
+  warm_up_workers(1);
+  warm_up_workers(-2);
+  EXPECT_EQ(threads_of_this_process(), before);
+  // Two threads: oneTBB's worker is up when it returns (this test's process had none, unless
+  // an earlier test in the same process started them).
+  warm_up_workers(2);
+  EXPECT_GE(threads_of_this_process(), std::max<std::size_t>(before, 2));
+}
+
 TEST(RunnerStatic, UnnamedBonesRowsAreTheQueriedOnes) {
   const auto l = load(test::assimp_model("MDL/MDL (HL1)/unnamed_bones.mdl").string());
   const auto run = [&](const char* method, QuerySet query, bool reuse) {

@@ -474,6 +474,20 @@ std::int32_t resolve_threads(std::int32_t threads) {
   return threads;
 }
 
+void warm_up_workers(std::int32_t threads) {
+  if (threads < 0 || threads == 1) return;  // a negative count is refused by the runner
+  const std::int32_t n = resolve_threads(threads);
+  if (n < 2) return;
+  // One task offered to an arena of n slots: oneTBB creates its scheduler and asks for workers;
+  // whether this thread or a worker then runs the task does not matter.
+  tbb::task_arena arena(n);
+  arena.execute([] {
+    tbb::task_group offered;
+    offered.run([] {});
+    offered.wait();
+  });
+}
+
 ClipRunner::ClipRunner(
     const skinning::Motion& motion, const RunOptions& options, MethodFactory factory)
     : ClipRunner(motion, options, skinning::build_topology(motion.mesh()), std::move(factory)) {}
