@@ -136,11 +136,6 @@ std::pair<std::vector<FrameReport>, std::vector<FrameReport>> serial_and_paralle
   return {std::move(out[0]), std::move(out[1])};
 }
 
-// A real clip that holds one pose: Debian's MDL (HL1)/unnamed_bones.mdl, 76 samples of one pose
-// with 1,852 contacts an interval (eight stacked slabs within float noise of each other). With
-// RunOptions::reuse_static_intervals most CCD rows are handed on (no stage time) and every row
-// equals the queried one; `dynamic` with `--query ccd` carries
-// state between intervals, so there nothing is handed on.
 // The threads of this process now (its entries in /proc/self/task).
 std::size_t threads_of_this_process() {
   std::size_t n = 0;
@@ -161,6 +156,11 @@ TEST(ParallelRunner, WarmingUpTheWorkersStartsThemForAParallelRunOnly) {
   EXPECT_GE(threads_of_this_process(), std::max<std::size_t>(before, 2));
 }
 
+// A real clip that holds one pose: Debian's MDL (HL1)/unnamed_bones.mdl, 76 samples of one pose
+// with 1,852 contacts an interval (eight stacked slabs within float noise of each other). With
+// RunOptions::reuse_static_intervals most CCD rows are handed on (no stage time) and every row
+// equals the queried one; `dynamic` with `--query ccd` carries
+// state between intervals, so there nothing is handed on.
 TEST(RunnerStatic, UnnamedBonesRowsAreTheQueriedOnes) {
   const auto l = load(test::assimp_model("MDL/MDL (HL1)/unnamed_bones.mdl").string());
   const auto run = [&](const char* method, QuerySet query, bool reuse) {

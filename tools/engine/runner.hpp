@@ -102,9 +102,9 @@ struct RunPlan {
 /// Starts oneTBB's thread pool for a run on `threads` (as `--threads`; nothing for 1) and returns
 /// once it has. A process's first arena costs 2-3 ms on this project's 2-core VM (the scheduler's
 /// set-up, its probe of the machine, the worker threads), which a parallel run would otherwise pay
-/// inside ClipRunner's constructor, between its set-up and its first block. Meant for a thread of
-/// its own beside a serial stretch of the set-up (check_model: the weld). The pool stays up once
-/// this returns.
+/// inside ClipRunner's constructor, between its set-up and its first block. Meant for a stretch in
+/// which this process only waits: `skelcd check` calls it while the import's child reads the model
+/// (skinning::ImportOptions::while_importing). The pool stays up once this returns.
 void warm_up_workers(std::int32_t threads);
 
 /// Builds the culling method for a mesh; the default calls culling::make_method(options.method…).
