@@ -535,7 +535,7 @@ TEST(ParallelRunner, IncrementalDcdRowsHoldTheFullDcdsPairsWithFewerTests) {
   }
 }
 
-// Without --block-samples the blocks hold B = clamp(samples / 16, 4, 64) samples while more than
+// Without --block-samples the blocks hold B = clamp(samples / 8, 4, 64) samples while more than
 // 4·B are left, then a quarter of what is left (at least 2), so that the last blocks a pipeline
 // hands out are small and the workers run out of work together: read from the rows, where a
 // block's first DCD is a full one (the full run's counters) and the others are updates.
@@ -570,7 +570,7 @@ TEST(ParallelRunner, DefaultBlocksShrinkTowardsTheEndOfTheClip) {
     starts.push_back(frames);  // one past the last block
     std::vector<std::int32_t> sizes;
     for (std::size_t b = 0; b + 1 < starts.size(); ++b) sizes.push_back(starts[b + 1] - starts[b]);
-    const std::int32_t largest = std::clamp(frames / 16, 4, 64);
+    const std::int32_t largest = std::clamp(frames / 8, 4, 64);
     std::int32_t left = frames;
     for (std::size_t b = 0; b < sizes.size(); ++b) {
       SCOPED_TRACE(b);

@@ -365,7 +365,7 @@ class WorkerPool {
 
 /// The blocks' first units and, last, `units` (block i is [starts[i], starts[i + 1])), whatever
 /// the thread count. `fixed` > 0: blocks of `fixed` units (RunOptions::block_samples). Otherwise
-/// blocks of B = clamp(units / 16, 4, 64) units while more than 4·B units are left, then of a
+/// blocks of B = clamp(units / 8, 4, 64) units while more than 4·B units are left, then of a
 /// quarter of what is left (at least kTailUnits): the blocks a pipeline hands out last are the
 /// small ones, so the workers run out of blocks at nearly the same time however the blocks' costs
 /// vary along the clip (equal blocks had left one worker idle for up to a block at the end). A
@@ -374,10 +374,16 @@ std::vector<std::int32_t> block_layout(std::int32_t units, std::int32_t fixed) {
   // A block starts with a full DCD (the others update it): blocks of one unit would pay it at
   // every sample.
   constexpr std::int32_t kTailUnits = 2;
+  // The first blocks hold an eighth of the clip each. A sixteenth (until 2026-12-06) fed up to
+  // 16 threads at once, but each block start's full DCD costs about a third of an interval on the
+  // real characters: 20 blocks of BCN_Epileptic's 99 intervals against 14 now took 2-4 % longer
+  // per interval on one and two threads alike (docs/benchmarks.md, "Fewer block starts"). An
+  // eighth still gives 8 threads a block each before the smaller ones at the end.
+  constexpr std::int32_t kFirstBlockShare = 8;
   assert(units >= 1);
   std::vector<std::int32_t> starts{0};
   const std::int32_t largest =
-      fixed > 0 ? fixed : std::clamp(units / 16, std::int32_t{4}, std::int32_t{64});
+      fixed > 0 ? fixed : std::clamp(units / kFirstBlockShare, std::int32_t{4}, std::int32_t{64});
   for (std::int32_t at = 0; at < units;) {
     const std::int32_t left = units - at;
     std::int32_t size =

@@ -53,8 +53,8 @@ struct RunOptions {
   /// A run is serial anyway when its method carries state between queries that would change its
   /// rows (RunPlan::serial_reason says why).
   std::int32_t threads = 1;
-  /// Samples per block a worker checks in a row (0: chosen from the clip length: an even number
-  /// of blocks, whatever the thread count, whose sizes differ by at most one sample).
+  /// Samples per block a worker checks in a row (0: chosen from the clip length, whatever the
+  /// thread count: an eighth of the clip, between 4 and 64, then smaller blocks towards the end).
   std::int32_t block_samples = 0;
   /// The factory's methods keep no state between queries that changes their findings or counters
   /// (methods of make_method are classified by name; a custom factory's only through this).
