@@ -376,7 +376,7 @@ std::vector<std::int32_t> block_layout(std::int32_t units, std::int32_t fixed) {
   constexpr std::int32_t kTailUnits = 2;
   // The first blocks hold an eighth of the clip each. A sixteenth (until 2026-12-06) fed up to
   // 16 threads at once, but each block start's full DCD costs about a third of an interval on the
-  // real characters: 20 blocks of BCN_Epileptic's 99 intervals against 14 now took 2-4 % longer
+  // real characters: 20 blocks of BCN_Epileptic's 100 samples against 14 now took 2-4 % longer
   // per interval on one and two threads alike (docs/benchmarks.md, "Fewer block starts"). An
   // eighth still gives 8 threads a block each before the smaller ones at the end.
   constexpr std::int32_t kFirstBlockShare = 8;
