@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <future>
 #include <memory>
+#include <optional>
 
 #include "culling/hierarchy_cache.hpp"
 #include "culling/method.hpp"
@@ -221,7 +222,6 @@ CheckOutcome check_model(
     }
   }();
   outcome.setup.methods = ms_since(phase);
-  if (baseline_task.valid()) baseline_task.get();
   outcome.plan = runner.plan();
   outcome.clip = motion->name();
   outcome.fps = motion->rate_hz();
@@ -232,15 +232,33 @@ CheckOutcome check_model(
     motion->positions(sample, out);
   };
   outcome.baseline = describe(request.baseline);
-  outcome.baseline_pairs = static_cast<std::int64_t>(baseline.pairs.size());
   const skinning::Rig* rig = model.rig && model.rig->mesh.num_vertices() == mesh.num_vertices()
                                  ? model.rig.get()
                                  : nullptr;
-  EventTracker tracker(
-      mesh, runner.topology(), rig, baseline, request.allow, request.baseline_slack, positions_at);
 
+  // What labels and logs the rows needs the baseline's findings: the tracker, and the log, which
+  // is created only once they are known (a refused baseline leaves no file behind). A serial run
+  // has them already. A parallel run's workers start on the blocks without them: the rows do not
+  // depend on the baseline, only their labels do, so the thread that reports the first row waits
+  // for the baseline's thread there, while the other workers go on checking blocks (before,
+  // every worker waited, and one core sat idle until the baseline was done: docs/check.md,
+  // "Threads"). The order of refusals is a serial run's: the baseline's, then the tracker's (an
+  // unknown part in the allowances), then the log's.
+  std::optional<EventTracker> tracker;
   std::unique_ptr<LogWriter> writer;
-  if (!request.log_path.empty()) {
+  const auto start_reporting = [&] {
+    if (tracker) return;
+    if (baseline_task.valid()) baseline_task.get();
+    outcome.baseline_pairs = static_cast<std::int64_t>(baseline.pairs.size());
+    tracker.emplace(
+        mesh,
+        runner.topology(),
+        rig,
+        baseline,
+        request.allow,
+        request.baseline_slack,
+        positions_at);
+    if (request.log_path.empty()) return;
     const std::string input = request.input_path.empty() ? model.path.string() : request.input_path;
     LogHeader header = log_header_base({
         .input_path = input,
@@ -268,9 +286,11 @@ CheckOutcome check_model(
     header.allow = request.allow.rules;
     header.allow_adjacent_bones = request.allow.adjacent_bones;
     writer = std::make_unique<LogWriter>(request.log_path, header);
-  }
+  };
+  if (!parallel) start_reporting();
 
   outcome.rows.reserve(static_cast<std::size_t>(outcome.plan.rows));
+  // A parallel run's baseline may still be running: its time overlaps the first blocks'.
   outcome.setup.total = ms_since(start);
   if (request.on_plan) request.on_plan(outcome.plan);
   const auto emit = [&](std::vector<FrameReport> ready) {
@@ -280,9 +300,20 @@ CheckOutcome check_model(
       if (on_row) on_row(report);
     }
   };
-  runner.run([&](const FrameReport& report) { emit(tracker.push(report)); });
-  emit(tracker.flush());
-  outcome.events = tracker.events();
+  try {
+    runner.run([&](const FrameReport& report) {
+      start_reporting();
+      emit(tracker->push(report));
+    });
+  } catch (...) {
+    // A block's failure before the first row was reported: the baseline's refusal comes first, as
+    // in a serial run (its thread is waited for either way: it reads this function's locals).
+    if (baseline_task.valid()) baseline_task.get();
+    throw;
+  }
+  start_reporting();  // a clip without rows
+  emit(tracker->flush());
+  outcome.events = tracker->events();
   if (writer) {
     writer->write_events(outcome.events);
     writer->finish();

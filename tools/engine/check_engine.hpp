@@ -53,8 +53,9 @@ struct CheckRequest {
   std::string command_line;
   /// When set, elementary tests count into it as they finish (a progress line inside one query).
   std::atomic<std::int64_t>* tests_done = nullptr;
-  /// Called once the check is planned and its log created, before the first row (a progress
-  /// line learns how many rows to expect).
+  /// Called once the check is planned, before the first row (a progress line learns how many
+  /// rows to expect): in a serial run after its log is created; a parallel run, whose baseline
+  /// may still be running, creates the log at its first row (and may still refuse the baseline).
   std::function<void(const RunPlan&)> on_plan;
 };
 
