@@ -4,12 +4,16 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cstdint>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <memory>
+#include <sstream>
 #include <string>
+#include <thread>
+#include <utility>
 #include <vector>
 
 #include "tests/support/test_support.hpp"
@@ -99,6 +103,50 @@ TEST(LargePages, ALargeVectorFollowsTheSetting) {
   const std::vector<char> as_asked(7 * kHugePage / 5, 'a');
   const std::string as_asked_end = test::vm_flags_at(&as_asked.back());
   EXPECT_EQ(as_asked_end.find(" hg"), std::string::npos) << as_asked_end;
+}
+
+/// The main heap's range (what brk has grown: the "[heap]" lines of /proc/self/maps, several once
+/// part of it is advised), or {0, 0}.
+std::pair<std::uintptr_t, std::uintptr_t> heap_range() {
+  std::ifstream maps("/proc/self/maps");
+  std::string line;
+  std::pair<std::uintptr_t, std::uintptr_t> range{0, 0};
+  while (std::getline(maps, line)) {
+    if (line.find("[heap]") == std::string::npos) continue;
+    std::uintptr_t lo = 0;
+    std::uintptr_t hi = 0;
+    char dash = 0;
+    std::istringstream head(line);
+    if (!(head >> std::hex >> lo >> dash >> hi) || dash != '-') continue;
+    range = range.second == 0 ? std::pair{lo, hi}
+                              : std::pair{std::min(range.first, lo), std::max(range.second, hi)};
+  }
+  return range;
+}
+
+// What `check` calls first (tools/cli/main.cpp). ctest runs each test in a process of its own, so
+// malloc's settings changed here reach no other test.
+TEST(LargePages, TheHeapsTopIsAdvisedAndEveryThreadAllocatesThere) {
+  const auto before = heap_range();
+  heap_on_huge_pages(kHeapOnHugePages);
+  const auto after = heap_range();
+  ASSERT_NE(after.second, 0U) << "no [heap] in /proc/self/maps";
+  // The heap grew by the block at once, and kept it as its free top (not trimmed).
+  EXPECT_GE(after.second - before.second, kHeapOnHugePages);
+  // Its huge pages advised where the kernel has them (the middle of the block is in one).
+  const auto* middle = reinterpret_cast<const void*>(before.second + kHeapOnHugePages / 2);
+  const std::string flags = test::vm_flags_at(middle);
+  EXPECT_EQ(flags.find(" hg") != std::string::npos, kernel_has_huge_pages()) << flags;
+  // A thread of its own allocates from that heap (no arena mapped apart for it).
+  const std::size_t bytes = std::size_t{100} << 10;
+  void* from_thread = nullptr;
+  std::thread([&] { from_thread = std::malloc(bytes); }).join();
+  ASSERT_NE(from_thread, nullptr);
+  const auto block = reinterpret_cast<std::uintptr_t>(from_thread);
+  EXPECT_TRUE(after.first <= block && block + bytes <= after.second)
+      << from_thread << " outside the heap " << std::hex << after.first << "-" << after.second;
+  std::free(from_thread);
+  EXPECT_EQ(heap_range().second, after.second);
 }
 
 TEST(LargePages, TheEnvironmentTurnsThemOff) {

@@ -355,7 +355,8 @@ CheckedClip check_clip(
   };
   std::atomic<std::int64_t> tests_done{0};  // shown by the progress line inside long queries
   request.tests_done = &tests_done;
-  // The progress line starts once the check is planned; a check refused before shows none.
+  // The progress line starts once the check is planned; a check refused before shows none (a
+  // parallel run's baseline refused later erases it, as any failure does, before the message).
   std::unique_ptr<Progress> progress;
   std::int64_t rows = 0;
   request.on_plan = [&](const RunPlan& plan) {
@@ -574,7 +575,9 @@ void run_check_command(const CheckArguments& args) {
   // that a check frees (the baseline DCD's hierarchy, a query's scratch) stay resident in the heap
   // and count in the peak RSS with the next ones: on cloth-funnel's CCD check, 1-2 MiB of its
   // ~17 MiB above the floor (docs/benchmarks.md, "Fixed costs"). Only here: `inspect` reads logs
-  // under libhdf5's own allocation pattern (tests/tools/test_log.cpp, the fuzzed logs).
+  // under libhdf5's own allocation pattern (tests/tools/test_log.cpp, the fuzzed logs). The
+  // executable has put the heap's top on huge pages before (tools/cli/main.cpp,
+  // heap_on_huge_pages, which leaves this threshold to be set here).
   mallopt(M_MMAP_THRESHOLD, 128 * 1024);
   // When glibc trims the heap's free top it keeps this much mapped (default 128 KiB): a check
   // frees and allocates its per-phase and per-query buffers over and over, and each page given
@@ -583,7 +586,8 @@ void run_check_command(const CheckArguments& args) {
   // 0.70 s) with the same peak RSS on one thread; 16 MiB gave the worker threads' heaps 8 MiB
   // more on two (docs/benchmarks.md, "The heap's top kept"). The import's child inherits it: an
   // import that needs all but the last 4 MiB of its limit may be refused (the limit is 64 MiB at
-  // least on the command line).
+  // least on the command line). With the heap's top on huge pages it is not trimmed below 60 MiB
+  // free, and the pad matters only with SKELCD_LARGE_PAGES=0 (or outside the executable).
   mallopt(M_TOP_PAD, 4 << 20);
   if (args.models.size() == 1 && is_scene_path(args.models.front())) {  // a scene (docs/scenes.md)
     run_scene_check(

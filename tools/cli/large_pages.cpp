@@ -2,6 +2,7 @@
 // its own test only, never into the libraries (python/ and the other tests keep the default one).
 #include "tools/cli/large_pages.hpp"
 
+#include <malloc.h>
 #include <sys/mman.h>
 
 #include <algorithm>
@@ -26,6 +27,26 @@ std::size_t large_block_size(std::size_t bytes) noexcept {
   if (tail == 0) return bytes;
   const std::size_t extra = kHugePage - tail;
   return extra <= bytes / kMaxRoundingShare ? bytes + extra : bytes;
+}
+
+void heap_on_huge_pages(std::size_t bytes) noexcept {
+  if (bytes < 2 * kHugePage) return;
+  // One heap for all threads: a worker's own arena is mapped apart and would first-touch 4 KiB at
+  // a time. The rows allocate a few dozen blocks per interval (BCN_Epileptic: 3.7k mallocs over
+  // 99 intervals), so its lock is not where threads wait.
+  mallopt(M_ARENA_MAX, 1);
+  // Trimmed and grown again, the top would come back on small pages.
+  mallopt(M_TRIM_THRESHOLD, static_cast<int>(2 * bytes));
+  // The block comes from the heap, not a mapping of its own (glibc takes thresholds up to 32 MiB).
+  mallopt(M_MMAP_THRESHOLD, static_cast<int>(std::size_t{32} << 20));
+  void* block = std::malloc(bytes);
+  if (block == nullptr) return;
+  const auto at = reinterpret_cast<std::uintptr_t>(block);
+  const std::uintptr_t first = (at + kHugePage - 1) & ~(kHugePage - 1);
+  const std::uintptr_t last = (at + bytes) & ~(kHugePage - 1);
+  // Advice only, as for the large blocks; the freed block stays the heap's top.
+  if (last > first) madvise(reinterpret_cast<void*>(first), last - first, MADV_HUGEPAGE);
+  std::free(block);
 }
 
 namespace {

@@ -30,6 +30,20 @@ std::size_t large_block_size(std::size_t bytes) noexcept;
 /// only "0", "off" and "no" turn them off.
 bool large_pages_wanted(const char* env) noexcept;
 
+/// The address space heap_on_huge_pages() advises at the heap's top: what a check's small blocks
+/// take on the largest inputs (the cloth-ball step's whole heap stays below it), and what the
+/// import's child advises of its own (skinning/detail/import_guard.cpp).
+inline constexpr std::size_t kHeapOnHugePages = std::size_t{30} << 20;
+
+/// Puts the blocks malloc serves from its heap on transparent huge pages, for every thread
+/// (docs/cli.md, "Large allocations"): grows the main heap by `bytes` at once (address space only:
+/// nothing is touched), advises its whole 2 MiB pages MADV_HUGEPAGE and frees the block back to
+/// the heap's top, which is then never trimmed below it; and makes every thread allocate from
+/// that heap (M_ARENA_MAX 1), whose top alone is advised. A check first-touches what it allocates
+/// there a 2 MiB page at a time instead of 4 KiB. Leaves the mmap threshold at 32 MiB: the
+/// caller sets its own after. Below two huge pages, or where malloc refuses, nothing is advised.
+void heap_on_huge_pages(std::size_t bytes) noexcept;
+
 /// The whole huge pages of an allocation of `bytes` bytes at `begin`: the bytes to advise from
 /// `begin` (rounded down to kHugePage; the tail stays on small pages, so nothing beyond the
 /// allocation is advised). `begin` is expected on a kHugePage boundary; 0 when it is not.

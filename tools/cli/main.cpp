@@ -3,11 +3,15 @@
 
 #include <CLI/CLI.hpp>
 #include <cstdio>
+#include <cstdlib>
 #include <exception>
 #include <iostream>
 
 #include "skelcd_version.hpp"
 #include "tools/cli/commands.hpp"
+#if defined(SKELCD_LARGE_PAGES)
+#include "tools/cli/large_pages.hpp"
+#endif
 
 int main(int argc, char** argv) {
   CLI::App app{"skelcd — finds self-collisions in skeleton-driven animation", "skelcd"};
@@ -24,6 +28,15 @@ int main(int argc, char** argv) {
   skelcd::tools::add_generate_command(app);
   skelcd::tools::add_ccd_queries_command(app);
   skelcd::tools::add_bench_command(app);
+#if defined(SKELCD_LARGE_PAGES)
+  // A check's small blocks on huge pages too (docs/cli.md, "Large allocations"), before its
+  // command sets malloc's thresholds; the other commands keep malloc as it is.
+  app.get_subcommand("check")->preparse_callback([](std::size_t) {
+    if (skelcd::tools::large_pages_wanted(std::getenv("SKELCD_LARGE_PAGES"))) {
+      skelcd::tools::heap_on_huge_pages(skelcd::tools::kHeapOnHugePages);
+    }
+  });
+#endif
 
   try {
     app.parse(argc, argv);
