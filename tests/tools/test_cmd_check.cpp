@@ -224,6 +224,11 @@ TEST(CmdCheck, BadInputsFailWithOneLineAndLeaveNoLog) {
       {{"check", kModel, "--baseline-slack", "-1", "-o", log}, "--baseline-slack"},
       {{"check", kModel, "--allow", "a-b", "-o", log}, "--allow 'a-b'"},
       {{"check", kModel, "--allow", "fin:fin", "-o", log}, "'fin' names neither a part nor a bone"},
+      // On two threads the baseline runs beside the first blocks, and the log waits for it.
+      {{"check", kModel, "--threads", "2", "--baseline", "sample:100", "-o", log},
+       "--baseline sample:100"},
+      {{"check", kModel, "--threads", "2", "--allow", "fin:fin", "-o", log},
+       "'fin' names neither a part nor a bone"},
   };
   for (const auto& [args, message] : cases) {
     const auto r = run_skelcd(args);

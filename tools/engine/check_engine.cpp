@@ -236,14 +236,15 @@ CheckOutcome check_model(
                                  ? model.rig.get()
                                  : nullptr;
 
-  // What labels and logs the rows needs the baseline's findings: the tracker, and the log, which
-  // is created only once they are known (a refused baseline leaves no file behind). A serial run
-  // has them already. A parallel run's workers start on the blocks without them: the rows do not
-  // depend on the baseline, only their labels do, so the thread that reports the first row waits
-  // for the baseline's thread there, while the other workers go on checking blocks (before,
-  // every worker waited, and one core sat idle until the baseline was done: docs/check.md,
-  // "Threads"). The order of refusals is a serial run's: the baseline's, then the tracker's (an
-  // unknown part in the allowances), then the log's.
+  // Labelling the rows and logging them need the baseline's findings: the tracker, and the log,
+  // which is created only once they are known (a refused baseline leaves no file behind). A serial
+  // run has them already, and so has a parallel run whose baseline is done by now. Otherwise the
+  // workers start on the blocks without them: the rows do not depend on the baseline, only their
+  // labels do, so the thread that reports the first row waits for the baseline's thread there,
+  // while the other workers go on checking blocks (before, every worker waited, and one core sat
+  // idle until the baseline was done: docs/check.md, "Threads"). The order of refusals is a
+  // serial run's: the baseline's, then the tracker's (an unknown part in the allowances), then
+  // the log's.
   std::optional<EventTracker> tracker;
   std::unique_ptr<LogWriter> writer;
   const auto start_reporting = [&] {
@@ -287,7 +288,10 @@ CheckOutcome check_model(
     header.allow_adjacent_bones = request.allow.adjacent_bones;
     writer = std::make_unique<LogWriter>(request.log_path, header);
   };
-  if (!parallel) start_reporting();
+  if (!baseline_task.valid() ||
+      baseline_task.wait_for(std::chrono::seconds(0)) == std::future_status::ready) {
+    start_reporting();
+  }
 
   outcome.rows.reserve(static_cast<std::size_t>(outcome.plan.rows));
   // A parallel run's baseline may still be running: its time overlaps the first blocks'.

@@ -54,8 +54,8 @@ struct CheckRequest {
   /// When set, elementary tests count into it as they finish (a progress line inside one query).
   std::atomic<std::int64_t>* tests_done = nullptr;
   /// Called once the check is planned, before the first row (a progress line learns how many
-  /// rows to expect): in a serial run after its log is created; a parallel run, whose baseline
-  /// may still be running, creates the log at its first row (and may still refuse the baseline).
+  /// rows to expect), after the log is created — except in a parallel run whose baseline is still
+  /// running: it creates the log at its first row (and may still refuse the baseline then).
   std::function<void(const RunPlan&)> on_plan;
 };
 
