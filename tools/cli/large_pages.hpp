@@ -30,9 +30,10 @@ std::size_t large_block_size(std::size_t bytes) noexcept;
 /// only "0", "off" and "no" turn them off.
 bool large_pages_wanted(const char* env) noexcept;
 
-/// The address space heap_on_huge_pages() advises at the heap's top: what a check's small blocks
-/// take on the largest inputs (the cloth-ball step's whole heap stays below it), and what the
-/// import's child advises of its own (skinning/detail/import_guard.cpp).
+/// The address space heap_on_huge_pages() advises at the heap's top, as much as the import's child
+/// advises of its own (skinning/detail/import_guard.cpp): more than a character's check takes
+/// there. The cloth-ball step's heap outgrows it by about 6 MiB, on small pages; advising 62 MiB
+/// halved that check's faults (3.9k → 1.9k) for 10–14 MiB more peak RSS (docs/benchmarks.md).
 inline constexpr std::size_t kHeapOnHugePages = std::size_t{30} << 20;
 
 /// Puts the blocks malloc serves from its heap on transparent huge pages, for every thread
