@@ -694,7 +694,6 @@ class AnswerWriter {
   bool started_ = false;
 };
 
-#if !defined(SKELCD_UNDER_ASAN)
 // The child starts with the parent's small heap and grows it for everything the import reads and
 // builds, a page fault per 4 KiB page first touched: a third of the child's time for the
 // 28k-triangle CesiumMan-dense on this project's VMs, whose faults are dear (docs/benchmarks.md,
@@ -702,10 +701,10 @@ class AnswerWriter {
 // the child's limit, and advised as transparent huge pages: what the import then allocates there
 // (large blocks too: malloc serves any request the top can hold before it maps one) is first
 // touched a 2 MiB page at a time, where the kernel offers them (its `madvise` or `always` mode).
-// Kept, not trimmed: the child exits when its import is done.
-constexpr std::size_t kHeapOnHugePages = std::size_t{30} << 20;
+// Kept, not trimmed: the child exits when its import is done. `skelcd check` calls it too.
+}  // namespace
 
-void grow_heap_on_huge_pages(std::size_t bytes) {
+void grow_heap_on_huge_pages(std::size_t bytes) noexcept {
   constexpr std::size_t kHuge = std::size_t{2} << 20;
   if (bytes < 2 * kHuge) return;
   // The freed block stays the top; it comes from the heap, not a mapping of its own (glibc takes
@@ -719,7 +718,8 @@ void grow_heap_on_huge_pages(std::size_t bytes) {
   if (last > first) (void)madvise(reinterpret_cast<void*>(first), last - first, MADV_HUGEPAGE);
   std::free(block);
 }
-#endif
+
+namespace {
 
 [[noreturn]] void child(
     int fd, const ImportLimits& limits, const std::function<void(const AnswerSink&)>& probe) {

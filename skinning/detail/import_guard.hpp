@@ -29,6 +29,18 @@ struct ImportLimits {
   std::function<void()> while_waiting{};
 };
 
+/// The heap the import's child grows at once and advises (ImportLimits::heap_on_huge_pages), and
+/// what `skelcd check` advises of its own before it imports (tools/cli/large_pages.hpp).
+inline constexpr std::size_t kHeapOnHugePages = std::size_t{30} << 20;
+
+/// Grows malloc's main heap by `bytes` at once (address space only: nothing is touched), advises
+/// its whole 2 MiB pages MADV_HUGEPAGE and frees the block back as the heap's top, which is then
+/// not trimmed below it (M_TRIM_THRESHOLD 2 × bytes): what malloc later serves from the top is
+/// first touched a 2 MiB page at a time, where the kernel offers them. Leaves the mmap threshold
+/// at 32 MiB, for the caller to set. Below two huge pages, or where malloc refuses (over a
+/// limit), nothing is advised and the heap grows as it would have.
+void grow_heap_on_huge_pages(std::size_t bytes) noexcept;
+
 /// Refuses a file whose header declares more elements than its size can hold, before any
 /// importer allocates for them. Knows the formats whose importers reserve by the declared count:
 /// OFF and PLY (ASCII and binary). Other files pass.

@@ -10,6 +10,8 @@
 #include <cstring>
 #include <new>
 
+#include "skinning/detail/import_guard.hpp"
+
 namespace skelcd::tools {
 
 bool large_pages_wanted(const char* env) noexcept {
@@ -35,18 +37,8 @@ void heap_on_huge_pages(std::size_t bytes) noexcept {
   // a time. The rows allocate a few dozen blocks per interval (BCN_Epileptic: 3.7k mallocs over
   // 99 intervals), so its lock is not where threads wait.
   mallopt(M_ARENA_MAX, 1);
-  // Trimmed and grown again, the top would come back on small pages.
-  mallopt(M_TRIM_THRESHOLD, static_cast<int>(2 * bytes));
-  // The block comes from the heap, not a mapping of its own (glibc takes thresholds up to 32 MiB).
-  mallopt(M_MMAP_THRESHOLD, static_cast<int>(std::size_t{32} << 20));
-  void* block = std::malloc(bytes);
-  if (block == nullptr) return;
-  const auto at = reinterpret_cast<std::uintptr_t>(block);
-  const std::uintptr_t first = (at + kHugePage - 1) & ~(kHugePage - 1);
-  const std::uintptr_t last = (at + bytes) & ~(kHugePage - 1);
-  // Advice only, as for the large blocks; the freed block stays the heap's top.
-  if (last > first) madvise(reinterpret_cast<void*>(first), last - first, MADV_HUGEPAGE);
-  std::free(block);
+  // The import's child's own growth, here for this process's heap.
+  skinning::detail::grow_heap_on_huge_pages(bytes);
 }
 
 namespace {

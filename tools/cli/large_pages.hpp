@@ -10,6 +10,8 @@
 #include <cstddef>
 #include <cstdint>
 
+#include "skinning/detail/import_guard.hpp"
+
 namespace skelcd::tools {
 
 /// The size of one transparent huge page on x86-64 (the kernel's PMD size).
@@ -30,11 +32,11 @@ std::size_t large_block_size(std::size_t bytes) noexcept;
 /// only "0", "off" and "no" turn them off.
 bool large_pages_wanted(const char* env) noexcept;
 
-/// The address space heap_on_huge_pages() advises at the heap's top, as much as the import's child
-/// advises of its own (skinning/detail/import_guard.cpp): more than a character's check takes
-/// there. The cloth-ball step's heap outgrows it by about 6 MiB, on small pages; advising 62 MiB
-/// halved that check's faults (3.9k → 1.9k) for 10–14 MiB more peak RSS (docs/benchmarks.md).
-inline constexpr std::size_t kHeapOnHugePages = std::size_t{30} << 20;
+/// The address space heap_on_huge_pages() advises at the heap's top: the import's child's own
+/// (skinning/detail/import_guard.hpp), more than a character's check takes there. The cloth-ball
+/// step's heap outgrows it by about 6 MiB, on small pages; advising 62 MiB halved that check's
+/// faults (3.9k → 1.9k) for 10–14 MiB more peak RSS (docs/benchmarks.md).
+inline constexpr std::size_t kHeapOnHugePages = skinning::detail::kHeapOnHugePages;
 
 /// Puts the blocks malloc serves from its heap on transparent huge pages, for every thread
 /// (docs/cli.md, "Large allocations"): grows the main heap by `bytes` at once (address space only:
