@@ -30,7 +30,8 @@ struct ImportLimits {
 };
 
 /// The heap the import's child grows at once and advises (ImportLimits::heap_on_huge_pages), and
-/// what `skelcd check` advises of its own before it imports (tools/cli/large_pages.hpp).
+/// what `skelcd check` advises of its own once it has imported a large mesh
+/// (tools/cli/large_pages.hpp).
 inline constexpr std::size_t kHeapOnHugePages = std::size_t{30} << 20;
 
 /// Grows malloc's main heap by `bytes` at once (address space only: nothing is touched), advises

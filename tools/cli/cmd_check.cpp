@@ -14,6 +14,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <iostream>
 #include <memory>
 #include <optional>
@@ -21,6 +22,7 @@
 #include <sstream>
 #include <string>
 #include <tuple>
+#include <utility>
 #include <vector>
 
 #include "culling/routed_method.hpp"
@@ -303,6 +305,16 @@ bool names_a_file(const std::string& model_arg) {
   return skinning::classify_model_path(model_arg) != skinning::ModelKind::frame_sequence;
 }
 
+/// commands.hpp, on_check_model_loaded.
+std::function<void(std::int64_t)>& model_loaded_hook() {
+  static std::function<void(std::int64_t)> hook;
+  return hook;
+}
+
+/// malloc's thresholds for a check (run_check_command), set again after the executable's hook,
+/// which may move them.
+void set_check_malloc_thresholds();
+
 skinning::LoadedModel load_checked_model(const CheckArguments& args, const std::string& model_arg) {
   if (names_a_file(model_arg)) require_exists(model_arg);
   // A parallel check starts its thread pool while the import's child reads the file: this
@@ -312,7 +324,12 @@ skinning::LoadedModel load_checked_model(const CheckArguments& args, const std::
   if (args.threads != 1) {
     load.import.while_importing = [threads = args.threads] { warm_up_workers(threads); };
   }
-  return skinning::load_model(model_arg, load);
+  auto model = skinning::load_model(model_arg, load);
+  if (const auto& hook = model_loaded_hook()) {
+    hook(model.mesh->num_triangles());
+    set_check_malloc_thresholds();
+  }
+  return model;
 }
 
 /// One clip checked: the summary as text and as JSON.
@@ -569,14 +586,14 @@ void run_batch(const CheckArguments& args, const std::vector<std::string>& model
   }
 }
 
-void run_check_command(const CheckArguments& args) {
+void set_check_malloc_thresholds() {
   // Blocks of 128 KiB or more get their own mapping, returned to the system when freed. glibc
   // raises this threshold by itself to the largest block freed so far, after which big buffers
   // that a check frees (the baseline DCD's hierarchy, a query's scratch) stay resident in the heap
   // and count in the peak RSS with the next ones: on cloth-funnel's CCD check, 1-2 MiB of its
   // ~17 MiB above the floor (docs/benchmarks.md, "Fixed costs"). Only here: `inspect` reads logs
-  // under libhdf5's own allocation pattern (tests/tools/test_log.cpp, the fuzzed logs). The
-  // executable has put the heap's top on huge pages before (tools/cli/main.cpp,
+  // under libhdf5's own allocation pattern (tests/tools/test_log.cpp, the fuzzed logs). Set again
+  // once the executable has put a large mesh's heap top on huge pages (tools/cli/main.cpp,
   // heap_on_huge_pages, which leaves this threshold to be set here).
   mallopt(M_MMAP_THRESHOLD, 128 * 1024);
   // When glibc trims the heap's free top it keeps this much mapped (default 128 KiB): a check
@@ -587,8 +604,13 @@ void run_check_command(const CheckArguments& args) {
   // more on two (docs/benchmarks.md, "The heap's top kept"). The import's child inherits it: an
   // import that needs all but the last 4 MiB of its limit may be refused (the limit is 64 MiB at
   // least on the command line). With the heap's top on huge pages it is not trimmed below 60 MiB
-  // free, and the pad matters only with SKELCD_LARGE_PAGES=0 (or outside the executable).
+  // free, and the pad matters only below the mesh size for them, with SKELCD_LARGE_PAGES=0, or
+  // outside the executable.
   mallopt(M_TOP_PAD, 4 << 20);
+}
+
+void run_check_command(const CheckArguments& args) {
+  set_check_malloc_thresholds();
   if (args.models.size() == 1 && is_scene_path(args.models.front())) {  // a scene (docs/scenes.md)
     run_scene_check(
         args.models.front(),
@@ -610,6 +632,10 @@ void run_check_command(const CheckArguments& args) {
 }
 
 }  // namespace
+
+void on_check_model_loaded(std::function<void(std::int64_t)> hook) {
+  model_loaded_hook() = std::move(hook);
+}
 
 void add_check_command(CLI::App& app) {
   auto args = std::make_shared<CheckArguments>();

@@ -3,6 +3,8 @@
 // the app with add_<name>_command; main.cpp calls them in the order `skelcd --help` lists them.
 
 #include <CLI/CLI.hpp>
+#include <cstdint>
+#include <functional>
 
 namespace skelcd::tools {
 
@@ -15,5 +17,11 @@ void add_export_command(CLI::App& app);
 void add_generate_command(CLI::App& app);
 void add_ccd_queries_command(CLI::App& app);
 void add_bench_command(CLI::App& app);
+
+/// What the executable does with a check's heap once it knows the size of the mesh (tools/cli/
+/// main.cpp: the heap's top on huge pages for large meshes, docs/cli.md "Large allocations"):
+/// `check` calls `hook` with the triangles of each model it loads, before it sets up its check.
+/// None by default (the CLI's library alone, as the tests link it).
+void on_check_model_loaded(std::function<void(std::int64_t triangles)> hook);
 
 }  // namespace skelcd::tools

@@ -38,6 +38,20 @@ bool large_pages_wanted(const char* env) noexcept;
 /// faults (3.9k → 1.9k) for 10–14 MiB more peak RSS (docs/benchmarks.md).
 inline constexpr std::size_t kHeapOnHugePages = skinning::detail::kHeapOnHugePages;
 
+/// The meshes whose check puts its heap on huge pages (heap_on_huge_pages), by triangles. A huge
+/// page is resident whole from its first touch: the heap's last one is 1 MiB too many on average
+/// and the top is never trimmed, 2-3 MiB more peak RSS per check (up to 6.7 MiB with two threads)
+/// for 1.03-1.18x on the whole check. Against issue 14's 1 KiB per triangle, on the 18-28k
+/// triangle inputs that sit near it, that fixed cost broke the bound (CesiumMan-dense `kdop` 1.00
+/// -> 1.08 KiB); from 64Ki triangles on 2 MiB is at most 0.03 KiB per triangle
+/// (docs/benchmarks.md, "The heap on huge pages for large meshes only").
+inline constexpr std::int64_t kHeapOnHugePagesMinTriangles = std::int64_t{1} << 16;
+
+/// Whether a check of a mesh of `triangles` triangles puts its heap on huge pages.
+constexpr bool heap_on_huge_pages_pays(std::int64_t triangles) noexcept {
+  return triangles >= kHeapOnHugePagesMinTriangles;
+}
+
 /// Puts the blocks malloc serves from its heap on transparent huge pages, for every thread
 /// (docs/cli.md, "Large allocations"): grows the main heap by `bytes` at once (address space only:
 /// nothing is touched), advises its whole 2 MiB pages MADV_HUGEPAGE and frees the block back to

@@ -2,6 +2,7 @@
 // one line on stderr and a non-zero exit status.
 
 #include <CLI/CLI.hpp>
+#include <cstdint>
 #include <cstdio>
 #include <cstdlib>
 #include <exception>
@@ -29,12 +30,16 @@ int main(int argc, char** argv) {
   skelcd::tools::add_ccd_queries_command(app);
   skelcd::tools::add_bench_command(app);
 #if defined(SKELCD_LARGE_PAGES)
-  // A check's small blocks on huge pages too (docs/cli.md, "Large allocations"), before its
-  // command sets malloc's thresholds; the other commands keep malloc as it is.
+  // A large mesh's check puts its small blocks on huge pages too (docs/cli.md, "Large
+  // allocations"), once its model is loaded and its size known; the other commands keep malloc as
+  // it is.
   app.get_subcommand("check")->preparse_callback([](std::size_t) {
-    if (skelcd::tools::large_pages_wanted(std::getenv("SKELCD_LARGE_PAGES"))) {
+    if (!skelcd::tools::large_pages_wanted(std::getenv("SKELCD_LARGE_PAGES"))) return;
+    skelcd::tools::on_check_model_loaded([advised = false](std::int64_t triangles) mutable {
+      if (advised || !skelcd::tools::heap_on_huge_pages_pays(triangles)) return;
       skelcd::tools::heap_on_huge_pages(skelcd::tools::kHeapOnHugePages);
-    }
+      advised = true;  // the first large model of a batch: the heap's top stays advised
+    });
   });
 #endif
 
