@@ -4,7 +4,10 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstddef>
+#include <cstdint>
 #include <memory>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -29,6 +32,19 @@ class Motion {
   /// Writes the #V × 3 positions at sample i into `out` (resized if needed).
   /// @pre 0 <= i < num_samples()
   virtual void positions(int i, Positions& out) const = 0;
+  /// The positions at sample i of `vertices` only: row k of `out` is vertex vertices[k]'s row of
+  /// positions(i), bit for bit (a check's welded positions: Topology::representative_vertex).
+  /// The default poses every vertex into a per-thread buffer and copies the rows; a motion that can
+  /// pose some vertices alone (a skinned rig) poses only those.
+  /// @pre 0 <= i < num_samples(); every entry of `vertices` is in [0, mesh().num_vertices()).
+  virtual void positions_of(int i, std::span<const std::int32_t> vertices, Positions& out) const {
+    thread_local Positions all;
+    positions(i, all);
+    out.resize(static_cast<Eigen::Index>(vertices.size()), 3);
+    for (std::size_t k = 0; k < vertices.size(); ++k) {
+      out.row(static_cast<Eigen::Index>(k)) = all.row(vertices[k]);
+    }
+  }
   /// Sample i's positions where the motion holds them in memory as they are (a frame sequence
   /// whose frames it keeps), else nullptr: then a caller reads them there instead of copying them
   /// through positions(). Valid while the motion lives.

@@ -71,6 +71,17 @@ void RigMotion::positions(int i, Positions& out) const {
   positions_at_time(sample_time(i), out);
 }
 
+void RigMotion::positions_of(int i, std::span<const std::int32_t> vertices, Positions& out) const {
+  assert(i >= 0 && i < num_samples_);
+  thread_local Pose pose;
+  if (clip_ >= 0) {
+    evaluator_.clip_pose(clip_, sample_time(i), pose);
+  } else {
+    evaluator_.bind_pose(pose);
+  }
+  skinning_.apply_rows(pose, vertices, out);
+}
+
 std::int32_t RigMotion::num_bones() const { return rig_->skeleton.num_bones(); }
 
 void RigMotion::bone_transforms(int i, std::vector<BoneTransform>& out) const {

@@ -3,6 +3,7 @@
 
 #include <cstdint>
 #include <memory>
+#include <span>
 #include <string>
 
 #include "skinning/lbs.hpp"
@@ -44,6 +45,8 @@ class RigMotion final : public Motion {
   /// repeated calls allocate nothing once `out` has its size.
   void positions(int i, Positions& out) const override;
 
+  /// Skinned positions of `vertices` only at sample i (LinearBlendSkinning::apply_rows).
+  void positions_of(int i, std::span<const std::int32_t> vertices, Positions& out) const override;
   /// Skinned positions at any time in seconds (clamped to the clip's keys).
   void positions_at_time(double time_s, Positions& out) const;
   /// Any time: positions_at_time (the tolerance is not needed).

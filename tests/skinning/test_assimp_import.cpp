@@ -227,6 +227,43 @@ TEST(AssimpImport, ClipsOfTestwusonAndFox) {
   EXPECT_EQ(fox.clips[1].key_times.size(), 18u);
 }
 
+// A check poses its welded vertices alone (tools/engine/runner.cpp, pose_sample): on the real
+// characters, RigMotion::positions_of gives each representative vertex's row of the whole pose bit
+// for bit, as the default Motion::positions_of (pose all, copy the rows) does, at the clip's first,
+// middle and last samples; and it poses fewer vertices than the whole pose on at least one of them.
+TEST(AssimpImport, PosingTheWeldedVerticesAloneGivesTheirRowsOfTheWholePose) {
+  std::int64_t fewer = 0;
+  for (const std::string file :
+       {"assets/characters/CesiumMan-dense.glb",
+        "assets/characters/Fox.glb",
+        "assets/characters/stormtrooper/stormtrooper.dae",
+        "X/BCN_Epileptic.X"}) {
+    const auto rig = std::make_shared<const Rig>(import_rig(resolve(file)).rig);
+    ASSERT_FALSE(rig->clips.empty()) << file;
+    const RigMotion motion(rig, RigMotionOptions{.clip = 0});
+    const Topology topology = build_topology(rig->mesh);
+    const std::vector<std::int32_t>& rows = topology.representative_vertex;
+    if (static_cast<Eigen::Index>(rows.size()) < rig->mesh.num_vertices()) ++fewer;
+    Positions all;
+    Positions some;
+    Positions copied;
+    for (const int i : {0, motion.num_samples() / 2, motion.num_samples() - 1}) {
+      motion.positions(i, all);
+      motion.positions_of(i, rows, some);
+      motion.Motion::positions_of(i, rows, copied);
+      ASSERT_EQ(some.rows(), static_cast<Eigen::Index>(rows.size())) << file;
+      ASSERT_EQ(copied.rows(), some.rows()) << file;
+      Eigen::Index differ = 0;
+      for (std::size_t k = 0; k < rows.size(); ++k) {
+        const auto r = static_cast<Eigen::Index>(k);
+        if (some.row(r) != all.row(rows[k]) || copied.row(r) != some.row(r)) ++differ;
+      }
+      EXPECT_EQ(differ, 0) << file << " sample " << i;
+    }
+  }
+  EXPECT_GE(fewer, 1);
+}
+
 TEST(AssimpImport, SimpleSkinPoseMatchesAHandComputation) {
   // glTF2/simple_skin: 10 vertices (x ∈ {0, 1}, y ∈ {0, 0.5, …, 2}), joints node 1 at (0,1,0)
   // and its child node 2; both inverse bind matrices translate by (-0.5, -1, 0). Node 2 rotates

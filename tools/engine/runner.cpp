@@ -104,12 +104,33 @@ struct PosedSample {
   std::vector<skinning::BoneTransform> bones;
 };
 
+/// Refuses sample i of the check's motion: `vertex` (the file's) has a non-finite position.
+[[noreturn]] void throw_non_finite(const RowContext& c, std::int32_t i, std::int32_t vertex) {
+  throw InvalidInput(
+      c.motion.name() + ": sample " + std::to_string(i) +
+      " (t = " + std::to_string(c.motion.sample_time(i)) + " s): vertex " + std::to_string(vertex) +
+      " has a non-finite position");
+}
+
 /// Poses sample i into `out` (`posed`: scratch); returns the microseconds it took.
 /// Finiteness is checked once per sample, here, where positions enter.
 double pose_sample(
     const RowContext& c, std::int32_t i, skinning::Positions& posed, PosedSample& out) {
   const auto start = Clock::now();
   if (c.bones) c.motion.bone_transforms(i, out.bones);
+  // A skinned rig poses the welded vertices alone (their representatives): no #V buffer, and no
+  // duplicate skinned only to be dropped. A vertex that is no welded vertex's representative is
+  // not posed, so not checked either: nothing reads it.
+  if (c.motion.skin_weights() != nullptr && c.motion.held_positions(i) == nullptr) {
+    out.lent = nullptr;
+    c.motion.positions_of(i, c.topology.representative_vertex, out.own);
+    if (!out.own.allFinite()) {
+      Eigen::Index bad = 0;
+      while (bad < out.own.rows() && out.own.row(bad).allFinite()) ++bad;
+      throw_non_finite(c, i, c.topology.representative_vertex[static_cast<std::size_t>(bad)]);
+    }
+    return microseconds_since(start);
+  }
   const auto& mesh = c.motion.mesh();
   // Held frames are read where they are (a copy would cost a sample's worth of fresh pages).
   const skinning::Positions* held = c.motion.held_positions(i);
@@ -126,10 +147,7 @@ double pose_sample(
   if (!x.allFinite()) {
     Eigen::Index bad = 0;
     while (bad < x.rows() && x.row(bad).allFinite()) ++bad;
-    throw InvalidInput(
-        c.motion.name() + ": sample " + std::to_string(i) +
-        " (t = " + std::to_string(c.motion.sample_time(i)) + " s): vertex " + std::to_string(bad) +
-        " has a non-finite position");
+    throw_non_finite(c, i, static_cast<std::int32_t>(bad));
   }
   // A held frame that welding leaves as it is is lent, not copied (a sample's worth of fresh pages
   // and a copy less).
@@ -228,7 +246,7 @@ bool takes_rigid_rows(std::string_view name) {
 struct Worker {
   std::unique_ptr<culling::CullingMethod> owned;
   culling::CullingMethod* method = nullptr;
-  skinning::Positions posed;
+  skinning::Positions posed;  // a sample's #V positions, for motions that pose every vertex
   PosedSample samples[2];
   culling::FrameResult result;
   // Incremental DCD: the last DCD's pairs and the last CCD's contacts, with their samples.
