@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "tests/support/test_support.hpp"
+#include "tools/cli/commands.hpp"
 #include "tools/cli/large_pages.hpp"
 
 namespace skelcd::tools {
@@ -147,6 +148,25 @@ TEST(LargePages, TheHeapsTopIsAdvisedAndEveryThreadAllocatesThere) {
       << from_thread << " outside the heap " << std::hex << after.first << "-" << after.second;
   std::free(from_thread);
   EXPECT_EQ(heap_range().second, after.second);
+}
+
+// Where the executable decides (tools/cli/main.cpp): `check` tells the hook the loaded mesh's
+// triangles before it sets up the check, and only a mesh of 64Ki triangles or more takes the
+// heap's top on huge pages (CesiumMan's 4,672 do not; the cloth-ball step's 92,230 do).
+TEST(LargePages, CheckTellsTheLoadedMeshsSizeAndOnlyLargeMeshesPay) {
+  std::vector<std::int64_t> asked;
+  on_check_model_loaded([&asked](std::int64_t triangles) { asked.push_back(triangles); });
+  CLI::App app;
+  add_check_command(app);
+  const std::string model = test::asset("characters/CesiumMan.glb").string();
+  const char* argv[] = {"skelcd", "check", model.c_str(), "--frames", "0:2", "--json"};
+  app.parse(static_cast<int>(std::size(argv)), argv);
+  on_check_model_loaded({});
+  EXPECT_EQ(asked, std::vector<std::int64_t>{4672});
+  EXPECT_FALSE(heap_on_huge_pages_pays(4672));
+  EXPECT_FALSE(heap_on_huge_pages_pays(kHeapOnHugePagesMinTriangles - 1));
+  EXPECT_TRUE(heap_on_huge_pages_pays(kHeapOnHugePagesMinTriangles));
+  EXPECT_TRUE(heap_on_huge_pages_pays(92230));
 }
 
 TEST(LargePages, TheEnvironmentTurnsThemOff) {
