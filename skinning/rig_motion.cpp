@@ -73,29 +73,22 @@ void RigMotion::positions(int i, Positions& out) const {
 
 void RigMotion::positions_of(int i, std::span<const std::int32_t> vertices, Positions& out) const {
   assert(i >= 0 && i < num_samples_);
-  thread_local Pose pose;
-  if (clip_ >= 0) {
-    evaluator_.clip_pose(clip_, sample_time(i), pose);
-  } else {
-    evaluator_.bind_pose(pose);
-  }
-  skinning_.apply_rows(pose, vertices, out);
+  skinning_.apply_rows(pose_at(sample_time(i)), vertices, out);
 }
 
 std::int32_t RigMotion::num_bones() const { return rig_->skeleton.num_bones(); }
 
 void RigMotion::bone_transforms(int i, std::vector<BoneTransform>& out) const {
   assert(i >= 0 && i < num_samples_);
-  thread_local Pose pose;
-  if (clip_ >= 0) {
-    evaluator_.clip_pose(clip_, sample_time(i), pose);
-  } else {
-    evaluator_.bind_pose(pose);
-  }
+  const Pose& pose = pose_at(sample_time(i));
   out.assign(pose.transforms.begin(), pose.transforms.end());
 }
 
 void RigMotion::positions_at_time(double time_s, Positions& out) const {
+  skinning_.apply(pose_at(time_s), out);
+}
+
+const Pose& RigMotion::pose_at(double time_s) const {
   // One pose buffer per thread, grown to the largest skeleton seen and then reused.
   thread_local Pose pose;
   if (clip_ >= 0) {
@@ -103,7 +96,7 @@ void RigMotion::positions_at_time(double time_s, Positions& out) const {
   } else {
     evaluator_.bind_pose(pose);
   }
-  skinning_.apply(pose, out);
+  return pose;
 }
 
 }  // namespace skelcd::skinning

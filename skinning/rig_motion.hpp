@@ -69,6 +69,10 @@ class RigMotion final : public Motion {
   [[nodiscard]] const LinearBlendSkinning& skinning() const { return skinning_; }
 
  private:
+  /// The clip's pose at `time_s` (the bind pose without a clip), in this thread's buffer: valid
+  /// until this thread's next call.
+  [[nodiscard]] const Pose& pose_at(double time_s) const;
+
   std::shared_ptr<const Rig> rig_;
   PoseEvaluator evaluator_;
   LinearBlendSkinning skinning_;
