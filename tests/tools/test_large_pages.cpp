@@ -169,6 +169,21 @@ TEST(LargePages, CheckTellsTheLoadedMeshsSizeAndOnlyLargeMeshesPay) {
   EXPECT_TRUE(heap_on_huge_pages_pays(92230));
 }
 
+// A scene's checks are all set up before the first runs, so they hold memory together: the hook is
+// told once, with the triangles of every object the scene checks, once they are all loaded.
+// cape.toml checks CesiumMan (4,672 triangles) and a cape sheet of 12 × 20 cells (480).
+TEST(LargePages, ASceneTellsTheTrianglesOfTheObjectsItChecksOnce) {
+  std::vector<std::int64_t> asked;
+  on_check_model_loaded([&asked](std::int64_t triangles) { asked.push_back(triangles); });
+  CLI::App app;
+  add_check_command(app);
+  const std::string scene = test::asset("scenes/cape.toml").string();
+  const char* argv[] = {"skelcd", "check", scene.c_str(), "--frames", "0:2", "--json"};
+  app.parse(static_cast<int>(std::size(argv)), argv);
+  on_check_model_loaded({});
+  EXPECT_EQ(asked, std::vector<std::int64_t>{4672 + 12 * 20 * 2});
+}
+
 TEST(LargePages, TheEnvironmentTurnsThemOff) {
   const pid_t child = fork();
   ASSERT_GE(child, 0);

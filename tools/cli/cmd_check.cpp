@@ -315,6 +315,15 @@ std::function<void(std::int64_t)>& model_loaded_hook() {
 /// which may move them.
 void set_check_malloc_thresholds();
 
+/// The executable's hook (model_loaded_hook) told a check's mesh size, and malloc's thresholds
+/// for the check set again after it (the hook may move them).
+void tell_model_loaded(std::int64_t triangles) {
+  if (const auto& hook = model_loaded_hook()) {
+    hook(triangles);
+    set_check_malloc_thresholds();
+  }
+}
+
 skinning::LoadedModel load_checked_model(const CheckArguments& args, const std::string& model_arg) {
   if (names_a_file(model_arg)) require_exists(model_arg);
   // A parallel check starts its thread pool while the import's child reads the file: this
@@ -325,10 +334,7 @@ skinning::LoadedModel load_checked_model(const CheckArguments& args, const std::
     load.import.while_importing = [threads = args.threads] { warm_up_workers(threads); };
   }
   auto model = skinning::load_model(model_arg, load);
-  if (const auto& hook = model_loaded_hook()) {
-    hook(model.mesh->num_triangles());
-    set_check_malloc_thresholds();
-  }
+  tell_model_loaded(model.mesh->num_triangles());
   return model;
 }
 
@@ -618,7 +624,8 @@ void run_check_command(const CheckArguments& args) {
             .output = args.output,
             .frames = args.frames,
             .threads = args.threads,
-            .json = args.json});
+            .json = args.json,
+            .on_loaded = tell_model_loaded});
     return;
   }
   bool expanded = false;

@@ -20,7 +20,8 @@ void add_bench_command(CLI::App& app);
 
 /// What the executable does with a check's heap once it knows the size of the mesh (tools/cli/
 /// main.cpp: the heap's top on huge pages for large meshes, docs/cli.md "Large allocations"):
-/// `check` calls `hook` with the triangles of each model it loads, before it sets up its check.
+/// `check` calls `hook` with the triangles of each model it loads (of a scene: of the objects it
+/// checks, once they are all loaded), before it sets up its check.
 /// None by default (the CLI's library alone, as the tests link it).
 void on_check_model_loaded(std::function<void(std::int64_t triangles)> hook);
 

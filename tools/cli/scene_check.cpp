@@ -45,6 +45,7 @@ void run_scene_check(const std::filesystem::path& scene_path, const SceneCheckAr
   }
   options.threads = args.threads;
   options.command_line = own_command_line();
+  options.on_loaded = args.on_loaded;
   options.on_check = [](const std::string& label, std::int64_t rows) {
     auto progress = std::make_shared<Progress>(label, rows);
     return std::function<void(std::int64_t)>(

@@ -4,6 +4,7 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <functional>
 #include <string>
 
 namespace skelcd::tools {
@@ -15,6 +16,10 @@ struct SceneCheckArguments {
   std::int32_t threads =
       1;  ///< self checks: worker threads (0: all cores); pair checks run serially
   bool json = false;
+  /// Called once the scene's objects are loaded, with the triangles of those it checks, before
+  /// any check is set up (`check`'s hook: the heap on huge pages for a large scene, as for a large
+  /// model; commands.hpp, on_check_model_loaded). Empty: nothing.
+  std::function<void(std::int64_t triangles)> on_loaded;
 };
 
 /// `skelcd check SCENE.toml`: prints the plan, runs, prints a summary per check (or one JSON

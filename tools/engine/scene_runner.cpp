@@ -527,6 +527,7 @@ SceneRunResult run_scene(const Scene& scene, const SceneRunOptions& options) {
     vertices += mesh.num_vertices();
     triangles += mesh.num_triangles();
   }
+  if (options.on_loaded) options.on_loaded(triangles);
 
   // 5. Self-check runners, built now so that everything they refuse is refused before the log
   //    exists. Segmentation only where the plan says so.

@@ -33,6 +33,11 @@ struct SceneRunOptions {
   std::function<void(const ScenePlan&)> on_plan;
   /// Called with an object's name when it is loaded (tests count loads through it).
   std::function<void(std::string_view)> on_load;
+  /// Called once every object is loaded and the plan made, with the triangles of the objects the
+  /// plan checks, before any check is set up: the checks' runners are built together and hold
+  /// their memory together, so this is the size the caller's allocation choices answer to
+  /// (`skelcd check`: the heap on huge pages, docs/cli.md "Large allocations").
+  std::function<void(std::int64_t triangles)> on_loaded;
   /// Called when a check starts, with its label ("check NAME") and rows; what it returns is called
   /// with the rows done after each row and destroyed when the check ends (the command line draws
   /// its progress line with it). Empty: nothing is shown.
