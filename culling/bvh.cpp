@@ -611,8 +611,17 @@ inline void merge_ends(NodeEndBoxes& a, const NodeEndBoxes& b) {
 #endif
 }
 
-/// Slots ahead for which refit_end_boxes and refit_slot_ends ask for the corners' end boxes.
+/// Slots ahead for which refit_end_boxes and refit_slot_ends ask for the corners' end boxes; and,
+/// twice as far, for the triangle's row of corner ids, which that request reads: a row fetched
+/// only then (the triangles by id are scattered over the slots) stalled the sweep there, on a
+/// third of refit_slot_ends' cycles.
 constexpr std::size_t kAheadEnds = 16;
+constexpr std::size_t kAheadRows = 2 * kAheadEnds;
+
+/// Asks for triangle f's row of corner ids.
+inline void prefetch_triangle_row(const skinning::Triangles& triangles, std::int32_t f) {
+  __builtin_prefetch(&triangles(static_cast<Eigen::Index>(f), 0));
+}
 
 /// Asks for the end boxes of triangle f's corners (scattered over the vertices).
 inline void prefetch_corner_ends(
@@ -641,6 +650,7 @@ inline NodeEndBoxes triangle_ends(
 struct CornerEndsSource {
   const skinning::Triangles& triangles;
   std::span<const NodeEndBoxes> vertex_ends;
+  void prefetch_row(std::int32_t f) const { prefetch_triangle_row(triangles, f); }
   void prefetch(std::int32_t f) const { prefetch_corner_ends(triangles, vertex_ends, f); }
   [[nodiscard]] NodeEndBoxes triangle(std::int32_t f) const {
     return triangle_ends(triangles, vertex_ends, f);
@@ -672,6 +682,7 @@ struct PositionEndsSource {
   const skinning::Positions& x_t0;
   const skinning::Positions& x_t1;
   double half_width;
+  void prefetch_row(std::int32_t f) const { prefetch_triangle_row(triangles, f); }
   void prefetch(std::int32_t f) const {
     for (Eigen::Index j = 0; j < 3; ++j) {
       const auto v = static_cast<std::size_t>(triangles(f, j));
@@ -818,6 +829,7 @@ void Bvh<N>::fill_end_boxes(const Source& source, bool with_slot_ends) {
     // The sweep meets the buckets in nearly decreasing slot order, the corners are scattered:
     // ask for the corners' boxes kAheadEnds slots below now (as refit_wide_only).
     for (std::size_t s = begin; s < end && s >= kAheadEnds; ++s) {
+      if (s >= kAheadRows) source.prefetch_row(order_[s - kAheadRows]);
       source.prefetch(order_[s - kAheadEnds]);
     }
     for (std::size_t s = begin; s < end; ++s) {
@@ -897,6 +909,7 @@ void Bvh<N>::fill_slot_ends(const Source& source) {
   if (slot_ends_.size() != 12 * stride) slot_ends_.assign(12 * stride, 0.0f);
   float* const rows = slot_ends_.data();
   for (std::size_t s = 0; s < order_.size(); ++s) {
+    if (s + kAheadRows < order_.size()) source.prefetch_row(order_[s + kAheadRows]);
     if (s + kAheadEnds < order_.size()) {
       source.prefetch(order_[s + kAheadEnds]);
     }
