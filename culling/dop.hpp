@@ -14,8 +14,10 @@
 #include <bit>
 #include <cassert>
 #include <cmath>
+#include <cstddef>
 #include <cstdint>
 #include <limits>
+#include <type_traits>
 
 #include "ccd/detail/float_bounds.hpp"
 
@@ -217,7 +219,43 @@ inline void round_outwards(
     std::array<float, static_cast<std::size_t>(N)>& hi) {
   constexpr auto kN = static_cast<std::size_t>(N);
 #if defined(__SSE2__)
-  // lo, then −hi (float_above(h) = −float_below(−h)), in groups of four; the last one padded.
+  // lo, then −hi (float_above(h) = −float_below(−h)), in groups of four, loaded from the volume
+  // itself where its layout gives them (lo[0..N) then hi[0..N), contiguous): filled through a
+  // buffer instead, each group's 16-byte loads waited for the 8-byte stores before them (no store
+  // forwarding across two stores), a fifth of the AABB refit's cycles.
+  static_assert(
+      std::is_standard_layout_v<Dop<N>> && offsetof(Dop<N>, hi) == kN * sizeof(double) &&
+      sizeof(Dop<N>) == 2 * kN * sizeof(double));
+  const __m128d minus = _mm_set1_pd(-0.0);
+  if constexpr (kN % 4 == 0) {
+    for (std::size_t g = 0; g < kN; g += 4) {
+      _mm_storeu_ps(
+          lo.data() + g,
+          detail::float_below4(_mm_loadu_pd(v.lo.data() + g), _mm_loadu_pd(v.lo.data() + g + 2)));
+      _mm_storeu_ps(
+          hi.data() + g,
+          _mm_xor_ps(
+              detail::float_below4(
+                  _mm_xor_pd(_mm_loadu_pd(v.hi.data() + g), minus),
+                  _mm_xor_pd(_mm_loadu_pd(v.hi.data() + g + 2), minus)),
+              _mm_set1_ps(-0.0f)));
+    }
+    return;
+  } else if constexpr (kN == 3) {
+    // (lo0, lo1 | lo2, −hi0) and (−hi1, −hi2 | 0, 0): the pairs at lo, lo + 2 and hi + 1.
+    alignas(16) std::array<float, 8> out;
+    const auto* d = reinterpret_cast<const double*>(&v);  // lo0 lo1 lo2 hi0 hi1 hi2
+    _mm_store_ps(
+        out.data(),
+        detail::float_below4(
+            _mm_loadu_pd(d), _mm_xor_pd(_mm_loadu_pd(d + 2), _mm_set_pd(-0.0, 0.0))));
+    _mm_store_ps(
+        out.data() + 4,
+        detail::float_below4(_mm_xor_pd(_mm_loadu_pd(d + 4), minus), _mm_setzero_pd()));
+    lo = {out[0], out[1], out[2]};
+    hi = {-out[3], -out[4], -out[5]};
+    return;
+  }
   constexpr std::size_t kGroups = (2 * kN + 3) / 4;
   alignas(16) std::array<double, 4 * kGroups> in{};
   alignas(16) std::array<float, 4 * kGroups> out{};
