@@ -861,8 +861,9 @@ TEST(FeatureBounds, StaticTrianglesFromTheCornersAreTheDerivedVolumesBitForBit) 
 
 // The CCD's triangle volumes straight from the six corners (no contact distance; `bvh` and
 // `kdop` without vertex volumes): on the coordinate axes the derived volumes bit for bit; on the
-// 16-DOP's diagonals never inside them (so they hold the motion wherever those do) and at most
-// one step wider at each end — on every generated scene and on a real character's interval.
+// 16-DOP's diagonals one step outwards from the corners' extreme projections, bit for bit, never
+// inside the derived volumes (so they hold the motion wherever those do) and at most one step
+// wider at each end — on every generated scene and on a real character's interval.
 template <int N>
 void expect_swept_triangles_hold_derived(
     const FeatureTopology& t,
@@ -888,6 +889,27 @@ void expect_swept_triangles_hold_derived(
             << what << " triangle " << f;
         continue;
       }
+      // Exactly one step outwards from the least and greatest of the six corners' rounded
+      // projections (the SSE2 lanes compute them as the scalar loop did).
+      const auto& axis = DopAxes<N>::kAxes[k];
+      double least = std::numeric_limits<double>::infinity();
+      double greatest = -least;
+      for (const skinning::Positions* x : {&x0, &x1}) {
+        for (const std::int32_t v : t.triangle(static_cast<std::int32_t>(f))) {
+          double p = 0.0;
+          for (std::size_t a = 0; a < 3; ++a) {
+            if (axis[a] != 0) p = p + axis[a] * (*x)(v, static_cast<Eigen::Index>(a));
+          }
+          least = std::min(least, p);
+          greatest = std::max(greatest, p);
+        }
+      }
+      ASSERT_EQ(
+          std::bit_cast<std::uint64_t>(d.lo[k]), std::bit_cast<std::uint64_t>(next_down(least)))
+          << what << " triangle " << f << " axis " << k;
+      ASSERT_EQ(
+          std::bit_cast<std::uint64_t>(d.hi[k]), std::bit_cast<std::uint64_t>(next_up(greatest)))
+          << what << " triangle " << f << " axis " << k;
       ASSERT_LE(d.lo[k], e.lo[k]) << what << " triangle " << f << " axis " << k;
       ASSERT_GE(d.lo[k], next_down(e.lo[k])) << what << " triangle " << f << " axis " << k;
       ASSERT_GE(d.hi[k], e.hi[k]) << what << " triangle " << f << " axis " << k;
