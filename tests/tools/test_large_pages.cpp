@@ -153,16 +153,21 @@ TEST(LargePages, TheHeapsTopIsAdvisedAndEveryThreadAllocatesThere) {
 // Where the executable decides (tools/cli/main.cpp): `check` tells the hook the loaded mesh's
 // triangles before it sets up the check, and only a mesh of 64Ki triangles or more takes the
 // heap's top on huge pages (CesiumMan's 4,672 do not; the cloth-ball step's 92,230 do).
-TEST(LargePages, CheckTellsTheLoadedMeshsSizeAndOnlyLargeMeshesPay) {
-  std::vector<std::int64_t> asked;
-  on_check_model_loaded([&asked](std::int64_t triangles) { asked.push_back(triangles); });
+/// The triangle counts `skelcd check ASSET --frames 0:2 --json` tells the hook, in order.
+std::vector<std::int64_t> triangles_told_checking(const std::string& asset) {
+  std::vector<std::int64_t> told;
+  on_check_model_loaded([&told](std::int64_t triangles) { told.push_back(triangles); });
   CLI::App app;
   add_check_command(app);
-  const std::string model = test::asset("characters/CesiumMan.glb").string();
-  const char* argv[] = {"skelcd", "check", model.c_str(), "--frames", "0:2", "--json"};
+  const std::string path = test::asset(asset).string();
+  const char* argv[] = {"skelcd", "check", path.c_str(), "--frames", "0:2", "--json"};
   app.parse(static_cast<int>(std::size(argv)), argv);
   on_check_model_loaded({});
-  EXPECT_EQ(asked, std::vector<std::int64_t>{4672});
+  return told;
+}
+
+TEST(LargePages, CheckTellsTheLoadedMeshsSizeAndOnlyLargeMeshesPay) {
+  EXPECT_EQ(triangles_told_checking("characters/CesiumMan.glb"), std::vector<std::int64_t>{4672});
   EXPECT_FALSE(heap_on_huge_pages_pays(4672));
   EXPECT_FALSE(heap_on_huge_pages_pays(kHeapOnHugePagesMinTriangles - 1));
   EXPECT_TRUE(heap_on_huge_pages_pays(kHeapOnHugePagesMinTriangles));
@@ -173,15 +178,8 @@ TEST(LargePages, CheckTellsTheLoadedMeshsSizeAndOnlyLargeMeshesPay) {
 // told once, with the triangles of every object the scene checks, once they are all loaded.
 // cape.toml checks CesiumMan (4,672 triangles) and a cape sheet of 12 × 20 cells (480).
 TEST(LargePages, ASceneTellsTheTrianglesOfTheObjectsItChecksOnce) {
-  std::vector<std::int64_t> asked;
-  on_check_model_loaded([&asked](std::int64_t triangles) { asked.push_back(triangles); });
-  CLI::App app;
-  add_check_command(app);
-  const std::string scene = test::asset("scenes/cape.toml").string();
-  const char* argv[] = {"skelcd", "check", scene.c_str(), "--frames", "0:2", "--json"};
-  app.parse(static_cast<int>(std::size(argv)), argv);
-  on_check_model_loaded({});
-  EXPECT_EQ(asked, std::vector<std::int64_t>{4672 + 12 * 20 * 2});
+  EXPECT_EQ(
+      triangles_told_checking("scenes/cape.toml"), std::vector<std::int64_t>{4672 + 12 * 20 * 2});
 }
 
 TEST(LargePages, TheEnvironmentTurnsThemOff) {
