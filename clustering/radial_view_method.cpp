@@ -1003,17 +1003,18 @@ void RadialViewMethod::ccd(const culling::Interval& interval, culling::FrameResu
       cluster_bounds_[at(a)] = culling::Aabb::empty();
       continue;
     }
-    local.refit(bounds_.triangles);
-    if (node_relative) {
-      // And the slots' (docs/culling.md "Apart at both ends in the leaves"): on an interval that
-      // moves this much, many pairs the swept volumes pass lie apart at both ends. Both from one
-      // gather of the corners' positions (no per-vertex end boxes held: 64 bytes a vertex).
-      local.refit_end_boxes(
-          topology_.welded_triangles(),
-          x_t0,
-          x_t1,
-          half_width,
-          culling::feature_stage_tests_ends(method_options_.min_separation));
+    const bool ends_tested = culling::feature_stage_tests_ends(method_options_.min_separation);
+    if (node_relative && ends_tested) {
+      // The swept volumes, the nodes' end boxes and the slots' (docs/culling.md "Apart at both
+      // ends in the leaves"): on an interval that moves this much, many pairs the swept volumes
+      // pass lie apart at both ends. All from one gather of the corners' positions (no
+      // per-vertex end boxes held: 64 bytes a vertex), the swept ones as the union of the ends'.
+      local.refit_swept_and_ends(topology_.welded_triangles(), x_t0, x_t1, true);
+    } else {
+      local.refit(bounds_.triangles);
+      if (node_relative) {
+        local.refit_end_boxes(topology_.welded_triangles(), x_t0, x_t1, half_width, ends_tested);
+      }
     }
     cluster_bounds_[at(a)] = local.root_bounds();
   }

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cassert>
 #include <cmath>
 #include <limits>
 #include <numeric>
@@ -690,6 +691,62 @@ struct PositionEndsSource {
       __builtin_prefetch(x_t1.data() + 3 * v);
     }
   }
+#if defined(__SSE2__)
+  /// The corners' exact extremes so far, in (x, y) and (z) lanes (refit_swept_and_ends' root).
+  struct Exact {
+    __m128d lo_xy = _mm_set1_pd(std::numeric_limits<double>::infinity());
+    __m128d lo_z = lo_xy;
+    __m128d hi_xy = _mm_set1_pd(-std::numeric_limits<double>::infinity());
+    __m128d hi_z = hi_xy;
+  };
+  /// triangle(f) without a width, the corners' extremes merged into `exact` on the way.
+  [[nodiscard]] NodeEndBoxes triangle(std::int32_t f, Exact& exact) const {
+    const auto i = static_cast<Eigen::Index>(f);
+    const std::array<std::size_t, 3> c{
+        3 * static_cast<std::size_t>(triangles(i, 0)),
+        3 * static_cast<std::size_t>(triangles(i, 1)),
+        3 * static_cast<std::size_t>(triangles(i, 2))};
+    NodeEndBoxes box;
+    const auto end = [&](const double* p, float* lo, float* hi) {
+      __m128d lo_xy = _mm_loadu_pd(p + c[0]);
+      __m128d lo_z = _mm_set_sd(p[c[0] + 2]);
+      __m128d hi_xy = lo_xy;
+      __m128d hi_z = lo_z;
+      for (std::size_t j = 1; j < 3; ++j) {
+        const __m128d xy = _mm_loadu_pd(p + c[j]);
+        const __m128d z = _mm_set_sd(p[c[j] + 2]);
+        lo_xy = _mm_min_pd(lo_xy, xy);
+        hi_xy = _mm_max_pd(hi_xy, xy);
+        lo_z = _mm_min_sd(lo_z, z);
+        hi_z = _mm_max_sd(hi_z, z);
+      }
+      store_outward(lo_xy, lo_z, hi_xy, hi_z, lo, hi);
+      exact.lo_xy = _mm_min_pd(exact.lo_xy, lo_xy);
+      exact.hi_xy = _mm_max_pd(exact.hi_xy, hi_xy);
+      exact.lo_z = _mm_min_sd(exact.lo_z, lo_z);
+      exact.hi_z = _mm_max_sd(exact.hi_z, hi_z);
+    };
+    end(x_t0.data(), box.lo0, box.hi0);
+    end(x_t1.data(), box.lo1, box.hi1);
+    return box;
+  }
+#else
+  struct Exact {
+    Dop<3> box = Dop<3>::empty();
+  };
+  [[nodiscard]] NodeEndBoxes triangle(std::int32_t f, Exact& exact) const {
+    for (const double* p : {x_t0.data(), x_t1.data()}) {
+      for (Eigen::Index j = 0; j < 3; ++j) {
+        const double* c = p + 3 * static_cast<std::size_t>(triangles(f, j));
+        for (std::size_t k = 0; k < 3; ++k) {
+          exact.box.lo[k] = std::min(exact.box.lo[k], c[k]);
+          exact.box.hi[k] = std::max(exact.box.hi[k], c[k]);
+        }
+      }
+    }
+    return triangle(f);
+  }
+#endif
   [[nodiscard]] NodeEndBoxes triangle(std::int32_t f) const {
     const auto i = static_cast<Eigen::Index>(f);
     const std::array<std::size_t, 3> c{
@@ -815,8 +872,34 @@ void Bvh<N>::refit_end_boxes(
 }
 
 template <int N>
+void Bvh<N>::refit_swept_and_ends(
+    const skinning::Triangles& triangles,
+    const skinning::Positions& x_t0,
+    const skinning::Positions& x_t1,
+    bool with_slot_ends) requires(N == 3) {
+  assert(!node_volumes_);
+  end_boxes_ready_ = false;
+  slot_ends_ready_ = false;
+  root_bounds_ = Volume::empty();
+  fill_end_boxes<true>(PositionEndsSource{triangles, x_t0, x_t1, 0.0}, with_slot_ends);
+}
+
+namespace {
+struct NoExact {};
+template <bool kSwept, class Source>
+struct ExactOf {
+  using type = NoExact;
+};
 template <class Source>
+struct ExactOf<true, Source> {
+  using type = typename Source::Exact;
+};
+}  // namespace
+
+template <int N>
+template <bool kSwept, class Source>
 void Bvh<N>::fill_end_boxes(const Source& source, bool with_slot_ends) {
+  using SweptExact = typename ExactOf<kSwept, Source>::type;
   constexpr float kInf = std::numeric_limits<float>::infinity();
   const std::size_t stride = slot_stride();
   if (with_slot_ends && slot_ends_.size() != 12 * stride) slot_ends_.assign(12 * stride, 0.0f);
@@ -832,8 +915,19 @@ void Bvh<N>::fill_end_boxes(const Source& source, bool with_slot_ends) {
       if (s >= kAheadRows) source.prefetch_row(order_[s - kAheadRows]);
       source.prefetch(order_[s - kAheadEnds]);
     }
+    [[maybe_unused]] SweptExact exact;
     for (std::size_t s = begin; s < end; ++s) {
-      const NodeEndBoxes box = source.triangle(order_[s]);
+      NodeEndBoxes box;
+      if constexpr (kSwept) {
+        box = source.triangle(order_[s], exact);
+        // refit()'s slot volume: the union of the two ends' rounded boxes (refit_swept_and_ends).
+        for (std::size_t k = 0; k < 3; ++k) {
+          slot_bounds_[k * stride + s] = std::min(box.lo0[k], box.lo1[k]);
+          slot_bounds_[(3 + k) * stride + s] = std::max(box.hi0[k], box.hi1[k]);
+        }
+      } else {
+        box = source.triangle(order_[s]);
+      }
       if (with_slot_ends) write_slot_ends(rows, stride, s, box);
       if (s == begin) {
         out = box;
@@ -841,12 +935,30 @@ void Bvh<N>::fill_end_boxes(const Source& source, bool with_slot_ends) {
         merge_ends(out, box);
       }
     }
+    if constexpr (kSwept) {
+      // The root's exact volume: the bucket's corners' extremes (in registers until here).
+#if defined(__SSE2__)
+      alignas(16) std::array<double, 2> lo_xy;
+      alignas(16) std::array<double, 2> hi_xy;
+      _mm_store_pd(lo_xy.data(), exact.lo_xy);
+      _mm_store_pd(hi_xy.data(), exact.hi_xy);
+      const std::array<double, 3> lo{lo_xy[0], lo_xy[1], _mm_cvtsd_f64(exact.lo_z)};
+      const std::array<double, 3> hi{hi_xy[0], hi_xy[1], _mm_cvtsd_f64(exact.hi_z)};
+#else
+      const auto& lo = exact.box.lo;
+      const auto& hi = exact.box.hi;
+#endif
+      for (std::size_t k = 0; k < 3; ++k) {
+        root_bounds_.lo[k] = std::min(root_bounds_.lo[k], lo[k]);
+        root_bounds_.hi[k] = std::max(root_bounds_.hi[k], hi[k]);
+      }
+    }
   };
   end_boxes_.resize(wide_.size());
   // As refit_wide_only: children after their parent, so one backward sweep is bottom-up; a
   // bucket's lane from its triangles' corners, an inner lane the union of its wide node's lanes.
   for (std::size_t n = wide_.size(); n-- > 0;) {
-    const WideBvhNode<N>& w = wide_[n];
+    WideBvhNode<N>& w = wide_[n];
     WideEndBoxes& e = end_boxes_[n];
     for (std::size_t k = 0; k < 3; ++k) {
       for (std::size_t i = 0; i < 4; ++i) {
@@ -880,6 +992,13 @@ void Bvh<N>::fill_end_boxes(const Source& source, bool with_slot_ends) {
         e.hi0[k][i] = lane_boxes.hi0[k];
         e.lo1[k][i] = lane_boxes.lo1[k];
         e.hi1[k][i] = lane_boxes.hi1[k];
+      }
+      if constexpr (kSwept) {
+        // refit()'s lane volume, the union of the lane's slots' (or its wide node's lanes').
+        for (std::size_t k = 0; k < 3; ++k) {
+          w.lo[k][i] = std::min(lane_boxes.lo0[k], lane_boxes.lo1[k]);
+          w.hi[k][i] = std::max(lane_boxes.hi0[k], lane_boxes.hi1[k]);
+        }
       }
     }
   }

@@ -239,6 +239,21 @@ class Bvh {
       const skinning::Positions& x_t1,
       double half_width,
       bool with_slot_ends);
+  /// refit() over the interval's swept AABBs and refit_end_boxes() on the positions without a
+  /// width (with the slots' rows when `with_slot_ends`), in one pass over the corners, for a tree
+  /// without binary node volumes (BvhOptions::node_volumes false; `dynamic`'s local trees with
+  /// node end boxes). A swept AABB from the corners is the union of its two end boxes, and the
+  /// rounding outwards is monotone, so the slots' and the wide nodes' float volumes are each the
+  /// union of the two rounded end boxes, bit for bit what refit() gives them from
+  /// FeatureBounds::swept_triangles' volumes; the root's double volume is the corners' extremes,
+  /// the same values (a zero's sign aside, which no comparison sees). The triangles' volumes are
+  /// not read: refit()'s scattered reads of them by triangle id and their rounding are saved.
+  /// @pre the tree was built with node_volumes false.
+  void refit_swept_and_ends(
+      const skinning::Triangles& triangles,
+      const skinning::Positions& x_t0,
+      const skinning::Positions& x_t1,
+      bool with_slot_ends) requires(N == 3);
   /// The triangles' own end boxes by slot, from their corners' (vertex_end_boxes): 12 rows of
   /// slot_stride() floats — lo at t = 0 on x, y, z, then hi at t = 0, lo at t = 1, hi at t = 1 —
   /// so that the traversals drop a triangle pair whose boxes lie apart on an axis at both ends
@@ -278,7 +293,9 @@ class Bvh {
   void refit_wide_only(std::span<const Volume> triangle_bounds);
   void refit_float_nodes(std::span<const Volume> triangle_bounds);
   /// refit_end_boxes and refit_slot_ends over a source of triangles' end boxes (bvh.cpp).
-  template <class Source>
+  /// With kSwept, also refit()'s slot and wide-node volumes and root_bounds() from the end boxes
+  /// (refit_swept_and_ends).
+  template <bool kSwept = false, class Source>
   void fill_end_boxes(const Source& source, bool with_slot_ends);
   template <class Source>
   void fill_slot_ends(const Source& source);

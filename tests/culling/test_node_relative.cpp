@@ -77,6 +77,9 @@ std::vector<float> slot_end_rows(const Bvh<3>& tree) {
   return r;
 }
 
+/// A float's bits (a zero's sign and every NaN told apart).
+std::uint32_t bits_of(float f) { return std::bit_cast<std::uint32_t>(f); }
+
 struct SweptCesium {
   Model m{"CesiumMan.glb"};
   FeatureTopology ft{*m.loaded.mesh, m.topology};
@@ -367,6 +370,82 @@ TEST(NodeRelative, EndBoxesFromPositionsAreTheVertexBoxesBitForBit) {
     const std::vector<float> got = slot_end_rows(from_positions);
     ASSERT_EQ(got.size(), expected.size());
     EXPECT_EQ(std::memcmp(expected.data(), got.data(), expected.size() * sizeof(float)), 0) << edgy;
+  }
+}
+
+// `dynamic`'s one pass (Bvh::refit_swept_and_ends) is refit() over the swept volumes from the
+// corners followed by refit_end_boxes() without a width, bit for bit: the slots' and the wide
+// nodes' float volumes, the end boxes and the slots' rows, and the root's double volume, on
+// CesiumMan's motion and on the coordinates where the rounding has edges.
+TEST(NodeRelative, OnePassRefitIsTheRefitAndItsEndBoxesBitForBit) {
+  SweptCesium c;
+  auto& [m, ft, x0, x1, bvh, bounds] = c;
+  skinning::Positions edgy0 = x0;
+  skinning::Positions edgy1 = x1;
+  const std::array<double, 6> edges{0.0, -0.0, 1e-310, -1e-41, 1e39, -3.4028235e38};
+  for (Eigen::Index v = 0; v < edgy0.rows(); v += 5) {
+    edgy0(v, v % 3) = edges[static_cast<std::size_t>(v % 6)];
+    edgy1((v + 2) % edgy1.rows(), (v + 1) % 3) = edges[static_cast<std::size_t>((v + 1) % 6)];
+  }
+  const BvhOptions wide_only{.node_volumes = false};
+  for (const bool edgy : {false, true}) {
+    const skinning::Positions& p0 = edgy ? edgy0 : x0;
+    const skinning::Positions& p1 = edgy ? edgy1 : x1;
+    FeatureBounds<3> swept;
+    swept.swept_triangles(ft, p0, p1);
+    for (const bool with_slots : {false, true}) {
+      Bvh<3> two_passes(ft.welded_triangles(), m.rest, wide_only);
+      Bvh<3> one_pass(ft.welded_triangles(), m.rest, wide_only);
+      two_passes.refit(swept.triangles);
+      two_passes.refit_end_boxes(ft.welded_triangles(), p0, p1, 0.0, with_slots);
+      // A refit of another interval first: everything the pass fills is overwritten.
+      one_pass.refit(bounds.triangles);
+      one_pass.refit_swept_and_ends(ft.welded_triangles(), p0, p1, with_slots);
+      const std::string what = std::to_string(edgy) + " " + std::to_string(with_slots);
+      const auto wide_a = two_passes.wide_nodes();
+      const auto wide_b = one_pass.wide_nodes();
+      ASSERT_EQ(wide_a.size(), wide_b.size());
+      ASSERT_GT(wide_a.size(), 1u);
+      for (std::size_t n = 0; n < wide_a.size(); ++n) {
+        for (int i = 0; i < wide_a[n].num_children; ++i) {
+          const auto l = static_cast<std::size_t>(i);
+          for (std::size_t k = 0; k < 3; ++k) {
+            ASSERT_EQ(bits_of(wide_a[n].lo[k][l]), bits_of(wide_b[n].lo[k][l])) << what << " " << n;
+            ASSERT_EQ(bits_of(wide_a[n].hi[k][l]), bits_of(wide_b[n].hi[k][l])) << what << " " << n;
+          }
+        }
+      }
+      const std::size_t stride = two_passes.slot_stride();
+      for (int k = 0; k < 3; ++k) {
+        EXPECT_EQ(
+            std::memcmp(two_passes.slot_lo(k), one_pass.slot_lo(k), stride * sizeof(float)), 0)
+            << what << " axis " << k;
+        EXPECT_EQ(
+            std::memcmp(two_passes.slot_hi(k), one_pass.slot_hi(k), stride * sizeof(float)), 0)
+            << what << " axis " << k;
+      }
+      ASSERT_EQ(two_passes.end_boxes().size(), one_pass.end_boxes().size());
+      EXPECT_EQ(
+          std::memcmp(
+              two_passes.end_boxes().data(),
+              one_pass.end_boxes().data(),
+              one_pass.end_boxes().size() * sizeof(WideEndBoxes)),
+          0)
+          << what;
+      if (with_slots) {
+        const std::vector<float> a = slot_end_rows(two_passes);
+        const std::vector<float> b = slot_end_rows(one_pass);
+        ASSERT_EQ(a.size(), 12 * static_cast<std::size_t>(ft.num_triangles()));
+        ASSERT_EQ(b.size(), a.size());
+        EXPECT_EQ(std::memcmp(a.data(), b.data(), a.size() * sizeof(float)), 0) << what;
+      } else {
+        EXPECT_EQ(one_pass.slot_ends(0), nullptr) << what;
+      }
+      for (std::size_t k = 0; k < 3; ++k) {
+        EXPECT_EQ(two_passes.root_bounds().lo[k], one_pass.root_bounds().lo[k]) << what;
+        EXPECT_EQ(two_passes.root_bounds().hi[k], one_pass.root_bounds().hi[k]) << what;
+      }
+    }
   }
 }
 
