@@ -699,8 +699,9 @@ struct PositionEndsSource {
     __m128d hi_xy = _mm_set1_pd(-std::numeric_limits<double>::infinity());
     __m128d hi_z = hi_xy;
   };
-  /// triangle(f) without a width, the corners' extremes merged into `exact` on the way.
-  [[nodiscard]] NodeEndBoxes triangle(std::int32_t f, Exact& exact) const {
+  /// Triangle f's end boxes without a width: as vertex_end_boxes, on the corners' least and
+  /// greatest coordinates; those extremes also merged into `exact` when it is not null.
+  [[nodiscard]] NodeEndBoxes without_width(std::int32_t f, Exact* exact) const {
     const auto i = static_cast<Eigen::Index>(f);
     const std::array<std::size_t, 3> c{
         3 * static_cast<std::size_t>(triangles(i, 0)),
@@ -721,14 +722,20 @@ struct PositionEndsSource {
         hi_z = _mm_max_sd(hi_z, z);
       }
       store_outward(lo_xy, lo_z, hi_xy, hi_z, lo, hi);
-      exact.lo_xy = _mm_min_pd(exact.lo_xy, lo_xy);
-      exact.hi_xy = _mm_max_pd(exact.hi_xy, hi_xy);
-      exact.lo_z = _mm_min_sd(exact.lo_z, lo_z);
-      exact.hi_z = _mm_max_sd(exact.hi_z, hi_z);
+      if (exact != nullptr) {
+        exact->lo_xy = _mm_min_pd(exact->lo_xy, lo_xy);
+        exact->hi_xy = _mm_max_pd(exact->hi_xy, hi_xy);
+        exact->lo_z = _mm_min_sd(exact->lo_z, lo_z);
+        exact->hi_z = _mm_max_sd(exact->hi_z, hi_z);
+      }
     };
     end(x_t0.data(), box.lo0, box.hi0);
     end(x_t1.data(), box.lo1, box.hi1);
     return box;
+  }
+  /// triangle(f) without a width, the corners' extremes merged into `exact` on the way.
+  [[nodiscard]] NodeEndBoxes triangle(std::int32_t f, Exact& exact) const {
+    return without_width(f, &exact);
   }
 #else
   struct Exact {
@@ -748,35 +755,15 @@ struct PositionEndsSource {
   }
 #endif
   [[nodiscard]] NodeEndBoxes triangle(std::int32_t f) const {
+#if defined(__SSE2__)
+    if (half_width == 0.0) return without_width(f, nullptr);
+#endif
     const auto i = static_cast<Eigen::Index>(f);
     const std::array<std::size_t, 3> c{
         3 * static_cast<std::size_t>(triangles(i, 0)),
         3 * static_cast<std::size_t>(triangles(i, 1)),
         3 * static_cast<std::size_t>(triangles(i, 2))};
     NodeEndBoxes box;
-#if defined(__SSE2__)
-    if (half_width == 0.0) {
-      // As vertex_end_boxes without a width, on the corners' least and greatest coordinates.
-      const auto end = [&](const double* p, float* lo, float* hi) {
-        __m128d lo_xy = _mm_loadu_pd(p + c[0]);
-        __m128d lo_z = _mm_set_sd(p[c[0] + 2]);
-        __m128d hi_xy = lo_xy;
-        __m128d hi_z = lo_z;
-        for (std::size_t j = 1; j < 3; ++j) {
-          const __m128d xy = _mm_loadu_pd(p + c[j]);
-          const __m128d z = _mm_set_sd(p[c[j] + 2]);
-          lo_xy = _mm_min_pd(lo_xy, xy);
-          hi_xy = _mm_max_pd(hi_xy, xy);
-          lo_z = _mm_min_sd(lo_z, z);
-          hi_z = _mm_max_sd(hi_z, z);
-        }
-        store_outward(lo_xy, lo_z, hi_xy, hi_z, lo, hi);
-      };
-      end(x_t0.data(), box.lo0, box.hi0);
-      end(x_t1.data(), box.lo1, box.hi1);
-      return box;
-    }
-#endif
     const auto end = [&](const double* p, float* lo, float* hi) {
       for (std::size_t k = 0; k < 3; ++k) {
         const double a = p[c[0] + k];

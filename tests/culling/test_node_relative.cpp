@@ -77,6 +77,25 @@ std::vector<float> slot_end_rows(const Bvh<3>& tree) {
   return r;
 }
 
+/// Copies of two samples with every `step`-th vertex given a coordinate where the rounding has
+/// edges — zeros of both signs, a subnormal, a float subnormal, beyond the float range and its
+/// edge — in the first sample at vertex v, axis v % 3, and in the second at vertex v + shift[0],
+/// axis (v + shift[1]) % 3, the edge (v + shift[2]) % 6.
+std::pair<skinning::Positions, skinning::Positions> with_edge_coordinates(
+    const skinning::Positions& x0,
+    const skinning::Positions& x1,
+    Eigen::Index step,
+    const std::array<Eigen::Index, 3>& shift) {
+  std::pair<skinning::Positions, skinning::Positions> edgy{x0, x1};
+  const std::array<double, 6> edges{0.0, -0.0, 1e-310, -1e-41, 1e39, -3.4028235e38};
+  for (Eigen::Index v = 0; v < x0.rows(); v += step) {
+    edgy.first(v, v % 3) = edges[static_cast<std::size_t>(v % 6)];
+    edgy.second((v + shift[0]) % x1.rows(), (v + shift[1]) % 3) =
+        edges[static_cast<std::size_t>((v + shift[2]) % 6)];
+  }
+  return edgy;
+}
+
 /// A float's bits (a zero's sign and every NaN told apart).
 std::uint32_t bits_of(float f) { return std::bit_cast<std::uint32_t>(f); }
 
@@ -313,13 +332,7 @@ TEST(NodeRelative, NodeAndSlotEndBoxesFromOneGatherAreTheTwoRefitsBitForBit) {
 TEST(NodeRelative, EndBoxesFromPositionsAreTheVertexBoxesBitForBit) {
   SweptCesium c;
   auto& [m, ft, x0, x1, bvh, bounds] = c;
-  skinning::Positions edgy0 = x0;
-  skinning::Positions edgy1 = x1;
-  const std::array<double, 6> edges{0.0, -0.0, 1e-310, -1e-41, 1e39, -3.4028235e38};
-  for (Eigen::Index v = 0; v < edgy0.rows(); v += 7) {
-    edgy0(v, v % 3) = edges[static_cast<std::size_t>(v % 6)];
-    edgy1((v + 1) % edgy1.rows(), (v + 2) % 3) = edges[static_cast<std::size_t>((v + 3) % 6)];
-  }
+  const auto [edgy0, edgy1] = with_edge_coordinates(x0, x1, 7, {1, 2, 3});
   const auto same_nodes = [](const Bvh<3>& a, const Bvh<3>& b) {
     return a.end_boxes().size() == b.end_boxes().size() && !a.end_boxes().empty() &&
            std::memcmp(
@@ -380,13 +393,7 @@ TEST(NodeRelative, EndBoxesFromPositionsAreTheVertexBoxesBitForBit) {
 TEST(NodeRelative, OnePassRefitIsTheRefitAndItsEndBoxesBitForBit) {
   SweptCesium c;
   auto& [m, ft, x0, x1, bvh, bounds] = c;
-  skinning::Positions edgy0 = x0;
-  skinning::Positions edgy1 = x1;
-  const std::array<double, 6> edges{0.0, -0.0, 1e-310, -1e-41, 1e39, -3.4028235e38};
-  for (Eigen::Index v = 0; v < edgy0.rows(); v += 5) {
-    edgy0(v, v % 3) = edges[static_cast<std::size_t>(v % 6)];
-    edgy1((v + 2) % edgy1.rows(), (v + 1) % 3) = edges[static_cast<std::size_t>((v + 1) % 6)];
-  }
+  const auto [edgy0, edgy1] = with_edge_coordinates(x0, x1, 5, {2, 1, 1});
   const BvhOptions wide_only{.node_volumes = false};
   for (const bool edgy : {false, true}) {
     const skinning::Positions& p0 = edgy ? edgy0 : x0;
