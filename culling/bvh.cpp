@@ -684,6 +684,14 @@ struct PositionEndsSource {
   const skinning::Positions& x_t1;
   double half_width;
   void prefetch_row(std::int32_t f) const { prefetch_triangle_row(triangles, f); }
+  /// Where triangle f's corners start in the row-major positions.
+  [[nodiscard]] std::array<std::size_t, 3> corner_offsets(std::int32_t f) const {
+    const auto i = static_cast<Eigen::Index>(f);
+    return {
+        3 * static_cast<std::size_t>(triangles(i, 0)),
+        3 * static_cast<std::size_t>(triangles(i, 1)),
+        3 * static_cast<std::size_t>(triangles(i, 2))};
+  }
   void prefetch(std::int32_t f) const {
     for (Eigen::Index j = 0; j < 3; ++j) {
       const auto v = static_cast<std::size_t>(triangles(f, j));
@@ -702,11 +710,7 @@ struct PositionEndsSource {
   /// Triangle f's end boxes without a width: as vertex_end_boxes, on the corners' least and
   /// greatest coordinates; those extremes also merged into `exact` when it is not null.
   [[nodiscard]] NodeEndBoxes without_width(std::int32_t f, Exact* exact) const {
-    const auto i = static_cast<Eigen::Index>(f);
-    const std::array<std::size_t, 3> c{
-        3 * static_cast<std::size_t>(triangles(i, 0)),
-        3 * static_cast<std::size_t>(triangles(i, 1)),
-        3 * static_cast<std::size_t>(triangles(i, 2))};
+    const std::array<std::size_t, 3> c = corner_offsets(f);
     NodeEndBoxes box;
     const auto end = [&](const double* p, float* lo, float* hi) {
       __m128d lo_xy = _mm_loadu_pd(p + c[0]);
@@ -758,11 +762,7 @@ struct PositionEndsSource {
 #if defined(__SSE2__)
     if (half_width == 0.0) return without_width(f, nullptr);
 #endif
-    const auto i = static_cast<Eigen::Index>(f);
-    const std::array<std::size_t, 3> c{
-        3 * static_cast<std::size_t>(triangles(i, 0)),
-        3 * static_cast<std::size_t>(triangles(i, 1)),
-        3 * static_cast<std::size_t>(triangles(i, 2))};
+    const std::array<std::size_t, 3> c = corner_offsets(f);
     NodeEndBoxes box;
     const auto end = [&](const double* p, float* lo, float* hi) {
       for (std::size_t k = 0; k < 3; ++k) {
