@@ -6,6 +6,7 @@
 #include <cmath>
 #include <limits>
 #include <numeric>
+#include <stdexcept>
 #include <string>
 
 #include "skinning/errors.hpp"
@@ -656,6 +657,8 @@ struct CornerEndsSource {
   [[nodiscard]] NodeEndBoxes triangle(std::int32_t f) const {
     return triangle_ends(triangles, vertex_ends, f);
   }
+  /// No exact extremes: only the positions' source fills refit()'s volumes too.
+  struct Exact {};
 };
 
 #if defined(__SSE2__)
@@ -737,30 +740,17 @@ struct PositionEndsSource {
     end(x_t1.data(), box.lo1, box.hi1);
     return box;
   }
-  /// triangle(f) without a width, the corners' extremes merged into `exact` on the way.
-  [[nodiscard]] NodeEndBoxes triangle(std::int32_t f, Exact& exact) const {
-    return without_width(f, &exact);
-  }
 #else
   struct Exact {
     Dop<3> box = Dop<3>::empty();
   };
-  [[nodiscard]] NodeEndBoxes triangle(std::int32_t f, Exact& exact) const {
-    for (const double* p : {x_t0.data(), x_t1.data()}) {
-      for (Eigen::Index j = 0; j < 3; ++j) {
-        const double* c = p + 3 * static_cast<std::size_t>(triangles(f, j));
-        for (std::size_t k = 0; k < 3; ++k) {
-          exact.box.lo[k] = std::min(exact.box.lo[k], c[k]);
-          exact.box.hi[k] = std::max(exact.box.hi[k], c[k]);
-        }
-      }
-    }
-    return triangle(f);
-  }
 #endif
-  [[nodiscard]] NodeEndBoxes triangle(std::int32_t f) const {
+  /// Triangle f's end boxes, grown by half_width; without a width and with `exact` not null, the
+  /// corners' extremes also merged into `exact` on the way (refit_swept_and_ends' root).
+  [[nodiscard]] NodeEndBoxes triangle(std::int32_t f, Exact* exact = nullptr) const {
+    assert(exact == nullptr || half_width == 0.0);
 #if defined(__SSE2__)
-    if (half_width == 0.0) return without_width(f, nullptr);
+    if (half_width == 0.0) return without_width(f, exact);
 #endif
     const std::array<std::size_t, 3> c = corner_offsets(f);
     NodeEndBoxes box;
@@ -771,6 +761,12 @@ struct PositionEndsSource {
         const double d = p[c[2] + k];
         const double l = std::min(std::min(a, b), d);
         const double h = std::max(std::max(a, b), d);
+#if !defined(__SSE2__)
+        if (exact != nullptr) {
+          exact->box.lo[k] = std::min(exact->box.lo[k], l);
+          exact->box.hi[k] = std::max(exact->box.hi[k], h);
+        }
+#endif
         lo[k] = float_below(half_width > 0.0 ? next_down(l - half_width) : l);
         hi[k] = float_above(half_width > 0.0 ? next_up(h + half_width) : h);
       }
@@ -864,29 +860,19 @@ void Bvh<N>::refit_swept_and_ends(
     const skinning::Positions& x_t0,
     const skinning::Positions& x_t1,
     bool with_slot_ends) requires(N == 3) {
-  assert(!node_volumes_);
+  if (node_volumes_) {
+    // refit() would also have to fill the binary nodes' volumes, which this pass never reads.
+    throw std::logic_error("Bvh::refit_swept_and_ends: the tree was built with node volumes");
+  }
   end_boxes_ready_ = false;
   slot_ends_ready_ = false;
   root_bounds_ = Volume::empty();
   fill_end_boxes<true>(PositionEndsSource{triangles, x_t0, x_t1, 0.0}, with_slot_ends);
 }
 
-namespace {
-struct NoExact {};
-template <bool kSwept, class Source>
-struct ExactOf {
-  using type = NoExact;
-};
-template <class Source>
-struct ExactOf<true, Source> {
-  using type = typename Source::Exact;
-};
-}  // namespace
-
 template <int N>
 template <bool kSwept, class Source>
 void Bvh<N>::fill_end_boxes(const Source& source, bool with_slot_ends) {
-  using SweptExact = typename ExactOf<kSwept, Source>::type;
   constexpr float kInf = std::numeric_limits<float>::infinity();
   const std::size_t stride = slot_stride();
   if (with_slot_ends && slot_ends_.size() != 12 * stride) slot_ends_.assign(12 * stride, 0.0f);
@@ -902,11 +888,11 @@ void Bvh<N>::fill_end_boxes(const Source& source, bool with_slot_ends) {
       if (s >= kAheadRows) source.prefetch_row(order_[s - kAheadRows]);
       source.prefetch(order_[s - kAheadEnds]);
     }
-    [[maybe_unused]] SweptExact exact;
+    [[maybe_unused]] typename Source::Exact exact;
     for (std::size_t s = begin; s < end; ++s) {
       NodeEndBoxes box;
       if constexpr (kSwept) {
-        box = source.triangle(order_[s], exact);
+        box = source.triangle(order_[s], &exact);
         // refit()'s slot volume: the union of the two ends' rounded boxes (refit_swept_and_ends).
         for (std::size_t k = 0; k < 3; ++k) {
           slot_bounds_[k * stride + s] = std::min(box.lo0[k], box.lo1[k]);

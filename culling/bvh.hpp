@@ -248,7 +248,7 @@ class Bvh {
   /// FeatureBounds::swept_triangles' volumes; the root's double volume is the corners' extremes,
   /// the same values (a zero's sign aside, which no comparison sees). The triangles' volumes are
   /// not read: refit()'s scattered reads of them by triangle id and their rounding are saved.
-  /// @pre the tree was built with node_volumes false.
+  /// @throws std::logic_error when the tree was built with node_volumes true (left unchanged).
   void refit_swept_and_ends(
       const skinning::Triangles& triangles,
       const skinning::Positions& x_t0,

@@ -168,6 +168,43 @@ inline void swept_corners_sse2(const std::array<const double*, 6>& c, Dop<N>& d)
 }  // namespace
 #endif
 
+namespace {
+
+/// The scalar form of swept_corners_sse2: the coordinates' extremes over the
+/// six corners, and Dop<8>'s diagonals as sums or differences of two coordinates, one rounding
+/// each, so that the exact value lies within one ulp of the rounded one.
+template <int N>
+[[maybe_unused]] void swept_corners_scalar(const std::array<const double*, 6>& c, Dop<N>& d) {
+  for (std::size_t a = 0; a < 3; ++a) {
+    double lo = c[0][a];
+    double hi = lo;
+    for (std::size_t k = 1; k < 6; ++k) {
+      lo = std::min(lo, c[k][a]);
+      hi = std::max(hi, c[k][a]);
+    }
+    d.lo[a] = lo;
+    d.hi[a] = hi;
+  }
+  for (std::size_t k = 3; k < static_cast<std::size_t>(N); ++k) {
+    const auto& axis = DopAxes<N>::kAxes[k];
+    const std::size_t i = axis[0] != 0 ? 0 : 1;
+    const std::size_t j = axis[2] != 0 ? 2 : 1;
+    const double si = axis[i];
+    const double sj = axis[j];
+    double lo = si * c[0][i] + sj * c[0][j];
+    double hi = lo;
+    for (std::size_t m = 1; m < 6; ++m) {
+      const double s = si * c[m][i] + sj * c[m][j];
+      lo = std::min(lo, s);
+      hi = std::max(hi, s);
+    }
+    d.lo[k] = next_down(lo);
+    d.hi[k] = next_up(hi);
+  }
+}
+
+}  // namespace
+
 template <int N>
 void FeatureBounds<N>::swept_triangles(
     const FeatureTopology& topology,
@@ -187,39 +224,11 @@ void FeatureBounds<N>::swept_triangles(
       c[2 * k] = p0 + 3 * at(t[k]);
       c[2 * k + 1] = p1 + 3 * at(t[k]);
     }
-    Dop<N>& d = triangles[f];
 #if defined(__SSE2__)
-    swept_corners_sse2(c, d);
-    continue;
+    swept_corners_sse2(c, triangles[f]);
+#else
+    swept_corners_scalar(c, triangles[f]);
 #endif
-    for (std::size_t a = 0; a < 3; ++a) {
-      double lo = c[0][a];
-      double hi = lo;
-      for (std::size_t k = 1; k < 6; ++k) {
-        lo = std::min(lo, c[k][a]);
-        hi = std::max(hi, c[k][a]);
-      }
-      d.lo[a] = lo;
-      d.hi[a] = hi;
-    }
-    // The other axes (Dop<8>'s diagonals) are sums or differences of two coordinates: one
-    // rounding each, so the exact value lies within one ulp of the rounded one.
-    for (std::size_t k = 3; k < static_cast<std::size_t>(N); ++k) {
-      const auto& axis = DopAxes<N>::kAxes[k];
-      const std::size_t i = axis[0] != 0 ? 0 : 1;
-      const std::size_t j = axis[2] != 0 ? 2 : 1;
-      const double si = axis[i];
-      const double sj = axis[j];
-      double lo = si * c[0][i] + sj * c[0][j];
-      double hi = lo;
-      for (std::size_t m = 1; m < 6; ++m) {
-        const double s = si * c[m][i] + sj * c[m][j];
-        lo = std::min(lo, s);
-        hi = std::max(hi, s);
-      }
-      d.lo[k] = next_down(lo);
-      d.hi[k] = next_up(hi);
-    }
   }
 }
 

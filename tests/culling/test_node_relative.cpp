@@ -12,6 +12,7 @@
 #include <cstring>
 #include <limits>
 #include <random>
+#include <stdexcept>
 #include <string>
 #include <utility>
 #include <vector>
@@ -453,6 +454,25 @@ TEST(NodeRelative, OnePassRefitIsTheRefitAndItsEndBoxesBitForBit) {
         EXPECT_EQ(two_passes.root_bounds().hi[k], one_pass.root_bounds().hi[k]) << what;
       }
     }
+  }
+}
+
+// The one pass fills no binary node volumes: on a tree that has them it refuses and changes
+// nothing (the end boxes refit_end_boxes gave stay readable, the root is refit()'s).
+TEST(NodeRelative, OnePassRefitRefusesATreeWithNodeVolumes) {
+  SweptCesium c;
+  auto& [m, ft, x0, x1, bvh, bounds] = c;
+  Bvh<3> with_nodes(ft.welded_triangles(), m.rest);
+  with_nodes.refit(bounds.triangles);
+  with_nodes.refit_end_boxes(ft.welded_triangles(), x0, x1, 0.0, true);
+  const auto root = with_nodes.root_bounds();
+  EXPECT_THROW(
+      with_nodes.refit_swept_and_ends(ft.welded_triangles(), x0, x1, true), std::logic_error);
+  EXPECT_FALSE(with_nodes.end_boxes().empty());
+  EXPECT_NE(with_nodes.slot_ends(0), nullptr);
+  for (std::size_t k = 0; k < 3; ++k) {
+    EXPECT_EQ(with_nodes.root_bounds().lo[k], root.lo[k]);
+    EXPECT_EQ(with_nodes.root_bounds().hi[k], root.hi[k]);
   }
 }
 

@@ -150,9 +150,6 @@ TEST(LargePages, TheHeapsTopIsAdvisedAndEveryThreadAllocatesThere) {
   EXPECT_EQ(heap_range().second, after.second);
 }
 
-// Where the executable decides (tools/cli/main.cpp): `check` tells the hook the loaded mesh's
-// triangles before it sets up the check, and only a mesh of 64Ki triangles or more takes the
-// heap's top on huge pages (CesiumMan's 4,672 do not; the cloth-ball step's 92,230 do).
 /// The triangle counts `skelcd check ASSET --frames 0:2 --json` tells the hook, in order.
 std::vector<std::int64_t> triangles_told_checking(const std::string& asset) {
   std::vector<std::int64_t> told;
@@ -166,6 +163,9 @@ std::vector<std::int64_t> triangles_told_checking(const std::string& asset) {
   return told;
 }
 
+// Where the executable decides (tools/cli/main.cpp): `check` tells the hook the loaded mesh's
+// triangles before it sets up the check, and only a mesh of 64Ki triangles or more takes the
+// heap's top on huge pages (CesiumMan's 4,672 do not; the cloth-ball step's 92,230 do).
 TEST(LargePages, CheckTellsTheLoadedMeshsSizeAndOnlyLargeMeshesPay) {
   EXPECT_EQ(triangles_told_checking("characters/CesiumMan.glb"), std::vector<std::int64_t>{4672});
   EXPECT_FALSE(heap_on_huge_pages_pays(4672));
