@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "skinning/mesh.hpp"
+#include "skinning/mesh_order.hpp"
 #include "skinning/motion.hpp"
 
 namespace skelcd::skinning {
@@ -58,6 +59,10 @@ struct FrameSequenceOptions {
   /// Frames kept in memory while #frames × #V × 24 ≤ this × #F; else only the first (the rest
   /// pose) is, and positions() reads a frame's file again (0: always read again).
   std::size_t kept_bytes_per_triangle = kKeptFrameBytesPerTriangle;
+  /// The order mesh() and positions() hold the vertices and triangles in (skinning/mesh_order.hpp):
+  /// the file's, or spatial_order of the first frame. Mesh::face_index_in_part and
+  /// vertex_index_in_part give each element's index in the files either way.
+  MeshOrder order = MeshOrder::file;
 };
 
 /// Every frame read and checked once at construction; kept in memory when they are few
@@ -74,12 +79,13 @@ class FrameSequenceMotion final : public Motion {
       const FrameSequenceOptions& options = {},
       std::string name = {});
 
-  /// The first frame: one part named after the sequence.
+  /// The first frame: one part named after the sequence, in FrameSequenceOptions::order.
   [[nodiscard]] const Mesh& mesh() const override { return data_->mesh; }
   [[nodiscard]] int num_samples() const override { return static_cast<int>(data_->files.size()); }
   [[nodiscard]] double sample_time(int i) const override { return i / rate_hz_; }
   [[nodiscard]] std::string name() const override { return data_->name; }
-  /// Frame i's positions: from memory, or read again from its file (thread-safe either way).
+  /// Frame i's positions (in mesh()'s vertex order): from memory, or read again from its file
+  /// (thread-safe either way).
   /// @throws IoError naming the file when it cannot be read again or its bytes are no longer
   ///   those read at construction.
   void positions(int i, Positions& out) const override;
@@ -101,6 +107,9 @@ class FrameSequenceMotion final : public Motion {
     std::vector<std::filesystem::path> files;
     std::vector<Positions> frames;       ///< every frame, or none (read again: positions())
     std::vector<std::size_t> checksums;  ///< of each file's bytes, as read at construction
+    /// Held in a spatial order: vertex v of mesh() is the files' vertex
+    /// mesh.vertex_index_in_part[v] (one part), which a frame read again is gathered by.
+    bool reordered = false;
     Mesh mesh;
     std::string name;
   };

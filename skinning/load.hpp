@@ -10,6 +10,7 @@
 
 #include "skinning/assimp_import.hpp"
 #include "skinning/mesh.hpp"
+#include "skinning/mesh_order.hpp"
 #include "skinning/motion.hpp"
 #include "skinning/rig.hpp"
 
@@ -37,6 +38,10 @@ struct LoadOptions {
   std::filesystem::path trajectory;
   std::filesystem::path srdf;
   std::vector<std::filesystem::path> package_path;
+  /// Frame sequences: the order the mesh and its frames are held in (FrameSequenceOptions::order):
+  /// spatial unless asked otherwise, as simulators write cloth in no order the checks can read
+  /// fast. Model files and robots keep the file's (their writers keep meshes in strips).
+  MeshOrder mesh_order = MeshOrder::spatial;
 };
 
 /// Name, duration, key rate and default sampling rate of one clip (or trajectory, or frame

@@ -93,6 +93,70 @@ TEST(FrameSequence, ClothFunnelIsReadBitExactly) {
   EXPECT_GT((p1 - rest).cwiseAbs().maxCoeff(), 0.0);
 }
 
+// In the spatial order (what load_model gives) every vertex and triangle is still the file's,
+// found under its index in the file: the same coordinates bit for bit in every frame, kept in
+// memory or read again from the file, and the same corners in the same turn.
+TEST(FrameSequence, TheSpatialOrderHoldsTheFilesElementsUnderTheirFileIndices) {
+  for (const std::size_t budget : {kKeptFrameBytesPerTriangle, std::size_t{0}}) {
+    const FrameSequenceMotion motion(
+        list_frame_files(funnel_frames()),
+        FrameSequenceOptions{.kept_bytes_per_triangle = budget, .order = MeshOrder::spatial});
+    EXPECT_EQ(motion.frames_in_memory(), budget != 0);
+    const Mesh& mesh = motion.mesh();
+    ASSERT_EQ(mesh.num_vertices(), 9450);
+    ASSERT_EQ(mesh.num_triangles(), 18484);
+    // Not the file's order, and each file index once.
+    std::vector<std::int32_t> faces = mesh.face_index_in_part;
+    std::vector<std::int32_t> vertices = mesh.vertex_index_in_part;
+    EXPECT_FALSE(std::is_sorted(faces.begin(), faces.end()));
+    EXPECT_FALSE(std::is_sorted(vertices.begin(), vertices.end()));
+    std::sort(faces.begin(), faces.end());
+    std::sort(vertices.begin(), vertices.end());
+    for (std::size_t f = 0; f < faces.size(); ++f)
+      ASSERT_EQ(faces[f], static_cast<std::int32_t>(f));
+    for (std::size_t v = 0; v < vertices.size(); ++v) {
+      ASSERT_EQ(vertices[v], static_cast<std::int32_t>(v));
+    }
+    for (int i = 0; i < 2; ++i) {
+      const FunnelPly ply = read_funnel_ply(motion.frame_file(i));
+      Positions p;
+      motion.positions(i, p);
+      ASSERT_EQ(p.rows(), 9450);
+      for (Eigen::Index v = 0; v < p.rows(); ++v) {
+        const auto file_v =
+            static_cast<std::size_t>(mesh.vertex_index_in_part[static_cast<std::size_t>(v)]);
+        for (int k = 0; k < 3; ++k) {
+          ASSERT_EQ(p(v, k), ply.xyz[3 * file_v + static_cast<std::size_t>(k)])
+              << "frame " << i << " vertex " << v;
+        }
+      }
+      if (i == 0) {
+        EXPECT_EQ(p, mesh.rest_positions);
+        for (Eigen::Index f = 0; f < mesh.num_triangles(); ++f) {
+          const auto file_f =
+              static_cast<std::size_t>(mesh.face_index_in_part[static_cast<std::size_t>(f)]);
+          for (int k = 0; k < 3; ++k) {
+            ASSERT_EQ(
+                mesh.vertex_index_in_part[static_cast<std::size_t>(mesh.triangles(f, k))],
+                ply.faces[file_f][static_cast<std::size_t>(k)])
+                << "triangle " << f;
+          }
+        }
+      }
+    }
+  }
+  // load_model's default is this order; MeshOrder::file keeps the file's.
+  const LoadedModel spatial = load_frame_sequence_model(funnel_frames(), {});
+  EXPECT_FALSE(std::is_sorted(
+      spatial.mesh->face_index_in_part.begin(), spatial.mesh->face_index_in_part.end()));
+  LoadOptions file_order;
+  file_order.mesh_order = MeshOrder::file;
+  const LoadedModel file = load_frame_sequence_model(funnel_frames(), file_order);
+  EXPECT_TRUE(
+      std::is_sorted(file.mesh->face_index_in_part.begin(), file.mesh->face_index_in_part.end()));
+  EXPECT_EQ(file.mesh->triangles, load_frame_sequence(funnel_frames()).mesh().triangles);
+}
+
 // assimp (float precision) reads the same vertices in the same order: each coordinate of ours
 // rounds to assimp's float.
 TEST(FrameSequence, VertexOrderAgreesWithAssimp) {

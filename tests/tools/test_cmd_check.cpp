@@ -182,6 +182,74 @@ TEST(CmdCheck, NoReuseQueriesEveryIntervalOfAHeldPoseAndFindsTheSame) {
   EXPECT_NE(logs[1].header.command_line.find("--no-reuse"), std::string::npos);
 }
 
+// A frame sequence is checked in a spatial order unless `--mesh-order file` asks for the files':
+// the cloth-funnel step gives the same findings either way, every feature named by its index in
+// the files (an EE pair or a DCD pair may list its two features the other way round).
+TEST(CmdCheck, TheMeshOrderChangesNoFindingNorItsName) {
+  const auto dir = skelcd::test::temp_dir("check-mesh-order");
+  const std::string funnel = skelcd::test::asset("cloth-funnel/frames").string();
+  std::vector<LogData> logs;
+  std::vector<nlohmann::json> summaries;
+  for (const char* order : {"spatial", "file"}) {
+    const auto log_path = (dir / (std::string(order) + ".h5")).string();
+    const auto r = run_skelcd(
+        {"check",
+         funnel,
+         "--method",
+         "kdop",
+         "--mesh-order",
+         order,
+         "--threads",
+         "1",
+         "--json",
+         "-o",
+         log_path});
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    summaries.push_back(nlohmann::json::parse(r.out));
+    logs.push_back(read_log(log_path));
+  }
+  const auto unordered = [](const LogData& log) {
+    std::vector<ContactKey> keys;
+    for (auto c : log.contacts) {
+      if (c.kind == skelcd::culling::CcdContact::Kind::ee &&
+          std::tie(c.b.part, c.b.index, c.b.side) < std::tie(c.a.part, c.a.index, c.a.side)) {
+        std::swap(c.a, c.b);
+      }
+      keys.emplace_back(
+          c.frame,
+          static_cast<int>(c.kind),
+          c.a.part,
+          c.a.index,
+          c.a.side,
+          c.b.part,
+          c.b.index,
+          c.b.side);
+    }
+    std::sort(keys.begin(), keys.end());
+    return keys;
+  };
+  const auto pairs = [](const LogData& log) {
+    std::vector<std::tuple<int, int, int, int, int>> keys;
+    for (const auto& p : log.dcd_pairs) {
+      const auto a = std::pair{p.a.part, p.a.index};
+      const auto b = std::pair{p.b.part, p.b.index};
+      const auto [lo, hi] = std::minmax(a, b);
+      keys.emplace_back(p.frame, lo.first, lo.second, hi.first, hi.second);
+    }
+    std::sort(keys.begin(), keys.end());
+    return keys;
+  };
+  EXPECT_GT(logs[0].contacts.size(), 0u);
+  EXPECT_EQ(unordered(logs[0]), unordered(logs[1]));
+  EXPECT_EQ(pairs(logs[0]), pairs(logs[1]));
+  for (const char* key : {"dcd_pairs", "ccd_vf", "ccd_ee", "new_ccd_contacts", "new_dcd_pairs"}) {
+    EXPECT_EQ(summaries[0][key], summaries[1][key]) << key;
+  }
+  const auto refused = run_skelcd({"check", funnel, "--mesh-order", "morton"});
+  EXPECT_NE(refused.exit_code, 0);
+  EXPECT_NE(refused.err.find("--mesh-order"), std::string::npos) << refused.err;
+}
+
 TEST(CmdCheck, BvhAndBruteFindTheSameContactsOnARealCharacter) {
   // The full clip comparison is scripts/check_methods_agree.sh; one interval here keeps ctest fast.
   const auto dir = skelcd::test::temp_dir("check-agree");

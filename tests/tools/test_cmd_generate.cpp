@@ -66,7 +66,11 @@ TEST(CmdGenerate, PlyFramesReadBackExactly) {
   skelcd::skinning::RigMotionOptions options;
   options.clip = 0;
   const skelcd::skinning::RigMotion motion(rig, options);
-  const auto model = skelcd::skinning::load_model(out);
+  // In the files' order, to compare them with the rig index for index (a check holds them in a
+  // spatial order).
+  skelcd::skinning::LoadOptions file_order;
+  file_order.mesh_order = skelcd::skinning::MeshOrder::file;
+  const auto model = skelcd::skinning::load_model(out, file_order);
   EXPECT_EQ(model.kind, skelcd::skinning::ModelKind::frame_sequence);
   const auto frames = model.motion({});
   ASSERT_EQ(frames->num_samples(), 12);

@@ -330,6 +330,7 @@ void add_bench_command(CLI::App& app) {
   cmd->add_flag("--json", args->json, "print the report as one JSON object");
   add_radial_view_options(*cmd, args->radial_view);
   add_model_options(*cmd, args->load);
+  add_mesh_order_option(*cmd, args->load);
   auto* query = cmd->get_option("--query");
   cmd->callback([args, query] { run_bench_command(*args, query->count() > 0); });
 }

@@ -725,6 +725,7 @@ void add_check_command(CLI::App& app) {
       "allow findings between triangles driven by the same bone or a bone and its parent");
   add_radial_view_options(*cmd, args->radial_view);
   add_model_options(*cmd, args->load);
+  add_mesh_order_option(*cmd, args->load);
   cmd->callback([args] { run_check_command(*args); });
 }
 

@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <map>
 #include <string>
 
 #include "culling/method_registry.hpp"
@@ -35,6 +36,20 @@ void add_model_options(CLI::App& command, skinning::LoadOptions& options) {
           "model files: memory one import may use, MiB (default " +
               std::to_string(skinning::kDefaultImportMemoryLimit >> 20) + ")")
       ->type_name("MIB");
+}
+
+void add_mesh_order_option(CLI::App& command, skinning::LoadOptions& options) {
+  const std::map<std::string, skinning::MeshOrder> orders{
+      {"spatial", skinning::MeshOrder::spatial}, {"file", skinning::MeshOrder::file}};
+  command
+      .add_option(
+          "--mesh-order",
+          options.mesh_order,
+          "frame sequences: hold vertices and triangles in a spatial order (faster when the "
+          "files store them in none) or in the files' order; findings name the files' indices "
+          "either way")
+      ->transform(CLI::CheckedTransformer(orders, CLI::ignore_case))
+      ->default_str("spatial");
 }
 
 std::string method_option_help(const std::string& lead) {

@@ -15,6 +15,10 @@ namespace skelcd::tools {
 /// `options` must outlive the parse.
 void add_model_options(CLI::App& command, skinning::LoadOptions& options);
 
+/// Adds --mesh-order (frame sequences: spatial, LoadOptions' default, or file) to a command that
+/// checks.
+void add_mesh_order_option(CLI::App& command, skinning::LoadOptions& options);
+
 /// The help text of a method option: every registered method (culling/method_registry.hpp) with
 /// its one line, and what it needs.
 [[nodiscard]] std::string method_option_help(const std::string& lead);

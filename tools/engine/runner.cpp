@@ -456,20 +456,40 @@ FrameRange parse_frame_range(std::string_view text) {
 }
 
 FeatureNumbering::FeatureNumbering(const skinning::Mesh& mesh, const skinning::Topology& topology)
-    : mesh_(mesh), topology_(topology) {
-  // Name every edge through the first triangle incident to it (CSR edge → faces) and the side of
-  // that triangle it is.
+    : mesh_(mesh) {
+  // File order: by part, then by index within it. A mesh held in another order
+  // (skinning::MeshOrder::spatial) names each feature as the file's order would.
+  const auto before = [](const FeatureId& x, const FeatureId& y) {
+    return x.part != y.part ? x.part < y.part : x.index < y.index;
+  };
+  const auto num_welded = static_cast<std::size_t>(topology.num_welded_vertices());
+  vertices_.assign(num_welded, FeatureId{});
+  std::vector<bool> named(num_welded, false);
+  for (std::size_t v = 0; v < topology.welded_of_vertex.size(); ++v) {
+    const auto w = static_cast<std::size_t>(topology.welded_of_vertex[v]);
+    const FeatureId id{mesh.vertex_part[v], mesh.vertex_index_in_part[v], -1};
+    if (!named[w] || before(id, vertices_[w])) {
+      vertices_[w] = id;
+      named[w] = true;
+    }
+  }
+  // Name every edge through its first incident triangle (CSR edge → faces) and the side of that
+  // triangle it is.
   const std::int32_t num_edges = topology.num_edges();
   edges_.assign(static_cast<std::size_t>(num_edges), FeatureId{});
   for (std::int32_t e = 0; e < num_edges; ++e) {
     const auto begin = topology.edge_face_offsets[static_cast<std::size_t>(e)];
     const auto end = topology.edge_face_offsets[static_cast<std::size_t>(e) + 1];
-    if (begin == end) continue;
-    const std::int32_t f = topology.edge_faces[static_cast<std::size_t>(begin)];
+    std::int32_t first = -1;
+    for (auto i = begin; i < end; ++i) {
+      const std::int32_t f = topology.edge_faces[static_cast<std::size_t>(i)];
+      if (first < 0 || before(triangle(f), triangle(first))) first = f;
+    }
+    if (first < 0) continue;
     for (std::int8_t k = 0; k < 3; ++k) {
-      if (topology.face_edges(f, k) == e) {
+      if (topology.face_edges(first, k) == e) {
         auto& id = edges_[static_cast<std::size_t>(e)];
-        id = triangle(f);
+        id = triangle(first);
         id.side = k;
         break;
       }
@@ -478,9 +498,7 @@ FeatureNumbering::FeatureNumbering(const skinning::Mesh& mesh, const skinning::T
 }
 
 FeatureId FeatureNumbering::vertex(std::int32_t welded_vertex) const {
-  const auto v = static_cast<std::size_t>(
-      topology_.representative_vertex[static_cast<std::size_t>(welded_vertex)]);
-  return FeatureId{mesh_.vertex_part[v], mesh_.vertex_index_in_part[v], -1};
+  return vertices_[static_cast<std::size_t>(welded_vertex)];
 }
 
 FeatureId FeatureNumbering::triangle(std::int32_t triangle) const {

@@ -206,15 +206,16 @@ class ClipRunner {
 class FeatureNumbering {
  public:
   FeatureNumbering(const skinning::Mesh& mesh, const skinning::Topology& topology);
-  /// Welded vertex → its representative file vertex.
+  /// Welded vertex → the first of its file vertices in file order (least part, then index in it):
+  /// the same name whatever order the mesh holds its vertices in (skinning::MeshOrder).
   [[nodiscard]] FeatureId vertex(std::int32_t welded_vertex) const;
   [[nodiscard]] FeatureId triangle(std::int32_t triangle) const;
-  /// Edge (Topology::edges row) → side of the first triangle incident to it.
+  /// Edge (Topology::edges row) → its side of the first triangle incident to it in file order.
   [[nodiscard]] FeatureId edge(std::int32_t edge) const;
 
  private:
   const skinning::Mesh& mesh_;
-  const skinning::Topology& topology_;
+  std::vector<FeatureId> vertices_;
   std::vector<FeatureId> edges_;
 };
 
