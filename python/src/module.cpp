@@ -25,6 +25,7 @@
 #include "skelcd_version.hpp"
 #include "skinning/errors.hpp"
 #include "skinning/load.hpp"
+#include "skinning/mesh_order.hpp"
 #include "skinning/topology.hpp"
 #include "tools/engine/check_engine.hpp"
 #include "tools/engine/run_summary.hpp"
@@ -42,11 +43,27 @@ namespace {
 class Model {
  public:
   Model(std::string argument, skinning::LoadedModel model)
-      : argument_(std::move(argument)), model_(std::move(model)) {}
+      : argument_(std::move(argument)), model_(std::move(model)) {
+    // A frame sequence is held in a spatial order (skinning::MeshOrder); the arrays shown here are
+    // in the files' order, as `skelcd export` writes them and the findings number them.
+    to_file_ = skinning::file_order(*model_.mesh);
+    if (!to_file_.faces.empty()) file_mesh_ = skinning::reordered(*model_.mesh, to_file_);
+  }
 
   /// The MODEL argument as given to load() (the log's input_path).
   [[nodiscard]] const std::string& argument() const { return argument_; }
   [[nodiscard]] const skinning::LoadedModel& model() const { return model_; }
+  /// The mesh in its files' order.
+  [[nodiscard]] const skinning::Mesh& file_mesh() const {
+    return to_file_.faces.empty() ? *model_.mesh : file_mesh_;
+  }
+  /// Positions of the held mesh's vertices in the files' order (moved out of `held`).
+  [[nodiscard]] skinning::Positions in_file_order(skinning::Positions held) const {
+    if (to_file_.vertices.empty()) return held;
+    skinning::Positions out;
+    skinning::gather_rows(held, to_file_.vertices, out);
+    return out;
+  }
 
   /// The motion of (clip, fps). Called with the GIL held, which also guards the cache.
   /// @throws InvalidInput for an unknown clip or a bad rate.
@@ -62,6 +79,8 @@ class Model {
  private:
   std::string argument_;
   skinning::LoadedModel model_;
+  skinning::MeshPermutation to_file_;  ///< empty: the mesh is in its files' order
+  skinning::Mesh file_mesh_;           ///< the mesh in its files' order, when to_file_ is not empty
   std::map<std::pair<std::string, double>, std::shared_ptr<const skinning::Motion>> motions_;
 };
 
@@ -257,7 +276,7 @@ py::list clips(const Model& model) {
 }
 
 py::array_t<std::int32_t> triangles(const Model& model) {
-  const auto& F = model.model().mesh->triangles;
+  const auto& F = model.file_mesh().triangles;
   py::array_t<std::int32_t> out({static_cast<py::ssize_t>(F.rows()), py::ssize_t{3}});
   std::memcpy(
       out.mutable_data(), F.data(), static_cast<std::size_t>(F.size()) * sizeof(std::int32_t));
@@ -297,6 +316,7 @@ py::array_t<double> positions(
   {
     py::gil_scoped_release release;
     motion->positions(sample, V);
+    V = model.in_file_order(std::move(V));
   }
   return to_array(V);
 }
@@ -490,7 +510,7 @@ PYBIND11_MODULE(_skelcd, m) {
       .def_property_readonly("triangles", &triangles, "#F x 3 int32 vertex indices")
       .def_property_readonly(
           "rest_positions",
-          [](const Model& model) { return to_array(model.model().mesh->rest_positions); },
+          [](const Model& model) { return to_array(model.file_mesh().rest_positions); },
           "#V x 3 float64 rest positions")
       .def_property_readonly(
           "part_names", [](const Model& model) { return model.model().mesh->part_names; })

@@ -35,7 +35,11 @@ struct ExportArgs {
 };
 
 void run_export(const ExportArgs& args) {
-  const auto model = skinning::load_model(args.model, args.load);
+  // The files' order (a frame sequence is otherwise held in a spatial one): the written mesh
+  // numbers its vertices and triangles as the input does.
+  skinning::LoadOptions load = args.load;
+  load.mesh_order = skinning::MeshOrder::file;
+  const auto model = skinning::load_model(args.model, load);
   const auto motion = model.motion({args.clip, args.rate});
   const auto fail = [&](const std::string& fault) {
     throw InvalidInput(args.model + ": " + fault);

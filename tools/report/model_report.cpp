@@ -44,6 +44,14 @@ std::string triangle_label(const skinning::Mesh& mesh, std::int32_t f) {
          std::to_string(mesh.face_index_in_part[static_cast<std::size_t>(f)]) + ")";
 }
 
+// "vertex 40 (part 'Head', its vertex 7)", as triangle_label.
+std::string vertex_label(const skinning::Mesh& mesh, std::int32_t v) {
+  const auto part = mesh.vertex_part[static_cast<std::size_t>(v)];
+  return "vertex " + std::to_string(v) + " (part '" +
+         mesh.part_names[static_cast<std::size_t>(part)] + "', its vertex " +
+         std::to_string(mesh.vertex_index_in_part[static_cast<std::size_t>(v)]) + ")";
+}
+
 }  // namespace
 
 nlohmann::json model_report(
@@ -119,8 +127,8 @@ nlohmann::json model_report(
     const auto b = topology.representative_vertex[static_cast<std::size_t>(topology.edges(e, 1))];
     problems.push_back(
         std::to_string(topology.non_manifold_edges.size()) +
-        " non-manifold edges (three or more triangles on one edge; first: between vertices " +
-        std::to_string(a) + " and " + std::to_string(b) + ")");
+        " non-manifold edges (three or more triangles on one edge; first: between " +
+        vertex_label(mesh, a) + " and " + vertex_label(mesh, b) + ")");
   }
   if (!topology.degenerate_triangles.empty()) {
     problems.push_back(
