@@ -59,43 +59,76 @@ FunnelPly read_funnel_ply(const fs::path& file) {
   return ply;
 }
 
-TEST(FrameSequence, ClothFunnelIsReadBitExactly) {
-  const FrameSequenceMotion motion = load_frame_sequence(funnel_frames());
-  ASSERT_EQ(motion.num_samples(), 2);
-  EXPECT_EQ(motion.frame_file(0).filename(), "227.ply");
-  EXPECT_EQ(motion.frame_file(1).filename(), "228.ply");
-  EXPECT_EQ(motion.name(), "frames");
+/// Every frame of the funnel sequence `motion` is its file's, bit for bit, each vertex and
+/// triangle found under its index in the files (Mesh::vertex_index_in_part, face_index_in_part:
+/// each index once, in any order the motion holds them in): the same coordinates, the same corners
+/// in the same turn; frame 0 is the rest positions.
+void expect_the_files_frames(const FrameSequenceMotion& motion) {
   const Mesh& mesh = motion.mesh();
-  EXPECT_EQ(mesh.num_vertices(), 9450);
-  EXPECT_EQ(mesh.num_triangles(), 18484);
-  EXPECT_EQ(mesh.num_parts(), 1);
-  EXPECT_DOUBLE_EQ(motion.sample_time(1), 1.0 / 30.0);
+  ASSERT_EQ(mesh.num_vertices(), 9450);
+  ASSERT_EQ(mesh.num_triangles(), 18484);
+  std::vector<std::int32_t> faces = mesh.face_index_in_part;
+  std::vector<std::int32_t> vertices = mesh.vertex_index_in_part;
+  std::sort(faces.begin(), faces.end());
+  std::sort(vertices.begin(), vertices.end());
+  for (std::size_t f = 0; f < faces.size(); ++f) ASSERT_EQ(faces[f], static_cast<std::int32_t>(f));
+  for (std::size_t v = 0; v < vertices.size(); ++v) {
+    ASSERT_EQ(vertices[v], static_cast<std::int32_t>(v));
+  }
   for (int i = 0; i < 2; ++i) {
     const FunnelPly ply = read_funnel_ply(motion.frame_file(i));
     Positions p;
     motion.positions(i, p);
     ASSERT_EQ(p.rows(), 9450);
     for (Eigen::Index v = 0; v < p.rows(); ++v) {
+      const auto file_v =
+          static_cast<std::size_t>(mesh.vertex_index_in_part[static_cast<std::size_t>(v)]);
       for (int k = 0; k < 3; ++k) {
-        ASSERT_EQ(p(v, k), ply.xyz[static_cast<std::size_t>(3 * v + k)]) << "frame " << i << " vertex " << v;
+        ASSERT_EQ(p(v, k), ply.xyz[3 * file_v + static_cast<std::size_t>(k)])
+            << "frame " << i << " vertex " << v;
       }
     }
+    if (i == 0) {
+      EXPECT_EQ(p, mesh.rest_positions);
+    }
     for (Eigen::Index f = 0; f < mesh.num_triangles(); ++f) {
-      for (int k = 0; k < 3; ++k) ASSERT_EQ(mesh.triangles(f, k), ply.faces[static_cast<std::size_t>(f)][static_cast<std::size_t>(k)]);
+      const auto file_f =
+          static_cast<std::size_t>(mesh.face_index_in_part[static_cast<std::size_t>(f)]);
+      for (int k = 0; k < 3; ++k) {
+        ASSERT_EQ(
+            mesh.vertex_index_in_part[static_cast<std::size_t>(mesh.triangles(f, k))],
+            ply.faces[file_f][static_cast<std::size_t>(k)])
+            << "frame " << i << " triangle " << f;
+      }
     }
   }
-  Positions rest;
-  motion.positions(0, rest);
-  EXPECT_EQ(rest, mesh.rest_positions);
+}
+
+TEST(FrameSequence, ClothFunnelIsReadBitExactly) {
+  const FrameSequenceMotion motion = load_frame_sequence(funnel_frames());
+  ASSERT_EQ(motion.num_samples(), 2);
+  EXPECT_EQ(motion.frame_file(0).filename(), "227.ply");
+  EXPECT_EQ(motion.frame_file(1).filename(), "228.ply");
+  EXPECT_EQ(motion.name(), "frames");
+  EXPECT_EQ(motion.mesh().num_parts(), 1);
+  EXPECT_DOUBLE_EQ(motion.sample_time(1), 1.0 / 30.0);
+  // The files' order (FrameSequenceOptions' default): every index where the file has it.
+  const Mesh& mesh = motion.mesh();
+  for (std::size_t f = 0; f < mesh.face_index_in_part.size(); ++f) {
+    ASSERT_EQ(mesh.face_index_in_part[f], static_cast<std::int32_t>(f));
+  }
+  for (std::size_t v = 0; v < mesh.vertex_index_in_part.size(); ++v) {
+    ASSERT_EQ(mesh.vertex_index_in_part[v], static_cast<std::int32_t>(v));
+  }
+  expect_the_files_frames(motion);
   // The two frames differ (the cloth moves).
   Positions p1;
   motion.positions(1, p1);
-  EXPECT_GT((p1 - rest).cwiseAbs().maxCoeff(), 0.0);
+  EXPECT_GT((p1 - mesh.rest_positions).cwiseAbs().maxCoeff(), 0.0);
 }
 
 // In the spatial order (what load_model gives) every vertex and triangle is still the file's,
-// found under its index in the file: the same coordinates bit for bit in every frame, kept in
-// memory or read again from the file, and the same corners in the same turn.
+// found under its index in the file, in every frame, kept in memory or read again from the file.
 TEST(FrameSequence, TheSpatialOrderHoldsTheFilesElementsUnderTheirFileIndices) {
   for (const std::size_t budget : {kKeptFrameBytesPerTriangle, std::size_t{0}}) {
     const FrameSequenceMotion motion(
@@ -103,47 +136,10 @@ TEST(FrameSequence, TheSpatialOrderHoldsTheFilesElementsUnderTheirFileIndices) {
         FrameSequenceOptions{.kept_bytes_per_triangle = budget, .order = MeshOrder::spatial});
     EXPECT_EQ(motion.frames_in_memory(), budget != 0);
     const Mesh& mesh = motion.mesh();
-    ASSERT_EQ(mesh.num_vertices(), 9450);
-    ASSERT_EQ(mesh.num_triangles(), 18484);
-    // Not the file's order, and each file index once.
-    std::vector<std::int32_t> faces = mesh.face_index_in_part;
-    std::vector<std::int32_t> vertices = mesh.vertex_index_in_part;
-    EXPECT_FALSE(std::is_sorted(faces.begin(), faces.end()));
-    EXPECT_FALSE(std::is_sorted(vertices.begin(), vertices.end()));
-    std::sort(faces.begin(), faces.end());
-    std::sort(vertices.begin(), vertices.end());
-    for (std::size_t f = 0; f < faces.size(); ++f)
-      ASSERT_EQ(faces[f], static_cast<std::int32_t>(f));
-    for (std::size_t v = 0; v < vertices.size(); ++v) {
-      ASSERT_EQ(vertices[v], static_cast<std::int32_t>(v));
-    }
-    for (int i = 0; i < 2; ++i) {
-      const FunnelPly ply = read_funnel_ply(motion.frame_file(i));
-      Positions p;
-      motion.positions(i, p);
-      ASSERT_EQ(p.rows(), 9450);
-      for (Eigen::Index v = 0; v < p.rows(); ++v) {
-        const auto file_v =
-            static_cast<std::size_t>(mesh.vertex_index_in_part[static_cast<std::size_t>(v)]);
-        for (int k = 0; k < 3; ++k) {
-          ASSERT_EQ(p(v, k), ply.xyz[3 * file_v + static_cast<std::size_t>(k)])
-              << "frame " << i << " vertex " << v;
-        }
-      }
-      if (i == 0) {
-        EXPECT_EQ(p, mesh.rest_positions);
-        for (Eigen::Index f = 0; f < mesh.num_triangles(); ++f) {
-          const auto file_f =
-              static_cast<std::size_t>(mesh.face_index_in_part[static_cast<std::size_t>(f)]);
-          for (int k = 0; k < 3; ++k) {
-            ASSERT_EQ(
-                mesh.vertex_index_in_part[static_cast<std::size_t>(mesh.triangles(f, k))],
-                ply.faces[file_f][static_cast<std::size_t>(k)])
-                << "triangle " << f;
-          }
-        }
-      }
-    }
+    EXPECT_FALSE(std::is_sorted(mesh.face_index_in_part.begin(), mesh.face_index_in_part.end()));
+    EXPECT_FALSE(
+        std::is_sorted(mesh.vertex_index_in_part.begin(), mesh.vertex_index_in_part.end()));
+    expect_the_files_frames(motion);
   }
   // load_model's default is this order; MeshOrder::file keeps the file's.
   const LoadedModel spatial = load_frame_sequence_model(funnel_frames(), {});
