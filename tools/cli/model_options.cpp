@@ -2,7 +2,6 @@
 
 #include <cmath>
 #include <cstdio>
-#include <map>
 #include <string>
 
 #include "culling/method_registry.hpp"
@@ -39,17 +38,17 @@ void add_model_options(CLI::App& command, skinning::LoadOptions& options) {
 }
 
 void add_mesh_order_option(CLI::App& command, skinning::LoadOptions& options) {
-  const std::map<std::string, skinning::MeshOrder> orders{
-      {"spatial", skinning::MeshOrder::spatial}, {"file", skinning::MeshOrder::file}};
   command
-      .add_option(
+      .add_option_function<std::string>(
           "--mesh-order",
-          options.mesh_order,
+          [&options](const std::string& order) {
+            options.mesh_order =
+                order == "file" ? skinning::MeshOrder::file : skinning::MeshOrder::spatial;
+          },
           "frame sequences: hold vertices and triangles in a spatial order (faster when the "
           "files store them in none) or in the files' order; findings name the files' indices "
-          "either way")
-      ->transform(CLI::CheckedTransformer(orders, CLI::ignore_case))
-      ->default_str("spatial");
+          "either way (default spatial)")
+      ->check(CLI::IsMember({"spatial", "file"}));
 }
 
 std::string method_option_help(const std::string& lead) {
