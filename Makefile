@@ -39,12 +39,13 @@ sanitize: deps
 	cd $(SAN_BUILD) && ctest --output-on-failure -j $(JOBS) -LE bench
 
 # CI's sanitizer lane (.ci/run): ASan + UBSan over the tests of what reads files and guards
-# processes — import (the forked child, memory limits), frame sequences, the CCD kernels, the log
-# (checksums, a full disk), bad input at the command line — within CI's time; and RobotExpressive's
-# whole clip checked with `bvh`, `dynamic` and `auto`, serial and parallel (ParallelCheck.WholeClip…,
-# 60-90 s here), which found a heap read before an array at its collapsed sides (stop 76).
+# processes — import (the forked child, memory limits), frame sequences and the order they are
+# held in, the CCD kernels, the log (checksums, a full disk), bad input at the command line —
+# within CI's time; and RobotExpressive's whole clip checked with `bvh`, `dynamic` and `auto`,
+# serial and parallel (ParallelCheck.WholeClip…, 60-90 s here), which found a heap read before an
+# array at its collapsed sides (stop 76).
 SAN_CI_TARGETS ?= skelcd skelcd_ccd_tests skelcd_skinning_tests skelcd_tools_tests
-SAN_CI_TESTS   ?= ImportRobustness|ImportGuard|AssimpImport|FrameSequence|Log\.|BadInputCli|CmdInspect|Vertex|Edge|TriangleTriangle|Expansion|CoplanarityScreen\.EachLaneIsTheKernelsScreenOnTheClothFunnel|RelativeBoxes\.(Keeps|Rejects|Without)|ParallelCheck\.WholeClipOfABundledCharacterLogsEqualSerialOnTwoThreads
+SAN_CI_TESTS   ?= ImportRobustness|ImportGuard|AssimpImport|FrameSequence|MeshOrder|Log\.|BadInputCli|CmdInspect|Vertex|Edge|TriangleTriangle|Expansion|CoplanarityScreen\.EachLaneIsTheKernelsScreenOnTheClothFunnel|RelativeBoxes\.(Keeps|Rejects|Without)|ParallelCheck\.WholeClipOfABundledCharacterLogsEqualSerialOnTwoThreads
 sanitize-ci: deps
 	cmake -S . -B $(SAN_BUILD) -G Ninja -DCMAKE_BUILD_TYPE=Debug -DSKELCD_SANITIZE=ON -DSKELCD_WERROR=$(WERROR) $(CMAKE_ARGS)
 	cmake --build $(SAN_BUILD) -j $(JOBS) --target $(SAN_CI_TARGETS)

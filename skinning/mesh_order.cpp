@@ -37,10 +37,10 @@ MeshPermutation spatial_order(const Positions& positions, const Triangles& trian
     for (int k = 0; k < 3; ++k) {
       const std::int32_t v = triangles(f, k);
       if (v < 0 || v >= nv) return {};
-      for (Eigen::Index a = 0; a < 3; ++a) c[static_cast<std::size_t>(a)] += positions(v, a);
+      // A third of each corner: no overflow where the corners themselves are finite.
+      for (Eigen::Index a = 0; a < 3; ++a) c[static_cast<std::size_t>(a)] += positions(v, a) / 3.0;
     }
     for (std::size_t a = 0; a < 3; ++a) {
-      c[a] /= 3.0;
       if (!std::isfinite(c[a])) return {};
       lo[a] = std::min(lo[a], c[a]);
       hi[a] = std::max(hi[a], c[a]);
@@ -57,7 +57,10 @@ MeshPermutation spatial_order(const Positions& positions, const Triangles& trian
   for (std::size_t f = 0; f < keyed.size(); ++f) {
     std::uint64_t code = 0;
     for (std::size_t a = 0; a < 3; ++a) {
-      const double cell = std::clamp((centroids[f][a] - lo[a]) * scale[a], 0.0, kCells);
+      // scale 0: one cell (an extent of 0, or one too large for a double, where c − lo may be
+      // infinite and inf · 0 would be NaN).
+      const double cell =
+          scale[a] > 0.0 ? std::clamp((centroids[f][a] - lo[a]) * scale[a], 0.0, kCells) : 0.0;
       code |= spread_bits(static_cast<std::uint64_t>(cell)) << a;
     }
     keyed[f] = {code, static_cast<std::int32_t>(f)};

@@ -28,9 +28,10 @@ struct MeshPermutation {
 
 /// Triangles sorted by the Morton code of their centroids (21 bits an axis over the bounding box of
 /// the centroids; ties in the old order), vertices in the order the sorted triangles first use
-/// them, then those no triangle uses, in the old order. Deterministic. Empty when a coordinate of
-/// a used vertex is not finite or an index is out of range (validate_mesh refuses such a mesh
-/// later; the caller then keeps the old order).
+/// them, then those no triangle uses, in the old order. Deterministic. An axis whose extent a
+/// double cannot hold counts as one cell. Empty when a coordinate of a used vertex is not finite
+/// or an index is out of range (validate_mesh refuses such a mesh later; the caller then keeps the
+/// old order).
 [[nodiscard]] MeshPermutation spatial_order(const Positions& positions, const Triangles& triangles);
 
 /// The permutation that puts `mesh` back in its files' order — triangles by (face_part,

@@ -196,6 +196,13 @@ TEST(MeshOrder, WhatCannotBeOrderedIsLeftAsItIs) {
   EXPECT_TRUE(spatial_order(m.rest_positions, out_of_range).faces.empty());
   out_of_range(3, 2) = -1;
   EXPECT_TRUE(spatial_order(m.rest_positions, out_of_range).faces.empty());
+  // Finite coordinates whose extent a double cannot hold (their difference overflows): that axis
+  // counts as one cell, the others still order the triangles.
+  Positions huge = m.rest_positions;
+  for (Eigen::Index v = 0; v < huge.rows(); ++v) huge(v, 2) = v < 8 ? 1.5e308 : -1.5e308;
+  const MeshPermutation wide = spatial_order(huge, m.triangles);
+  ASSERT_TRUE(is_permutation_of(wide.faces, static_cast<std::size_t>(m.num_triangles())));
+  ASSERT_TRUE(is_permutation_of(wide.vertices, static_cast<std::size_t>(m.num_vertices())));
   // A vertex no triangle uses holds no position that matters: it goes last, in the old order.
   Positions extra(m.num_vertices() + 2, 3);
   extra.topRows(m.num_vertices()) = m.rest_positions;
