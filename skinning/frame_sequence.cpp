@@ -710,50 +710,30 @@ FrameSequenceMotion::FrameSequenceMotion(
     if (keep) data->frames.push_back(std::move(frame.positions));
   }
   Mesh& mesh = data->mesh;
-  if (options.order == MeshOrder::spatial) {
-    MeshPermutation order = spatial_order(first, triangles);
-    if (!order.faces.empty()) {
-      // The first frame's triangles renumbered into the new vertex order, the kept frames and the
-      // rest positions gathered into it.
-      std::vector<std::int32_t> new_id(order.vertices.size());
-      for (std::size_t i = 0; i < order.vertices.size(); ++i) {
-        new_id[static_cast<std::size_t>(order.vertices[i])] = static_cast<std::int32_t>(i);
-      }
-      Triangles laid_out(triangles.rows(), 3);
-      for (std::size_t i = 0; i < order.faces.size(); ++i) {
-        for (int k = 0; k < 3; ++k) {
-          laid_out(static_cast<Eigen::Index>(i), k) =
-              new_id[static_cast<std::size_t>(triangles(order.faces[i], k))];
-        }
-      }
-      triangles = std::move(laid_out);
-      Positions gathered;
-      for (Positions& kept : data->frames) {
-        gather_rows(kept, order.vertices, gathered);
-        std::swap(kept, gathered);
-      }
-      gather_rows(first, order.vertices, gathered);
-      first = std::move(gathered);
-      mesh.face_index_in_part = std::move(order.faces);
-      mesh.vertex_index_in_part = std::move(order.vertices);
-      data->reordered = true;
-    }
-  }
   mesh.rest_positions = std::move(first);
   mesh.triangles = std::move(triangles);
   const auto nv = static_cast<std::size_t>(mesh.num_vertices());
   const auto nf = static_cast<std::size_t>(mesh.num_triangles());
   mesh.face_part.assign(nf, 0);
   mesh.vertex_part.assign(nv, 0);
-  if (!data->reordered) {  // the files' order
-    mesh.face_index_in_part.resize(nf);
-    mesh.vertex_index_in_part.resize(nv);
-    for (std::size_t f = 0; f < nf; ++f) mesh.face_index_in_part[f] = static_cast<std::int32_t>(f);
-    for (std::size_t v = 0; v < nv; ++v) {
-      mesh.vertex_index_in_part[v] = static_cast<std::int32_t>(v);
+  mesh.face_index_in_part.resize(nf);
+  mesh.vertex_index_in_part.resize(nv);
+  for (std::size_t f = 0; f < nf; ++f) mesh.face_index_in_part[f] = static_cast<std::int32_t>(f);
+  for (std::size_t v = 0; v < nv; ++v) mesh.vertex_index_in_part[v] = static_cast<std::int32_t>(v);
+  mesh.part_names = {data->name};
+  if (options.order == MeshOrder::spatial) {
+    const MeshPermutation order = spatial_order(mesh.rest_positions, mesh.triangles);
+    if (!order.faces.empty()) {
+      // The mesh renumbered (its file indices moved with each element), the kept frames gathered.
+      mesh = reordered(mesh, order);
+      Positions gathered;
+      for (Positions& kept : data->frames) {
+        gather_rows(kept, order.vertices, gathered);
+        std::swap(kept, gathered);
+      }
+      data->reordered = true;
     }
   }
-  mesh.part_names = {data->name};
   validate_mesh(mesh, files[0].string());
   data->files = std::move(files);
   data_ = std::move(data);
