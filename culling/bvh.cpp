@@ -9,6 +9,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "culling/detail/swept_corners.hpp"
 #include "skinning/errors.hpp"
 
 #if defined(__SSE2__)
@@ -432,6 +433,7 @@ void Bvh<N>::refit(std::span<const Volume> triangle_bounds) {
   constexpr auto kN = static_cast<std::size_t>(N);
   end_boxes_ready_ = false;  // they were of another interval
   slot_ends_ready_ = false;
+  slot_whole_ = false;
   if (!node_volumes_) {
     refit_wide_only(triangle_bounds);
     return;
@@ -538,8 +540,28 @@ void Bvh<N>::refit_float_nodes(std::span<const Volume> triangle_bounds) {
 
 template <int N>
 void Bvh<N>::refit_wide_only(std::span<const Volume> triangle_bounds) {
+  // The triangles' volumes are by id, scattered over the slots.
+  struct ById {
+    std::span<const Volume> bounds;
+    std::span<const std::int32_t> order;
+    void prefetch(std::size_t s) const {
+      __builtin_prefetch(&bounds[static_cast<std::size_t>(order[s])]);
+    }
+    [[nodiscard]] const Volume& volume(std::size_t s) const {
+      return bounds[static_cast<std::size_t>(order[s])];
+    }
+  };
+  refit_wide_from<false>(ById{triangle_bounds, order_});
+}
+
+template <int N>
+template <bool kWhole, class Source>
+void Bvh<N>::refit_wide_from(const Source& source) {
   constexpr auto kN = static_cast<std::size_t>(N);
   constexpr std::size_t kAhead = 16;
+  [[maybe_unused]] constexpr auto kDiagonals = static_cast<std::size_t>(kSlotDiagonals);
+  [[maybe_unused]] constexpr auto kFirstDiagonal = static_cast<std::size_t>(kSlotAxes);
+  [[maybe_unused]] const std::size_t stride = slot_stride();
   // A wide node's inner children come after it (built depth first), so one backward sweep is
   // bottom-up. A bucket lane is its triangles' union, rounded outwards; an inner lane the union of
   // the lanes of its wide node, which partition its triangles. float_below and float_above are
@@ -553,11 +575,9 @@ void Bvh<N>::refit_wide_only(std::span<const Volume> triangle_bounds) {
         // A bucket: its triangles' float volumes by slot, and their union.
         const auto begin = static_cast<std::size_t>(~w.child[i]);
         const auto end = begin + static_cast<std::size_t>(w.count[i]);
-        // The sweep meets the buckets in nearly decreasing slot order, and the triangles' volumes
-        // are by id, scattered: ask for those kAhead slots below now.
-        for (std::size_t s = begin; s < end && s >= kAhead; ++s) {
-          __builtin_prefetch(&triangle_bounds[static_cast<std::size_t>(order_[s - kAhead])]);
-        }
+        // The sweep meets the buckets in nearly decreasing slot order: ask for the volumes (or
+        // what they are computed from) kAhead slots below now.
+        for (std::size_t s = begin; s < end && s >= kAhead; ++s) source.prefetch(s - kAhead);
         FloatBounds lo;
         FloatBounds hi;
         lo.fill(std::numeric_limits<float>::infinity());
@@ -565,9 +585,15 @@ void Bvh<N>::refit_wide_only(std::span<const Volume> triangle_bounds) {
         for (std::size_t s = begin; s < end; ++s) {
           FloatBounds tl;
           FloatBounds th;
-          const Volume& t = triangle_bounds[static_cast<std::size_t>(order_[s])];
+          const Volume& t = source.volume(s);
           root_bounds_.merge(t);
           round_slot(s, t, tl, th);
+          if constexpr (kWhole && kDiagonals > 0) {
+            for (std::size_t k = 0; k < kDiagonals; ++k) {
+              slot_diagonals_[k * stride + s] = tl[kFirstDiagonal + k];
+              slot_diagonals_[(kDiagonals + k) * stride + s] = th[kFirstDiagonal + k];
+            }
+          }
           for (std::size_t k = 0; k < kN; ++k) {
             lo[k] = std::min(lo[k], tl[k]);
             hi[k] = std::max(hi[k], th[k]);
@@ -866,8 +892,66 @@ void Bvh<N>::refit_swept_and_ends(
   }
   end_boxes_ready_ = false;
   slot_ends_ready_ = false;
+  slot_whole_ = false;
   root_bounds_ = Volume::empty();
   fill_end_boxes<true>(PositionEndsSource{triangles, x_t0, x_t1, 0.0}, with_slot_ends);
+}
+
+template <int N>
+void Bvh<N>::refit_swept(
+    const skinning::Triangles& triangles,
+    const skinning::Positions& x_t0,
+    const skinning::Positions& x_t1) {
+  if (node_volumes_) {
+    // refit() would also have to fill the binary nodes' volumes, which this pass never reads.
+    throw std::logic_error("Bvh::refit_swept: the tree was built with node volumes");
+  }
+  end_boxes_ready_ = false;
+  slot_ends_ready_ = false;
+  constexpr auto kDiagonals = static_cast<std::size_t>(kSlotDiagonals);
+  if constexpr (kDiagonals > 0) {
+    const std::size_t stride = slot_stride();
+    if (slot_diagonals_.size() != 2 * kDiagonals * stride) {
+      // Allocated at the first call; the padding slots stay empty, as slot_bounds_'.
+      slot_diagonals_.assign(2 * kDiagonals * stride, std::numeric_limits<float>::infinity());
+      std::fill(
+          slot_diagonals_.begin() + static_cast<std::ptrdiff_t>(kDiagonals * stride),
+          slot_diagonals_.end(),
+          -std::numeric_limits<float>::infinity());
+    }
+  }
+  // Each slot's volume from its triangle's corners, computed where it is rounded: the corners'
+  // rows are scattered over the slots as the volumes by id were, and asked for as fill_end_boxes
+  // asks for them (the triangle's row twice as far ahead as its corners).
+  struct FromCorners {
+    const skinning::Triangles& triangles;
+    const double* p0;
+    const double* p1;
+    std::span<const std::int32_t> order;
+    mutable Volume scratch;
+    void prefetch(std::size_t s) const {
+      if (s >= kAheadEnds) prefetch_triangle_row(triangles, order[s - kAheadEnds]);
+      const auto f = static_cast<Eigen::Index>(order[s]);
+      for (Eigen::Index j = 0; j < 3; ++j) {
+        const auto v = static_cast<std::size_t>(triangles(f, j));
+        __builtin_prefetch(p0 + 3 * v);
+        __builtin_prefetch(p1 + 3 * v);
+      }
+    }
+    [[nodiscard]] const Volume& volume(std::size_t s) const {
+      const auto f = static_cast<Eigen::Index>(order[s]);
+      std::array<const double*, 6> c{};
+      for (Eigen::Index j = 0; j < 3; ++j) {
+        const auto v = static_cast<std::size_t>(triangles(f, j));
+        c[static_cast<std::size_t>(2 * j)] = p0 + 3 * v;
+        c[static_cast<std::size_t>(2 * j + 1)] = p1 + 3 * v;
+      }
+      detail::swept_corners(c, scratch);
+      return scratch;
+    }
+  };
+  refit_wide_from<true>(FromCorners{triangles, x_t0.data(), x_t1.data(), order_, {}});
+  slot_whole_ = true;
 }
 
 template <int N>

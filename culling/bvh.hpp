@@ -170,6 +170,7 @@ class Bvh {
   void refit_wide(std::span<const Volume> triangle_bounds) {
     end_boxes_ready_ = false;
     slot_ends_ready_ = false;
+    slot_whole_ = false;
     refit_wide_only(triangle_bounds);
   }
 
@@ -254,6 +255,39 @@ class Bvh {
       const skinning::Positions& x_t0,
       const skinning::Positions& x_t1,
       bool with_slot_ends) requires(N == 3);
+  /// refit() over the interval's swept volumes, each computed from its triangle's corners at the
+  /// two ends (bit for bit FeatureBounds::swept_triangles' volume) and rounded into its slot
+  /// without being stored, for a tree without binary node volumes: the slots' and the wide nodes'
+  /// float volumes and root_bounds() are refit()'s over those volumes, bit for bit. The slots'
+  /// volumes are then whole (slot_volumes_whole): on every axis, the diagonal ones in
+  /// slot_diagonal_lo / slot_diagonal_hi, so that a traversal tests a triangle pair on the floats
+  /// alone (rounded outwards: they only prune less than the exact volumes, within a float's step)
+  /// and reads no volume by triangle id (docs/culling.md, "Whole slot volumes"). 128 bytes a
+  /// triangle of double volumes are not held; 8 · (N − 3) bytes a slot of diagonals are, from the
+  /// first call on. Valid until the next refit() or refit_wide().
+  /// @throws std::logic_error when the tree was built with node_volumes true (left unchanged).
+  void refit_swept(
+      const skinning::Triangles& triangles,
+      const skinning::Positions& x_t0,
+      const skinning::Positions& x_t1);
+  /// Whether the slots' float volumes hold the triangles' whole volumes (every axis) of the last
+  /// refit: true after refit_swept, false after refit() and refit_wide().
+  [[nodiscard]] bool slot_volumes_whole() const { return slot_whole_; }
+  /// Axes of a slot volume past the first kSlotAxes: N − kSlotAxes (none for an AABB).
+  static constexpr int kSlotDiagonals = N - kSlotAxes;
+  /// The slots' float volumes on axis kSlotAxes + k, k < kSlotDiagonals, by slot as slot_lo /
+  /// slot_hi (the padding slots empty); null unless slot_volumes_whole().
+  [[nodiscard]] const float* slot_diagonal_lo(int k) const {
+    return slot_whole_ && kSlotDiagonals > 0
+               ? slot_diagonals_.data() + static_cast<std::size_t>(k) * slot_stride()
+               : nullptr;
+  }
+  [[nodiscard]] const float* slot_diagonal_hi(int k) const {
+    return slot_whole_ && kSlotDiagonals > 0
+               ? slot_diagonals_.data() +
+                     static_cast<std::size_t>(kSlotDiagonals + k) * slot_stride()
+               : nullptr;
+  }
   /// The triangles' own end boxes by slot, from their corners' (vertex_end_boxes): 12 rows of
   /// slot_stride() floats — lo at t = 0 on x, y, z, then hi at t = 0, lo at t = 1, hi at t = 1 —
   /// so that the traversals drop a triangle pair whose boxes lie apart on an axis at both ends
@@ -291,6 +325,10 @@ class Bvh {
   std::size_t count_wide(std::int32_t node) const;
   std::int32_t build_wide_node(std::int32_t node, int depth);
   void refit_wide_only(std::span<const Volume> triangle_bounds);
+  /// refit_wide_only over a source of the slots' volumes: `source.prefetch(s)` asks for slot
+  /// s's, `source.volume(s)` gives it. kWhole also writes the slots' diagonal axes.
+  template <bool kWhole, class Source>
+  void refit_wide_from(const Source& source);
   void refit_float_nodes(std::span<const Volume> triangle_bounds);
   /// refit_end_boxes and refit_slot_ends over a source of triangles' end boxes (bvh.cpp).
   /// With kSwept, also refit()'s slot and wide-node volumes and root_bounds() from the end boxes
@@ -316,6 +354,8 @@ class Bvh {
   bool slot_ends_ready_ = false;
   static constexpr std::size_t kSlotPadding = 3;
   std::vector<float> slot_bounds_;  // 2·kSlotAxes rows of slot_stride(): lo by axis, then hi
+  std::vector<float> slot_diagonals_;  // 2·kSlotDiagonals rows, as slot_bounds_: refit_swept
+  bool slot_whole_ = false;
   struct Item {
     Eigen::Vector3d centroid;  // three times the centroid (the split only compares them)
     Eigen::Vector3d lo;        // the triangle's box at the build positions

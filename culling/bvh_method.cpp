@@ -87,14 +87,17 @@ class BvhMethod final : public MethodBase {
     // volumes: the feature stage forms them from the vertices' (bounded memory). Without a
     // contact distance it reads the positions at both ends instead, and no vertex volumes are
     // held: the triangles' come from their corners directly.
+    // Without one, no triangle volumes are held either: the refit computes each from the corners
+    // where it rounds it into its slot, on every axis, and the walk tests the floats alone
+    // (Bvh::refit_swept; docs/culling.md, "Whole slot volumes").
     const bool ends_tested = feature_stage_tests_ends(options_.min_separation);
     if (ends_tested) {
-      bounds_.swept_triangles(topology_, x_t0, x_t1);
+      bvh_.refit_swept(topology_.welded_triangles(), x_t0, x_t1);
     } else {
       swept_vertex_bounds<N>(x_t0, x_t1, 0.5 * options_.min_separation, bounds_.vertices);
       bounds_.derive(topology_, /*with_edges=*/false);
+      bvh_.refit(bounds_.triangles);
     }
-    bvh_.refit(bounds_.triangles);
     // `kdop`: node pairs tested in the relative motion too when the interval moves enough for it
     // to prune (docs/culling.md "Relative boxes at the nodes").
     const bool node_ends =

@@ -198,6 +198,16 @@ class Walk {
       b_lo_[k] = b.slot_lo(axis);
       b_hi_[k] = b.slot_hi(axis);
     }
+    whole_ = a.slot_volumes_whole() && b.slot_volumes_whole();
+    if (whole_) {
+      for (std::size_t k = 0; k < kDiagonals; ++k) {
+        const auto axis = static_cast<int>(k);
+        da_lo_[k] = a.slot_diagonal_lo(axis);
+        da_hi_[k] = a.slot_diagonal_hi(axis);
+        db_lo_[k] = b.slot_diagonal_lo(axis);
+        db_hi_[k] = b.slot_diagonal_hi(axis);
+      }
+    }
     slot_ends_ = a.slot_ends(0) != nullptr && b.slot_ends(0) != nullptr;
     if (slot_ends_) {
       for (std::size_t r = 0; r < 12; ++r) {
@@ -426,6 +436,11 @@ class Walk {
             apart_ += kBitsIn4[apart];
             mask &= ~apart;
           }
+          // Whole slot volumes (Bvh::refit_swept): the axes past the first three in floats, four
+          // slots at once, instead of the exact volumes by triangle id pair by pair below.
+          if constexpr (kDiagonals > 0) {
+            if (whole_ && mask != 0) mask &= diagonal_overlap(i, j0);
+          }
           while (mask != 0) {
             const std::int32_t sj = j0 + std::countr_zero(mask);
             const std::int32_t tj = order_b_[to_size(sj)];
@@ -439,7 +454,8 @@ class Walk {
             if constexpr (kSieve) {
               if (settles(i, sj, ti, tj, settled)) continue;
             }
-            if (!overlap(bounds_a_[to_size(ti)], bounds_b_[to_size(tj)])) continue;
+            // Whole slot volumes held the exact test's axes already (in floats).
+            if (!whole_ && !overlap(bounds_a_[to_size(ti)], bounds_b_[to_size(tj)])) continue;
             // Ordered a < b within one tree (a select, not a branch), as given across two (a
             // masked walk's two trees are parts of one mesh: ordered too).
             if constexpr (kSelf || kMasked) {
@@ -518,6 +534,7 @@ class Walk {
 
   static constexpr int kSlotAxes = Bvh<N>::kSlotAxes;
   static constexpr auto kAxes = static_cast<std::size_t>(kSlotAxes);
+  static constexpr auto kDiagonals = static_cast<std::size_t>(Bvh<N>::kSlotDiagonals);
 
 #if defined(__SSE2__)
   /// The float volumes of four consecutive slots of b, by axis.
@@ -572,6 +589,30 @@ class Walk {
     return mask;
   }
 #endif
+
+  /// Bit c set when slot sa of a and slot sb + c of b (c < 4) overlap on the diagonal axes of
+  /// their whole slot volumes (Bvh::slot_diagonal_lo): floats rounded outwards, so apart here is
+  /// apart in the exact volumes too.
+  [[nodiscard]] unsigned diagonal_overlap(std::int32_t sa, std::int32_t sb) const {
+#if defined(__SSE2__)
+    __m128 ok = _mm_castsi128_ps(_mm_set1_epi32(-1));
+    for (std::size_t k = 0; k < kDiagonals; ++k) {
+      ok = _mm_and_ps(ok, _mm_cmple_ps(_mm_loadu_ps(db_lo_[k] + sb), _mm_set1_ps(da_hi_[k][sa])));
+      ok = _mm_and_ps(ok, _mm_cmple_ps(_mm_set1_ps(da_lo_[k][sa]), _mm_loadu_ps(db_hi_[k] + sb)));
+    }
+    return static_cast<unsigned>(_mm_movemask_ps(ok));
+#else
+    unsigned mask = 0;
+    for (int c = 0; c < kWidth; ++c) {
+      bool hit = true;
+      for (std::size_t k = 0; k < kDiagonals; ++k) {
+        hit = hit && db_lo_[k][sb + c] <= da_hi_[k][sa] && da_lo_[k][sa] <= db_hi_[k][sb + c];
+      }
+      mask |= static_cast<unsigned>(hit) << c;
+    }
+    return mask;
+#endif
+  }
 
   /// The exact (double) volume test of a triangle pair.
   [[nodiscard]] static bool overlap(const Dop<N>& a, const Dop<N>& b) {
@@ -636,6 +677,12 @@ class Walk {
   std::array<const float*, kAxes> a_hi_{};
   std::array<const float*, kAxes> b_lo_{};
   std::array<const float*, kAxes> b_hi_{};
+  // Both trees' slot volumes whole (Bvh::refit_swept): their diagonal axes, and no exact test.
+  bool whole_ = false;
+  std::array<const float*, kDiagonals> da_lo_{};
+  std::array<const float*, kDiagonals> da_hi_{};
+  std::array<const float*, kDiagonals> db_lo_{};
+  std::array<const float*, kDiagonals> db_hi_{};
   // The slots' end boxes of both trees (Bvh::refit_slot_ends), when both have them.
   bool slot_ends_ = false;
   std::int64_t apart_ = 0;

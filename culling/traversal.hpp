@@ -141,7 +141,10 @@ bool row_skip(
 /// itself, and each two children whose float volumes overlap against each other; two nodes → the
 /// children of the one with more triangles are tested against the other, four at once. Float
 /// volumes are rounded outwards, so they let through every pair the double volumes would (and
-/// a few more); a triangle pair is emitted only when its exact double volumes overlap.
+/// a few more); a triangle pair is emitted only when its exact double volumes overlap. On a tree
+/// whose slot volumes are whole (Bvh::refit_swept, both trees in a pair walk) the slots' floats on
+/// every axis decide instead and `triangle_bounds` is not read (it may be empty): every pair whose
+/// exact volumes overlap, and the few more whose volumes are apart by less than a float step.
 /// @param triangle_bounds indexed by triangle id; the volumes `bvh` was refit from.
 /// @param bv_tests incremented once per node-pair (float) and triangle-pair (double) volume test.
 /// @note Allocation-free once `scratch` is reserved and `out` has the capacity.

@@ -6,10 +6,12 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
 #include <bit>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
+#include <iterator>
 #include <limits>
 #include <random>
 #include <stdexcept>
@@ -471,6 +473,150 @@ TEST(NodeRelative, OnePassRefitRefusesATreeWithNodeVolumes) {
   EXPECT_FALSE(with_nodes.end_boxes().empty());
   EXPECT_NE(with_nodes.slot_ends(0), nullptr);
   for (std::size_t k = 0; k < 3; ++k) {
+    EXPECT_EQ(with_nodes.root_bounds().lo[k], root.lo[k]);
+    EXPECT_EQ(with_nodes.root_bounds().hi[k], root.hi[k]);
+  }
+}
+
+// Bvh::refit_swept computes each slot's swept volume from its corners where it rounds it, instead
+// of reading FeatureBounds::swept_triangles' by triangle id: the slots' and wide nodes' floats and
+// the root are refit()'s over those volumes bit for bit, and the slots' diagonal axes are each
+// volume's own rounded outwards — on CesiumMan's motion and on coordinates where the rounding has
+// edges, for 16-DOPs and AABBs (which have no diagonal rows). A refit() drops the whole slots.
+template <int N>
+void expect_refit_swept_is_refit_bit_for_bit() {
+  const Model m("CesiumMan.glb");
+  const FeatureTopology ft(*m.loaded.mesh, m.topology);
+  const skinning::Positions x0 = m.sample(0);
+  const skinning::Positions x1 = m.sample(20);
+  const auto [edgy0, edgy1] = with_edge_coordinates(x0, x1, 5, {2, 1, 1});
+  const BvhOptions wide_only{.node_volumes = false};
+  constexpr auto kN = static_cast<std::size_t>(N);
+  for (const bool edgy : {false, true}) {
+    const skinning::Positions& p0 = edgy ? edgy0 : x0;
+    const skinning::Positions& p1 = edgy ? edgy1 : x1;
+    FeatureBounds<N> swept;
+    swept.swept_triangles(ft, p0, p1);
+    Bvh<N> stored(ft.welded_triangles(), m.rest, wide_only);
+    Bvh<N> computed(ft.welded_triangles(), m.rest, wide_only);
+    stored.refit(swept.triangles);
+    computed.refit_swept(ft.welded_triangles(), p0, p1);
+    EXPECT_FALSE(stored.slot_volumes_whole());
+    ASSERT_TRUE(computed.slot_volumes_whole());
+    const auto wide_a = stored.wide_nodes();
+    const auto wide_b = computed.wide_nodes();
+    ASSERT_EQ(wide_a.size(), wide_b.size());
+    ASSERT_GT(wide_a.size(), 1u);
+    for (std::size_t n = 0; n < wide_a.size(); ++n) {
+      for (int i = 0; i < wide_a[n].num_children; ++i) {
+        const auto l = static_cast<std::size_t>(i);
+        for (std::size_t k = 0; k < kN; ++k) {
+          ASSERT_EQ(bits_of(wide_a[n].lo[k][l]), bits_of(wide_b[n].lo[k][l])) << edgy << " " << n;
+          ASSERT_EQ(bits_of(wide_a[n].hi[k][l]), bits_of(wide_b[n].hi[k][l])) << edgy << " " << n;
+        }
+      }
+    }
+    const std::size_t stride = stored.slot_stride();
+    for (int k = 0; k < Bvh<N>::kSlotAxes; ++k) {
+      EXPECT_EQ(std::memcmp(stored.slot_lo(k), computed.slot_lo(k), stride * sizeof(float)), 0)
+          << edgy << " axis " << k;
+      EXPECT_EQ(std::memcmp(stored.slot_hi(k), computed.slot_hi(k), stride * sizeof(float)), 0)
+          << edgy << " axis " << k;
+    }
+    for (std::size_t k = 0; k < kN; ++k) {
+      EXPECT_EQ(stored.root_bounds().lo[k], computed.root_bounds().lo[k]) << edgy << " " << k;
+      EXPECT_EQ(stored.root_bounds().hi[k], computed.root_bounds().hi[k]) << edgy << " " << k;
+    }
+    // The diagonal rows: each slot's triangle volume rounded outwards, on the axes past three.
+    const auto order = computed.triangle_order();
+    for (int d = 0; d < Bvh<N>::kSlotDiagonals; ++d) {
+      const float* lo = computed.slot_diagonal_lo(d);
+      const float* hi = computed.slot_diagonal_hi(d);
+      ASSERT_NE(lo, nullptr);
+      ASSERT_NE(hi, nullptr);
+      EXPECT_EQ(stored.slot_diagonal_lo(d), nullptr);
+      for (std::size_t s = 0; s < order.size(); ++s) {
+        std::array<float, kN> rlo;
+        std::array<float, kN> rhi;
+        round_outwards(swept.triangles[static_cast<std::size_t>(order[s])], rlo, rhi);
+        const auto k = static_cast<std::size_t>(Bvh<N>::kSlotAxes + d);
+        ASSERT_EQ(bits_of(lo[s]), bits_of(rlo[k])) << edgy << " slot " << s << " axis " << k;
+        ASSERT_EQ(bits_of(hi[s]), bits_of(rhi[k])) << edgy << " slot " << s << " axis " << k;
+      }
+    }
+    computed.refit(swept.triangles);
+    EXPECT_FALSE(computed.slot_volumes_whole());
+    if constexpr (Bvh<N>::kSlotDiagonals > 0) {
+      EXPECT_EQ(computed.slot_diagonal_lo(0), nullptr);
+    }
+  }
+}
+
+TEST(WholeSlots, RefitSweptIsRefitOverTheSweptVolumesBitForBitOnKdops) {
+  expect_refit_swept_is_refit_bit_for_bit<8>();
+}
+
+TEST(WholeSlots, RefitSweptIsRefitOverTheSweptVolumesBitForBitOnAabbs) {
+  expect_refit_swept_is_refit_bit_for_bit<3>();
+}
+
+// On whole slot volumes the walk tests floats only (no exact volume by triangle id): it keeps every
+// pair the exact volumes keep, and each pair more has float volumes (rounded outwards from the
+// exact ones) that overlap on every axis — the exact ones then are apart by less than a float
+// step. On CesiumMan's 16-DOPs that is a handful of pairs in ten thousands.
+TEST(WholeSlots, TheWalkOnWholeSlotsKeepsEveryExactPairAndOnlyFloatStepsMore) {
+  const Model m("CesiumMan.glb");
+  const FeatureTopology ft(*m.loaded.mesh, m.topology);
+  const skinning::Positions x0 = m.sample(0);
+  const skinning::Positions x1 = m.sample(20);
+  FeatureBounds<8> swept;
+  swept.swept_triangles(ft, x0, x1);
+  Bvh<8> bvh(ft.welded_triangles(), m.rest, BvhOptions{.node_volumes = false});
+  const auto walk = [&](std::span<const Dop<8>> bounds) {
+    TraversalScratch scratch;
+    std::vector<TrianglePair> pairs;
+    std::int64_t bv_tests = 0;
+    self_traverse<8>(bvh, bounds, scratch, pairs, bv_tests);
+    std::sort(pairs.begin(), pairs.end());
+    return pairs;
+  };
+  bvh.refit(swept.triangles);
+  const std::vector<TrianglePair> exact = walk(swept.triangles);
+  bvh.refit_swept(ft.welded_triangles(), x0, x1);
+  const std::vector<TrianglePair> whole = walk({});  // no triangle volumes to read
+  ASSERT_GT(exact.size(), 1000u);
+  EXPECT_TRUE(std::includes(whole.begin(), whole.end(), exact.begin(), exact.end()));
+  std::vector<TrianglePair> more;
+  std::set_difference(
+      whole.begin(), whole.end(), exact.begin(), exact.end(), std::back_inserter(more));
+  EXPECT_LE(more.size() * 1000, exact.size()) << more.size() << " of " << exact.size();
+  for (const TrianglePair& p : more) {
+    std::array<float, 8> alo, ahi, blo, bhi;
+    round_outwards(swept.triangles[static_cast<std::size_t>(p.a)], alo, ahi);
+    round_outwards(swept.triangles[static_cast<std::size_t>(p.b)], blo, bhi);
+    for (std::size_t k = 0; k < 8; ++k) {
+      EXPECT_TRUE(alo[k] <= bhi[k] && blo[k] <= ahi[k]) << p.a << " " << p.b << " axis " << k;
+    }
+  }
+  // A refit() makes the walk read the exact volumes again: the exact pairs.
+  bvh.refit(swept.triangles);
+  EXPECT_EQ(walk(swept.triangles), exact);
+}
+
+// refit_swept fills no binary node volumes: on a tree that has them it refuses and changes nothing.
+TEST(WholeSlots, RefitSweptRefusesATreeWithNodeVolumes) {
+  const Model m("CesiumMan.glb");
+  const FeatureTopology ft(*m.loaded.mesh, m.topology);
+  const skinning::Positions x0 = m.sample(0);
+  const skinning::Positions x1 = m.sample(20);
+  FeatureBounds<8> swept;
+  swept.swept_triangles(ft, x0, x1);
+  Bvh<8> with_nodes(ft.welded_triangles(), m.rest);
+  with_nodes.refit(swept.triangles);
+  const auto root = with_nodes.root_bounds();
+  EXPECT_THROW(with_nodes.refit_swept(ft.welded_triangles(), x0, x1), std::logic_error);
+  EXPECT_FALSE(with_nodes.slot_volumes_whole());
+  for (std::size_t k = 0; k < 8; ++k) {
     EXPECT_EQ(with_nodes.root_bounds().lo[k], root.lo[k]);
     EXPECT_EQ(with_nodes.root_bounds().hi[k], root.hi[k]);
   }
