@@ -353,7 +353,7 @@ class Bvh {
   std::vector<float> slot_ends_;  // 12 rows of slot_stride(): refit_slot_ends
   bool slot_ends_ready_ = false;
   static constexpr std::size_t kSlotPadding = 3;
-  std::vector<float> slot_bounds_;  // 2·kSlotAxes rows of slot_stride(): lo by axis, then hi
+  std::vector<float> slot_bounds_;     // 2·kSlotAxes rows of slot_stride(): lo by axis, then hi
   std::vector<float> slot_diagonals_;  // 2·kSlotDiagonals rows, as slot_bounds_: refit_swept
   bool slot_whole_ = false;
   struct Item {
