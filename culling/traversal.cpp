@@ -575,18 +575,42 @@ class Walk {
     }
     return static_cast<unsigned>(_mm_movemask_ps(ok));
   }
+#endif
+
+  /// Bit c set when slot sa of a and slot sb + c of b (c < 4) overlap on the K axes whose rows
+  /// of slot floats are given (lo and hi of a, then of b).
+  template <std::size_t K>
+  [[nodiscard]] static unsigned rows_overlap(
+      const std::array<const float*, K>& a_lo,
+      const std::array<const float*, K>& a_hi,
+      const std::array<const float*, K>& b_lo,
+      const std::array<const float*, K>& b_hi,
+      std::int32_t sa,
+      std::int32_t sb) {
+#if defined(__SSE2__)
+    __m128 ok = _mm_castsi128_ps(_mm_set1_epi32(-1));
+    for (std::size_t k = 0; k < K; ++k) {
+      ok = _mm_and_ps(ok, _mm_cmple_ps(_mm_loadu_ps(b_lo[k] + sb), _mm_set1_ps(a_hi[k][sa])));
+      ok = _mm_and_ps(ok, _mm_cmple_ps(_mm_set1_ps(a_lo[k][sa]), _mm_loadu_ps(b_hi[k] + sb)));
+    }
+    return static_cast<unsigned>(_mm_movemask_ps(ok));
 #else
-  /// Bit c set when the float volume of slot si of a overlaps that of slot sb + c of b, c < 4.
-  [[nodiscard]] unsigned float_overlap_slots(std::int32_t si, std::int32_t sb) const {
     unsigned mask = 0;
     for (int c = 0; c < kWidth; ++c) {
       bool hit = true;
-      for (std::size_t k = 0; k < kAxes; ++k) {
-        hit = hit && b_lo_[k][sb + c] <= a_hi_[k][si] && a_lo_[k][si] <= b_hi_[k][sb + c];
+      for (std::size_t k = 0; k < K; ++k) {
+        hit = hit && b_lo[k][sb + c] <= a_hi[k][sa] && a_lo[k][sa] <= b_hi[k][sb + c];
       }
       mask |= static_cast<unsigned>(hit) << c;
     }
     return mask;
+#endif
+  }
+
+#if !defined(__SSE2__)
+  /// Bit c set when the float volume of slot si of a overlaps that of slot sb + c of b, c < 4.
+  [[nodiscard]] unsigned float_overlap_slots(std::int32_t si, std::int32_t sb) const {
+    return rows_overlap(a_lo_, a_hi_, b_lo_, b_hi_, si, sb);
   }
 #endif
 
@@ -594,24 +618,7 @@ class Walk {
   /// their whole slot volumes (Bvh::slot_diagonal_lo): floats rounded outwards, so apart here is
   /// apart in the exact volumes too.
   [[nodiscard]] unsigned diagonal_overlap(std::int32_t sa, std::int32_t sb) const {
-#if defined(__SSE2__)
-    __m128 ok = _mm_castsi128_ps(_mm_set1_epi32(-1));
-    for (std::size_t k = 0; k < kDiagonals; ++k) {
-      ok = _mm_and_ps(ok, _mm_cmple_ps(_mm_loadu_ps(db_lo_[k] + sb), _mm_set1_ps(da_hi_[k][sa])));
-      ok = _mm_and_ps(ok, _mm_cmple_ps(_mm_set1_ps(da_lo_[k][sa]), _mm_loadu_ps(db_hi_[k] + sb)));
-    }
-    return static_cast<unsigned>(_mm_movemask_ps(ok));
-#else
-    unsigned mask = 0;
-    for (int c = 0; c < kWidth; ++c) {
-      bool hit = true;
-      for (std::size_t k = 0; k < kDiagonals; ++k) {
-        hit = hit && db_lo_[k][sb + c] <= da_hi_[k][sa] && da_lo_[k][sa] <= db_hi_[k][sb + c];
-      }
-      mask |= static_cast<unsigned>(hit) << c;
-    }
-    return mask;
-#endif
+    return rows_overlap(da_lo_, da_hi_, db_lo_, db_hi_, sa, sb);
   }
 
   /// The exact (double) volume test of a triangle pair.

@@ -102,6 +102,33 @@ std::pair<skinning::Positions, skinning::Positions> with_edge_coordinates(
 /// A float's bits (a zero's sign and every NaN told apart).
 std::uint32_t bits_of(float f) { return std::bit_cast<std::uint32_t>(f); }
 
+/// Two trees over the same triangles have the same wide nodes' and slots' float volumes, bit for
+/// bit (`what` names the case in a failure).
+template <int N>
+void expect_same_float_volumes(const Bvh<N>& a, const Bvh<N>& b, const std::string& what) {
+  const auto wide_a = a.wide_nodes();
+  const auto wide_b = b.wide_nodes();
+  ASSERT_EQ(wide_a.size(), wide_b.size());
+  ASSERT_GT(wide_a.size(), 1u);
+  for (std::size_t n = 0; n < wide_a.size(); ++n) {
+    for (int i = 0; i < wide_a[n].num_children; ++i) {
+      const auto l = static_cast<std::size_t>(i);
+      for (std::size_t k = 0; k < static_cast<std::size_t>(N); ++k) {
+        ASSERT_EQ(bits_of(wide_a[n].lo[k][l]), bits_of(wide_b[n].lo[k][l])) << what << " " << n;
+        ASSERT_EQ(bits_of(wide_a[n].hi[k][l]), bits_of(wide_b[n].hi[k][l])) << what << " " << n;
+      }
+    }
+  }
+  const std::size_t stride = a.slot_stride();
+  ASSERT_EQ(stride, b.slot_stride());
+  for (int k = 0; k < Bvh<N>::kSlotAxes; ++k) {
+    EXPECT_EQ(std::memcmp(a.slot_lo(k), b.slot_lo(k), stride * sizeof(float)), 0)
+        << what << " axis " << k;
+    EXPECT_EQ(std::memcmp(a.slot_hi(k), b.slot_hi(k), stride * sizeof(float)), 0)
+        << what << " axis " << k;
+  }
+}
+
 struct SweptCesium {
   Model m{"CesiumMan.glb"};
   FeatureTopology ft{*m.loaded.mesh, m.topology};
@@ -412,28 +439,7 @@ TEST(NodeRelative, OnePassRefitIsTheRefitAndItsEndBoxesBitForBit) {
       one_pass.refit(bounds.triangles);
       one_pass.refit_swept_and_ends(ft.welded_triangles(), p0, p1, with_slots);
       const std::string what = std::to_string(edgy) + " " + std::to_string(with_slots);
-      const auto wide_a = two_passes.wide_nodes();
-      const auto wide_b = one_pass.wide_nodes();
-      ASSERT_EQ(wide_a.size(), wide_b.size());
-      ASSERT_GT(wide_a.size(), 1u);
-      for (std::size_t n = 0; n < wide_a.size(); ++n) {
-        for (int i = 0; i < wide_a[n].num_children; ++i) {
-          const auto l = static_cast<std::size_t>(i);
-          for (std::size_t k = 0; k < 3; ++k) {
-            ASSERT_EQ(bits_of(wide_a[n].lo[k][l]), bits_of(wide_b[n].lo[k][l])) << what << " " << n;
-            ASSERT_EQ(bits_of(wide_a[n].hi[k][l]), bits_of(wide_b[n].hi[k][l])) << what << " " << n;
-          }
-        }
-      }
-      const std::size_t stride = two_passes.slot_stride();
-      for (int k = 0; k < 3; ++k) {
-        EXPECT_EQ(
-            std::memcmp(two_passes.slot_lo(k), one_pass.slot_lo(k), stride * sizeof(float)), 0)
-            << what << " axis " << k;
-        EXPECT_EQ(
-            std::memcmp(two_passes.slot_hi(k), one_pass.slot_hi(k), stride * sizeof(float)), 0)
-            << what << " axis " << k;
-      }
+      expect_same_float_volumes(two_passes, one_pass, what);
       ASSERT_EQ(two_passes.end_boxes().size(), one_pass.end_boxes().size());
       EXPECT_EQ(
           std::memcmp(
@@ -503,26 +509,7 @@ void expect_refit_swept_is_refit_bit_for_bit() {
     computed.refit_swept(ft.welded_triangles(), p0, p1);
     EXPECT_FALSE(stored.slot_volumes_whole());
     ASSERT_TRUE(computed.slot_volumes_whole());
-    const auto wide_a = stored.wide_nodes();
-    const auto wide_b = computed.wide_nodes();
-    ASSERT_EQ(wide_a.size(), wide_b.size());
-    ASSERT_GT(wide_a.size(), 1u);
-    for (std::size_t n = 0; n < wide_a.size(); ++n) {
-      for (int i = 0; i < wide_a[n].num_children; ++i) {
-        const auto l = static_cast<std::size_t>(i);
-        for (std::size_t k = 0; k < kN; ++k) {
-          ASSERT_EQ(bits_of(wide_a[n].lo[k][l]), bits_of(wide_b[n].lo[k][l])) << edgy << " " << n;
-          ASSERT_EQ(bits_of(wide_a[n].hi[k][l]), bits_of(wide_b[n].hi[k][l])) << edgy << " " << n;
-        }
-      }
-    }
-    const std::size_t stride = stored.slot_stride();
-    for (int k = 0; k < Bvh<N>::kSlotAxes; ++k) {
-      EXPECT_EQ(std::memcmp(stored.slot_lo(k), computed.slot_lo(k), stride * sizeof(float)), 0)
-          << edgy << " axis " << k;
-      EXPECT_EQ(std::memcmp(stored.slot_hi(k), computed.slot_hi(k), stride * sizeof(float)), 0)
-          << edgy << " axis " << k;
-    }
+    expect_same_float_volumes(stored, computed, std::to_string(edgy));
     for (std::size_t k = 0; k < kN; ++k) {
       EXPECT_EQ(stored.root_bounds().lo[k], computed.root_bounds().lo[k]) << edgy << " " << k;
       EXPECT_EQ(stored.root_bounds().hi[k], computed.root_bounds().hi[k]) << edgy << " " << k;
@@ -560,17 +547,23 @@ TEST(WholeSlots, RefitSweptIsRefitOverTheSweptVolumesBitForBitOnAabbs) {
   expect_refit_swept_is_refit_bit_for_bit<3>();
 }
 
+/// CesiumMan's samples 0 → 20 and the triangles' swept 16-DOPs of that interval.
+struct SweptCesiumKdops {
+  Model m{"CesiumMan.glb"};
+  FeatureTopology ft{*m.loaded.mesh, m.topology};
+  skinning::Positions x0 = m.sample(0);
+  skinning::Positions x1 = m.sample(20);
+  FeatureBounds<8> swept;
+  SweptCesiumKdops() { swept.swept_triangles(ft, x0, x1); }
+};
+
 // On whole slot volumes the walk tests floats only (no exact volume by triangle id): it keeps every
 // pair the exact volumes keep, and each pair more has float volumes (rounded outwards from the
 // exact ones) that overlap on every axis — the exact ones then are apart by less than a float
 // step. On CesiumMan's 16-DOPs that is a handful of pairs in ten thousands.
 TEST(WholeSlots, TheWalkOnWholeSlotsKeepsEveryExactPairAndOnlyFloatStepsMore) {
-  const Model m("CesiumMan.glb");
-  const FeatureTopology ft(*m.loaded.mesh, m.topology);
-  const skinning::Positions x0 = m.sample(0);
-  const skinning::Positions x1 = m.sample(20);
-  FeatureBounds<8> swept;
-  swept.swept_triangles(ft, x0, x1);
+  const SweptCesiumKdops c;
+  const auto& [m, ft, x0, x1, swept] = c;
   Bvh<8> bvh(ft.welded_triangles(), m.rest, BvhOptions{.node_volumes = false});
   const auto walk = [&](std::span<const Dop<8>> bounds) {
     TraversalScratch scratch;
@@ -605,12 +598,8 @@ TEST(WholeSlots, TheWalkOnWholeSlotsKeepsEveryExactPairAndOnlyFloatStepsMore) {
 
 // refit_swept fills no binary node volumes: on a tree that has them it refuses and changes nothing.
 TEST(WholeSlots, RefitSweptRefusesATreeWithNodeVolumes) {
-  const Model m("CesiumMan.glb");
-  const FeatureTopology ft(*m.loaded.mesh, m.topology);
-  const skinning::Positions x0 = m.sample(0);
-  const skinning::Positions x1 = m.sample(20);
-  FeatureBounds<8> swept;
-  swept.swept_triangles(ft, x0, x1);
+  const SweptCesiumKdops c;
+  const auto& [m, ft, x0, x1, swept] = c;
   Bvh<8> with_nodes(ft.welded_triangles(), m.rest);
   with_nodes.refit(swept.triangles);
   const auto root = with_nodes.root_bounds();
