@@ -712,15 +712,7 @@ FrameSequenceMotion::FrameSequenceMotion(
   Mesh& mesh = data->mesh;
   mesh.rest_positions = std::move(first);
   mesh.triangles = std::move(triangles);
-  const auto nv = static_cast<std::size_t>(mesh.num_vertices());
-  const auto nf = static_cast<std::size_t>(mesh.num_triangles());
-  mesh.face_part.assign(nf, 0);
-  mesh.vertex_part.assign(nv, 0);
-  mesh.face_index_in_part.resize(nf);
-  mesh.vertex_index_in_part.resize(nv);
-  for (std::size_t f = 0; f < nf; ++f) mesh.face_index_in_part[f] = static_cast<std::int32_t>(f);
-  for (std::size_t v = 0; v < nv; ++v) mesh.vertex_index_in_part[v] = static_cast<std::int32_t>(v);
-  mesh.part_names = {data->name};
+  label_one_part_in_file_order(mesh, data->name);
   if (options.order == MeshOrder::spatial) {
     const MeshPermutation order = spatial_order(mesh.rest_positions, mesh.triangles);
     if (!order.faces.empty()) {

@@ -8,6 +8,7 @@
 #include "skinning/generators_common.hpp"
 #include "skinning/lbs.hpp"
 #include "skinning/load.hpp"
+#include "skinning/mesh_order.hpp"
 #include "skinning/pose.hpp"
 
 namespace skelcd::skinning {
@@ -215,13 +216,7 @@ Rig RigBuilder::finish(MeshBuilder&& mesh, const std::string& part_name, Clip&& 
   for (Eigen::Index f = 0; f < nf; ++f) {
     for (int k = 0; k < 3; ++k) m.triangles(f, k) = mesh.triangles[static_cast<std::size_t>(f)][static_cast<std::size_t>(k)];
   }
-  m.face_part.assign(static_cast<std::size_t>(nf), 0);
-  m.vertex_part.assign(static_cast<std::size_t>(nv), 0);
-  m.face_index_in_part.resize(static_cast<std::size_t>(nf));
-  m.vertex_index_in_part.resize(static_cast<std::size_t>(nv));
-  for (Eigen::Index f = 0; f < nf; ++f) m.face_index_in_part[static_cast<std::size_t>(f)] = static_cast<std::int32_t>(f);
-  for (Eigen::Index v = 0; v < nv; ++v) m.vertex_index_in_part[static_cast<std::size_t>(v)] = static_cast<std::int32_t>(v);
-  m.part_names = {part_name};
+  label_one_part_in_file_order(m, part_name);
   rig.weights.resize(nv, static_cast<Eigen::Index>(skeleton_.bones.size()));
   rig.weights.setFromTriplets(triplets_.begin(), triplets_.end());
   rig.weights.makeCompressed();

@@ -5,6 +5,7 @@
 #include <cassert>
 #include <cmath>
 #include <limits>
+#include <numeric>
 #include <utility>
 
 namespace skelcd::skinning {
@@ -115,6 +116,18 @@ void gather_rows(const Positions& from, const std::vector<std::int32_t>& rows, P
   for (std::size_t i = 0; i < rows.size(); ++i) {
     out.row(static_cast<Eigen::Index>(i)) = from.row(rows[i]);
   }
+}
+
+void label_one_part_in_file_order(Mesh& mesh, std::string name) {
+  const auto nf = static_cast<std::size_t>(mesh.num_triangles());
+  const auto nv = static_cast<std::size_t>(mesh.num_vertices());
+  mesh.face_part.assign(nf, 0);
+  mesh.vertex_part.assign(nv, 0);
+  mesh.face_index_in_part.resize(nf);
+  mesh.vertex_index_in_part.resize(nv);
+  std::iota(mesh.face_index_in_part.begin(), mesh.face_index_in_part.end(), 0);
+  std::iota(mesh.vertex_index_in_part.begin(), mesh.vertex_index_in_part.end(), 0);
+  mesh.part_names = {std::move(name)};
 }
 
 Mesh reordered(const Mesh& mesh, const MeshPermutation& p) {

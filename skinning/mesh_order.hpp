@@ -8,6 +8,7 @@
 // finding is reported in (docs/formats.md, "Frame sequences").
 
 #include <cstdint>
+#include <string>
 #include <vector>
 
 #include "skinning/mesh.hpp"
@@ -41,6 +42,11 @@ struct MeshPermutation {
 
 /// Rows of `from` in the order `rows` lists them (out.row(i) = from.row(rows[i])).
 void gather_rows(const Positions& from, const std::vector<std::int32_t>& rows, Positions& out);
+
+/// Labels every triangle and vertex of `mesh` (its rest_positions and triangles set) as one part
+/// named `name` in file order: part 0, each element at its own index (a frame sequence, a
+/// generated mesh).
+void label_one_part_in_file_order(Mesh& mesh, std::string name);
 
 /// `mesh` with its vertices and triangles in the order `p` gives (both complete permutations):
 /// the triangles' corners renumbered, every per-vertex and per-face array moved with its element,

@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "skinning/mesh.hpp"
+#include "skinning/mesh_order.hpp"
 #include "skinning/topology.hpp"
 
 namespace skelcd::test {
@@ -93,15 +94,7 @@ inline Mesh single_part_mesh(Positions x, Triangles f, const char* name = "part0
   Mesh m;
   m.rest_positions = std::move(x);
   m.triangles = std::move(f);
-  const auto nf = static_cast<std::size_t>(m.triangles.rows());
-  const auto nv = static_cast<std::size_t>(m.rest_positions.rows());
-  m.face_part.assign(nf, 0);
-  m.vertex_part.assign(nv, 0);
-  m.face_index_in_part.resize(nf);
-  m.vertex_index_in_part.resize(nv);
-  for (std::size_t i = 0; i < nf; ++i) m.face_index_in_part[i] = static_cast<std::int32_t>(i);
-  for (std::size_t i = 0; i < nv; ++i) m.vertex_index_in_part[i] = static_cast<std::int32_t>(i);
-  m.part_names = {name};
+  skinning::label_one_part_in_file_order(m, name);
   return m;
 }
 

@@ -33,15 +33,7 @@ Mesh grid_sheet(int n) {
       m.triangles.row(f++) << v, v + n + 1, v + n;
     }
   }
-  const auto nv = static_cast<std::size_t>(m.num_vertices());
-  const auto nf = static_cast<std::size_t>(m.num_triangles());
-  m.face_part.assign(nf, 0);
-  m.vertex_part.assign(nv, 0);
-  m.face_index_in_part.resize(nf);
-  m.vertex_index_in_part.resize(nv);
-  std::iota(m.face_index_in_part.begin(), m.face_index_in_part.end(), 0);
-  std::iota(m.vertex_index_in_part.begin(), m.vertex_index_in_part.end(), 0);
-  m.part_names = {"sheet"};
+  label_one_part_in_file_order(m, "sheet");
   return m;
 }
 

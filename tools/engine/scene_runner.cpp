@@ -18,6 +18,7 @@
 #include "culling/routed_method.hpp"
 #include "skinning/errors.hpp"
 #include "skinning/generators.hpp"
+#include "skinning/mesh_order.hpp"
 #include "skinning/rig_motion.hpp"
 #include "skinning/topology.hpp"
 #include "tools/engine/events.hpp"
@@ -177,12 +178,7 @@ skinning::Rig sheet_rig(
       m.triangles.row(f++) << v, v + side + 1, v + side;
     }
   }
-  m.part_names = {name};
-  m.face_part.assign(static_cast<std::size_t>(f), 0);
-  for (Eigen::Index k = 0; k < f; ++k) m.face_index_in_part.push_back(static_cast<std::int32_t>(k));
-  m.vertex_part.assign(static_cast<std::size_t>(vertices), 0);
-  for (Eigen::Index k = 0; k < vertices; ++k)
-    m.vertex_index_in_part.push_back(static_cast<std::int32_t>(k));
+  skinning::label_one_part_in_file_order(m, name);
 
   // Weight transfer from the nearest skinned target vertex.
   const auto& w = target.weights;
