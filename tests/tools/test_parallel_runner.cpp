@@ -203,6 +203,32 @@ TEST(RunnerStatic, UnnamedBonesRowsAreTheQueriedOnes) {
   EXPECT_EQ(queried, 12) << "a method that carries state is queried every time";
 }
 
+TEST(ParallelRunner, RowsTheCallbackTakesEqualRowsItCopiesSerialAndParallel) {
+  const auto l = load(kCharacter);
+  for (const std::int32_t threads : {1, 2}) {
+    SCOPED_TRACE(threads);
+    std::vector<FrameReport> rows[2];
+    for (const bool take : {false, true}) {
+      RunOptions options;
+      options.method = "bvh";
+      options.frames = parse_frame_range("36:41");
+      options.threads = threads;
+      options.block_samples = 2;
+      ClipRunner runner(*l.motion, options);
+      ASSERT_EQ(runner.plan().threads, threads);
+      runner.run([&](FrameReport& r) {
+        if (take) {
+          rows[1].push_back(std::move(r));
+        } else {
+          rows[0].push_back(r);
+        }
+      });
+    }
+    EXPECT_EQ(rows[0].size(), 6u + 5u);
+    EXPECT_GT(expect_same_rows(rows[0], rows[1]), 0u) << "no findings: the clip proves nothing";
+  }
+}
+
 TEST(ParallelRunner, RealCharacterRowsEqualSerialForBvhDynamicAndAuto) {
   const auto l = load(kCharacter);
   for (const char* method : {"bvh", "dynamic", "auto"}) {

@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <limits>
 #include <vector>
 
@@ -140,7 +141,15 @@ struct RunOutput {
   RunPlan plan;
 };
 
-RunOutput run(QuerySet query, FrameRange frames, int samples = 4, int nan_sample = -1) {
+/// What a callback does with each row: by default, copies it into `out.reports`.
+using TakeRow = std::function<void(FrameReport&, RunOutput&)>;
+
+RunOutput run(
+    QuerySet query,
+    FrameRange frames,
+    int samples = 4,
+    int nan_sample = -1,
+    const TakeRow& take = {}) {
   ShiftMotion motion(two_part_mesh(), samples);
   motion.nan_sample = nan_sample;
   RunOutput out;
@@ -161,7 +170,13 @@ RunOutput run(QuerySet query, FrameRange frames, int samples = 4, int nan_sample
                     });
   out.plan = runner.plan();
   try {
-    runner.run([&](const FrameReport& r) { out.reports.push_back(r); });
+    runner.run([&](FrameReport& r) {
+      if (take) {
+        take(r, out);
+      } else {
+        out.reports.push_back(r);
+      }
+    });
   } catch (...) {
     if (nan_sample < 0) throw;
   }
@@ -207,6 +222,47 @@ TEST(Runner, BothQueriesInterleaveRowsInTimeOrder) {
   // Each of the 4 samples is posed once; the skinning time of sample i+1 is charged to the CCD row.
   EXPECT_EQ(out.record.dcd_inputs.size(), 4u);
   EXPECT_EQ(out.record.ccd_inputs.size(), 3u);
+}
+
+TEST(Runner, ARowIsTheCallbacksToTakeAndVectorsHandedBackAreClearedAndRefilled) {
+  const auto copied = run(QuerySet::both, FrameRange{});
+  // Each row moved out whole, and in its place vectors with room for 64 findings handed back,
+  // each holding a finding of no row (what a caller's emptied buffers may still hold).
+  std::vector<const ContactRow*> contacts_back;
+  std::vector<const DcdPairRow*> pairs_back;
+  std::size_t rows_in_handed_back = 0;
+  const auto taken = run(QuerySet::both, FrameRange{}, 4, -1, [&](FrameReport& r, RunOutput& out) {
+    if (!contacts_back.empty()) {
+      rows_in_handed_back +=
+          r.contacts.data() == contacts_back.back() && r.dcd_pairs.data() == pairs_back.back();
+    }
+    out.reports.push_back(std::move(r));
+    std::vector<ContactRow> contacts(64);
+    contacts.resize(1);
+    contacts.front().frame = -7;
+    std::vector<DcdPairRow> pairs(64);
+    pairs.resize(1);
+    pairs.front().frame = -7;
+    contacts_back.push_back(contacts.data());
+    pairs_back.push_back(pairs.data());
+    r.contacts = std::move(contacts);
+    r.dcd_pairs = std::move(pairs);
+  });
+  ASSERT_EQ(taken.reports.size(), 7u);
+  ASSERT_EQ(copied.reports.size(), 7u);
+  // Every row after the first came in the vectors handed back after the one before it.
+  EXPECT_EQ(rows_in_handed_back, 6u);
+  std::size_t findings = 0;
+  for (std::size_t i = 0; i < 7; ++i) {
+    EXPECT_EQ(taken.reports[i].row.kind, copied.reports[i].row.kind) << i;
+    EXPECT_EQ(taken.reports[i].row.sample, copied.reports[i].row.sample) << i;
+    EXPECT_EQ(
+        taken.reports[i].row.counters.vf_contacts, copied.reports[i].row.counters.vf_contacts);
+    EXPECT_EQ(taken.reports[i].contacts, copied.reports[i].contacts) << i;
+    EXPECT_EQ(taken.reports[i].dcd_pairs, copied.reports[i].dcd_pairs) << i;
+    findings += copied.reports[i].contacts.size() + copied.reports[i].dcd_pairs.size();
+  }
+  EXPECT_EQ(findings, 4u * 1 + 3u * 2);  // a DCD pair per sample, two contacts per interval
 }
 
 TEST(Runner, QuerySubsetsAndFrameRanges) {

@@ -74,6 +74,9 @@ struct CheckOutcome {
   SetupTimes setup;                 ///< where the time before the first row went
 };
 
+/// Called with each labelled row of check_model, in order; the row is only lent.
+using RowCallback = std::function<void(const FrameReport&)>;
+
 /// Checks one clip of `model`: one FrameReport per DCD sample and CCD interval, in order, passed
 /// to `on_row` (after it reached the log, when there is one). Everything that can be refused — the
 /// clip, the rate, the frame range, the method, the segmentation — is refused before the log is
@@ -82,7 +85,7 @@ struct CheckOutcome {
 [[nodiscard]] CheckOutcome check_model(
     const skinning::LoadedModel& model,
     const CheckRequest& request,
-    const FrameCallback& on_row = {});
+    const RowCallback& on_row = {});
 
 /// The identity fields of the check's summary (summary_json): the model's path, the clip, rate,
 /// samples, method, accuracy, query and the log.

@@ -832,7 +832,7 @@ void ClipRunner::run_parallel(const FrameCallback& on_frame) {
       const SampleSequence part{
           .first = block.first, .end = block.end, .last = last, .dcd = dcd, .ccd = ccd};
       check_samples(
-          context, part, *acquired, [&](const FrameReport& r) { block.reports.push_back(r); });
+          context, part, *acquired, [&](FrameReport& r) { block.reports.push_back(std::move(r)); });
     } catch (...) {
       // Reported after the rows before it, in order: as a serial run would.
       block.error = std::current_exception();
@@ -880,7 +880,7 @@ void ClipRunner::run_parallel(const FrameCallback& on_frame) {
                 tbb::filter_mode::serial_in_order, [&](const std::shared_ptr<Block>& block) {
                   if (failure) return;  // rows after the first failure: a serial run has none
                   try {
-                    for (const auto& report : block->reports) on_frame(report);
+                    for (auto& report : block->reports) on_frame(report);
                   } catch (...) {
                     failure = std::current_exception();
                   }

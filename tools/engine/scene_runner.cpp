@@ -697,8 +697,9 @@ SceneRunResult run_scene(const Scene& scene, const SceneRunOptions& options) {
         record(report);
         if (progress) progress(static_cast<std::int64_t>(check.rows.size()));
       };
-      runners[k]->run([&](const FrameReport& report) {
-        for (auto& labelled : trackers[k]->push(report)) shifted(labelled);
+      // The tracker takes each row whole, not a copy (runner.hpp, FrameCallback).
+      runners[k]->run([&](FrameReport& report) {
+        for (auto& labelled : trackers[k]->push(std::move(report))) shifted(labelled);
       });
       for (auto& labelled : trackers[k]->flush()) shifted(labelled);
       for (auto e : trackers[k]->events()) {
