@@ -35,14 +35,16 @@ Memory on the inputs of at least 10,000 triangles (the issue's "1 KiB per triang
 findings themselves need"), per method: the raw figure, (peak RSS - floor) / triangles, and beside
 it the same minus the findings, (peak RSS - floor - findings) / triangles, where
 
-  findings = n x (32 + 32 + 56 + 56) bytes + min(log, n x 56 bytes)
+  findings = n x (32 + 32 + 56) bytes + min(log, n x 56 bytes)
 
 - n: the most contacts of one interval (counted per /contacts `frame` in the method's log).
-- In memory: while an interval is reported, the run holds each of its contacts four times: the
+- In memory: while an interval is reported, the run holds each of its contacts three times: the
   method's culling::CcdContact (32 bytes, the query's FrameResult), the buffer its radix sort
-  keeps per thread for the next query (32, culling/pair_sort.cpp), the interval's
-  tools::ContactRow (56, the FrameReport) and the event tracker's labelled ContactRow (56)
-  (tools/engine/runner.cpp, check_engine.cpp). Counted at their sizes: what the vectors hold
+  keeps per thread for the next query (32, culling/pair_sort.cpp) and the interval's
+  tools::ContactRow (56, the FrameReport, which the event tracker labels in place and, with
+  `--query ccd`, hands back at once: tools/engine/runner.cpp, check_engine.cpp, events.hpp).
+  Until 2026-12-06 the tracker labelled a copy of it and held it until the next interval (56 more,
+  and 56 again while the next one was copied). Counted at their sizes: what the vectors hold
   beyond (they grow by doubling) stays in the figure.
 - The log writer buffers each contact once more as a detail::ContactDisk row (56 bytes) before
   HDF5 writes them. That is counted only as far as the log raised the peak: `log` is measured, the
@@ -52,7 +54,7 @@ it the same minus the findings, (peak RSS - floor - findings) / triangles, where
   "Fixed costs") is not the findings' and stays in the figure.
 tests/tools/test_log.cpp checks the sizes. On the cloth steps the heap peak is reached while
 the in-memory copies are held (valgrind massif, docs/benchmarks.md "Real assets"); where a
-peak is reached before any contact exists, "minus findings" understates it by up to n x 176 bytes.
+peak is reached before any contact exists, "minus findings" understates it by up to n x 120 bytes.
 """
 
 import argparse
@@ -73,8 +75,7 @@ LARGE_TRIANGLES = 10000  # per-method memory line: inputs this large or larger
 # Bytes of one CCD contact in each record held in memory while an interval is reported, and in the
 # log writer's row buffer (the module docstring; tests/tools/test_log.cpp checks the sizes).
 CONTACT_RECORD_BYTES = {"culling::CcdContact": 32, "culling::CcdContact (sort buffer)": 32,
-                        "tools::ContactRow (report)": 56,
-                        "tools::ContactRow (labelled copy)": 56}
+                        "tools::ContactRow (report)": 56}
 CONTACT_DISK_BYTES = 56  # tools::detail::ContactDisk
 
 

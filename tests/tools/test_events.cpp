@@ -39,6 +39,7 @@ TEST(IntersectionLength, SeparateOrCoplanarTrianglesGiveZero) {
 #include "skinning/errors.hpp"
 #include "skinning/generators.hpp"
 #include "skinning/load.hpp"
+#include "skinning/topology.hpp"
 #include "tools/engine/check_engine.hpp"
 #include "tools/engine/run_summary.hpp"
 
@@ -535,6 +536,65 @@ TEST(EventTracking, EventsMergeEndAfterAGapAndStartAgain) {
   EXPECT_EQ(events[3].first_sample, 11);
   EXPECT_EQ(events[3].dcd_pairs, 1);
   EXPECT_EQ(events[3].parts, (std::vector<std::int32_t>{3, 4}));
+}
+
+// A run without DCD rows (`--query ccd`): the tracker labels each CCD row at the push that brings
+// it, instead of holding it until the next, and the labels, counters and events are those of a
+// tracker that held it. CesiumMan's whole clip, every contact new (no baseline): its events.
+TEST(EventTracking, ACcdOnlyRunLabelsEachRowAtOnceAsWhenItWasHeld) {
+  const auto model = skinning::load_model(test::asset("characters/CesiumMan.glb"));
+  const BaselineSpec none{.kind = BaselineSpec::Kind::none, .sample = 0, .log_path = {}};
+  const auto run = check(model, none, QuerySet::ccd);
+  ASSERT_GT(run.reports.size(), 10u);
+  ASSERT_GT(run.outcome.events.size(), 1u) << "no events: the clip proves nothing";
+  const auto motion = model.motion();
+  const auto topology = skinning::build_topology(motion->mesh());
+  const auto positions_at = [&](std::int32_t sample, skinning::Positions& out) {
+    motion->positions(sample, out);
+  };
+  std::vector<FrameReport> labelled[2];
+  std::vector<EventRecord> events[2];
+  for (const auto rows : {EventTracker::DcdRows::expected, EventTracker::DcdRows::none}) {
+    const auto k = static_cast<std::size_t>(rows == EventTracker::DcdRows::none);
+    EventTracker tracker(
+        motion->mesh(),
+        topology,
+        model.rig.get(),
+        BaselineFindings{},
+        Allowances{},
+        2,
+        positions_at,
+        rows);
+    for (const auto& report : run.reports) {
+      FrameReport unlabelled = report;
+      unlabelled.row.counters.new_ccd_contacts = 0;
+      for (auto& c : unlabelled.contacts) c.label = kLabelNone;
+      auto out = tracker.push(std::move(unlabelled));
+      // Held, a row comes out at the next push; without DCD rows, at its own.
+      EXPECT_EQ(out.size(), k == 1 || &report != &run.reports.front() ? 1u : 0u);
+      if (k == 1 && out.size() == 1) {
+        EXPECT_EQ(out.front().row.sample, report.row.sample);
+      }
+      for (auto& r : out) labelled[k].push_back(std::move(r));
+    }
+    auto rest = tracker.flush();
+    EXPECT_EQ(rest.size(), 1 - k);
+    for (auto& r : rest) labelled[k].push_back(std::move(r));
+    events[k] = tracker.events();
+  }
+  ASSERT_EQ(labelled[0].size(), run.reports.size());
+  ASSERT_EQ(labelled[1].size(), run.reports.size());
+  std::int64_t new_contacts = 0;
+  for (std::size_t i = 0; i < run.reports.size(); ++i) {
+    EXPECT_EQ(labelled[1][i].contacts, labelled[0][i].contacts) << i;  // the labels with them
+    EXPECT_EQ(labelled[1][i].contacts, run.reports[i].contacts) << i;  // the check's own run
+    EXPECT_EQ(
+        labelled[1][i].row.counters.new_ccd_contacts, labelled[0][i].row.counters.new_ccd_contacts);
+    new_contacts += labelled[1][i].row.counters.new_ccd_contacts;
+  }
+  EXPECT_GT(new_contacts, 0);
+  EXPECT_EQ(events[1], events[0]);
+  EXPECT_EQ(events[1], run.outcome.events);
 }
 
 }  // namespace

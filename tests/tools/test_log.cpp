@@ -874,10 +874,10 @@ TEST(Log, EachTableCachesOneOfItsChunksNotHdf5sMegabyte) {
 }
 
 TEST(Log, ContactRecordsHaveTheSizesBenchRealCounts) {
-  // scripts/bench_real.py (CONTACT_RECORD_BYTES) counts n × (32 + 32 + 56 + 56) bytes of a peak as
-  // the findings of an interval with n contacts (the contacts, their sort buffer, the report's and
-  // the event tracker's rows), and the log writer's rows (56 each) inside its measured share:
-  // keep them in step.
+  // scripts/bench_real.py (CONTACT_RECORD_BYTES) counts n × (32 + 32 + 56) bytes of a peak as the
+  // findings of an interval with n contacts (the contacts, their sort buffer, the report's rows,
+  // which the event tracker labels in place), and the log writer's rows (56 each) inside its
+  // measured share: keep them in step.
   EXPECT_EQ(sizeof(skelcd::culling::CcdContact), 32u);
   EXPECT_EQ(sizeof(ContactRow), 56u);
   EXPECT_EQ(sizeof(skelcd::tools::detail::ContactDisk), 56u);

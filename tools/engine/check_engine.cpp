@@ -258,7 +258,9 @@ CheckOutcome check_model(
         baseline,
         request.allow,
         request.baseline_slack,
-        positions_at);
+        positions_at,
+        options.query == QuerySet::ccd ? EventTracker::DcdRows::none
+                                       : EventTracker::DcdRows::expected);
     if (request.log_path.empty()) return;
     const std::string input = request.input_path.empty() ? model.path.string() : request.input_path;
     LogHeader header = log_header_base({
@@ -309,13 +311,18 @@ CheckOutcome check_model(
       start_reporting();
       // The tracker takes the row whole, not a copy: a copy of the cloth-ball step's contacts
       // first-touched 6.4 MB more at every interval, at the moment the run's memory peaked. The
-      // last row it gives back, once written, returns its vectors to the runner, which refills
-      // them for its next row instead of allocating (runner.hpp, FrameCallback).
+      // largest vectors of the rows it gives back, once written, return to the runner, which
+      // refills them for its next row instead of allocating (runner.hpp, FrameCallback): a CCD
+      // row's contacts, also when a DCD row came out after it.
       std::vector<FrameReport> ready = tracker->push(std::move(report));
       emit(ready);
-      if (!ready.empty()) {
-        report.contacts = std::move(ready.back().contacts);
-        report.dcd_pairs = std::move(ready.back().dcd_pairs);
+      for (auto& done : ready) {
+        if (done.contacts.capacity() > report.contacts.capacity()) {
+          report.contacts = std::move(done.contacts);
+        }
+        if (done.dcd_pairs.capacity() > report.dcd_pairs.capacity()) {
+          report.dcd_pairs = std::move(done.dcd_pairs);
+        }
       }
     });
   } catch (...) {

@@ -864,8 +864,10 @@ EventTracker::EventTracker(
     const BaselineFindings& baseline,
     const Allowances& allowances,
     std::int32_t baseline_slack,
-    PositionsAt positions_at)
-    : impl_(std::make_unique<Impl>(mesh, topology, rig, std::move(positions_at))) {
+    PositionsAt positions_at,
+    DcdRows dcd_rows)
+    : impl_(std::make_unique<Impl>(mesh, topology, rig, std::move(positions_at))),
+      dcd_rows_(dcd_rows) {
   if (baseline_slack < 0) {
     throw InvalidInput(
         "--baseline-slack " + std::to_string(baseline_slack) + ": expected a number of rings >= 0");
@@ -887,7 +889,12 @@ std::vector<FrameReport> EventTracker::push(FrameReport report) {
       out.push_back(std::move(*held));
       held.reset();
     }
-    held = std::move(report);
+    if (dcd_rows_ == DcdRows::none) {
+      impl_->process(&report, nullptr);
+      out.push_back(std::move(report));
+    } else {
+      held = std::move(report);
+    }
     return out;
   }
   if (held && held->row.sample + 1 == report.row.sample) {

@@ -64,11 +64,18 @@ struct BaselineFindings {
 /// Labels every finding of a run (FrameReport rows in run order) against the baseline and the
 /// allowances and groups the new ones into events (docs/events.md). Rows go in through push()
 /// and come out labelled, in the same order; a CCD row is held until the DCD row of the sample
-/// that ends its interval has arrived (both belong to the same step of the event tracking).
+/// that ends its interval has arrived (both belong to the same step of the event tracking), in a
+/// run that has DCD rows.
 class EventTracker {
  public:
   /// Posed file positions of a sample (for the depth measure).
   using PositionsAt = std::function<void(std::int32_t sample, skinning::Positions& out)>;
+
+  /// Whether the run has DCD rows. Without them (`--query ccd`) a CCD row has nothing to wait
+  /// for and comes out labelled at once: the same labels as when it was held until the next row
+  /// (it is labelled without a DCD row either way, and in the same order), but the run no longer
+  /// holds two intervals' findings at a time.
+  enum class DcdRows : std::uint8_t { expected, none };
 
   /// `rig` may be null (no bones: a frame sequence). `mesh`, `topology` and `rig` must outlive
   /// the tracker. @throws InvalidInput for an allowance naming neither a part nor a bone.
@@ -79,7 +86,8 @@ class EventTracker {
       const BaselineFindings& baseline,
       const Allowances& allowances,
       std::int32_t baseline_slack,
-      PositionsAt positions_at);
+      PositionsAt positions_at,
+      DcdRows dcd_rows = DcdRows::expected);
   ~EventTracker();
   EventTracker(const EventTracker&) = delete;
   EventTracker& operator=(const EventTracker&) = delete;
@@ -97,6 +105,7 @@ class EventTracker {
  private:
   struct Impl;
   std::unique_ptr<Impl> impl_;
+  DcdRows dcd_rows_;
 };
 
 /// The baseline findings a spec asks for, from DCD at the baseline's pose or from a log.

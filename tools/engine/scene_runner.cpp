@@ -586,7 +586,8 @@ SceneRunResult run_scene(const Scene& scene, const SceneRunOptions& options) {
           so.baseline_slack,
           [motion](std::int32_t sample, skinning::Positions& out) {
             motion->positions(sample, out);
-          });
+          },
+          c.query == QuerySet::ccd ? EventTracker::DcdRows::none : EventTracker::DcdRows::expected);
       baselines += (baselines.empty() ? "" : "; ") + so.name + ": " + describe(so.baseline);
     } catch (const std::exception& e) {
       throw InvalidInput(scene.where(c.line, "object '" + so.name + "': " + e.what()));
