@@ -45,7 +45,7 @@ sanitize: deps
 # serial and parallel (ParallelCheck.WholeClip…, 60-90 s here), which found a heap read before an
 # array at its collapsed sides (stop 76).
 SAN_CI_TARGETS ?= skelcd skelcd_ccd_tests skelcd_skinning_tests skelcd_tools_tests
-SAN_CI_TESTS   ?= WholeSlots|ImportRobustness|ImportGuard|AssimpImport|FrameSequence|MeshOrder|Log\.|BadInputCli|CmdInspect|Vertex|Edge|TriangleTriangle|Expansion|CoplanarityScreen\.EachLaneIsTheKernelsScreenOnTheClothFunnel|RelativeBoxes\.(Keeps|Rejects|Without)|ParallelCheck\.WholeClipOfABundledCharacterLogsEqualSerialOnTwoThreads
+SAN_CI_TESTS   ?= WholeSlots|Runner\.ARowIsTheCallbacks|ParallelRunner\.RowsTheCallbackTakes|ImportRobustness|ImportGuard|AssimpImport|FrameSequence|MeshOrder|Log\.|BadInputCli|CmdInspect|Vertex|Edge|TriangleTriangle|Expansion|CoplanarityScreen\.EachLaneIsTheKernelsScreenOnTheClothFunnel|RelativeBoxes\.(Keeps|Rejects|Without)|ParallelCheck\.WholeClipOfABundledCharacterLogsEqualSerialOnTwoThreads
 sanitize-ci: deps
 	cmake -S . -B $(SAN_BUILD) -G Ninja -DCMAKE_BUILD_TYPE=Debug -DSKELCD_SANITIZE=ON -DSKELCD_WERROR=$(WERROR) $(CMAKE_ARGS)
 	cmake --build $(SAN_BUILD) -j $(JOBS) --target $(SAN_CI_TARGETS)
