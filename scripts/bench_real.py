@@ -35,7 +35,7 @@ Memory on the inputs of at least 10,000 triangles (the issue's "1 KiB per triang
 findings themselves need"), per method: the raw figure, (peak RSS - floor) / triangles, and beside
 it the same minus the findings, (peak RSS - floor - findings) / triangles, where
 
-  findings = n x (32 + 32 + 56) bytes + min(log, n x 56 bytes)
+  findings = n x (32 + 32 + 56) bytes + min(log, min(n, 8192) x 56 bytes)
 
 - n: the most contacts of one interval (counted per /contacts `frame` in the method's log).
 - In memory: while an interval is reported, the run holds each of its contacts three times: the
@@ -46,8 +46,8 @@ it the same minus the findings, (peak RSS - floor - findings) / triangles, where
   Until 2026-12-06 the tracker labelled a copy of it and held it until the next interval (56 more,
   and 56 again while the next one was copied). Counted at their sizes: what the vectors hold
   beyond (they grow by doubling) stays in the figure.
-- The log writer buffers each contact once more as a detail::ContactDisk row (56 bytes) before
-  HDF5 writes them. That is counted only as far as the log raised the peak: `log` is measured, the
+- The log writer converts the contacts into detail::ContactDisk rows (56 bytes) 8,192 at a time
+  (since 2026-12-06; before, all of an interval's at once) before HDF5 writes them. That is counted only as far as the log raised the peak: `log` is measured, the
   peak RSS of the same command minus that of the command without `-o LOG`. The rest of `log` (about
   4 MiB whatever the findings, see cloth-funnel's 134 contacts: mostly libhdf5's own pages, about
   2.8 MiB resident once a file is written, and the metadata cache's 0.5 MB index; docs/benchmarks.md
@@ -77,6 +77,7 @@ LARGE_TRIANGLES = 10000  # per-method memory line: inputs this large or larger
 CONTACT_RECORD_BYTES = {"culling::CcdContact": 32, "culling::CcdContact (sort buffer)": 32,
                         "tools::ContactRow (report)": 56}
 CONTACT_DISK_BYTES = 56  # tools::detail::ContactDisk
+DISK_ROWS_PER_APPEND = 8192  # the log writer's block (tools/io/log/log_writer.cpp, kRowsPerAppend)
 
 
 def load_sibling(name):
@@ -138,7 +139,7 @@ def findings_mib(run):
     """What the findings take at the peak, MiB (the module docstring): the contacts' records in
     memory, computed, and the log writer's rows, as far as the measured log share goes."""
     n = run["max_interval_contacts"]
-    rows = n * CONTACT_DISK_BYTES / 2.0**20
+    rows = min(n, DISK_ROWS_PER_APPEND) * CONTACT_DISK_BYTES / 2.0**20
     return n * sum(CONTACT_RECORD_BYTES.values()) / 2.0**20 + min(max(run["log_mib"], 0.0), rows)
 
 
@@ -367,7 +368,7 @@ def main():
                   f"KiB per triangle above the floor {raw:.2f}, minus findings {net:.2f} "
                   f"(findings {run['findings_mib']:.1f} MiB: {run['max_interval_contacts']} "
                   f"contacts x {sum(CONTACT_RECORD_BYTES.values())} bytes in memory, log rows "
-                  f"{min(max(run['log_mib'], 0.0), run['max_interval_contacts'] * CONTACT_DISK_BYTES / 2.0**20):.1f} "
+                  f"{min(max(run['log_mib'], 0.0), min(run['max_interval_contacts'], DISK_ROWS_PER_APPEND) * CONTACT_DISK_BYTES / 2.0**20):.1f} "
                   f"of the log's {run['log_mib']:.1f})")
         if vals:
             worst = max(vals)

@@ -279,6 +279,31 @@ TEST(Log, RoundTripsEveryField) {
   EXPECT_EQ(summary_only.events, sample_events());  // events are read either way
 }
 
+TEST(Log, ARowOfManyFindingsIsAppendedInBlocksAndVerifiedWhole) {
+  // 20,000 contacts and 9,000 pairs in one row: appended 8,192 at a time (log_writer.cpp,
+  // kRowsPerAppend), the row's checksums continued over its blocks.
+  const auto path = skelcd::test::temp_dir("log-blocks") / "run.h5";
+  const std::vector<FrameReport> reports{
+      sample_report(7, QueryKind::ccd, 20000, 0),
+      sample_report(8, QueryKind::dcd, 0, 9000),
+      sample_report(8, QueryKind::ccd, 3, 0)};
+  {
+    LogWriter writer(path, sample_header());
+    for (const auto& r : reports) writer.append(r);
+    writer.finish();
+  }
+  const auto data = read_log(path);
+  EXPECT_TRUE(data.verified);
+  EXPECT_TRUE(data.damage.empty());
+  ASSERT_EQ(data.frames.size(), 3u);
+  std::vector<ContactRow> contacts = reports[0].contacts;
+  contacts.insert(contacts.end(), reports[2].contacts.begin(), reports[2].contacts.end());
+  EXPECT_EQ(data.contacts, contacts);
+  EXPECT_EQ(data.dcd_pairs, reports[1].dcd_pairs);
+  for (std::size_t i = 0; i < reports.size(); ++i)
+    expect_rows_equal(data.frames[i], reports[i].row);
+}
+
 TEST(Log, EventsAreWrittenOnceBeforeFinishAndAbsentEventsAreNotNoEvents) {
   const auto dir = skelcd::test::temp_dir("log-events");
   {
@@ -876,8 +901,8 @@ TEST(Log, EachTableCachesOneOfItsChunksNotHdf5sMegabyte) {
 TEST(Log, ContactRecordsHaveTheSizesBenchRealCounts) {
   // scripts/bench_real.py (CONTACT_RECORD_BYTES) counts n × (32 + 32 + 56) bytes of a peak as the
   // findings of an interval with n contacts (the contacts, their sort buffer, the report's rows,
-  // which the event tracker labels in place), and the log writer's rows (56 each) inside its
-  // measured share: keep them in step.
+  // which the event tracker labels in place), and the log writer's rows (56 each, at most 8,192
+  // at a time) inside its measured share: keep them in step.
   EXPECT_EQ(sizeof(skelcd::culling::CcdContact), 32u);
   EXPECT_EQ(sizeof(ContactRow), 56u);
   EXPECT_EQ(sizeof(skelcd::tools::detail::ContactDisk), 56u);
