@@ -35,16 +35,16 @@ Memory on the inputs of at least 10,000 triangles (the issue's "1 KiB per triang
 findings themselves need"), per method: the raw figure, (peak RSS - floor) / triangles, and beside
 it the same minus the findings, (peak RSS - floor - findings) / triangles, where
 
-  findings = n x (32 + 32 + 56) bytes + min(log, min(n, 8192) x 56 bytes)
+  findings = n x (32 + 56) bytes + min(log, min(n, 8192) x 56 bytes)
 
 - n: the most contacts of one interval (counted per /contacts `frame` in the method's log).
-- In memory: while an interval is reported, the run holds each of its contacts three times: the
-  method's culling::CcdContact (32 bytes, the query's FrameResult), the buffer its radix sort
-  keeps per thread for the next query (32, culling/pair_sort.cpp) and the interval's
+- In memory: while an interval is reported, the run holds each of its contacts twice: the
+  method's culling::CcdContact (32 bytes, the query's FrameResult) and the interval's
   tools::ContactRow (56, the FrameReport, which the event tracker labels in place and, with
   `--query ccd`, hands back at once: tools/engine/runner.cpp, check_engine.cpp, events.hpp).
-  Until 2026-12-06 the tracker labelled a copy of it and held it until the next interval (56 more,
-  and 56 again while the next one was copied). Counted at their sizes: what the vectors hold
+  Until 2026-12-06 the contacts' radix sort kept a buffer of their size per thread (32 more,
+  culling/pair_sort.cpp; they are sorted in place now) and the tracker labelled a copy of the
+  row and held it until the next interval (56 more, and 56 again while the next was copied). Counted at their sizes: what the vectors hold
   beyond (they grow by doubling) stays in the figure.
 - The log writer converts the contacts into detail::ContactDisk rows (56 bytes) 8,192 at a time
   (since 2026-12-06; before, all of an interval's at once) before HDF5 writes them. That is counted only as far as the log raised the peak: `log` is measured, the
@@ -54,7 +54,7 @@ it the same minus the findings, (peak RSS - floor - findings) / triangles, where
   "Fixed costs") is not the findings' and stays in the figure.
 tests/tools/test_log.cpp checks the sizes. On the cloth steps the heap peak is reached while
 the in-memory copies are held (valgrind massif, docs/benchmarks.md "Real assets"); where a
-peak is reached before any contact exists, "minus findings" understates it by up to n x 120 bytes.
+peak is reached before any contact exists, "minus findings" understates it by up to n x 88 bytes.
 """
 
 import argparse
@@ -74,8 +74,7 @@ CCD_METHODS = ["bvh", "kdop", "dynamic", "auto"]
 LARGE_TRIANGLES = 10000  # per-method memory line: inputs this large or larger
 # Bytes of one CCD contact in each record held in memory while an interval is reported, and in the
 # log writer's row buffer (the module docstring; tests/tools/test_log.cpp checks the sizes).
-CONTACT_RECORD_BYTES = {"culling::CcdContact": 32, "culling::CcdContact (sort buffer)": 32,
-                        "tools::ContactRow (report)": 56}
+CONTACT_RECORD_BYTES = {"culling::CcdContact": 32, "tools::ContactRow (report)": 56}
 CONTACT_DISK_BYTES = 56  # tools::detail::ContactDisk
 DISK_ROWS_PER_APPEND = 8192  # the log writer's block (tools/io/log/log_writer.cpp, kRowsPerAppend)
 

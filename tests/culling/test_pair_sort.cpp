@@ -1,7 +1,7 @@
 // sort_pairs (culling/pair_sort.hpp) orders triangle pairs exactly as std::sort does: on short and
 // long spans, on ids that need few bits and on ids up to INT32_MAX, with repeated pairs, and on a
-// part of a vector whose front is left alone. sort_contacts orders CCD contacts as a stable sort by
-// CcdContact::before does, each contact's times of impact moving with it.
+// part of a vector whose front is left alone. sort_contacts orders CCD contacts as std::sort by
+// CcdContact::before and then the times does (a total order), each contact's times moving with it.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -84,16 +84,22 @@ std::vector<CcdContact> random_contacts(std::size_t n, std::int32_t largest, std
   return contacts;
 }
 
+/// CcdContact::before, then the times: sort_contacts's whole order.
+bool before_then_times(const CcdContact& a, const CcdContact& b) {
+  if (a.before(b)) return true;
+  if (b.before(a)) return false;
+  if (a.toi_lower != b.toi_lower) return a.toi_lower < b.toi_lower;
+  return a.toi_upper < b.toi_upper;
+}
+
 void expect_contacts_sorted_like_std(std::vector<CcdContact> contacts) {
   std::vector<CcdContact> expected = contacts;
-  std::stable_sort(expected.begin(), expected.end(), [](const CcdContact& a, const CcdContact& b) {
-    return a.before(b);
-  });
+  std::sort(expected.begin(), expected.end(), before_then_times);
   sort_contacts(contacts);
   EXPECT_EQ(contacts, expected);  // the times too: each record moved whole
 }
 
-TEST(ContactSort, OrdersAsAStableSortByBeforeForEverySizeAndIdRange) {
+TEST(ContactSort, OrdersByBeforeThenTheTimesForEverySizeAndIdRange) {
   const std::int32_t kLargest[] = {0, 3, 92229, std::numeric_limits<std::int32_t>::max()};
   const std::size_t kSizes[] = {0, 1, 255, 256, 257, 120000};
   std::uint32_t seed = 100;
@@ -105,16 +111,18 @@ TEST(ContactSort, OrdersAsAStableSortByBeforeForEverySizeAndIdRange) {
   }
 }
 
-TEST(ContactSort, SortsOnlyTheSpanItIsGivenAndKeepsRepeatedPairsInOrder) {
+TEST(ContactSort, SortsOnlyTheSpanItIsGivenAndOrdersRepeatedPairsByTheirTimes) {
   std::vector<CcdContact> contacts = random_contacts(3000, 20, 5);  // many repeated (kind, a, b)
   const std::vector<CcdContact> front(contacts.begin(), contacts.begin() + 500);
   std::vector<CcdContact> back(contacts.begin() + 500, contacts.end());
-  std::stable_sort(back.begin(), back.end(), [](const CcdContact& a, const CcdContact& b) {
-    return a.before(b);
-  });
+  std::sort(back.begin(), back.end(), before_then_times);
   sort_contacts(std::span(contacts).subspan(500));
   EXPECT_TRUE(std::equal(front.begin(), front.end(), contacts.begin()));
   EXPECT_TRUE(std::equal(back.begin(), back.end(), contacts.begin() + 500));
+  // The same contacts in another order sort the same: the order is total.
+  std::vector<CcdContact> reversed(contacts.rbegin(), contacts.rend() - 500);
+  sort_contacts(reversed);
+  EXPECT_TRUE(std::equal(back.begin(), back.end(), reversed.begin()));
 }
 
 }  // namespace

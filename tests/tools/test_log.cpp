@@ -899,8 +899,8 @@ TEST(Log, EachTableCachesOneOfItsChunksNotHdf5sMegabyte) {
 }
 
 TEST(Log, ContactRecordsHaveTheSizesBenchRealCounts) {
-  // scripts/bench_real.py (CONTACT_RECORD_BYTES) counts n × (32 + 32 + 56) bytes of a peak as the
-  // findings of an interval with n contacts (the contacts, their sort buffer, the report's rows,
+  // scripts/bench_real.py (CONTACT_RECORD_BYTES) counts n × (32 + 56) bytes of a peak as the
+  // findings of an interval with n contacts (the contacts, sorted in place, and the report's rows,
   // which the event tracker labels in place), and the log writer's rows (56 each, at most 8,192
   // at a time) inside its measured share: keep them in step.
   EXPECT_EQ(sizeof(skelcd::culling::CcdContact), 32u);
