@@ -73,13 +73,16 @@ std::vector<CcdContact> random_contacts(std::size_t n, std::int32_t largest, std
   std::uniform_real_distribution<double> time(0.0, 1.0);
   std::vector<CcdContact> contacts(n);
   for (auto& c : contacts) {
-    const double t = time(rng);
+    // Lower bounds repeat (three values) and upper bounds are drawn apart from them, so that a
+    // pair's contacts are ordered by each of the two times in turn.
+    const double lower = 0.25 * static_cast<double>(rng() % 3);
+    const double upper = lower + 0.5 * time(rng);
     c = {
         rng() % 2 == 0 ? CcdContact::Kind::vf : CcdContact::Kind::ee,
         id(rng),
         id(rng),
-        t,
-        t + 0.001};
+        lower,
+        upper};
   }
   return contacts;
 }
