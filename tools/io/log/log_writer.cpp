@@ -487,7 +487,6 @@ struct LogWriter::Impl {
     }
   }
 
-  /// Appends the report's contacts, DCD pairs and /frames row, then flushes with checksums.
   /// Appends `rows` to `table` kRowsPerAppend at a time, each converted by `to_disk` into
   /// `buffer`; returns their CRC (rows_crc, from 0).
   template <class Disk, class Row, class ToDisk>
@@ -509,6 +508,7 @@ struct LogWriter::Impl {
     return crc;
   }
 
+  /// Appends the report's contacts, DCD pairs and /frames row, then flushes with checksums.
   void write(const FrameReport& report) {
     // Contacts and pairs first, the /frames row last: a row on disk implies its findings are too.
     const std::uint32_t contacts_crc = append_in_blocks(
