@@ -679,6 +679,19 @@ template <bool kExclusions, class Boxes, class FaceBox>
   }
 }
 
+/// What owned_feature_pairs holds of two triangles' face diagonals: nothing (a placeholder) where
+/// `Boxes` tests no triangles first.
+template <class Boxes, bool = Boxes::kTrianglesFirst>
+struct DiagonalsOf {
+  using Corners = char;
+  using Box = char;
+};
+template <class Boxes>
+struct DiagonalsOf<Boxes, true> {
+  using Corners = typename Boxes::DiagonalCorners;
+  using Box = typename Boxes::DiagonalBox;
+};
+
 /// The feature stage of ccd_candidates_from_triangle_pairs, with the part-exclusion checks compiled
 /// in or out (`kExclusions` = topology.has_exclusions(): without exclusions every *_excluded is
 /// false), feature pairs tested on `boxes` (SweptVolumes, EndPositions or EndPositionsWide).
@@ -761,6 +774,24 @@ template <bool kExclusions, bool kFans, class Boxes>
       if (!Boxes::meet(face_a, face_b)) continue;
     }
     ++candidate_pairs;
+    // Neither triangle owns a vertex and one owns no edge: no feature pair to test (a twelfth of
+    // the candidates on the cloth-ball step, an eighth on BCN_Epileptic).
+    if (a.num_vertices == 0 && b.num_vertices == 0 && (a.num_edges == 0 || b.num_edges == 0)) {
+      continue;
+    }
+    // The two triangles apart on a face diagonal at both ends hold every pair of their features
+    // apart (the axes' argument along a fixed direction; rounded projections strictly apart are
+    // exact ones strictly apart): a candidate with no feature pairs, dropped before any feature
+    // pair is tested.
+    [[maybe_unused]] typename DiagonalsOf<Boxes>::Corners diagonals_a{}, diagonals_b{};
+    [[maybe_unused]] typename DiagonalsOf<Boxes>::Box diagonal_face_a{}, diagonal_face_b{};
+    if constexpr (Boxes::kTrianglesFirst) {
+      diagonals_a = boxes.diagonal_corners(corners_a, a.corners);
+      diagonals_b = boxes.diagonal_corners(corners_b, b.corners);
+      diagonal_face_a = Boxes::diagonal_face(diagonals_a);
+      diagonal_face_b = Boxes::diagonal_face(diagonals_b);
+      if (!Boxes::diagonal_meet(diagonal_face_a, diagonal_face_b)) continue;
+    }
     const std::size_t vf_before = num_vf;
     const std::size_t ee_before = num_ee;
     // VF: the vertices each triangle owns against the other triangle's face.
@@ -815,44 +846,30 @@ template <bool kExclusions, bool kFans, class Boxes>
       }
     }
     // Feature pairs kept, apart on a face diagonal at both ends: none of them can touch (the
-    // axes' argument along a fixed direction; rounded projections strictly apart are exact ones
-    // strictly apart). Dropped again; pairs that kept nothing are not tested. The two triangles
-    // first: apart, they hold every pair of their features apart.
+    // axes' argument along a fixed direction, as for the two triangles above). Dropped again.
     if constexpr (Boxes::kTrianglesFirst) {
-      if (num_vf != vf_before || num_ee != ee_before) {
-        const auto diagonals_a = boxes.diagonal_corners(corners_a, a.corners);
-        const auto diagonals_b = boxes.diagonal_corners(corners_b, b.corners);
-        const auto diagonal_face_a = Boxes::diagonal_face(diagonals_a);
-        const auto diagonal_face_b = Boxes::diagonal_face(diagonals_b);
-        if (!Boxes::diagonal_meet(diagonal_face_a, diagonal_face_b)) {
-          num_vf = vf_before;
-          num_ee = ee_before;
-        } else {
-          std::size_t kept = vf_before;
-          for (std::size_t r = vf_before; r < num_vf; ++r) {
-            const unsigned d = vf_slot[r];
-            const bool meet =
-                (d & kOwnedByB) != 0
-                    ? Boxes::diagonal_meet(
-                          Boxes::diagonal_vertex(diagonals_b, d & 3u), diagonal_face_a)
-                    : Boxes::diagonal_meet(
-                          Boxes::diagonal_vertex(diagonals_a, d & 3u), diagonal_face_b);
-            vf[kept] = vf[r];
-            kept += static_cast<std::size_t>(meet);
-          }
-          num_vf = kept;
-          kept = ee_before;
-          for (std::size_t r = ee_before; r < num_ee; ++r) {
-            const unsigned d = ee_slots[r];
-            const bool meet = Boxes::diagonal_meet(
-                Boxes::diagonal_edge(diagonals_a, a.edge_slots[d >> 2]),
-                Boxes::diagonal_edge(diagonals_b, b.edge_slots[d & 3u]));
-            ee[kept] = ee[r];
-            kept += static_cast<std::size_t>(meet);
-          }
-          num_ee = kept;
-        }
+      std::size_t kept = vf_before;
+      for (std::size_t r = vf_before; r < num_vf; ++r) {
+        const unsigned d = vf_slot[r];
+        const bool meet =
+            (d & kOwnedByB) != 0
+                ? Boxes::diagonal_meet(Boxes::diagonal_vertex(diagonals_b, d & 3u), diagonal_face_a)
+                : Boxes::diagonal_meet(
+                      Boxes::diagonal_vertex(diagonals_a, d & 3u), diagonal_face_b);
+        vf[kept] = vf[r];
+        kept += static_cast<std::size_t>(meet);
       }
+      num_vf = kept;
+      kept = ee_before;
+      for (std::size_t r = ee_before; r < num_ee; ++r) {
+        const unsigned d = ee_slots[r];
+        const bool meet = Boxes::diagonal_meet(
+            Boxes::diagonal_edge(diagonals_a, a.edge_slots[d >> 2]),
+            Boxes::diagonal_edge(diagonals_b, b.edge_slots[d & 3u]));
+        ee[kept] = ee[r];
+        kept += static_cast<std::size_t>(meet);
+      }
+      num_ee = kept;
     }
     if (++in_chunk == kChunkPairs) {
       flush();
