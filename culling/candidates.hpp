@@ -202,10 +202,13 @@ void ccd_candidates_from_triangle_pairs(
     const IntervalEnds& ends = {});
 
 namespace detail {
-/// For the tests: true makes ccd_candidates_from_triangle_pairs run its baseline (SSE2) build
-/// even on a CPU with AVX2, false lets it choose again. Both builds give the same pairs in the
-/// same order.
-void force_baseline_feature_stage(bool baseline);
+/// The builds of ccd_candidates_from_triangle_pairs' feature stage: `best` is the widest the CPU
+/// has (AVX-512 VL, else AVX2, else the baseline SSE2 one); all give the same pairs in the same
+/// order, with the same counters.
+enum class FeatureStageBuild { best, baseline, avx2, avx512 };
+/// For the tests: run `build` (or the widest below it that the CPU has) until asked again;
+/// `best` lets it choose again.
+void force_feature_stage_build(FeatureStageBuild build);
 }  // namespace detail
 
 /// CCD brute force: appends every VF pair (vertex on some triangle × triangle) and EE pair

@@ -46,6 +46,23 @@ inline bool cpu_has_avx2() {
 #endif
 }
 
+/// Whether this CPU and its OS have AVX-512 F, VL and DQ: builds of the AVX2 code that may also
+/// use the 16 further vector registers (and the mask registers) EVEX encodes, chosen at run time
+/// (the culling feature stage). libgcc's check includes the OS's saving of the AVX-512 state.
+/// Valgrind's CPU has no AVX-512, so under it the AVX2 builds run. Asked once per process.
+inline bool cpu_has_avx512vl() {
+#if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
+  static const bool kHas = [] {
+    __builtin_cpu_init();
+    return __builtin_cpu_supports("avx512f") != 0 && __builtin_cpu_supports("avx512vl") != 0 &&
+           __builtin_cpu_supports("avx512dq") != 0;
+  }();
+  return kHas;
+#else
+  return false;
+#endif
+}
+
 /// |v| per lane as std::abs does it: the sign bit cleared.
 inline Lanes lane_abs(Lanes v) {
   constexpr std::uint64_t kMagnitude = ~(std::uint64_t{1} << 63);

@@ -501,13 +501,17 @@ TEST(CcdCandidates, EndsOnTheAxesAndDiagonalsDropOnlyPairsThatNeverTouchAndMatch
       std::vector<TrianglePair> pairs;
       Counters counters;
       self_traverse<3>(bvh, b.bounds.triangles, scratch, pairs, counters.bv_tests);
-      for (const bool baseline : {false, true}) {
-        SCOPED_TRACE(baseline ? "baseline build" : "as the CPU allows");
-        detail::force_baseline_feature_stage(baseline);
+      using Build = detail::FeatureStageBuild;
+      for (const Build build : {Build::best, Build::avx2, Build::baseline}) {
+        SCOPED_TRACE(
+            build == Build::baseline ? "baseline build"
+            : build == Build::avx2   ? "AVX2 (or below)"
+                                     : "as the CPU allows");
+        detail::force_feature_stage_build(build);
         FeatureCandidates got;
         ccd_candidates_from_triangle_pairs<3>(
             b.topology, pairs, b.bounds, got, counters, nullptr, ends);
-        detail::force_baseline_feature_stage(false);
+        detail::force_feature_stage_build(Build::best);
         EXPECT_FALSE(has_duplicates(got.vf));
         EXPECT_FALSE(has_duplicates(got.ee));
         EXPECT_EQ(sorted(got.vf), by_ends.vf);
@@ -589,13 +593,18 @@ TEST(CcdCandidates, TheKernelsRelativeStageRejectsNoFeaturePairTheFeatureStageKe
     TraversalScratch scratch;
     std::vector<TrianglePair> pairs;
     self_traverse<8>(bvh, bounds.triangles, scratch, pairs, counters.bv_tests);
-    for (const bool baseline : {false, true}) {
-      detail::force_baseline_feature_stage(baseline);
+    using Build = detail::FeatureStageBuild;
+    for (const Build build : {Build::best, Build::avx2, Build::baseline}) {
+      SCOPED_TRACE(
+          build == Build::baseline ? "baseline build"
+          : build == Build::avx2   ? "AVX2 (or below)"
+                                   : "as the CPU allows");
+      detail::force_feature_stage_build(build);
       FeatureCandidates got;
       ccd_candidates_from_triangle_pairs<8>(t, pairs, bounds, got, counters, nullptr, ends);
-      detail::force_baseline_feature_stage(false);
+      detail::force_feature_stage_build(Build::best);
       const auto [apart, unused] = ends_apart_counts(t, c.x_t0, c.x_t1, got, FeatureCandidates{});
-      EXPECT_EQ(apart, 0) << (baseline ? "baseline build" : "as the CPU allows");
+      EXPECT_EQ(apart, 0);
       EXPECT_EQ(sorted(got.vf), brute.vf);
       EXPECT_EQ(sorted(got.ee), brute.ee);
     }

@@ -254,13 +254,13 @@ std::vector<TrianglePair> swept_box_pairs(
   return pairs;
 }
 
-TEST(FeatureStage, BothBuildsGiveTheSamePairsInTheSameOrderOnTheClothFunnelStep) {
-  // ccd_candidates_from_triangle_pairs runs an AVX2 build of its feature stage where the CPU has
-  // it (EndPositionsWide) and its SSE2 build elsewhere: the same pairs in the same order and the
-  // same counters, with and without the interval's vertex fans, on a real step whose triangle
-  // pairs the face diagonals drop in numbers; the AVX2 build also from the positions packed a
-  // line per vertex (PackedEnds, as the methods hand them over). On a CPU without AVX2 every run
-  // takes the baseline.
+TEST(FeatureStage, EveryBuildGivesTheSamePairsInTheSameOrderOnTheClothFunnelStep) {
+  // ccd_candidates_from_triangle_pairs runs an AVX-512 VL build of its feature stage where the CPU
+  // has it, else an AVX2 build (both on EndPositionsWide), else its SSE2 build: the same pairs in
+  // the same order and the same counters, with and without the interval's vertex fans, on a real
+  // step whose triangle pairs the face diagonals drop in numbers; the wide builds also from the
+  // positions packed a line per vertex (PackedEnds, as the methods hand them over). A build the
+  // CPU lacks runs the widest below it (the runs then compare a build with itself).
   const test::OpenScene s = test::cloth_funnel_scene(test::asset("cloth-funnel/frames"));
   const FeatureTopology features(s.mesh, s.topo);
   const skinning::Positions& x_t0 = s.frames[0];
@@ -269,10 +269,11 @@ TEST(FeatureStage, BothBuildsGiveTheSamePairsInTheSameOrderOnTheClothFunnelStep)
   ASSERT_GT(pairs.size(), 50000u);
   PackedEnds packed;
   packed.pack(x_t0, x_t1);
+  using Build = detail::FeatureStageBuild;
   for (const bool with_fans : {false, true}) {
     SCOPED_TRACE(with_fans ? "with fans" : "without fans");
-    const auto run = [&](bool baseline, const double* packed_ends = nullptr) {
-      detail::force_baseline_feature_stage(baseline);
+    const auto run = [&](Build build, const double* packed_ends = nullptr) {
+      detail::force_feature_stage_build(build);
       IntervalFans fans;
       fans.start(features.fans(), x_t0, x_t1, features.num_vertices());
       FeatureCandidates out;
@@ -285,21 +286,22 @@ TEST(FeatureStage, BothBuildsGiveTheSamePairsInTheSameOrderOnTheClothFunnelStep)
           counters,
           with_fans ? &fans : nullptr,
           {&x_t0, &x_t1, packed_ends});
-      detail::force_baseline_feature_stage(false);
+      detail::force_feature_stage_build(Build::best);
       return std::make_pair(std::move(out), counters);
     };
-    const auto [wide, wide_counters] = run(false);
-    const auto [baseline, baseline_counters] = run(true);
-    const auto [from_packed, packed_counters] = run(false, packed.data());
-    EXPECT_GT(wide.ee.size(), 2000u);
-    EXPECT_TRUE(wide.vf == baseline.vf);
-    EXPECT_TRUE(wide.ee == baseline.ee);
-    EXPECT_TRUE(from_packed.vf == baseline.vf);
-    EXPECT_TRUE(from_packed.ee == baseline.ee);
-    EXPECT_EQ(wide_counters.candidate_pairs, baseline_counters.candidate_pairs);
-    EXPECT_EQ(wide_counters.feature_bv_tests, baseline_counters.feature_bv_tests);
-    EXPECT_EQ(packed_counters.candidate_pairs, baseline_counters.candidate_pairs);
-    EXPECT_EQ(packed_counters.feature_bv_tests, baseline_counters.feature_bv_tests);
+    const auto [baseline, baseline_counters] = run(Build::baseline);
+    EXPECT_GT(baseline.ee.size(), 2000u);
+    for (const Build build : {Build::avx2, Build::avx512}) {
+      SCOPED_TRACE(build == Build::avx2 ? "AVX2" : "AVX-512 VL");
+      for (const double* packed_ends : {static_cast<const double*>(nullptr), packed.data()}) {
+        SCOPED_TRACE(packed_ends != nullptr ? "packed ends" : "positions");
+        const auto [wide, wide_counters] = run(build, packed_ends);
+        EXPECT_TRUE(wide.vf == baseline.vf);
+        EXPECT_TRUE(wide.ee == baseline.ee);
+        EXPECT_EQ(wide_counters.candidate_pairs, baseline_counters.candidate_pairs);
+        EXPECT_EQ(wide_counters.feature_bv_tests, baseline_counters.feature_bv_tests);
+      }
+    }
   }
 }
 
