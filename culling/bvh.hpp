@@ -273,9 +273,6 @@ class Bvh {
   /// Whether the slots' float volumes hold the triangles' whole volumes (every axis) of the last
   /// refit: true after refit_swept, false after refit() and refit_wide().
   [[nodiscard]] bool slot_volumes_whole() const { return slot_whole_; }
-  /// Whether the tree keeps binary node volumes (BvhOptions::node_volumes): refit_swept and
-  /// refit_swept_and_ends need a tree without.
-  [[nodiscard]] bool has_node_volumes() const { return node_volumes_; }
   /// Axes of a slot volume past the first kSlotAxes: N − kSlotAxes (none for an AABB).
   static constexpr int kSlotDiagonals = N - kSlotAxes;
   /// The slots' float volumes on axis kSlotAxes + k, k < kSlotDiagonals, by slot as slot_lo /

@@ -343,26 +343,6 @@ constexpr std::size_t kNear = 8;
 /// (bench/real/ab_dcd.py, 2026-11-28).
 constexpr std::int32_t kPrefetchFrom = 32768;
 
-/// Whether the boxes of two triangles (corner ids `a`, `b`) at positions x lie apart on a
-/// coordinate axis: the negation of Dop<3>::overlaps on FeatureBounds::static_triangles' volumes,
-/// from the corners (the extremes of doubles are exact: the same answer bit for bit).
-[[gnu::always_inline]] inline bool boxes_apart(
-    const skinning::Positions& x,
-    const std::array<std::int32_t, 3>& a,
-    const std::array<std::int32_t, 3>& b) {
-  const double* const p = x.data();  // row-major: vertex v at p + 3 v
-  bool apart = false;
-  for (std::size_t k = 0; k < 3; ++k) {
-    const auto c = [&](std::int32_t v) { return p[3 * static_cast<std::size_t>(v) + k]; };
-    const double a_lo = std::min(std::min(c(a[0]), c(a[1])), c(a[2]));
-    const double a_hi = std::max(std::max(c(a[0]), c(a[1])), c(a[2]));
-    const double b_lo = std::min(std::min(c(b[0]), c(b[1])), c(b[2]));
-    const double b_hi = std::max(std::max(c(b[0]), c(b[1])), c(b[2]));
-    apart = apart | (a_lo > b_hi) | (b_lo > a_hi);
-  }
-  return apart;
-}
-
 void dcd_tests(
     const FeatureTopology& topology,
     std::span<const TrianglePair> pairs,
@@ -372,8 +352,7 @@ void dcd_tests(
     std::span<const ccd::TrianglePlane> planes,
     bool filter,
     bool sorted,
-    FrameResult& out,
-    bool boxes_first = false) {
+    FrameResult& out) {
   assert(tests.triangles != nullptr);
   assert(
       planes.empty() || (tests.triangles == &ccd::triangles_intersect &&
@@ -410,10 +389,6 @@ void dcd_tests(
         const TrianglePair& p = pairs[i];
         assert(p.a < p.b);
         o.kept = true;
-        if (boxes_first && boxes_apart(x, topology.triangle(p.a), topology.triangle(p.b))) {
-          o = Outcome{.hit = false, .tested = false, .kept = false};
-          return;
-        }
         if (filter && topology.triangles_excluded(p.a, p.b)) {
           o = Outcome{.hit = false, .tested = false, .kept = false};
           return;
@@ -511,19 +486,8 @@ void filter_and_run_dcd_tests(
     const ElementaryTests& tests,
     std::span<const std::uint8_t> certified,
     std::span<const ccd::TrianglePlane> planes,
-    FrameResult& out,
-    bool boxes_first) {
-  dcd_tests(
-      topology,
-      pairs,
-      x,
-      tests,
-      certified,
-      planes,
-      /*filter=*/true,
-      /*sorted=*/false,
-      out,
-      boxes_first);
+    FrameResult& out) {
+  dcd_tests(topology, pairs, x, tests, certified, planes, /*filter=*/true, /*sorted=*/false, out);
 }
 
 void dcd_planes(

@@ -151,9 +151,6 @@ void dcd_planes(
 /// with each pair's shared corners looked up once (the traversing methods' blocks). The
 /// intersecting pairs are appended in the order of `pairs`, not sorted: PairBlocks::finish sorts a
 /// query's pairs once, after its last block.
-/// @param boxes_first drop first, as no candidate, a pair whose triangles' boxes at x lie apart on
-/// a coordinate axis (the exact test a traversal over whole float slots leaves out: see
-/// sieved_dcd_at); the pairs that reach the rest are those an exact leaf test would have passed.
 /// @param planes dcd_planes at x, or empty (the test computes each pair's planes).
 void filter_and_run_dcd_tests(
     const FeatureTopology& topology,
@@ -162,7 +159,6 @@ void filter_and_run_dcd_tests(
     const ElementaryTests& tests,
     std::span<const std::uint8_t> certified_fans,
     std::span<const ccd::TrianglePlane> planes,
-    FrameResult& out,
-    bool boxes_first = false);
+    FrameResult& out);
 
 }  // namespace skelcd::culling

@@ -98,11 +98,9 @@ void PairBlocks<N>::start_dcd(
     const FeatureTopology& topology,
     const skinning::Positions& x,
     const ElementaryTests& tests,
-    FrameResult& out,
-    bool boxes_first) {
+    FrameResult& out) {
   start(topology, tests, out);
   continuous_ = false;
-  boxes_first_ = boxes_first;
   x_t0_ = &x;
   x_t1_ = &x;
   first_ = out.dcd_pairs.size();
@@ -213,8 +211,7 @@ void PairBlocks<N>::flush_block(std::vector<TrianglePair>& block) {
         fans_,
         use_planes_ ? std::span<const ccd::TrianglePlane>(planes_)
                     : std::span<const ccd::TrianglePlane>{},
-        out,
-        boxes_first_);
+        out);
     feature_us_ += micros(t0, t1);
     test_us_ += micros(t1, Clock::now());
   }

@@ -61,15 +61,12 @@ class PairBlocks {
   /// Starts a DCD query at x: each block → (a, b) ordered → filter_and_run_dcd_tests (the DCD
   /// filter and the tests in one pass) into `out`, with the vertex fans certified once here, and
   /// the triangles' planes computed once at the first block when it holds at least
-  /// min(block_pairs, #triangles) pairs (the planes change no answer, only the time). With
-  /// `boxes_first`, the filter first drops the pairs whose triangles' boxes lie apart at x
-  /// (filter_and_run_dcd_tests), for a producer whose leaves tested float slots only.
+  /// min(block_pairs, #triangles) pairs (the planes change no answer, only the time).
   void start_dcd(
       const FeatureTopology& topology,
       const skinning::Positions& x,
       const ElementaryTests& tests,
-      FrameResult& out,
-      bool boxes_first = false);
+      FrameResult& out);
 
   /// The DCD query's certified vertex fans (empty when the tests do not use them): what a
   /// FanSieve of the producer may settle pairs with.
@@ -185,7 +182,6 @@ class PairBlocks {
   std::vector<std::uint8_t> interval_flags_;  ///< CCD: certify_interval_fans' flags
   std::vector<ccd::TrianglePlane> planes_;  ///< the DCD instant's (dcd_planes); kept across queries
   bool use_planes_ = false;  ///< planes_ holds this instant's planes (the first block decides)
-  bool boxes_first_ = false;  ///< start_dcd's boxes_first
   std::size_t first_ = 0;    ///< out's findings before this query
   std::int64_t blocks_ = 0;
   std::int64_t candidates_at_start_ = 0;  ///< out.counters.candidate_pairs at start_*

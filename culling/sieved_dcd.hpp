@@ -4,7 +4,6 @@
 // share a vertex whose fan is certified at the instant settled where the traversal meets them
 // (FanSieve, culling/traversal.hpp; docs/culling.md "DCD").
 
-#include <cassert>
 #include <chrono>
 #include <cstdint>
 #include <span>
@@ -67,26 +66,12 @@ void sieved_dcd_at(
     return std::chrono::duration<double, std::micro>(to - from).count();
   };
   const auto t0 = Clock::now();
-  // An AABB tree without binary node volumes: each slot's float box straight from its corners
-  // (refit_swept with both ends at x: whole slots), no triangle volumes written and read back by
-  // id; the leaves then test the floats alone, and the DCD filter applies the exact test of the
-  // two boxes first, on the corners it reads anyway — the same pairs, tests and counters
-  // (docs/culling.md, "Whole slots in the DCD"). A 16-DOP's diagonal axes would need their
-  // bracketed exact test there too: `kdop` keeps the volumes.
-  bool boxes_first = false;
-  if constexpr (N == 3) boxes_first = !bvh.has_node_volumes();
-  if (boxes_first) {
-    bvh.refit_swept(topology.welded_triangles(), x, x);
-    bounds.triangles.clear();  // not read: the leaves test whole slots
-  } else {
-    bounds.static_triangles(topology, x);
-    bvh.refit(bounds.triangles);
-  }
+  bounds.static_triangles(topology, x);
+  bvh.refit(bounds.triangles);
   const auto t1 = Clock::now();
   // Self traversal → overlapping triangle pairs → the DCD rules → tests, in blocks as the CCD
   // (bounded memory), the vertex fans certified once for the instant.
-  blocks.start_dcd(topology, x, tests, out, boxes_first);
-  assert(!boxes_first || bvh.slot_volumes_whole());
+  blocks.start_dcd(topology, x, tests, out);
   sieved_self_dcd<N>(bvh, bounds.triangles, topology, slots, full_slots, scratch, blocks, out);
   blocks.finish();
   const auto t2 = Clock::now();

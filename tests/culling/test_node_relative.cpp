@@ -22,13 +22,9 @@
 #include "culling/bvh.hpp"
 #include "culling/candidates.hpp"
 #include "culling/cluster_checks.hpp"
-#include "culling/elementary.hpp"
 #include "culling/feature_topology.hpp"
-#include "culling/frame_result.hpp"
 #include "culling/method.hpp"
-#include "culling/pair_blocks.hpp"
 #include "culling/relative_aabb.hpp"
-#include "culling/sieved_dcd.hpp"
 #include "culling/traversal.hpp"
 #include "culling/vertex_bounds.hpp"
 #include "skinning/load.hpp"
@@ -598,57 +594,6 @@ TEST(WholeSlots, TheWalkOnWholeSlotsKeepsEveryExactPairAndOnlyFloatStepsMore) {
   // A refit() makes the walk read the exact volumes again: the exact pairs.
   bvh.refit(swept.triangles);
   EXPECT_EQ(walk(swept.triangles), exact);
-}
-
-// The DCD over an AABB tree without node volumes (sieved_dcd_at: `bvh`'s) refits whole slots from
-// the corners and stores no boxes by id; its filter then makes the exact box test the leaves leave
-// out. So it finds the pairs, and counts the candidates, triangle tests and box tests, of the
-// stored boxes' path (a tree with node volumes) — on CesiumMan moved 10^4 away, where a float step
-// is about a millimetre and the whole slots let many pairs through that the exact boxes hold apart.
-TEST(WholeSlots, TheDcdOnWholeSlotsFindsAndCountsWhatTheStoredBoxesDo) {
-  const Model m("CesiumMan.glb");
-  const FeatureTopology ft(*m.loaded.mesh, m.topology);
-  skinning::Positions far = m.sample(20);
-  far.array() += 1e4;
-  // The floats keep pairs the exact boxes drop (else this proved nothing).
-  {
-    AabbBvh tree(ft.welded_triangles(), m.rest, BvhOptions{.node_volumes = false});
-    const auto walk = [&](std::span<const Dop<3>> bounds) {
-      TraversalScratch scratch;
-      std::vector<TrianglePair> pairs;
-      std::int64_t bv_tests = 0;
-      self_traverse<3>(tree, bounds, scratch, pairs, bv_tests);
-      return pairs.size();
-    };
-    FeatureBounds<3> boxes;
-    boxes.static_triangles(ft, far);
-    tree.refit(boxes.triangles);
-    const std::size_t exact = walk(boxes.triangles);
-    tree.refit_swept(ft.welded_triangles(), far, far);
-    EXPECT_GT(walk({}), exact + 100) << exact;
-  }
-  const ElementaryTests tests = with_ccd_defaults({});
-  const auto dcd = [&](bool node_volumes) {
-    AabbBvh tree(ft.welded_triangles(), m.rest, BvhOptions{.node_volumes = node_volumes});
-    const SlotAdjacency slots(ft, tree.triangle_order());
-    std::vector<std::uint8_t> full_slots;
-    FeatureBounds<3> bounds;
-    TraversalScratch scratch;
-    scratch.reserve_self(tree);
-    PairBlocks<3> blocks;
-    FrameResult out;
-    sieved_dcd_at<3>(far, tree, bounds, ft, slots, full_slots, scratch, blocks, tests, out);
-    EXPECT_EQ(tree.slot_volumes_whole(), !node_volumes);
-    return out;
-  };
-  const FrameResult stored = dcd(true);
-  const FrameResult whole = dcd(false);
-  EXPECT_GT(stored.counters.dcd_pairs, 0);
-  EXPECT_EQ(whole.dcd_pairs, stored.dcd_pairs);
-  EXPECT_EQ(whole.counters.dcd_pairs, stored.counters.dcd_pairs);
-  EXPECT_EQ(whole.counters.candidate_pairs, stored.counters.candidate_pairs);
-  EXPECT_EQ(whole.counters.tt_tests, stored.counters.tt_tests);
-  EXPECT_EQ(whole.counters.bv_tests, stored.counters.bv_tests);
 }
 
 // refit_swept fills no binary node volumes: on a tree that has them it refuses and changes nothing.
