@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
 #include <bit>
 #include <cmath>
 #include <cstdint>
@@ -30,6 +31,25 @@
 
 namespace skelcd::culling {
 namespace {
+
+using detail::FeatureStageBuild;
+
+/// The feature stage's builds the tests run: the widest the CPU has, AVX2 (or the baseline where
+/// the CPU lacks it) and the baseline SSE2 one (ccd_candidates_from_triangle_pairs).
+constexpr std::array<FeatureStageBuild, 3> kEveryBuild{
+    FeatureStageBuild::best, FeatureStageBuild::avx2, FeatureStageBuild::baseline};
+
+/// A build's name in a failure's trace.
+const char* build_name(FeatureStageBuild build) {
+  switch (build) {
+    case FeatureStageBuild::baseline:
+      return "baseline build";
+    case FeatureStageBuild::avx2:
+      return "AVX2 (or below)";
+    default:
+      return "as the CPU allows";
+  }
+}
 
 struct Scene {
   std::string name;
@@ -501,17 +521,13 @@ TEST(CcdCandidates, EndsOnTheAxesAndDiagonalsDropOnlyPairsThatNeverTouchAndMatch
       std::vector<TrianglePair> pairs;
       Counters counters;
       self_traverse<3>(bvh, b.bounds.triangles, scratch, pairs, counters.bv_tests);
-      using Build = detail::FeatureStageBuild;
-      for (const Build build : {Build::best, Build::avx2, Build::baseline}) {
-        SCOPED_TRACE(
-            build == Build::baseline ? "baseline build"
-            : build == Build::avx2   ? "AVX2 (or below)"
-                                     : "as the CPU allows");
+      for (const FeatureStageBuild build : kEveryBuild) {
+        SCOPED_TRACE(build_name(build));
         detail::force_feature_stage_build(build);
         FeatureCandidates got;
         ccd_candidates_from_triangle_pairs<3>(
             b.topology, pairs, b.bounds, got, counters, nullptr, ends);
-        detail::force_feature_stage_build(Build::best);
+        detail::force_feature_stage_build(FeatureStageBuild::best);
         EXPECT_FALSE(has_duplicates(got.vf));
         EXPECT_FALSE(has_duplicates(got.ee));
         EXPECT_EQ(sorted(got.vf), by_ends.vf);
@@ -593,16 +609,12 @@ TEST(CcdCandidates, TheKernelsRelativeStageRejectsNoFeaturePairTheFeatureStageKe
     TraversalScratch scratch;
     std::vector<TrianglePair> pairs;
     self_traverse<8>(bvh, bounds.triangles, scratch, pairs, counters.bv_tests);
-    using Build = detail::FeatureStageBuild;
-    for (const Build build : {Build::best, Build::avx2, Build::baseline}) {
-      SCOPED_TRACE(
-          build == Build::baseline ? "baseline build"
-          : build == Build::avx2   ? "AVX2 (or below)"
-                                   : "as the CPU allows");
+    for (const FeatureStageBuild build : kEveryBuild) {
+      SCOPED_TRACE(build_name(build));
       detail::force_feature_stage_build(build);
       FeatureCandidates got;
       ccd_candidates_from_triangle_pairs<8>(t, pairs, bounds, got, counters, nullptr, ends);
-      detail::force_feature_stage_build(Build::best);
+      detail::force_feature_stage_build(FeatureStageBuild::best);
       const auto [apart, unused] = ends_apart_counts(t, c.x_t0, c.x_t1, got, FeatureCandidates{});
       EXPECT_EQ(apart, 0);
       EXPECT_EQ(sorted(got.vf), brute.vf);
