@@ -264,6 +264,15 @@ RadialViewMethod::RadialViewMethod(
   bounds_.triangles.reserve(num_faces);
   cluster_bounds_.resize(num_atomic);
   triangle_mask_.assign(num_faces, culling::kMaskOther);
+  // Rigid rows given for the real triangles (the runner's welded numbering: the capped mesh's
+  // ghosts come after them and have none).
+  if (method_options.rigid_rows != nullptr &&
+      method_options.rigid_rows->triangle_row.size() == at(real_triangles_)) {
+    rigid_rows_ = method_options.rigid_rows;
+    row_of_.assign(num_faces, -1);
+    row_certified_.reserve(at(rigid_rows_->num_rows()));
+    rest_pairs_.reserve(rigid_rows_->rest_pairs.size());
+  }
   node_masks_.resize(num_atomic);
   std::size_t deepest = 0;
   for (std::int32_t a = 0; a < clusters_.num_atomic(); ++a) {
@@ -769,9 +778,67 @@ void RadialViewMethod::compute_masks() {
 
 // --- intra- and inter-cluster checks (§6) ---------------------------------------------------------
 
+bool RadialViewMethod::certify_rows(const culling::Interval& interval) {
+  rest_pairs_.clear();
+  rows_live_ = false;
+  if (!rigid_rows_ || interval.bones_t0.empty() || interval.bones_t1.empty()) return false;
+  const culling::RigidRows& rows = *rigid_rows_;
+  culling::certify_rigid_rows(
+      rows, interval.bones_t0, interval.bones_t1, method_options_.min_separation, row_certified_);
+  for (const std::uint8_t c : row_certified_) stats_.rows_certified += c;
+  if (stats_.rows_certified == 0) return false;
+  for (std::int32_t f = 0; f < real_triangles_; ++f) {
+    const std::int32_t r = rows.triangle_row[at(f)];
+    row_of_[at(f)] = r >= 0 && row_certified_[at(r)] != 0 ? r : -1;
+  }
+  for (const culling::TrianglePair& p : rows.rest_pairs) {
+    if (row_of_[at(p.a)] >= 0) rest_pairs_.push_back(p);
+  }
+  stats_.rest_pairs = static_cast<std::int64_t>(rest_pairs_.size());
+  rows_live_ = true;
+  return true;
+}
+
+std::int64_t RadialViewMethod::drop_row_pairs(
+    std::vector<culling::TrianglePair>& pairs, std::size_t first) const {
+  const auto kept = std::remove_if(
+      pairs.begin() + static_cast<std::ptrdiff_t>(first),
+      pairs.end(),
+      [&](const culling::TrianglePair& p) {
+        const std::int32_t r = row_of_[at(p.a)];
+        return r >= 0 && r == row_of_[at(p.b)];
+      });
+  const auto dropped = static_cast<std::int64_t>(pairs.end() - kept);
+  pairs.erase(kept, pairs.end());
+  return dropped;
+}
+
+void RadialViewMethod::stream_rest_pairs(double half_width) {
+  if (rest_pairs_.empty()) return;
+  std::size_t next = 0;
+  blocks_.drain([&](std::vector<culling::TrianglePair>& pairs, std::size_t max_pairs) {
+    // At most an installment's worth at a time, so that a block stays bounded.
+    const std::size_t first = pairs.size();
+    const std::size_t take =
+        std::min(rest_pairs_.size() - next, max_pairs > first ? max_pairs - first : std::size_t{1});
+    pairs.insert(
+        pairs.end(),
+        rest_pairs_.begin() + static_cast<std::ptrdiff_t>(next),
+        rest_pairs_.begin() + static_cast<std::ptrdiff_t>(next + take));
+    next += take;
+    if (filters_pairs()) {
+      stats_.relative_aabb_culled += relative_filter_.filter(topology_, half_width, pairs, first);
+    }
+    return next == rest_pairs_.size();
+  });
+}
+
 std::int64_t RadialViewMethod::traverse(double half_width, culling::FrameResult& out) {
   const std::span<const culling::Aabb> tri_bounds(bounds_.triangles);
   std::int64_t& bv_tests = out.counters.bv_tests;
+  // Rigid rows (docs/radial-view.md "Rigid rows"): the certified rows' rest pairs are tested
+  // first; the walks' pairs of two triangles of one such row are dropped below.
+  if (rows_live_) stream_rest_pairs(half_width);
   // Each traversal runs in installments; the pairs of an installment go through the relative AABB
   // filter (§6) as they come, and every full block is tested before the traversal goes on.
   std::int64_t found = 0;
@@ -780,6 +847,7 @@ std::int64_t RadialViewMethod::traverse(double half_width, culling::FrameResult&
       const std::size_t first = pairs.size();
       const bool done = some(pairs, max_pairs);
       found += static_cast<std::int64_t>(pairs.size() - first);
+      if (rows_live_) stats_.rigid_pairs_skipped += drop_row_pairs(pairs, first);
       if (filters_pairs()) {
         stats_.relative_aabb_culled += relative_filter_.filter(topology_, half_width, pairs, first);
       }
@@ -932,6 +1000,8 @@ std::int64_t RadialViewMethod::retest_frontier(
         }
       }
     }
+    // A rest pair was tested at the start (stream_rest_pairs); the row's other pairs need none.
+    if (rows_live_) stats_.rigid_pairs_skipped += drop_row_pairs(pairs, first);
     found += static_cast<std::int64_t>(pairs.size() - first);
     if (filters_pairs()) {
       stats_.relative_aabb_culled += relative_filter_.filter(topology_, half_width, pairs, first);
@@ -966,6 +1036,7 @@ void RadialViewMethod::ccd(const culling::Interval& interval, culling::FrameResu
   stats_ = RadialViewStats{};
   const std::int32_t num_components = clusters_.num_components();
   stats_.components = num_components;
+  certify_rows(interval);
 
   // 1. Which components the radial-view argument may be applied to in this interval, and where
   //    in them: the intersecting pairs at the start, the uncut patches and their winding numbers.

@@ -68,8 +68,9 @@ struct RadialViewStats {
   /// Components with a triangle escalated: a self-contact touched its skippable triangles.
   std::int32_t components_escalated = 0;
   std::int64_t relative_aabb_culled = 0;  ///< candidate pairs removed by the relative AABB filter
-  std::int64_t skipped_pairs_retested = 0;  ///< overlapping skipped pairs tested on escalation
-  std::int64_t escalation_contacts = 0;     ///< contacts found only by the escalation passes
+  /// Overlapping skipped pairs tested on escalation (a certified rigid row's own not counted).
+  std::int64_t skipped_pairs_retested = 0;
+  std::int64_t escalation_contacts = 0;  ///< contacts found only by the escalation passes
   /// Blocks of candidate triangle pairs tested, all passes (MethodOptions::block_pairs each).
   std::int64_t blocks = 0;
   // The local guard (docs/radial-view.md, "The local guard").
@@ -85,6 +86,10 @@ struct RadialViewStats {
   std::int32_t ghost_loops = 0;          ///< boundary loops closed by ghost triangles
   std::int64_t ghost_contacts = 0;       ///< contacts of a ghost's features (used, not reported)
   std::int64_t ghost_pairs_skipped = 0;  ///< candidate pairs of two ghosts, never tested
+  // Rigid rows (culling/rigid_rows.hpp, docs/radial-view.md "Rigid rows").
+  std::int32_t rows_certified = 0;       ///< rows the interval certifies
+  std::int64_t rigid_pairs_skipped = 0;  ///< walked pairs of two triangles of one such row
+  std::int64_t rest_pairs = 0;           ///< those rows' rest pairs, tested instead
 };
 
 class RadialViewMethod final : public culling::CullingMethod {
@@ -187,6 +192,15 @@ class RadialViewMethod final : public culling::CullingMethod {
   /// Streams the skipped pairs of frontier_'s triangles into blocks_ (each once: not with a
   /// triangle of an earlier round), through the relative AABB filter; returns the pairs found.
   std::int64_t retest_frontier(std::int32_t round, double half_width, culling::FrameResult& out);
+  /// Certifies the rigid rows for `interval` (its own bone transforms; none without them):
+  /// row_of_ gets each triangle's row when certified, else −1, and rest_pairs_ the certified
+  /// rows' rest pairs. Returns whether any triangle has a certified row.
+  bool certify_rows(const culling::Interval& interval);
+  /// Removes from pairs[first, end) every pair of two triangles of one certified row (their
+  /// order kept) and returns how many: no such pair can touch (culling/rigid_rows.hpp).
+  std::int64_t drop_row_pairs(std::vector<culling::TrianglePair>& pairs, std::size_t first) const;
+  /// Streams rest_pairs_ into blocks_ (a query started there), through the relative AABB filter.
+  void stream_rest_pairs(double half_width);
   void record_dcd(const skinning::Positions& x, const culling::FrameResult& result);
   /// detect_dcd's hierarchy (dcd_): `bvh`'s tree over the welded triangles and the slots its fan
   /// sieve reads (culling/sieved_dcd.hpp).
@@ -269,6 +283,13 @@ class RadialViewMethod final : public culling::CullingMethod {
   std::vector<std::int32_t> frontier_;   // triangles escalated in the current round
   std::vector<std::uint8_t> component_escalated_;
   std::vector<culling::TrianglePair> cluster_pairs_;
+  // Rigid rows (MethodOptions::rigid_rows, when given for this mesh's triangles): per row this
+  // interval, per triangle its certified row or −1, and the certified rows' rest pairs.
+  std::shared_ptr<const culling::RigidRows> rigid_rows_;
+  std::vector<std::uint8_t> row_certified_;
+  std::vector<std::int32_t> row_of_;
+  std::vector<culling::TrianglePair> rest_pairs_;
+  bool rows_live_ = false;
   // The candidate triangle pairs of a pass, in bounded blocks (docs/culling.md "Bounded memory").
   culling::PairBlocks<3> blocks_;
   culling::TraversalScratch scratch_;

@@ -68,6 +68,8 @@ culling::MethodInfo radial_view_info(
       .name = std::move(name),
       .description = std::move(description),
       .needs = {.bone_poses = true, .segmentation = true},
+      // Its CCD drops the pairs of a certified rigid row (docs/radial-view.md "Rigid rows").
+      .takes_rigid_rows = true,
       .serial_reason =
           [n](const culling::MethodOptions& options, bool dcd_before_each_ccd) {
             return carried_state(n, options, dcd_before_each_ccd);

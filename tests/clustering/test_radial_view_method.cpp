@@ -14,6 +14,7 @@
 #include "clustering/radial_view_method.hpp"
 #include "clustering/radial_view_methods.hpp"
 #include "culling/method_registry.hpp"
+#include "culling/rigid_rows.hpp"
 #include "culling/routed_method.hpp"
 #include "skinning/errors.hpp"
 #include "skinning/generators.hpp"
@@ -270,6 +271,114 @@ TEST(RadialViewMethod, RealCharacters) {
     const auto c = compare(scene, k.first, k.last, test::DcdQueries::every);
     for (const auto& f : c.dynamic.frames) EXPECT_GT(f.counters.atomic_clusters, 0);
   }
+}
+
+/// `method` over intervals [first, last) of the scene's clip with the bone transforms the runner
+/// gives every interval (Motion::bone_transforms: the rigid rows are certified from them).
+ClipRun run_with_transforms(
+    RadialViewScene& scene, culling::CullingMethod& method, std::int32_t first, std::int32_t last) {
+  ClipRun run;
+  skinning::Positions x0, x1;
+  std::vector<skinning::BoneTransform> b0, b1;
+  scene.welded(first, x1);
+  scene.motion->bone_transforms(first, b1);
+  for (std::int32_t i = first; i < last; ++i) {
+    std::swap(x0, x1);
+    std::swap(b0, b1);
+    scene.welded(i + 1, x1);
+    scene.motion->bone_transforms(i + 1, b1);
+    culling::FrameResult out;
+    method.detect_ccd(
+        culling::Interval{
+            .x_t0 = x0,
+            .x_t1 = x1,
+            .bones_t0 = b0,
+            .bones_t1 = b1,
+            .sample_t0 = i,
+            .sample_t1 = i + 1},
+        out);
+    for (const auto& c : out.contacts) run.contacts.push_back({i, c.kind, c.a, c.b});
+    if (const auto* rv = dynamic_cast<const RadialViewMethod*>(&method)) {
+      run.stats.push_back(rv->last_stats());
+    }
+    run.frames.push_back(std::move(out));
+  }
+  std::sort(run.contacts.begin(), run.contacts.end());
+  return run;
+}
+
+std::shared_ptr<const culling::RigidRows> rows_of(const RadialViewScene& scene) {
+  const skinning::SkinWeights& w = *scene.motion->skin_weights();
+  return std::make_shared<const culling::RigidRows>(culling::build_rigid_rows(
+      scene.rig->mesh, scene.topology, w, static_cast<std::int32_t>(w.cols())));
+}
+
+TEST(RadialViewMethod, RigidRowsDropTheirPairsAndEveryContactStays) {
+  // docs/radial-view.md "Rigid rows": the pairs of two triangles of one row an interval certifies
+  // are dropped from the walks and re-tests, the row's rest pairs tested instead. The ninja's
+  // shells touch at rest within one row (the rest pairs carry those contacts), the robot's parts
+  // hang rigidly from nodes, Testwuson walks.
+  struct Case {
+    std::filesystem::path path;
+    std::int32_t first;
+    std::int32_t last;
+  };
+  const std::vector<Case> cases = {
+      {test::asset("characters/ninja/ninja.mesh"), 0, 30},
+      {test::asset("characters/RobotExpressive.glb"), 20, 32},
+      {test::assimp_model("X/Testwuson.X"), 0, 10},
+  };
+  for (const auto& k : cases) {
+    SCOPED_TRACE(k.path.string());
+    RadialViewScene scene(loaded(k.path), 0);
+    const auto rows = rows_of(scene);
+    ASSERT_GT(rows->num_rows(), 0);
+    auto bvh = scene.method("bvh");
+    const ClipRun reference = run_with_transforms(scene, *bvh, k.first, k.last);
+    ASSERT_FALSE(reference.contacts.empty());
+    for (const char* name : {"rvbc", "dynamic"}) {
+      SCOPED_TRACE(name);
+      auto plain = scene.method(name);
+      auto skipping = scene.method(name, {}, culling::MethodOptions{.rigid_rows = rows});
+      const ClipRun without = run_with_transforms(scene, *plain, k.first, k.last);
+      const ClipRun with = run_with_transforms(scene, *skipping, k.first, k.last);
+      EXPECT_EQ(without.contacts, reference.contacts);
+      EXPECT_EQ(with.contacts, reference.contacts);
+      std::int64_t skipped = 0;
+      std::int32_t certified = 0;
+      for (const auto& st : with.stats) {
+        skipped += st.rigid_pairs_skipped;
+        certified += st.rows_certified;
+      }
+      for (const auto& st : without.stats) EXPECT_EQ(st.rigid_pairs_skipped, 0);
+      // The local guard's re-tests drop them too (its rounds re-test fewer pairs).
+      std::int64_t retested_with = 0;
+      std::int64_t retested_without = 0;
+      for (const auto& st : with.stats) retested_with += st.skipped_pairs_retested;
+      for (const auto& st : without.stats) retested_without += st.skipped_pairs_retested;
+      EXPECT_LT(retested_with, retested_without);
+      EXPECT_GT(certified, 0);
+      EXPECT_GT(skipped, 0);
+      // Fewer pairs reach the feature stage: a tenth fewer at least on these rigs.
+      EXPECT_LT(
+          10 * total(with, &culling::Counters::candidate_pairs),
+          9 * total(without, &culling::Counters::candidate_pairs));
+    }
+  }
+}
+
+TEST(RadialViewMethod, WithoutItsRestPairsDynamicWouldLoseTheNinjasContacts) {
+  // The rest pairs are what keeps the contacts of shells that touch at rest within one row: the
+  // same drop without them loses some (so the test above could fail).
+  RadialViewScene scene(loaded(test::asset("characters/ninja/ninja.mesh")), 0);
+  auto rows = std::make_shared<culling::RigidRows>(*rows_of(scene));
+  ASSERT_FALSE(rows->rest_pairs.empty());
+  rows->rest_pairs.clear();
+  auto plain = scene.method("dynamic");
+  auto skipping = scene.method("dynamic", {}, culling::MethodOptions{.rigid_rows = rows});
+  EXPECT_LT(
+      run_with_transforms(scene, *skipping, 0, 30).contacts.size(),
+      run_with_transforms(scene, *plain, 0, 30).contacts.size());
 }
 
 TEST(RadialViewMethod, CesiumMansWalkIntersectsItselfAndTheLocalGuardStillFindsWhatBvhFinds) {

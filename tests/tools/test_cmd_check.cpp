@@ -182,6 +182,38 @@ TEST(CmdCheck, NoReuseQueriesEveryIntervalOfAHeldPoseAndFindsTheSame) {
   EXPECT_NE(logs[1].header.command_line.find("--no-reuse"), std::string::npos);
 }
 
+// The runner gives `dynamic` the rigid rows (docs/radial-view.md "Rigid rows") unless
+// `--no-rigid-rows`: on RobotExpressive, whose parts hang rigidly from nodes, the same contacts and
+// DCD pairs row by row (the logs' rows whole), fewer candidate pairs over the clip's start.
+TEST(CmdCheck, DynamicTakesTheRigidRowsAndFindsTheSame) {
+  const auto dir = skelcd::test::temp_dir("check-dynamic-rows");
+  const std::string model = skelcd::test::asset("characters/RobotExpressive.glb").string();
+  std::vector<LogData> logs;
+  for (const bool rows : {false, true}) {
+    const auto log_path = (dir / (rows ? "rows.h5" : "none.h5")).string();
+    std::vector<std::string> args{
+        "check", model, "--frames", "20:30", "--method", "dynamic", "-o", log_path};
+    if (!rows) args.emplace_back("--no-rigid-rows");
+    const auto r = run_skelcd(args);
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    logs.push_back(read_log(log_path));
+  }
+  ASSERT_EQ(logs[0].frames.size(), logs[1].frames.size());
+  ASSERT_FALSE(logs[0].contacts.empty());
+  EXPECT_EQ(logs[0].contacts, logs[1].contacts);
+  EXPECT_EQ(logs[0].dcd_pairs, logs[1].dcd_pairs);
+  std::int64_t without = 0;
+  std::int64_t with = 0;
+  for (std::size_t i = 0; i < logs[0].frames.size(); ++i) {
+    EXPECT_LE(
+        logs[1].frames[i].counters.candidate_pairs, logs[0].frames[i].counters.candidate_pairs)
+        << i;
+    without += logs[0].frames[i].counters.candidate_pairs;
+    with += logs[1].frames[i].counters.candidate_pairs;
+  }
+  EXPECT_LT(with, without);
+}
+
 // A frame sequence is checked in a spatial order unless `--mesh-order file` asks for the files':
 // the cloth-funnel step gives the same findings either way, every feature named by its index in
 // the files (an EE pair or a DCD pair may list its two features the other way round).

@@ -699,9 +699,9 @@ void add_check_command(CLI::App& app) {
   cmd->add_flag(
       "--no-rigid-rows",
       args->no_rigid_rows,
-      "kdop, and auto where it sends a whole mesh to bvh: test the pairs that skinning moves by "
-      "one matrix too; by default their CCD skips them where the interval certifies their row "
-      "(the same contacts, docs/culling.md \"Rigid rows\")");
+      "kdop, rvbc, dynamic and auto: test the pairs that skinning moves by one matrix too; by "
+      "default their CCD skips them where the interval certifies their row (the same contacts, "
+      "docs/culling.md \"Rigid rows\")");
   cmd->add_flag("--json", args->json, "print the summary as one JSON object");
   cmd->add_option(
          "--baseline",
