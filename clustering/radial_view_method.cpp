@@ -270,6 +270,19 @@ RadialViewMethod::RadialViewMethod(
       method_options.rigid_rows->triangle_row.size() == at(real_triangles_)) {
     rigid_rows_ = method_options.rigid_rows;
     row_of_.assign(num_faces, -1);
+    cluster_row_.assign(num_atomic, -1);
+    cluster_live_row_.assign(num_atomic, -1);
+    for (std::int32_t a = 0; a < clusters_.num_atomic(); ++a) {
+      const auto faces = clusters_.triangles(a);
+      std::int32_t row = faces.empty() || faces.front() >= real_triangles_
+                             ? -1
+                             : rigid_rows_->triangle_row[at(faces.front())];
+      for (const std::int32_t f : faces) {
+        if (row < 0) break;
+        if (f >= real_triangles_ || rigid_rows_->triangle_row[at(f)] != row) row = -1;
+      }
+      cluster_row_[at(a)] = row;
+    }
     row_certified_.reserve(at(rigid_rows_->num_rows()));
     rest_pairs_.reserve(rigid_rows_->rest_pairs.size());
   }
@@ -791,6 +804,10 @@ bool RadialViewMethod::certify_rows(const culling::Interval& interval) {
     const std::int32_t r = rows.triangle_row[at(f)];
     row_of_[at(f)] = r >= 0 && row_certified_[at(r)] != 0 ? r : -1;
   }
+  for (std::size_t a = 0; a < cluster_row_.size(); ++a) {
+    const std::int32_t r = cluster_row_[a];
+    cluster_live_row_[a] = r >= 0 && row_certified_[at(r)] != 0 ? r : -1;
+  }
   for (const culling::TrianglePair& p : rows.rest_pairs) {
     if (row_of_[at(p.a)] >= 0) rest_pairs_.push_back(p);
   }
@@ -868,7 +885,16 @@ std::int64_t RadialViewMethod::traverse(double half_width, culling::FrameResult&
     });
   };
   // Intra-cluster: each atomic cluster against itself, with the masks of its mega cluster.
+  // A cluster (or two) whose triangles all have one certified row holds no pair to test.
+  const auto one_row = [&](std::int32_t a, std::int32_t b) {
+    if (!rows_live_) return false;
+    const std::int32_t r = cluster_live_row_[at(a)];
+    if (r < 0 || r != cluster_live_row_[at(b)]) return false;
+    ++stats_.rigid_walks_skipped;
+    return true;
+  };
   for (std::int32_t a = 0; a < clusters_.num_atomic(); ++a) {
+    if (one_row(a, a)) continue;
     const auto& local = clusters_.local_bvh(a);
     culling::start_masked_self_traversal<3>(local, scratch_);
     stream([&](std::vector<culling::TrianglePair>& pairs, std::size_t max_pairs) {
@@ -887,6 +913,7 @@ std::int64_t RadialViewMethod::traverse(double half_width, culling::FrameResult&
   // one mega cluster with masks (intra-cluster check across atomic clusters), across mega
   // clusters without (inter-cluster check).
   for (const auto& cp : cluster_pairs_) {
+    if (one_row(cp.a, cp.b)) continue;
     const bool same_mega = classes_.atomic_mega[at(cp.a)] == classes_.atomic_mega[at(cp.b)];
     const auto& local_a = clusters_.local_bvh(cp.a);
     const auto& local_b = clusters_.local_bvh(cp.b);
@@ -965,8 +992,11 @@ std::int64_t RadialViewMethod::retest_frontier(
       const std::uint8_t mask = triangle_mask_[at(t)];
       const culling::Aabb& box = tri_bounds[at(t)];
       const std::int32_t mega = classes_.atomic_mega[at(clusters_.atomic_of(t))];
+      const std::int32_t row = rows_live_ ? row_of_[at(t)] : -1;
       for (std::int32_t a = 0; a < clusters_.num_atomic(); ++a) {
         if (classes_.atomic_mega[at(a)] != mega) continue;
+        // Every triangle of `a` in t's certified row: no pair of t's there to re-test.
+        if (row >= 0 && cluster_live_row_[at(a)] == row) continue;
         ++bv_tests;
         if (!cluster_bounds_[at(a)].overlaps(box)) continue;
         // Down the cluster's wide copy: a lane whose node holds no triangle of t's mask, or

@@ -89,7 +89,10 @@ struct RadialViewStats {
   // Rigid rows (culling/rigid_rows.hpp, docs/radial-view.md "Rigid rows").
   std::int32_t rows_certified = 0;       ///< rows the interval certifies
   std::int64_t rigid_pairs_skipped = 0;  ///< walked pairs of two triangles of one such row
-  std::int64_t rest_pairs = 0;           ///< those rows' rest pairs, tested instead
+  /// Cluster walks not made (a cluster against itself, or two clusters) because every triangle
+  /// in them has the same certified row.
+  std::int64_t rigid_walks_skipped = 0;
+  std::int64_t rest_pairs = 0;  ///< those rows' rest pairs, tested instead
 };
 
 class RadialViewMethod final : public culling::CullingMethod {
@@ -289,6 +292,9 @@ class RadialViewMethod final : public culling::CullingMethod {
   std::vector<std::uint8_t> row_certified_;
   std::vector<std::int32_t> row_of_;
   std::vector<culling::TrianglePair> rest_pairs_;
+  // Per atomic cluster: the row all its triangles share, or −1 (built with the rows); this
+  // interval, that row when certified, else −1 (its walks then hold only pairs to drop).
+  std::vector<std::int32_t> cluster_row_, cluster_live_row_;
   bool rows_live_ = false;
   // The candidate triangle pairs of a pass, in bounded blocks (docs/culling.md "Bounded memory").
   culling::PairBlocks<3> blocks_;

@@ -345,9 +345,11 @@ TEST(RadialViewMethod, RigidRowsDropTheirPairsAndEveryContactStays) {
       EXPECT_EQ(without.contacts, reference.contacts);
       EXPECT_EQ(with.contacts, reference.contacts);
       std::int64_t skipped = 0;
+      std::int64_t walks_skipped = 0;  // clusters (or two) of one certified row, not walked
       std::int32_t certified = 0;
       for (const auto& st : with.stats) {
         skipped += st.rigid_pairs_skipped;
+        walks_skipped += st.rigid_walks_skipped;
         certified += st.rows_certified;
       }
       for (const auto& st : without.stats) EXPECT_EQ(st.rigid_pairs_skipped, 0);
@@ -359,6 +361,7 @@ TEST(RadialViewMethod, RigidRowsDropTheirPairsAndEveryContactStays) {
       EXPECT_LT(retested_with, retested_without);
       EXPECT_GT(certified, 0);
       EXPECT_GT(skipped, 0);
+      EXPECT_GT(walks_skipped, 0);
       // Fewer pairs reach the feature stage: a tenth fewer at least on these rigs.
       EXPECT_LT(
           10 * total(with, &culling::Counters::candidate_pairs),
