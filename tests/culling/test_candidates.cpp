@@ -34,10 +34,10 @@ namespace {
 
 using detail::FeatureStageBuild;
 
-/// The feature stage's builds the tests run: the widest the CPU has, AVX2 (or the baseline where
-/// the CPU lacks it) and the baseline SSE2 one (ccd_candidates_from_triangle_pairs).
+/// The feature stage's builds the tests run: AVX-512, AVX2 and the baseline SSE2 one
+/// (ccd_candidates_from_triangle_pairs), each clamped to the widest the CPU has.
 constexpr std::array<FeatureStageBuild, 3> kEveryBuild{
-    FeatureStageBuild::best, FeatureStageBuild::avx2, FeatureStageBuild::baseline};
+    FeatureStageBuild::avx512, FeatureStageBuild::avx2, FeatureStageBuild::baseline};
 
 /// A build's name in a failure's trace.
 const char* build_name(FeatureStageBuild build) {
@@ -46,9 +46,12 @@ const char* build_name(FeatureStageBuild build) {
       return "baseline build";
     case FeatureStageBuild::avx2:
       return "AVX2 (or below)";
-    default:
+    case FeatureStageBuild::avx512:
+      return "AVX-512 (or below)";
+    case FeatureStageBuild::best:
       return "as the CPU allows";
   }
+  return "?";
 }
 
 struct Scene {
