@@ -8,6 +8,7 @@
 #include <cstdint>
 #include <map>
 #include <memory>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -99,6 +100,11 @@ enum class DcdQueries : std::uint8_t {
   every,  ///< a DCD at every interval's start sample (`check --query both`)
 };
 
+/// The bone transforms an interval carries: the fixture's BonePoses (the bones the observers
+/// ride), or the motion's own (Motion::bone_transforms: the bones, then any part attachments —
+/// what the runner gives every interval, and what rigid rows are certified from).
+enum class Transforms : std::uint8_t { poses, motion };
+
 /// `method`'s CCD of the interval from x0 (sample i) to x1 (sample i + 1), the bone poses of the
 /// two samples selected first, into `out`.
 inline void interval_ccd(
@@ -107,14 +113,21 @@ inline void interval_ccd(
     std::int32_t i,
     const skinning::Positions& x0,
     const skinning::Positions& x1,
-    culling::FrameResult& out) {
+    culling::FrameResult& out,
+    Transforms transforms = Transforms::poses) {
   scene.poses->select_samples(i, i + 1);
+  std::vector<skinning::BoneTransform> b0, b1;
+  if (transforms == Transforms::motion) {
+    scene.motion->bone_transforms(i, b0);
+    scene.motion->bone_transforms(i + 1, b1);
+  }
+  const bool own = transforms == Transforms::motion;
   method.detect_ccd(
       culling::Interval{
           .x_t0 = x0,
           .x_t1 = x1,
-          .bones_t0 = scene.poses->t0(),
-          .bones_t1 = scene.poses->t1(),
+          .bones_t0 = own ? std::span<const skinning::BoneTransform>(b0) : scene.poses->t0(),
+          .bones_t1 = own ? std::span<const skinning::BoneTransform>(b1) : scene.poses->t1(),
           .sample_t0 = i,
           .sample_t1 = i + 1},
       out);
@@ -126,7 +139,8 @@ inline ClipRun run_clip(
     culling::CullingMethod& method,
     std::int32_t first,
     std::int32_t last,
-    DcdQueries dcd = DcdQueries::none) {
+    DcdQueries dcd = DcdQueries::none,
+    Transforms transforms = Transforms::poses) {
   ClipRun run;
   skinning::Positions x0, x1;
   scene.welded(first, x1);
@@ -140,7 +154,7 @@ inline ClipRun run_clip(
       out.clear();
     }
     const auto start = std::chrono::steady_clock::now();
-    interval_ccd(scene, method, i, x0, x1, out);
+    interval_ccd(scene, method, i, x0, x1, out, transforms);
     run.ccd_ms.push_back(
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count());
     for (const auto& c : out.contacts) run.contacts.push_back({i, c.kind, c.a, c.b});

@@ -274,37 +274,10 @@ TEST(RadialViewMethod, RealCharacters) {
 }
 
 /// `method` over intervals [first, last) of the scene's clip with the bone transforms the runner
-/// gives every interval (Motion::bone_transforms: the rigid rows are certified from them).
+/// gives every interval (the rigid rows are certified from them).
 ClipRun run_with_transforms(
     RadialViewScene& scene, culling::CullingMethod& method, std::int32_t first, std::int32_t last) {
-  ClipRun run;
-  skinning::Positions x0, x1;
-  std::vector<skinning::BoneTransform> b0, b1;
-  scene.welded(first, x1);
-  scene.motion->bone_transforms(first, b1);
-  for (std::int32_t i = first; i < last; ++i) {
-    std::swap(x0, x1);
-    std::swap(b0, b1);
-    scene.welded(i + 1, x1);
-    scene.motion->bone_transforms(i + 1, b1);
-    culling::FrameResult out;
-    method.detect_ccd(
-        culling::Interval{
-            .x_t0 = x0,
-            .x_t1 = x1,
-            .bones_t0 = b0,
-            .bones_t1 = b1,
-            .sample_t0 = i,
-            .sample_t1 = i + 1},
-        out);
-    for (const auto& c : out.contacts) run.contacts.push_back({i, c.kind, c.a, c.b});
-    if (const auto* rv = dynamic_cast<const RadialViewMethod*>(&method)) {
-      run.stats.push_back(rv->last_stats());
-    }
-    run.frames.push_back(std::move(out));
-  }
-  std::sort(run.contacts.begin(), run.contacts.end());
-  return run;
+  return run_clip(scene, method, first, last, test::DcdQueries::none, test::Transforms::motion);
 }
 
 std::shared_ptr<const culling::RigidRows> rows_of(const RadialViewScene& scene) {
