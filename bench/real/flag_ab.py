@@ -1,6 +1,8 @@
 #!/usr/bin/env python3
-"""A/B of one skelcd build with and without a `check` flag: REPEAT alternating rounds (the run
-with the flag first in each), each row's least total and traverse ms over the rounds
+"""A/B of one skelcd build with and without a `check` flag: REPEAT rounds of both runs, the run
+with the flag first in odd rounds and last in even ones (with it always first, Testwuson's
+`dynamic` read 0.84x with --no-rigid-rows where alternating rounds read 1.08x: the first of two
+back-to-back runs was the faster on this VM), each row's least total and traverse ms over the rounds
 (`skelcd inspect --frames`: each row's own stage times, the steadier reading on these VMs), their
 means over the rows with flag/without, the summaries' candidate pairs and set-up ms, and whether
 the contacts agree (exit 1 when the VF or EE contact counts differ, or the logs' /contacts do).
@@ -41,8 +43,8 @@ def main():
     least, summary, contacts = {}, {}, {}
     with tempfile.TemporaryDirectory() as logs:
         log = os.path.join(logs, "check.h5")
-        for _ in range(repeat):
-            for side in ("with", "without"):
+        for r in range(repeat):
+            for side in ("with", "without") if r % 2 == 0 else ("without", "with"):
                 s, rows, body = run(exe, args + ([flag] if side == "with" else []), log)
                 old = least.get(side)
                 least[side] = rows if old is None else [
