@@ -791,15 +791,15 @@ void RadialViewMethod::compute_masks() {
 
 // --- intra- and inter-cluster checks (§6) ---------------------------------------------------------
 
-bool RadialViewMethod::certify_rows(const culling::Interval& interval) {
+void RadialViewMethod::certify_rows(const culling::Interval& interval) {
   rest_pairs_.clear();
   rows_live_ = false;
-  if (!rigid_rows_ || interval.bones_t0.empty() || interval.bones_t1.empty()) return false;
+  if (!rigid_rows_ || interval.bones_t0.empty() || interval.bones_t1.empty()) return;
   const culling::RigidRows& rows = *rigid_rows_;
   culling::certify_rigid_rows(
       rows, interval.bones_t0, interval.bones_t1, method_options_.min_separation, row_certified_);
   for (const std::uint8_t c : row_certified_) stats_.rows_certified += c;
-  if (stats_.rows_certified == 0) return false;
+  if (stats_.rows_certified == 0) return;
   for (std::int32_t f = 0; f < real_triangles_; ++f) {
     const std::int32_t r = rows.triangle_row[at(f)];
     row_of_[at(f)] = r >= 0 && row_certified_[at(r)] != 0 ? r : -1;
@@ -813,7 +813,6 @@ bool RadialViewMethod::certify_rows(const culling::Interval& interval) {
   }
   stats_.rest_pairs = static_cast<std::int64_t>(rest_pairs_.size());
   rows_live_ = true;
-  return true;
 }
 
 std::int64_t RadialViewMethod::drop_row_pairs(

@@ -197,8 +197,8 @@ class RadialViewMethod final : public culling::CullingMethod {
   std::int64_t retest_frontier(std::int32_t round, double half_width, culling::FrameResult& out);
   /// Certifies the rigid rows for `interval` (its own bone transforms; none without them):
   /// row_of_ gets each triangle's row when certified, else −1, and rest_pairs_ the certified
-  /// rows' rest pairs. Returns whether any triangle has a certified row.
-  bool certify_rows(const culling::Interval& interval);
+  /// rows' rest pairs; rows_live_ says whether any row is certified.
+  void certify_rows(const culling::Interval& interval);
   /// Removes from pairs[first, end) every pair of two triangles of one certified row (their
   /// order kept) and returns how many: no such pair can touch (culling/rigid_rows.hpp).
   std::int64_t drop_row_pairs(std::vector<culling::TrianglePair>& pairs, std::size_t first) const;

@@ -116,12 +116,12 @@ inline void interval_ccd(
     culling::FrameResult& out,
     Transforms transforms = Transforms::poses) {
   scene.poses->select_samples(i, i + 1);
+  const bool own = transforms == Transforms::motion;
   std::vector<skinning::BoneTransform> b0, b1;
-  if (transforms == Transforms::motion) {
+  if (own) {
     scene.motion->bone_transforms(i, b0);
     scene.motion->bone_transforms(i + 1, b1);
   }
-  const bool own = transforms == Transforms::motion;
   method.detect_ccd(
       culling::Interval{
           .x_t0 = x0,
