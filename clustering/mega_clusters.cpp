@@ -15,6 +15,10 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 constexpr std::int64_t kNoLimit = std::numeric_limits<std::int64_t>::max();
+// MegaClusterBuilder's kept outcomes of a cluster against a joint.
+constexpr std::uint8_t kUntried = 0;
+constexpr std::uint8_t kPassed = 1;
+constexpr std::uint8_t kFailed = 2;
 
 std::size_t at(std::int32_t i) { return static_cast<std::size_t>(i); }
 
@@ -93,14 +97,53 @@ MegaClusterBuilder::MegaClusterBuilder(const ClusterSet& clusters, const MegaClu
   unplaced_slot_.assign(num_atomic, -1);
   queue_.reserve(num_atomic + 2 * clusters.joints().size());
   tried_by_.assign(num_atomic, 0);
+  joint_offsets_.assign(1, 0);
+  for (std::int32_t a = 0; a < clusters.num_atomic(); ++a) {
+    const auto first = joint_ids_.size();
+    for (const ClusterNeighbour& nb : clusters.neighbours(a)) {
+      if (std::find(
+              joint_ids_.begin() + static_cast<std::ptrdiff_t>(first), joint_ids_.end(), nb.edge) ==
+          joint_ids_.end()) {
+        joint_ids_.push_back(nb.edge);
+      }
+    }
+    joint_offsets_.push_back(static_cast<std::int32_t>(joint_ids_.size()));
+  }
+  joint_outcomes_.assign(joint_ids_.size(), kUntried);
+  joint_failures_.resize(joint_ids_.size());
+}
+
+std::int32_t MegaClusterBuilder::joint_slot(std::int32_t a, std::int32_t e) const {
+  for (auto i = joint_offsets_[at(a)]; i < joint_offsets_[at(a) + 1]; ++i) {
+    if (joint_ids_[at(i)] == e) return i;
+  }
+  return -1;
+}
+
+bool MegaClusterBuilder::evaluate_at_joint(
+    std::int32_t a,
+    std::int32_t e,
+    const MovingObserver& joint,
+    std::int64_t limit,
+    IntervalClasses& out) {
+  const std::int32_t slot = joint_slot(a, e);
+  if (slot < 0) return evaluate(a, joint, limit, out);
+  std::vector<std::int32_t>& failed_on = joint_failures_[at(slot)];
+  const bool passed = evaluate(a, joint, limit, out, failed_on);
+  joint_outcomes_[at(slot)] = passed ? kPassed : kFailed;
+  // A failure's non-positive triangles (at most `limit`): the next evaluation here starts there.
+  failed_on.assign(passed ? found_.end() : found_.begin(), found_.end());
+  return passed;
 }
 
 bool MegaClusterBuilder::evaluate(
     std::int32_t a,
     const MovingObserver& observer,
     std::int64_t limit,
-    IntervalClasses& out) {
+    IntervalClasses& out,
+    std::span<const std::int32_t> first) {
   const auto start = Clock::now();
+  found_.clear();
   if (++evaluation_ == 0) {  // the stamps wrapped around: clear them once
     std::fill(stamp_.begin(), stamp_.end(), 0u);
     evaluation_ = 1;
@@ -123,7 +166,10 @@ bool MegaClusterBuilder::evaluate(
     out.triangle_class[at(f)] = c;
     stamp_[at(f)] = evaluation_;
     ++classified;
-    if (c != OrientationClass::positive) ++non_positive;
+    if (c != OrientationClass::positive) {
+      ++non_positive;
+      found_.push_back(f);
+    }
     return non_positive < limit;
   };
   // The triangles are screened four at a time (screen_classes_x4: the classes classify gives
@@ -158,11 +204,16 @@ bool MegaClusterBuilder::evaluate(
     batch[in_batch++] = f;
     return in_batch < 4 || flush();
   };
-  // Last interval's non-positive triangles first: they decide most failing merges early.
+  // The triangles a failing evaluation against this observer found last, then last interval's
+  // non-positive triangles: they decide most failing merges early. Each list's stamps are set
+  // before the next is looked at.
+  for (auto i = first.begin(); i != first.end() && below; ++i) below = classify_one(*i);
+  below = below && flush();
   const auto p_begin = previous_offsets_[at(a)];
   const auto p_end = previous_offsets_[at(a) + 1];
-  for (auto i = p_begin; i < p_end && below; ++i) below = classify_one(previous_[at(i)]);
-  // Their stamps are set before the cluster's own triangles are looked at.
+  for (auto i = p_begin; i < p_end && below; ++i) {
+    if (stamp_[at(previous_[at(i)])] != evaluation_) below = classify_one(previous_[at(i)]);
+  }
   below = below && flush();
   if (below) {
     for (const std::int32_t f : clusters_.triangles(a)) {
@@ -276,17 +327,42 @@ void MegaClusterBuilder::build(
     // Both must stay below γ against that joint (the seed's triangles are re-classified too:
     // they are no longer seen from their own primitive).
     MovingObserver joint;
+    joint.kind = segmentation::ObserverKind::point;
     std::int32_t second = -1;
+    std::int32_t joint_edge = -1;
+    // The seed's classes are for seed_joint (it passed there) until it is classified again; the
+    // joints it failed at need no neighbour classified.
+    std::int32_t seed_joint = -1;
+    seed_failed_.clear();
+    const auto seed_passes = [&](std::int32_t e) {
+      if (seed_joint == e) return true;
+      seed_joint = -1;
+      if (!evaluate_at_joint(seed, e, joint, limit(seed), out)) {
+        seed_failed_.push_back(e);
+        return false;
+      }
+      seed_joint = e;
+      return true;
+    };
     for (const ClusterNeighbour& nb : clusters_.neighbours(seed)) {
       if (placed(nb.cluster)) continue;
-      joint.kind = segmentation::ObserverKind::point;
-      joint.point = observers.joints[at(nb.edge)];
       ++out.merge_attempts;
-      if (evaluate(nb.cluster, joint, limit(nb.cluster), out) &&
-          evaluate(seed, joint, limit(seed), out)) {
-        second = nb.cluster;
-        break;
-      }
+      const std::int32_t e = nb.edge;
+      if (std::find(seed_failed_.begin(), seed_failed_.end(), e) != seed_failed_.end()) continue;
+      joint.point = observers.joints[at(e)];
+      // Both must pass; the seed first when it failed here last interval and the neighbour
+      // did not.
+      const auto failed_before = [&](std::int32_t a) {
+        const std::int32_t slot = joint_slot(a, e);
+        return slot >= 0 && joint_outcomes_[at(slot)] == kFailed;
+      };
+      const bool seed_first = seed_joint != e && failed_before(seed) && !failed_before(nb.cluster);
+      if (seed_first && !seed_passes(e)) continue;
+      if (!evaluate_at_joint(nb.cluster, e, joint, limit(nb.cluster), out)) continue;
+      if (!seed_passes(e)) continue;
+      second = nb.cluster;
+      joint_edge = e;
+      break;
     }
     if (second < 0) {
       // Nothing joins: the seed keeps its own observer (point or line).
@@ -314,7 +390,7 @@ void MegaClusterBuilder::build(
       if (placed(c) || tried_by_[at(c)] == stamp) continue;
       tried_by_[at(c)] = stamp;
       ++out.merge_attempts;
-      if (!evaluate(c, joint, limit(c), out)) continue;
+      if (!evaluate_at_joint(c, joint_edge, joint, limit(c), out)) continue;
       place(c);
       out.atomic_mega[at(c)] = out.num_mega() - 1;
       out.mega_members.push_back(c);

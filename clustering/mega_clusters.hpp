@@ -102,13 +102,26 @@ class MegaClusterBuilder {
 
  private:
   /// Classifies the triangles of atomic cluster a against `observer` into out.triangle_class,
-  /// last interval's non-positive ones first; stops as soon as the non-positive count reaches
-  /// `limit` (then returns false). Returns true when it stays below the limit.
+  /// those of `first` first, then last interval's non-positive ones; stops as soon as the
+  /// non-positive count reaches `limit` (then returns false). Returns true when it stays below
+  /// the limit. The outcome does not depend on the order; the work does. The non-positive
+  /// triangles it met are left in found_.
   bool evaluate(
       std::int32_t a,
       const MovingObserver& observer,
       std::int64_t limit,
+      IntervalClasses& out,
+      std::span<const std::int32_t> first = {});
+  /// evaluate() against joint e (ClusterSet::joints), its outcome kept for the next interval.
+  bool evaluate_at_joint(
+      std::int32_t a,
+      std::int32_t e,
+      const MovingObserver& joint,
+      std::int64_t limit,
       IntervalClasses& out);
+  /// The slot of a's kept outcome against joint e (e one of the joints a meets a neighbour at),
+  /// else −1.
+  [[nodiscard]] std::int32_t joint_slot(std::int32_t a, std::int32_t e) const;
   void remember_non_positive(IntervalClasses& out);
 
   const ClusterSet& clusters_;
@@ -126,6 +139,15 @@ class MegaClusterBuilder {
   std::vector<std::int32_t> unplaced_, unplaced_slot_, queue_;
   std::vector<std::uint32_t> tried_by_;
   std::uint32_t mega_stamp_ = 0;
+  // Per atomic cluster, the joints it meets its neighbours at (CSR) and its last outcome against
+  // each (kUntried, kPassed, kFailed), kept over the intervals: a merge of two clusters needs
+  // both to pass, and the one that failed last time is classified first (the merge's outcome is
+  // the same in either order, only the classifications it takes differ).
+  std::vector<std::int32_t> joint_offsets_, joint_ids_;
+  std::vector<std::uint8_t> joint_outcomes_;
+  std::vector<std::vector<std::int32_t>> joint_failures_;  // per slot: what its last failure met
+  std::vector<std::int32_t> found_;                        // evaluate's non-positive triangles
+  std::vector<std::int32_t> seed_failed_;  // joints the current seed failed at in this interval
 };
 
 /// The limit on non-positive triangles for an atomic cluster of `size` triangles: D < γ holds
