@@ -742,33 +742,39 @@ void RadialViewMethod::compute_masks() {
   // (representative triangles, culling/feature_topology.hpp) is pure with that label: then every
   // feature pair the triangle pair produces joins two pure features of one sign, which is what
   // the argument rules out (docs/radial-view.md, "Why features, not triangles").
-  const auto label = [&](std::int32_t f) -> std::int64_t {
+  const auto label = [&](std::int32_t f) -> std::int32_t {
     const std::int32_t k = clusters_.component_of_triangle(f);
     // Ghost triangles are Hᵘ: tested against everything, never skipped.
     if (culled_[at(k)] == 0 || skippable_[at(f)] == 0 || f >= real_triangles_) return -1;
     const OrientationClass c = classes_.triangle_class[at(f)];
     if (c == OrientationClass::uncertain) return -1;
     const std::int32_t mega = classes_.atomic_mega[at(clusters_.atomic_of(f))];
-    return 2 * static_cast<std::int64_t>(mega) + (c == OrientationClass::negative ? 1 : 0);
+    return 2 * mega + (c == OrientationClass::negative ? 1 : 0);
   };
+  // A feature is pure with label l when every triangle at it has label l. Only the features a
+  // labelled triangle owns are asked about, each by its one owner: decided there. An edge's
+  // triangles are its owner and the neighbour across it (face_neighbours_), the edge's list only
+  // where it has more than two; the labels are 4 bytes (on a 28k-triangle mesh the edges' lists
+  // and 8-byte labels it read before no longer fitted the second-level cache).
   const std::int32_t num_faces = topology_.num_triangles();
   for (std::int32_t f = 0; f < num_faces; ++f) triangle_label_[at(f)] = label(f);
-  // A feature is pure with label l when every triangle at it has label l. Only the features a
-  // labelled triangle owns are asked about, each by its one owner: decided there.
-  const auto vertex_pure = [&](std::int32_t w, std::int64_t l) {
+  const auto vertex_pure = [&](std::int32_t w, std::int32_t l) {
     for (const std::int32_t f : updater_.vertex_triangles(w)) {
       if (triangle_label_[at(f)] != l) return false;
     }
     return true;
   };
-  const auto edge_pure = [&](std::int32_t e, std::int64_t l) {
-    for (const std::int32_t f : updater_.edge_triangles(e)) {
-      if (triangle_label_[at(f)] != l) return false;
+  const auto edge_pure = [&](std::int32_t f, int side, std::int32_t l) {
+    const std::int32_t n = face_neighbours_[3 * at(f) + at(side)];
+    if (n >= 0) return triangle_label_[at(n)] == l;
+    if (n == kNoNeighbour) return true;  // a boundary edge: f is its only triangle
+    for (const std::int32_t g : updater_.edge_triangles(topology_.face_edge(f, side))) {
+      if (triangle_label_[at(g)] != l) return false;
     }
     return true;
   };
   for (std::int32_t f = 0; f < num_faces; ++f) {
-    const std::int64_t l = triangle_label_[at(f)];
+    const std::int32_t l = triangle_label_[at(f)];
     std::uint8_t mask = culling::kMaskOther;
     if (l >= 0) {
       const std::uint8_t owned = topology_.owned(f);
@@ -776,9 +782,7 @@ void RadialViewMethod::compute_masks() {
       bool pure = true;
       for (int k = 0; k < 3 && pure; ++k) {
         if ((owned & (1u << k)) != 0 && !vertex_pure(corners[at(k)], l)) pure = false;
-        if (pure && (owned & (1u << (3 + k))) != 0 && !edge_pure(topology_.face_edge(f, k), l)) {
-          pure = false;
-        }
+        if (pure && (owned & (1u << (3 + k))) != 0 && !edge_pure(f, k, l)) pure = false;
       }
       if (pure) mask = (l & 1) != 0 ? culling::kMaskNegative : culling::kMaskPositive;
     }

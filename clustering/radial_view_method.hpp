@@ -273,7 +273,7 @@ class RadialViewMethod final : public culling::CullingMethod {
   std::vector<culling::Aabb> cluster_bounds_;
   std::vector<std::uint8_t> triangle_mask_;
   std::vector<culling::ClassMasks> node_masks_;  // per atomic cluster
-  std::vector<std::int64_t> triangle_label_;     // compute_masks'
+  std::vector<std::int32_t> triangle_label_;     // compute_masks'
   std::vector<Status> status_;                   // per component, at the interval's start
   std::vector<std::uint8_t> culled_;     // per component: pairs may be skipped this interval
   std::vector<std::uint8_t> cut_;        // per triangle: in a self-intersecting pair at the start
