@@ -303,7 +303,7 @@ RadialViewMethod::RadialViewMethod(
   component_escalated_.assign(num_components, 0);
   cut_.assign(num_faces, 0);
   skippable_.assign(num_faces, 0);
-  patch_.assign(num_faces, -1);
+  taken_.assign(num_faces, 0);
   escalated_.assign(num_faces, 0);
   patch_order_.reserve(num_faces);
   // Component → triangles (CSR, from Topology::components), for the rays of the patches.
@@ -575,7 +575,9 @@ void RadialViewMethod::build_patches() {
   patch_order_.clear();
   patch_offsets_.assign(1, 0);
   component_patches_.assign(at(num_components) + 1, 0);
-  std::fill(patch_.begin(), patch_.end(), -1);
+  // A triangle is taken (cut, or in a patch already) when its byte is set: one byte read per
+  // neighbour met.
+  std::copy(cut_.begin(), cut_.end(), taken_.begin());
   for (std::int32_t k = 0; k < num_components; ++k) {
     component_patches_[at(k)] = static_cast<std::int32_t>(patch_offsets_.size() - 1);
     if (culled_[at(k)] == 0 || status_[at(k)] != Status::dirty) continue;
@@ -583,14 +585,13 @@ void RadialViewMethod::build_patches() {
     const auto last = static_cast<std::ptrdiff_t>(component_offsets_[at(k) + 1]);
     for (std::ptrdiff_t i = first; i < last; ++i) {
       const std::int32_t seed = component_triangles_[static_cast<std::size_t>(i)];
-      if (cut_[at(seed)] != 0 || patch_[at(seed)] >= 0) continue;
-      const auto id = static_cast<std::int32_t>(patch_offsets_.size() - 1);
+      if (taken_[at(seed)] != 0) continue;
       std::size_t head = patch_order_.size();
       patch_order_.push_back(seed);
-      patch_[at(seed)] = id;
+      taken_[at(seed)] = 1;
       const auto join = [&](std::int32_t g) {
-        if (cut_[at(g)] != 0 || patch_[at(g)] >= 0) return;
-        patch_[at(g)] = id;
+        if (taken_[at(g)] != 0) return;
+        taken_[at(g)] = 1;
         patch_order_.push_back(g);
       };
       while (head < patch_order_.size()) {

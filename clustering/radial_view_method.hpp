@@ -278,7 +278,7 @@ class RadialViewMethod final : public culling::CullingMethod {
   std::vector<std::uint8_t> culled_;     // per component: pairs may be skipped this interval
   std::vector<std::uint8_t> cut_;        // per triangle: in a self-intersecting pair at the start
   std::vector<std::uint8_t> skippable_;  // per triangle: its patch has its component's value
-  std::vector<std::int32_t> patch_;      // per triangle of a dirty component: its patch, or −1
+  std::vector<std::uint8_t> taken_;      // build_patches': cut, or in a patch already
   std::vector<std::int32_t> patch_order_, patch_offsets_;  // CSR patch → triangles (BFS order)
   std::vector<std::pair<std::int32_t, std::int32_t>> patch_sizes_;  // (−size, patch) to classify
   std::vector<std::int32_t> component_patches_;  // CSR component → its patches (ids)
