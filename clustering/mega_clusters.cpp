@@ -15,10 +15,6 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 constexpr std::int64_t kNoLimit = std::numeric_limits<std::int64_t>::max();
-// MegaClusterBuilder's kept outcomes of a cluster against a joint.
-constexpr std::uint8_t kUntried = 0;
-constexpr std::uint8_t kPassed = 1;
-constexpr std::uint8_t kFailed = 2;
 
 std::size_t at(std::int32_t i) { return static_cast<std::size_t>(i); }
 
@@ -109,7 +105,7 @@ MegaClusterBuilder::MegaClusterBuilder(const ClusterSet& clusters, const MegaClu
     }
     joint_offsets_.push_back(static_cast<std::int32_t>(joint_ids_.size()));
   }
-  joint_outcomes_.assign(joint_ids_.size(), kUntried);
+  joint_failed_.assign(joint_ids_.size(), 0);
   joint_failures_.resize(joint_ids_.size());
 }
 
@@ -130,7 +126,7 @@ bool MegaClusterBuilder::evaluate_at_joint(
   if (slot < 0) return evaluate(a, joint, limit, out);
   std::vector<std::int32_t>& failed_on = joint_failures_[at(slot)];
   const bool passed = evaluate(a, joint, limit, out, failed_on);
-  joint_outcomes_[at(slot)] = passed ? kPassed : kFailed;
+  joint_failed_[at(slot)] = passed ? 0 : 1;
   // A failure's non-positive triangles (at most `limit`): the next evaluation here starts there.
   failed_on.assign(passed ? found_.end() : found_.begin(), found_.end());
   return passed;
@@ -354,7 +350,7 @@ void MegaClusterBuilder::build(
       // did not.
       const auto failed_before = [&](std::int32_t a) {
         const std::int32_t slot = joint_slot(a, e);
-        return slot >= 0 && joint_outcomes_[at(slot)] == kFailed;
+        return slot >= 0 && joint_failed_[at(slot)] != 0;
       };
       const bool seed_first = seed_joint != e && failed_before(seed) && !failed_before(nb.cluster);
       if (seed_first && !seed_passes(e)) continue;

@@ -139,12 +139,12 @@ class MegaClusterBuilder {
   std::vector<std::int32_t> unplaced_, unplaced_slot_, queue_;
   std::vector<std::uint32_t> tried_by_;
   std::uint32_t mega_stamp_ = 0;
-  // Per atomic cluster, the joints it meets its neighbours at (CSR) and its last outcome against
-  // each (kUntried, kPassed, kFailed), kept over the intervals: a merge of two clusters needs
-  // both to pass, and the one that failed last time is classified first (the merge's outcome is
-  // the same in either order, only the classifications it takes differ).
+  // Per atomic cluster, the joints it meets its neighbours at (CSR) and whether its last
+  // evaluation at each failed, kept over the intervals: a merge of two clusters needs both to
+  // pass, and the one that failed last time is classified first (the merge's outcome is the same
+  // in either order, only the classifications it takes differ).
   std::vector<std::int32_t> joint_offsets_, joint_ids_;
-  std::vector<std::uint8_t> joint_outcomes_;
+  std::vector<std::uint8_t> joint_failed_;
   std::vector<std::vector<std::int32_t>> joint_failures_;  // per slot: what its last failure met
   std::vector<std::int32_t> found_;                        // evaluate's non-positive triangles
   std::vector<std::int32_t> seed_failed_;  // joints the current seed failed at in this interval

@@ -696,8 +696,7 @@ inline void store_outward(
   const __m128d sign = _mm_set1_pd(-0.0);
   // Lane 3 zeroed in the register, not by a store of its own after the vector's: a 16-byte read
   // of the box that follows two stores cannot be forwarded from them and waits until both have
-  // left the store buffer (in a refit, the box is read back at once: about a tenth of
-  // refit_swept_and_ends' time went to that wait).
+  // left the store buffer (a refit reads each box back at once).
   const __m128 xyz = _mm_castsi128_ps(_mm_set_epi32(0, -1, -1, -1));
   _mm_store_ps(lo, _mm_and_ps(detail::float_below4(lo_xy, lo_z), xyz));
   _mm_store_ps(
