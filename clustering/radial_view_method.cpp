@@ -516,6 +516,7 @@ void RadialViewMethod::start_status(const skinning::Positions& x_t0, culling::Fr
   const std::int32_t num_components = clusters_.num_components();
   std::fill(status_.begin(), status_.end(), Status::unknown);
   std::fill(cut_.begin(), cut_.end(), 0);
+  start_by_own_dcd_ = false;
   const bool culling_possible = method_options_.min_separation == 0.0;
   if (!culling_possible) return;  // nothing is skipped: the start state does not matter
   if (!options_.guard) {
@@ -532,6 +533,7 @@ void RadialViewMethod::start_status(const skinning::Positions& x_t0, culling::Fr
     start_pairs_.swap(carry_pairs_);
   } else {
     scratch_result_.clear();
+    start_by_own_dcd_ = true;
     start_dcd(x_t0, scratch_result_);
     start_pairs_.assign(scratch_result_.dcd_pairs.begin(), scratch_result_.dcd_pairs.end());
     out.counters.bv_tests += scratch_result_.counters.bv_tests;

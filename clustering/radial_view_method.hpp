@@ -119,6 +119,9 @@ class RadialViewMethod final : public culling::CullingMethod {
   [[nodiscard]] std::shared_ptr<const culling::FeatureTopology> shared_features() const override {
     return features_;
   }
+  /// False after an interval whose start pairs took a DCD of this method's own (its counters
+  /// hold that DCD's; a query with the previous interval's end state would not).
+  [[nodiscard]] bool last_ccd_row_reusable() const override { return !start_by_own_dcd_; }
 
   /// The `bvh` method's DCD (recorded: a following detect_ccd from the same positions knows which
   /// components are free of self-intersection without a pass of its own).
@@ -311,6 +314,8 @@ class RadialViewMethod final : public culling::CullingMethod {
   skinning::Positions carry_x_;
   std::vector<culling::TrianglePair> carry_pairs_;
   bool has_dcd_ = false;
+  /// The last interval's start pairs came from a DCD made for it (neither of the two above).
+  bool start_by_own_dcd_ = false;
   skinning::Positions dcd_x_;
   std::vector<culling::TrianglePair> dcd_pairs_;
   culling::FrameResult scratch_result_;

@@ -74,6 +74,13 @@ culling::MethodInfo radial_view_info(
           [n](const culling::MethodOptions& options, bool dcd_before_each_ccd) {
             return carried_state(n, options, dcd_before_each_ccd);
           },
+      // What it carries is the set of intersecting pairs at the last interval's end, exact unless
+      // `fast` missed a contact; the mega-cluster builder's memory changes its work, never its
+      // classes (docs/radial-view.md, "Dynamic mega clusters").
+      .carried_state_follows_pose =
+          [](const culling::MethodOptions& options) {
+            return options.accuracy != ccd::Accuracy::fast;
+          },
       .route = route,
       .route_priority = route == culling::RouteKind::closed ? 10 : 0,
       .closes_holes_up_to = kMaxGhostLoop,

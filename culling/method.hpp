@@ -132,6 +132,12 @@ class CullingMethod {
   [[nodiscard]] virtual std::shared_ptr<const FeatureTopology> shared_features() const {
     return {};
   }
+  /// Whether the last CCD's row (findings and counters) is the one this method gives for that
+  /// interval whenever the query before it ended at the interval's start: what a later query of
+  /// the same held interval would give, which the runner may then hand on instead (docs/check.md,
+  /// "Static intervals"). True for a method that keeps nothing between queries; a radial-view
+  /// method's is false after an interval whose start it had to find by a DCD of its own.
+  [[nodiscard]] virtual bool last_ccd_row_reusable() const { return true; }
 
   /// Intersecting triangle pairs at one instant: every pair of distinct triangles with a common
   /// point beyond the vertices or edge they share (exact), except part-excluded pairs and

@@ -117,6 +117,19 @@ void add_culling_methods(Registry& r) {
              }
              return std::string();
            },
+       .carried_state_follows_pose =
+           [](const MethodOptions& options) {
+             for (const auto& route : auto_group_methods(options)) {
+               const MethodInfo* m = find_method(route);
+               if (m == nullptr || !m->serial_reason || m->serial_reason(options, false).empty()) {
+                 continue;
+               }
+               if (!m->carried_state_follows_pose || !m->carried_state_follows_pose(options)) {
+                 return false;
+               }
+             }
+             return true;
+           },
        .order = 65,
        .make =
            [](const skinning::Mesh& mesh,

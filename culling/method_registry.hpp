@@ -53,6 +53,11 @@ struct MethodInfo {
   /// serial run.
   std::function<std::string(const MethodOptions& options, bool dcd_before_each_ccd)>
       serial_reason{};
+  /// For a method with a serial_reason: true when what it carries is a function of the pose the
+  /// last query ended at, so that a held interval queried after one ending at its pose always
+  /// gets the same row (CullingMethod::last_ccd_row_reusable says when that was the case) and the
+  /// runner may hand that row on to the next such interval. Unset: false.
+  std::function<bool(const MethodOptions& options)> carried_state_follows_pose{};
   /// Where `auto` may route components, and its preference among the methods of that kind whose
   /// needs are met (highest first).
   RouteKind route = RouteKind::none;

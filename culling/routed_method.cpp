@@ -446,6 +446,11 @@ class AutoMethod final : public detail::MethodBase {
   [[nodiscard]] std::span<const ComponentRoute> component_routes() const override {
     return routes_;
   }
+  /// Its rows are its groups' together with the pairs between them, which keep nothing.
+  [[nodiscard]] bool last_ccd_row_reusable() const override {
+    return (!open_method_ || open_method_->last_ccd_row_reusable()) &&
+           (!closed_method_ || closed_method_->last_ccd_row_reusable());
+  }
 
   void dcd(const Instant& at, FrameResult& out) override {
     const skinning::Positions& x = at.x;

@@ -695,7 +695,8 @@ void add_check_command(CLI::App& app) {
       args->no_reuse,
       "query every CCD interval; by default an interval that holds the pose of the last held one "
       "(the same positions at both ends) gets that one's row without a query, where the method "
-      "keeps no state between queries (docs/check.md \"Static intervals\")");
+      "keeps no state between queries or only what follows from the pose (docs/check.md "
+      "\"Static intervals\")");
   cmd->add_flag(
       "--no-rigid-rows",
       args->no_rigid_rows,

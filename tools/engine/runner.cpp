@@ -335,7 +335,7 @@ void check_samples(
                   .sample_t0 = k,
                   .sample_t1 = k + 1},
               w.result);
-          if (held) {
+          if (held && w.method->last_ccd_row_reusable()) {
             w.static_pose = a;
             w.static_result = w.result;
             w.has_static = true;
@@ -595,7 +595,8 @@ ClipRunner::ClipRunner(
                                       method_options_.rigid_rows != nullptr);
   // What the method carries from one query to the next that would change its rows (empty:
   // nothing). It keeps a run serial (RunPlan::serial_reason) and, for the same reason, keeps a
-  // held interval from reusing the last held one's row.
+  // held interval from reusing the last held one's row unless what is carried follows from the
+  // pose (below).
   std::string carried;
   if (!factory_) {
     const culling::MethodInfo* m = culling::find_method(options.method);
@@ -605,7 +606,15 @@ ClipRunner::ClipRunner(
   } else if (!options.factory_methods_stateless) {
     carried = "the method factory's methods are not known to be stateless";
   }
-  reuse_static_ = options.reuse_static_intervals && carried.empty();
+  // A method whose carried state is a function of the pose the last query ended at may hand a
+  // held row on too (the row is stored only where the method says it is the usual one).
+  bool state_follows_pose = carried.empty();
+  if (!state_follows_pose && !factory_) {
+    const culling::MethodInfo* m = culling::find_method(options.method);
+    state_follows_pose = m != nullptr && m->carried_state_follows_pose &&
+                         m->carried_state_follows_pose(method_options_);
+  }
+  reuse_static_ = options.reuse_static_intervals && state_follows_pose;
 
   // Threads: blocks of consecutive samples (a DCD at k, then the CCD k → k+1) go to workers. The
   // blocks do not depend on the thread count: with incremental DCD each block starts with a full

@@ -72,7 +72,9 @@ struct RunOptions {
   /// findings and counters instead of a query: a method that keeps no state between queries
   /// answers an identical query identically (docs/check.md, "Static intervals"). Only where the
   /// method is known to be stateless for the run (RunPlan::serial_reason would be empty; a
-  /// factory's only with factory_methods_stateless). False: every interval is queried.
+  /// factory's only with factory_methods_stateless) or to carry only what follows from the pose
+  /// (culling::MethodInfo::carried_state_follows_pose; then only rows the method calls reusable,
+  /// CullingMethod::last_ccd_row_reusable, are handed on). False: every interval is queried.
   bool reuse_static_intervals = true;
   /// A method that takes rigid rows (culling::MethodInfo::takes_rigid_rows: `kdop`, `auto`) gets
   /// them when the run has CCD intervals and the motion is linear blend skinning
