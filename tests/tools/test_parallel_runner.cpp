@@ -188,7 +188,9 @@ TEST(RunnerStatic, UnnamedBonesRowsAreTheQueriedOnes) {
     queried = handed_on = 0;
     for (const auto& r : rows) {
       if (r.row.kind != QueryKind::ccd) continue;
-      if (all_contacts) EXPECT_EQ(r.row.counters.vf_contacts + r.row.counters.ee_contacts, 1852);
+      if (all_contacts) {
+        EXPECT_EQ(r.row.counters.vf_contacts + r.row.counters.ee_contacts, 1852);
+      }
       (r.row.times.elementary_us > 0.0 ? queried : handed_on) += 1;
     }
   };
