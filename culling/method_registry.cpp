@@ -117,14 +117,13 @@ void add_culling_methods(Registry& r) {
              }
              return std::string();
            },
+       // … and what they carry follows from the pose when it does for each of them.
        .carried_state_follows_pose =
            [](const MethodOptions& options) {
              for (const auto& route : auto_group_methods(options)) {
                const MethodInfo* m = find_method(route);
-               if (m == nullptr || !m->serial_reason || m->serial_reason(options, false).empty()) {
-                 continue;
-               }
-               if (!m->carried_state_follows_pose || !m->carried_state_follows_pose(options)) {
+               if (m != nullptr && m->serial_reason &&
+                   !(m->carried_state_follows_pose && m->carried_state_follows_pose(options))) {
                  return false;
                }
              }

@@ -595,24 +595,21 @@ ClipRunner::ClipRunner(
                                       method_options_.rigid_rows != nullptr);
   // What the method carries from one query to the next that would change its rows (empty:
   // nothing). It keeps a run serial (RunPlan::serial_reason) and, for the same reason, keeps a
-  // held interval from reusing the last held one's row unless what is carried follows from the
-  // pose (below).
+  // held interval from reusing the last held one's row — unless what is carried is a function
+  // of the pose the last query ended at (the row is then stored only where the method says it
+  // is the usual one, CullingMethod::last_ccd_row_reusable).
   std::string carried;
+  bool state_follows_pose = true;
   if (!factory_) {
     const culling::MethodInfo* m = culling::find_method(options.method);
     if (m != nullptr && m->serial_reason) {
       carried = m->serial_reason(method_options_, options.query != QuerySet::ccd);
     }
+    state_follows_pose = carried.empty() || (m->carried_state_follows_pose &&
+                                             m->carried_state_follows_pose(method_options_));
   } else if (!options.factory_methods_stateless) {
     carried = "the method factory's methods are not known to be stateless";
-  }
-  // A method whose carried state is a function of the pose the last query ended at may hand a
-  // held row on too (the row is stored only where the method says it is the usual one).
-  bool state_follows_pose = carried.empty();
-  if (!state_follows_pose && !factory_) {
-    const culling::MethodInfo* m = culling::find_method(options.method);
-    state_follows_pose = m != nullptr && m->carried_state_follows_pose &&
-                         m->carried_state_follows_pose(method_options_);
+    state_follows_pose = false;
   }
   reuse_static_ = options.reuse_static_intervals && state_follows_pose;
 
