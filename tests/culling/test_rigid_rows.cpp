@@ -4,6 +4,8 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
+#include <algorithm>
+#include <array>
 #include <cmath>
 #include <map>
 #include <memory>
@@ -13,6 +15,9 @@
 #include <string>
 #include <vector>
 
+#include "ccd/edge_edge.hpp"
+#include "ccd/vertex_face.hpp"
+#include "culling/elementary.hpp"
 #include "culling/method.hpp"
 #include "culling/rigid_rows.hpp"
 #include "skinning/load.hpp"
@@ -108,6 +113,72 @@ TEST(RigidRows, EachRowIsOneWeightRowAndItsRestPairsLieWithinTheTolerance) {
         rows.triangle_row[static_cast<std::size_t>(p.a)],
         rows.triangle_row[static_cast<std::size_t>(p.b)]);
   }
+}
+
+TEST(RigidRows, TheRestPairsAreThePairsOfARowThatTheKernelFindsWithinTheTolerance) {
+  // By definition (rigid_rows.hpp): every pair of two triangles of one row with a vertex-face or
+  // edge-edge pair sharing no vertex that the conservative kernel, on the held rest pose, finds
+  // within rest_tolerance. Here every pair of a row against the kernel, no box or sweep before
+  // it: build_rigid_rows' sweep and its boxes may drop only pairs the kernel would have dropped.
+  const Rig r = load(test::asset("characters/ninja/ninja.mesh"));
+  ASSERT_NE(r.rows, nullptr);
+  const RigidRows& rows = *r.rows;
+  ASSERT_TRUE(r.model.mesh->excluded_part_pairs.empty());  // else those pairs are never kept
+  skinning::Positions rest;
+  skinning::gather_welded(r.topology, r.model.mesh->rest_positions, rest);
+  ccd::CcdOptions within;
+  within.min_separation = rows.rest_tolerance;
+  const auto corners = [&](std::int32_t f) {
+    return std::array<std::int32_t, 3>{
+        r.topology.welded_triangles(f, 0),
+        r.topology.welded_triangles(f, 1),
+        r.topology.welded_triangles(f, 2)};
+  };
+  const auto kernel_finds = [&](std::int32_t fa, std::int32_t fb) {
+    const auto a = corners(fa);
+    const auto b = corners(fb);
+    const auto in = [](std::int32_t v, const std::array<std::int32_t, 3>& t) {
+      return v == t[0] || v == t[1] || v == t[2];
+    };
+    for (int side = 0; side < 2; ++side) {
+      const auto& p = side == 0 ? a : b;
+      const auto& q = side == 0 ? b : a;
+      for (const std::int32_t v : p) {
+        if (in(v, q)) continue;
+        const auto query = vertex_face_query(rest, rest, v, rest, rest, q);
+        if (ccd::vertex_face_ccd(query, ccd::Accuracy::conservative, within).hit) return true;
+      }
+    }
+    for (std::size_t i = 0; i < 3; ++i) {
+      for (std::size_t j = 0; j < 3; ++j) {
+        const std::array<std::int32_t, 2> ea{a[i], a[(i + 1) % 3]};
+        const std::array<std::int32_t, 2> eb{b[j], b[(j + 1) % 3]};
+        if (ea[0] == eb[0] || ea[0] == eb[1] || ea[1] == eb[0] || ea[1] == eb[1]) continue;
+        const auto query = edge_edge_query(rest, rest, ea, rest, rest, eb);
+        if (ccd::edge_edge_ccd(query, ccd::Accuracy::conservative, within).hit) return true;
+      }
+    }
+    return false;
+  };
+  std::vector<std::vector<std::int32_t>> of_row(static_cast<std::size_t>(rows.num_rows()));
+  for (std::size_t f = 0; f < rows.triangle_row.size(); ++f) {
+    if (rows.triangle_row[f] >= 0) {
+      of_row[static_cast<std::size_t>(rows.triangle_row[f])].push_back(
+          static_cast<std::int32_t>(f));
+    }
+  }
+  std::vector<TrianglePair> expected;
+  for (const auto& triangles : of_row) {
+    for (std::size_t i = 0; i < triangles.size(); ++i) {
+      for (std::size_t j = i + 1; j < triangles.size(); ++j) {
+        if (kernel_finds(triangles[i], triangles[j]))
+          expected.push_back({triangles[i], triangles[j]});
+      }
+    }
+  }
+  std::sort(expected.begin(), expected.end());
+  ASSERT_FALSE(expected.empty());
+  EXPECT_EQ(rows.rest_pairs, expected);
 }
 
 TEST(RigidRows, AnIntervalCertifiesARowOnlyWhileItsBlendStaysFarFromSingular) {
