@@ -93,9 +93,8 @@ using VBits = std::int64_t __attribute__((vector_size(32)));
   // detail::times_subnormal_power_of_two<1070>(1 + x), both of its branches per lane. The scaled
   // branch scales 1 + x only in the lanes that take it (1 + x >= 2^48, or NaN), and 2^48 in the
   // others: its products are then normal numbers in every lane. Scaling 1 + x < 2^48 there gave
-  // a subnormal product, whose microcode assist (x86 takes one per instruction that produces a
-  // subnormal in any lane, about 30 ns) cost a fifth of this screen's time although the lane
-  // then discarded it.
+  // a subnormal product in every real screen, and with it the CPU's slow path for one (a fifth of
+  // this screen's samples sat on it) for a value the lane then discarded.
   const V one_x = 1.0 + x;
   const auto in_range = (one_x >= 0.0) & (one_x < 0x1p48);
   const V shifted = one_x * 16.0 + 0x1p52;
