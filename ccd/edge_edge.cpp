@@ -2,16 +2,12 @@
 
 #include "ccd/edge_edge.hpp"
 
-#include <cassert>
-
 #include "ccd/after_swept_aabbs.hpp"
-#include "ccd/coplanarity_screen.hpp"
 #include "ccd/detail/conservative_pipeline.hpp"
+#include "ccd/detail/entry_points.hpp"
 #include "ccd/detail/fast_ccd.hpp"
 #include "ccd/detail/relative_boxes.hpp"
-#include "ccd/detail/screen_x4.hpp"
 #include "ccd/exact_ccd.hpp"
-#include "ccd/filters.hpp"
 
 namespace skelcd::ccd {
 namespace {
@@ -28,7 +24,8 @@ CcdResult conservative_after_aabbs(
   const detail::DifferenceTriple t0{q.eb0_t0 - q.ea0_t0, q.ea1_t0 - q.ea0_t0, q.eb1_t0 - q.eb0_t0};
   const detail::DifferenceTriple t1{q.eb0_t1 - q.ea0_t1, q.ea1_t1 - q.ea0_t1, q.eb1_t1 - q.eb0_t1};
   // With w = b0 - a0: the segment parameters are u / nn and v / nn, nn = n . n, where
-  // u = (w x d_b) . n, nn - u = ((a1 - b0) x d_b) . n, v = (w x d_a) . n, nn - v = (d_a x (b1 - a0)) . n.
+  // u = (w x d_b) . n, nn - u = ((a1 - b0) x d_b) . n, v = (w x d_a) . n, nn - v = (d_a x (b1 -
+  // a0)) . n.
   const std::array<const Eigen::Vector3d*, 4> at_t0{&q.ea0_t0, &q.ea1_t0, &q.eb0_t0, &q.eb1_t0};
   const std::array<const Eigen::Vector3d*, 4> at_t1{&q.ea0_t1, &q.ea1_t1, &q.eb0_t1, &q.eb1_t1};
   const auto quartic_inputs = [&](detail::QuadrupleDifferences* g, double* lengths) {
@@ -62,15 +59,6 @@ CcdResult conservative_after_aabbs(
       t0, t1, known, quartic_inputs, quartics_x4, problem, relative_apart, options, stats);
 }
 
-// conservative: swept AABBs, then the rest of the pipeline.
-CcdResult conservative(const EdgeEdgeQuery& q, const CcdOptions& options, CcdStats& stats) {
-  if (swept_aabbs_disjoint(q, options.min_separation)) {
-    ++stats.aabb_rejected;
-    return {};
-  }
-  return conservative_after_aabbs(q, options, stats);
-}
-
 }  // namespace
 
 CcdResult edge_edge_ccd(const EdgeEdgeQuery& query, Accuracy accuracy, const CcdOptions& options) {
@@ -78,37 +66,30 @@ CcdResult edge_edge_ccd(const EdgeEdgeQuery& query, Accuracy accuracy, const Ccd
   return edge_edge_ccd(query, accuracy, options, stats);
 }
 
-CcdResult edge_edge_ccd(const EdgeEdgeQuery& query,
-                        Accuracy accuracy,
-                        const CcdOptions& options,
-                        CcdStats& stats) {
-  assert(options.min_separation >= 0.0);
-  CcdResult r;
-  switch (accuracy) {
-    case Accuracy::exact:
-      r = swept_aabbs_disjoint(query, 0.0) ? CcdResult{} : edge_edge_ccd_exact(to_rational(query), options);
-      break;
-    case Accuracy::conservative:
-      r = conservative(query, options, stats);
-      break;
-    case Accuracy::fast:
-      r = detail::edge_edge_ccd_fast(query);
-      break;
-  }
-  ++stats.queries;
-  if (r.hit) ++stats.hits;
-  return r;
+CcdResult edge_edge_ccd(
+    const EdgeEdgeQuery& query, Accuracy accuracy, const CcdOptions& options, CcdStats& stats) {
+  return detail::ccd_at_accuracy(
+      query,
+      accuracy,
+      options,
+      stats,
+      conservative_after_aabbs,
+      [](const EdgeEdgeQuery& q, const CcdOptions& o) {
+        return edge_edge_ccd_exact(to_rational(q), o);
+      },
+      detail::edge_edge_ccd_fast);
 }
 
 CcdResult edge_edge_ccd_after_swept_aabbs(
     const EdgeEdgeQuery& query, Accuracy accuracy, const CcdOptions& options) {
-  // With min_separation 0 the swept-AABB stage rejects exactly the queries whose boxes are
-  // disjoint (fl(x - y) > 0 iff x > y), which the precondition rules out: skip it.
-  if (accuracy != Accuracy::conservative || options.min_separation != 0.0) {
-    return edge_edge_ccd(query, accuracy, options);
-  }
-  CcdStats stats;
-  return conservative_after_aabbs(query, options, stats);
+  return detail::ccd_after_swept_aabbs(
+      query,
+      accuracy,
+      options,
+      conservative_after_aabbs,
+      [](const EdgeEdgeQuery& q, Accuracy a, const CcdOptions& o) {
+        return edge_edge_ccd(q, a, o);
+      });
 }
 
 CcdResult edge_edge_ccd_after_screen(
@@ -116,10 +97,7 @@ CcdResult edge_edge_ccd_after_screen(
     const CcdOptions& options,
     const CoplanarityScreens& screens,
     int lane) {
-  assert(options.min_separation == 0.0 && (screens.apart >> lane & 1u) == 0);
-  const detail::TrilinearScreen known = detail::lane_screen(screens, lane);
-  CcdStats stats;
-  return conservative_after_aabbs(query, options, stats, &known);
+  return detail::ccd_after_screen(query, options, screens, lane, conservative_after_aabbs);
 }
 
 }  // namespace skelcd::ccd

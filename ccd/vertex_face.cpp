@@ -2,16 +2,12 @@
 
 #include "ccd/vertex_face.hpp"
 
-#include <cassert>
-
 #include "ccd/after_swept_aabbs.hpp"
-#include "ccd/coplanarity_screen.hpp"
 #include "ccd/detail/conservative_pipeline.hpp"
+#include "ccd/detail/entry_points.hpp"
 #include "ccd/detail/fast_ccd.hpp"
 #include "ccd/detail/relative_boxes.hpp"
-#include "ccd/detail/screen_x4.hpp"
 #include "ccd/exact_ccd.hpp"
-#include "ccd/filters.hpp"
 
 namespace skelcd::ccd {
 namespace {
@@ -65,54 +61,38 @@ CcdResult conservative_after_aabbs(
       t0, t1, known, quartic_inputs, quartics_x4, problem, relative_apart, options, stats);
 }
 
-// conservative: swept AABBs, then the rest of the pipeline.
-CcdResult conservative(const VertexFaceQuery& q, const CcdOptions& options, CcdStats& stats) {
-  if (swept_aabbs_disjoint(q, options.min_separation)) {
-    ++stats.aabb_rejected;
-    return {};
-  }
-  return conservative_after_aabbs(q, options, stats);
-}
-
 }  // namespace
 
-CcdResult vertex_face_ccd(const VertexFaceQuery& query, Accuracy accuracy, const CcdOptions& options) {
+CcdResult vertex_face_ccd(
+    const VertexFaceQuery& query, Accuracy accuracy, const CcdOptions& options) {
   CcdStats stats;
   return vertex_face_ccd(query, accuracy, options, stats);
 }
 
-CcdResult vertex_face_ccd(const VertexFaceQuery& query,
-                          Accuracy accuracy,
-                          const CcdOptions& options,
-                          CcdStats& stats) {
-  assert(options.min_separation >= 0.0);
-  CcdResult r;
-  switch (accuracy) {
-    case Accuracy::exact:
-      // The swept-box test is exact in double and saves the rational conversion.
-      r = swept_aabbs_disjoint(query, 0.0) ? CcdResult{} : vertex_face_ccd_exact(to_rational(query), options);
-      break;
-    case Accuracy::conservative:
-      r = conservative(query, options, stats);
-      break;
-    case Accuracy::fast:
-      r = detail::vertex_face_ccd_fast(query);
-      break;
-  }
-  ++stats.queries;
-  if (r.hit) ++stats.hits;
-  return r;
+CcdResult vertex_face_ccd(
+    const VertexFaceQuery& query, Accuracy accuracy, const CcdOptions& options, CcdStats& stats) {
+  return detail::ccd_at_accuracy(
+      query,
+      accuracy,
+      options,
+      stats,
+      conservative_after_aabbs,
+      [](const VertexFaceQuery& q, const CcdOptions& o) {
+        return vertex_face_ccd_exact(to_rational(q), o);
+      },
+      detail::vertex_face_ccd_fast);
 }
 
 CcdResult vertex_face_ccd_after_swept_aabbs(
     const VertexFaceQuery& query, Accuracy accuracy, const CcdOptions& options) {
-  // With min_separation 0 the swept-AABB stage rejects exactly the queries whose boxes are
-  // disjoint (fl(x - y) > 0 iff x > y), which the precondition rules out: skip it.
-  if (accuracy != Accuracy::conservative || options.min_separation != 0.0) {
-    return vertex_face_ccd(query, accuracy, options);
-  }
-  CcdStats stats;
-  return conservative_after_aabbs(query, options, stats);
+  return detail::ccd_after_swept_aabbs(
+      query,
+      accuracy,
+      options,
+      conservative_after_aabbs,
+      [](const VertexFaceQuery& q, Accuracy a, const CcdOptions& o) {
+        return vertex_face_ccd(q, a, o);
+      });
 }
 
 CcdResult vertex_face_ccd_after_screen(
@@ -120,10 +100,7 @@ CcdResult vertex_face_ccd_after_screen(
     const CcdOptions& options,
     const CoplanarityScreens& screens,
     int lane) {
-  assert(options.min_separation == 0.0 && (screens.apart >> lane & 1u) == 0);
-  const detail::TrilinearScreen known = detail::lane_screen(screens, lane);
-  CcdStats stats;
-  return conservative_after_aabbs(query, options, stats, &known);
+  return detail::ccd_after_screen(query, options, screens, lane, conservative_after_aabbs);
 }
 
 }  // namespace skelcd::ccd
