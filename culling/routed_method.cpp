@@ -143,15 +143,23 @@ bool all_closed_rule_asked(
   return !routing.all_closed_method.empty() && routing.closed_method.empty() && !components.empty();
 }
 
-/// RoutingOptions::all_closed_method's rule: it is asked (all_closed_rule_asked), and every
-/// component is closed, under min_open_triangles, or open only at holes the highest-priority
-/// closed-part method caps (first_closed_method) — whether that method's needs are met or not.
+/// RoutingOptions::all_closed_method's rule: it is asked (all_closed_rule_asked), the mesh has
+/// fewer triangles than all_closed_below_triangles (when that is set), and every component is
+/// closed, under min_open_triangles, or open only at holes the highest-priority closed-part
+/// method caps (first_closed_method) — whether that method's needs are met or not.
 /// `capped_by_first`: capped_components for first_closed_method().
 bool whole_to_all_closed_method(
     const std::vector<skinning::Component>& components,
     const RoutingOptions& routing,
     const std::vector<std::uint8_t>& capped_by_first) {
   if (!all_closed_rule_asked(components, routing)) return false;
+  if (routing.all_closed_below_triangles > 0) {
+    std::int64_t triangles = 0;
+    for (const auto& component : components) {
+      triangles += static_cast<std::int64_t>(component.faces.size());
+    }
+    if (triangles >= routing.all_closed_below_triangles) return false;
+  }
   for (std::size_t c = 0; c < components.size(); ++c) {
     if (!components[c].closed && capped_by_first[c] == 0 &&
         static_cast<std::int32_t>(components[c].faces.size()) >= routing.min_open_triangles) {
@@ -792,11 +800,62 @@ std::vector<std::string> auto_group_methods(
   return {routing.open_method, closed_method_name(options, routing)};
 }
 
+/// `auto` when every component goes to the closed group and its method is a whole-mesh method
+/// (`dynamic` on a large rig closed throughout: RoutingOptions::all_closed_below_triangles): that
+/// method on the whole mesh, answering for `auto` under its name with its routes. Nothing is
+/// traversed between groups, so AutoMethod would only add its own feature topology, blocks and a
+/// copy of each row (0.15 KiB per triangle more than `dynamic` on CesiumMan-dense).
+class WholeMeshAuto final : public CullingMethod {
+ public:
+  WholeMeshAuto(std::unique_ptr<CullingMethod> method, std::vector<ComponentRoute> routes)
+      : method_(std::move(method)), routes_(std::move(routes)) {}
+  [[nodiscard]] std::string_view name() const override { return "auto"; }
+  [[nodiscard]] std::span<const ComponentRoute> component_routes() const override {
+    return routes_;
+  }
+  [[nodiscard]] const ConeStatistics* cone_statistics() const override {
+    return method_->cone_statistics();
+  }
+  [[nodiscard]] std::shared_ptr<const FeatureTopology> shared_features() const override {
+    return method_->shared_features();
+  }
+  [[nodiscard]] bool last_ccd_row_reusable() const override {
+    return method_->last_ccd_row_reusable();
+  }
+  [[nodiscard]] const CullingMethod& method() const { return *method_; }
+
+ protected:
+  void dcd(const Instant& at, FrameResult& out) override { method_->detect_dcd(at, out); }
+  void ccd(const Interval& interval, FrameResult& out) override {
+    method_->detect_ccd(interval, out);
+  }
+
+ private:
+  std::unique_ptr<CullingMethod> method_;
+  std::vector<ComponentRoute> routes_;
+};
+
 std::unique_ptr<CullingMethod> make_routed_method(
     const skinning::Mesh& mesh,
     const skinning::Topology& topology,
     const MethodOptions& options,
     const RoutingOptions& routing) {
+  if (routing.dcd_cone_share >= 0 && routing.ccd_cone_share >= 0) {
+    RoutePlan plan = plan_routes(topology, options, routing);
+    const bool all_closed = !plan.routes.empty() &&
+                            std::all_of(plan.routes.begin(), plan.routes.end(), in_closed_group);
+    if (!plan.whole && all_closed && whole_mesh_method(plan.routes.front().method)) {
+      std::unique_ptr<CullingMethod> method =
+          make_method(plan.routes.front().method, mesh, topology, options);
+      for (auto& r : plan.routes) {
+        if (r.part < 0 && !plan.components[sz(r.component)].faces.empty()) {
+          const std::int32_t f = plan.components[sz(r.component)].faces[0];
+          r.part = mesh.face_part.empty() ? 0 : mesh.face_part[sz(f)];
+        }
+      }
+      return std::make_unique<WholeMeshAuto>(std::move(method), std::move(plan.routes));
+    }
+  }
   return std::make_unique<AutoMethod>(mesh, topology, options, routing);
 }
 
@@ -805,6 +864,13 @@ std::span<const ComponentRoute> routes_of(const CullingMethod& method) {
 }
 
 RoutedStructures routed_structures(const CullingMethod& method) {
+  if (const auto* whole = dynamic_cast<const WholeMeshAuto*>(&method); whole != nullptr) {
+    // Nothing of its own: the one method's feature topology, when it is one of culling/'s.
+    RoutedStructures r;
+    const auto* base = dynamic_cast<const detail::MethodBase*>(&whole->method());
+    r.feature_topologies = base != nullptr ? 1 : 0;
+    return r;
+  }
   const auto* routed = dynamic_cast<const AutoMethod*>(&method);
   if (routed == nullptr) {
     throw InvalidInput(

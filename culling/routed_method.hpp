@@ -30,16 +30,23 @@ struct RoutingOptions {
   /// Method for closed components: empty picks the best registered closed-part method whose needs
   /// are met, else kClosedFallbackMethod. Otherwise any name above, or any registered method.
   std::string closed_method;
-  /// With `closed_method` empty: a mesh whose every component is closed, has fewer than
-  /// min_open_triangles triangles, or is open only at holes the registered closed-part method of
-  /// highest priority caps (whether its needs are met or not; none for the open method) goes
-  /// whole to this method instead. `bvh` by default: on the real characters that are closed
-  /// throughout, `dynamic` took 0.81-1.48x `bvh`'s time per interval, 1.09x in geometric mean,
-  /// since every method's feature stage drops what radial view culls there, and 1.16x on
-  /// BCN_Epileptic, capped throughout (docs/benchmarks.md "auto against bvh: the default
-  /// method", docs/dual-cone.md "Routing"). Empty: the closed method, as for any mesh. It must
-  /// need nothing beyond the mesh (no bones, no segmentation).
+  /// With `closed_method` empty: a mesh of fewer than all_closed_below_triangles triangles whose
+  /// every component is closed, has fewer than min_open_triangles triangles, or is open only at
+  /// holes the registered closed-part method of highest priority caps (whether its needs are met
+  /// or not; none for the open method) goes whole to this method instead. `bvh` by default: on
+  /// the real characters that are closed throughout, `dynamic` took 0.81-1.48x `bvh`'s time per
+  /// interval, 1.09x in geometric mean, since every method's feature stage drops what radial
+  /// view culls there, and 1.16x on BCN_Epileptic, capped throughout (docs/benchmarks.md "auto
+  /// against bvh: the default method", docs/dual-cone.md "Routing"). Empty: the closed method, as
+  /// for any mesh. It must need nothing beyond the mesh (no bones, no segmentation).
   std::string all_closed_method = std::string(kClosedFallbackMethod);
+  /// The size from which a mesh closed throughout goes to the closed method after all (`dynamic`
+  /// on a rig's clip, else `bvh` as well): on the denser copies of real characters of 24,576 to
+  /// 112,128 triangles a default check (both queries, two threads) took 1.09-1.43x less time
+  /// with `dynamic` than with `bvh`, its segmentation and local hierarchies included, and
+  /// 0.96-1.02x on those of 6,144 and 13,824 (docs/benchmarks.md "`auto` on dense characters").
+  /// 0: whatever the size.
+  std::int64_t all_closed_below_triangles = 20000;
   /// Open components with fewer triangles go with the closed ones (ComponentRoute::small): the
   /// cone methods have nothing to gain on a small open part, and a group of its own costs `auto`
   /// the group's hierarchies and the traversal between the groups (docs/dual-cone.md, "Routing").
@@ -64,9 +71,9 @@ struct RoutingOptions {
     const MethodOptions& options, const RoutingOptions& routing = {});
 
 /// Whether `auto` sends the whole mesh to RoutingOptions::all_closed_method (every component
-/// closed, under min_open_triangles or capped, `closed_method` not named), so that what only the
-/// closed method needs (a segmentation) need not be made: the answer depends on the topology
-/// alone.
+/// closed, under min_open_triangles or capped, fewer triangles than all_closed_below_triangles,
+/// `closed_method` not named), so that what only the closed method needs (a segmentation) need
+/// not be made: the answer depends on the topology alone.
 [[nodiscard]] bool routes_whole_mesh_to_all_closed_method(
     const skinning::Topology& topology, const RoutingOptions& routing = {});
 

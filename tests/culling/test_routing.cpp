@@ -289,6 +289,60 @@ TEST(Routing, AMeshClosedThroughoutGoesWholeToBvh) {
   EXPECT_FALSE(routes_whole_mesh_to_all_closed_method(s.topo));
 }
 
+TEST(Routing, AMeshClosedThroughoutFromTheRulesSizeOnGoesToTheClosedPartMethod) {
+  // RoutingOptions::all_closed_below_triangles: the rule sends a mesh closed throughout to `bvh`
+  // only below it. CesiumMan (4,672 triangles) with the limit set at its size goes to the
+  // closed-part method (test-closed, as `dynamic` on a rig): that method on the whole mesh,
+  // answering as `auto` with its routes, and finding what `bvh` finds.
+  const auto model = skinning::load_model(test::asset("characters/CesiumMan.glb"));
+  const auto motion = model.motion({});
+  const skinning::Mesh& mesh = *model.mesh;
+  const auto topo = skinning::build_topology(mesh);
+  const auto n = static_cast<std::int64_t>(mesh.num_triangles());
+  RoutingOptions limit;
+  limit.all_closed_below_triangles = n + 1;
+  EXPECT_TRUE(routes_whole_mesh_to_all_closed_method(topo, limit));
+  limit.all_closed_below_triangles = 0;  // no limit
+  EXPECT_TRUE(routes_whole_mesh_to_all_closed_method(topo, limit));
+  limit.all_closed_below_triangles = n;
+  EXPECT_FALSE(routes_whole_mesh_to_all_closed_method(topo, limit));
+  MethodOptions options;
+  options.num_bones = 1;
+  const int before = fake_built;
+  auto a = make_routed_method(mesh, topo, options, limit);
+  EXPECT_EQ(fake_built, before + 1);
+  EXPECT_EQ(a->name(), "auto");
+  ASSERT_FALSE(routes_of(*a).empty());
+  for (const auto& r : routes_of(*a)) {
+    EXPECT_EQ(r.method, "test-closed");
+    EXPECT_TRUE(r.closed);
+    EXPECT_EQ(r.part, 0);
+  }
+  // Nothing of its own beside the one method (not one of culling/'s here: no feature topology).
+  EXPECT_EQ(routed_structures(*a).feature_topologies, 0);
+  EXPECT_EQ(routed_structures(*a).own_hierarchies, 0);
+  auto b = make_method("bvh", mesh, topo, options);
+  skinning::Positions p0, p1;
+  motion->positions(0, p0);
+  motion->positions(std::min(6, motion->num_samples() - 1), p1);
+  const skinning::Positions x0 = test::welded(topo, p0);
+  const skinning::Positions x1 = test::welded(topo, p1);
+  const FrameResult want = ccd(*b, x0, x1);
+  EXPECT_FALSE(want.contacts.empty()) << "no contacts: the interval proves nothing";
+  EXPECT_EQ(ccd(*a, x0, x1).contacts, want.contacts);
+  EXPECT_EQ(dcd(*a, x1).dcd_pairs, dcd(*b, x1).dcd_pairs);
+  // Without bones the closed-part method's needs are not met: `bvh` takes it all the same.
+  auto c = make_routed_method(mesh, topo, MethodOptions{}, limit);
+  EXPECT_EQ(fake_built, before + 1);
+  for (const auto& r : routes_of(*c)) EXPECT_EQ(r.method, "bvh");
+  EXPECT_EQ(ccd(*c, x0, x1).contacts, want.contacts);
+  // By default the limit keeps CesiumMan with `bvh` and sends its 28,032-triangle subdivision
+  // (assets/characters/CesiumMan-dense.glb) on.
+  EXPECT_TRUE(routes_whole_mesh_to_all_closed_method(topo));
+  const auto dense = skinning::load_model(test::asset("characters/CesiumMan-dense.glb"));
+  EXPECT_FALSE(routes_whole_mesh_to_all_closed_method(skinning::build_topology(*dense.mesh)));
+}
+
 TEST(Routing, RobotExpressiveCharacterRoutesItsOpenAndClosedPartsAndMatchesBvh) {
   // A real skinned character with open parts (SOURCES.md): each component goes where it fits,
   // and over a clip interval the routed answer is bvh's.

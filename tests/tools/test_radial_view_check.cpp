@@ -111,6 +111,42 @@ TEST(RadialViewCheck, ReusesAPreprocessedSegmentation) {
   EXPECT_NE(bad.err.find("not-a-seg.h5"), std::string::npos) << bad.err;
 }
 
+TEST(RadialViewCheck, AutoTakesRadialViewOnADenseRigClosedThroughout) {
+  // `auto` sends a mesh closed throughout to `bvh` only under 20,000 triangles
+  // (culling::RoutingOptions::all_closed_below_triangles): CesiumMan (4,672) goes to `bvh`,
+  // CesiumMan-dense (28,032) to `dynamic` on the rig's own weights — its log's Table 3 columns
+  // and routes say so — and finds `bvh`'s contacts and DCD pairs.
+  const auto dir = skelcd::test::temp_dir("rv-auto-dense");
+  const std::string dense = skelcd::test::asset("characters/CesiumMan-dense.glb").string();
+  std::vector<LogData> logs;
+  std::vector<nlohmann::json> summaries;
+  for (const char* method : {"bvh", "auto"}) {
+    const auto log = (dir / (std::string(method) + ".h5")).string();
+    const auto r =
+        run_skelcd({"check", dense, "--frames", "0:4", "--method", method, "--json", "-o", log});
+    ASSERT_EQ(r.exit_code, 0) << method << ": " << r.err;
+    summaries.push_back(nlohmann::json::parse(r.out));
+    logs.push_back(read_log(log));
+  }
+  EXPECT_EQ(summaries[1]["method"], "auto");
+  EXPECT_EQ(summaries[1]["segmentation"], "computed (rig weights)");
+  ASSERT_FALSE(logs[0].contacts.empty());
+  EXPECT_EQ(contact_keys(logs[1]), contact_keys(logs[0]));
+  EXPECT_GT(summaries[0]["dcd_pairs"].get<std::int64_t>(), 0);
+  EXPECT_EQ(summaries[1]["dcd_pairs"], summaries[0]["dcd_pairs"]);
+  EXPECT_EQ(summaries[1]["ccd_vf"], summaries[0]["ccd_vf"]);
+  EXPECT_EQ(summaries[1]["ccd_ee"], summaries[0]["ccd_ee"]);
+  bool culled = false;
+  for (const auto& row : logs[1].frames) culled = culled || row.counters.mega_clusters > 0;
+  EXPECT_TRUE(culled) << "no CCD row of auto's ran radial view";
+  const auto small = run_skelcd({"check", kCesium, "--frames", "0:2", "--json"});
+  ASSERT_EQ(small.exit_code, 0) << small.err;
+  EXPECT_EQ(
+      nlohmann::json::parse(small.out)["segmentation"],
+      "none (auto: every part closed, small or capped, under 20000 triangles, the whole mesh to "
+      "bvh)");
+}
+
 TEST(RadialViewCheck, DcdOnlyBuildsNoSegmentationAndFindsBvhsPairs) {
   // Radial view culls intervals; at an instant rvbc/dynamic answer with bvh. So --query dcd must
   // not segment: a --segmentation file is not even read (this one is no HDF5 file at all).

@@ -56,16 +56,18 @@ RadialViewSetup setup_radial_view(
     return setup;
   }
   // Nor when every part is closed, small (under 256 triangles) or open only at holes the radial
-  // view would cap: `auto` then sends the whole mesh to `bvh` (culling::RoutingOptions::
-  // all_closed_method).
+  // view would cap, in a mesh under 20,000 triangles: `auto` then sends the whole mesh to `bvh`
+  // (culling::RoutingOptions::all_closed_method, all_closed_below_triangles).
   if (method == "auto" && topology != nullptr &&
       culling::routes_whole_mesh_to_all_closed_method(*topology)) {
+    const std::string size = "under " +
+                             std::to_string(culling::RoutingOptions{}.all_closed_below_triangles) +
+                             " triangles";
     setup.segmentation_source =
-        "none (auto: every part closed, small or capped, the whole mesh to bvh)";
+        "none (auto: every part closed, small or capped, " + size + ", the whole mesh to bvh)";
     if (!args.segmentation.empty()) {
-      std::cerr << "skelcd: note: " << args.segmentation
-                << " is not used: auto sends a mesh whose every part is closed, small or capped to "
-                   "bvh\n";
+      std::cerr << "skelcd: note: " << args.segmentation << " is not used: auto sends a mesh "
+                << size << " whose every part is closed, small or capped to bvh\n";
     }
     return setup;
   }
