@@ -42,9 +42,10 @@ struct RoutingOptions {
   std::string all_closed_method = std::string(kClosedFallbackMethod);
   /// The size from which a mesh closed throughout goes to the closed method after all (`dynamic`
   /// on a rig's clip, else `bvh` as well): on the denser copies of real characters of 24,576 to
-  /// 112,128 triangles a default check (both queries, two threads) took 1.09-1.43x less time
-  /// with `dynamic` than with `bvh`, its segmentation and local hierarchies included, and
-  /// 0.96-1.02x on those of 6,144 and 13,824 (docs/benchmarks.md "`auto` on dense characters").
+  /// 112,128 triangles a default check (both queries, two threads) took 1.08-1.55x less time
+  /// with `dynamic` than with `bvh`, its segmentation and local hierarchies included (within the
+  /// noise at 28,032), and 0.90-1.02x on those of 6,144 and 13,824 (docs/benchmarks.md "`auto` on
+  /// dense characters").
   /// 0: whatever the size.
   std::int64_t all_closed_below_triangles = 20000;
   /// Open components with fewer triangles go with the closed ones (ComponentRoute::small): the
