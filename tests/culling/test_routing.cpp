@@ -233,14 +233,32 @@ TEST(Routing, ClothFunnelRoutesThreeClothPartsAndTheFunnelAndMatchesBvh) {
   EXPECT_EQ(keys(ccd(*a, s.frames[0], s.frames[1])), keys(ccd(*b, s.frames[0], s.frames[1])));
 }
 
+/// CesiumMan's mesh, welded, and the welded positions of one interval of its walk (samples 0 and
+/// 6): one closed component whose interval has contacts.
+struct CesiumInterval {
+  skinning::LoadedModel model = skinning::load_model(test::asset("characters/CesiumMan.glb"));
+  const skinning::Mesh& mesh = *model.mesh;
+  skinning::Topology topo = skinning::build_topology(mesh);
+  skinning::Positions x0, x1;
+  CesiumInterval() {
+    const auto motion = model.motion({});
+    skinning::Positions p0, p1;
+    motion->positions(0, p0);
+    motion->positions(std::min(6, motion->num_samples() - 1), p1);
+    x0 = test::welded(topo, p0);
+    x1 = test::welded(topo, p1);
+  }
+};
+
 TEST(Routing, AMeshClosedThroughoutGoesWholeToBvh) {
   // CesiumMan: one closed component. With bones announced the closed-part method would be
   // test-closed; a mesh closed throughout goes whole to RoutingOptions::all_closed_method (`bvh`)
   // instead, which answers itself: bvh's pairs, and every counter bvh's.
-  const auto model = skinning::load_model(test::asset("characters/CesiumMan.glb"));
-  const auto motion = model.motion({});
-  const skinning::Mesh& mesh = *model.mesh;
-  const auto topo = skinning::build_topology(mesh);
+  const CesiumInterval cesium;
+  const skinning::Mesh& mesh = cesium.mesh;
+  const skinning::Topology& topo = cesium.topo;
+  const skinning::Positions& x0 = cesium.x0;
+  const skinning::Positions& x1 = cesium.x1;
   MethodOptions options;
   options.num_bones = 1;
   EXPECT_TRUE(routes_whole_mesh_to_all_closed_method(topo));
@@ -252,11 +270,6 @@ TEST(Routing, AMeshClosedThroughoutGoesWholeToBvh) {
   // The `bvh` method it hands the mesh to is built on auto's own FeatureTopology.
   EXPECT_EQ(routed_structures(*a).feature_topologies, 1);
   auto b = make_method("bvh", mesh, topo, options);
-  skinning::Positions p0, p1;
-  motion->positions(0, p0);
-  motion->positions(std::min(6, motion->num_samples() - 1), p1);
-  const skinning::Positions x0 = test::welded(topo, p0);
-  const skinning::Positions x1 = test::welded(topo, p1);
   const FrameResult want = ccd(*b, x0, x1);
   const FrameResult got = ccd(*a, x0, x1);
   EXPECT_GT(want.counters.candidate_pairs, 0);
@@ -294,10 +307,11 @@ TEST(Routing, AMeshClosedThroughoutFromTheRulesSizeOnGoesToTheClosedPartMethod) 
   // only below it. CesiumMan (4,672 triangles) with the limit set at its size goes to the
   // closed-part method (test-closed, as `dynamic` on a rig): that method on the whole mesh,
   // answering as `auto` with its routes, and finding what `bvh` finds.
-  const auto model = skinning::load_model(test::asset("characters/CesiumMan.glb"));
-  const auto motion = model.motion({});
-  const skinning::Mesh& mesh = *model.mesh;
-  const auto topo = skinning::build_topology(mesh);
+  const CesiumInterval cesium;
+  const skinning::Mesh& mesh = cesium.mesh;
+  const skinning::Topology& topo = cesium.topo;
+  const skinning::Positions& x0 = cesium.x0;
+  const skinning::Positions& x1 = cesium.x1;
   const auto n = static_cast<std::int64_t>(mesh.num_triangles());
   RoutingOptions limit;
   limit.all_closed_below_triangles = n + 1;
@@ -322,11 +336,6 @@ TEST(Routing, AMeshClosedThroughoutFromTheRulesSizeOnGoesToTheClosedPartMethod) 
   EXPECT_EQ(routed_structures(*a).feature_topologies, 0);
   EXPECT_EQ(routed_structures(*a).own_hierarchies, 0);
   auto b = make_method("bvh", mesh, topo, options);
-  skinning::Positions p0, p1;
-  motion->positions(0, p0);
-  motion->positions(std::min(6, motion->num_samples() - 1), p1);
-  const skinning::Positions x0 = test::welded(topo, p0);
-  const skinning::Positions x1 = test::welded(topo, p1);
   const FrameResult want = ccd(*b, x0, x1);
   EXPECT_FALSE(want.contacts.empty()) << "no contacts: the interval proves nothing";
   EXPECT_EQ(ccd(*a, x0, x1).contacts, want.contacts);
