@@ -231,24 +231,18 @@ skinning::Mesh closed_only_mesh(
 
 class AutoMethod final : public detail::MethodBase {
  public:
+  /// `plan`: plan_routes(topology, options, routing), made by make_routed_method.
   AutoMethod(
       const skinning::Mesh& mesh,
       const skinning::Topology& topology,
       const MethodOptions& options,
-      const RoutingOptions& routing)
+      const RoutingOptions& routing,
+      RoutePlan plan)
       : MethodBase("auto", mesh, topology, options),
         blocks_(
             options.block_pairs,
             block_reserve(options.block_pairs, options.bvh.leaf_size, topology_.num_triangles())) {
-    if (routing.dcd_cone_share < 0 || routing.ccd_cone_share < 0) {
-      throw InvalidInput(
-          "culling::make_method(auto): dcd_cone_share and ccd_cone_share must be 0 (never the "
-          "cones) or more (got " +
-          std::to_string(routing.dcd_cone_share) + " and " +
-          std::to_string(routing.ccd_cone_share) + ")");
-    }
     // The plan, with each component's part taken from the mesh.
-    RoutePlan plan = plan_routes(topology, options, routing);
     routes_ = std::move(plan.routes);
     const auto& components = plan.components;
     // The whole mesh to all_closed_method: one group, whatever each part would have been (an
@@ -840,23 +834,28 @@ std::unique_ptr<CullingMethod> make_routed_method(
     const skinning::Topology& topology,
     const MethodOptions& options,
     const RoutingOptions& routing) {
-  if (routing.dcd_cone_share >= 0 && routing.ccd_cone_share >= 0) {
-    RoutePlan plan = plan_routes(topology, options, routing);
-    const bool all_closed = !plan.routes.empty() &&
-                            std::all_of(plan.routes.begin(), plan.routes.end(), in_closed_group);
-    if (!plan.whole && all_closed && whole_mesh_method(plan.routes.front().method)) {
-      std::unique_ptr<CullingMethod> method =
-          make_method(plan.routes.front().method, mesh, topology, options);
-      for (auto& r : plan.routes) {
-        if (r.part < 0 && !plan.components[sz(r.component)].faces.empty()) {
-          const std::int32_t f = plan.components[sz(r.component)].faces[0];
-          r.part = mesh.face_part.empty() ? 0 : mesh.face_part[sz(f)];
-        }
-      }
-      return std::make_unique<WholeMeshAuto>(std::move(method), std::move(plan.routes));
-    }
+  if (routing.dcd_cone_share < 0 || routing.ccd_cone_share < 0) {
+    throw InvalidInput(
+        "culling::make_method(auto): dcd_cone_share and ccd_cone_share must be 0 (never the "
+        "cones) or more (got " +
+        std::to_string(routing.dcd_cone_share) + " and " + std::to_string(routing.ccd_cone_share) +
+        ")");
   }
-  return std::make_unique<AutoMethod>(mesh, topology, options, routing);
+  RoutePlan plan = plan_routes(topology, options, routing);
+  const bool all_closed =
+      !plan.routes.empty() && std::all_of(plan.routes.begin(), plan.routes.end(), in_closed_group);
+  if (!plan.whole && all_closed && whole_mesh_method(plan.routes.front().method)) {
+    std::unique_ptr<CullingMethod> method =
+        make_method(plan.routes.front().method, mesh, topology, options);
+    for (auto& r : plan.routes) {
+      if (r.part < 0 && !plan.components[sz(r.component)].faces.empty()) {
+        const std::int32_t f = plan.components[sz(r.component)].faces[0];
+        r.part = mesh.face_part.empty() ? 0 : mesh.face_part[sz(f)];
+      }
+    }
+    return std::make_unique<WholeMeshAuto>(std::move(method), std::move(plan.routes));
+  }
+  return std::make_unique<AutoMethod>(mesh, topology, options, routing, std::move(plan));
 }
 
 std::span<const ComponentRoute> routes_of(const CullingMethod& method) {
