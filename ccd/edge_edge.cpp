@@ -24,8 +24,8 @@ CcdResult conservative_after_aabbs(
   const detail::DifferenceTriple t0{q.eb0_t0 - q.ea0_t0, q.ea1_t0 - q.ea0_t0, q.eb1_t0 - q.eb0_t0};
   const detail::DifferenceTriple t1{q.eb0_t1 - q.ea0_t1, q.ea1_t1 - q.ea0_t1, q.eb1_t1 - q.eb0_t1};
   // With w = b0 - a0: the segment parameters are u / nn and v / nn, nn = n . n, where
-  // u = (w x d_b) . n, nn - u = ((a1 - b0) x d_b) . n, v = (w x d_a) . n, nn - v = (d_a x (b1 -
-  // a0)) . n.
+  // u = (w x d_b) . n, nn - u = ((a1 - b0) x d_b) . n,
+  // v = (w x d_a) . n, nn - v = (d_a x (b1 - a0)) . n.
   const std::array<const Eigen::Vector3d*, 4> at_t0{&q.ea0_t0, &q.ea1_t0, &q.eb0_t0, &q.eb1_t0};
   const std::array<const Eigen::Vector3d*, 4> at_t1{&q.ea0_t1, &q.ea1_t1, &q.eb0_t1, &q.eb1_t1};
   const auto quartic_inputs = [&](detail::QuadrupleDifferences* g, double* lengths) {

@@ -242,7 +242,6 @@ class AutoMethod final : public detail::MethodBase {
         blocks_(
             options.block_pairs,
             block_reserve(options.block_pairs, options.bvh.leaf_size, topology_.num_triangles())) {
-    // The plan, with each component's part taken from the mesh.
     routes_ = std::move(plan.routes);
     const auto& components = plan.components;
     // The whole mesh to all_closed_method: one group, whatever each part would have been (an
@@ -252,9 +251,7 @@ class AutoMethod final : public detail::MethodBase {
     const auto nf = static_cast<std::size_t>(topology_.num_triangles());
     std::vector<std::uint8_t> open_face(nf, 0);
     for (std::size_t c = 0; c < components.size(); ++c) {
-      auto& r = routes_[c];
-      if (r.part < 0 && !components[c].faces.empty())
-        r.part = topology_.face_part(components[c].faces[0]);
+      const auto& r = routes_[c];
       const bool closed = whole || in_closed_group(r);
       for (const std::int32_t f : components[c].faces) {
         (closed ? closed_triangles_ : open_triangles_).push_back(f);
@@ -841,18 +838,19 @@ std::unique_ptr<CullingMethod> make_routed_method(
         std::to_string(routing.dcd_cone_share) + " and " + std::to_string(routing.ccd_cone_share) +
         ")");
   }
+  // The plan, with each component's part taken from the mesh.
   RoutePlan plan = plan_routes(topology, options, routing);
+  for (auto& r : plan.routes) {
+    const auto& faces = plan.components[sz(r.component)].faces;
+    if (r.part < 0 && !faces.empty()) {
+      r.part = mesh.face_part.empty() ? 0 : mesh.face_part[sz(faces.front())];
+    }
+  }
   const bool all_closed =
       !plan.routes.empty() && std::all_of(plan.routes.begin(), plan.routes.end(), in_closed_group);
   if (!plan.whole && all_closed && whole_mesh_method(plan.routes.front().method)) {
     std::unique_ptr<CullingMethod> method =
         make_method(plan.routes.front().method, mesh, topology, options);
-    for (auto& r : plan.routes) {
-      if (r.part < 0 && !plan.components[sz(r.component)].faces.empty()) {
-        const std::int32_t f = plan.components[sz(r.component)].faces[0];
-        r.part = mesh.face_part.empty() ? 0 : mesh.face_part[sz(f)];
-      }
-    }
     return std::make_unique<WholeMeshAuto>(std::move(method), std::move(plan.routes));
   }
   return std::make_unique<AutoMethod>(mesh, topology, options, routing, std::move(plan));

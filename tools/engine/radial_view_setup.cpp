@@ -16,6 +16,11 @@
 
 namespace skelcd::tools {
 
+std::string auto_whole_mesh_size() {
+  return "under " + std::to_string(culling::RoutingOptions{}.all_closed_below_triangles) +
+         " triangles";
+}
+
 RadialViewSetup setup_radial_view(
     const RadialViewArguments& args,
     const skinning::LoadedModel& model,
@@ -60,9 +65,7 @@ RadialViewSetup setup_radial_view(
   // (culling::RoutingOptions::all_closed_method, all_closed_below_triangles).
   if (method == "auto" && topology != nullptr &&
       culling::routes_whole_mesh_to_all_closed_method(*topology)) {
-    const std::string size = "under " +
-                             std::to_string(culling::RoutingOptions{}.all_closed_below_triangles) +
-                             " triangles";
+    const std::string size = auto_whole_mesh_size();
     setup.segmentation_source =
         "none (auto: every part closed, small or capped, " + size + ", the whole mesh to bvh)";
     if (!args.segmentation.empty()) {

@@ -50,4 +50,9 @@ struct RadialViewSetup {
     RunOptions& options,
     const skinning::Topology* topology = nullptr);
 
+/// "under N triangles": the size below which `auto` sends a mesh closed, small or capped
+/// throughout whole to `bvh` (culling::RoutingOptions::all_closed_below_triangles), as the
+/// messages that say so put it.
+[[nodiscard]] std::string auto_whole_mesh_size();
+
 }  // namespace skelcd::tools

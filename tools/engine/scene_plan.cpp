@@ -2,18 +2,11 @@
 #include "tools/engine/scene_plan.hpp"
 
 #include "culling/method_registry.hpp"
-#include "culling/routed_method.hpp"
 #include "skinning/errors.hpp"
+#include "tools/engine/radial_view_setup.hpp"
 
 namespace skelcd::tools {
 namespace {
-
-/// The size under which `auto` sends a mesh closed, small or capped throughout to `bvh`
-/// (culling::RoutingOptions::all_closed_below_triangles).
-std::string auto_whole_size() {
-  return "under " + std::to_string(culling::RoutingOptions{}.all_closed_below_triangles) +
-         " triangles";
-}
 
 bool is_cone_method(const std::string& method) {
   return method == "normal-cone" || method == "dual-cone" || method == "enhanced-dual-cone";
@@ -60,7 +53,7 @@ void decide_stages(ObjectPlan& o) {
     } else if (o.method == "auto") {
       s.push_back(
           o.facts.open_components > 0
-              ? "cones: every part closed, small or capped and " + auto_whole_size() +
+              ? "cones: every part closed, small or capped and " + auto_whole_mesh_size() +
                     " (auto sends the whole mesh to bvh)"
               : std::string(
                     "cones: no open part (auto uses cones only for parts with a boundary)"));
@@ -80,7 +73,7 @@ void decide_stages(ObjectPlan& o) {
           o.facts.closed_components == 0
               ? "segmentation: no closed part (auto segments only closed parts)"
           : o.facts.auto_whole_to_bvh
-              ? "segmentation: every part closed, small or capped and " + auto_whole_size() +
+              ? "segmentation: every part closed, small or capped and " + auto_whole_mesh_size() +
                     " (auto sends the whole mesh to bvh)"
               : std::string(
                     "segmentation: not moved by its own skeleton (closed parts go to bvh)"));
