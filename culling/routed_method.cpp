@@ -786,6 +786,31 @@ bool routes_whole_mesh_to_all_closed_method(
       components, routing, capped_components(topology, components.size(), first_closed_method()));
 }
 
+AutoGroups auto_groups(
+    const skinning::Topology& topology, bool rig, const RoutingOptions& routing) {
+  AutoGroups out;
+  const auto components = components_of(topology);
+  const MethodInfo* first = first_closed_method();
+  const std::vector<std::uint8_t> capped_by_first =
+      capped_components(topology, components.size(), first);
+  out.whole = whole_to_all_closed_method(components, routing, capped_by_first);
+  // route_components' closed method: a named one, else the first when a rig meets its needs.
+  const MethodInfo* closed_info = !routing.closed_method.empty()
+                                      ? find_method(routing.closed_method)
+                                  : rig ? first
+                                        : find_method(kClosedFallbackMethod);
+  const std::vector<std::uint8_t> capped =
+      closed_info == first ? capped_by_first
+                           : capped_components(topology, components.size(), closed_info);
+  for (std::size_t c = 0; c < components.size(); ++c) {
+    const bool to_open =
+        !out.whole && !components[c].closed && capped[c] == 0 &&
+        static_cast<std::int32_t>(components[c].faces.size()) >= routing.min_open_triangles;
+    (to_open ? out.open_components : out.closed_components)++;
+  }
+  return out;
+}
+
 std::vector<std::string> auto_group_methods(
     const MethodOptions& options, const RoutingOptions& routing) {
   return {routing.open_method, closed_method_name(options, routing)};

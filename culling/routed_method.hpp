@@ -78,6 +78,23 @@ struct RoutingOptions {
 [[nodiscard]] bool routes_whole_mesh_to_all_closed_method(
     const skinning::Topology& topology, const RoutingOptions& routing = {});
 
+/// What `auto` gives each of its groups, decided from the topology alone (before any method or
+/// segmentation exists: a check's set-up, a scene's plan).
+struct AutoGroups {
+  bool whole = false;                  ///< routes_whole_mesh_to_all_closed_method
+  std::int32_t open_components = 0;    ///< for the open method (cones): open, large, not capped
+  std::int32_t closed_components = 0;  ///< for the closed method: closed, small or capped
+};
+
+/// The groups of route_components on a mesh whose closed method is, with `rig`, the registered
+/// closed-part method of highest priority (`dynamic`, which a rig's clip gets once segmented: its
+/// hole capping decides which open components join the closed ones), and kClosedFallbackMethod
+/// otherwise. A rig's clip needs a segmentation under `auto` only when the closed group is not
+/// empty and the whole mesh does not go to all_closed_method; it runs cones only when the open
+/// group is not empty.
+[[nodiscard]] AutoGroups auto_groups(
+    const skinning::Topology& topology, bool rig, const RoutingOptions& routing = {});
+
 /// The plan of make_routed_method: one route per component, in component order. Uses
 /// Topology::components, or finds the edge-connected components itself when that is empty.
 /// @throws InvalidInput naming the method when a group's method is unknown or unusable here.

@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <nlohmann/json.hpp>
 #include <set>
 #include <string>
 #include <tuple>
@@ -13,6 +14,7 @@
 #include <vector>
 
 #include "clustering/ghost_caps.hpp"
+#include "culling/routed_method.hpp"
 #include "skinning/load.hpp"
 #include "skinning/topology.hpp"
 #include "tests/support/test_support.hpp"
@@ -51,6 +53,7 @@ struct RoutesSeen {
   std::set<bool> kinds;                ///< closed and/or open components
   std::set<std::string> open_methods;  ///< the methods of the open components
   bool whole = false;  ///< every component closed, under 256 triangles, or with small holes only
+  std::string segmentation;  ///< the summary's `segmentation`: where it came from, or why none
 };
 
 /// Runs `check --method auto` on a rig's clip and checks its /routes against the mesh's own edges:
@@ -61,9 +64,19 @@ struct RoutesSeen {
 RoutesSeen check_routes(const std::filesystem::path& model, const std::string& name) {
   RoutesSeen seen;
   const auto log = skelcd::test::temp_dir("routes-log-" + name) / "auto.h5";
-  const auto r = run_skelcd({"check", model.string(), "--method", "auto", "--frames", "0:1", "-o", log.string()});
+  const auto r = run_skelcd(
+      {"check",
+       model.string(),
+       "--method",
+       "auto",
+       "--frames",
+       "0:1",
+       "--json",
+       "-o",
+       log.string()});
   EXPECT_EQ(r.exit_code, 0) << r.err;
   if (r.exit_code != 0) return seen;
+  seen.segmentation = nlohmann::json::parse(r.out).at("segmentation").get<std::string>();
 
   const auto loaded = skinning::load_model(model);
   const auto topology = skinning::build_topology(*loaded.mesh);
@@ -128,6 +141,16 @@ RoutesSeen check_routes(const std::filesystem::path& model, const std::string& n
     seen.kinds.insert(closed);
   }
   EXPECT_EQ(triangles, loaded.mesh->num_triangles());
+  // What the set-up and a scene's plan decide from the topology alone (culling::auto_groups) is
+  // what the routes show: a segmentation only for a closed group that is not the whole mesh's bvh.
+  const culling::AutoGroups groups = culling::auto_groups(topology, /*rig=*/true);
+  EXPECT_EQ(groups.whole, seen.whole);
+  std::int32_t open_group = 0;
+  for (const auto& route : header.routes) open_group += route.method == "enhanced-dual-cone";
+  EXPECT_EQ(groups.open_components, open_group);
+  EXPECT_EQ(groups.closed_components, static_cast<std::int32_t>(header.routes.size()) - open_group);
+  const bool segmented = seen.segmentation.rfind("computed", 0) == 0;
+  EXPECT_EQ(segmented, !seen.whole && groups.closed_components > 0) << seen.segmentation;
   return seen;
 }
 
@@ -146,6 +169,37 @@ TEST(RoutesLog, AutoWritesWhereEachComponentWent) {
   EXPECT_TRUE(bcn.whole);
   EXPECT_EQ(bcn.kinds, (std::set<bool>{false}));
   EXPECT_EQ(bcn.open_methods, (std::set<std::string>{"bvh"}));
+}
+
+TEST(RoutesLog, AGarmentOnItsOwnSkeletonGoesToConesUnsegmented) {
+  // gen:cloth: one open sheet of 256 triangles or more on hinge bones, its boundary no hole to
+  // cap — `auto` sends it whole to the cones, so no segmentation is made for a closed group that
+  // would be empty, and the answer is bvh's.
+  const std::string model = "gen:cloth?triangles=1200&frames=12";
+  const RoutesSeen cloth = check_routes(model, "cloth");
+  EXPECT_FALSE(cloth.whole);
+  EXPECT_EQ(cloth.kinds, (std::set<bool>{false}));
+  EXPECT_EQ(cloth.open_methods, (std::set<std::string>{"enhanced-dual-cone"}));
+  EXPECT_EQ(cloth.segmentation.rfind("none (auto: every part open", 0), 0u) << cloth.segmentation;
+  // A segmentation file given anyway is not read, and the user is told why.
+  const auto dir = skelcd::test::temp_dir("routes-cloth");
+  const auto unused = dir / "unused.h5";
+  const auto note = run_skelcd(
+      {"check", model, "--method", "auto", "--frames", "0:1", "--segmentation", unused.string()});
+  EXPECT_EQ(note.exit_code, 0) << note.err;
+  EXPECT_NE(
+      note.err.find("is not used: auto sends every part of this mesh to cones"), std::string::npos)
+      << note.err;
+  std::vector<nlohmann::json> runs;
+  for (const char* method : {"auto", "bvh"}) {
+    const auto r = run_skelcd({"check", model, "--method", method, "--baseline", "none", "--json"});
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    runs.push_back(nlohmann::json::parse(r.out));
+  }
+  EXPECT_GT(runs[1]["new_ccd_contacts"].get<std::int64_t>(), 0);
+  for (const char* key : {"ccd_vf", "ccd_ee", "dcd_pairs"}) {
+    EXPECT_EQ(runs[0][key], runs[1][key]) << key;
+  }
 }
 
 TEST(RoutesLog, AutoWithEveryComponentInOneGroupIsThatGroupsMethod) {

@@ -177,6 +177,8 @@ ObjectFacts facts(std::int32_t samples, std::int32_t open, std::int32_t closed, 
   f.samples = samples;
   f.open_components = open;
   f.closed_components = closed;
+  f.auto_open_group = open;  // every open part large and uncapped
+  f.auto_closed_group = closed;
   f.rig_motion = rig;
   return f;
 }
@@ -244,6 +246,51 @@ TEST(ScenePlan, BuildsOnlyWhatTheChecksNeed) {
   const auto json = plan_json(no_rig);
   EXPECT_EQ(json["objects"][4]["stages"]["load"], false);
   EXPECT_EQ(json["objects"][0]["stages"]["swept_bounds"], false);
+}
+
+TEST(ScenePlan, AutoRunsConesAndSegmentsOnlyForTheGroupsItFills) {
+  // What `auto` makes of an object (culling::auto_groups) decides its cones and its segmentation,
+  // not whether it has open or closed parts at all.
+  const auto path = scene_in_assets(
+      "[objects.a]\nmodel = \"gen:rope\"\nchecks = [\"self-ccd\"]\nmethod = \"auto\"\n");
+  const Scene s = parse_scene(path);
+  const auto plan_of = [&](const ObjectFacts& f) {
+    return plan_scene(s, {f}, std::nullopt).objects[0];
+  };
+  const auto skipped = [](const ObjectPlan& o, const std::string& start) {
+    return std::any_of(o.skipped.begin(), o.skipped.end(), [&](const std::string& why) {
+      return why.rfind(start, 0) == 0;
+    });
+  };
+  // A large rig whose open parts are all small or capped: they go with the closed parts to
+  // dynamic; no cones, a segmentation.
+  ObjectFacts capped = facts(10, 2, 1, true);
+  capped.auto_open_group = 0;
+  capped.auto_closed_group = 3;
+  const ObjectPlan a = plan_of(capped);
+  EXPECT_FALSE(a.cones);
+  EXPECT_TRUE(a.segmentation);
+  EXPECT_TRUE(skipped(a, "cones: every open part under 256 triangles or capped"));
+  // Open parts only, one of them capped: a closed group after all, so a segmentation.
+  ObjectFacts open_capped = facts(10, 2, 0, true);
+  open_capped.auto_open_group = 1;
+  open_capped.auto_closed_group = 1;
+  const ObjectPlan b = plan_of(open_capped);
+  EXPECT_TRUE(b.cones);
+  EXPECT_TRUE(b.segmentation);
+  // A garment on its own skeleton, every part large and open: cones, no segmentation.
+  const ObjectPlan c = plan_of(facts(10, 1, 0, true));
+  EXPECT_TRUE(c.cones);
+  EXPECT_FALSE(c.segmentation);
+  EXPECT_TRUE(skipped(c, "segmentation: no closed part, and no open one under 256 triangles"));
+  // The whole mesh to bvh: neither.
+  ObjectFacts whole = facts(10, 2, 1, true);
+  whole.auto_whole_to_bvh = true;
+  whole.auto_open_group = 0;
+  whole.auto_closed_group = 3;
+  const ObjectPlan d = plan_of(whole);
+  EXPECT_FALSE(d.cones || d.segmentation);
+  EXPECT_TRUE(skipped(d, "cones: every part closed, small or capped and under 20000 triangles"));
 }
 
 TEST(ScenePlan, ATargetOnlyCarryingASheetIsLoadedButNeverPosed) {

@@ -62,15 +62,29 @@ RadialViewSetup setup_radial_view(
   }
   // Nor when every part is closed, small (under 256 triangles) or open only at holes the radial
   // view would cap, in a mesh under 20,000 triangles: `auto` then sends the whole mesh to `bvh`
-  // (culling::RoutingOptions::all_closed_method, all_closed_below_triangles).
-  if (method == "auto" && topology != nullptr &&
-      culling::routes_whole_mesh_to_all_closed_method(*topology)) {
+  // (culling::RoutingOptions::all_closed_method, all_closed_below_triangles). Nor when `auto`
+  // sends nothing to `dynamic`: every part open, of 256 triangles or more and not capped (a
+  // garment on its own skeleton goes whole to the cones).
+  const culling::AutoGroups groups = method == "auto" && topology != nullptr
+                                         ? culling::auto_groups(*topology, /*rig=*/true)
+                                         : culling::AutoGroups{.closed_components = 1};
+  if (groups.whole) {
     const std::string size = auto_whole_mesh_size();
     setup.segmentation_source =
         "none (auto: every part closed, small or capped, " + size + ", the whole mesh to bvh)";
     if (!args.segmentation.empty()) {
       std::cerr << "skelcd: note: " << args.segmentation << " is not used: auto sends a mesh "
                 << size << " whose every part is closed, small or capped to bvh\n";
+    }
+    return setup;
+  }
+  if (groups.closed_components == 0) {
+    setup.segmentation_source =
+        "none (auto: every part open, 256 triangles or more and not capped, all to cones)";
+    if (!args.segmentation.empty()) {
+      std::cerr << "skelcd: note: " << args.segmentation
+                << " is not used: auto sends every part of this mesh to cones (each is open, "
+                   "has 256 triangles or more and no hole dynamic caps)\n";
     }
     return setup;
   }

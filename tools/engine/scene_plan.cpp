@@ -30,14 +30,14 @@ void decide_stages(ObjectPlan& o) {
   if (self && is_cone_method(o.method)) {
     o.cones = true;
   } else if (self && o.method == "auto") {
-    o.cones = o.facts.open_components > 0 && !o.facts.auto_whole_to_bvh;
+    o.cones = o.facts.auto_open_group > 0;
   }
   // Radial view culls intervals only: a DCD-only object answers with `bvh` and is not segmented.
   if (o.self_ccd && radial) {
     o.segmentation = true;
   } else if (o.self_ccd && o.method == "auto") {
     o.segmentation =
-        o.facts.closed_components > 0 && o.facts.rig_motion && !o.facts.auto_whole_to_bvh;
+        o.facts.auto_closed_group > 0 && o.facts.rig_motion && !o.facts.auto_whole_to_bvh;
   }
   if (!o.load) return;
   auto& s = o.skipped;
@@ -52,11 +52,14 @@ void decide_stages(ObjectPlan& o) {
       s.push_back("cones: pair checks only (pairs use the hierarchies)");
     } else if (o.method == "auto") {
       s.push_back(
-          o.facts.open_components > 0
+          o.facts.open_components == 0
+              ? std::string("cones: no open part (auto uses cones only for parts with a boundary)")
+          : o.facts.auto_whole_to_bvh
               ? "cones: every part closed, small or capped and " + auto_whole_mesh_size() +
                     " (auto sends the whole mesh to bvh)"
               : std::string(
-                    "cones: no open part (auto uses cones only for parts with a boundary)"));
+                    "cones: every open part under 256 triangles or capped (auto sends them with "
+                    "the closed parts)"));
     } else {
       s.push_back("cones: method " + o.method + " uses none");
     }
@@ -70,8 +73,10 @@ void decide_stages(ObjectPlan& o) {
           " answers instants with bvh; radial view culls intervals)");
     } else if (o.method == "auto") {
       s.push_back(
-          o.facts.closed_components == 0
-              ? "segmentation: no closed part (auto segments only closed parts)"
+          o.facts.auto_closed_group == 0
+              ? std::string(
+                    "segmentation: no closed part, and no open one under 256 triangles or capped "
+                    "(auto segments only the parts it sends to dynamic)")
           : o.facts.auto_whole_to_bvh
               ? "segmentation: every part closed, small or capped and " + auto_whole_mesh_size() +
                     " (auto sends the whole mesh to bvh)"

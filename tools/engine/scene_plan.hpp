@@ -28,6 +28,11 @@ struct ObjectFacts {
   /// `auto` sends the whole mesh to `bvh`
   /// (culling::routes_whole_mesh_to_all_closed_method), with no cones and no segmentation.
   bool auto_whole_to_bvh = false;
+  /// Components `auto` would give its cone method (open, 256 triangles or more, not capped) and
+  /// its closed-part method (the others) on this object's motion (culling::auto_groups): the
+  /// cones run only for the first, a segmentation is made only for the second.
+  std::int32_t auto_open_group = 0;
+  std::int32_t auto_closed_group = 0;
 };
 
 struct ObjectPlan {

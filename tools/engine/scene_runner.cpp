@@ -290,7 +290,10 @@ ObjectFacts facts_of(const SceneObject& so, const LoadedObject& lo) {
   for (const auto& c : lo.topology.components)
     (c.closed ? f.closed_components : f.open_components)++;
   f.rig_motion = lo.motion->num_bones() > 0;
-  f.auto_whole_to_bvh = culling::routes_whole_mesh_to_all_closed_method(lo.topology);
+  const culling::AutoGroups groups = culling::auto_groups(lo.topology, f.rig_motion);
+  f.auto_whole_to_bvh = groups.whole;
+  f.auto_open_group = groups.open_components;
+  f.auto_closed_group = groups.closed_components;
   return f;
 }
 
