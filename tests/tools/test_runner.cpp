@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "skinning/errors.hpp"
+#include "skinning/load.hpp"
 #include "tests/support/test_support.hpp"
 #include "tools/engine/runner.hpp"
 
@@ -455,6 +456,28 @@ class CrossingMotion : public skinning::Motion {
  private:
   skinning::Mesh mesh_;
 };
+
+TEST(Runner, AutoTakesRigidRowsOnlyForAClosedGroup) {
+  // Rigid rows go to the methods that take them; under `auto` those are its closed group's. A
+  // garment on its own skeleton (gen:cloth: one open sheet, its boundary no hole to cap) goes
+  // whole to the cones, which take none: no rows are built. RobotExpressive, closed parts hanging
+  // rigidly from nodes, goes whole to `bvh` with them.
+  const auto rows_of = [](const std::string& model, const std::string& method, bool asked) {
+    const auto loaded = skinning::load_model(model);
+    const auto motion = loaded.motion({});
+    RunOptions options;
+    options.method = method;
+    options.rigid_rows = asked;
+    options.frames = FrameRange{0, 2};
+    return ClipRunner(*motion, options).has_rigid_rows();
+  };
+  const std::string cloth = "gen:cloth?triangles=1200&frames=6";
+  const std::string robot = test::asset("characters/RobotExpressive.glb").string();
+  EXPECT_FALSE(rows_of(cloth, "auto", true));
+  EXPECT_TRUE(rows_of(cloth, "kdop", true));  // the sheet has rows, and kdop takes them
+  EXPECT_TRUE(rows_of(robot, "auto", true));
+  EXPECT_FALSE(rows_of(robot, "auto", false));  // --no-rigid-rows
+}
 
 TEST(Runner, RealMethodsFindTheHandCountedContactsInFileNumbering) {
   const CrossingMotion motion;

@@ -580,8 +580,14 @@ ClipRunner::ClipRunner(
   // pairs), the motion is linear blend skinning and they hold a twentieth of the triangles at
   // least (fewer did not pay for their certificates: the stormtrooper's 2 %, docs/benchmarks.md
   // "Rigid rows in `kdop`"); their intervals then carry the bone transforms that certify them.
+  // `auto` gives them only to its closed group's method (`dynamic`, or `bvh` for the whole mesh):
+  // none when every part goes to the cones (a garment on its own skeleton; on gen:cloth's 20,000
+  // triangles the rows took 200 ms of set-up for nothing). Should `auto` then drop an idle cone
+  // group for `bvh`, that `bvh` runs without rows: the same findings, without their skipped pairs.
   if (!factory_ && options.rigid_rows && options.query != QuerySet::dcd &&
-      motion.skin_weights() != nullptr && takes_rigid_rows(options.method)) {
+      motion.skin_weights() != nullptr && takes_rigid_rows(options.method) &&
+      (options.method != "auto" ||
+       culling::auto_groups(*topology_, motion.num_bones() > 0).closed_components > 0)) {
     const skinning::SkinWeights& weights = *motion.skin_weights();
     auto rows = std::make_shared<const culling::RigidRows>(culling::build_rigid_rows(
         motion.mesh(),

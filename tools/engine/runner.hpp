@@ -161,6 +161,10 @@ class ClipRunner {
   [[nodiscard]] const RunPlan& plan() const { return plan_; }
   [[nodiscard]] const skinning::Topology& topology() const { return *topology_; }
   [[nodiscard]] std::string_view method_name() const { return method_->name(); }
+  /// Whether the method was given rigid rows (RunOptions::rigid_rows; docs/culling.md "Rigid
+  /// rows"): a method that takes them, CCD intervals, a skinned motion, and rows that hold a
+  /// twentieth of the triangles; under `auto`, a closed group too.
+  [[nodiscard]] bool has_rigid_rows() const { return method_options_.rigid_rows != nullptr; }
   /// Under `auto`, where each connected component went (the log's /routes rows); empty for any
   /// other method. `part_offset` is added to each route's part id (a scene's object offset).
   [[nodiscard]] std::vector<LogRoute> routes(std::int32_t part_offset = 0) const;
