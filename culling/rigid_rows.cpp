@@ -6,7 +6,6 @@
 #include <array>
 #include <cmath>
 #include <limits>
-#include <map>
 #include <string>
 
 #include "ccd/edge_edge.hpp"
@@ -55,11 +54,55 @@ bool held_boxes_apart(
   return false;
 }
 
+/// Row v of the row-major positions `x`.
+Eigen::Vector3d point(const skinning::Positions& x, std::int32_t v) {
+  const double* p = x.data() + 3 * static_cast<std::size_t>(v);
+  return {p[0], p[1], p[2]};
+}
+
+/// Whether the point sets a and b of the held pose `x` lie more than 2s apart along the direction
+/// u, whatever u is: the gap between their projections on u, over |u|, is a lower bound of their
+/// distance. Computed, the projections are off by a few units of roundoff of |u| times the
+/// coordinates' size, and |u| by two: with 2s in place of s, a gap this accepts is more than s
+/// exactly while s is above some 10⁻¹⁴ of the coordinates (the rest tolerance is 10⁻⁶ of them).
+/// A degenerate u (zero, not finite) settles nothing.
+template <std::size_t NA, std::size_t NB>
+bool apart_along(
+    const skinning::Positions& x,
+    const Eigen::Vector3d& u,
+    const std::array<std::int32_t, NA>& a,
+    const std::array<std::int32_t, NB>& b,
+    double s) {
+  const double norm = u.norm();
+  if (!(norm > 0.0) || !std::isfinite(norm)) return false;
+  const Eigen::Vector3d origin = point(x, b[0]);
+  const auto range = [&](const auto& set) {
+    double lo = std::numeric_limits<double>::infinity();
+    double hi = -lo;
+    for (const std::int32_t v : set) {
+      const double d = u.dot(point(x, v) - origin);
+      lo = std::min(lo, d);
+      hi = std::max(hi, d);
+    }
+    return std::pair{lo, hi};
+  };
+  const auto [a_lo, a_hi] = range(a);
+  const auto [b_lo, b_hi] = range(b);
+  const double need = 2.0 * s * norm;
+  return a_lo - b_hi > need || b_lo - a_hi > need;
+}
+
 /// Whether triangles a and b (welded corners) have a vertex-face or edge-edge pair sharing no
 /// vertex that the conservative CCD test of the held pose `x` finds within
 /// options.min_separation. A pair whose boxes are apart (held_boxes_apart, the kernel's own first
 /// test) is not handed to the kernel: nearly all of them are, and forming the query cost more
 /// than the kernel's answer (the same answers; docs/benchmarks.md "Rest pairs without queries").
+/// Nor is one that a direction shows more than twice the tolerance apart (apart_along): the face's
+/// normal and its sides' normals in its plane for a vertex-face pair; the two edges' cross product,
+/// the triangles' normals and each edge's normal in its triangle's plane for an edge-edge pair.
+/// Neighbours in a flat or smooth stretch of a row pass the boxes but not these, and the kernel
+/// on such a nearly coplanar held pose is at its slowest (docs/benchmarks.md "Rest pairs apart
+/// along a direction").
 bool features_within(
     const skinning::Positions& x,
     const std::array<std::int32_t, 3>& a,
@@ -69,8 +112,21 @@ bool features_within(
     return v == t[0] || v == t[1] || v == t[2];
   };
   const double s = options.min_separation;
+  const auto normal = [&](const std::array<std::int32_t, 3>& t) -> Eigen::Vector3d {
+    const Eigen::Vector3d p0 = point(x, t[0]);
+    return (point(x, t[1]) - p0).cross(point(x, t[2]) - p0);
+  };
+  const Eigen::Vector3d n_a = normal(a);
+  const Eigen::Vector3d n_b = normal(b);
   const auto vertex_face = [&](std::int32_t v, const std::array<std::int32_t, 3>& f) {
-    if (held_boxes_apart(x, std::array<std::int32_t, 1>{v}, f, s)) return false;
+    const std::array<std::int32_t, 1> p{v};
+    if (held_boxes_apart(x, p, f, s)) return false;
+    const Eigen::Vector3d& n = &f == &a ? n_a : n_b;
+    if (apart_along(x, n, p, f, s)) return false;
+    for (std::size_t i = 0; i < 3; ++i) {
+      const Eigen::Vector3d side = point(x, f[(i + 1) % 3]) - point(x, f[i]);
+      if (apart_along(x, n.cross(side), p, f, s)) return false;
+    }
     return ccd::vertex_face_ccd(
                vertex_face_query(x, x, v, x, x, f), ccd::Accuracy::conservative, options)
         .hit;
@@ -88,8 +144,14 @@ bool features_within(
       const std::int32_t b0 = b[j];
       const std::int32_t b1 = b[(j + 1) % 3];
       if (a0 == b0 || a0 == b1 || a1 == b0 || a1 == b1) continue;
-      if (held_boxes_apart(
-              x, std::array<std::int32_t, 2>{a0, a1}, std::array<std::int32_t, 2>{b0, b1}, s)) {
+      const std::array<std::int32_t, 2> ea{a0, a1};
+      const std::array<std::int32_t, 2> eb{b0, b1};
+      if (held_boxes_apart(x, ea, eb, s)) continue;
+      const Eigen::Vector3d da = point(x, a1) - point(x, a0);
+      const Eigen::Vector3d db = point(x, b1) - point(x, b0);
+      if (apart_along(x, da.cross(db), ea, eb, s) || apart_along(x, n_a, ea, eb, s) ||
+          apart_along(x, n_b, ea, eb, s) || apart_along(x, n_a.cross(da), ea, eb, s) ||
+          apart_along(x, n_b.cross(db), ea, eb, s)) {
         continue;
       }
       const ccd::EdgeEdgeQuery q = edge_edge_query(x, x, {a0, a1}, x, x, {b0, b1});
@@ -151,9 +213,15 @@ RigidRows build_rigid_rows(
   const auto nf = static_cast<std::int32_t>(topology.welded_triangles.rows());
   RigidRows out;
   out.num_transforms = num_transforms;
-  // Each welded vertex's row: its representative's influences, exactly as stored.
-  std::map<Influences, std::int32_t> index;
-  std::vector<std::int32_t> vertex_row(at(nw), -1);
+  // Each welded vertex's row: its representative's influences, exactly as stored, copied into
+  // one array (`columns`, `values`, vertex w's at [start[w], start[w + 1])). Equal rows are found
+  // by sorting the vertices by their rows, not through a map of row vectors (on a subdivided
+  // rig nearly every vertex has a row of its own: a vector and a map node each, most of this
+  // function's instructions on CesiumMan-dense); rows are numbered in the order of their first
+  // vertex, as such a map filled vertex by vertex numbers them.
+  std::vector<std::int32_t> columns;
+  std::vector<double> values;
+  std::vector<std::size_t> start(at(nw) + 1, 0);
   skinning::Positions rest(nw, 3);
   double extent = 0.0;
   for (std::int32_t w = 0; w < nw; ++w) {
@@ -164,17 +232,65 @@ RigidRows build_rigid_rows(
     rest.row(w) = mesh.rest_positions.row(v);
     if (!rest.row(w).allFinite()) fail("vertex " + std::to_string(v) + " is not finite at rest");
     extent = std::max(extent, rest.row(w).cwiseAbs().maxCoeff());
-    Influences row;
     for (skinning::SkinWeights::InnerIterator it(weights, v); it; ++it) {
       if (!std::isfinite(it.value()))
         fail("vertex " + std::to_string(v) + " has a non-finite weight");
-      row.emplace_back(static_cast<std::int32_t>(it.col()), it.value());
+      columns.push_back(static_cast<std::int32_t>(it.col()));
+      values.push_back(it.value());
     }
-    if (row.empty()) continue;  // a vertex that skinning leaves at rest: not a blend
-    const auto [it, added] = index.emplace(row, static_cast<std::int32_t>(out.rows.size()));
-    if (added) out.rows.push_back(std::move(row));
-    vertex_row[at(w)] = it->second;
+    start[at(w) + 1] = columns.size();
   }
+  // Lexicographic on (column, weight) pairs, a shorter row first where one is the other's
+  // beginning: the order of std::vector<std::pair<int, double>>, so that equal means equal there.
+  const auto row_less = [&](std::int32_t a, std::int32_t b) {
+    const std::size_t na = start[at(a) + 1] - start[at(a)];
+    const std::size_t nb = start[at(b) + 1] - start[at(b)];
+    for (std::size_t k = 0; k < std::min(na, nb); ++k) {
+      const std::size_t i = start[at(a)] + k;
+      const std::size_t j = start[at(b)] + k;
+      if (columns[i] != columns[j]) return columns[i] < columns[j];
+      if (values[i] < values[j]) return true;
+      if (values[j] < values[i]) return false;
+    }
+    return na < nb;
+  };
+  std::vector<std::int32_t> by_row;  // the vertices skinning blends (a row), sorted by row
+  for (std::int32_t w = 0; w < nw; ++w) {
+    if (start[at(w) + 1] > start[at(w)]) by_row.push_back(w);  // else left at rest: not a blend
+  }
+  std::stable_sort(by_row.begin(), by_row.end(), row_less);
+  // Each run of equal rows, numbered by its first vertex (stable: a run's first is its least).
+  std::vector<std::int32_t> vertex_row(at(nw), -1);
+  std::vector<std::int32_t> run_first;  // per run: its least vertex
+  std::vector<std::int32_t> vertex_run(at(nw), -1);
+  for (std::size_t i = 0; i < by_row.size(); ++i) {
+    if (i == 0 || row_less(by_row[i - 1], by_row[i])) run_first.push_back(by_row[i]);
+    vertex_run[at(by_row[i])] = static_cast<std::int32_t>(run_first.size() - 1);
+  }
+  std::vector<std::int32_t> run_order(run_first.size());
+  for (std::size_t r = 0; r < run_order.size(); ++r) run_order[r] = static_cast<std::int32_t>(r);
+  std::sort(run_order.begin(), run_order.end(), [&](std::int32_t a, std::int32_t b) {
+    return run_first[at(a)] < run_first[at(b)];
+  });
+  std::vector<std::int32_t> run_row(run_first.size());
+  for (std::size_t k = 0; k < run_order.size(); ++k) {
+    run_row[at(run_order[k])] = static_cast<std::int32_t>(k);
+  }
+  for (std::int32_t w = 0; w < nw; ++w) {
+    if (vertex_run[at(w)] >= 0) vertex_row[at(w)] = run_row[at(vertex_run[at(w)])];
+  }
+  // A row's influences, from its first vertex (the rows kept below only).
+  std::vector<std::int32_t> row_vertex(run_first.size());
+  for (std::size_t r = 0; r < run_first.size(); ++r) row_vertex[at(run_row[r])] = run_first[r];
+  const auto influences = [&](std::int32_t r) {
+    const std::int32_t w = row_vertex[at(r)];
+    Influences row;
+    for (std::size_t i = start[at(w)]; i < start[at(w) + 1]; ++i) {
+      row.emplace_back(columns[i], values[i]);
+    }
+    return row;
+  };
+  const auto num_rows = static_cast<std::int32_t>(run_first.size());
   out.rest_extent = std::max(extent, 1e-300);
   out.rest_tolerance = 1e-6 * out.rest_extent;
   out.triangle_row.assign(at(nf), -1);
@@ -182,7 +298,7 @@ RigidRows build_rigid_rows(
   const auto corners = [&](std::int32_t f) {
     return std::array<std::int32_t, 3>{tris(f, 0), tris(f, 1), tris(f, 2)};
   };
-  std::vector<std::int32_t> triangles_in(out.rows.size(), 0);
+  std::vector<std::int32_t> triangles_in(at(num_rows), 0);
   for (std::int32_t f = 0; f < nf; ++f) {
     const auto c = corners(f);
     if (c[0] == c[1] || c[1] == c[2] || c[0] == c[2]) continue;
@@ -194,14 +310,12 @@ RigidRows build_rigid_rows(
   }
   // Only rows of two triangles or more have a pair to skip: the others are dropped (each would
   // cost a certificate per interval), the rest renumbered in order.
-  std::vector<std::int32_t> renumbered(out.rows.size(), -1);
-  std::vector<Influences> kept;
-  for (std::size_t r = 0; r < out.rows.size(); ++r) {
-    if (triangles_in[r] < 2) continue;
-    renumbered[r] = static_cast<std::int32_t>(kept.size());
-    kept.push_back(std::move(out.rows[r]));
+  std::vector<std::int32_t> renumbered(at(num_rows), -1);
+  for (std::int32_t r = 0; r < num_rows; ++r) {
+    if (triangles_in[at(r)] < 2) continue;
+    renumbered[at(r)] = static_cast<std::int32_t>(out.rows.size());
+    out.rows.push_back(influences(r));
   }
-  out.rows = std::move(kept);
   for (std::int32_t& r : out.triangle_row) {
     if (r >= 0) r = renumbered[at(r)];
     if (r >= 0) ++out.triangles_in_rows;

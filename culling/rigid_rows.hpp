@@ -32,8 +32,10 @@ struct RigidRows {
   std::vector<std::vector<std::pair<std::int32_t, double>>> rows;
   /// Pairs (a < b) of triangles of one row with a vertex-face or edge-edge pair that shares no
   /// vertex and lies within rest_tolerance at rest (conservatively: the CCD kernel's conservative
-  /// test of the held rest pose with that contact distance), except pairs of excluded parts
-  /// (Mesh::excluded_part_pairs), which are never tested. Tested whenever their row is skipped.
+  /// test of the held rest pose with that contact distance, asked about every feature pair that
+  /// neither its boxes nor a separating direction show to lie more than that apart), except
+  /// pairs of excluded parts (Mesh::excluded_part_pairs), which are never tested. Tested whenever
+  /// their row is skipped.
   std::vector<TrianglePair> rest_pairs;
   /// Rest distance below which a row's pairs are kept in rest_pairs: 1e-6 of rest_extent.
   double rest_tolerance = 0.0;
