@@ -262,33 +262,32 @@ TEST(ScenePlan, AutoRunsConesAndSegmentsOnlyForTheGroupsItFills) {
       return why.rfind(start, 0) == 0;
     });
   };
+  // Open and closed components, and what auto's groups get of them.
+  const auto groups =
+      [](std::int32_t open, std::int32_t closed, std::int32_t to_cones, bool whole) {
+        ObjectFacts f = facts(10, open, closed, true);
+        f.auto_open_group = to_cones;
+        f.auto_closed_group = open + closed - to_cones;
+        f.auto_whole_to_bvh = whole;
+        return f;
+      };
   // A large rig whose open parts are all small or capped: they go with the closed parts to
   // dynamic; no cones, a segmentation.
-  ObjectFacts capped = facts(10, 2, 1, true);
-  capped.auto_open_group = 0;
-  capped.auto_closed_group = 3;
-  const ObjectPlan a = plan_of(capped);
+  const ObjectPlan a = plan_of(groups(2, 1, 0, false));
   EXPECT_FALSE(a.cones);
   EXPECT_TRUE(a.segmentation);
   EXPECT_TRUE(skipped(a, "cones: every open part under 256 triangles or capped"));
   // Open parts only, one of them capped: a closed group after all, so a segmentation.
-  ObjectFacts open_capped = facts(10, 2, 0, true);
-  open_capped.auto_open_group = 1;
-  open_capped.auto_closed_group = 1;
-  const ObjectPlan b = plan_of(open_capped);
+  const ObjectPlan b = plan_of(groups(2, 0, 1, false));
   EXPECT_TRUE(b.cones);
   EXPECT_TRUE(b.segmentation);
   // A garment on its own skeleton, every part large and open: cones, no segmentation.
-  const ObjectPlan c = plan_of(facts(10, 1, 0, true));
+  const ObjectPlan c = plan_of(groups(1, 0, 1, false));
   EXPECT_TRUE(c.cones);
   EXPECT_FALSE(c.segmentation);
   EXPECT_TRUE(skipped(c, "segmentation: no closed part, and no open one under 256 triangles"));
   // The whole mesh to bvh: neither.
-  ObjectFacts whole = facts(10, 2, 1, true);
-  whole.auto_whole_to_bvh = true;
-  whole.auto_open_group = 0;
-  whole.auto_closed_group = 3;
-  const ObjectPlan d = plan_of(whole);
+  const ObjectPlan d = plan_of(groups(2, 1, 0, true));
   EXPECT_FALSE(d.cones || d.segmentation);
   EXPECT_TRUE(skipped(d, "cones: every part closed, small or capped and under 20000 triangles"));
 }

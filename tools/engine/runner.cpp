@@ -587,7 +587,9 @@ ClipRunner::ClipRunner(
   if (!factory_ && options.rigid_rows && options.query != QuerySet::dcd &&
       motion.skin_weights() != nullptr && takes_rigid_rows(options.method) &&
       (options.method != "auto" ||
-       culling::auto_groups(*topology_, motion.num_bones() > 0).closed_components > 0)) {
+       culling::auto_groups(
+           *topology_, motion.num_bones() > 0 && method_options_.segmentation != nullptr)
+               .closed_components > 0)) {
     const skinning::SkinWeights& weights = *motion.skin_weights();
     auto rows = std::make_shared<const culling::RigidRows>(culling::build_rigid_rows(
         motion.mesh(),
