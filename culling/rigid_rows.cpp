@@ -259,29 +259,26 @@ RigidRows build_rigid_rows(
     if (start[at(w) + 1] > start[at(w)]) by_row.push_back(w);  // else left at rest: not a blend
   }
   std::stable_sort(by_row.begin(), by_row.end(), row_less);
-  // Each run of equal rows, numbered by its first vertex (stable: a run's first is its least).
-  std::vector<std::int32_t> vertex_row(at(nw), -1);
-  std::vector<std::int32_t> run_first;  // per run: its least vertex
-  std::vector<std::int32_t> vertex_run(at(nw), -1);
+  // Each blended vertex's first vertex with its row (stable: a run's first is its least), then
+  // the rows numbered as those first vertices come, each later vertex taking its first's.
+  std::vector<std::int32_t> first_of(at(nw), -1);
   for (std::size_t i = 0; i < by_row.size(); ++i) {
-    if (i == 0 || row_less(by_row[i - 1], by_row[i])) run_first.push_back(by_row[i]);
-    vertex_run[at(by_row[i])] = static_cast<std::int32_t>(run_first.size() - 1);
+    const bool starts_run = i == 0 || row_less(by_row[i - 1], by_row[i]);
+    first_of[at(by_row[i])] = starts_run ? by_row[i] : first_of[at(by_row[i - 1])];
   }
-  std::vector<std::int32_t> run_order(run_first.size());
-  for (std::size_t r = 0; r < run_order.size(); ++r) run_order[r] = static_cast<std::int32_t>(r);
-  std::sort(run_order.begin(), run_order.end(), [&](std::int32_t a, std::int32_t b) {
-    return run_first[at(a)] < run_first[at(b)];
-  });
-  std::vector<std::int32_t> run_row(run_first.size());
-  for (std::size_t k = 0; k < run_order.size(); ++k) {
-    run_row[at(run_order[k])] = static_cast<std::int32_t>(k);
-  }
+  std::vector<std::int32_t> vertex_row(at(nw), -1);
+  std::vector<std::int32_t> row_vertex;  // each row's first vertex
   for (std::int32_t w = 0; w < nw; ++w) {
-    if (vertex_run[at(w)] >= 0) vertex_row[at(w)] = run_row[at(vertex_run[at(w)])];
+    const std::int32_t first = first_of[at(w)];
+    if (first < 0) continue;
+    if (first == w) {
+      vertex_row[at(w)] = static_cast<std::int32_t>(row_vertex.size());
+      row_vertex.push_back(w);
+    } else {
+      vertex_row[at(w)] = vertex_row[at(first)];  // first < w: numbered already
+    }
   }
   // A row's influences, from its first vertex (the rows kept below only).
-  std::vector<std::int32_t> row_vertex(run_first.size());
-  for (std::size_t r = 0; r < run_first.size(); ++r) row_vertex[at(run_row[r])] = run_first[r];
   const auto influences = [&](std::int32_t r) {
     const std::int32_t w = row_vertex[at(r)];
     Influences row;
@@ -290,7 +287,7 @@ RigidRows build_rigid_rows(
     }
     return row;
   };
-  const auto num_rows = static_cast<std::int32_t>(run_first.size());
+  const auto num_rows = static_cast<std::int32_t>(row_vertex.size());
   out.rest_extent = std::max(extent, 1e-300);
   out.rest_tolerance = 1e-6 * out.rest_extent;
   out.triangle_row.assign(at(nf), -1);
