@@ -163,6 +163,57 @@ TEST(CmdBench, EveryMethodOnABundledCharacterMissesNothingButDualCone) {
   EXPECT_GT(dual_cone_misses, 0);
 }
 
+TEST(CmdBench, AutoIsSegmentedOnlyWhereCheckSegmentsIt) {
+  // `auto` gets a segmentation only for a closed group it sends to `dynamic`, decided as `check`
+  // decides it: the bench's note is the check's `segmentation` value, word for word, for a garment
+  // on its own skeleton (every part to the cones) and a character under 20,000 triangles (the
+  // whole mesh to `bvh`); a denser character, whose closed body goes to `dynamic`, gets no note.
+  // `auto` misses nothing against the reference either way, and `dynamic` beside it is still
+  // segmented.
+  const auto dense = skelcd::test::asset("characters/CesiumMan-dense.glb").string();
+  const std::vector<std::pair<std::string, bool>> models = {
+      {"gen:cloth", true},
+      {skelcd::test::asset("characters/CesiumMan.glb").string(), true},
+      {dense, false}};
+  for (const auto& [model, without] : models) {
+    const auto check = run_skelcd({"check", model, "--frames", "0:2", "--json"});
+    ASSERT_EQ(check.exit_code, 0) << model << ": " << check.err;
+    const std::string segmentation = nlohmann::json::parse(check.out)["segmentation"];
+    EXPECT_EQ(segmentation.rfind("none (auto: ", 0) == 0, without) << model << ": " << segmentation;
+
+    const auto r = run_skelcd(
+        {"bench",
+         model,
+         "--frames",
+         "0:2",
+         "--methods",
+         "auto,dynamic",
+         "--accuracies",
+         "conservative",
+         "--reference",
+         "bvh",
+         "--json"});
+    ASSERT_EQ(r.exit_code, 0) << model << ": " << r.err;
+    const auto j = nlohmann::json::parse(r.out);
+    const auto notes = j["notes"].get<std::vector<std::string>>();
+    const std::string note = "auto: segmentation " + segmentation;
+    EXPECT_EQ(std::count(notes.begin(), notes.end(), note), without ? 1 : 0)
+        << model << ": " << r.out;
+    if (!without) {
+      for (const auto& n : notes) EXPECT_NE(n.rfind("auto: ", 0), 0u) << model << ": " << n;
+    }
+    ASSERT_EQ(j["rows"].size(), 2u) << r.out;
+    for (const auto& row : j["rows"]) {
+      EXPECT_EQ(row["false_negatives"], 0) << model << " " << row.dump();
+      EXPECT_EQ(row["false_positives"], 0) << model << " " << row.dump();
+    }
+    // `dynamic` ran its radial view (a segmentation was made for it): its classify stage took time.
+    const auto& dynamic = j["rows"][1];
+    ASSERT_EQ(dynamic["method"], "dynamic");
+    EXPECT_GT(dynamic["stages_ms"]["classify"].get<double>(), 0.0) << model;
+  }
+}
+
 TEST(CmdBench, BadInputFailsWithOneLineAndWritesNothing) {
   const auto dir = skelcd::test::temp_dir("bench-bad");
   const auto csv = (dir / "out.csv").string();

@@ -14,6 +14,7 @@
 #include "skinning/generators.hpp"
 #include "skinning/load.hpp"
 #include "skinning/rig_motion.hpp"
+#include "skinning/topology.hpp"
 #include "tools/cli/cli_util.hpp"
 #include "tools/cli/commands.hpp"
 #include "tools/cli/model_options.hpp"
@@ -124,27 +125,50 @@ BenchReport bench_target(
   struct RadialViewCache {
     bool ready = false;
     RunOptions options;
+    /// Whether `auto` was asked yet, and why it makes no segmentation (empty: it makes one, the
+    /// one `rvbc` and `dynamic` share), as `check` says it.
+    bool auto_asked = false;
+    std::string auto_without;
   };
   auto cache = std::make_shared<RadialViewCache>();
-  options.prepare =
-      [cache, &args, &model, &motion, radial_view = options.radial_view](RunOptions& run) {
-        // Methods that need a segmentation, and `auto` (closed components to `dynamic`) on a rig's
-        // clip, as `check` does.
-        const culling::MethodInfo* info = culling::find_method(run.method);
-        const bool uses_radial_view =
-            (info != nullptr && info->needs.segmentation) || (run.method == "auto" && radial_view);
-        if (!uses_radial_view) return;
-        if (!cache->ready) {
-          cache->options = run;
-          cache->options.method = "dynamic";
-          (void)setup_radial_view(args.radial_view, model, motion, cache->options);
-          cache->ready = true;
-        }
-        run.segmentation = cache->options.segmentation;
-        run.method_parameters = cache->options.method_parameters;
-      };
+  options.prepare = [cache, &args, &model, &motion, radial_view = options.radial_view](
+                        RunOptions& run) {
+    // Methods that need a segmentation, and `auto` (closed components to `dynamic`) on a rig's
+    // clip, as `check` does.
+    const culling::MethodInfo* info = culling::find_method(run.method);
+    const bool is_auto = run.method == "auto";
+    const bool uses_radial_view =
+        (info != nullptr && info->needs.segmentation) || (is_auto && radial_view);
+    if (!uses_radial_view) return;
+    if (is_auto && !cache->auto_asked && run.query != QuerySet::dcd) {
+      // `auto` segments only for a closed group it sends to `dynamic`: not for a mesh it sends
+      // whole to `bvh`, nor for a garment whose every part goes to the cones (decided on the
+      // mesh's topology, as `check` decides it).
+      if (auto without = auto_without_segmentation(skinning::build_topology(motion.mesh()))) {
+        cache->auto_without = std::move(without->source);
+      }
+      cache->auto_asked = true;
+    }
+    if (is_auto && !cache->auto_without.empty()) {
+      run.method_parameters =
+          culling::MethodParameters{.gamma = args.radial_view.gamma, .seed = args.radial_view.seed};
+      return;
+    }
+    if (!cache->ready) {
+      cache->options = run;
+      cache->options.method = "dynamic";
+      (void)setup_radial_view(args.radial_view, model, motion, cache->options);
+      cache->ready = true;
+    }
+    run.segmentation = cache->options.segmentation;
+    run.method_parameters = cache->options.method_parameters;
+  };
   options.progress = true;
-  return run_bench(motion, options);
+  BenchReport report = run_bench(motion, options);
+  if (!cache->auto_without.empty()) {
+    report.notes.push_back("auto: segmentation " + cache->auto_without);
+  }
+  return report;
 }
 
 /// The query a scene object's self checks ask for.

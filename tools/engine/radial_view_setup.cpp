@@ -21,6 +21,27 @@ std::string auto_whole_mesh_size() {
          " triangles";
 }
 
+std::optional<AutoWithoutSegmentation> auto_without_segmentation(
+    const skinning::Topology& topology) {
+  const culling::AutoGroups groups = culling::auto_groups(topology, /*rig=*/true);
+  if (groups.whole) {
+    const std::string size = auto_whole_mesh_size();
+    return AutoWithoutSegmentation{
+        .source =
+            "none (auto: every part closed, small or capped, " + size + ", the whole mesh to bvh)",
+        .why = "auto sends a mesh " + size + " whose every part is closed, small or capped to bvh"};
+  }
+  if (groups.closed_components == 0) {
+    return AutoWithoutSegmentation{
+        .source =
+            "none (auto: every part open, 256 triangles or more and not capped, all to cones)",
+        .why =
+            "auto sends every part of this mesh to cones (each is open, has 256 triangles or "
+            "more and no hole dynamic caps)"};
+  }
+  return std::nullopt;
+}
+
 RadialViewSetup setup_radial_view(
     const RadialViewArguments& args,
     const skinning::LoadedModel& model,
@@ -65,28 +86,15 @@ RadialViewSetup setup_radial_view(
   // (culling::RoutingOptions::all_closed_method, all_closed_below_triangles). Nor when `auto`
   // sends nothing to `dynamic`: every part open, of 256 triangles or more and not capped (a
   // garment on its own skeleton goes whole to the cones).
-  const culling::AutoGroups groups = method == "auto" && topology != nullptr
-                                         ? culling::auto_groups(*topology, /*rig=*/true)
-                                         : culling::AutoGroups{.closed_components = 1};
-  if (groups.whole) {
-    const std::string size = auto_whole_mesh_size();
-    setup.segmentation_source =
-        "none (auto: every part closed, small or capped, " + size + ", the whole mesh to bvh)";
-    if (!args.segmentation.empty()) {
-      std::cerr << "skelcd: note: " << args.segmentation << " is not used: auto sends a mesh "
-                << size << " whose every part is closed, small or capped to bvh\n";
+  if (method == "auto" && topology != nullptr) {
+    if (auto skipped = auto_without_segmentation(*topology)) {
+      setup.segmentation_source = std::move(skipped->source);
+      if (!args.segmentation.empty()) {
+        std::cerr << "skelcd: note: " << args.segmentation << " is not used: " << skipped->why
+                  << "\n";
+      }
+      return setup;
     }
-    return setup;
-  }
-  if (groups.closed_components == 0) {
-    setup.segmentation_source =
-        "none (auto: every part open, 256 triangles or more and not capped, all to cones)";
-    if (!args.segmentation.empty()) {
-      std::cerr << "skelcd: note: " << args.segmentation
-                << " is not used: auto sends every part of this mesh to cones (each is open, "
-                   "has 256 triangles or more and no hole dynamic caps)\n";
-    }
-    return setup;
   }
   if (!model.rig) {
     throw InvalidInput(

@@ -50,6 +50,22 @@ struct RadialViewSetup {
     RunOptions& options,
     const skinning::Topology* topology = nullptr);
 
+/// Why `auto` on a rig's clip makes no segmentation for this mesh, when it makes none: it sends
+/// the whole mesh to `bvh` (every part closed, small or capped, under the whole-mesh size), or
+/// every part to the cones (each open, of 256 triangles or more, not capped), so that no group
+/// goes to `dynamic` (culling::auto_groups with the rig's closed method).
+struct AutoWithoutSegmentation {
+  std::string source;  ///< the summary's `segmentation` value, "none (auto: …)"
+  std::string why;     ///< why a --segmentation file given is not read
+};
+
+/// What auto_groups(topology, rig) says of the segmentation, as setup_radial_view decides it for
+/// `auto` (also `bench`, so that its `auto` runs as `check`'s); nothing when a closed group goes
+/// to `dynamic`.
+/// @param topology `skinning::build_topology` of the mesh the motion moves.
+[[nodiscard]] std::optional<AutoWithoutSegmentation> auto_without_segmentation(
+    const skinning::Topology& topology);
+
 /// "under N triangles": the size below which `auto` sends a mesh closed, small or capped
 /// throughout whole to `bvh` (culling::RoutingOptions::all_closed_below_triangles), as the
 /// messages that say so put it.
