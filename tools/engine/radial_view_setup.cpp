@@ -21,6 +21,10 @@ std::string auto_whole_mesh_size() {
          " triangles";
 }
 
+std::string auto_open_size() {
+  return std::to_string(culling::RoutingOptions{}.min_open_triangles) + " triangles";
+}
+
 std::optional<AutoWithoutSegmentation> auto_without_segmentation(
     const skinning::Topology& topology) {
   const culling::AutoGroups groups = culling::auto_groups(topology, /*rig=*/true);
@@ -32,12 +36,11 @@ std::optional<AutoWithoutSegmentation> auto_without_segmentation(
         .why = "auto sends a mesh " + size + " whose every part is closed, small or capped to bvh"};
   }
   if (groups.closed_components == 0) {
+    const std::string size = auto_open_size();
     return AutoWithoutSegmentation{
-        .source =
-            "none (auto: every part open, 256 triangles or more and not capped, all to cones)",
-        .why =
-            "auto sends every part of this mesh to cones (each is open, has 256 triangles or "
-            "more and no hole dynamic caps)"};
+        .source = "none (auto: every part open, " + size + " or more and not capped, all to cones)",
+        .why = "auto sends every part of this mesh to cones (each is open, has " + size +
+               " or more and no hole dynamic caps)"};
   }
   return std::nullopt;
 }
@@ -81,11 +84,11 @@ RadialViewSetup setup_radial_view(
     }
     return setup;
   }
-  // Nor when every part is closed, small (under 256 triangles) or open only at holes the radial
-  // view would cap, in a mesh under 20,000 triangles: `auto` then sends the whole mesh to `bvh`
-  // (culling::RoutingOptions::all_closed_method, all_closed_below_triangles). Nor when `auto`
-  // sends nothing to `dynamic`: every part open, of 256 triangles or more and not capped (a
-  // garment on its own skeleton goes whole to the cones).
+  // Nor when every part is closed, small (under 256 triangles: auto_open_size()) or open only at
+  // holes the radial view would cap, in a mesh under 20,000 triangles: `auto` then sends the whole
+  // mesh to `bvh` (culling::RoutingOptions::all_closed_method, all_closed_below_triangles). Nor
+  // when `auto` sends nothing to `dynamic`: every part open, of 256 triangles or more and not
+  // capped (a garment on its own skeleton goes whole to the cones).
   if (method == "auto" && topology != nullptr) {
     if (auto skipped = auto_without_segmentation(*topology)) {
       setup.segmentation_source = std::move(skipped->source);

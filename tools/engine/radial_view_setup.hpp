@@ -71,4 +71,8 @@ struct AutoWithoutSegmentation {
 /// messages that say so put it.
 [[nodiscard]] std::string auto_whole_mesh_size();
 
+/// "N triangles": the size from which `auto` gives an open part that dynamic does not cap to its
+/// cone method (culling::RoutingOptions::min_open_triangles), as the messages that say so put it.
+[[nodiscard]] std::string auto_open_size();
+
 }  // namespace skelcd::tools

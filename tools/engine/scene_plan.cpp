@@ -57,9 +57,8 @@ void decide_stages(ObjectPlan& o) {
           : o.facts.auto_whole_to_bvh
               ? "cones: every part closed, small or capped and " + auto_whole_mesh_size() +
                     " (auto sends the whole mesh to bvh)"
-              : std::string(
-                    "cones: every open part under 256 triangles or capped (auto sends them with "
-                    "the closed parts)"));
+              : "cones: every open part under " + auto_open_size() +
+                    " or capped (auto sends them with the closed parts)");
     } else {
       s.push_back("cones: method " + o.method + " uses none");
     }
@@ -74,9 +73,8 @@ void decide_stages(ObjectPlan& o) {
     } else if (o.method == "auto") {
       s.push_back(
           o.facts.auto_closed_group == 0
-              ? std::string(
-                    "segmentation: no closed part, and no open one under 256 triangles or capped "
-                    "(auto segments only the parts it sends to dynamic)")
+              ? "segmentation: no closed part, and no open one under " + auto_open_size() +
+                    " or capped (auto segments only the parts it sends to dynamic)"
           : o.facts.auto_whole_to_bvh
               ? "segmentation: every part closed, small or capped and " + auto_whole_mesh_size() +
                     " (auto sends the whole mesh to bvh)"
