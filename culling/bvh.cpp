@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <array>
+#include <atomic>
 #include <cassert>
 #include <cmath>
 #include <limits>
@@ -15,8 +16,79 @@
 #if defined(__SSE2__)
 #include <emmintrin.h>
 #endif
+#if defined(__x86_64__) && defined(__GNUC__)
+#define SKELCD_BVH_AVX 1
+#include <immintrin.h>
+
+#include "ccd/detail/lanes.hpp"
+#endif
 
 namespace skelcd::culling {
+
+namespace {
+
+/// detail::force_bvh_baseline_binning's switch.
+std::atomic<bool> baseline_binning{false};
+
+/// The surface-area split's slabs per axis (Bvh::sah_split).
+constexpr int kSahBins = 16;
+
+/// A slab's box as x, y, z and a pad, so that two lanes of SSE2 (or four of AVX) update it (min /
+/// max pick the same operand as std::min / std::max, so the boxes are those of a scalar loop, bit
+/// for bit; the pad is never read).
+struct alignas(32) SahBinBox {
+  double lo[4];
+  double hi[4];
+};
+using SahCounts = std::array<std::array<std::int32_t, kSahBins>, 3>;
+using SahBoxes = std::array<std::array<SahBinBox, kSahBins>, 3>;
+
+#if defined(SKELCD_BVH_AVX)
+/// sah_split's binning of the items [first, last) on every axis, built for AVX where the CPU has
+/// it: the same bins (the same SSE2 arithmetic, VEX-encoded) and the same boxes (each slab's lo
+/// and hi updated by one four-lane min and max instead of two two-lane ones; lane 3 takes 0 and
+/// is never read). `origin` and `scale` are the range's centroid box's low corner and kSahBins
+/// over its extents (0 on an axis not used).
+template <class Item>
+[[gnu::target("avx")]] void sah_bins_avx(
+    const Item* first,
+    const Item* last,
+    const double* origin,
+    const double* scale,
+    SahCounts& counts,
+    SahBoxes& boxes) {
+  const __m128d origin01 = _mm_loadu_pd(origin);
+  const __m128d origin2 = _mm_load_sd(origin + 2);
+  const __m128d scale01 = _mm_loadu_pd(scale);
+  const __m128d scale2 = _mm_load_sd(scale + 2);
+  const __m128d last_bin = _mm_set1_pd(kSahBins - 1.0);
+  const __m128d zero = _mm_setzero_pd();
+  for (const Item* item = first; item != last; ++item) {
+    const __m256d lo = _mm256_insertf128_pd(
+        _mm256_castpd128_pd256(_mm_loadu_pd(item->lo.data())), _mm_load_sd(item->lo.data() + 2), 1);
+    const __m256d hi = _mm256_insertf128_pd(
+        _mm256_castpd128_pd256(_mm_loadu_pd(item->hi.data())), _mm_load_sd(item->hi.data() + 2), 1);
+    const __m128d t01 =
+        _mm_mul_pd(_mm_sub_pd(_mm_loadu_pd(item->centroid.data()), origin01), scale01);
+    const __m128d t2 =
+        _mm_mul_sd(_mm_sub_sd(_mm_load_sd(item->centroid.data() + 2), origin2), scale2);
+    const __m128i j01 = _mm_cvttpd_epi32(_mm_max_pd(_mm_min_pd(last_bin, t01), zero));
+    const std::array<int, 3> bins{
+        _mm_cvtsi128_si32(j01),
+        _mm_cvtsi128_si32(_mm_srli_si128(j01, 4)),
+        _mm_cvttsd_si32(_mm_max_sd(_mm_min_sd(last_bin, t2), zero))};
+    for (std::size_t a = 0; a < 3; ++a) {
+      const auto j = static_cast<std::size_t>(bins[a]);
+      ++counts[a][j];
+      SahBinBox& b = boxes[a][j];
+      _mm256_store_pd(b.lo, _mm256_min_pd(lo, _mm256_load_pd(b.lo)));
+      _mm256_store_pd(b.hi, _mm256_max_pd(hi, _mm256_load_pd(b.hi)));
+    }
+  }
+}
+#endif
+
+}  // namespace
 
 template <int N>
 Bvh<N>::Bvh(
@@ -224,21 +296,28 @@ std::int32_t Bvh<N>::build_wide_node(std::int32_t node, int depth) {
 }
 
 template <int N>
-std::int32_t Bvh<N>::build_range(std::int32_t begin, std::int32_t end, int depth) {
+std::int32_t Bvh<N>::build_range(
+    std::int32_t begin, std::int32_t end, int depth, const CentroidBox* known) {
   const auto index = static_cast<std::int32_t>(nodes_.size());
   nodes_.push_back({begin, end, 0});
   depth_ = std::max(depth_, depth);
   if (end - begin <= leaf_size_) return index;
 
-  // Longest axis of the centroids' bounding box.
-  Eigen::Vector3d lo = items_[static_cast<std::size_t>(begin)].centroid;
-  Eigen::Vector3d hi = lo;
-  for (std::int32_t i = begin + 1; i < end; ++i) {
-    lo = lo.cwiseMin(items_[static_cast<std::size_t>(i)].centroid);
-    hi = hi.cwiseMax(items_[static_cast<std::size_t>(i)].centroid);
+  // Longest axis of the centroids' bounding box (the split that made this range met them all:
+  // its box comes with it, else one pass here).
+  CentroidBox box;
+  if (known != nullptr) {
+    box = *known;
+  } else {
+    box.lo = items_[static_cast<std::size_t>(begin)].centroid;
+    box.hi = box.lo;
+    for (std::int32_t i = begin + 1; i < end; ++i) {
+      box.lo = box.lo.cwiseMin(items_[static_cast<std::size_t>(i)].centroid);
+      box.hi = box.hi.cwiseMax(items_[static_cast<std::size_t>(i)].centroid);
+    }
   }
   Eigen::Index axis = 0;
-  (hi - lo).maxCoeff(&axis);
+  (box.hi - box.lo).maxCoeff(&axis);
 
   // The surface-area heuristic's split where it finds one (down to kMaxSahDepth, which bounds
   // the recursion and the tree's depth on any input, and above the buckets: inside one the split
@@ -249,7 +328,9 @@ std::int32_t Bvh<N>::build_range(std::int32_t begin, std::int32_t end, int depth
   constexpr int kMaxSahDepth = 48;
   const bool surface_area = split_ == BvhSplit::surface_area && depth < kMaxSahDepth &&
                             end - begin > bucket_size(leaf_size_);
-  std::int32_t mid = surface_area ? sah_split(begin, end, lo, hi) : -1;
+  std::array<CentroidBox, 2> sides;
+  std::int32_t mid = surface_area ? sah_split(begin, end, box.lo, box.hi, sides) : -1;
+  const bool sides_known = mid >= 0;
   if (mid < 0) {
     mid = begin + (end - begin) / 2;
     const auto before = [axis](const Item& s, const Item& t) {
@@ -261,25 +342,24 @@ std::int32_t Bvh<N>::build_range(std::int32_t begin, std::int32_t end, int depth
     std::nth_element(items_.begin() + begin, items_.begin() + mid, items_.begin() + end, before);
   }
 
-  build_range(begin, mid, depth + 1);
-  const std::int32_t right = build_range(mid, end, depth + 1);
+  build_range(begin, mid, depth + 1, sides_known ? &sides[0] : nullptr);
+  const std::int32_t right = build_range(mid, end, depth + 1, sides_known ? &sides[1] : nullptr);
   nodes_[static_cast<std::size_t>(index)].right = right;
   return index;
 }
 
 template <int N>
 std::int32_t Bvh<N>::sah_split(
-    std::int32_t begin, std::int32_t end, const Eigen::Vector3d& lo, const Eigen::Vector3d& hi) {
+    std::int32_t begin,
+    std::int32_t end,
+    const Eigen::Vector3d& lo,
+    const Eigen::Vector3d& hi,
+    std::array<CentroidBox, 2>& sides) {
   // Binned (Wald 2007): the centroids in kBins equal slabs per axis, each bin's count and box;
   // the cost of the split after bin j is area(left) · #left + area(right) · #right, the expected
   // work of a query that meets the parent's box meeting each child's.
-  constexpr int kBins = 16;
-  // A bin's box as x, y, z and a pad, so that two lanes of SSE2 update it (min / max pick the
-  // same operand as std::min / std::max, so the boxes are those of a scalar loop, bit for bit).
-  struct alignas(16) BinBox {
-    double lo[4];
-    double hi[4];
-  };
+  constexpr int kBins = kSahBins;
+  using BinBox = SahBinBox;
   const auto area = [](const double* l, const double* h) {
     const double dx = std::max(h[0] - l[0], 0.0);
     const double dy = std::max(h[1] - l[1], 0.0);
@@ -300,8 +380,8 @@ std::int32_t Bvh<N>::sah_split(
     scale[a] = usable[a] ? kBins / extent : 0.0;
   }
   constexpr double kInf = std::numeric_limits<double>::infinity();
-  std::array<std::array<std::int32_t, kBins>, 3> counts{};
-  std::array<std::array<BinBox, kBins>, 3> boxes;
+  SahCounts counts{};
+  SahBoxes boxes;
   for (auto& axis_boxes : boxes) {
     for (BinBox& b : axis_boxes) {
       for (int k = 0; k < 4; ++k) {
@@ -310,31 +390,65 @@ std::int32_t Bvh<N>::sah_split(
       }
     }
   }
-  for (std::int32_t i = begin; i < end; ++i) {
-    const Item& item = items_[static_cast<std::size_t>(i)];
-#if defined(__SSE2__)
-    const __m128d lo01 = _mm_loadu_pd(item.lo.data());
-    const __m128d lo2 = _mm_load_sd(item.lo.data() + 2);
-    const __m128d hi01 = _mm_loadu_pd(item.hi.data());
-    const __m128d hi2 = _mm_load_sd(item.hi.data() + 2);
-#endif
-    for (Eigen::Index axis = 0; axis < 3; ++axis) {
-      const auto a = static_cast<std::size_t>(axis);
-      const auto j = static_cast<std::size_t>(bin_of(item, axis, scale[a]));
-      ++counts[a][j];
-      BinBox& b = boxes[a][j];
-#if defined(__SSE2__)
-      // _mm_min_pd(x, y) is x < y ? x : y: std::min(y, x), as the scalar loop below.
-      _mm_store_pd(b.lo, _mm_min_pd(lo01, _mm_load_pd(b.lo)));
-      _mm_store_pd(b.lo + 2, _mm_min_pd(lo2, _mm_load_pd(b.lo + 2)));
-      _mm_store_pd(b.hi, _mm_max_pd(hi01, _mm_load_pd(b.hi)));
-      _mm_store_pd(b.hi + 2, _mm_max_pd(hi2, _mm_load_pd(b.hi + 2)));
+#if defined(SKELCD_BVH_AVX)
+  const bool avx = ccd::detail::cpu_has_avx2() && !baseline_binning.load(std::memory_order_relaxed);
+  if (avx) {
+    sah_bins_avx(
+        items_.data() + begin, items_.data() + end, lo.data(), scale.data(), counts, boxes);
+  }
 #else
-      for (Eigen::Index k = 0; k < 3; ++k) {
-        b.lo[k] = std::min(b.lo[k], item.lo[k]);
-        b.hi[k] = std::max(b.hi[k], item.hi[k]);
-      }
+  constexpr bool avx = false;
 #endif
+  if (!avx) {
+#if defined(__SSE2__)
+    // bin_of on the three axes at once, x and y in two lanes: the same subtraction and product,
+    // then _mm_min_pd(15, t) = 15 < t ? 15 : t = std::min(t, 15) and _mm_max_pd(m, 0) = m > 0 ? m :
+    // 0 = std::max(0, m) (NaN: 0), truncated as static_cast<int> truncates: the same bins.
+    const __m128d origin01 = _mm_loadu_pd(lo.data());
+    const __m128d origin2 = _mm_load_sd(lo.data() + 2);
+    const __m128d scale01 = _mm_loadu_pd(scale.data());
+    const __m128d scale2 = _mm_load_sd(scale.data() + 2);
+    const __m128d last_bin = _mm_set1_pd(kBins - 1.0);
+    const __m128d zero = _mm_setzero_pd();
+#endif
+    for (std::int32_t i = begin; i < end; ++i) {
+      const Item& item = items_[static_cast<std::size_t>(i)];
+#if defined(__SSE2__)
+      const __m128d lo01 = _mm_loadu_pd(item.lo.data());
+      const __m128d lo2 = _mm_load_sd(item.lo.data() + 2);
+      const __m128d hi01 = _mm_loadu_pd(item.hi.data());
+      const __m128d hi2 = _mm_load_sd(item.hi.data() + 2);
+      const __m128d t01 =
+          _mm_mul_pd(_mm_sub_pd(_mm_loadu_pd(item.centroid.data()), origin01), scale01);
+      const __m128d t2 =
+          _mm_mul_sd(_mm_sub_sd(_mm_load_sd(item.centroid.data() + 2), origin2), scale2);
+      const __m128i j01 = _mm_cvttpd_epi32(_mm_max_pd(_mm_min_pd(last_bin, t01), zero));
+      const int j2 = _mm_cvttsd_si32(_mm_max_sd(_mm_min_sd(last_bin, t2), zero));
+      const std::array<int, 3> bins{
+          _mm_cvtsi128_si32(j01), _mm_cvtsi128_si32(_mm_srli_si128(j01, 4)), j2};
+#endif
+      for (Eigen::Index axis = 0; axis < 3; ++axis) {
+        const auto a = static_cast<std::size_t>(axis);
+#if defined(__SSE2__)
+        const auto j = static_cast<std::size_t>(bins[a]);
+#else
+        const auto j = static_cast<std::size_t>(bin_of(item, axis, scale[a]));
+#endif
+        ++counts[a][j];
+        BinBox& b = boxes[a][j];
+#if defined(__SSE2__)
+        // _mm_min_pd(x, y) is x < y ? x : y: std::min(y, x), as the scalar loop below.
+        _mm_store_pd(b.lo, _mm_min_pd(lo01, _mm_load_pd(b.lo)));
+        _mm_store_pd(b.lo + 2, _mm_min_pd(lo2, _mm_load_pd(b.lo + 2)));
+        _mm_store_pd(b.hi, _mm_max_pd(hi01, _mm_load_pd(b.hi)));
+        _mm_store_pd(b.hi + 2, _mm_max_pd(hi2, _mm_load_pd(b.hi + 2)));
+#else
+        for (Eigen::Index k = 0; k < 3; ++k) {
+          b.lo[k] = std::min(b.lo[k], item.lo[k]);
+          b.hi[k] = std::max(b.hi[k], item.hi[k]);
+        }
+#endif
+      }
     }
   }
   double best_cost = kInf;
@@ -404,12 +518,52 @@ std::int32_t Bvh<N>::sah_split(
   Item* const last = items_.data() + end;
   Item* const spill = spill_.data();
   std::size_t spilled = 0;
+  // Each side's centroid box on the way (its children's split axis and bins, which build_range
+  // would otherwise find in a pass of its own): the least and greatest coordinates of the same
+  // centroids, so the same values as that pass for finite centroids (a tie of −0 and +0 may keep
+  // the other zero; the bins and extents computed from them are the same either way).
+  constexpr double kBig = std::numeric_limits<double>::infinity();
+#if defined(__SSE2__)
+  struct SideBox {
+    __m128d lo01 = _mm_set1_pd(kBig), lo2 = lo01;
+    __m128d hi01 = _mm_set1_pd(-kBig), hi2 = hi01;
+    // _mm_min_pd(c, l) is c < l ? c : l = std::min(l, c), Eigen's cwiseMin.
+    void take(const Item& item) {
+      const __m128d c01 = _mm_loadu_pd(item.centroid.data());
+      const __m128d c2 = _mm_load_sd(item.centroid.data() + 2);
+      lo01 = _mm_min_pd(c01, lo01);
+      lo2 = _mm_min_sd(c2, lo2);
+      hi01 = _mm_max_pd(c01, hi01);
+      hi2 = _mm_max_sd(c2, hi2);
+    }
+    [[nodiscard]] CentroidBox box() const {
+      CentroidBox b;
+      _mm_storeu_pd(b.lo.data(), lo01);
+      _mm_store_sd(b.lo.data() + 2, lo2);
+      _mm_storeu_pd(b.hi.data(), hi01);
+      _mm_store_sd(b.hi.data() + 2, hi2);
+      return b;
+    }
+  };
+#else
+  struct SideBox {
+    Eigen::Vector3d lo = Eigen::Vector3d::Constant(kBig), hi = -lo;
+    void take(const Item& item) {
+      lo = lo.cwiseMin(item.centroid);
+      hi = hi.cwiseMax(item.centroid);
+    }
+    [[nodiscard]] CentroidBox box() const { return CentroidBox{lo, hi}; }
+  };
+#endif
+  SideBox left_box, right_box;
   if (best_left <= end - begin - best_left) {
     Item* write = last;  // the rights, from the back; never ahead of the read
     for (Item* read = last; read-- != first;) {
       if (goes_left(*read)) {
+        left_box.take(*read);
         spill[spilled++] = *read;
       } else {
+        right_box.take(*read);
         *--write = *read;
       }
     }
@@ -418,13 +572,17 @@ std::int32_t Bvh<N>::sah_split(
     Item* write = first;  // the lefts, from the front; never ahead of the read
     for (Item* read = first; read != last; ++read) {
       if (goes_left(*read)) {
+        left_box.take(*read);
         *write++ = *read;
       } else {
+        right_box.take(*read);
         spill[spilled++] = *read;
       }
     }
     std::copy(spill, spill + spilled, write);
   }
+  sides[0] = left_box.box();
+  sides[1] = right_box.box();
   return begin + best_left;
 }
 
@@ -1101,5 +1259,13 @@ void Bvh<N>::fill_slot_ends(const Source& source) {
 
 template class Bvh<3>;
 template class Bvh<8>;
+
+namespace detail {
+
+void force_bvh_baseline_binning(bool baseline) {
+  baseline_binning.store(baseline, std::memory_order_relaxed);
+}
+
+}  // namespace detail
 
 }  // namespace skelcd::culling

@@ -319,7 +319,15 @@ class Bvh {
 
  private:
   void build(const skinning::Triangles& triangles, const skinning::Positions& positions);
-  std::int32_t build_range(std::int32_t begin, std::int32_t end, int depth);
+  /// The bounding box of a range's centroids (build_range's split axis and bins).
+  struct CentroidBox {
+    Eigen::Vector3d lo;
+    Eigen::Vector3d hi;
+  };
+  /// Builds the subtree of items [begin, end); `known`, when given, is the box of their
+  /// centroids (the split that made the range has it), else it is computed here.
+  std::int32_t build_range(
+      std::int32_t begin, std::int32_t end, int depth, const CentroidBox* known = nullptr);
   void build_wide();
   int wide_lanes(std::int32_t node, std::array<std::int32_t, WideBvhNode<N>::kWidth>& lanes) const;
   std::size_t count_wide(std::int32_t node) const;
@@ -363,9 +371,14 @@ class Bvh {
     std::int32_t id;
   };
   /// The surface-area split of [begin, end) (docs/culling.md "The hierarchy"), or −1 when the
-  /// centroids fall in one bin on every axis; partitions items_ when it finds one.
+  /// centroids fall in one bin on every axis; partitions items_ when it finds one, and then
+  /// gives each side's centroid box in `sides` (left, right), met on the way.
   std::int32_t sah_split(
-      std::int32_t begin, std::int32_t end, const Eigen::Vector3d& lo, const Eigen::Vector3d& hi);
+      std::int32_t begin,
+      std::int32_t end,
+      const Eigen::Vector3d& lo,
+      const Eigen::Vector3d& hi,
+      std::array<CentroidBox, 2>& sides);
   std::vector<Item> items_;  // build-time only, by slot; freed after the build
   std::vector<Item> spill_;  // build-time only: the smaller side of a split while partitioning
   int depth_ = 0;
@@ -378,5 +391,11 @@ class Bvh {
 
 using AabbBvh = Bvh<3>;
 using KdopBvh = Bvh<8>;
+
+namespace detail {
+/// For the tests: with `baseline` true the surface-area build bins its items with its SSE2 loop
+/// even where the CPU has AVX (the same trees either way), until asked again.
+void force_bvh_baseline_binning(bool baseline);
+}  // namespace detail
 
 }  // namespace skelcd::culling

@@ -339,11 +339,9 @@ void expect_reference_tree(
   }
 }
 
-TEST(Bvh, SurfaceAreaTreeIsTheOneItsPlainDefinitionBuilds) {
-  // The build bins, skips empty bins and partitions through a spill of the smaller side; the
-  // reference evaluates every split from the items. Real characters (shells, creases), a tube,
-  // a random soup (splits of every balance), a flat strip (costs of zero: ties by balance) and
-  // coincident centroids (no split: the median).
+/// expect_reference_tree on real characters, a tube, a random soup, a flat strip and coincident
+/// centroids.
+void expect_reference_trees() {
   for (const std::string file : {"CesiumMan.glb", "stormtrooper/stormtrooper.dae"}) {
     const test::WeldedCharacter c(file);
     expect_reference_tree<3>(c.topology.welded_triangles, c.sample(0), file);
@@ -374,6 +372,39 @@ TEST(Bvh, SurfaceAreaTreeIsTheOneItsPlainDefinitionBuilds) {
     same.row(3 * f + 2) << 1.0 - static_cast<double>(f), 2.0, 3.0;  // every centroid (1, 2, 3)
   }
   expect_reference_tree<3>(soup_triangles, same, "coincident centroids");
+}
+
+TEST(Bvh, SurfaceAreaTreeIsTheOneItsPlainDefinitionBuilds) {
+  // The build bins, skips empty bins and partitions through a spill of the smaller side; the
+  // reference evaluates every split from the items. Real characters (shells, creases), a tube,
+  // a random soup (splits of every balance), a flat strip (costs of zero: ties by balance) and
+  // coincident centroids (no split: the median). Both binning loops: the AVX one where the CPU has
+  // it, and the SSE2 one.
+  for (const bool baseline : {false, true}) {
+    SCOPED_TRACE(baseline ? "SSE2 binning" : "the CPU's binning");
+    detail::force_bvh_baseline_binning(baseline);
+    expect_reference_trees();
+  }
+  detail::force_bvh_baseline_binning(false);
+}
+
+TEST(Bvh, BinningLoopsBuildTheSameTreesOnRealMeshes) {
+  // The AVX and SSE2 binning loops, and the split boxes handed down from the partition, on a
+  // dense character and the stormtrooper's overlapping shells: the same nodes and order.
+  for (const std::string file : {"CesiumMan-dense.glb", "stormtrooper/stormtrooper.dae"}) {
+    const test::WeldedCharacter c(file);
+    detail::force_bvh_baseline_binning(true);
+    const Bvh<8> sse2(c.topology.welded_triangles, c.sample(0));
+    detail::force_bvh_baseline_binning(false);
+    const Bvh<8> best(c.topology.welded_triangles, c.sample(0));
+    ASSERT_EQ(sse2.nodes().size(), best.nodes().size()) << file;
+    for (std::size_t n = 0; n < sse2.nodes().size(); ++n) {
+      ASSERT_EQ(sse2.nodes()[n].begin, best.nodes()[n].begin) << file << " node " << n;
+      ASSERT_EQ(sse2.nodes()[n].end, best.nodes()[n].end) << file << " node " << n;
+      ASSERT_EQ(sse2.nodes()[n].right, best.nodes()[n].right) << file << " node " << n;
+    }
+    EXPECT_TRUE(std::ranges::equal(sse2.triangle_order(), best.triangle_order())) << file;
+  }
 }
 
 TEST(Bvh, SubsetBuildHoldsOnlyTheSubset) {
